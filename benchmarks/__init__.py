@@ -1,0 +1,1 @@
+"""Benchmarks: timings and force-call counts, printed as ratios. Run ``make bench``."""

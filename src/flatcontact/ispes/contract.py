@@ -1,0 +1,181 @@
+"""The ISPES grid file contract (``ispes.nc``) shared by the scan and the analysis.
+
+Layout (xarray, netCDF4 written with h5netcdf):
+
+dims
+    ``shift_a``, ``shift_b``: fractional lateral shift of slab 2 along the
+    primitive in-plane lattice vectors ``a1``, ``a2``; values in [0, 1),
+    equally spaced, endpoint excluded (the grid is periodic).
+    ``thickness``: distance between surfaces 1 and 4 in Å (the paper's z),
+    strictly increasing.
+variables (all on ``(shift_a, shift_b, thickness)``)
+    ``energy``: total potential energy of the cell, eV.
+    ``normal_stress``: normal load per area, GPa, positive when the slabs are
+    pressed together.
+    ``converged``: bool; ``force_calls``: int.
+attrs
+    ``a1``, ``a2``: in-plane primitive vectors (Å, 2-vectors in the x-y plane);
+    ``area``: |a1 × a2| in Å²; ``potential``: description of the model;
+    ``flatcontact_version``.
+
+Points not computed yet are NaN with ``converged = False``.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from flatcontact import __version__
+from flatcontact.errors import InputError
+from flatcontact.fileio import atomic_path
+
+DIM_A = "shift_a"
+DIM_B = "shift_b"
+DIM_Z = "thickness"
+DIMS = (DIM_A, DIM_B, DIM_Z)
+
+VAR_ENERGY = "energy"
+VAR_STRESS = "normal_stress"
+VAR_CONVERGED = "converged"
+VAR_FORCE_CALLS = "force_calls"
+
+REQUIRED_VARIABLES = (VAR_ENERGY, VAR_STRESS)
+REQUIRED_ATTRS = ("a1", "a2", "area")
+UNITS = {VAR_ENERGY: "eV", VAR_STRESS: "GPa", DIM_Z: "angstrom", DIM_A: "1", DIM_B: "1"}
+
+_AREA_RTOL = 1e-6
+
+
+def fractional_shifts(n: int) -> np.ndarray:
+    """``n`` equally spaced fractional shifts in [0, 1), endpoint excluded."""
+    if n < 1:
+        raise InputError(f"grid size must be at least 1 lateral point, got {n}")
+    return np.arange(n) / n
+
+
+def cell_area(a1: np.ndarray, a2: np.ndarray) -> float:
+    """Area |a1 × a2| (Å²) of the in-plane cell spanned by two 2-vectors."""
+    a1 = np.asarray(a1, dtype=float)
+    a2 = np.asarray(a2, dtype=float)
+    return float(abs(a1[0] * a2[1] - a1[1] * a2[0]))
+
+
+def empty_grid(
+    n_a: int,
+    n_b: int,
+    thickness_angstrom: np.ndarray,
+    a1: np.ndarray,
+    a2: np.ndarray,
+    potential: str,
+    **attrs: object,
+) -> xr.Dataset:
+    """A contract-conforming grid with every point missing (NaN, not converged)."""
+    z = np.asarray(thickness_angstrom, dtype=float)
+    if z.ndim != 1 or z.size < 1:
+        raise InputError("thickness: expected a non-empty list of values in Å")
+    shape = (n_a, n_b, z.size)
+    coords = {DIM_A: fractional_shifts(n_a), DIM_B: fractional_shifts(n_b), DIM_Z: z}
+    ds = xr.Dataset(
+        {
+            VAR_ENERGY: (DIMS, np.full(shape, np.nan)),
+            VAR_STRESS: (DIMS, np.full(shape, np.nan)),
+            VAR_CONVERGED: (DIMS, np.zeros(shape, dtype=bool)),
+            VAR_FORCE_CALLS: (DIMS, np.zeros(shape, dtype=np.int64)),
+        },
+        coords=coords,
+    )
+    a1 = np.asarray(a1, dtype=float)[:2]
+    a2 = np.asarray(a2, dtype=float)[:2]
+    ds.attrs.update(
+        a1=a1,
+        a2=a2,
+        area=cell_area(a1, a2),
+        potential=potential,
+        flatcontact_version=__version__,
+        **attrs,
+    )
+    _set_units(ds)
+    return validate_ispes(ds.sortby(DIM_Z), source="new grid")
+
+
+def _set_units(ds: xr.Dataset) -> None:
+    for name, unit in UNITS.items():
+        if name in ds.variables:
+            ds[name].attrs["units"] = unit
+
+
+def validate_ispes(ds: xr.Dataset, source: str = "ISPES grid") -> xr.Dataset:
+    """Check ``ds`` against the contract and return it with ``thickness`` ascending.
+
+    Raises
+    ------
+    InputError
+        With one line naming ``source`` and the first thing that is wrong.
+    """
+    for dim in DIMS:
+        if dim not in ds.dims:
+            raise InputError(f"{source}: missing dimension '{dim}' (expected dims {DIMS})")
+    for var in REQUIRED_VARIABLES:
+        if var not in ds.data_vars:
+            raise InputError(f"{source}: missing variable '{var}'")
+        if set(ds[var].dims) != set(DIMS):
+            raise InputError(
+                f"{source}: variable '{var}' must have dims {DIMS}, has {ds[var].dims}"
+            )
+    for attr in REQUIRED_ATTRS:
+        if attr not in ds.attrs:
+            raise InputError(f"{source}: missing attribute '{attr}' (Å vectors a1, a2 and area Å²)")
+    a1 = np.asarray(ds.attrs["a1"], dtype=float).ravel()
+    a2 = np.asarray(ds.attrs["a2"], dtype=float).ravel()
+    if a1.size < 2 or a2.size < 2:
+        raise InputError(f"{source}: attributes a1, a2 must be in-plane 2-vectors in Å")
+    area = cell_area(a1, a2)
+    if not area > 0:
+        raise InputError(f"{source}: a1 and a2 are parallel (zero cell area)")
+    if not np.isclose(float(ds.attrs["area"]), area, rtol=_AREA_RTOL):
+        raise InputError(
+            f"{source}: attribute area={float(ds.attrs['area']):.6g} Å² differs from |a1 × a2| = {area:.6g} Å²"
+        )
+    for dim in (DIM_A, DIM_B):
+        s = np.asarray(ds[dim].values, dtype=float)
+        expected = np.arange(s.size) / s.size
+        if not np.allclose(np.sort(s), expected, atol=1e-9):
+            raise InputError(
+                f"{source}: coordinate '{dim}' must be {s.size} equally spaced fractions in [0, 1) "
+                "with the endpoint excluded"
+            )
+    z = np.asarray(ds[DIM_Z].values, dtype=float)
+    if not np.all(np.isfinite(z)) or np.unique(z).size != z.size:
+        raise InputError(f"{source}: coordinate 'thickness' must be finite and without repeats")
+    ds = ds.sortby([DIM_A, DIM_B, DIM_Z])
+    if VAR_CONVERGED not in ds:
+        ds[VAR_CONVERGED] = np.isfinite(ds[VAR_ENERGY]) & np.isfinite(ds[VAR_STRESS])
+    ds = ds.transpose(*DIMS, ...)
+    return ds
+
+
+def open_ispes(path: str | os.PathLike[str]) -> xr.Dataset:
+    """Read and validate an ``ispes.nc`` file into memory."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{path}: no such ISPES file")
+    try:
+        with xr.open_dataset(path, engine="h5netcdf") as ds:
+            ds = ds.load()
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{path}: not a readable netCDF file ({exc.__class__.__name__})") from None
+    return validate_ispes(ds, source=str(path))
+
+
+def write_ispes(ds: xr.Dataset, path: str | os.PathLike[str]) -> Path:
+    """Validate ``ds`` and write it to ``path`` atomically (netCDF4 via h5netcdf)."""
+    ds = validate_ispes(ds, source=str(path))
+    ds = ds.copy()
+    _set_units(ds)
+    with atomic_path(path) as tmp:
+        ds.to_netcdf(tmp, engine="h5netcdf")
+    return Path(path)
