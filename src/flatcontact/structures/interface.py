@@ -1,0 +1,304 @@
+"""The two-slab interface (the ``interface.extxyz`` contract of DESIGN.md).
+
+Conventions (paper, Fig. 1):
+
+- ASE ``Atoms``, periodic in x and y, non-periodic in z; cell vectors 1 and 2
+  are the primitive in-plane lattice vectors a1, a2 (z-component 0); slab 1
+  lies below slab 2.
+- ``atoms.arrays["slab"]`` ∈ {1, 2}.
+- ``atoms.arrays["surface"]`` ∈ {0, 1, 2, 3, 4}: 0 inner atoms, 1 outer (bottom)
+  face of slab 1, 2 inner face of slab 1, 3 inner face of slab 2, 4 outer (top)
+  face of slab 2.
+- ``atoms.info["a1"]``, ``atoms.info["a2"]``: in-plane primitive vectors (Å,
+  2-vectors); ``atoms.info["recipe"]``: JSON string of how it was built.
+- The thickness z is mean z(surface 4) − mean z(surface 1) (Å), the paper's
+  "distance between surface 1 and 4".
+- Atoms of surfaces 1 and 4 are held fixed during a scan (``fixed_mask``).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+from ase import Atoms
+from ase.io import read, write
+from ase.neighborlist import neighbor_list
+
+from flatcontact.errors import InputError, require
+from flatcontact.fileio import atomic_path
+
+#: Closest allowed distance (Å) between an atom of slab 1 and one of slab 2 in
+#: :func:`place_slab2`; shorter means the slabs overlap (a Si–O bond is 1.6 Å).
+MIN_INTERSLAB_DISTANCE_ANGSTROM = 1.0
+#: Vacuum (Å) kept above and below the interface along z in the stored cell.
+DEFAULT_VACUUM_ANGSTROM = 10.0
+
+SURFACE_INNER = 0
+SURFACE_OUTER_1 = 1
+SURFACE_INNER_1 = 2
+SURFACE_INNER_2 = 3
+SURFACE_OUTER_2 = 4
+FIXED_SURFACES = (SURFACE_OUTER_1, SURFACE_OUTER_2)
+
+
+# --------------------------------------------------------------------------- tags and geometry
+def face_tags(
+    slab: Atoms, face_atoms: int | None = None, face_depth_angstrom: float | None = None
+) -> np.ndarray:
+    """Tag the two faces of a single slab by height: 1 = bottom face, 2 = top face, 0 = inner.
+
+    Exactly one of ``face_atoms`` (the ``n`` lowest and ``n`` highest atoms, e.g.
+    one O–Si–O unit of a 1×1 quartz cell = 3) or ``face_depth_angstrom`` (atoms
+    within this depth of the lowest/highest atom) selects the faces.
+    """
+    z = slab.positions[:, 2]
+    n = len(slab)
+    tags = np.zeros(n, dtype=int)
+    if (face_atoms is None) == (face_depth_angstrom is None):
+        raise InputError("give exactly one of face_atoms or face_depth_angstrom to tag slab faces")
+    if face_atoms is not None:
+        require(
+            0 < face_atoms and 2 * face_atoms < n,
+            f"face_atoms={face_atoms}: expected 1 <= face_atoms < {n}/2 for a {n}-atom slab",
+        )
+        order = np.argsort(z, kind="stable")
+        tags[order[:face_atoms]] = 1
+        tags[order[-face_atoms:]] = 2
+    else:
+        require(
+            face_depth_angstrom > 0, f"face_depth_angstrom must be > 0, got {face_depth_angstrom}"
+        )
+        bottom = z <= z.min() + face_depth_angstrom
+        top = z >= z.max() - face_depth_angstrom
+        require(
+            not np.any(bottom & top),
+            f"face_depth_angstrom={face_depth_angstrom} is more than half the slab height {np.ptp(z):.2f} Å",
+        )
+        tags[bottom] = 1
+        tags[top] = 2
+    return tags
+
+
+def in_plane_vectors(atoms: Atoms) -> tuple[np.ndarray, np.ndarray]:
+    """The primitive in-plane vectors (a1, a2) as 2-vectors (Å) from the cell."""
+    cell = atoms.cell.array
+    return cell[0, :2].copy(), cell[1, :2].copy()
+
+
+def thickness(atoms: Atoms) -> float:
+    """The paper's z: mean z of the surface-4 atoms minus mean z of the surface-1 atoms (Å)."""
+    surface = _array(atoms, "surface")
+    z = atoms.positions[:, 2]
+    return float(z[surface == SURFACE_OUTER_2].mean() - z[surface == SURFACE_OUTER_1].mean())
+
+
+def fixed_mask(atoms: Atoms) -> np.ndarray:
+    """Boolean mask of the atoms held fixed during a scan: surfaces 1 and 4."""
+    return np.isin(_array(atoms, "surface"), FIXED_SURFACES)
+
+
+def interslab_min_distance(atoms: Atoms, cutoff_angstrom: float = 4.0) -> float:
+    """Closest distance (Å) between an atom of slab 1 and one of slab 2 (lateral PBC).
+
+    Returns ``inf`` if no pair is closer than ``cutoff_angstrom``.
+    """
+    slab = _array(atoms, "slab")
+    i, j, d = neighbor_list("ijd", atoms, cutoff_angstrom)
+    cross = slab[i] != slab[j]
+    return float(d[cross].min()) if np.any(cross) else float("inf")
+
+
+# --------------------------------------------------------------------------- construction
+def make_interface(
+    slab: Atoms,
+    gap_angstrom: float,
+    *,
+    face_atoms: int | None = None,
+    face_depth_angstrom: float | None = None,
+    vacuum_angstrom: float = DEFAULT_VACUUM_ANGSTROM,
+    recipe: dict | None = None,
+) -> Atoms:
+    """Two identical slabs facing each other: slab 2 is slab 1 translated along z.
+
+    Parameters
+    ----------
+    slab
+        One slab, periodic in x, y with cell vectors 1, 2 in the x-y plane.
+        For α-quartz (0001) the two faces are related by the crystal's in-plane
+        2-fold axes, so a translated copy presents the same surface to slab 1.
+    gap_angstrom
+        Vertical distance between the highest atom of slab 1 and the lowest of slab 2.
+    face_atoms, face_depth_angstrom
+        How the faces are tagged (see :func:`face_tags`).
+    vacuum_angstrom
+        Vacuum kept below and above along z in the stored cell.
+    recipe
+        JSON-serialisable record of how the slab was built; stored in ``info["recipe"]``.
+    """
+    _require_in_plane_cell(slab, "slab")
+    require(gap_angstrom > 0, f"gap_angstrom must be > 0, got {gap_angstrom}")
+    tags = face_tags(slab, face_atoms=face_atoms, face_depth_angstrom=face_depth_angstrom)
+    lower = slab.copy()
+    lower.positions[:, 2] -= lower.positions[:, 2].min()
+    height = float(lower.positions[:, 2].max())
+    upper = lower.copy()
+    upper.positions[:, 2] += height + gap_angstrom
+    atoms = lower + upper
+    n = len(slab)
+    atoms.arrays["slab"] = np.repeat([1, 2], n)
+    surface = np.zeros(2 * n, dtype=int)
+    surface[:n][tags == 1] = SURFACE_OUTER_1
+    surface[:n][tags == 2] = SURFACE_INNER_1
+    surface[n:][tags == 1] = SURFACE_INNER_2
+    surface[n:][tags == 2] = SURFACE_OUTER_2
+    atoms.arrays["surface"] = surface
+    for key in ("tags", "momenta", "initial_magmoms", "initial_charges"):
+        atoms.arrays.pop(key, None)
+    atoms.positions[:, 2] += vacuum_angstrom
+    _set_vertical_cell(atoms, vacuum_angstrom)
+    a1, a2 = in_plane_vectors(atoms)
+    atoms.info = {"a1": a1, "a2": a2, "recipe": json.dumps(recipe or {}, sort_keys=True)}
+    return atoms
+
+
+def place_slab2(
+    reference: Atoms,
+    shift_a: float,
+    shift_b: float,
+    thickness_angstrom: float,
+    *,
+    min_distance_angstrom: float = MIN_INTERSLAB_DISTANCE_ANGSTROM,
+) -> Atoms:
+    """A copy of ``reference`` with slab 2 moved rigidly to lateral shift (a, b) and thickness z.
+
+    Slab 2 is translated by shift_a·a1 + shift_b·a2 (fractions of the primitive
+    in-plane vectors; atoms wrapped back into the cell) and vertically so that
+    ``thickness(result) == thickness_angstrom``. Slab 1 is untouched.
+
+    Raises
+    ------
+    InputError
+        If the shifts or thickness are not finite, or the slabs would overlap
+        (closest inter-slab distance below ``min_distance_angstrom``).
+    """
+    validate_interface(reference, "reference interface")
+    for name, value in (
+        ("shift_a", shift_a),
+        ("shift_b", shift_b),
+        ("thickness", thickness_angstrom),
+    ):
+        require(np.isfinite(value), f"{name}={value}: expected a finite number")
+    atoms = reference.copy()
+    upper = atoms.arrays["slab"] == 2
+    a1, a2 = in_plane_vectors(atoms)
+    lateral = shift_a * a1 + shift_b * a2
+    dz = thickness_angstrom - thickness(reference)
+    atoms.positions[upper] += np.array([lateral[0], lateral[1], dz])
+    atoms.wrap()
+    _set_vertical_cell(atoms, DEFAULT_VACUUM_ANGSTROM, keep_at_least=reference.cell.array[2, 2])
+    closest = interslab_min_distance(atoms, cutoff_angstrom=max(2.0 * min_distance_angstrom, 2.0))
+    if closest < min_distance_angstrom:
+        raise InputError(
+            f"thickness {thickness_angstrom:.3f} Å at shift ({shift_a:.4g}, {shift_b:.4g}) makes the slabs "
+            f"overlap: closest inter-slab distance {closest:.3f} Å < {min_distance_angstrom} Å"
+        )
+    return atoms
+
+
+# --------------------------------------------------------------------------- I/O and validation
+def validate_interface(atoms: Atoms, source: str = "interface") -> None:
+    """Check the interface contract; raise a one-line :class:`InputError` naming ``source``."""
+    for key in ("slab", "surface"):
+        require(key in atoms.arrays, f"{source}: missing per-atom array '{key}'")
+    slab = np.asarray(atoms.arrays["slab"])
+    surface = np.asarray(atoms.arrays["surface"])
+    require(bool(np.all(np.isin(slab, (1, 2)))), f"{source}: array 'slab' must hold only 1 and 2")
+    require(
+        bool(np.all(np.isin(surface, (0, 1, 2, 3, 4)))),
+        f"{source}: array 'surface' must hold only 0..4",
+    )
+    for tag, owner in ((1, 1), (2, 1), (3, 2), (4, 2)):
+        members = surface == tag
+        require(bool(np.any(members)), f"{source}: no atoms tagged surface={tag}")
+        require(
+            bool(np.all(slab[members] == owner)),
+            f"{source}: surface={tag} atoms must belong to slab {owner}",
+        )
+    require(bool(atoms.pbc[0] and atoms.pbc[1]), f"{source}: must be periodic in x and y")
+    _require_in_plane_cell(atoms, source)
+    z = atoms.positions[:, 2]
+    require(z[slab == 1].mean() < z[slab == 2].mean(), f"{source}: slab 1 must lie below slab 2")
+
+
+def write_interface(atoms: Atoms, path: str | os.PathLike[str]) -> Path:
+    """Write the interface as extended XYZ (arrays and info kept), atomically."""
+    validate_interface(atoms, str(path))
+    out = atoms.copy()
+    out.calc = None
+    a1, a2 = in_plane_vectors(out)
+    out.info = {
+        "a1": np.asarray(a1, dtype=float),
+        "a2": np.asarray(a2, dtype=float),
+        "recipe": str(atoms.info.get("recipe", "{}")),
+    }
+    out.arrays["slab"] = np.asarray(out.arrays["slab"], dtype=int)
+    out.arrays["surface"] = np.asarray(out.arrays["surface"], dtype=int)
+    with atomic_path(path) as tmp:
+        write(tmp, out, format="extxyz")
+    return Path(path)
+
+
+def read_interface(path: str | os.PathLike[str]) -> Atoms:
+    """Read an ``interface.extxyz`` and validate it (one-line :class:`InputError` if not valid)."""
+    path = Path(path)
+    require(path.is_file(), f"{path}: interface file not found")
+    try:
+        atoms = read(path, format="extxyz", index=-1)
+    except Exception as exc:  # malformed file: report it as the user's to fix
+        raise InputError(
+            f"{path}: not a readable extended XYZ file ({type(exc).__name__}: {exc})"
+        ) from None
+    validate_interface(atoms, str(path))
+    atoms.arrays["slab"] = np.asarray(atoms.arrays["slab"], dtype=int)
+    atoms.arrays["surface"] = np.asarray(atoms.arrays["surface"], dtype=int)
+    a1, a2 = in_plane_vectors(atoms)
+    recipe = atoms.info.get("recipe", "{}")
+    if not isinstance(recipe, str):
+        recipe = json.dumps(recipe)
+    atoms.info = {"a1": a1, "a2": a2, "recipe": recipe}
+    return atoms
+
+
+# --------------------------------------------------------------------------- helpers
+def _array(atoms: Atoms, key: str) -> np.ndarray:
+    if key not in atoms.arrays:
+        raise InputError(
+            f"interface Atoms has no per-atom array '{key}' (see interface.extxyz contract)"
+        )
+    return np.asarray(atoms.arrays[key])
+
+
+def _require_in_plane_cell(atoms: Atoms, source: str) -> None:
+    cell = atoms.cell.array
+    require(
+        abs(cell[0, 2]) < 1e-8 and abs(cell[1, 2]) < 1e-8,
+        f"{source}: cell vectors 1 and 2 must lie in the x-y plane (z-components 0)",
+    )
+    require(
+        abs(cell[0, 0] * cell[1, 1] - cell[0, 1] * cell[1, 0]) > 1e-8,
+        f"{source}: in-plane cell vectors are degenerate",
+    )
+
+
+def _set_vertical_cell(atoms: Atoms, vacuum_angstrom: float, keep_at_least: float = 0.0) -> None:
+    """Make cell vector 3 = (0, 0, max(height + 2·vacuum, keep_at_least)) and pbc = (T, T, F)."""
+    z = atoms.positions[:, 2]
+    height = float(z.max() - z.min())
+    c = max(height + 2.0 * vacuum_angstrom, keep_at_least)
+    cell = atoms.cell.array.copy()
+    cell[2] = (0.0, 0.0, c)
+    atoms.set_cell(cell, scale_atoms=False)
+    atoms.pbc = (True, True, False)
