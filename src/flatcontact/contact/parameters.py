@@ -1,0 +1,165 @@
+"""Parameters of the continuum contact model, with the paper's defaults.
+
+Values are stored in the units a person reads (``radius_um``, ``p0_gpa``,
+``k_mpa_per_gpa`` ...) and validated on construction; the ``*_si`` properties
+give the SI values (m, Pa, dimensionless) the physics functions take.
+
+Shear-modulus convention
+------------------------
+``shear_modulus_gpa`` is the paper's G* (Dong et al., Eq. for q0):
+``q0 = G*·u/(π a)``, so a fully stuck contact has lateral stiffness
+``∫q dA / u = 2 G* a``. Johnson (*Contact Mechanics*, 1985, §7.2) writes the
+same traction as ``q0 = 4 G*_J u/(π a)`` with ``1/G*_J = (2−ν1)/G1 + (2−ν2)/G2``
+(stiffness ``8 G*_J a``); hence ``G*_paper = 4 G*_J``. Use
+:func:`flatcontact.contact.mindlin.paper_shear_modulus_from_johnson` to convert.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import asdict, dataclass, replace
+from typing import Any
+
+from flatcontact import units
+from flatcontact.errors import require
+
+#: The paper's parameters (Dong, Uluca, Cross, Sanvito): tip radius, DFT moduli of
+#: α-quartz and the ISPES load laws τ = k·p + τ0, σ = μ·p + σ0.
+PAPER_DEFAULTS: dict[str, float] = {
+    "radius_um": 5.0,
+    "contact_modulus_gpa": 52.5,
+    "shear_modulus_gpa": 29.0,
+    "k_mpa_per_gpa": 4.52,
+    "tau0_mpa": 26.7,
+    "mu_mpa_per_gpa": 0.21,
+    "sigma0_mpa": 11.1,
+}
+
+#: p0 values (GPa) used when none are given: the paper's Fig. 4 (1 GPa) and
+#: experiment (1.77 GPa) loads, bracketed by a light and two heavier loads.
+DEFAULT_P0_GPA: tuple[float, ...] = (0.5, 1.0, 1.77, 2.0, 3.0)
+
+
+def _finite(name: str, value: Any) -> float:
+    require(
+        isinstance(value, numbers.Real) and not isinstance(value, bool),
+        f"{name} must be a number, got {value!r}",
+    )
+    require(math.isfinite(value), f"{name} must be finite, got {value!r}")
+    return float(value)
+
+
+def check_positive(name: str, value: Any) -> float:
+    """Return ``value`` as float or raise InputError unless it is finite and > 0."""
+    v = _finite(name, value)
+    require(v > 0.0, f"{name} must be > 0, got {value!r}")
+    return v
+
+
+def check_non_negative(name: str, value: Any) -> float:
+    """Return ``value`` as float or raise InputError unless it is finite and >= 0."""
+    v = _finite(name, value)
+    require(v >= 0.0, f"{name} must be >= 0, got {value!r}")
+    return v
+
+
+@dataclass(frozen=True)
+class ContactParameters:
+    """Sphere-on-flat contact with load-dependent interfacial shear laws.
+
+    Parameters
+    ----------
+    radius_um : float
+        Tip radius R (µm), > 0.
+    contact_modulus_gpa : float
+        Hertz contact modulus E* (GPa), ``1/E* = (1−ν1²)/E1 + (1−ν2²)/E2``, > 0.
+    shear_modulus_gpa : float
+        The paper's effective shear modulus G* (GPa) in ``q0 = G*·u/(π a)``
+        (= 4× Johnson's G*_J), > 0.
+    k_mpa_per_gpa, tau0_mpa : float
+        Shear-strength law τ(p) = k·p + τ0 (k in MPa/GPa, τ0 in MPa), both >= 0
+        and not both zero.
+    mu_mpa_per_gpa, sigma0_mpa : float
+        Slip-zone ("minimal-scale sliding") friction law σ(p) = μ·p + σ0, >= 0.
+    work_of_adhesion_j_m2 : float
+        Work of adhesion w (J/m²) for the DMT/JKR/Maugis–Dugdale radii, >= 0
+        (0: no adhesion correction).
+    """
+
+    radius_um: float = PAPER_DEFAULTS["radius_um"]
+    contact_modulus_gpa: float = PAPER_DEFAULTS["contact_modulus_gpa"]
+    shear_modulus_gpa: float = PAPER_DEFAULTS["shear_modulus_gpa"]
+    k_mpa_per_gpa: float = PAPER_DEFAULTS["k_mpa_per_gpa"]
+    tau0_mpa: float = PAPER_DEFAULTS["tau0_mpa"]
+    mu_mpa_per_gpa: float = PAPER_DEFAULTS["mu_mpa_per_gpa"]
+    sigma0_mpa: float = PAPER_DEFAULTS["sigma0_mpa"]
+    work_of_adhesion_j_m2: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("radius_um", "contact_modulus_gpa", "shear_modulus_gpa"):
+            object.__setattr__(self, name, check_positive(name, getattr(self, name)))
+        for name in (
+            "k_mpa_per_gpa",
+            "tau0_mpa",
+            "mu_mpa_per_gpa",
+            "sigma0_mpa",
+            "work_of_adhesion_j_m2",
+        ):
+            object.__setattr__(self, name, check_non_negative(name, getattr(self, name)))
+        require(
+            self.k_mpa_per_gpa > 0.0 or self.tau0_mpa > 0.0,
+            "k_mpa_per_gpa and tau0_mpa are both 0: the interface would have no shear "
+            "strength and no stick zone; give k > 0 or tau0 > 0",
+        )
+
+    # --- SI views -------------------------------------------------------------
+    @property
+    def radius_m(self) -> float:
+        """R in m."""
+        return self.radius_um * units.UM_TO_M
+
+    @property
+    def contact_modulus_pa(self) -> float:
+        """E* in Pa."""
+        return self.contact_modulus_gpa * units.GPA_TO_PA
+
+    @property
+    def shear_modulus_pa(self) -> float:
+        """The paper's G* in Pa."""
+        return self.shear_modulus_gpa * units.GPA_TO_PA
+
+    @property
+    def k(self) -> float:
+        """Pressure coefficient of the shear strength, dimensionless (MPa/GPa · 1e-3)."""
+        return self.k_mpa_per_gpa * units.MPA_PER_GPA_TO_RATIO
+
+    @property
+    def tau0_pa(self) -> float:
+        """τ0 in Pa."""
+        return self.tau0_mpa * units.MPA_TO_PA
+
+    @property
+    def mu(self) -> float:
+        """Pressure coefficient of the slip friction, dimensionless."""
+        return self.mu_mpa_per_gpa * units.MPA_PER_GPA_TO_RATIO
+
+    @property
+    def sigma0_pa(self) -> float:
+        """σ0 in Pa."""
+        return self.sigma0_mpa * units.MPA_TO_PA
+
+    def replace(self, **changes: float) -> ContactParameters:
+        """A validated copy with some fields changed."""
+        return replace(self, **changes)
+
+    def as_dict(self) -> dict[str, float]:
+        """Fields with their unit-bearing names (for JSON and netCDF attributes)."""
+        return asdict(self)
+
+
+def check_p0_gpa(p0_gpa: Any, name: str = "p0_gpa") -> list[float]:
+    """Validate one or several peak Hertz pressures (GPa) and return them as floats."""
+    values = [p0_gpa] if isinstance(p0_gpa, numbers.Real) else list(p0_gpa)
+    require(len(values) > 0, f"{name}: give at least one peak pressure")
+    return [check_positive(name, v) for v in values]
