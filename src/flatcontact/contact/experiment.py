@@ -1,0 +1,322 @@
+"""Measured lateral stiffness vs mean shear stress: loading, collapse detection, inverse τ0.
+
+CSV format
+----------
+Two columns, one a stress and one a lateral stiffness, each with its unit in the
+header, either in brackets or as a snake-case suffix, e.g.::
+
+    mean shear stress [MPa],lateral stiffness [N/m]
+    mean_shear_stress_mpa,lateral_stiffness_n_per_m
+
+Stress units: Pa, kPa, MPa, GPa. Stiffness units: <force>/<length> with force in
+N, mN, µN (uN), nN, kN and length in m, mm, µm (um), nm (e.g. N/m, mN/m, µN/nm).
+Lines starting with ``#`` are comments. Which column is which is decided by its
+unit.
+
+Collapse from data
+------------------
+The points are sorted by stress; the low-stress plateau is the median stiffness
+of the ``plateau_points`` (default 3) lowest-stress points; the collapse stress is
+where the stiffness first falls below ``fraction`` (default 0.2) of the plateau,
+linearly interpolated between the two bracketing points.
+
+Model side and inverse problem
+------------------------------
+The same criterion is applied to the model: the stress (same measure as the
+data: amplitude Q_max/(π a²) by default, or rms ⟨Q⟩/(π a²)) at which the model
+stiffness falls to ``fraction`` of its zero-stress value k0. With the default
+0.2 this lies within ~1 % below the model's gross-sliding collapse at Q_peak
+(k falls to 0 only logarithmically as Q_max -> Q_peak). :func:`fit_tau0` finds the
+τ0 (others fixed) for which model and data collapse coincide (brentq; the
+criterion is monotone increasing in τ0, checked on the bracket).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import brentq
+
+from flatcontact import units
+from flatcontact.contact import mindlin
+from flatcontact.contact.oscillation import (
+    STRESS_MEASURES,
+    amplitude_at_stiffness_fraction,
+    lateral_stiffness,
+)
+from flatcontact.contact.parameters import ContactParameters, check_positive
+from flatcontact.errors import InputError, require
+
+FloatArray = NDArray[np.float64]
+
+_PRESSURE_TO_PA = {"pa": 1.0, "kpa": 1.0e3, "mpa": units.MPA_TO_PA, "gpa": units.GPA_TO_PA}
+_FORCE_TO_N = {"n": 1.0, "kn": 1.0e3, "mn": 1.0e-3, "un": units.UN_TO_N, "nn": 1.0e-9}
+_LENGTH_TO_M = {"m": 1.0, "mm": 1.0e-3, "um": units.UM_TO_M, "nm": units.NM_TO_M}
+_BRACKET = re.compile(r"^(?P<name>.*?)\s*[\[(](?P<unit>[^\])]+)[\])]\s*$")
+_SNAKE_STIFF = re.compile(r"^(?P<name>.+?)_(?P<f>kn|mn|un|nn|n)_per_(?P<l>mm|um|nm|m)$")
+_SNAKE_PRESS = re.compile(r"^(?P<name>.+?)_(?P<u>kpa|mpa|gpa|pa)$")
+
+
+def _normalise_unit(text: str) -> str:
+    return text.strip().replace("µ", "u").replace("μ", "u").replace(" ", "").lower()
+
+
+def parse_unit(unit: str) -> tuple[str, float]:
+    """('stress', factor to Pa) or ('stiffness', factor to N/m) for a unit string.
+
+    Raises
+    ------
+    InputError
+        For a unit that is neither a pressure nor a force per length.
+    """
+    u = _normalise_unit(unit)
+    if u in _PRESSURE_TO_PA:
+        return "stress", _PRESSURE_TO_PA[u]
+    if "/" in u:
+        f, _, ln = u.partition("/")
+        if f in _FORCE_TO_N and ln in _LENGTH_TO_M:
+            return "stiffness", _FORCE_TO_N[f] / _LENGTH_TO_M[ln]
+    raise InputError(
+        f"unknown unit {unit!r}: expected a stress (Pa, kPa, MPa, GPa) or a stiffness "
+        "(force/length, e.g. N/m, mN/m, µN/nm)"
+    )
+
+
+def parse_column(header: str) -> tuple[str, str, float]:
+    """(name, kind, factor) from a header like 'mean shear stress [MPa]' or 'stress_mpa'."""
+    h = header.strip()
+    m = _BRACKET.match(h)
+    if m:
+        kind, factor = parse_unit(m.group("unit"))
+        return m.group("name").strip(), kind, factor
+    low = h.lower()
+    m = _SNAKE_STIFF.match(low)
+    if m:
+        return m.group("name"), "stiffness", _FORCE_TO_N[m.group("f")] / _LENGTH_TO_M[m.group("l")]
+    m = _SNAKE_PRESS.match(low)
+    if m:
+        return m.group("name"), "stress", _PRESSURE_TO_PA[m.group("u")]
+    raise InputError(
+        f"column {header!r} has no unit: write it as 'name [unit]' or 'name_<unit>' "
+        "(e.g. 'mean shear stress [MPa]', 'lateral_stiffness_n_per_m')"
+    )
+
+
+@dataclass(frozen=True)
+class MeasuredStiffness:
+    """Measured stiffness curve in SI, sorted by stress.
+
+    Attributes
+    ----------
+    stress_pa : mean shear stress (Pa), in the measure the experiment used
+    stiffness_n_per_m : lateral stiffness (N/m)
+    source : file name
+    stress_column, stiffness_column : the header cells as read
+    """
+
+    stress_pa: FloatArray
+    stiffness_n_per_m: FloatArray
+    source: str
+    stress_column: str
+    stiffness_column: str
+
+
+def load_stiffness_csv(path: str | Path) -> MeasuredStiffness:
+    """Read a two-column stress/stiffness CSV with units in the header (see module doc).
+
+    Raises
+    ------
+    InputError
+        Missing file, not two columns, a column without a unit or with an unknown
+        one, two columns of the same kind, a non-numeric or NaN/inf cell, a
+        negative stress, fewer than 4 rows.
+    """
+    p = Path(path)
+    require(p.is_file(), f"experiment file {str(p)!r} does not exist")
+    lines = [
+        ln for ln in p.read_text().splitlines() if ln.strip() and not ln.lstrip().startswith("#")
+    ]
+    require(len(lines) > 0, f"{p.name}: empty file, expected a header and data rows")
+    header = [c.strip() for c in lines[0].split(",")]
+    require(
+        len(header) == 2,
+        f"{p.name}: expected 2 columns (mean shear stress, lateral stiffness), got {len(header)}: {header}",
+    )
+    cols = []
+    for h in header:
+        try:
+            cols.append(parse_column(h))
+        except InputError as exc:
+            raise InputError(f"{p.name}: {exc}") from None
+    kinds = [c[1] for c in cols]
+    require(
+        sorted(kinds) == ["stiffness", "stress"],
+        f"{p.name}: need one stress column and one stiffness column, got kinds {kinds} from {header}",
+    )
+    i_stress = kinds.index("stress")
+    rows = []
+    for n, ln in enumerate(lines[1:], start=2):
+        cells = [c.strip() for c in ln.split(",")]
+        require(len(cells) == 2, f"{p.name}: data line {n} has {len(cells)} cells, expected 2")
+        try:
+            vals = [float(c) for c in cells]
+        except ValueError:
+            raise InputError(f"{p.name}: data line {n} is not numeric: {ln.strip()!r}") from None
+        require(
+            all(math.isfinite(v) for v in vals),
+            f"{p.name}: data line {n} has NaN or inf: {ln.strip()!r}",
+        )
+        rows.append(vals)
+    require(len(rows) >= 4, f"{p.name}: need at least 4 data rows, got {len(rows)}")
+    data = np.array(rows)
+    stress = data[:, i_stress] * cols[i_stress][2]
+    stiff = data[:, 1 - i_stress] * cols[1 - i_stress][2]
+    require(
+        bool(np.all(stress >= 0.0)), f"{p.name}: stress must be >= 0 (column {header[i_stress]!r})"
+    )
+    order = np.argsort(stress, kind="stable")
+    return MeasuredStiffness(
+        stress_pa=stress[order],
+        stiffness_n_per_m=stiff[order],
+        source=p.name,
+        stress_column=header[i_stress],
+        stiffness_column=header[1 - i_stress],
+    )
+
+
+@dataclass(frozen=True)
+class CollapseEstimate:
+    """Collapse of a measured stiffness curve.
+
+    Attributes
+    ----------
+    stress_pa : interpolated stress where stiffness < fraction·plateau first (Pa)
+    plateau_n_per_m : median stiffness of the lowest-stress points (N/m)
+    fraction : the criterion's fraction
+    """
+
+    stress_pa: float
+    plateau_n_per_m: float
+    fraction: float
+
+
+def collapse_stress(
+    stress_pa: ArrayLike,
+    stiffness_n_per_m: ArrayLike,
+    *,
+    fraction: float = 0.2,
+    plateau_points: int = 3,
+) -> CollapseEstimate:
+    """Collapse stress of a stiffness curve (see module doc for the precise definition).
+
+    Raises
+    ------
+    InputError
+        If the fraction is not in (0, 1), there are too few points, the plateau is
+        not positive, or the stiffness never falls below the threshold.
+    """
+    require(0.0 < fraction < 1.0, f"collapse fraction must be in (0, 1), got {fraction!r}")
+    x = np.asarray(stress_pa, dtype=float)
+    y = np.asarray(stiffness_n_per_m, dtype=float)
+    require(
+        x.shape == y.shape and x.ndim == 1,
+        "stress and stiffness must be 1-D arrays of equal length",
+    )
+    require(
+        x.size > plateau_points,
+        f"need more than {plateau_points} points to find a collapse, got {x.size}",
+    )
+    order = np.argsort(x, kind="stable")
+    x, y = x[order], y[order]
+    plateau = float(np.median(y[:plateau_points]))
+    require(plateau > 0.0, f"low-stress stiffness plateau must be > 0, got {plateau!r} N/m")
+    thr = fraction * plateau
+    below = np.nonzero(y[plateau_points:] < thr)[0]
+    require(
+        below.size > 0,
+        f"no collapse: the stiffness never falls below {fraction:g} of its plateau ({plateau:.4g} N/m)",
+    )
+    i = int(below[0]) + plateau_points
+    x0, x1, y0, y1 = x[i - 1], x[i], y[i - 1], y[i]
+    t = (y0 - thr) / (y0 - y1) if y0 != y1 else 1.0
+    return CollapseEstimate(
+        stress_pa=float(x0 + t * (x1 - x0)), plateau_n_per_m=plateau, fraction=float(fraction)
+    )
+
+
+def _measure_factor(measure: str) -> float:
+    require(
+        measure in STRESS_MEASURES,
+        f"stress measure must be one of {STRESS_MEASURES}, got {measure!r}",
+    )
+    return 1.0 if measure == "amplitude" else 1.0 / np.sqrt(2.0)
+
+
+def model_stiffness_at_stress(
+    stress_pa: ArrayLike, p0_pa: float, params: ContactParameters, measure: str = "amplitude"
+) -> FloatArray:
+    """Model lateral stiffness (N/m) at mean shear stresses (Pa) of ``measure``; 0 beyond collapse."""
+    factor = _measure_factor(measure)
+    s = np.asarray(stress_pa, dtype=float)
+    a = float(mindlin.contact_radius(p0_pa, params))
+    qmax = s * np.pi * a**2 / factor
+    q_peak = float(mindlin.peak_force(p0_pa, params).force_n)
+    inside = (qmax >= 0.0) & (qmax < q_peak)
+    k = lateral_stiffness(np.where(inside, qmax, 0.0), p0_pa, params)
+    return np.where(inside, k, 0.0)
+
+
+def model_collapse_stress(
+    p0_pa: float, params: ContactParameters, *, fraction: float = 0.2, measure: str = "amplitude"
+) -> float:
+    """The model's stress (Pa, ``measure``) where k falls to ``fraction``·k0 — the data criterion."""
+    factor = _measure_factor(measure)
+    a = float(mindlin.contact_radius(p0_pa, params))
+    return amplitude_at_stiffness_fraction(p0_pa, params, fraction) * factor / (np.pi * a**2)
+
+
+def fit_tau0(
+    measured_collapse_pa: float,
+    p0_pa: float,
+    params: ContactParameters,
+    *,
+    fraction: float = 0.2,
+    measure: str = "amplitude",
+    tau0_max_mpa: float = 1.0e5,
+) -> float:
+    """τ0 (MPa) for which the model collapse (same criterion and measure) equals the measured one.
+
+    Raises
+    ------
+    InputError
+        If the measured collapse is below what τ0 = 0 gives (or, with k = 0, what
+        τ0 -> 0 gives) or above what ``tau0_max_mpa`` gives.
+    """
+    target = check_positive("measured collapse stress (Pa)", measured_collapse_pa)
+    p0 = check_positive("p0_pa", p0_pa)
+
+    def resid(tau0_mpa: float) -> float:
+        return (
+            model_collapse_stress(
+                p0, params.replace(tau0_mpa=tau0_mpa), fraction=fraction, measure=measure
+            )
+            - target
+        )
+
+    lo = 0.0 if params.k_mpa_per_gpa > 0.0 else 1e-9
+    r_lo = resid(lo)
+    require(
+        r_lo <= 0.0,
+        f"measured collapse {target / units.MPA_TO_PA:.4g} MPa is below the model's at tau0 = {lo:g} MPa "
+        f"({(r_lo + target) / units.MPA_TO_PA:.4g} MPa): no tau0 >= 0 fits",
+    )
+    hi = max(1.0, 2.0 * params.tau0_mpa)
+    while resid(hi) < 0.0:
+        hi *= 2.0
+        require(hi <= tau0_max_mpa, f"measured collapse needs tau0 > {tau0_max_mpa:g} MPa")
+    return float(brentq(resid, lo, hi, xtol=1e-10, rtol=1e-10))
