@@ -1,0 +1,218 @@
+"""Where grid points run: serially, in local worker processes, or on a Dask cluster.
+
+Every executor takes ``submit(fn, *args)`` and returns a handle; ``wait_first``
+blocks until at least one handle is finished. Workers build their calculator once
+(:func:`flatcontact.ispes.relax.worker_calculator`, cached per worker thread) and
+reuse it for every point they receive. Workers never write files: results come back
+to the driver, which alone writes the point store.
+
+- :class:`SerialExecutor`: in the driver process (debugging, tests, 1 core).
+- :class:`ProcessExecutor`: ``concurrent.futures.ProcessPoolExecutor`` with the
+  ``spawn`` start method (no fork of a process that holds a LAMMPS instance or MPI),
+  one worker per core by default; workers ignore SIGINT so Ctrl-C reaches only the
+  driver.
+- :class:`DaskExecutor`: a ``distributed.Client`` on a running scheduler
+  (``--dask-address tcp://host:8786``), a ``LocalCluster``, or a dask-jobqueue
+  cluster (SLURM, PBS, ...) described by a dict (see :func:`jobqueue_cluster`).
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import multiprocessing
+import os
+import signal
+from collections.abc import Callable, Iterable
+from typing import Any
+
+from flatcontact.errors import InputError
+
+
+def default_workers() -> int:
+    """One worker per core available to this process."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+class SerialExecutor:
+    """Runs each task at submission, in the driver process."""
+
+    workers = 1
+    name = "serial"
+
+    def submit(self, fn: Callable, *args: Any) -> cf.Future:
+        fut: cf.Future = cf.Future()
+        try:
+            fut.set_result(fn(*args))
+        except BaseException as exc:
+            if isinstance(exc, KeyboardInterrupt):
+                raise
+            fut.set_exception(exc)
+        return fut
+
+    def wait_first(self, handles: Iterable[cf.Future]) -> tuple[set, set]:
+        return cf.wait(list(handles), return_when=cf.FIRST_COMPLETED)
+
+    @staticmethod
+    def result(handle: cf.Future) -> Any:
+        return handle.result()
+
+    def close(self, cancel: bool = False) -> None:
+        pass
+
+
+def _ignore_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+class ProcessExecutor(SerialExecutor):
+    """Local worker processes (``spawn``), ``workers`` of them (default: one per core)."""
+
+    name = "processes"
+
+    def __init__(self, workers: int | None = None):
+        workers = default_workers() if workers is None else workers
+        if int(workers) != workers or workers < 1:
+            raise InputError(
+                f"workers: expected a positive number of worker processes, got {workers}"
+            )
+        self.workers = int(workers)
+        self._pool = cf.ProcessPoolExecutor(
+            max_workers=self.workers,
+            mp_context=multiprocessing.get_context("spawn"),
+            initializer=_ignore_sigint,
+        )
+
+    def submit(self, fn: Callable, *args: Any) -> cf.Future:
+        return self._pool.submit(fn, *args)
+
+    def close(self, cancel: bool = False) -> None:
+        self._pool.shutdown(wait=not cancel, cancel_futures=cancel)
+
+
+def jobqueue_cluster(spec: dict) -> Any:
+    """A dask-jobqueue cluster from ``{"kind": "slurm"|"pbs"|..., "jobs": N, **kwargs}``.
+
+    ``kwargs`` go to the cluster class unchanged (``cores``, ``memory``, ``queue``,
+    ``account``, ``walltime``, ``job_extra_directives``, ...); ``jobs`` batch jobs are
+    requested with ``cluster.scale(jobs=N)``. Needs the ``jobqueue`` extra
+    (``pip install 'flatcontact[jobqueue]'``).
+    """
+    spec = dict(spec)
+    kind = str(spec.pop("kind", "")).lower()
+    jobs = int(spec.pop("jobs", 1))
+    try:
+        import dask_jobqueue
+    except ImportError:
+        raise InputError(
+            "jobqueue: dask-jobqueue is not installed; pip install 'flatcontact[jobqueue]'"
+        ) from None
+    classes = {
+        "slurm": "SLURMCluster",
+        "pbs": "PBSCluster",
+        "sge": "SGECluster",
+        "lsf": "LSFCluster",
+        "htcondor": "HTCondorCluster",
+        "oar": "OARCluster",
+        "moab": "MoabCluster",
+    }
+    if kind not in classes:
+        raise InputError(f"jobqueue.kind: expected one of {', '.join(classes)}, got {kind!r}")
+    try:
+        cluster = getattr(dask_jobqueue, classes[kind])(**spec)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"jobqueue: cannot build a {classes[kind]} from {spec} ({exc})") from None
+    cluster.scale(jobs=jobs)
+    return cluster
+
+
+class DaskExecutor(SerialExecutor):
+    """Tasks on a Dask distributed cluster.
+
+    Parameters
+    ----------
+    address
+        Scheduler address (``tcp://host:8786``); checked with a ``timeout_s`` connection
+        attempt, and an unreachable scheduler is a one-line InputError.
+    cluster
+        Alternatively a cluster object (``LocalCluster``, a dask-jobqueue cluster).
+    """
+
+    name = "dask"
+
+    def __init__(self, address: str | None = None, cluster: Any = None, timeout_s: float = 10.0):
+        from distributed import Client
+
+        if (address is None) == (cluster is None):
+            raise InputError("dask: give either a scheduler address or a cluster")
+        self._own_cluster = None
+        try:
+            self._client = Client(
+                address if address is not None else cluster,
+                timeout=f"{timeout_s}s",
+                set_as_default=False,
+            )
+        except (OSError, TimeoutError) as exc:
+            raise InputError(
+                f"dask-address {address}: no Dask scheduler reachable ({exc.__class__.__name__})"
+            ) from None
+        except ValueError as exc:
+            raise InputError(f"dask-address {address!r}: not a scheduler address ({exc})") from None
+        info = self._client.scheduler_info()
+        self.workers = max(1, sum(w.get("nthreads", 1) for w in info.get("workers", {}).values()))
+
+    @classmethod
+    def local(cls, workers: int = 2) -> DaskExecutor:
+        """A ``LocalCluster`` of ``workers`` single-threaded worker processes (owned and closed)."""
+        from distributed import LocalCluster
+
+        cluster = LocalCluster(
+            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None
+        )
+        ex = cls(cluster=cluster)
+        ex._own_cluster = cluster
+        return ex
+
+    def submit(self, fn: Callable, *args: Any):
+        return self._client.submit(fn, *args, pure=False)
+
+    def wait_first(self, handles):
+        from distributed import wait
+
+        done, not_done = wait(list(handles), return_when="FIRST_COMPLETED")
+        return set(done), set(not_done)
+
+    def close(self, cancel: bool = False) -> None:
+        self._client.close()
+        if self._own_cluster is not None:
+            self._own_cluster.close()
+
+
+def make_executor(
+    kind: str = "processes",
+    workers: int | None = None,
+    dask_address: str | None = None,
+    jobqueue: dict | None = None,
+):
+    """Build an executor: ``serial``, ``processes`` (default), or ``dask``.
+
+    ``dask_address`` or ``jobqueue`` imply ``dask``; without either, ``dask`` starts a
+    ``LocalCluster`` of ``workers`` processes.
+    """
+    if dask_address is not None or jobqueue is not None:
+        kind = "dask"
+    if kind == "serial":
+        return SerialExecutor()
+    if kind == "processes":
+        if workers == 1:
+            return SerialExecutor()
+        return ProcessExecutor(workers)
+    if kind == "dask":
+        if dask_address is not None:
+            return DaskExecutor(address=dask_address)
+        if jobqueue is not None:
+            return DaskExecutor(cluster=jobqueue_cluster(jobqueue))
+        return DaskExecutor.local(workers or default_workers())
+    raise InputError(f"executor: expected serial, processes or dask, got {kind!r}")

@@ -1,0 +1,102 @@
+"""Geometry of a scan point: where slab 2 goes and how a warm start is carried over.
+
+The interface contract (``interface.extxyz``, see ``DESIGN.md``) is implemented by
+:mod:`flatcontact.structures.interface` (``fixed_mask``, ``thickness``,
+``place_slab2``). This module re-exports those three functions and adds what only the
+scan needs: the fractional lateral displacement between two grid points with the
+periodic minimum image, and the transfer of a relaxed neighbour's free-atom positions
+to a new point (:func:`warm_start_positions`).
+
+Conventions
+-----------
+Shifts ``(shift_a, shift_b)`` are fractions of the in-plane primitive vectors
+``a1``, ``a2``; slab 2 is displaced laterally by ``shift_a * a1 + shift_b * a2``
+relative to the reference interface. The thickness ``z`` (Å) is the distance between
+the mean planes of surface 1 and surface 4 (the paper's z, Fig. 1).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from ase import Atoms
+
+try:  # the structures package owns the interface contract
+    from flatcontact.structures.interface import fixed_mask, place_slab2, thickness
+except ModuleNotFoundError:  # pragma: no cover - until flatcontact.structures lands
+    from flatcontact.ispes._interface_fallback import fixed_mask, place_slab2, thickness
+
+__all__ = [
+    "fixed_mask",
+    "in_plane_vectors",
+    "lateral_displacement",
+    "place_slab2",
+    "thickness",
+    "warm_start_positions",
+]
+
+
+def in_plane_vectors(atoms: Atoms) -> tuple[np.ndarray, np.ndarray]:
+    """The primitive in-plane vectors ``a1``, ``a2`` (Å, 2-vectors) of an interface."""
+    if "a1" in atoms.info and "a2" in atoms.info:
+        a1 = np.asarray(atoms.info["a1"], dtype=float).ravel()[:2]
+        a2 = np.asarray(atoms.info["a2"], dtype=float).ravel()[:2]
+    else:
+        a1, a2 = atoms.cell[0][:2].copy(), atoms.cell[1][:2].copy()
+    return a1, a2
+
+
+def lateral_displacement(
+    shift_from: tuple[float, float], shift_to: tuple[float, float], a1: np.ndarray, a2: np.ndarray
+) -> np.ndarray:
+    """Cartesian in-plane displacement (Å, 3-vector with z = 0) from one shift to another.
+
+    The fractional difference is taken with the periodic minimum image (each
+    component in [-1/2, 1/2)), so neighbours across the cell boundary are one grid
+    step apart, not a whole cell.
+    """
+    d = np.asarray(shift_to, dtype=float) - np.asarray(shift_from, dtype=float)
+    d = d - np.floor(d + 0.5)
+    out = np.zeros(3)
+    out[:2] = d[0] * np.asarray(a1)[:2] + d[1] * np.asarray(a2)[:2]
+    return out
+
+
+def warm_start_positions(
+    placed: Atoms,
+    neighbour_positions: np.ndarray,
+    shift_neighbour: tuple[float, float],
+    shift_new: tuple[float, float],
+    thickness_neighbour: float,
+    thickness_new: float,
+    fixed: np.ndarray,
+) -> np.ndarray:
+    """Start positions for a new point from the relaxed positions of a neighbouring point.
+
+    Slab 2's atoms of the neighbour are translated rigidly by the lateral
+    displacement (minimum image) and by ``thickness_new - thickness_neighbour``
+    along z; slab 1's atoms are kept. The fixed atoms are then set exactly to
+    their positions in ``placed`` (the new point built from the reference by
+    :func:`place_slab2`), so the constraint of a point never depends on the path
+    that led to it, only the initial guess of the free atoms does.
+
+    Parameters
+    ----------
+    placed
+        The new point as built by ``place_slab2(reference, shift_new, thickness_new)``.
+    neighbour_positions
+        Relaxed Cartesian positions (Å) of the neighbour, same atom order.
+    shift_neighbour, shift_new
+        Fractional shifts ``(shift_a, shift_b)`` of the two points.
+    thickness_neighbour, thickness_new
+        Thicknesses z (Å) of the two points.
+    fixed
+        Boolean mask of the fixed atoms (surfaces 1 and 4).
+    """
+    a1, a2 = in_plane_vectors(placed)
+    d = lateral_displacement(shift_neighbour, shift_new, a1, a2)
+    d[2] = thickness_new - thickness_neighbour
+    pos = np.array(neighbour_positions, dtype=float, copy=True)
+    slab2 = np.asarray(placed.arrays["slab"]) == 2
+    pos[slab2] += d
+    pos[fixed] = placed.positions[fixed]
+    return pos

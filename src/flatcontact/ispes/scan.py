@@ -1,0 +1,322 @@
+"""The scan driver: validate, open the store, resolve thicknesses, schedule, assemble.
+
+:func:`run_scan` is the whole ISPES stage from Python; ``flatcontact scan`` is a thin
+wrapper. The driver validates everything before any relaxation (grid size,
+thicknesses that would make the slabs overlap, the store's settings, the executor),
+then computes only the points missing from ``points.db``, each committed as soon as it
+returns, and finally writes ``ispes.nc`` atomically. Interrupted (Ctrl-C, or a kill of
+the driver), the store keeps every finished point and a rerun continues from there;
+because each point's warm start comes from a fixed neighbour
+(:mod:`flatcontact.ispes.order`), the resumed grid equals an uninterrupted one.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from ase import Atoms
+
+from flatcontact.errors import InputError
+from flatcontact.ispes import grid as grid_mod
+from flatcontact.ispes.geometry import fixed_mask, in_plane_vectors, thickness
+from flatcontact.ispes.order import PREFERENCES, search_tree
+from flatcontact.ispes.relax import (
+    PointTask,
+    RelaxSettings,
+    ScanContext,
+    relax_point,
+    run_task,
+    worker_calculator,
+)
+from flatcontact.ispes.store import PointStore, interface_hash
+
+POINTS_DB = "points.db"
+ISPES_NC = "ispes.nc"
+
+
+@dataclasses.dataclass
+class ScanResult:
+    """What a scan did. ``dataset`` is the assembled ``ispes.nc`` content."""
+
+    dataset: Any
+    ispes_path: Path
+    store_path: Path
+    points_total: int
+    points_done: int
+    points_computed: int
+    seconds: float
+    force_calls_computed: list[int]
+    adhesion: dict | None
+    notes: list[str]
+    interrupted: bool = False
+
+
+def validate_interface(atoms: Atoms) -> None:
+    """One-line InputError unless ``atoms`` follows the interface contract."""
+    for key in ("slab", "surface"):
+        if key not in atoms.arrays:
+            raise InputError(
+                f"interface: missing per-atom array '{key}' (see the interface.extxyz contract)"
+            )
+    slab = np.asarray(atoms.arrays["slab"])
+    surface = np.asarray(atoms.arrays["surface"])
+    if not set(np.unique(slab)) <= {1, 2} or not {1, 2} <= set(np.unique(slab)):
+        raise InputError("interface: array 'slab' must hold both 1 and 2 and nothing else")
+    for s, sl in ((1, 1), (4, 2)):
+        sel = surface == s
+        if not sel.any():
+            raise InputError(
+                f"interface: no atoms on surface {s} (the fixed outer face of slab {sl})"
+            )
+        if np.any(slab[sel] != sl):
+            raise InputError(f"interface: surface-{s} atoms must belong to slab {sl}")
+    if np.all(fixed_mask(atoms)):
+        raise InputError("interface: every atom is fixed; nothing to relax")
+    if not (atoms.pbc[0] and atoms.pbc[1]):
+        raise InputError("interface: must be periodic along a1 and a2 (pbc in x and y)")
+
+
+def scan_settings(
+    reference: Atoms, factory: Any, grid: grid_mod.GridSpec, relax: RelaxSettings
+) -> dict:
+    """The store fingerprint of a scan (everything that changes the numbers)."""
+    return {
+        "interface_sha256": interface_hash(reference),
+        "potential": json.loads(factory.fingerprint),
+        "relax": relax.as_dict(),
+        "grid": grid.as_dict(),
+    }
+
+
+def _probe(
+    reference: Atoms, factory: Any, grid: grid_mod.GridSpec, relax: RelaxSettings
+) -> tuple[dict, list[str]]:
+    calc = worker_calculator(factory, reference)
+    shift = grid_mod.lowest_energy_stacking(reference, calc, grid)
+
+    def relax_one(a, b, z, start, start_z):
+        task = PointTask((0, 0, 0), a, b, z, start, (a, b) if start is not None else None, start_z)
+        r = relax_point(reference, calc, task, relax)
+        return r.energy_ev, r.normal_stress_gpa, r.force_calls, r.positions
+
+    lo, hi, n = grid.p_range_gpa
+    probe = grid_mod.probe_column(relax_one, reference, shift, hi)
+    adh = grid_mod.adhesion(probe)
+    z, notes = grid_mod.thicknesses_for_pressures(probe, lo, hi, n)
+    return {
+        "thickness_angstrom": z.tolist(),
+        "probe": probe.as_dict(),
+        "adhesion": adh.as_dict(),
+        "notes": notes,
+    }, notes
+
+
+def _progress(console, total: int, done: int):
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        ProgressColumn,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+    from rich.text import Text
+
+    class Rate(ProgressColumn):
+        def render(self, task):
+            speed = task.finished_speed or task.speed
+            return Text("-- pt/s" if speed is None else f"{speed:.2f} pt/s")
+
+    prog = Progress(
+        TextColumn("ISPES"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        Rate(),
+        TimeElapsedColumn(),
+        TextColumn("ETA"),
+        TimeRemainingColumn(),
+        console=console,
+        transient=False,
+    )
+    task = prog.add_task("scan", total=total, completed=done)
+    return prog, task
+
+
+def run_scan(
+    reference: Atoms,
+    factory: Any,
+    grid: grid_mod.GridSpec,
+    out_dir: str | Path,
+    relax: RelaxSettings | None = None,
+    order: str = "z",
+    executor: Any = None,
+    executor_options: dict | None = None,
+    progress: bool = False,
+    console: Any = None,
+    max_new_points: int | None = None,
+) -> ScanResult:
+    """Compute the ISPES grid of ``reference`` with ``factory``'s calculator into ``out_dir``.
+
+    Parameters
+    ----------
+    reference
+        The relaxed reference interface (slab 2 at shift (0, 0)), interface contract.
+    factory
+        A picklable calculator factory with a ``fingerprint`` (see
+        :mod:`flatcontact.ispes.calculators`).
+    grid
+        The lateral grid and thicknesses or pressure range.
+    out_dir
+        Receives ``points.db`` and ``ispes.nc``.
+    relax
+        Relaxation settings (tolerance, optimiser, step cap).
+    order
+        Warm-start tree preference: ``"z"``, ``"lateral"`` or ``"cold"``.
+    executor
+        An executor object (:mod:`flatcontact.ispes.executors`); if None, one is built
+        from ``executor_options`` (``make_executor`` keywords) after validation.
+    max_new_points
+        Stop after computing this many new points (benchmarks); the store stays resumable.
+
+    Returns
+    -------
+    ScanResult
+    """
+    from flatcontact.ispes.executors import make_executor
+
+    t0 = time.perf_counter()
+    relax = relax or RelaxSettings()
+    if order not in PREFERENCES:
+        raise InputError(f"order: expected one of {', '.join(PREFERENCES)}, got {order!r}")
+    validate_interface(reference)
+    if grid.thickness_angstrom is not None:
+        grid_mod.check_thicknesses(reference, grid, grid.thickness_angstrom)
+    out_dir = Path(out_dir)
+    store = PointStore(
+        out_dir / POINTS_DB, scan_settings(reference, factory, grid, relax), reference
+    )
+    own_executor = executor is None
+    if own_executor:
+        executor = make_executor(**(executor_options or {}))
+    notes: list[str] = []
+    interrupted = False
+    computed_calls: list[int] = []
+    try:
+        if store.resolved is None:
+            a1, a2 = in_plane_vectors(reference)
+            resolved = {"a1": a1.tolist(), "a2": a2.tolist(), "potential_label": factory.label}
+            if grid.thickness_angstrom is not None:
+                resolved["thickness_angstrom"] = list(grid.thickness_angstrom)
+            else:
+                extra, notes = _probe(reference, factory, grid, relax)
+                resolved.update(extra)
+            store.set_resolved(resolved)
+        resolved = store.resolved
+        notes = list(resolved.get("notes", notes))
+        z = np.asarray(resolved["thickness_angstrom"], dtype=float)
+        if grid.thickness_angstrom is None:
+            grid_mod.check_thicknesses(reference, grid, z)
+        shape = (grid.n_a, grid.n_b, z.size)
+        sa, sb = grid.shifts()
+        root = (0, 0, int(np.argmin(np.abs(z - thickness(reference)))))
+        parent = search_tree(shape, root, order)
+        context = ScanContext(reference, factory, relax)
+        rank = {idx: k for k, idx in enumerate(parent)}
+        todo = [idx for idx in parent if idx not in store]
+        total = len(parent)
+        prog = None
+        if progress:
+            prog, ptask = _progress(console, total, len(store))
+            prog.start()
+        in_flight: dict[Any, tuple] = {}
+        cap = 2 * max(1, getattr(executor, "workers", 1))
+        pending = set(todo)
+
+        def ready(idx):
+            par = parent[idx]
+            return par is None or par in store
+
+        def make_task(idx):
+            par = parent[idx]
+            ia, ib, iz = idx
+            if par is not None and store.done()[par]["converged"]:
+                pa, pb, pz = par
+                return PointTask(
+                    idx,
+                    float(sa[ia]),
+                    float(sb[ib]),
+                    float(z[iz]),
+                    store.positions(par),
+                    (float(sa[pa]), float(sb[pb])),
+                    float(z[pz]),
+                    par,
+                )
+            return PointTask(idx, float(sa[ia]), float(sb[ib]), float(z[iz]))
+
+        submitted = 0
+        try:
+            while pending or in_flight:
+                if max_new_points is not None and submitted >= max_new_points and not in_flight:
+                    break
+                candidates = sorted((i for i in pending if ready(i)), key=rank.__getitem__)
+                for idx in candidates:
+                    if len(in_flight) >= cap or (
+                        max_new_points is not None and submitted >= max_new_points
+                    ):
+                        break
+                    handle = executor.submit(run_task, context, make_task(idx))
+                    in_flight[handle] = idx
+                    pending.discard(idx)
+                    submitted += 1
+                if not in_flight:
+                    break
+                done, _ = executor.wait_first(in_flight)
+                for handle in done:
+                    idx = in_flight.pop(handle)
+                    result = executor.result(handle)
+                    store.write(result)
+                    computed_calls.append(result.force_calls)
+                    if prog is not None:
+                        prog.update(ptask, completed=len(store))
+        except KeyboardInterrupt:
+            interrupted = True
+        finally:
+            if prog is not None:
+                prog.stop()
+    finally:
+        if own_executor:
+            executor.close(cancel=True)
+    ds = store.assemble()
+    path = store.write_ispes(out_dir / ISPES_NC)
+    result = ScanResult(
+        dataset=ds,
+        ispes_path=path,
+        store_path=store.path,
+        points_total=int(np.prod(shape)),
+        points_done=len(store),
+        points_computed=len(computed_calls),
+        seconds=time.perf_counter() - t0,
+        force_calls_computed=computed_calls,
+        adhesion=resolved.get("adhesion"),
+        notes=notes,
+        interrupted=interrupted,
+    )
+    if interrupted:
+        raise ScanInterrupted(result)
+    return result
+
+
+class ScanInterrupted(KeyboardInterrupt):
+    """Raised after Ctrl-C, once the store is consistent and a partial ``ispes.nc`` is written."""
+
+    def __init__(self, result: ScanResult):
+        super().__init__(
+            f"interrupted: {result.points_done} of {result.points_total} points stored"
+        )
+        self.result = result

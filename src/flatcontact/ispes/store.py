@@ -1,0 +1,244 @@
+"""The resumable point store ``points.db`` (ASE SQLite database) and ``ispes.nc`` assembly.
+
+One row per finished grid point, keyed by ``i_a``, ``i_b``, ``i_z`` (key-value pairs),
+holding the relaxed structure (positions; the energy in the row's ``energy``) and the
+record ``shift_a``, ``shift_b``, ``thickness`` (Å), ``normal_stress_gpa``, ``reaction_stress_gpa``,
+``force_calls``, ``steps``, ``converged``, ``max_force_ev_per_a``, ``seconds`` and
+``start`` (the neighbour it was warm-started from, ``"i_a,i_b,i_z"``, empty if cold).
+
+The database metadata holds ``settings`` (the fingerprint: interface hash, potential,
+relaxation settings, grid request) and ``resolved`` (the thicknesses actually used,
+a1, a2, the potential label, the probe column and adhesion if the thicknesses were
+chosen from a pressure range). A store whose settings differ from the current ones is
+refused with a line naming the first difference.
+
+Crash safety: only the driver process writes; every point is one SQLite transaction
+(ASE commits each ``write``), so a kill at any moment leaves every committed point
+intact and loses at most the points in flight.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+from ase import Atoms
+from ase.calculators.singlepoint import SinglePointCalculator
+
+from flatcontact.errors import InputError
+from flatcontact.ispes import contract
+from flatcontact.ispes.relax import Index, PointResult
+
+FORMAT = "flatcontact.points/1"
+
+
+def interface_hash(atoms: Atoms) -> str:
+    """SHA-256 of what defines an interface: species, positions, cell, pbc, slab/surface tags.
+
+    Positions and cell are rounded to 1e-6 Å so that a file round trip gives the same hash.
+    """
+    h = hashlib.sha256()
+    h.update(np.asarray(atoms.numbers, dtype=np.int64).tobytes())
+    h.update(np.round(atoms.positions, 6).astype(np.float64).tobytes())
+    h.update(np.round(atoms.cell.array, 6).astype(np.float64).tobytes())
+    h.update(np.asarray(atoms.pbc, dtype=np.int8).tobytes())
+    for key in ("slab", "surface"):
+        h.update(np.asarray(atoms.arrays[key], dtype=np.int64).tobytes())
+    return h.hexdigest()
+
+
+def _flatten(d: Any, prefix: str = "") -> dict[str, Any]:
+    if isinstance(d, dict):
+        out: dict[str, Any] = {}
+        for k, v in d.items():
+            out.update(_flatten(v, f"{prefix}.{k}" if prefix else str(k)))
+        return out
+    return {prefix: d}
+
+
+def settings_difference(stored: dict, current: dict) -> str | None:
+    """The first difference between two settings dicts as ``key: stored vs current``, or None."""
+    a, b = _flatten(json.loads(json.dumps(stored))), _flatten(json.loads(json.dumps(current)))
+    for key in sorted(set(a) | set(b)):
+        if a.get(key, "<absent>") != b.get(key, "<absent>"):
+            sa, sb = json.dumps(a.get(key, "<absent>")), json.dumps(b.get(key, "<absent>"))
+            if len(sa) > 60:
+                sa = sa[:57] + "..."
+            if len(sb) > 60:
+                sb = sb[:57] + "..."
+            return f"{key}: {sa} in the store vs {sb} now"
+    return None
+
+
+class PointStore:
+    """A ``points.db`` opened for one set of settings (the driver's single writer).
+
+    Parameters
+    ----------
+    path
+        The database file (created if missing).
+    settings
+        The fingerprint dict (JSON-serialisable). An existing store with other
+        settings raises InputError naming the first difference.
+    reference
+        The reference interface; stored rows keep only positions and energy, the
+        rest (species, cell, tags) comes from it.
+    """
+
+    def __init__(self, path: str | os.PathLike[str], settings: dict, reference: Atoms):
+        import ase.db
+
+        self.path = Path(path)
+        self.settings = json.loads(json.dumps(settings))
+        self.reference = reference
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        existed = self.path.exists()
+        try:
+            self._db = ase.db.connect(str(self.path), type="db", append=True)
+            meta = self._db.metadata if existed else {}
+            n_rows = self._db.count() if existed else 0
+        except Exception as exc:  # sqlite3.DatabaseError, JSON errors
+            raise InputError(
+                f"{self.path}: not a readable points database ({exc.__class__.__name__}: {exc})"
+            ) from None
+        if meta.get("format") is not None and meta.get("format") != FORMAT:
+            raise InputError(
+                f"{self.path}: not a flatcontact point store (format {meta.get('format')!r})"
+            )
+        if "settings" in meta:
+            diff = settings_difference(meta["settings"], self.settings)
+            if diff is not None:
+                raise InputError(
+                    f"{self.path} was made with different settings ({diff}); use another --out or remove the store"
+                )
+        elif n_rows:
+            raise InputError(
+                f"{self.path}: has {n_rows} rows but no flatcontact settings; refusing to mix"
+            )
+        else:
+            self._db.metadata = {"format": FORMAT, "settings": self.settings}
+        self._meta = self._db.metadata
+        self._done: dict[Index, dict] = {}
+        for row in self._db.select():
+            self._done[(row.i_a, row.i_b, row.i_z)] = self._record(row)
+
+    @staticmethod
+    def _record(row) -> dict:
+        start = row.get("start", "")
+        return {
+            "id": row.id,
+            "energy_ev": float(row.energy),
+            "normal_stress_gpa": float(row.normal_stress_gpa),
+            "force_calls": int(row.force_calls),
+            "converged": bool(row.converged),
+            "shift": (float(row.shift_a), float(row.shift_b)),
+            "thickness": float(row.thickness),
+            "start": tuple(int(s) for s in start.split(",")) if start else None,
+        }
+
+    # -- metadata -------------------------------------------------------------------
+    @property
+    def resolved(self) -> dict | None:
+        """What the run resolved once (thicknesses, a1, a2, probe), or None if not yet."""
+        return self._meta.get("resolved")
+
+    def set_resolved(self, resolved: dict) -> None:
+        meta = dict(self._meta)
+        meta["resolved"] = json.loads(json.dumps(resolved))
+        self._db.metadata = meta
+        self._meta = self._db.metadata
+
+    # -- points ---------------------------------------------------------------------
+    def done(self) -> dict[Index, dict]:
+        """Finished points: index -> record (energy_ev, normal_stress_gpa, converged, ...)."""
+        return dict(self._done)
+
+    def __contains__(self, index: Index) -> bool:
+        return tuple(index) in self._done
+
+    def __len__(self) -> int:
+        return len(self._done)
+
+    def positions(self, index: Index) -> np.ndarray:
+        """Relaxed positions (Å) of a finished point."""
+        return self._db.get(id=self._done[tuple(index)]["id"]).positions.copy()
+
+    def write(self, result: PointResult) -> None:
+        """Commit one finished point (one transaction). A point already stored is ignored."""
+        index = tuple(result.index)
+        if index in self._done:
+            return
+        atoms = Atoms(
+            numbers=self.reference.numbers,
+            positions=result.positions,
+            cell=self.reference.cell,
+            pbc=self.reference.pbc,
+        )
+        atoms.calc = SinglePointCalculator(atoms, energy=result.energy_ev)
+        kvp = {
+            "i_a": index[0],
+            "i_b": index[1],
+            "i_z": index[2],
+            "shift_a": result.shift_a,
+            "shift_b": result.shift_b,
+            "thickness": result.thickness,
+            "normal_stress_gpa": result.normal_stress_gpa,
+            "reaction_stress_gpa": result.reaction_stress_gpa,
+            "force_calls": result.force_calls,
+            "steps": result.steps,
+            "converged": bool(result.converged),
+            "max_force_ev_per_a": result.max_force_ev_per_a,
+            "seconds": result.seconds,
+            "start": ",".join(str(i) for i in result.start_index) if result.start_index else "",
+        }
+        row_id = self._db.write(atoms, key_value_pairs=kvp)
+        rec = self._record(self._db.get(id=row_id))
+        self._done[index] = rec
+
+    # -- assembly -------------------------------------------------------------------
+    def assemble(self) -> xr.Dataset:
+        """The ``ispes.nc`` dataset of this store (missing points NaN, ``converged=False``)."""
+        resolved = self.resolved
+        if resolved is None:
+            raise InputError(f"{self.path}: the grid is not resolved yet (no thicknesses recorded)")
+        grid = self.settings["grid"]
+        z = np.asarray(resolved["thickness_angstrom"], dtype=float)
+        extra = {
+            "fmax_ev_per_a": self.settings["relax"]["fmax_ev_per_a"],
+            "optimizer": self.settings["relax"]["optimizer"],
+            "interface_sha256": self.settings["interface_sha256"],
+            "points_total": int(grid["n_a"] * grid["n_b"] * z.size),
+            "points_done": len(self._done),
+        }
+        for key, value in (resolved.get("adhesion") or {}).items():
+            extra[key] = (
+                int(value) if isinstance(value, bool) else value
+            )  # netCDF has no bool attrs
+        ds = contract.empty_grid(
+            grid["n_a"],
+            grid["n_b"],
+            z,
+            resolved["a1"],
+            resolved["a2"],
+            resolved["potential_label"],
+            **extra,
+        )
+        order = np.argsort(z)
+        rank = np.empty_like(order)
+        rank[order] = np.arange(z.size)
+        for (ia, ib, iz), rec in self._done.items():
+            k = int(rank[iz])
+            ds[contract.VAR_ENERGY].values[ia, ib, k] = rec["energy_ev"]
+            ds[contract.VAR_STRESS].values[ia, ib, k] = rec["normal_stress_gpa"]
+            ds[contract.VAR_CONVERGED].values[ia, ib, k] = rec["converged"]
+            ds[contract.VAR_FORCE_CALLS].values[ia, ib, k] = rec["force_calls"]
+        return ds
+
+    def write_ispes(self, path: str | os.PathLike[str]) -> Path:
+        """Assemble and write ``ispes.nc`` atomically."""
+        return contract.write_ispes(self.assemble(), path)
