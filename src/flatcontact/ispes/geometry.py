@@ -20,10 +20,13 @@ from __future__ import annotations
 import numpy as np
 from ase import Atoms
 
-try:  # the structures package owns the interface contract
-    from flatcontact.structures.interface import fixed_mask, place_slab2, thickness
-except ModuleNotFoundError:  # pragma: no cover - until flatcontact.structures lands
-    from flatcontact.ispes._interface_fallback import fixed_mask, place_slab2, thickness
+from flatcontact.structures.interface import (
+    fixed_mask,
+    in_plane_vectors,
+    place_slab2,
+    thickness,
+    validate_interface,
+)
 
 __all__ = [
     "fixed_mask",
@@ -31,18 +34,9 @@ __all__ = [
     "lateral_displacement",
     "place_slab2",
     "thickness",
+    "validate_interface",
     "warm_start_positions",
 ]
-
-
-def in_plane_vectors(atoms: Atoms) -> tuple[np.ndarray, np.ndarray]:
-    """The primitive in-plane vectors ``a1``, ``a2`` (Å, 2-vectors) of an interface."""
-    if "a1" in atoms.info and "a2" in atoms.info:
-        a1 = np.asarray(atoms.info["a1"], dtype=float).ravel()[:2]
-        a2 = np.asarray(atoms.info["a2"], dtype=float).ravel()[:2]
-    else:
-        a1, a2 = atoms.cell[0][:2].copy(), atoms.cell[1][:2].copy()
-    return a1, a2
 
 
 def lateral_displacement(

@@ -23,7 +23,7 @@ from ase import Atoms
 
 from flatcontact.errors import InputError
 from flatcontact.ispes import grid as grid_mod
-from flatcontact.ispes.geometry import fixed_mask, in_plane_vectors, thickness
+from flatcontact.ispes.geometry import fixed_mask, in_plane_vectors, thickness, validate_interface
 from flatcontact.ispes.order import PREFERENCES, search_tree
 from flatcontact.ispes.relax import (
     PointTask,
@@ -56,29 +56,11 @@ class ScanResult:
     interrupted: bool = False
 
 
-def validate_interface(atoms: Atoms) -> None:
-    """One-line InputError unless ``atoms`` follows the interface contract."""
-    for key in ("slab", "surface"):
-        if key not in atoms.arrays:
-            raise InputError(
-                f"interface: missing per-atom array '{key}' (see the interface.extxyz contract)"
-            )
-    slab = np.asarray(atoms.arrays["slab"])
-    surface = np.asarray(atoms.arrays["surface"])
-    if not set(np.unique(slab)) <= {1, 2} or not {1, 2} <= set(np.unique(slab)):
-        raise InputError("interface: array 'slab' must hold both 1 and 2 and nothing else")
-    for s, sl in ((1, 1), (4, 2)):
-        sel = surface == s
-        if not sel.any():
-            raise InputError(
-                f"interface: no atoms on surface {s} (the fixed outer face of slab {sl})"
-            )
-        if np.any(slab[sel] != sl):
-            raise InputError(f"interface: surface-{s} atoms must belong to slab {sl}")
+def check_interface(atoms: Atoms) -> None:
+    """One-line InputError unless ``atoms`` follows the interface contract and has free atoms."""
+    validate_interface(atoms, "interface")
     if np.all(fixed_mask(atoms)):
-        raise InputError("interface: every atom is fixed; nothing to relax")
-    if not (atoms.pbc[0] and atoms.pbc[1]):
-        raise InputError("interface: must be periodic along a1 and a2 (pbc in x and y)")
+        raise InputError("interface: every atom is on surface 1 or 4 (fixed); nothing to relax")
 
 
 def scan_settings(
@@ -194,7 +176,7 @@ def run_scan(
     relax = relax or RelaxSettings()
     if order not in PREFERENCES:
         raise InputError(f"order: expected one of {', '.join(PREFERENCES)}, got {order!r}")
-    validate_interface(reference)
+    check_interface(reference)
     if grid.thickness_angstrom is not None:
         grid_mod.check_thicknesses(reference, grid, grid.thickness_angstrom)
     out_dir = Path(out_dir)
