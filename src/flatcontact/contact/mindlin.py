@@ -232,7 +232,7 @@ def _quadratic_roots(qa, qb, qc):
     q = -0.5 * (qb + np.copysign(sq, qb))
     scale = np.maximum(np.abs(qb), np.abs(qc)) + np.abs(qa)
     linear = np.abs(qa) <= 1e-14 * scale
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         r1 = np.where(linear, -qc / qb, q / qa)
         r2 = np.where(linear, np.nan, qc / q)
     return r1, r2
@@ -321,6 +321,15 @@ def _cubic_real_roots(c3, c2, c1, c0):
             r = np.where(np.abs(ck) > 0.0, -(b + ck + d0 / ck) / 3.0, -b / 3.0)
         roots.append(r)
     cub = np.stack(roots, axis=-1)
+    # the root of smallest magnitude loses relative accuracy to cancellation; recover it
+    # from Vieta (x1 x2 x3 = −d) and the two larger roots
+    idx = np.argmin(np.abs(cub), axis=-1)[..., None]
+    others = np.prod(cub, axis=-1) / np.take_along_axis(cub, idx, axis=-1)[..., 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        small = np.where(
+            np.abs(others) > 0.0, -d / others, np.take_along_axis(cub, idx, axis=-1)[..., 0]
+        )
+    np.put_along_axis(cub, idx, small[..., None], axis=-1)
     q1, q2 = _quadratic_roots(c2, c1, c0)
     quad = np.stack([q1, q2, np.full_like(q1, np.nan)], axis=-1).astype(complex)
     return np.where(cubic[..., None], cub, quad)
@@ -354,12 +363,11 @@ def s_on_rising_branch(
     s = np.min(np.where(ok, re, np.inf), axis=-1)
     s = np.where(np.isfinite(s), s, pk.s)  # only at the double root of the peak
     s = np.clip(s, 0.0, pk.s)
-    for _ in range(2):  # Newton polish, kept inside [0, s_peak]
-        g = _poly(s, a1, a2, a3) - y
+    for _ in range(2):  # Newton polish in the cancellation-free form, kept inside [0, s_peak]
         dg = _dpoly(s, a1, a2, a3)
         good = dg > 1e-12 * scale
-        step = np.where(good, g / np.where(good, dg, 1.0), 0.0)
-        s = np.clip(s - step, 0.0, pk.s)
+        newton = (y + (a2 + 2.0 * a3 * s) * s * s) / np.where(good, dg, 1.0)
+        s = np.clip(np.where(good, newton, s), 0.0, pk.s)
     return np.where(y <= 0.0, 0.0, s)
 
 

@@ -1,0 +1,276 @@
+"""Modified Mindlin model: closed forms against the paper's integrals, limits, properties."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.integrate import quad
+from scipy.optimize import brentq
+
+from flatcontact import units
+from flatcontact.contact import mindlin as m
+from flatcontact.contact.parameters import ContactParameters
+from flatcontact.errors import InputError
+
+P = ContactParameters()
+P0 = 1.0e9
+A = float(m.contact_radius(P0, P))
+
+params_st = st.builds(
+    ContactParameters,
+    k_mpa_per_gpa=st.floats(0.0, 50.0),
+    tau0_mpa=st.floats(1.0, 300.0),
+    mu_mpa_per_gpa=st.floats(0.0, 50.0),
+    sigma0_mpa=st.floats(0.0, 100.0),
+    shear_modulus_gpa=st.floats(1.0, 200.0),
+)
+
+
+def test_full_stick_integral():
+    # ∫ q dA over the full-stick contact = 2π a² q0 = 2 G* a u (paper's G*) = 8 G*_J a u (Johnson)
+    u = 0.05e-9
+    q0 = float(m.full_stick_q0(u, A, P))
+    # q(r) 2πr = 2π r q0 a / √((a−r)(a+r)): algebraic weight (a−r)^(-1/2)
+    val, _ = quad(
+        lambda r: 2 * np.pi * r * q0 * A / np.sqrt(A + r), 0, A, weight="alg", wvar=(0, -0.5)
+    )
+    assert val == pytest.approx(2 * P.shear_modulus_pa * A * u, rel=1e-10)
+    gj = float(m.johnson_shear_modulus_from_paper(P.shear_modulus_pa))
+    assert val == pytest.approx(8 * gj * A * u, rel=1e-10)
+
+
+def test_shear_modulus_conversion():
+    g, nu = 30e9, 0.2
+    gj = m.johnson_effective_shear_modulus(g, nu, g, nu)
+    assert gj == pytest.approx(g / (2 * (2 - nu)))
+    assert float(m.paper_shear_modulus_from_johnson(gj)) == pytest.approx(4 * gj)
+    assert float(
+        m.johnson_shear_modulus_from_paper(m.paper_shear_modulus_from_johnson(gj))
+    ) == pytest.approx(gj)
+
+
+def _paper_integrals(u, p0, prm):
+    """The paper's Q_stick and Q_slip integrals by quadrature, c from q(c) = τ(c) by brentq."""
+    a = float(m.contact_radius(p0, prm))
+    q0 = prm.shear_modulus_pa * u / (np.pi * a)
+
+    def mismatch(r):
+        s = np.sqrt(1 - (r / a) ** 2)
+        return q0 / s - (prm.k * p0 * s + prm.tau0_pa)
+
+    if q0 == 0.0 or mismatch(a * (1 - 1e-15)) < 0:
+        c = a
+    elif mismatch(0.0) >= 0:
+        c = 0.0
+    else:
+        c = brentq(mismatch, 0.0, a * (1 - 1e-15), xtol=1e-16 * a)
+    stick = quad(
+        lambda r: 2 * np.pi * r * q0 / np.sqrt(1 - (r / a) ** 2), 0, c, epsabs=0, epsrel=1e-12
+    )[0]
+    slip = quad(
+        lambda r: 2 * np.pi * r * (prm.mu * p0 * np.sqrt(max(1 - (r / a) ** 2, 0)) + prm.sigma0_pa),
+        c,
+        a,
+        epsabs=0,
+        epsrel=1e-12,
+    )[0]
+    return c, stick, slip
+
+
+@settings(max_examples=40, deadline=None)
+@given(params_st, st.floats(0.05, 5.0), st.floats(0.0, 1.3))
+def test_closed_forms_match_paper_integrals(prm, p0_gpa, u_frac):
+    p0 = p0_gpa * 1e9
+    u = u_frac * float(m.full_slip_displacement(p0, prm))
+    c, stick, slip = _paper_integrals(u, p0, prm)
+    r = m.lateral_force(u, p0, prm)
+    a = float(m.contact_radius(p0, prm))
+    assert float(r.stick_radius_m) == pytest.approx(c, abs=1e-7 * a)
+    scale = float(m.peak_force(p0, prm).force_n)
+    assert float(r.stick_force_n) == pytest.approx(stick, abs=1e-7 * scale)
+    assert float(r.slip_force_n) == pytest.approx(slip, abs=1e-7 * scale)
+
+
+def test_stick_boundary_condition_and_k_zero():
+    u = 0.2e-9
+    r = m.lateral_force(u, P0, P)
+    c = float(r.stick_radius_m)
+    p_c = P0 * np.sqrt(1 - (c / A) ** 2)
+    assert float(m.full_stick_traction(c, u, A, P)) == pytest.approx(
+        float(m.shear_strength(p_c, P)), rel=1e-12
+    )
+    # paper Fig. 4a: u = 0.2 nm at 1 GPa has a stick zone covering most of the contact
+    assert 0.5 * A < c < A
+    # k = 0: s = q0/τ0 exactly
+    p = P.replace(k_mpa_per_gpa=0.0)
+    q0 = float(m.full_stick_q0(u, A, p))
+    assert float(m.stick_boundary_s(q0, P0, p)) == pytest.approx(q0 / p.tau0_pa, rel=1e-14)
+
+
+def test_saturation_is_integral_of_sigma():
+    val = quad(
+        lambda r: 2 * np.pi * r * float(m.slip_friction(P0 * np.sqrt(1 - (r / A) ** 2), P)), 0, A
+    )[0]
+    assert float(m.saturated_force(P0, P)) == pytest.approx(val, rel=1e-9)
+    u_big = 3 * float(m.full_slip_displacement(P0, P))
+    assert float(m.lateral_force(u_big, P0, P).lateral_force_n) == pytest.approx(val, rel=1e-9)
+    assert float(m.lateral_force(u_big, P0, P).stick_radius_m) == 0.0
+
+
+def test_q_of_u_shape_paper_parameters():
+    u = np.linspace(0, 1.5, 20001) * float(m.full_slip_displacement(P0, P))
+    r = m.lateral_force(u, P0, P)
+    q = r.lateral_force_n
+    pk = m.peak_force(P0, P)
+    # stick contribution rises then falls; slip contribution is monotone
+    i = int(np.argmax(r.stick_force_n))
+    assert 0 < i < u.size - 1
+    assert np.all(np.diff(r.stick_force_n[: i + 1]) >= 0) and np.all(
+        np.diff(r.stick_force_n[i:]) <= 0
+    )
+    assert np.all(np.diff(r.slip_force_n) >= 0)
+    # continuous (no jumps bigger than the local slope allows) and bounded by the peak
+    assert np.max(np.abs(np.diff(q))) < 0.01 * float(pk.force_n)
+    assert np.max(q) <= float(pk.force_n) * (1 + 1e-12)
+    assert np.max(q) == pytest.approx(float(pk.force_n), rel=1e-6)
+    assert u[np.argmax(q)] == pytest.approx(float(pk.displacement_m), rel=2e-3)
+    # overshoot: the paper's parameters have Q_peak > Q_sat (τ > σ at the centre)
+    assert bool(pk.overshoot) and float(pk.force_n) > float(pk.saturated_force_n)
+    # stick radius decreases with u
+    assert np.all(np.diff(r.stick_radius_m) <= 0)
+
+
+def test_no_overshoot_when_friction_exceeds_strength():
+    p = P.replace(tau0_mpa=5.0, sigma0_mpa=20.0)  # σ(centre) > τ(centre)
+    pk = m.peak_force(P0, p)
+    assert not bool(pk.overshoot)
+    assert float(pk.force_n) == pytest.approx(float(pk.saturated_force_n))
+    assert float(pk.s) == 1.0
+
+
+def test_paper_statement_effective_strength_below_uniform():
+    # "nonuniform pressure substantially lowers the effective static friction"
+    for p0 in np.array([0.5, 1.0, 1.77, 3.0]) * 1e9:
+        a = float(m.contact_radius(p0, P))
+        eff = float(m.peak_force(p0, P).force_n) / (np.pi * a**2)
+        uniform = float(m.shear_strength(2 * p0 / 3, P))
+        assert eff < 0.7 * uniform
+
+
+@settings(max_examples=40, deadline=None)
+@given(params_st, st.floats(0.05, 5.0), st.floats(0.0, 1.0))
+def test_inverse_on_rising_branch(prm, p0_gpa, frac):
+    p0 = p0_gpa * 1e9
+    pk = m.peak_force(p0, prm)
+    q = frac * float(pk.force_n)
+    u = float(m.displacement_on_rising_branch(q, p0, prm))
+    assert float(m.lateral_force(u, p0, prm).lateral_force_n) == pytest.approx(
+        q, rel=1e-9, abs=1e-12 * float(pk.force_n)
+    )
+    assert 0.0 <= u <= float(pk.displacement_m) * (1 + 1e-9)
+    # it is the first crossing: Q(u') < q for u' < u
+    up = np.linspace(0, u, 200)[:-1]
+    assert np.all(m.lateral_force(up, p0, prm).lateral_force_n <= q * (1 + 1e-9))
+
+
+def test_vectorised_over_u_and_p0():
+    p0 = np.array([0.5, 1.0, 2.0])[:, None] * 1e9
+    u = np.linspace(0, 1e-9, 7)[None, :]
+    r = m.lateral_force(u, p0, P)
+    assert r.lateral_force_n.shape == (3, 7)
+    for i in range(3):
+        np.testing.assert_allclose(
+            r.lateral_force_n[i], m.lateral_force(u[0], p0[i, 0], P).lateral_force_n
+        )
+
+
+# ---------------------------------------------------------------- classical limit
+
+
+def _classical():
+    # k = μ, τ0 = σ0 = 0; μ = 0.3 (300 MPa/GPa)
+    return ContactParameters(
+        k_mpa_per_gpa=300.0, mu_mpa_per_gpa=300.0, tau0_mpa=0.0, sigma0_mpa=0.0
+    )
+
+
+def test_classical_limit_agreements():
+    prm = _classical()
+    a = float(m.contact_radius(P0, prm))
+    load = 2 / 3 * np.pi * a**2 * P0
+    mup = prm.mu * load
+    gj = float(m.johnson_shear_modulus_from_paper(prm.shear_modulus_pa))
+    # full slip: Q = μP in both
+    assert float(m.saturated_force(P0, prm)) == pytest.approx(mup, rel=1e-12)
+    assert float(m.cattaneo_mindlin_force(1.0, mup, a, gj)) == pytest.approx(mup)
+    # initial stiffness 8 G*_J a in both
+    du = 1e-7 * float(m.full_slip_displacement(P0, prm))
+    k_paper = float(m.lateral_force(du, P0, prm).lateral_force_n) / du
+    k_cm = float(m.cattaneo_mindlin_force(du, mup, a, gj)) / du
+    assert k_paper == pytest.approx(8 * gj * a, rel=1e-3)
+    assert k_cm == pytest.approx(8 * gj * a, rel=1e-3)
+    # CM: c/a and δ formulas are consistent with each other (δ <-> Q round trip)
+    q = np.linspace(0, 1, 11) * mup
+    d = m.cattaneo_mindlin_displacement(q, mup, a, gj)
+    np.testing.assert_allclose(m.cattaneo_mindlin_force(d, mup, a, gj), q, rtol=1e-10, atol=1e-20)
+
+
+def test_classical_limit_exact_relation_of_paper_model():
+    """The paper keeps the full-stick traction in the stick zone, so in the classical limit
+    Q/μP = 3s² − 2s³ (not 1 − (c/a)³) and u = 2 δ_CM at the same stick radius c."""
+    prm = _classical()
+    a = float(m.contact_radius(P0, prm))
+    mup = prm.mu * 2 / 3 * np.pi * a**2 * P0
+    gj = float(m.johnson_shear_modulus_from_paper(prm.shear_modulus_pa))
+    u = np.linspace(0, 1, 101)[1:-1] * float(m.full_slip_displacement(P0, prm))
+    r = m.lateral_force(u, P0, prm)
+    s = np.sqrt(1 - (r.stick_radius_m / a) ** 2)
+    np.testing.assert_allclose(r.lateral_force_n / mup, 3 * s**2 - 2 * s**3, rtol=1e-10)
+    # CM displacement for the Q that gives CM the same c: Q_CM/μP = 1 − (c/a)³
+    q_cm = mup * (1 - (r.stick_radius_m / a) ** 3)
+    np.testing.assert_allclose(
+        u / m.cattaneo_mindlin_displacement(q_cm, mup, a, gj), 2.0, rtol=1e-9
+    )
+    # the two models differ in between: max |ΔQ|/μP = 2/9 at u = (8/9) δ*_CM (exact)
+    cmp = m.classical_limit_of_paper_model()
+    assert cmp.max_force_deviation == pytest.approx(2 / 9, abs=1e-9)
+    assert cmp.displacement_of_max_deviation == pytest.approx(8 / 9, abs=1e-5)
+    assert cmp.max_stick_radius_deviation == pytest.approx(1 - np.sqrt(3) / 2, abs=1e-6)
+    assert cmp.displacement_ratio_at_equal_stick_radius == pytest.approx(2.0, rel=1e-9)
+    # the same deviation from the real functions
+    dstar = 3 * mup / (16 * gj * a)
+    uu = np.linspace(0, 2, 4001) * dstar
+    dev = (
+        np.abs(
+            m.lateral_force(uu, P0, prm).lateral_force_n - m.cattaneo_mindlin_force(uu, mup, a, gj)
+        )
+        / mup
+    )
+    assert dev.max() == pytest.approx(2 / 9, abs=1e-6)
+
+
+@pytest.mark.parametrize(
+    "field,value",
+    [
+        ("radius_um", 0.0),
+        ("contact_modulus_gpa", -1.0),
+        ("shear_modulus_gpa", float("nan")),
+        ("k_mpa_per_gpa", -0.1),
+        ("tau0_mpa", float("inf")),
+        ("sigma0_mpa", -1.0),
+    ],
+)
+def test_parameters_reject_bad_values(field, value):
+    with pytest.raises(InputError, match=field):
+        ContactParameters(**{field: value})
+
+
+def test_parameters_reject_no_strength():
+    with pytest.raises(InputError, match="k_mpa_per_gpa and tau0_mpa"):
+        ContactParameters(k_mpa_per_gpa=0.0, tau0_mpa=0.0)
+
+
+def test_units_of_parameters():
+    assert P.k == pytest.approx(4.52e-3)
+    assert P.tau0_pa == pytest.approx(26.7e6)
+    assert P.radius_m == pytest.approx(5 * units.UM_TO_M)
