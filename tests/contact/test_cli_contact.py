@@ -1,0 +1,131 @@
+"""`flatcontact contact`: JSON keys, outputs, the experiment flow and one-line input errors."""
+
+import json
+
+import numpy as np
+import pytest
+
+from flatcontact.cli import main
+from flatcontact.contact import experiment as ex
+from flatcontact.contact.parameters import ContactParameters
+
+KEYS = {
+    "p0_gpa",
+    "contact_radius_nm",
+    "normal_load_un",
+    "peak_lateral_force_un",
+    "displacement_at_peak_nm",
+    "effective_shear_strength_mpa",
+    "effective_shear_strength_rms_mpa",
+    "gross_sliding_stress_mpa",
+    "uniform_shear_strength_mpa",
+}
+
+
+def _run(argv, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main([*argv])
+    out = capsys.readouterr()
+    return exc.value.code, out.out, out.err
+
+
+def test_json_keys_and_paper_values(capsys):
+    code, out, _ = _run(["contact", "--p0-gpa", "1.0", "--p0-gpa", "0.5,2", "--json"], capsys)
+    assert code in (0, None)
+    doc = json.loads(out)
+    res = doc["results"]
+    assert [r["p0_gpa"] for r in res] == [1.0, 0.5, 2.0]
+    for r in res:
+        assert KEYS <= set(r)
+        assert "contact_radius_dmt_nm" not in r
+    assert res[0]["contact_radius_nm"] == pytest.approx(149.6, abs=0.05)
+    assert res[0]["normal_load_un"] == pytest.approx(46.87, abs=0.005)
+    assert res[0]["effective_shear_strength_mpa"] < res[0]["uniform_shear_strength_mpa"]
+    assert doc["parameters"]["tau0_mpa"] == 26.7
+
+
+def test_json_with_adhesion(capsys):
+    _code, out, _ = _run(
+        [
+            "contact",
+            "--p0-gpa",
+            "0.5",
+            "--work-of-adhesion-j-m2",
+            "0.2",
+            "--maugis-lambda",
+            "1",
+            "--json",
+        ],
+        capsys,
+    )
+    r = json.loads(out)["results"][0]
+    assert (
+        r["contact_radius_nm"]
+        < r["contact_radius_dmt_nm"]
+        < r["contact_radius_maugis_dugdale_nm"]
+        < r["contact_radius_jkr_nm"]
+    )
+
+
+def test_out_dir_and_experiment(tmp_path, capsys):
+    # synthetic "measurement" made by the model at tau0 = 40 MPa (no real data is shipped)
+    truth = ContactParameters(tau0_mpa=40.0)
+    p0 = 1.77e9
+    cs = ex.model_collapse_stress(p0, truth)
+    stress = np.linspace(0.02, 1.4, 40) * cs
+    k = ex.model_stiffness_at_stress(stress, p0, truth)
+    csv = tmp_path / "synthetic.csv"
+    csv.write_text(
+        "mean shear stress [MPa],lateral stiffness [N/m]\n"
+        + "".join(f"{s / 1e6},{v}\n" for s, v in zip(stress, k, strict=True))
+    )
+    out = tmp_path / "run"
+    code, stdout, _ = _run(
+        ["contact", "--p0-gpa", "1,1.77", "--experiment", str(csv), "--out", str(out), "--json"],
+        capsys,
+    )
+    assert code in (0, None)
+    doc = json.loads(stdout)
+    assert doc["experiment"]["fitted_tau0_mpa"] == pytest.approx(40.0, rel=0.02)
+    names = {p.name for p in out.iterdir()}
+    for stem in ("fig4_traction", "fig5_force_stiffness", "fig6_experiment"):
+        assert {f"{stem}.png", f"{stem}.svg"} <= names
+    assert {"summary.json", "contact.nc"} <= names
+    assert not [n for n in names if n.endswith(".part")]
+    import xarray as xr
+
+    with xr.open_dataset(out / "contact.nc", engine="h5netcdf") as ds:
+        assert ds.lateral_stiffness.attrs["units"] == "N/m"
+        assert ds.p0.attrs["units"] == "GPa"
+        np.testing.assert_allclose(
+            ds.contact_radius.values, [r["contact_radius_nm"] for r in doc["results"]]
+        )
+
+
+@pytest.mark.parametrize(
+    "argv,needle",
+    [
+        (["--radius-um", "-5"], "--radius-um"),
+        (["--contact-modulus-gpa", "0"], "--contact-modulus-gpa"),
+        (["--k-mpa-per-gpa", "-1"], "--k-mpa-per-gpa"),
+        (["--tau0-mpa", "nan"], "--tau0-mpa"),
+        (["--p0-gpa", "0"], "--p0-gpa"),
+        (["--p0-gpa", "abc"], "--p0-gpa"),
+        (["--work-of-adhesion-j-m2", "-0.1"], "--work-of-adhesion-j-m2"),
+        (["--maugis-lambda", "1"], "--maugis-lambda"),
+        (["--experiment", "/nonexistent.csv"], "does not exist"),
+    ],
+)
+def test_bad_input_one_line_exit_2(argv, needle, capsys, tmp_path):
+    code, _out, err = _run(["contact", "--out", str(tmp_path / "o"), *argv], capsys)
+    assert code == 2
+    lines = [ln for ln in err.strip().splitlines() if ln.strip()]
+    assert len(lines) == 1 and needle in lines[0]
+    assert not (tmp_path / "o").exists()
+
+
+def test_bad_csv_exit_2(tmp_path, capsys):
+    f = tmp_path / "x.csv"
+    f.write_text("stress,stiffness\n1,2\n2,3\n3,4\n4,5\n")
+    code, _, err = _run(["contact", "--experiment", str(f)], capsys)
+    assert code == 2 and "no unit" in err and len(err.strip().splitlines()) == 1
