@@ -1,0 +1,328 @@
+"""Constant-pressure ISPES: from columns U(z), p(z) to the lateral landscape at a fixed load.
+
+For each lateral point (a *column* of the grid) the paper links ``U(z)`` and
+``p(z)`` at the same thickness ``z`` into the 1-D relation ``Ũ(p)`` and reads it
+at the target loads ``P`` (paper, "Interfacial sliding potential energy surface",
+Eq. for ``Ũ(p)|_{X,Y}``). Here:
+
+- ``U(z)`` and ``p(z)`` are interpolated with not-a-knot cubic splines
+  (fourth-order accurate) on the column's thickness values;
+- ``z*(P)`` is the root of ``p(z) = P`` on the *repulsive branch*: from the
+  smallest thickness up to the sample of lowest ``p`` (the maximum tension). On
+  this branch ``p`` must decrease strictly with ``z``; it is the mechanically
+  stable branch under a fixed load, since ``d²(U + P A z)/dz² = -A dp/dz > 0``.
+  Beyond the maximum tension lies the *adhesive tail* (``p`` rises back towards
+  0): ``p(z)`` is not invertible there, it is reported and never used;
+- a ``P`` outside ``[p_min, p_max]`` of a column's branch is an error naming the
+  column and its range: nothing is extrapolated.
+
+Energies are per area of the cell. Two forms are offered:
+
+- ``"internal"`` (the paper's, default): ``ẽ(x, y)|_P = U(z*)/A``;
+- ``"enthalpy"``: ``h(x, y)|_P = U(z*)/A + P z*``. By the envelope theorem
+  ``∇h|_P = ∇U|_z``: its gradient is the lateral force at constant load,
+  including the work done against the load when the gap ``z*`` changes with
+  the lateral position. The internal form omits that work (``∇ẽ = ∇U|_z - P∇z*``).
+
+Units: thickness Å, energy eV, stress eV/Å³ inside; pressures in and out of the
+public wrapper in GPa (the contract's unit).
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+import xarray as xr
+from scipy.interpolate import CubicSpline
+
+from flatcontact import units
+from flatcontact.analysis.diagnostics import StressEnergyMismatchWarning, UnconvergedPointsWarning
+from flatcontact.errors import InputError
+from flatcontact.ispes import contract
+
+FORMS = ("internal", "enthalpy")
+#: Minimum number of thickness values per column (cubic splines, not-a-knot).
+MIN_THICKNESS_POINTS = 4
+#: Relative stress/energy mismatch (of the column's p range) above which we warn.
+MISMATCH_WARN = 0.05
+_BISECTION_STEPS = 64
+
+
+@dataclass(frozen=True)
+class ColumnInversion:
+    """Result of :func:`invert_columns` for ``n_col`` columns and ``n_p`` loads."""
+
+    thickness_angstrom: np.ndarray  #: z*(P), shape (n_p, n_col)
+    energy_ev_per_a2: np.ndarray  #: U(z*)/A, shape (n_p, n_col)
+    branch_p_range_ev_per_a3: np.ndarray  #: (n_col, 2): lowest and highest p on the branch
+    tail_start_angstrom: np.ndarray  #: (n_col,) z of maximum tension if a tail follows, else NaN
+    mismatch: np.ndarray  #: (n_col,) max |p + (1/A)dU/dz| on the branch nodes / p range
+
+
+def invert_columns(
+    z: np.ndarray,
+    energy_ev_per_a2: np.ndarray,
+    stress_ev_per_a3: np.ndarray,
+    p_ev_per_a3: np.ndarray,
+    labels: list[str] | None = None,
+) -> ColumnInversion:
+    """Energy per area at fixed loads for columns sharing the thickness values ``z``.
+
+    Parameters
+    ----------
+    z
+        Thickness values (Å), strictly increasing, shape ``(n_z,)``, ``n_z >= 4``.
+    energy_ev_per_a2
+        ``U/A`` per column, shape ``(n_col, n_z)``, finite.
+    stress_ev_per_a3
+        Normal stress per column (positive when pressed), shape ``(n_col, n_z)``.
+    p_ev_per_a3
+        Target loads ``P`` (eV/Å³), shape ``(n_p,)``.
+    labels
+        Names of the columns for error messages.
+
+    Raises
+    ------
+    InputError
+        Non-monotonic repulsive branch, or a ``P`` outside a column's branch.
+    """
+    z = np.asarray(z, dtype=float)
+    e = np.atleast_2d(np.asarray(energy_ev_per_a2, dtype=float))
+    p = np.atleast_2d(np.asarray(stress_ev_per_a3, dtype=float))
+    targets = np.atleast_1d(np.asarray(p_ev_per_a3, dtype=float))
+    n_col, n_z = p.shape
+    labels = labels or [f"column {j}" for j in range(n_col)]
+    if n_z < MIN_THICKNESS_POINTS:
+        raise InputError(
+            f"{labels[0]}: {n_z} thickness values; at least {MIN_THICKNESS_POINTS} are needed "
+            "to interpolate U(z) and p(z)"
+        )
+    if not np.all(np.diff(z) > 0):
+        raise InputError("thickness: values must be strictly increasing")
+
+    # repulsive branch: samples 0..m with m the lowest p (maximum tension)
+    m = np.argmin(p, axis=1)
+    idx = np.arange(n_z - 1)
+    rising = (np.diff(p, axis=1) >= 0) & (idx[None, :] < m[:, None])
+    if np.any(m == 0):
+        j = int(np.flatnonzero(m == 0)[0])
+        raise InputError(
+            f"{labels[j]}: normal_stress rises with thickness from the first point "
+            f"(p = {p[j, 0] * units.EV_PER_A3_TO_GPA:.4g} GPa at z = {z[0]:.4g} Å); "
+            "no repulsive branch to invert"
+        )
+    if np.any(rising):
+        j, k = (int(v) for v in np.argwhere(rising)[0])
+        raise InputError(
+            f"{labels[j]}: normal_stress is not monotonic on the repulsive branch: "
+            f"p = {p[j, k] * units.EV_PER_A3_TO_GPA:.4g} GPa at z = {z[k]:.4g} Å, "
+            f"{p[j, k + 1] * units.EV_PER_A3_TO_GPA:.4g} GPa at z = {z[k + 1]:.4g} Å "
+            "(expected p to decrease with thickness up to the maximum tension)"
+        )
+    p_lo = p[np.arange(n_col), m]
+    p_hi = p[:, 0]
+    outside = (targets[:, None] < p_lo[None, :]) | (targets[:, None] > p_hi[None, :])
+    if np.any(outside):
+        i, j = (int(v) for v in np.argwhere(outside)[0])
+        raise InputError(
+            f"P = {targets[i] * units.EV_PER_A3_TO_GPA:.4g} GPa is outside the data of {labels[j]}: "
+            f"its repulsive branch spans p = {p_lo[j] * units.EV_PER_A3_TO_GPA:.4g} .. "
+            f"{p_hi[j] * units.EV_PER_A3_TO_GPA:.4g} GPa (thickness {z[0]:.4g} .. {z[m[j]]:.4g} Å); "
+            "extend the scan in thickness or choose P inside that range"
+        )
+
+    spline_p = CubicSpline(z, p.T, axis=0)
+    spline_e = CubicSpline(z, e.T, axis=0)
+    # segment k with p_k >= P >= p_{k+1}, k < m  (p strictly decreasing there)
+    on_branch = np.arange(n_z)[None, None, :] <= m[None, :, None]
+    count = np.sum((p[None, :, :] >= targets[:, None, None]) & on_branch, axis=2)
+    k = np.clip(count - 1, 0, np.maximum(m - 1, 0)[None, :])  # (n_p, n_col)
+    cols = np.broadcast_to(np.arange(n_col), k.shape)
+    coef = spline_p.c[:, k, cols]  # (4, n_p, n_col), polynomial in (zz - z_k)
+    lo = np.zeros(k.shape)
+    hi = z[k + 1] - z[k]
+    rhs = targets[:, None]
+    for _ in range(_BISECTION_STEPS):
+        mid = 0.5 * (lo + hi)
+        val = ((coef[0] * mid + coef[1]) * mid + coef[2]) * mid + coef[3] - rhs
+        above = val > 0  # p still above P: root lies further out
+        lo = np.where(above, mid, lo)
+        hi = np.where(above, hi, mid)
+    dz = 0.5 * (lo + hi)
+    ce = spline_e.c[:, k, cols]
+    e_star = ((ce[0] * dz + ce[1]) * dz + ce[2]) * dz + ce[3]
+
+    # diagnostics: tail and stress/energy consistency on the branch nodes
+    tail = np.where(m < n_z - 1, z[m], np.nan)
+    dedz = spline_e(z, 1).T  # (n_col, n_z)
+    span = np.maximum(p_hi - p_lo, np.finfo(float).tiny)
+    node_ok = np.arange(n_z)[None, :] <= m[:, None]
+    mismatch = np.max(np.where(node_ok, np.abs(p + dedz), 0.0), axis=1) / span
+    return ColumnInversion(
+        thickness_angstrom=z[k] + dz,
+        energy_ev_per_a2=e_star,
+        branch_p_range_ev_per_a3=np.column_stack([p_lo, p_hi]),
+        tail_start_angstrom=tail,
+        mismatch=mismatch,
+    )
+
+
+@dataclass(frozen=True)
+class ConstantPressureISPES:
+    """Constant-pressure landscapes on the lateral grid of an ISPES file.
+
+    Arrays are indexed ``[pressure, shift_a, shift_b]``; energies are per area of
+    the cell in eV/Å² and keep the file's energy constant (set the zero later).
+    """
+
+    p_gpa: np.ndarray
+    form: str
+    shift_a: np.ndarray
+    shift_b: np.ndarray
+    a1: np.ndarray
+    a2: np.ndarray
+    area_angstrom2: float
+    energy_ev_per_a2: np.ndarray  #: the chosen form (internal or enthalpy)
+    internal_ev_per_a2: np.ndarray  #: U(z*)/A
+    thickness_angstrom: np.ndarray  #: z*
+    branch_p_range_gpa: np.ndarray  #: (n_a, n_b, 2) invertible load range per column
+    tail_start_angstrom: np.ndarray  #: (n_a, n_b), NaN where no adhesive tail is in the data
+    stress_energy_mismatch: float  #: max over columns, relative to each column's p range
+
+    @property
+    def common_p_range_gpa(self) -> tuple[float, float]:
+        """Loads that every column can be read at."""
+        r = self.branch_p_range_gpa
+        return float(np.max(r[..., 0])), float(np.min(r[..., 1]))
+
+
+def _missing_message(ds: xr.Dataset, bad: np.ndarray, source: str) -> str:
+    where = np.argwhere(bad)
+    shown = ", ".join(
+        f"(shift_a={ds[contract.DIM_A].values[i]:.4g}, shift_b={ds[contract.DIM_B].values[j]:.4g}, "
+        f"thickness={ds[contract.DIM_Z].values[k]:.4g} Å)"
+        for i, j, k in where[:3]
+    )
+    more = f" and {len(where) - 3} more" if len(where) > 3 else ""
+    return (
+        f"{source}: {len(where)} grid points are missing (NaN energy or normal_stress): "
+        f"{shown}{more}; finish the scan or allow missing points (--allow-missing)"
+    )
+
+
+def constant_pressure(
+    ds: xr.Dataset,
+    p_gpa: np.ndarray | list[float],
+    form: str = "internal",
+    allow_missing: bool = False,
+    source: str = "ISPES grid",
+) -> ConstantPressureISPES:
+    """Constant-pressure ISPES of a contract grid at the loads ``p_gpa`` (GPa).
+
+    Parameters
+    ----------
+    ds
+        Grid following :mod:`flatcontact.ispes.contract` (validated here).
+    p_gpa
+        Target loads (GPa), positive when pressed.
+    form
+        ``"internal"`` (paper, default) or ``"enthalpy"``.
+    allow_missing
+        If true, a column with missing (NaN) thickness points is interpolated
+        through its remaining points (at least 4); otherwise missing points are
+        an error listing them.
+    source
+        Name of the grid in messages (usually the file name).
+    """
+    if form not in FORMS:
+        raise InputError(f"energy form: expected one of {FORMS}, got {form!r}")
+    targets_gpa = np.atleast_1d(np.asarray(p_gpa, dtype=float))
+    if targets_gpa.size == 0 or not np.all(np.isfinite(targets_gpa)):
+        raise InputError(f"p_gpa: expected finite pressures in GPa, got {targets_gpa.tolist()}")
+    ds = contract.validate_ispes(ds, source=source)
+    energy = ds[contract.VAR_ENERGY].values.astype(float)
+    stress = ds[contract.VAR_STRESS].values.astype(float)
+    z = ds[contract.DIM_Z].values.astype(float)
+    area = float(ds.attrs["area"])
+    n_a, n_b, n_z = energy.shape
+    finite = np.isfinite(energy) & np.isfinite(stress)
+    if not np.all(finite) and not allow_missing:
+        raise InputError(_missing_message(ds, ~finite, source))
+    converged = ds[contract.VAR_CONVERGED].values.astype(bool)
+    unconverged = finite & ~converged
+    if np.any(unconverged):
+        warnings.warn(
+            f"{source}: {int(unconverged.sum())} finite grid points are marked converged=False "
+            "and are used as they are",
+            UnconvergedPointsWarning,
+            stacklevel=2,
+        )
+    targets = targets_gpa / units.EV_PER_A3_TO_GPA
+    e_cols = (energy / area).reshape(n_a * n_b, n_z)
+    p_cols = (stress / units.EV_PER_A3_TO_GPA).reshape(n_a * n_b, n_z)
+    fin_cols = finite.reshape(n_a * n_b, n_z)
+    sa, sb = ds[contract.DIM_A].values, ds[contract.DIM_B].values
+    labels = [
+        f"{source} column (shift_a={sa[i]:.4g}, shift_b={sb[j]:.4g})"
+        for i in range(n_a)
+        for j in range(n_b)
+    ]
+    n_col = n_a * n_b
+    zstar = np.empty((targets.size, n_col))
+    estar = np.empty((targets.size, n_col))
+    prange = np.empty((n_col, 2))
+    tail = np.empty(n_col)
+    mismatch = np.empty(n_col)
+
+    def store(sel: np.ndarray, res: ColumnInversion) -> None:
+        zstar[:, sel] = res.thickness_angstrom
+        estar[:, sel] = res.energy_ev_per_a2
+        prange[sel] = res.branch_p_range_ev_per_a3
+        tail[sel] = res.tail_start_angstrom
+        mismatch[sel] = res.mismatch
+
+    full = np.all(fin_cols, axis=1)
+    if np.any(full):
+        sel = np.flatnonzero(full)
+        store(sel, invert_columns(z, e_cols[sel], p_cols[sel], targets, [labels[j] for j in sel]))
+    for j in np.flatnonzero(~full):
+        keep = fin_cols[j]
+        if keep.sum() < MIN_THICKNESS_POINTS:
+            raise InputError(
+                f"{labels[j]}: only {int(keep.sum())} of {n_z} thickness points are present; "
+                f"at least {MIN_THICKNESS_POINTS} are needed"
+            )
+        store(
+            np.array([j]),
+            invert_columns(z[keep], e_cols[j, keep], p_cols[j, keep], targets, [labels[j]]),
+        )
+
+    worst = float(np.max(mismatch))
+    if worst > MISMATCH_WARN:
+        j = int(np.argmax(mismatch))
+        warnings.warn(
+            f"{labels[j]}: normal_stress differs from -(1/A) dU/dz by {100 * worst:.1f}% of its "
+            "range; energy and stress may come from different calculations",
+            StressEnergyMismatchWarning,
+            stacklevel=2,
+        )
+    internal = estar.reshape(targets.size, n_a, n_b)
+    zmap = zstar.reshape(targets.size, n_a, n_b)
+    chosen = internal + targets[:, None, None] * zmap if form == "enthalpy" else internal
+    return ConstantPressureISPES(
+        p_gpa=targets_gpa,
+        form=form,
+        shift_a=sa.astype(float),
+        shift_b=sb.astype(float),
+        a1=np.asarray(ds.attrs["a1"], dtype=float).ravel()[:2],
+        a2=np.asarray(ds.attrs["a2"], dtype=float).ravel()[:2],
+        area_angstrom2=area,
+        energy_ev_per_a2=chosen,
+        internal_ev_per_a2=internal,
+        thickness_angstrom=zmap,
+        branch_p_range_gpa=prange.reshape(n_a, n_b, 2) * units.EV_PER_A3_TO_GPA,
+        tail_start_angstrom=tail.reshape(n_a, n_b),
+        stress_energy_mismatch=worst,
+    )

@@ -1,0 +1,26 @@
+"""Named warnings of the ISPES analysis.
+
+They are :class:`UserWarning` subclasses (not ``RuntimeWarning``): each says
+something about the *input data* that the user should know, with the number it
+concerns. Turn them into errors with ``warnings.simplefilter("error", AnalysisWarning)``.
+"""
+
+
+class AnalysisWarning(UserWarning):
+    """Base class of the analysis warnings."""
+
+
+class UnconvergedPointsWarning(AnalysisWarning):
+    """Grid points with finite values but ``converged = False`` are being used."""
+
+
+class StressEnergyMismatchWarning(AnalysisWarning):
+    """``normal_stress`` disagrees with ``-(1/A) dU/dz`` of the energy column."""
+
+
+class PathNotPeriodicWarning(AnalysisWarning):
+    """The sliding path did not reach a minimum equivalent to its start within the maximum length."""
+
+
+class LinearFitWarning(AnalysisWarning):
+    """Too few points below the threshold for a load law with standard errors."""
