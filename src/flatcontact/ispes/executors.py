@@ -181,7 +181,8 @@ class DaskExecutor(SerialExecutor):
     def wait_first(self, handles):
         from distributed import wait
 
-        done, not_done = wait(list(handles), return_when="FIRST_COMPLETED")
+        with self._client.as_current():
+            done, not_done = wait(list(handles), return_when="FIRST_COMPLETED")
         return set(done), set(not_done)
 
     def close(self, cancel: bool = False) -> None:

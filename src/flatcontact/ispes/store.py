@@ -97,11 +97,10 @@ class PointStore:
         self.settings = json.loads(json.dumps(settings))
         self.reference = reference
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        existed = self.path.exists()
         try:
             self._db = ase.db.connect(str(self.path), type="db", append=True)
-            meta = self._db.metadata if existed else {}
-            n_rows = self._db.count() if existed else 0
+            n_rows = self._db.count()  # creates the tables of a new store
+            meta = self._db.metadata
         except Exception as exc:  # sqlite3.DatabaseError, JSON errors
             raise InputError(
                 f"{self.path}: not a readable points database ({exc.__class__.__name__}: {exc})"
@@ -121,8 +120,9 @@ class PointStore:
                 f"{self.path}: has {n_rows} rows but no flatcontact settings; refusing to mix"
             )
         else:
-            self._db.metadata = {"format": FORMAT, "settings": self.settings}
-        self._meta = self._db.metadata
+            meta = {"format": FORMAT, "settings": self.settings}
+            self._db.metadata = meta
+        self._meta = meta
         self._done: dict[Index, dict] = {}
         for row in self._db.select():
             self._done[(row.i_a, row.i_b, row.i_z)] = self._record(row)
@@ -151,7 +151,7 @@ class PointStore:
         meta = dict(self._meta)
         meta["resolved"] = json.loads(json.dumps(resolved))
         self._db.metadata = meta
-        self._meta = self._db.metadata
+        self._meta = meta
 
     # -- points ---------------------------------------------------------------------
     def done(self) -> dict[Index, dict]:

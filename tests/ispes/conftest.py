@@ -1,0 +1,16 @@
+"""Fixtures for the ISPES scan tests: the toy two-slab LJ interface (fast)."""
+
+import pytest
+
+from flatcontact.ispes.calculators import CalculatorFactory
+from flatcontact.ispes.toy import toy_interface
+
+
+@pytest.fixture(scope="session")
+def toy_reference():
+    return toy_interface(layers=3)
+
+
+@pytest.fixture(scope="session")
+def toy_factory():
+    return CalculatorFactory.from_target("flatcontact.ispes.toy:toy_calculator")

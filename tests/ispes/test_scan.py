@@ -1,0 +1,231 @@
+"""The scan driver on the toy interface: store, resume after kill -9, executors, orders, errors."""
+
+import os
+import signal
+import sqlite3
+import subprocess
+import sys
+import textwrap
+import time
+
+import numpy as np
+import pytest
+
+from flatcontact.errors import InputError
+from flatcontact.ispes.contract import open_ispes
+from flatcontact.ispes.executors import DaskExecutor, ProcessExecutor, SerialExecutor
+from flatcontact.ispes.geometry import thickness
+from flatcontact.ispes.grid import GridSpec
+from flatcontact.ispes.relax import RelaxSettings
+from flatcontact.ispes.scan import run_scan
+
+SETTINGS = RelaxSettings(fmax_ev_per_a=1e-4, optimizer="FIRE")
+
+
+def _grid(ref, n=2):
+    z0 = thickness(ref)
+    return GridSpec(n, n, thickness_angstrom=(z0 - 0.25, z0 + 0.3))
+
+
+def _values(ds):
+    return ds.energy.values, ds.normal_stress.values
+
+
+def test_scan_writes_a_contract_grid_and_a_rerun_computes_nothing(
+    tmp_path, toy_reference, toy_factory
+):
+    r = run_scan(
+        toy_reference,
+        toy_factory,
+        _grid(toy_reference),
+        tmp_path,
+        SETTINGS,
+        executor=SerialExecutor(),
+    )
+    assert r.points_done == r.points_computed == r.points_total == 8
+    ds = open_ispes(tmp_path / "ispes.nc")
+    assert ds.converged.all() and np.isfinite(ds.energy).all()
+    assert (ds.force_calls > 0).all()
+    # compressed thickness loads, stretched thickness pulls, at every stacking
+    assert (ds.normal_stress.isel(thickness=0) > 0).all() and (
+        ds.normal_stress.isel(thickness=1) < 0
+    ).all()
+    again = run_scan(
+        toy_reference,
+        toy_factory,
+        _grid(toy_reference),
+        tmp_path,
+        SETTINGS,
+        executor=SerialExecutor(),
+    )
+    assert again.points_computed == 0
+    np.testing.assert_array_equal(_values(again.dataset)[0], _values(ds)[0])
+
+
+def test_store_with_other_settings_is_refused(tmp_path, toy_reference, toy_factory):
+    run_scan(
+        toy_reference,
+        toy_factory,
+        GridSpec(1, 1, thickness_angstrom=(thickness(toy_reference),)),
+        tmp_path,
+        SETTINGS,
+        executor=SerialExecutor(),
+    )
+    other = RelaxSettings(fmax_ev_per_a=1e-3, optimizer="FIRE")
+    with pytest.raises(
+        InputError, match=r"relax\.fmax_ev_per_a: 0\.0001 in the store vs 0\.001 now"
+    ) as err:
+        run_scan(
+            toy_reference,
+            toy_factory,
+            GridSpec(1, 1, thickness_angstrom=(thickness(toy_reference),)),
+            tmp_path,
+            other,
+            executor=SerialExecutor(),
+        )
+    assert "\n" not in str(err.value)
+    with pytest.raises(InputError, match=r"grid\.n_a"):
+        run_scan(
+            toy_reference,
+            toy_factory,
+            GridSpec(2, 1, thickness_angstrom=(thickness(toy_reference),)),
+            tmp_path,
+            SETTINGS,
+            executor=SerialExecutor(),
+        )
+
+
+def test_executors_give_the_same_grid(tmp_path, toy_reference, toy_factory):
+    grid = _grid(toy_reference)
+    serial = run_scan(
+        toy_reference, toy_factory, grid, tmp_path / "s", SETTINGS, executor=SerialExecutor()
+    )
+    pool = ProcessExecutor(2)
+    try:
+        procs = run_scan(toy_reference, toy_factory, grid, tmp_path / "p", SETTINGS, executor=pool)
+    finally:
+        pool.close()
+    dask = DaskExecutor.local(2)
+    try:
+        dsk = run_scan(toy_reference, toy_factory, grid, tmp_path / "d", SETTINGS, executor=dask)
+    finally:
+        dask.close()
+    for other in (procs, dsk):
+        for a, b in zip(_values(serial.dataset), _values(other.dataset), strict=True):
+            np.testing.assert_allclose(a, b, rtol=0, atol=1e-12)
+
+
+def test_warm_start_orders_agree_within_tolerance(tmp_path, toy_reference, toy_factory):
+    grid = _grid(toy_reference, n=3)
+    fast = RelaxSettings(fmax_ev_per_a=1e-4, optimizer="BFGS")
+    runs = {
+        o: run_scan(
+            toy_reference,
+            toy_factory,
+            grid,
+            tmp_path / o,
+            SETTINGS,
+            order=o,
+            executor=SerialExecutor(),
+        )
+        for o in ("z", "lateral", "cold")
+    }
+    e_ref, p_ref = _values(runs["cold"].dataset)
+    # fmax = 1e-4 eV/Å bounds the energy error to ~fmax^2/k per atom and the load to ~fmax/A per atom
+    for o in ("z", "lateral"):
+        e, p = _values(runs[o].dataset)
+        np.testing.assert_allclose(e, e_ref, atol=1e-6)
+        np.testing.assert_allclose(p, p_ref, atol=5e-3)
+    assert np.median(runs["z"].force_calls_computed) < np.median(runs["cold"].force_calls_computed)
+
+
+KILLED_RUN = textwrap.dedent(
+    """
+    import sys
+    from flatcontact.ispes.calculators import CalculatorFactory
+    from flatcontact.ispes.executors import SerialExecutor
+    from flatcontact.ispes.geometry import thickness
+    from flatcontact.ispes.grid import GridSpec
+    from flatcontact.ispes.relax import RelaxSettings
+    from flatcontact.ispes.scan import run_scan
+    from flatcontact.ispes.toy import toy_interface
+
+    ref = toy_interface(layers=3)
+    z0 = thickness(ref)
+    run_scan(ref, CalculatorFactory.from_target("flatcontact.ispes.toy:toy_calculator"),
+             GridSpec(3, 3, thickness_angstrom=(z0 - 0.25, z0 + 0.3)), sys.argv[1],
+             RelaxSettings(fmax_ev_per_a=1e-4, optimizer="FIRE"), executor=SerialExecutor())
+    """
+)
+
+
+def _rows(db):
+    if not db.exists():
+        return 0
+    try:
+        with sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=1) as con:
+            return con.execute("select count(*) from systems").fetchone()[0]
+    except sqlite3.OperationalError:
+        return 0
+
+
+def test_resume_after_kill_9_gives_the_uninterrupted_grid(tmp_path, toy_reference, toy_factory):
+    out = tmp_path / "killed"
+    proc = subprocess.Popen(
+        [sys.executable, "-c", KILLED_RUN, str(out)], env={**os.environ, "OMP_NUM_THREADS": "1"}
+    )
+    deadline = time.monotonic() + 120
+    while _rows(out / "points.db") < 4 and time.monotonic() < deadline and proc.poll() is None:
+        time.sleep(0.02)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    before = _rows(out / "points.db")
+    assert 4 <= before < 18, "the run was not killed mid-scan"
+    z0 = thickness(toy_reference)
+    grid = GridSpec(3, 3, thickness_angstrom=(z0 - 0.25, z0 + 0.3))
+    resumed = run_scan(toy_reference, toy_factory, grid, out, SETTINGS, executor=SerialExecutor())
+    assert resumed.points_computed == 18 - before
+    whole = run_scan(
+        toy_reference, toy_factory, grid, tmp_path / "whole", SETTINGS, executor=SerialExecutor()
+    )
+    for a, b in zip(_values(resumed.dataset), _values(whole.dataset), strict=True):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-12)
+
+
+def test_bad_input_fails_before_any_work(tmp_path, toy_reference, toy_factory):
+    z0 = thickness(toy_reference)
+    with pytest.raises(InputError, match="overlap"):
+        run_scan(
+            toy_reference,
+            toy_factory,
+            GridSpec(2, 2, thickness_angstrom=(z0 - 2.5,)),
+            tmp_path / "o",
+            SETTINGS,
+            executor=SerialExecutor(),
+        )
+    assert not (tmp_path / "o").exists()
+    broken = toy_reference.copy()
+    del broken.arrays["surface"]
+    with pytest.raises(InputError, match="surface"):
+        run_scan(
+            broken,
+            toy_factory,
+            _grid(toy_reference),
+            tmp_path / "b",
+            SETTINGS,
+            executor=SerialExecutor(),
+        )
+    with pytest.raises(InputError, match="order"):
+        run_scan(
+            toy_reference,
+            toy_factory,
+            _grid(toy_reference),
+            tmp_path / "b",
+            SETTINGS,
+            order="spiral",
+            executor=SerialExecutor(),
+        )
+    with pytest.raises(InputError, match="no Dask scheduler reachable"):
+        DaskExecutor(address="tcp://127.0.0.1:9", timeout_s=2)
+    with pytest.raises(InputError, match="optimizer"):
+        RelaxSettings(optimizer="Newton")
