@@ -61,7 +61,9 @@ def _mean_u_direct(qmax, counter):
     def u_of_q(q):
         if q <= 0:
             return 0.0
-        return brentq(lambda u: _q_direct(u, counter) - q, 0.0, float(pk.displacement_m), xtol=1e-22)
+        return brentq(
+            lambda u: _q_direct(u, counter) - q, 0.0, float(pk.displacement_m), xtol=1e-22
+        )
 
     def integrand(t):
         return u_of_q(qmax * np.sin(t)) ** 2

@@ -77,8 +77,9 @@ def _paper_integrals(u, p0, prm):
     return c, stick, slip
 
 
+@pytest.mark.filterwarnings("ignore::scipy.integrate.IntegrationWarning")
 @settings(max_examples=40, deadline=None)
-@given(params_st, st.floats(0.05, 5.0), st.floats(0.0, 1.3))
+@given(params_st, st.floats(0.05, 5.0), st.one_of(st.just(0.0), st.floats(1e-12, 1.3)))
 def test_closed_forms_match_paper_integrals(prm, p0_gpa, u_frac):
     p0 = p0_gpa * 1e9
     u = u_frac * float(m.full_slip_displacement(p0, prm))

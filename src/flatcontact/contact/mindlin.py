@@ -324,8 +324,8 @@ def _cubic_real_roots(c3, c2, c1, c0):
     # the root of smallest magnitude loses relative accuracy to cancellation; recover it
     # from Vieta (x1 x2 x3 = −d) and the two larger roots
     idx = np.argmin(np.abs(cub), axis=-1)[..., None]
-    others = np.prod(cub, axis=-1) / np.take_along_axis(cub, idx, axis=-1)[..., 0]
     with np.errstate(divide="ignore", invalid="ignore"):
+        others = np.prod(cub, axis=-1) / np.take_along_axis(cub, idx, axis=-1)[..., 0]
         small = np.where(
             np.abs(others) > 0.0, -d / others, np.take_along_axis(cub, idx, axis=-1)[..., 0]
         )
@@ -368,7 +368,30 @@ def s_on_rising_branch(
         good = dg > 1e-12 * scale
         newton = (y + (a2 + 2.0 * a3 * s) * s * s) / np.where(good, dg, 1.0)
         s = np.clip(np.where(good, newton, s), 0.0, pk.s)
+    # safeguard: where the closed form is not accurate to ~1e-12 (near-degenerate cubic,
+    # near the double root at the peak) finish by bisection on the bracket where Q(s)
+    # rises through Q (unique there)
+    bad = np.abs(_poly(s, a1, a2, a3) - y) > 1e-12 * np.maximum(y, 1e-300) + 1e-15 * scale * s
+    bad &= y > 0.0
+    if np.any(bad):
+        s = np.where(bad, _bisect_rising(y, a1, a2, a3, pk), s)
     return np.where(y <= 0.0, 0.0, s)
+
+
+def _bisect_rising(y, a1, a2, a3, pk: PeakForce, iterations: int = 64):
+    """Smallest s with Q(s)/(2π a²) = y by vectorised bisection on a monotone bracket."""
+    s1 = pk.first_local_max_s
+    first = y <= _poly(s1, a1, a2, a3)
+    lo = np.where(first, 0.0, s1)
+    hi = np.where(first, s1, pk.s)
+    lo, hi = np.broadcast_arrays(lo, hi)
+    lo, hi = lo.copy(), hi.copy()
+    for _ in range(iterations):
+        mid = 0.5 * (lo + hi)
+        up = _poly(mid, a1, a2, a3) >= y
+        hi = np.where(up, mid, hi)
+        lo = np.where(up, lo, mid)
+    return hi
 
 
 def displacement_on_rising_branch(
