@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from flatcontact.errors import InputError
+from flatcontact.ispes.geometry import thickness
 from flatcontact.ispes.grid import (
     ColumnProbe,
     GridSpec,
@@ -11,7 +12,6 @@ from flatcontact.ispes.grid import (
     check_thicknesses,
     thicknesses_for_pressures,
 )
-from flatcontact.ispes.geometry import thickness
 from flatcontact.units import EV_PER_A2_TO_J_PER_M2, EV_PER_A3_TO_GPA
 
 
@@ -76,7 +76,7 @@ def test_thicknesses_span_the_pressure_range():
     assert notes == []
     p_at = np.interp(z, probe.thickness_angstrom, probe.normal_stress_gpa)
     np.testing.assert_allclose(np.sort(p_at)[::-1], np.linspace(-0.1, 2.0, 5)[::-1], atol=2e-3)
-    z2, notes = thicknesses_for_pressures(probe, -50.0, 2.0, 3)
+    _, notes = thicknesses_for_pressures(probe, -50.0, 2.0, 3)
     assert notes and "maximum adhesive tension" in notes[0]
     with pytest.raises(InputError, match="most compressed"):
         thicknesses_for_pressures(probe, 0.0, 1e4, 3)

@@ -117,7 +117,6 @@ def test_executors_give_the_same_grid(tmp_path, toy_reference, toy_factory):
 
 def test_warm_start_orders_agree_within_tolerance(tmp_path, toy_reference, toy_factory):
     grid = _grid(toy_reference, n=3)
-    fast = RelaxSettings(fmax_ev_per_a=1e-4, optimizer="BFGS")
     runs = {
         o: run_scan(
             toy_reference,
@@ -153,7 +152,7 @@ KILLED_RUN = textwrap.dedent(
     ref = toy_interface(layers=3)
     z0 = thickness(ref)
     run_scan(ref, CalculatorFactory.from_target("flatcontact.ispes.toy:toy_calculator"),
-             GridSpec(3, 3, thickness_angstrom=(z0 - 0.25, z0 + 0.3)), sys.argv[1],
+             GridSpec(6, 6, thickness_angstrom=(z0 - 0.25, z0 + 0.3)), sys.argv[1],
              RelaxSettings(fmax_ev_per_a=1e-4, optimizer="FIRE"), executor=SerialExecutor())
     """
 )
@@ -180,11 +179,11 @@ def test_resume_after_kill_9_gives_the_uninterrupted_grid(tmp_path, toy_referenc
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     before = _rows(out / "points.db")
-    assert 4 <= before < 18, "the run was not killed mid-scan"
+    assert 4 <= before < 72, "the run was not killed mid-scan"
     z0 = thickness(toy_reference)
-    grid = GridSpec(3, 3, thickness_angstrom=(z0 - 0.25, z0 + 0.3))
+    grid = GridSpec(6, 6, thickness_angstrom=(z0 - 0.25, z0 + 0.3))
     resumed = run_scan(toy_reference, toy_factory, grid, out, SETTINGS, executor=SerialExecutor())
-    assert resumed.points_computed == 18 - before
+    assert resumed.points_computed == 72 - before
     whole = run_scan(
         toy_reference, toy_factory, grid, tmp_path / "whole", SETTINGS, executor=SerialExecutor()
     )
