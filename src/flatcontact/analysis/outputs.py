@@ -1,0 +1,211 @@
+"""Files of the analysis stage (contract in ``DESIGN.md``), all written atomically.
+
+- ``friction.csv``: one row per load: ``p_gpa``, ``tau_mpa``,
+  ``sigma_mss_mpa``, ``shear_stiffness_gpa_per_nm`` and path diagnostics;
+- ``friction.nc``: the same per load plus the paths (dims ``p_gpa``,
+  ``sample``; NaN-padded), the constant-pressure maps (meV/Å², dims
+  ``p_gpa``, ``shift_a``, ``shift_b``) and ``z*`` (Å);
+- ``laws.json``: ``k_mpa_per_gpa``, ``tau0_mpa``, ``mu_mpa_per_gpa``,
+  ``sigma0_mpa``, their standard errors, ``p_max_gpa`` and the regime ends.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from flatcontact import __version__, units
+from flatcontact.analysis.friction import EV_PER_A4_TO_GPA_PER_NM
+from flatcontact.analysis.pipeline import AnalysisResult
+from flatcontact.fileio import atomic_path, write_json_atomic, write_text_atomic
+
+CSV_COLUMNS = (
+    "p_gpa",
+    "tau_mpa",
+    "sigma_mss_mpa",
+    "shear_stiffness_gpa_per_nm",
+    "tau_position_angstrom",
+    "tau_limited_by",
+    "n_barriers",
+    "n_jumps",
+    "period_angstrom",
+    "periodic",
+    "mep_barrier_mev_per_a2",
+)
+
+
+def _clean(v: object) -> object:
+    if isinstance(v, float | np.floating):
+        return None if not math.isfinite(float(v)) else float(v)
+    return v
+
+
+def per_pressure_rows(result: AnalysisResult) -> list[dict]:
+    """One dict per load with the CSV columns (floats; NaN as None)."""
+    rows = []
+    for pa in result.pressures:
+        fr, path = pa.friction, pa.path
+        rows.append(
+            {
+                "p_gpa": pa.p_gpa,
+                "tau_mpa": fr.tau_mpa,
+                "sigma_mss_mpa": fr.sigma_mss_mpa,
+                "shear_stiffness_gpa_per_nm": fr.shear_stiffness_gpa_per_nm,
+                "tau_position_angstrom": fr.tau_position_angstrom,
+                "tau_limited_by": fr.tau_limited_by,
+                "n_barriers": len(fr.barriers),
+                "n_jumps": len(path.jumps),
+                "period_angstrom": path.length_angstrom if path.periodic else float("nan"),
+                "periodic": bool(path.periodic),
+                "mep_barrier_mev_per_a2": (
+                    pa.mep.barrier * units.EV_PER_A2_TO_MEV_PER_A2 if pa.mep else float("nan")
+                ),
+            }
+        )
+    return [{k: _clean(v) for k, v in row.items()} for row in rows]
+
+
+def summary_json(result: AnalysisResult) -> dict:
+    """What ``flatcontact analyze --json`` prints."""
+    out = {
+        "direction_deg": result.direction_deg,
+        "energy_form": result.form,
+        "pressures": [
+            {
+                k: row[k]
+                for k in (
+                    "p_gpa",
+                    "tau_mpa",
+                    "sigma_mss_mpa",
+                    "shear_stiffness_gpa_per_nm",
+                    "tau_limited_by",
+                    "n_jumps",
+                    "periodic",
+                )
+            }
+            for row in per_pressure_rows(result)
+        ],
+        "laws": result.laws.to_json(),
+    }
+    sym = [pa.symmetry for pa in result.pressures if pa.symmetry is not None]
+    if sym:
+        out["symmetry_kept"] = {
+            str(pa.p_gpa): pa.symmetry.kept for pa in result.pressures if pa.symmetry
+        }
+    return out
+
+
+def friction_csv_text(result: AnalysisResult) -> str:
+    """``friction.csv`` content (empty cells for undefined values)."""
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=CSV_COLUMNS, lineterminator="\n")
+    writer.writeheader()
+    for row in per_pressure_rows(result):
+        writer.writerow({k: ("" if row[k] is None else row[k]) for k in CSV_COLUMNS})
+    return buf.getvalue()
+
+
+def friction_dataset(result: AnalysisResult) -> xr.Dataset:
+    """``friction.nc`` as an xarray Dataset (units in attributes)."""
+    p = result.p_gpa
+    n = max(len(pa.path.t_angstrom) for pa in result.pressures)
+
+    def padded(get) -> np.ndarray:
+        out = np.full((p.size, n), np.nan)
+        for i, pa in enumerate(result.pressures):
+            v = get(pa)
+            out[i, : len(v)] = v
+        return out
+
+    mev = units.EV_PER_A2_TO_MEV_PER_A2
+    cp = result.constant_pressure
+    maps = np.stack([pa.surface.values for pa in result.pressures]) * mev
+    rows = per_pressure_rows(result)
+
+    def col(name: str) -> np.ndarray:
+        return np.array([np.nan if r[name] is None else r[name] for r in rows], dtype=float)
+
+    ds = xr.Dataset(
+        {
+            "tau_mpa": ("p_gpa", col("tau_mpa"), {"units": "MPa"}),
+            "sigma_mss_mpa": ("p_gpa", col("sigma_mss_mpa"), {"units": "MPa"}),
+            "shear_stiffness_gpa_per_nm": (
+                "p_gpa",
+                col("shear_stiffness_gpa_per_nm"),
+                {"units": "GPa/nm"},
+            ),
+            "n_jumps": ("p_gpa", np.array([len(pa.path.jumps) for pa in result.pressures])),
+            "path_t": (
+                ("p_gpa", "sample"),
+                padded(lambda pa: pa.path.t_angstrom),
+                {"units": "angstrom"},
+            ),
+            "path_x": (
+                ("p_gpa", "sample"),
+                padded(lambda pa: pa.path.xy_angstrom[:, 0]),
+                {"units": "angstrom"},
+            ),
+            "path_y": (
+                ("p_gpa", "sample"),
+                padded(lambda pa: pa.path.xy_angstrom[:, 1]),
+                {"units": "angstrom"},
+            ),
+            "path_energy": (
+                ("p_gpa", "sample"),
+                padded(lambda pa: pa.path.energy * mev),
+                {"units": "meV/angstrom^2"},
+            ),
+            "path_force": (
+                ("p_gpa", "sample"),
+                padded(lambda pa: pa.path.force * units.EV_PER_A3_TO_MPA),
+                {"units": "MPa"},
+            ),
+            "path_stiffness": (
+                ("p_gpa", "sample"),
+                padded(lambda pa: pa.path.curvature * EV_PER_A4_TO_GPA_PER_NM),
+                {"units": "GPa/nm"},
+            ),
+            "energy_map": (("p_gpa", "shift_a", "shift_b"), maps, {"units": "meV/angstrom^2"}),
+            "thickness_at_p": (
+                ("p_gpa", "shift_a", "shift_b"),
+                cp.thickness_angstrom,
+                {"units": "angstrom"},
+            ),
+        },
+        coords={
+            "p_gpa": ("p_gpa", p, {"units": "GPa"}),
+            "shift_a": cp.shift_a,
+            "shift_b": cp.shift_b,
+        },
+        attrs={
+            "a1": cp.a1,
+            "a2": cp.a2,
+            "area": cp.area_angstrom2,
+            "direction_deg": result.direction_deg,
+            "energy_form": result.form,
+            "energy_zero": result.energy_zero,
+            "force_sign": "path_force = de/dt, the resisting lateral stress (positive while climbing)",
+            "flatcontact_version": __version__,
+        },
+    )
+    return ds
+
+
+def write_outputs(result: AnalysisResult, out_dir: str | os.PathLike[str]) -> dict[str, Path]:
+    """Write ``friction.csv``, ``friction.nc`` and ``laws.json`` into ``out_dir`` atomically."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    paths = {
+        "friction.csv": write_text_atomic(out / "friction.csv", friction_csv_text(result)),
+        "laws.json": write_json_atomic(out / "laws.json", result.laws.to_json()),
+    }
+    with atomic_path(out / "friction.nc") as tmp:
+        friction_dataset(result).to_netcdf(tmp, engine="h5netcdf")
+    paths["friction.nc"] = out / "friction.nc"
+    return paths

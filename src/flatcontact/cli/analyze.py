@@ -1,0 +1,175 @@
+"""``flatcontact analyze``: ISPES grid → τ, σ_MSS, shear stiffness per load and the load laws.
+
+Thin: parses flags, calls :func:`flatcontact.analysis.pipeline.analyze_ispes`,
+prints a table or JSON and, with ``--out``, writes ``friction.csv``,
+``friction.nc``, ``laws.json`` and the figures (Fig. 2 per load, Fig. 3).
+
+``--p-gpa`` takes several values after one flag (``--p-gpa 0.5 1 2``), repeated
+flags or comma-separated lists; negative (tensile) loads are accepted.
+"""
+
+from __future__ import annotations
+
+import json
+import warnings
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from flatcontact.cli.app import app, console, err_console
+from flatcontact.errors import InputError
+
+
+def _split_arguments(items: list[str], p_values: list[str] | None) -> tuple[Path, list[float]]:
+    """The ISPES path and the pressures from the positional items and ``--p-gpa`` values."""
+    files, numbers = [], []
+    for token in list(p_values or []) + list(items):
+        for part in token.split(","):
+            part = part.strip()
+            if not part:
+                continue
+            try:
+                numbers.append(float(part))
+            except ValueError:
+                files.append(part)
+    if len(files) != 1:
+        raise InputError(
+            f"analyze: expected one ISPES file and numeric --p-gpa values, got {files or 'no file'}"
+        )
+    if not numbers:
+        raise InputError("--p-gpa: give at least one target pressure in GPa (e.g. --p-gpa 0.5 1 2)")
+    return Path(files[0]), numbers
+
+
+@app.command(
+    "analyze",
+    context_settings={"ignore_unknown_options": True, "allow_interspersed_args": True},
+)
+def analyze_command(
+    items: Annotated[
+        list[str],
+        typer.Argument(
+            help="ISPES.nc, followed by more --p-gpa values if given after the flag.",
+            show_default=False,
+        ),
+    ],
+    p_gpa: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--p-gpa",
+            help="Target normal pressure(s) P in GPa: --p-gpa 0.5 1 2 (or repeat/comma-separate).",
+        ),
+    ] = None,
+    direction_deg: Annotated[
+        float,
+        typer.Option(
+            "--direction-deg", help="Pulling direction, degrees from x (90 = y, the paper's)."
+        ),
+    ] = 90.0,
+    energy: Annotated[
+        str,
+        typer.Option("--energy", help="'internal' (paper: U at z*(P)) or 'enthalpy' (U + P·A·z*)."),
+    ] = "internal",
+    energy_zero: Annotated[
+        str,
+        typer.Option(
+            "--energy-zero",
+            help="Energy zero: 'lowest-p' (global minimum at the lowest P), 'each', 'none'.",
+        ),
+    ] = "lowest-p",
+    threshold_gpa: Annotated[
+        float, typer.Option("--threshold-gpa", help="Fit the load laws on P <= this (GPa).")
+    ] = 3.0,
+    allow_missing: Annotated[
+        bool,
+        typer.Option(
+            "--allow-missing",
+            help="Interpolate columns with missing (NaN) points instead of refusing.",
+        ),
+    ] = False,
+    mep: Annotated[
+        bool, typer.Option("--mep", help="Also compute the string-method minimum-energy path.")
+    ] = False,
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", help="Directory for friction.csv/.nc, laws.json and the figures."),
+    ] = None,
+    svg: Annotated[bool, typer.Option("--svg/--no-svg", help="Also write SVG figures.")] = True,
+    as_json: Annotated[bool, typer.Option("--json", help="Print the results as JSON.")] = False,
+) -> None:
+    """Constant-pressure ISPES, sliding path, τ, σ_MSS, shear stiffness and load laws."""
+    from flatcontact.analysis.diagnostics import AnalysisWarning
+    from flatcontact.analysis.outputs import per_pressure_rows, summary_json, write_outputs
+    from flatcontact.analysis.pipeline import analyze_ispes
+    from flatcontact.ispes.contract import open_ispes
+
+    path, pressures = _split_arguments(items, p_gpa)
+    ds = open_ispes(path)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", AnalysisWarning)
+        result = analyze_ispes(
+            ds,
+            pressures,
+            direction_deg=direction_deg,
+            form=energy,
+            energy_zero=energy_zero,
+            allow_missing=allow_missing,
+            threshold_gpa=threshold_gpa,
+            with_mep=mep,
+            source=str(path),
+        )
+    for w in caught:
+        if issubclass(w.category, AnalysisWarning):
+            err_console.print(
+                f"warning: {w.category.__name__}: {w.message}", highlight=False, soft_wrap=True
+            )
+        else:
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+    written = []
+    if out is not None:
+        from flatcontact.plots.analysis import write_figures
+
+        written = list(write_outputs(result, out).values())
+        written += write_figures(result, out, svg=svg)
+
+    if as_json:
+        typer.echo(json.dumps(summary_json(result), indent=2))
+        return
+    from rich.table import Table
+
+    table = Table(title=f"{path.name}: {energy} energy, pulling at {direction_deg:g}°")
+    for col in ("P (GPa)", "τ (MPa)", "σ_MSS (MPa)", "G_int (GPa/nm)", "τ limited by", "jumps"):
+        table.add_column(col, justify="right")
+    for row in per_pressure_rows(result):
+        table.add_row(
+            f"{row['p_gpa']:g}",
+            _fmt(row["tau_mpa"]),
+            _fmt(row["sigma_mss_mpa"]),
+            _fmt(row["shear_stiffness_gpa_per_nm"]),
+            str(row["tau_limited_by"]),
+            str(row["n_jumps"]),
+        )
+    console.print(table)
+    laws = result.laws.to_json()
+    if laws["k_mpa_per_gpa"] is not None:
+        console.print(
+            f"τ = ({_fmt(laws['k_mpa_per_gpa'])} ± {_fmt(laws['k_stderr_mpa_per_gpa'])}) MPa/GPa · P "
+            f"+ ({_fmt(laws['tau0_mpa'])} ± {_fmt(laws['tau0_stderr_mpa'])}) MPa"
+        )
+    if laws["mu_mpa_per_gpa"] is not None:
+        console.print(
+            f"σ = ({_fmt(laws['mu_mpa_per_gpa'])} ± {_fmt(laws['mu_stderr_mpa_per_gpa'])}) MPa/GPa · P "
+            f"+ ({_fmt(laws['sigma0_mpa'])} ± {_fmt(laws['sigma0_stderr_mpa'])}) MPa   (P ≤ {laws['p_max_gpa']} GPa)"
+        )
+    sym = result.pressures[0].symmetry
+    if sym is not None:
+        console.print(
+            f"symmetry at P = {result.pressures[0].p_gpa:g} GPa: {sym.summary()}", highlight=False
+        )
+    for p in written:
+        console.print(f"wrote {p}", highlight=False)
+
+
+def _fmt(v: float | None) -> str:
+    return "n/a" if v is None else f"{v:.4g}"

@@ -1,0 +1,157 @@
+"""Figures of the ISPES analysis: the paper's Fig. 2 (per load) and Fig. 3 (load laws).
+
+Fig. 2: (a) the constant-pressure ISPES (meV/Å²) around the path, with the
+path (white; jumps dashed) and the rectangular supercell (red dotted);
+(b) the energy profile along the path with each barrier ΔU_i marked by an
+arrow; (c) the force profile as a stress (MPa) with the initial slope (shear
+stiffness, dashed) and τ (red circle).
+Fig. 3: τ and σ against P with their linear fits over the fitted range.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+
+from flatcontact import units
+from flatcontact.analysis.pipeline import AnalysisResult, PressureAnalysis
+from flatcontact.fileio import atomic_path
+
+MEV = units.EV_PER_A2_TO_MEV_PER_A2
+
+
+def _save(fig: plt.Figure, stem: Path, svg: bool) -> list[Path]:
+    out = []
+    for ext in ("png", "svg") if svg else ("png",):
+        target = stem.parent / f"{stem.name}.{ext}"
+        with atomic_path(target) as tmp:
+            fig.savefig(tmp, format=ext, dpi=150, bbox_inches="tight")
+        out.append(target)
+    plt.close(fig)
+    return out
+
+
+def figure_pressure(pa: PressureAnalysis, result: AnalysisResult) -> plt.Figure:
+    """The three panels of Fig. 2 at one load."""
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.4))
+    surf, path, fr = pa.surface, pa.path, pa.friction
+    xy = path.xy_angstrom
+    r0 = pa.minimum_xy_angstrom
+    corners = [xy]
+    if result.supercell is not None:
+        u, v = result.supercell
+        rect = np.array([r0, r0 + u, r0 + u + v, r0 + v, r0])
+        corners.append(rect)
+    pts = np.vstack(corners)
+    pad = 0.15 * max(np.linalg.norm(surf.a1), np.linalg.norm(surf.a2))
+    lo, hi = pts.min(0) - pad, pts.max(0) + pad
+    gx, gy = np.linspace(lo[0], hi[0], 160), np.linspace(lo[1], hi[1], 160)
+    mx, my = np.meshgrid(gx, gy)
+    z = surf(np.stack([mx, my], -1)) * MEV
+    ax = axes[0]
+    im = ax.pcolormesh(mx, my, z, shading="auto", cmap="viridis")
+    fig.colorbar(im, ax=ax, label="energy (meV/Å²)")
+    for b in np.unique(path.branch):
+        sel = path.branch == b
+        ax.plot(xy[sel, 0], xy[sel, 1], color="white", lw=2)
+    for j in path.jumps:
+        ax.plot([j.xy_before[0], j.xy_after[0]], [j.xy_before[1], j.xy_after[1]], "w--", lw=1)
+    if result.supercell is not None:
+        ax.plot(rect[:, 0], rect[:, 1], "r:", lw=1.5, label="1×2 rectangular cell")
+        ax.legend(loc="upper right", fontsize=8)
+    if pa.mep is not None:
+        ax.plot(
+            pa.mep.xy_angstrom[:, 0], pa.mep.xy_angstrom[:, 1], color="orange", lw=1, label="MEP"
+        )
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (Å)")
+    ax.set_ylabel("y (Å)")
+    ax.set_title(f"(a) constant-P ISPES, P = {pa.p_gpa:g} GPa ({result.form})")
+
+    t = path.t_angstrom
+    ax = axes[1]
+    ax.plot(t, path.energy * MEV, "k-")
+    for b in fr.barriers:
+        ax.annotate(
+            "",
+            xy=(b.t_max_angstrom, b.energy_max * MEV),
+            xytext=(b.t_max_angstrom, b.energy_min * MEV),
+            arrowprops={"arrowstyle": "->", "color": "red"},
+        )
+    ax.set_xlabel(f"displacement along {result.direction_deg:g}° (Å)")
+    ax.set_ylabel("energy (meV/Å²)")
+    ax.set_title(f"(b) energy profile, σ = {fr.sigma_mss_mpa:.3g} MPa")
+
+    ax = axes[2]
+    f = path.force * units.EV_PER_A3_TO_MPA
+    ax.plot(t, f, "k-")
+    g = fr.shear_stiffness_ev_per_a4 * units.EV_PER_A3_TO_MPA  # MPa per Å
+    t_lin = np.linspace(0, min(fr.tau_position_angstrom * 1.5 + 1e-9, t[-1]), 20)
+    ax.plot(t_lin, g * t_lin, "b--", label=f"G = {fr.shear_stiffness_gpa_per_nm:.3g} GPa/nm")
+    ax.plot(
+        [fr.tau_position_angstrom],
+        [fr.tau_mpa],
+        "o",
+        mfc="none",
+        mec="red",
+        ms=10,
+        label=f"τ = {fr.tau_mpa:.3g} MPa",
+    )
+    ax.axhline(0, color="grey", lw=0.5)
+    ax.set_ylim(f.min() * 1.15 - 1e-12, max(f.max(), fr.tau_mpa) * 1.15 + 1e-12)
+    ax.set_xlabel(f"displacement along {result.direction_deg:g}° (Å)")
+    ax.set_ylabel("force / area (MPa)")
+    ax.set_title("(c) force profile")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+def figure_laws(result: AnalysisResult) -> plt.Figure:
+    """Fig. 3: τ and σ vs P with the linear fits."""
+    fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    p = result.p_gpa
+    for name, law, style, label in (
+        ("tau_mpa", result.laws.tau, "o", "τ"),
+        ("sigma_mss_mpa", result.laws.sigma, "s", "σ"),
+    ):
+        y = result.column(name)
+        line = ax.plot(p, y, style, label=label)[0]
+        if law is not None:
+            pf = np.linspace(min(0.0, p.min()), law.p_max_gpa, 50)
+            ax.plot(
+                pf,
+                law(pf),
+                "-",
+                color=line.get_color(),
+                label=f"{label} = {law.slope:.3g}·P + {law.intercept:.3g}",
+            )
+            if p.max() > law.p_max_gpa:
+                pe = np.linspace(law.p_max_gpa, p.max(), 20)
+                ax.plot(pe, law(pe), ":", color=line.get_color())
+    ax.set_xlabel("P (GPa)")
+    ax.set_ylabel("stress (MPa)")
+    ax.set_title(f"load laws (fit P ≤ {result.laws.threshold_gpa:g} GPa)")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+def write_figures(
+    result: AnalysisResult, out_dir: str | os.PathLike[str], svg: bool = True
+) -> list[Path]:
+    """Fig. 2 per load (``fig2_p<P>gpa``) and Fig. 3 (``fig3_laws``), PNG (+SVG)."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for pa in result.pressures:
+        stem = out / f"fig2_p{pa.p_gpa:g}gpa"
+        written += _save(figure_pressure(pa, result), stem, svg)
+    written += _save(figure_laws(result), out / "fig3_laws", svg)
+    return written
