@@ -1,0 +1,111 @@
+"""`flatcontact analyze`: flags, JSON, files, one-line errors."""
+
+import json
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from flatcontact.analysis import synthetic as syn
+from flatcontact.cli import main
+from flatcontact.ispes.contract import write_ispes
+
+A1, A2 = syn.hexagonal_cell()
+
+
+@pytest.fixture(scope="module")
+def grid_file(tmp_path_factory):
+    model = syn.SyntheticInterface(
+        A1,
+        A2,
+        syn.three_cosine(A1, A2, (1.0, 0.9, 1.1)),
+        corrugation_ev_per_a2=-2e-4,
+        gap_modulation_angstrom=-0.02,
+    )
+    path = tmp_path_factory.mktemp("grid") / "ispes.nc"
+    write_ispes(model.grid(10, 10, np.linspace(24.3, 26.4, 16)), path)
+    return path
+
+
+def _run(args, capsys):
+    with pytest.raises(SystemExit) as info:
+        main(args)
+    out = capsys.readouterr()
+    return info.value.code, out.out, out.err
+
+
+def test_json_output_with_values_after_one_flag_including_negative(grid_file, capsys):
+    code, out, _ = _run(
+        ["analyze", str(grid_file), "--p-gpa", "-0.2", "0.5", "1", "2", "--json"], capsys
+    )
+    assert code == 0
+    data = json.loads(out)
+    assert [row["p_gpa"] for row in data["pressures"]] == [-0.2, 0.5, 1.0, 2.0]
+    for row in data["pressures"]:
+        assert row["tau_mpa"] > row["sigma_mss_mpa"] > 0 and row["shear_stiffness_gpa_per_nm"] > 0
+    assert set(data["laws"]) >= {
+        "k_mpa_per_gpa",
+        "tau0_mpa",
+        "mu_mpa_per_gpa",
+        "sigma0_mpa",
+        "p_max_gpa",
+    }
+
+
+def test_out_writes_contract_files_and_figures(grid_file, tmp_path, capsys):
+    out = tmp_path / "res"
+    code, _, _ = _run(
+        [
+            "analyze",
+            str(grid_file),
+            "--p-gpa",
+            "0.5,1",
+            "--p-gpa",
+            "2",
+            "--energy",
+            "enthalpy",
+            "--out",
+            str(out),
+            "--no-svg",
+        ],
+        capsys,
+    )
+    assert code == 0
+    names = {p.name for p in out.iterdir()}
+    assert {
+        "friction.csv",
+        "friction.nc",
+        "laws.json",
+        "fig3_laws.png",
+        "fig2_p0.5gpa.png",
+    } <= names
+    assert not [n for n in names if n.endswith(".part")]
+    header = (out / "friction.csv").read_text().splitlines()[0].split(",")
+    assert header[:4] == ["p_gpa", "tau_mpa", "sigma_mss_mpa", "shear_stiffness_gpa_per_nm"]
+    ds = xr.open_dataset(out / "friction.nc", engine="h5netcdf")
+    assert ds.tau_mpa.attrs["units"] == "MPa" and ds.energy_map.shape == (3, 10, 10)
+    laws = json.loads((out / "laws.json").read_text())
+    assert laws["k_mpa_per_gpa"] > 0  # enthalpy form of a cobblestone: friction grows with load
+    ds.close()
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (
+            ["--p-gpa", "0.5", "--energy", "gibbs"],
+            "error: --energy: expected one of internal, enthalpy",
+        ),
+        (["--p-gpa", "90"], "error: P = 90 GPa is outside the data of"),
+        ([], "error: --p-gpa: give at least one target pressure"),
+    ],
+)
+def test_bad_input_is_one_line_exit_2(grid_file, capsys, args, message):
+    code, _, err = _run(["analyze", str(grid_file), *args], capsys)
+    assert code == 2
+    assert err.strip().startswith(message) and len(err.strip().splitlines()) == 1
+
+
+def test_missing_file_is_one_line(tmp_path, capsys):
+    code, _, err = _run(["analyze", str(tmp_path / "nope.nc"), "--p-gpa", "1"], capsys)
+    assert code == 2 and "no such ISPES file" in err
