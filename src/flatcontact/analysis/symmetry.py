@@ -127,7 +127,7 @@ def symmetry_report(surface: PeriodicSurface, tolerance: float = 0.02) -> Symmet
             ops.append(PointOperation(name, kind, angle, r, 0.0, np.zeros(2), True))
             continue
         if kind == "rotation":
-            n = 4 * max(c.shape)
+            n = 2 * max(c.shape)
             g = np.arange(n) / n
             grid = np.stack(np.meshgrid(g, g, indexing="ij"), -1).reshape(-1, 2)
             best = grid[int(np.argmax(overlap(grid)))]
