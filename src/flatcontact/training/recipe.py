@@ -1,0 +1,271 @@
+"""The ``sio2`` training-set recipe: diverse silica configurations, deterministic in a seed.
+
+Groups (``info["config_type"]``):
+
+``quartz_strain``
+    alpha-quartz cells (1x1x1, 2x1x1, 1x1x2) with every strain component drawn
+    uniformly in ±4 % and atoms rattled (Gaussian, 0.01-0.05 Å per component).
+``quartz_relaxed_strain``
+    alpha-quartz under single Voigt strains ±0.5 ... ±4 % with ions relaxed by
+    the teacher (these carry the relaxed-ion elastic response).
+``quartz_pressure``
+    teacher relaxation (cell + ions) of alpha-quartz under hydrostatic
+    pressure 0-10 GPa: trajectory frames and the end points.
+``polymorph``
+    cristobalite, coesite and stishovite (:mod:`.polymorphs`) strained (±3 %),
+    rattled, and compressed.
+``md``
+    snapshots of NVT MD with the Vashishta (1990) potential at 300-1500 K
+    (bulk quartz 2x2x2 and stishovite), LAMMPS, 1 fs steps.
+``slab``
+    (0001) quartz slabs (2 cells thick, 1x1 and 2x1 in-plane, 15 Å vacuum) cut
+    at every distinct height, Vashishta-annealed snapshots and frames of the
+    teacher's relaxation towards the dense reconstructed surface.
+``defect``
+    vacancies (non-stoichiometric, they also separate the Si and O reference
+    energies), stretched/broken Si-O bonds (pairs pulled 0.2-1.0 Å apart; no
+    two atoms closer than 1.35 Å) and 6 % compressed, rattled cells.
+
+Frames that need relaxation use the teacher calculator passed in, so the
+recipe is deterministic for a given seed and teacher.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+from ase import Atoms
+from ase.filters import FrechetCellFilter
+from ase.neighborlist import neighbor_list
+from ase.optimize import FIRE
+from ase.units import GPa
+
+from flatcontact.potentials.lammps_runtime import new_lammps
+from flatcontact.training.lammps_bulk import setup_box, vashishta_pair_commands
+from flatcontact.training.polymorphs import build_polymorph
+
+RECIPES = ("sio2",)
+#: Bond-breaking frames with two atoms closer than this (Å) are redrawn.
+MIN_CONTACT_ANGSTROM = 1.35
+
+
+def alpha_quartz() -> Atoms:
+    """alpha-quartz unit cell (9 atoms)."""
+    return build_polymorph("alpha_quartz")
+
+
+def strain_cell(atoms: Atoms, voigt_strain: np.ndarray) -> Atoms:
+    """Copy of ``atoms`` homogeneously deformed by the (engineering) Voigt strain."""
+    e = np.asarray(voigt_strain, dtype=float)
+    eps = np.array(
+        [[e[0], e[5] / 2, e[4] / 2], [e[5] / 2, e[1], e[3] / 2], [e[4] / 2, e[3] / 2, e[2]]]
+    )
+    out = atoms.copy()
+    out.set_cell(np.asarray(atoms.cell) @ (np.eye(3) + eps), scale_atoms=True)
+    return out
+
+
+def quartz_slab(
+    shift: float, repeats: tuple[int, int] = (1, 1), cells: int = 2, vacuum: float = 15.0
+) -> Atoms:
+    """(0001) alpha-quartz slab cut at fractional height ``shift`` of the c axis.
+
+    The slab is ``cells`` unit cells thick, ``repeats`` in-plane, with ``vacuum``
+    Å of vacuum along z (still periodic, as training frames must be).
+    """
+    q = alpha_quartz()
+    s = q.get_scaled_positions()
+    s[:, 2] = (s[:, 2] - shift) % 1.0
+    q.set_scaled_positions(s)
+    slab = q.repeat((repeats[0], repeats[1], cells))
+    cell = np.asarray(slab.cell).copy()
+    cell[2] = [0.0, 0.0, cell[2, 2] + vacuum]
+    slab.set_cell(cell, scale_atoms=False)
+    slab.positions[:, 2] += vacuum / 2
+    slab.wrap()
+    return slab
+
+
+def slab_cut_heights() -> list[float]:
+    """Fractional heights between consecutive distinct atomic planes of quartz along c."""
+    z = np.unique(np.round(alpha_quartz().get_scaled_positions()[:, 2] % 1.0, 4))
+    gaps = np.diff(np.append(z, z[0] + 1.0))
+    return [float((zi + g / 2) % 1.0) for zi, g in zip(z, gaps, strict=True)]
+
+
+def vashishta_md(
+    atoms: Atoms, temperature_k: float, n_frames: int, stride: int, seed: int, equil: int = 2000
+) -> list[Atoms]:
+    """NVT (Nosé-Hoover, 0.1 ps) MD with Vashishta (1990) in LAMMPS; ``n_frames`` snapshots."""
+    lmp = new_lammps()
+    prism = setup_box(lmp, atoms, ["Si", "O"])
+    lmp.commands_string("\n".join(vashishta_pair_commands()))
+    lmp.commands_string(
+        f"timestep 0.001\nvelocity all create {temperature_k!r} {seed} mom yes rot no dist gaussian\n"
+        f"fix nvt all nvt temp {temperature_k!r} {temperature_k!r} 0.1\nrun {equil}"
+    )
+    frames = []
+    for _ in range(n_frames):
+        lmp.command(f"run {stride}")
+        x = np.array(lmp.numpy.extract_atom("x")[: len(atoms)], dtype=float)
+        snap = atoms.copy()
+        snap.positions = prism.vector_to_ase(x)
+        snap.wrap()
+        frames.append(snap)
+    lmp.close()
+    return frames
+
+
+def _relax_frames(
+    atoms: Atoms, calc, fmax: float, steps: int, every: int, pressure_gpa=None
+) -> list[Atoms]:
+    """Frames along a teacher relaxation (every ``every`` steps, plus the end point)."""
+    a = atoms.copy()
+    a.calc = calc
+    obj = a if pressure_gpa is None else FrechetCellFilter(a, scalar_pressure=pressure_gpa * GPa)
+    opt = FIRE(obj, logfile=None)
+    frames = []
+    for k, _ in enumerate(opt.irun(fmax=fmax, steps=steps)):
+        if k % every == 0:
+            frames.append(_bare(a))
+    frames.append(_bare(a))
+    return frames
+
+
+def _bare(atoms: Atoms) -> Atoms:
+    out = Atoms(atoms.get_chemical_symbols(), positions=atoms.positions, cell=atoms.cell, pbc=True)
+    return out
+
+
+def sio2_recipe(
+    seed: int,
+    calc,
+    scale: float = 1.0,
+    progress: Callable[[str], None] | None = None,
+) -> list[Atoms]:
+    """Unlabelled configurations of the ``sio2`` recipe (see the module docstring).
+
+    Parameters
+    ----------
+    seed
+        Seed of every random choice (strains, rattles, MD velocities, defects).
+    calc
+        Teacher calculator used for the relaxation-derived groups.
+    scale
+        Multiplies the number of frames of the random groups (1.0 = default size).
+    """
+    rng = np.random.default_rng(seed)
+    say = progress or (lambda msg: None)
+    out: list[Atoms] = []
+
+    def add(frames, group):
+        for f in frames:
+            f = _bare(f)
+            f.info["config_type"] = group
+            out.append(f)
+
+    def n(k):
+        return max(1, round(k * scale))
+
+    q = alpha_quartz()
+    say("quartz_strain")
+    frames = []
+    for rep in [(1, 1, 1)] * n(40) + [(2, 1, 1)] * n(20) + [(1, 1, 2)] * n(20):
+        a = strain_cell(q.repeat(rep), rng.uniform(-0.04, 0.04, 6))
+        a.positions += rng.normal(0.0, rng.uniform(0.01, 0.05), a.positions.shape)
+        frames.append(a)
+    add(frames, "quartz_strain")
+
+    say("quartz_relaxed_strain")
+    q0 = _relax_frames(q, calc, fmax=0.01, steps=300, every=10**6, pressure_gpa=0.0)[-1]
+    frames = [q0]
+    for comp in range(6):
+        for mag in (-0.04, -0.02, -0.01, -0.005, 0.005, 0.01, 0.02, 0.04):
+            e = np.zeros(6)
+            e[comp] = mag
+            traj = _relax_frames(strain_cell(q0, e), calc, fmax=0.01, steps=200, every=15)
+            frames += [traj[0], traj[-1]]
+    add(frames, "quartz_relaxed_strain")
+
+    say("quartz_pressure")
+    frames = []
+    for p in (-1.0, 1.0, 2.0, 4.0, 6.0, 8.0, 10.0, 12.0):
+        frames += _relax_frames(q0, calc, fmax=0.01, steps=300, every=20, pressure_gpa=p)
+    for a in list(frames[-8:]):
+        b = a.copy()
+        b.positions += rng.normal(0.0, 0.03, b.positions.shape)
+        frames.append(b)
+    add(frames, "quartz_pressure")
+
+    say("polymorph")
+    frames = []
+    for name, rep in (
+        ("cristobalite", (1, 1, 1)),
+        ("coesite", (1, 1, 1)),
+        ("stishovite", (2, 2, 2)),
+    ):
+        p0 = build_polymorph(name).repeat(rep)
+        frames += _relax_frames(p0, calc, fmax=0.02, steps=200, every=25, pressure_gpa=0.0)
+        for _ in range(n(10)):
+            a = strain_cell(p0, rng.uniform(-0.03, 0.03, 6))
+            a.positions += rng.normal(0.0, 0.03, a.positions.shape)
+            frames.append(a)
+        for s in (0.97, 0.94):
+            frames.append(strain_cell(p0, np.array([s - 1, s - 1, s - 1, 0, 0, 0])))
+    add(frames, "polymorph")
+
+    say("md")
+    frames = []
+    bulk = q0.repeat((2, 2, 2))
+    for k, t in enumerate((300.0, 600.0, 900.0, 1200.0, 1500.0)):
+        frames += vashishta_md(bulk, t, n_frames=n(8), stride=250, seed=seed + 11 * k + 1)
+    st = build_polymorph("stishovite").repeat((2, 2, 3))
+    for k, t in enumerate((300.0, 900.0)):
+        frames += vashishta_md(st, t, n_frames=n(4), stride=250, seed=seed + 7 * k + 3)
+    add(frames, "md")
+
+    say("slab")
+    frames = []
+    for k, h in enumerate(slab_cut_heights()):
+        slab = quartz_slab(h)
+        md = vashishta_md(slab, 1200.0, n_frames=2, stride=2000, seed=seed + 101 + k, equil=1000)
+        frames += md
+        frames += _relax_frames(slab, calc, fmax=0.03, steps=250, every=25)
+        frames += _relax_frames(md[-1], calc, fmax=0.03, steps=250, every=25)
+    for h in slab_cut_heights()[::2]:
+        slab = quartz_slab(h, repeats=(2, 1))
+        frames += vashishta_md(slab, 600.0, n_frames=2, stride=1000, seed=seed + 201, equil=500)
+    add(frames, "slab")
+
+    say("defect")
+    frames = []
+    big = q0.repeat((2, 2, 1))
+    symbols = np.array(big.get_chemical_symbols())
+    for _ in range(n(8)):
+        for el in ("O", "Si"):
+            a = big.copy()
+            del a[int(rng.choice(np.flatnonzero(symbols == el)))]
+            a.positions += rng.normal(0.0, 0.03, a.positions.shape)
+            frames.append(a)
+    si, o = np.flatnonzero(symbols == "Si"), np.flatnonzero(symbols == "O")
+    n_bonds = 0
+    while n_bonds < n(16):
+        # pull one Si-O pair apart symmetrically: a stretched or broken bond
+        a = big.copy()
+        i = int(rng.choice(si))
+        j = int(o[np.argmin(a.get_distances(i, o, mic=True))])
+        vec = a.get_distance(i, j, mic=True, vector=True)
+        stretch = rng.uniform(0.2, 1.0)
+        a.positions[j] += 0.5 * stretch * vec / np.linalg.norm(vec)
+        a.positions[i] -= 0.5 * stretch * vec / np.linalg.norm(vec)
+        a.positions += rng.normal(0.0, 0.02, a.positions.shape)
+        if neighbor_list("d", a, MIN_CONTACT_ANGSTROM).size == 0:
+            frames.append(a)
+            n_bonds += 1
+    for _ in range(n(6)):
+        a = strain_cell(big, np.array([-0.06, -0.06, -0.06, 0, 0, 0]))
+        a.positions += rng.normal(0.0, 0.04, a.positions.shape)
+        frames.append(a)
+    add(frames, "defect")
+    return out

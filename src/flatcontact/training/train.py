@@ -1,0 +1,177 @@
+"""End-to-end SNAP training: dataset (recipe + teacher labels, or a file) -> fit -> files + report.
+
+Output directory layout (``train_snap(..., out=DIR)``)::
+
+    DIR/dataset.extxyz          labelled frames (recipe runs only)
+    DIR/<name>.snapcoeff        LAMMPS coefficients
+    DIR/<name>.snapparam        LAMMPS descriptor parameters
+    DIR/fit_report.json         hyper-parameters, RMSEs per split and group, search table
+    DIR/parity.png              parity plots (energy, force, stress) on the test split
+    DIR/provenance.json         teacher, recipe + seed, sizes, package versions, command
+"""
+
+from __future__ import annotations
+
+import importlib.metadata as md
+import platform
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from flatcontact.errors import InputError
+from flatcontact.fileio import atomic_path, write_json_atomic
+from flatcontact.training.dataset import read_dataset, write_dataset
+from flatcontact.training.fit import FitResult, default_hypers, default_settings, fit_snap
+from flatcontact.training.snapfiles import write_snap_files
+from flatcontact.units import EV_PER_A3_TO_GPA
+
+ELEMENTS = ("Si", "O")
+#: Extra weight of the groups that carry bulk alpha-quartz elasticity and EOS.
+DEFAULT_GROUP_WEIGHTS = {"quartz_relaxed_strain": 3.0, "quartz_pressure": 2.0}
+
+
+def package_versions() -> dict:
+    """Versions of the packages that shape a training run."""
+    out = {"python": platform.python_version()}
+    for pkg in ("flatcontact", "numpy", "scipy", "ase", "lammps", "chgnet", "torch"):
+        try:
+            out[pkg] = md.version(pkg)
+        except md.PackageNotFoundError:
+            out[pkg] = None
+    return out
+
+
+def build_recipe_dataset(
+    recipe: str, seed: int, label: str, scale: float, say: Callable[[str], None]
+) -> tuple[list, dict]:
+    """Generate and label the recipe's frames; return (frames, info with timings)."""
+    from flatcontact.training.label import label_frames, teacher_calculator, teacher_info
+    from flatcontact.training.recipe import RECIPES, sio2_recipe
+
+    if recipe not in RECIPES:
+        raise InputError(f"--recipe {recipe!r}: expected one of {list(RECIPES)}")
+    calc = teacher_calculator(label)
+    t0 = time.perf_counter()
+    frames = sio2_recipe(seed, calc, scale=scale, progress=lambda g: say(f"recipe: {g}"))
+    t1 = time.perf_counter()
+    say(f"recipe: {len(frames)} frames, {sum(len(a) for a in frames)} atoms in {t1 - t0:.0f} s")
+    last = [0.0]
+
+    def prog(k, n):
+        if time.perf_counter() - last[0] > 10 or k == n:
+            last[0] = time.perf_counter()
+            say(f"labelling {k}/{n}")
+
+    labelled = label_frames(frames, calc, progress=prog)
+    t2 = time.perf_counter()
+    info = {
+        **teacher_info(label),
+        "recipe": recipe,
+        "seed": seed,
+        "scale": scale,
+        "recipe_s": t1 - t0,
+        "labelling_s": t2 - t1,
+    }
+    return labelled, info
+
+
+def parity_plot(result: FitResult, path: Path, split: str = "test") -> Path:
+    """Energy / force / stress parity plots of ``split`` (PNG, written atomically)."""
+    import matplotlib.pyplot as plt
+
+    p = result.predictions.get(split) or result.predictions["validation"]
+    fig, axes = plt.subplots(1, 3, figsize=(12, 4))
+    pairs = [
+        ("energy (eV/atom)", p["energy_ref"], p["energy_pred"]),
+        ("force component (eV/Å)", p["force_ref"], p["force_pred"]),
+        (
+            "stress component (GPa)",
+            p["stress_ref"] * EV_PER_A3_TO_GPA,
+            p["stress_pred"] * EV_PER_A3_TO_GPA,
+        ),
+    ]
+    for ax, (name, ref, pred) in zip(axes, pairs, strict=True):
+        ax.plot(ref, pred, ".", ms=2, alpha=0.5)
+        if len(ref):
+            lo, hi = float(np.min([ref.min(), pred.min()])), float(np.max([ref.max(), pred.max()]))
+            ax.plot([lo, hi], [lo, hi], "k-", lw=0.7)
+        ax.set_xlabel(f"reference {name}")
+        ax.set_ylabel(f"SNAP {name}")
+    fig.suptitle(f"SNAP vs reference, {split} split")
+    fig.tight_layout()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
+    plt.close(fig)
+    return path
+
+
+def train_snap(
+    out: str | Path,
+    data: str | Path | None = None,
+    recipe: str | None = None,
+    label: str = "chgnet",
+    seed: int = 0,
+    name: str = "snap",
+    scale: float = 1.0,
+    hypers=None,
+    settings_grid=None,
+    quadratic: bool = False,
+    command: str = "",
+    progress: Callable[[str], None] | None = None,
+) -> dict:
+    """Train a SNAP from ``data`` (extxyz) or ``recipe`` labelled by ``label``; write ``out``.
+
+    Returns the fit report (also written to ``out/fit_report.json``).
+    """
+    say = progress or (lambda msg: None)
+    if (data is None) == (recipe is None):
+        raise InputError("give exactly one of --data FILE.extxyz or --recipe NAME")
+    out = Path(out)
+    t_start = time.perf_counter()
+    if data is not None:
+        frames = read_dataset(data, ELEMENTS)
+        info = {"dataset_file": str(data), "seed": seed}
+        say(f"read {len(frames)} frames from {data}")
+    else:
+        frames, info = build_recipe_dataset(recipe, seed, label, scale, say)
+        write_dataset(frames, out / "dataset.extxyz")
+    hypers = hypers or default_hypers(ELEMENTS, quadratic=quadratic)
+    settings_grid = settings_grid or default_settings(DEFAULT_GROUP_WEIGHTS)
+    t0 = time.perf_counter()
+    result = fit_snap(frames, ELEMENTS, hypers, settings_grid, seed=seed, progress=say)
+    fit_s = time.perf_counter() - t0
+    header = f"flatcontact SNAP '{name}' for {' '.join(ELEMENTS)}; trained on {info.get('recipe') or info.get('dataset_file')}"
+    coeff, param = write_snap_files(out / name, result.coefficients, header=header)
+    parity_plot(result, out / "parity.png")
+    report = {
+        "name": name,
+        "elements": list(ELEMENTS),
+        "hyper": result.coefficients.hyper.as_dict(),
+        "settings": result.settings.as_dict(),
+        "errors": result.errors,
+        "split_sizes": {k: len(v) for k, v in result.split.items()},
+        "search": result.search,
+        "timings_s": {**result.timings, "fit_total_s": fit_s},
+    }
+    write_json_atomic(out / "fit_report.json", report)
+    provenance = {
+        **info,
+        "n_frames": len(frames),
+        "n_atoms": int(sum(len(a) for a in frames)),
+        "frames_by_config_type": {
+            ct: sum(1 for a in frames if a.info.get("config_type") == ct)
+            for ct in sorted({a.info.get("config_type", "default") for a in frames})
+        },
+        "split_seed": seed,
+        "split_sizes": report["split_sizes"],
+        "hyper": report["hyper"],
+        "settings": report["settings"],
+        "package_versions": package_versions(),
+        "command": command,
+        "wall_time_s": time.perf_counter() - t_start,
+        "files": [coeff.name, param.name],
+    }
+    write_json_atomic(out / "provenance.json", provenance)
+    return report
