@@ -16,7 +16,7 @@ def _adjacent(p, q, shape):
     st.integers(1, 6),
     st.integers(1, 6),
     st.integers(1, 5),
-    st.sampled_from(["z", "lateral"]),
+    st.sampled_from(["columns", "planes"]),
     st.data(),
 )
 def test_tree_spans_the_grid_with_neighbour_parents(na, nb, nz, prefer, data):
@@ -57,10 +57,11 @@ def test_lateral_neighbours_wrap_around_the_cell():
 
 def test_preferences_choose_different_parents():
     shape = (3, 3, 3)
-    z_first = search_tree(shape, (0, 0, 1), "z")
-    lateral_first = search_tree(shape, (0, 0, 1), "lateral")
-    # off the root column, "z" grows planes laterally; off the root plane, "lateral" grows columns
-    assert z_first[(1, 0, 2)] == (0, 0, 2)
-    assert lateral_first[(1, 0, 2)] == (1, 0, 1)
+    planes = search_tree(shape, (0, 0, 1), "planes")
+    columns = search_tree(shape, (0, 0, 1), "columns")
+    # off the root column, "planes" spreads each plane laterally; off the root plane,
+    # "columns" walks each column along z
+    assert planes[(1, 0, 2)] == (0, 0, 2)
+    assert columns[(1, 0, 2)] == (1, 0, 1)
     cold = search_tree(shape, (0, 0, 1), "cold")
     assert all(p is None for p in cold.values()) and len(cold) == 27

@@ -104,13 +104,14 @@ def scan_command(
     ] = None,
     optimizer: Annotated[
         str | None,
-        typer.Option("--optimizer", help="FIRE (default), FIRE2, BFGS, LBFGS, BFGSLineSearch."),
+        typer.Option("--optimizer", help="LBFGS (default), BFGS, FIRE, FIRE2, BFGSLineSearch."),
     ] = None,
     max_steps: Annotated[
         int | None, typer.Option("--max-steps", help="Optimiser step cap (default 2000).")
     ] = None,
     order: Annotated[
-        str | None, typer.Option("--order", help="Warm-start tree: z (default), lateral, cold.")
+        str | None,
+        typer.Option("--order", help="Warm-start tree: columns (default), planes, cold."),
     ] = None,
     out: Annotated[
         str | None, typer.Option("--out", help="Output directory (default ./ispes).")

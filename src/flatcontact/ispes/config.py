@@ -8,7 +8,7 @@ A YAML file may hold these keys at the top level or under ``scan:``::
       grid: [12, 12]
       p_range_gpa: [-0.5, 5.0, 8]    # or thickness: [10.8, 11.0, 11.2]
       fmax_ev_per_a: 0.005
-      optimizer: FIRE
+      optimizer: LBFGS
       workers: 2                     # local processes; or dask_address / jobqueue
       out: ispes
 
@@ -39,9 +39,9 @@ class ScanConfig(BaseModel):
     thickness: tuple[float, ...] | None = None
     p_range_gpa: tuple[float, float, int] | None = None
     fmax_ev_per_a: float = 0.005
-    optimizer: str = "FIRE"
+    optimizer: str = "LBFGS"
     max_steps: int = 2000
-    order: Literal["z", "lateral", "cold"] = "z"
+    order: Literal["columns", "planes", "cold"] = "columns"
     executor: Literal["serial", "processes", "dask"] = "processes"
     workers: int | None = None
     dask_address: str | None = None

@@ -142,7 +142,7 @@ class DaskExecutor(SerialExecutor):
 
     name = "dask"
 
-    def __init__(self, address: str | None = None, cluster: Any = None, timeout_s: float = 10.0):
+    def __init__(self, address: str | None = None, cluster: Any = None, timeout_s: float = 5.0):
         from distributed import Client
 
         if (address is None) == (cluster is None):

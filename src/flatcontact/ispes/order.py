@@ -11,10 +11,13 @@ starts each point from the same neighbour and gives the same numbers.
 
 Preferences
 -----------
-``"z"``: the root's column is walked first, then each thickness plane spreads laterally
-(parents are lateral neighbours, except along the root column).
-``"lateral"``: the root's plane is walked first, then each lateral point's column
-(parents are thickness neighbours, except in the root plane).
+``"columns"`` (default): the root's thickness plane is spread first, then every
+lateral point's column is walked along z, so almost every parent is a thickness
+neighbour at the same stacking (the cheaper warm start, measured in
+``benchmarks/bench_scan.py``), and a parent-grandparent pair in one column allows a
+linear extrapolation in z.
+``"planes"``: the root's column is walked first, then each thickness plane is spread
+laterally (parents are lateral neighbours, except along the root column).
 ``"cold"``: no parents; every point starts from the reference structure.
 """
 
@@ -24,11 +27,13 @@ from collections import deque
 from typing import Literal
 
 Index = tuple[int, int, int]
-Preference = Literal["z", "lateral", "cold"]
-PREFERENCES = ("z", "lateral", "cold")
+Preference = Literal["columns", "planes", "cold"]
+PREFERENCES = ("columns", "planes", "cold")
 
 
-def neighbours(index: Index, shape: tuple[int, int, int], prefer: Preference = "z") -> list[Index]:
+def neighbours(
+    index: Index, shape: tuple[int, int, int], prefer: Preference = "columns"
+) -> list[Index]:
     """Grid neighbours of ``index`` (periodic laterally), in the preferred order, without repeats."""
     ia, ib, iz = index
     na, nb, nz = shape
@@ -39,12 +44,12 @@ def neighbours(index: Index, shape: tuple[int, int, int], prefer: Preference = "
         (ia, (ib + 1) % nb, iz),
     ]
     normal = [(ia, ib, k) for k in (iz - 1, iz + 1) if 0 <= k < nz]
-    ordered = normal + lateral if prefer == "z" else lateral + normal
+    ordered = normal + lateral if prefer == "planes" else lateral + normal
     return [n for n in dict.fromkeys(ordered) if n != index]
 
 
 def search_tree(
-    shape: tuple[int, int, int], root: Index, prefer: Preference = "z"
+    shape: tuple[int, int, int], root: Index, prefer: Preference = "columns"
 ) -> dict[Index, Index | None]:
     """Parent of every grid point in a breadth-first search from ``root`` (``None`` for roots).
 

@@ -69,7 +69,7 @@ class RelaxSettings:
     """
 
     fmax_ev_per_a: float = 0.005
-    optimizer: str = "FIRE"
+    optimizer: str = "LBFGS"
     max_steps: int = 2000
 
     def __post_init__(self) -> None:
@@ -99,6 +99,10 @@ class PointTask:
     start_shift: tuple[float, float] | None = None
     start_thickness: float | None = None
     start_index: Index | None = None
+    #: relaxed positions and thickness of the parent's parent when both lie in the same
+    #: column (same shift) as this point: the start is then extrapolated linearly in z
+    previous_positions: np.ndarray | None = None
+    previous_thickness: float | None = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -170,6 +174,8 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
             task.thickness,
             fixed,
         )
+        if task.previous_positions is not None:
+            atoms.positions = extrapolated_start(atoms, task, fixed)
     fixed_positions = atoms.positions[fixed].copy()
     atoms.set_constraint(FixAtoms(mask=fixed))
     calc = count_force_calls(calc)
@@ -200,6 +206,26 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
     )
     atoms.calc = None
     return result
+
+
+def extrapolated_start(placed: Atoms, task: PointTask, fixed: np.ndarray) -> np.ndarray:
+    """Linear extrapolation in z of two relaxed points of the same column.
+
+    x_start = x1 + (z - z1)/(z1 - z0) (x1 - x0), with x1, x0 the relaxed positions at
+    z1 (the parent) and z0 (its parent) at the same lateral shift; the difference is
+    taken with the lateral minimum image. Fixed atoms are then placed exactly.
+    """
+    x1 = np.asarray(task.start_positions, dtype=float)
+    x0 = np.asarray(task.previous_positions, dtype=float)
+    z1, z0 = float(task.start_thickness), float(task.previous_thickness)
+    d = x1 - x0
+    cell = placed.cell.array
+    frac = np.linalg.solve(cell.T, d.T).T
+    frac[:, :2] -= np.round(frac[:, :2])
+    d = frac @ cell
+    pos = x1 + (task.thickness - z1) / (z1 - z0) * d
+    pos[fixed] = placed.positions[fixed]
+    return pos
 
 
 @dataclasses.dataclass(frozen=True)

@@ -136,7 +136,7 @@ def run_scan(
     grid: grid_mod.GridSpec,
     out_dir: str | Path,
     relax: RelaxSettings | None = None,
-    order: str = "z",
+    order: str = "columns",
     executor: Any = None,
     executor_options: dict | None = None,
     progress: bool = False,
@@ -159,7 +159,8 @@ def run_scan(
     relax
         Relaxation settings (tolerance, optimiser, step cap).
     order
-        Warm-start tree preference: ``"z"``, ``"lateral"`` or ``"cold"``.
+        Warm-start tree preference: ``"columns"`` (default), ``"planes"`` or ``"cold"``
+        (:mod:`flatcontact.ispes.order`).
     executor
         An executor object (:mod:`flatcontact.ispes.executors`); if None, one is built
         from ``executor_options`` (``make_executor`` keywords) after validation.
@@ -224,22 +225,33 @@ def run_scan(
             par = parent[idx]
             return par is None or par in store
 
+        def converged(idx):
+            return idx is not None and idx in store and store.done()[idx]["converged"]
+
         def make_task(idx):
             par = parent[idx]
             ia, ib, iz = idx
-            if par is not None and store.done()[par]["converged"]:
-                pa, pb, pz = par
-                return PointTask(
-                    idx,
-                    float(sa[ia]),
-                    float(sb[ib]),
-                    float(z[iz]),
-                    store.positions(par),
-                    (float(sa[pa]), float(sb[pb])),
-                    float(z[pz]),
-                    par,
-                )
-            return PointTask(idx, float(sa[ia]), float(sb[ib]), float(z[iz]))
+            if not converged(par):
+                return PointTask(idx, float(sa[ia]), float(sb[ib]), float(z[iz]))
+            pa, pb, pz = par
+            grand = parent[par]
+            previous = {}
+            if converged(grand) and grand[:2] == par[:2] == idx[:2]:
+                previous = {
+                    "previous_positions": store.positions(grand),
+                    "previous_thickness": float(z[grand[2]]),
+                }
+            return PointTask(
+                idx,
+                float(sa[ia]),
+                float(sb[ib]),
+                float(z[iz]),
+                store.positions(par),
+                (float(sa[pa]), float(sb[pb])),
+                float(z[pz]),
+                par,
+                **previous,
+            )
 
         submitted = 0
         try:
