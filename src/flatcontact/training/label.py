@@ -9,6 +9,8 @@ module imports it only when asked. Any ASE calculator can label instead.
 
 from __future__ import annotations
 
+import contextlib
+import sys
 from collections.abc import Callable, Sequence
 
 from ase import Atoms
@@ -44,8 +46,9 @@ def teacher_calculator(name: str = "chgnet", model_name: str = "r2scan", threads
     from chgnet.model.dynamics import CHGNetCalculator
 
     torch.set_num_threads(threads)
-    model = CHGNet.load(model_name=model_name, verbose=False)
-    return CHGNetCalculator(model=model, use_device="cpu")
+    with contextlib.redirect_stdout(sys.stderr):  # CHGNet prints banners on stdout
+        model = CHGNet.load(model_name=model_name, verbose=False)
+        return CHGNetCalculator(model=model, use_device="cpu")
 
 
 def teacher_info(name: str = "chgnet", model_name: str = "r2scan") -> dict:

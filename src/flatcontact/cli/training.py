@@ -1,0 +1,174 @@
+"""Commands ``train-snap``, ``validate-potential`` and ``elastic``."""
+
+from __future__ import annotations
+
+import json
+import shlex
+import sys
+from pathlib import Path
+
+import typer
+
+from flatcontact.cli.app import app, console, err_console
+
+
+def _say(msg: str) -> None:
+    err_console.print(f"[dim]{msg}[/dim]")
+
+
+@app.command("train-snap")
+def train_snap_cmd(
+    data: Path = typer.Option(None, "--data", help="Labelled extxyz (energies, forces, stresses)."),
+    recipe: str = typer.Option(None, "--recipe", help="Training-set recipe to generate (sio2)."),
+    label: str = typer.Option("chgnet", "--label", help="Teacher for --recipe labels (chgnet)."),
+    out: Path = typer.Option(Path("snap-training"), "--out", help="Output directory."),
+    name: str = typer.Option("snap", "--name", help="Base name of the .snapcoeff/.snapparam."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the recipe and the data split."),
+    scale: float = typer.Option(1.0, "--scale", help="Size factor of the recipe's random groups."),
+    quadratic: bool = typer.Option(False, "--quadratic", help="Quadratic SNAP."),
+) -> None:
+    """Fit a SNAP (LAMMPS .snapcoeff/.snapparam) to a dataset or a generated recipe."""
+    from flatcontact.training.train import train_snap
+
+    command = "flatcontact " + " ".join(shlex.quote(a) for a in sys.argv[1:])
+    report = train_snap(
+        out,
+        data=data,
+        recipe=recipe,
+        label=label,
+        seed=seed,
+        name=name,
+        scale=scale,
+        quadratic=quadratic,
+        command=command,
+        progress=_say,
+    )
+    h = report["hyper"]
+    console.print(
+        f"SNAP 2J={h['twojmax']} rcutfac={h['rcutfac']} quadratic={h['quadratic']} -> {out}/{name}.snapcoeff"
+    )
+    for split in ("train", "validation", "test"):
+        e = report["errors"].get(split)
+        if e:
+            console.print(
+                f"{split:>10}: {e['n_frames']:4d} frames  E {e['energy_rmse_mev_per_atom']:.1f} meV/atom  "
+                f"F {e['force_rmse_mev_per_angstrom']:.0f} meV/Å  S {e['stress_rmse_gpa']:.2f} GPa"
+            )
+
+
+@app.command("validate-potential")
+def validate_potential_cmd(
+    potential: str = typer.Argument(
+        ..., help="Bundled name (sio2-snap), .snapcoeff path, or vashishta."
+    ),
+    reference: str = typer.Option(
+        None,
+        "--reference",
+        help="Reference model (chgnet) or a labelled extxyz of held-out frames.",
+    ),
+    json_out: bool = typer.Option(False, "--json", help="Print the report as JSON."),
+    surface: bool = typer.Option(True, "--surface/--no-surface", help="Dense-surface checks."),
+    out: Path = typer.Option(None, "--out", help="Also write the report to this JSON file."),
+) -> None:
+    """Held-out RMSEs, alpha-quartz lattice, Cij, EOS, dense surface; vs reference and experiment."""
+    from flatcontact.fileio import write_json_atomic
+    from flatcontact.training.dataset import read_dataset
+    from flatcontact.training.potentials import bulk_calculator
+    from flatcontact.training.validate import validate_potential
+
+    calc = bulk_calculator(potential)
+    ref_calc, frames, ref_label = None, None, None
+    if reference is not None:
+        if Path(reference).suffix in (".extxyz", ".xyz"):
+            frames = read_dataset(reference, ["Si", "O"])
+            ref_label = reference
+        else:
+            ref_calc = bulk_calculator(reference)
+            ref_label = reference
+    report = validate_potential(
+        calc, potential, ref_calc, ref_label, frames=frames, surface=surface, progress=_say
+    )
+    if out is not None:
+        write_json_atomic(out, report)
+    if json_out:
+        print(json.dumps(report, indent=2))
+        return
+    _print_validation(report)
+
+
+def _print_validation(report: dict) -> None:
+    from rich.table import Table
+
+    from flatcontact.training.validate import (
+        QUARTZ_CIJ_EXPERIMENT_GPA,
+        QUARTZ_LATTICE_EXPERIMENT_ANGSTROM,
+    )
+
+    cols = [c for c in ("potential", "reference") if isinstance(report.get(c), dict)]
+    t = Table(title=f"alpha-quartz: {report['potential_label']}")
+    t.add_column("quantity")
+    for c in cols:
+        t.add_column(c)
+    t.add_column("experiment")
+    for key, unit in (("a_angstrom", "Å"), ("c_angstrom", "Å"), ("density_g_cm3", "g/cm³")):
+        exp = QUARTZ_LATTICE_EXPERIMENT_ANGSTROM.get(key[0]) if key != "density_g_cm3" else 2.648
+        t.add_row(
+            f"{key.split('_')[0]} ({unit})",
+            *[f"{report[c]['lattice'][key]:.4f}" for c in cols],
+            f"{exp}",
+        )
+    for k, v in QUARTZ_CIJ_EXPERIMENT_GPA.items():
+        t.add_row(
+            f"{k} (GPa)", *[f"{report[c]['elastic']['cij_gpa'][k]:.1f}" for c in cols], f"{v}"
+        )
+    for k in ("bulk_modulus", "shear_modulus", "e_star", "g_star_johnson", "g_star_paper"):
+        t.add_row(f"{k} (GPa)", *[f"{report[c]['elastic']['moduli_gpa'][k]:.1f}" for c in cols], "")
+    for c in cols:
+        ds = report[c].get("dense_surface")
+        if ds and "error" not in ds:
+            t.add_row(
+                f"dense surface ({c})",
+                *[""] * (cols.index(c)),
+                f"relax {ds['dense_after_relaxation']}, MD {ds['dense_after_md_300k']}, "
+                f"γ {ds['surface_energy_j_per_m2']:.2f} J/m²",
+                *[""] * (len(cols) - cols.index(c)),
+            )
+    console.print(t)
+    he = report.get("heldout_errors")
+    if he:
+        console.print(
+            f"held-out: E {he['energy_rmse_mev_per_atom']:.1f} meV/atom, "
+            f"F {he['force_rmse_mev_per_angstrom']:.0f} meV/Å"
+        )
+    if "targets_met" in report:
+        console.print(f"targets met: {report['targets_met']}")
+
+
+@app.command("elastic")
+def elastic_cmd(
+    potential: str = typer.Option(
+        "sio2-snap", "--potential", help="Bundled name, .snapcoeff path, vashishta or chgnet."
+    ),
+    strain: float = typer.Option(0.005, "--strain", help="Finite strain amplitude (fraction)."),
+    json_out: bool = typer.Option(False, "--json", help="Print JSON."),
+) -> None:
+    """alpha-quartz Cij (relaxed ions), Voigt-Reuss-Hill K, G, E, nu and contact moduli E*, G*."""
+    from flatcontact.elastic import quartz_contact_moduli
+
+    res = quartz_contact_moduli(potential, strain=strain)
+    if json_out:
+        print(json.dumps(res, indent=2))
+        return
+    console.print(
+        f"alpha-quartz with {potential}: a = {res['a_angstrom']:.4f} Å, c = {res['c_angstrom']:.4f} Å"
+    )
+    console.print("  " + "  ".join(f"{k} {v:.1f}" for k, v in res["cij_gpa"].items()) + "  (GPa)")
+    m = res["moduli_gpa"]
+    console.print(
+        f"  Hill: K {m['bulk_modulus']:.1f}  G {m['shear_modulus']:.1f}  E {m['youngs_modulus']:.1f} GPa  "
+        f"nu {m['poisson_ratio']:.3f}"
+    )
+    console.print(
+        f"  two identical bodies: E* {m['e_star']:.1f} GPa; G* {m['g_star_johnson']:.1f} GPa (Johnson, "
+        f"q0 = 4G*u/(pi a)) = {m['g_star_paper']:.1f} GPa (paper, q0 = G*u/(pi a))"
+    )
