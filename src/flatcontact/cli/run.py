@@ -1,0 +1,77 @@
+"""``flatcontact run`` (the whole study in a run directory) and ``flatcontact config``.
+
+Thin: loads and validates the configuration (:mod:`flatcontact.config`), runs
+:class:`flatcontact.pipeline.Pipeline` with rich progress and prints where the report is.
+Ctrl-C stops cleanly; the same command resumes.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from flatcontact.cli.app import app, console, err_console
+
+_PRESET_HELP = "quick (default: minutes on a 2-core laptop) or paper (the paper's grids and loads)."
+
+
+@app.command("run")
+def run_command(
+    config: Annotated[
+        Path | None,
+        typer.Argument(help="Run configuration (YAML); default: the built-in default (preset)."),
+    ] = None,
+    out: Annotated[
+        Path, typer.Option("--out", help="Run directory (created; rerun to resume).")
+    ] = Path("flatcontact-run"),
+    preset: Annotated[str | None, typer.Option("--preset", help=_PRESET_HELP)] = None,
+) -> None:
+    """Interface -> ISPES scan -> τ, σ per load -> load laws -> modified Mindlin contact -> report.
+
+    Rerunning skips stages whose inputs did not change and resumes an interrupted scan.
+    """
+    from flatcontact.config import load_config
+    from flatcontact.pipeline import Pipeline
+
+    cfg = load_config(config, preset)
+    with Pipeline(cfg, out, console=console) as pipe:
+        model = cfg.calculator.target if cfg.calculator is not None else cfg.potential.label
+        console.print(
+            f"flatcontact run: preset {cfg.preset}, {cfg.structure.kind}, {model} -> {out}",
+            highlight=False,
+        )
+        try:
+            report = pipe.run()
+        except KeyboardInterrupt:
+            err_console.print(
+                f"interrupted; finished work is kept in {out}. Rerun the same command to resume.",
+                highlight=False,
+            )
+            raise typer.Exit(130) from None
+    console.print(f"report: {report.resolve()}", highlight=False)
+
+
+@app.command("config")
+def config_command(
+    show_default: Annotated[
+        bool, typer.Option("--show-default", help="Print the default configuration as YAML.")
+    ] = False,
+    preset: Annotated[str | None, typer.Option("--preset", help=_PRESET_HELP)] = None,
+    check: Annotated[
+        Path | None,
+        typer.Option("--check", help="Validate this YAML file and print it fully resolved."),
+    ] = None,
+    comments: Annotated[
+        bool, typer.Option("--comments/--no-comments", help="Describe each field in a comment.")
+    ] = True,
+) -> None:
+    """Print the default run configuration (with every field described) or check a file."""
+    from flatcontact.config import load_config, to_yaml
+    from flatcontact.errors import InputError
+
+    if not show_default and check is None:
+        raise InputError("config: give --show-default [--preset quick|paper] or --check FILE")
+    cfg = load_config(check, preset)
+    typer.echo(to_yaml(cfg, comments=comments), nl=False)

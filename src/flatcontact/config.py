@@ -1,0 +1,612 @@
+"""The run configuration: pydantic models, presets, YAML in and out.
+
+A configuration is a YAML mapping with the sections of :class:`RunConfig`
+(``structure``, ``potential``, ``calculator``, ``scan``, ``analysis``, ``elastic``,
+``contact``, ``report``) and an optional ``preset`` key. Values not given come from the
+preset (``quick`` by default, or ``paper``), so a file only lists what it changes::
+
+    preset: quick
+    scan:
+      grid: [8, 8]
+    contact:
+      p0_gpa: [0.5, 1.0, 2.0]
+
+Every field carries its unit in its name (``radius_um``, ``p0_gpa``,
+``fmax_ev_per_angstrom``) and a description (``flatcontact config --show-default``
+prints them as comments). Unknown keys are refused. :func:`load_config` turns every
+problem into one :class:`~flatcontact.errors.InputError` line that names the file and
+the dotted path of the field, e.g.
+``config.yaml: scan.grid: expected two positive integers, got [0, 4]``.
+
+Units follow ``DESIGN.md``: atomistic quantities in eV and Å, loads in GPa, laws in MPa
+and MPa/GPa, contact geometry in µm/nm.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+from pathlib import Path
+from typing import Any, Literal
+
+import yaml
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
+
+from flatcontact.errors import InputError
+from flatcontact.ispes.order import PREFERENCES
+from flatcontact.ispes.relax import OPTIMIZERS, RelaxSettings
+from flatcontact.potentials.spec import BUNDLED_DIR, PotentialSpec
+
+#: The bundled SNAP the default run uses when it is present.
+BUNDLED_SNAP = "sio2-snap"
+#: The paper's load laws and contact parameters (Dong et al.), for comparison tables.
+PAPER_VALUES = {
+    "k_mpa_per_gpa": 4.52,
+    "tau0_mpa": 26.7,
+    "mu_mpa_per_gpa": 0.21,
+    "sigma0_mpa": 11.1,
+    "radius_um": 5.0,
+    "contact_modulus_gpa": 52.5,
+    "shear_modulus_gpa": 29.0,
+}
+
+
+class _Section(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+def _positive_pair(value: Any, what: str) -> tuple[int, int]:
+    ok = (
+        isinstance(value, list | tuple)
+        and len(value) == 2
+        and all(isinstance(v, int) and not isinstance(v, bool) and v > 0 for v in value)
+    )
+    if not ok:
+        raise ValueError(f"expected two positive integers, got {_show(value)}")
+    return (int(value[0]), int(value[1]))
+
+
+def _show(value: Any) -> str:
+    if isinstance(value, tuple):
+        value = list(value)
+    try:
+        return json.dumps(value)
+    except TypeError:
+        return repr(value)
+
+
+class StructureConfig(_Section):
+    """Which interface to build (stage ``build``)."""
+
+    kind: Literal["quartz-dense", "file", "toy-lj"] = Field(
+        "quartz-dense",
+        description="quartz-dense: the paper's alpha-quartz (0001) dense interface; "
+        "file: an interface.extxyz following the interface contract (path in 'file'); "
+        "toy-lj: a tiny two-slab Lennard-Jones model (tests and demos only; "
+        "needs calculator.target flatcontact.ispes.toy:toy_calculator)",
+    )
+    layers: int = Field(
+        6, description="O-Si-O layers per slab (quartz-dense; >= 5) or atomic layers (toy-lj; >= 3)"
+    )
+    source: Literal["auto", "shipped", "seed"] = Field(
+        "auto",
+        description="quartz-dense starting slab: shipped (CHGNet-relaxed 6-layer slab), "
+        "seed (seeded dense reconstruction relaxed with the potential) or auto "
+        "(shipped if present and layers == 6, else seed)",
+    )
+    file: str | None = Field(
+        None, description="kind=file: path of an interface.extxyz (relative to the config file)"
+    )
+    gap_angstrom: float = Field(
+        3.0, gt=0, description="initial gap between the slabs before the interface relaxation (Å)"
+    )
+    fmax_ev_per_angstrom: float = Field(
+        0.01, gt=0, description="force tolerance of the slab and interface relaxations (eV/Å)"
+    )
+
+    @model_validator(mode="after")
+    def _consistent(self) -> StructureConfig:
+        if self.kind == "file" and not self.file:
+            raise ValueError("kind 'file' needs 'file: path/to/interface.extxyz'")
+        if self.kind == "quartz-dense" and self.layers < 5:
+            raise ValueError(f"layers={self.layers}: the dense quartz interface needs >= 5")
+        if self.kind == "toy-lj" and self.layers < 3:
+            raise ValueError(f"layers={self.layers}: the toy interface needs >= 3")
+        return self
+
+
+class CalculatorConfig(_Section):
+    """A whole-interface ASE calculator replacing ``potential`` (optional)."""
+
+    target: str = Field(
+        description="'module:callable'; callable(atoms, **kwargs) returns an ASE calculator "
+        "for the whole interface"
+    )
+    kwargs: dict[str, Any] = Field(
+        default_factory=dict, description="keyword arguments of the callable (JSON values)"
+    )
+
+
+class PressureRange(_Section):
+    """n loads evenly spaced from lo_gpa to hi_gpa at the probe stacking."""
+
+    lo_gpa: float = Field(description="lowest target load (GPa; negative = tension)")
+    hi_gpa: float = Field(gt=0, description="highest target load (GPa, compressive)")
+    n: int = Field(ge=2, description="number of thicknesses")
+
+    @model_validator(mode="after")
+    def _order(self) -> PressureRange:
+        if not self.lo_gpa < self.hi_gpa:
+            raise ValueError(f"expected lo_gpa < hi_gpa, got {self.lo_gpa} and {self.hi_gpa}")
+        return self
+
+
+class ScanConfig(_Section):
+    """The ISPES grid (stage ``scan``)."""
+
+    grid: tuple[int, int] = Field(
+        (12, 12), description="lateral points along a1 and a2 over the primitive cell"
+    )
+    p_range_gpa: PressureRange | None = Field(
+        None,
+        description="choose the thicknesses z so that the loads at the probe stacking span "
+        "lo_gpa..hi_gpa (n values); exclusive with thickness_angstrom",
+    )
+    thickness_angstrom: list[float] | None = Field(
+        None, description="explicit thicknesses z (Å, surface 1 to surface 4)"
+    )
+    fmax_ev_per_angstrom: float = Field(
+        0.005, gt=0, description="force tolerance on the free atoms at each point (eV/Å)"
+    )
+    optimizer: str = Field(
+        RelaxSettings().optimizer,
+        description="ASE optimiser of each point: " + ", ".join(OPTIMIZERS),
+    )
+    max_steps: int = Field(2000, ge=1, description="optimiser step cap per point")
+    order: str = Field(
+        "columns",
+        description="warm-start tree: columns (walk each column along z), planes, cold",
+    )
+    executor: Literal["serial", "processes", "dask"] = Field(
+        "processes", description="serial, local processes, or Dask"
+    )
+    workers: int | None = Field(None, ge=1, description="worker processes (default: one per core)")
+    dask_address: str | None = Field(None, description="address of a running Dask scheduler")
+
+    @field_validator("optimizer")
+    @classmethod
+    def _optimizer(cls, value: str) -> str:
+        if value not in OPTIMIZERS:
+            raise ValueError(f"expected one of {', '.join(OPTIMIZERS)}, got {_show(value)}")
+        return value
+
+    @field_validator("order")
+    @classmethod
+    def _order(cls, value: str) -> str:
+        if value not in PREFERENCES:
+            raise ValueError(f"expected one of {', '.join(PREFERENCES)}, got {_show(value)}")
+        return value
+
+    @field_validator("grid", mode="before")
+    @classmethod
+    def _grid(cls, value: Any) -> tuple[int, int]:
+        return _positive_pair(value, "grid")
+
+    @model_validator(mode="after")
+    def _one_of(self) -> ScanConfig:
+        if (self.p_range_gpa is None) == (self.thickness_angstrom is None):
+            raise ValueError("give exactly one of p_range_gpa and thickness_angstrom")
+        if self.thickness_angstrom is not None:
+            z = self.thickness_angstrom
+            if not z or any(not v > 0 for v in z):
+                raise ValueError(f"thickness_angstrom: expected positive values in Å, got {z}")
+        return self
+
+
+class AnalysisConfig(_Section):
+    """Constant-pressure ISPES, sliding paths, τ, σ and the load laws (stages ``analyze``, ``laws``)."""
+
+    p_gpa: list[float] = Field(
+        [0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0],
+        description="target normal pressures P (GPa) at which the constant-pressure ISPES is analysed",
+    )
+    direction_deg: float = Field(
+        90.0, description="pulling direction, degrees from x (90 = y, the paper's)"
+    )
+    energy_form: Literal["internal", "enthalpy"] = Field(
+        "internal", description="internal: U at z*(P) (the paper's); enthalpy: U + P·A·z*"
+    )
+    energy_zero: Literal["lowest-p", "each", "none"] = Field(
+        "lowest-p",
+        description="energy zero of the maps: global minimum at the lowest P, each, none",
+    )
+    threshold_gpa: float = Field(
+        3.0, gt=0, description="fit the linear load laws on P <= this (GPa; the paper's 3 GPa)"
+    )
+    allow_missing: bool = Field(
+        False, description="interpolate columns with unconverged/missing points instead of refusing"
+    )
+    with_mep: bool = Field(False, description="also compute the string-method minimum-energy path")
+
+    @field_validator("p_gpa")
+    @classmethod
+    def _pressures(cls, value: list[float]) -> list[float]:
+        if len(value) < 2 or len(set(value)) != len(value):
+            raise ValueError(f"expected at least two distinct pressures in GPa, got {_show(value)}")
+        return sorted(float(v) for v in value)
+
+
+class ElasticConfig(_Section):
+    """Self-consistent contact moduli E*, G* from the potential (stage ``elastic``, optional)."""
+
+    strain: float = Field(
+        0.005, gt=0, lt=0.05, description="finite strain of the central differences for C_ij"
+    )
+    enabled: bool = Field(
+        False,
+        description="compute E* and G* (paper's convention) of bulk alpha-quartz with the "
+        "potential (vashishta or snap); otherwise contact.contact_modulus_gpa/shear_modulus_gpa",
+    )
+
+
+class ContactConfig(_Section):
+    """The modified Mindlin contact (stage ``contact``)."""
+
+    p0_gpa: list[float] = Field(
+        [0.5, 1.0, 1.77, 2.0, 3.0], description="peak Hertz pressures p0 (GPa)"
+    )
+    radius_um: float = Field(5.0, gt=0, description="tip radius R (µm)")
+    contact_modulus_gpa: float = Field(
+        52.5, gt=0, description="Hertz contact modulus E* (GPa; the paper's DFT value)"
+    )
+    shear_modulus_gpa: float = Field(
+        29.0,
+        gt=0,
+        description="effective shear modulus G* (GPa) in the paper's q0 = G*·u/(π a) (= 4 × Johnson's G*_J)",
+    )
+    k_mpa_per_gpa: float | None = Field(
+        None, ge=0, description="override k of τ = k·P + τ0 (MPa/GPa); null: the fitted law"
+    )
+    tau0_mpa: float | None = Field(None, ge=0, description="override τ0 (MPa); null: fitted")
+    mu_mpa_per_gpa: float | None = Field(
+        None, ge=0, description="override μ of σ = μ·P + σ0 (MPa/GPa); null: fitted"
+    )
+    sigma0_mpa: float | None = Field(None, ge=0, description="override σ0 (MPa); null: fitted")
+    work_of_adhesion_j_m2: float | None = Field(
+        None,
+        ge=0,
+        description="work of adhesion w (J/m²) for DMT/JKR radii; null: the work of separation "
+        "measured by the scan",
+    )
+    knee_fraction: float = Field(
+        0.5, gt=0, lt=1, description="knee: stiffness falls to this fraction of its initial value"
+    )
+    experiment_csv: str | None = Field(
+        None,
+        description="measured stiffness CSV ('mean shear stress [MPa],lateral stiffness [N/m]') "
+        "for the Fig. 6 overlay (relative to the config file)",
+    )
+    experiment_p0_gpa: float = Field(1.77, gt=0, description="p0 of the measured data (GPa)")
+    experiment_stress_measure: Literal["amplitude", "rms"] = Field(
+        "amplitude", description="stress of the data: amplitude Q_max/πa² or rms ⟨Q⟩/πa²"
+    )
+    collapse_fraction: float = Field(
+        0.2, gt=0, lt=1, description="collapse: stiffness first below this fraction of the plateau"
+    )
+
+    @field_validator("p0_gpa")
+    @classmethod
+    def _p0(cls, value: list[float]) -> list[float]:
+        if not value or any(not v > 0 for v in value):
+            raise ValueError(f"expected positive peak pressures in GPa, got {_show(value)}")
+        return [float(v) for v in value]
+
+
+class ReportConfig(_Section):
+    """The HTML report (stage ``report``)."""
+
+    title: str = Field("flatcontact run", description="report title")
+    fig2_p_gpa: list[float] | None = Field(
+        None,
+        description="pressures (GPa, among analysis.p_gpa) with a Fig. 2 panel; null: lowest, "
+        "middle and highest",
+    )
+    svg: bool = Field(True, description="also write SVG figures next to the PNGs")
+
+
+class RunConfig(_Section):
+    """A whole ``flatcontact run``."""
+
+    preset: Literal["quick", "paper"] = Field(
+        "quick", description="preset the values below were resolved from"
+    )
+    structure: StructureConfig = Field(default_factory=StructureConfig)
+    potential: PotentialSpec = Field(
+        default_factory=PotentialSpec,
+        description="intra-slab model + cross-interface TS-vdW LJ (flatcontact.potentials)",
+    )
+    calculator: CalculatorConfig | None = Field(
+        None, description="a whole-interface ASE calculator used instead of 'potential'"
+    )
+    scan: ScanConfig = Field(
+        default_factory=lambda: ScanConfig(p_range_gpa=PressureRange(lo_gpa=-0.5, hi_gpa=3.5, n=8))
+    )
+    analysis: AnalysisConfig = Field(default_factory=AnalysisConfig)
+    elastic: ElasticConfig = Field(default_factory=ElasticConfig)
+    contact: ContactConfig = Field(default_factory=ContactConfig)
+    report: ReportConfig = Field(default_factory=ReportConfig)
+
+    @model_validator(mode="after")
+    def _cross(self) -> RunConfig:
+        if self.structure.kind == "toy-lj" and self.calculator is None:
+            raise ValueError(
+                "structure.kind 'toy-lj' needs calculator.target: flatcontact.ispes.toy:toy_calculator"
+            )
+        fig = self.report.fig2_p_gpa
+        if fig is not None and any(p not in self.analysis.p_gpa for p in fig):
+            raise ValueError(
+                f"report.fig2_p_gpa {_show(fig)} must be among analysis.p_gpa {_show(self.analysis.p_gpa)}"
+            )
+        return self
+
+    def section(self, name: str) -> dict:
+        """JSON-ready dict of one section (``None`` sections as ``None``)."""
+        value = getattr(self, name)
+        return None if value is None else json.loads(value.model_dump_json())
+
+    def to_dict(self) -> dict:
+        """The whole configuration as plain JSON-ready data."""
+        return json.loads(self.model_dump_json())
+
+
+# --------------------------------------------------------------------------- presets
+
+
+def default_potential() -> dict:
+    """The default interaction model: the bundled SiO₂ SNAP if present, else Vashishta 1990.
+
+    Vashishta is the best validated silica model shipped with LAMMPS here: relaxed
+    α-quartz a = 4.829 Å (exp. 4.916) and it keeps the dense (0001) reconstruction
+    defect-free through the interface relaxation (verified by the builder).
+    """
+    snap = BUNDLED_DIR / BUNDLED_SNAP / f"{BUNDLED_SNAP}.snapcoeff"
+    intra = f"snap:{BUNDLED_SNAP}" if snap.is_file() else "vashishta"
+    return {"intra": intra, "lj": {"c6_source": "ts", "cutoff_angstrom": 10.0}}
+
+
+def _paper_slab_source() -> str:
+    """``shipped`` if the CHGNet-relaxed 6-layer dense slab is installed, else ``seed``."""
+    from flatcontact.structures.build import SHIPPED_DENSE_SLAB
+
+    return "shipped" if SHIPPED_DENSE_SLAB.is_file() else "seed"
+
+
+def preset(name: str) -> dict:
+    """The raw data of preset ``name`` (``quick`` or ``paper``) as a nested dict."""
+    if name == "quick":
+        return {
+            "preset": "quick",
+            "structure": {"kind": "quartz-dense", "layers": 5, "source": "seed"},
+            "potential": default_potential(),
+            "scan": {
+                "grid": [8, 8],
+                "p_range_gpa": {"lo_gpa": -1.2, "hi_gpa": 4.5, "n": 12},
+                "fmax_ev_per_angstrom": 0.01,
+            },
+            "analysis": {"p_gpa": [0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5]},
+            "contact": {"p0_gpa": [0.5, 1.0, 1.77, 2.0, 3.0]},
+            "report": {"title": "flatcontact run (quick preset)"},
+        }
+    if name == "paper":
+        return {
+            "preset": "paper",
+            "structure": {"kind": "quartz-dense", "layers": 6, "source": _paper_slab_source()},
+            "potential": default_potential(),
+            "scan": {
+                "grid": [12, 12],
+                "p_range_gpa": {"lo_gpa": -1.2, "hi_gpa": 5.5, "n": 20},
+                "fmax_ev_per_angstrom": 0.005,
+            },
+            "analysis": {"p_gpa": [0.0, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 4.5]},
+            "contact": {"p0_gpa": [0.5, 1.0, 1.5, 1.77, 2.0, 2.5, 3.0]},
+            "report": {"title": "flatcontact run (paper preset)", "fig2_p_gpa": [0.5, 1.0, 3.0]},
+        }
+    raise InputError(f"preset: expected quick or paper, got {name!r}")
+
+
+def _merge(base: dict, over: dict) -> dict:
+    out = copy.deepcopy(base)
+    for key, value in over.items():
+        if isinstance(value, dict) and isinstance(out.get(key), dict) and key != "kwargs":
+            # an explicit pressure range or thickness list replaces the other
+            if key == "scan":
+                if "thickness_angstrom" in value:
+                    out[key].pop("p_range_gpa", None)
+                if "p_range_gpa" in value:
+                    out[key].pop("thickness_angstrom", None)
+            out[key] = _merge(out[key], value)
+        else:
+            out[key] = copy.deepcopy(value)
+    return out
+
+
+_MESSAGES = {
+    "greater_than": "expected a value > {gt}",
+    "greater_than_equal": "expected a value >= {ge}",
+    "less_than": "expected a value < {lt}",
+    "less_than_equal": "expected a value <= {le}",
+    "float_parsing": "expected a number",
+    "float_type": "expected a number",
+    "int_parsing": "expected an integer",
+    "int_type": "expected an integer",
+    "int_from_float": "expected an integer",
+    "bool_parsing": "expected true or false",
+    "bool_type": "expected true or false",
+    "string_type": "expected a string",
+    "list_type": "expected a list",
+    "tuple_type": "expected a list",
+    "dict_type": "expected a mapping",
+    "model_type": "expected a mapping",
+    "model_attributes_type": "expected a mapping",
+    "literal_error": "expected {expected}",
+    "extra_forbidden": "unknown field",
+    "missing": "required field missing",
+}
+
+
+def _one_line(exc: ValidationError, source: str) -> InputError:
+    """The first pydantic error as ``<source>: <dotted.path>: expected ..., got <value>``."""
+    first = exc.errors()[0]
+    loc = [str(p) for p in first.get("loc", ()) if not str(p).startswith("function-")]
+    where = ".".join(loc)
+    kind = first.get("type", "")
+    if kind in _MESSAGES:
+        try:
+            msg = _MESSAGES[kind].format(**first.get("ctx", {}))
+        except (KeyError, IndexError):
+            msg = str(first.get("msg", "invalid"))
+        if kind not in ("extra_forbidden", "missing"):
+            msg += f", got {_show(first.get('input'))}"
+    else:
+        msg = str(first.get("msg", "invalid")).removeprefix("Value error, ")
+        if where == "potential" and msg.startswith("potential "):  # PotentialSpec's InputError
+            return InputError(f"{source}: potential.{msg.removeprefix('potential ')}")
+    return InputError(f"{source}: {where}: {msg}" if where else f"{source}: {msg}")
+
+
+def build_config(
+    data: dict | None = None, preset_name: str | None = None, source: str = "config"
+) -> RunConfig:
+    """A validated :class:`RunConfig` from ``data`` laid over a preset.
+
+    Parameters
+    ----------
+    data
+        Nested mapping as read from YAML (may be empty or ``None``).
+    preset_name
+        ``quick`` or ``paper``; overrides ``data['preset']``; default ``quick``.
+    source
+        Name used in error messages (the file path).
+    """
+    data = dict(data or {})
+    name = preset_name or data.pop("preset", None) or "quick"
+    data.pop("preset", None)
+    if name not in ("quick", "paper"):
+        raise InputError(f"{source}: preset: expected quick or paper, got {_show(name)}")
+    merged = _merge(preset(name), data)
+    try:
+        return RunConfig.model_validate(merged)
+    except ValidationError as exc:
+        raise _one_line(exc, source) from None
+    except InputError as exc:  # PotentialSpec's own one-line errors ("potential intra: ...")
+        text = str(exc)
+        if text.startswith("potential "):
+            text = "potential." + text.removeprefix("potential ")
+        raise InputError(f"{source}: {text}") from None
+
+
+def load_config(path: str | Path | None = None, preset_name: str | None = None) -> RunConfig:
+    """Read and validate a run configuration (YAML); ``None`` gives the preset alone.
+
+    Relative paths inside the file (``structure.file``, ``contact.experiment_csv``) are
+    resolved against the file's directory. Every problem is one :class:`InputError` line
+    naming the file and the field path.
+    """
+    if path is None:
+        return build_config({}, preset_name, "default config")
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{path}: no such config file")
+    try:
+        data = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" (line {mark.line + 1})" if mark is not None else ""
+        raise InputError(f"{path}: not valid YAML{where}") from None
+    if data is None:
+        data = {}
+    if not isinstance(data, dict):
+        raise InputError(f"{path}: expected a mapping of sections, got {type(data).__name__}")
+    for section, key in (("structure", "file"), ("contact", "experiment_csv")):
+        block = data.get(section)
+        if isinstance(block, dict) and isinstance(block.get(key), str):
+            target = Path(block[key]).expanduser()
+            if not target.is_absolute():
+                block[key] = str((path.parent / target).resolve())
+    return build_config(data, preset_name, str(path))
+
+
+# --------------------------------------------------------------------------- YAML out
+
+
+def _descriptions(model: type[BaseModel]) -> dict[str, str]:
+    return {name: (f.description or "") for name, f in model.model_fields.items()}
+
+
+def _section_model(name: str) -> type[BaseModel] | None:
+    ann = RunConfig.model_fields[name].annotation
+    for cand in (
+        StructureConfig,
+        PotentialSpec,
+        CalculatorConfig,
+        ScanConfig,
+        AnalysisConfig,
+        ElasticConfig,
+        ContactConfig,
+        ReportConfig,
+    ):
+        if ann is cand or (hasattr(ann, "__args__") and cand in ann.__args__):
+            return cand
+    return None
+
+
+def _yaml_value(value: Any) -> str:
+    return (
+        yaml.safe_dump(value, default_flow_style=True, allow_unicode=True, width=1000)
+        .strip()
+        .removesuffix("\n...")
+        .removesuffix("...")
+        .strip()
+    )
+
+
+def to_yaml(config: RunConfig, comments: bool = True) -> str:
+    """The configuration as YAML, with each field's description as a comment above it."""
+    data = config.to_dict()
+    lines = [
+        "# flatcontact run configuration (units in the names: GPa, MPa, Å, eV, µm, J/m²)",
+        "# values not given in a file come from the preset",
+    ]
+    top = _descriptions(RunConfig)
+    for key, value in data.items():
+        if comments and top.get(key):
+            lines.append(f"# {top[key]}")
+        if not isinstance(value, dict):
+            lines.append(f"{key}: {_yaml_value(value)}")
+            continue
+        lines.append(f"{key}:")
+        model = _section_model(key)
+        desc = _descriptions(model) if model is not None else {}
+        if key == "potential":
+            desc = {
+                "intra": "intra-slab model: vashishta, tersoff, snap:<name|path.snapcoeff>, "
+                "ase:module:factory",
+                "lj": "cross-interface Lennard-Jones (c6_source ts = Tkatchenko-Scheffler)",
+            }
+        for sub, subval in value.items():
+            if comments and desc.get(sub):
+                lines.append(f"  # {desc[sub]}")
+            if isinstance(subval, dict) and subval:
+                lines.append(f"  {sub}:")
+                for k2, v2 in subval.items():
+                    lines.append(f"    {k2}: {_yaml_value(v2)}")
+            else:
+                lines.append(f"  {sub}: {_yaml_value(subval)}")
+    return "\n".join(lines) + "\n"
