@@ -87,3 +87,17 @@ def test_build_quartz_interface_vashishta_seed():
     interface, report = build_quartz_interface(PotentialSpec(intra="vashishta"), 6, source="seed")
     assert all(v["dense"] for v in report["interface_verification"].values())
     assert fixed_mask(interface).sum() == 12
+
+
+@pytest.mark.parametrize("intra", ["vashishta", "tersoff"])
+def test_shipped_chgnet_slab_is_dense_and_survives_relaxation(intra):
+    from flatcontact.structures.build import load_shipped_dense_slab
+    from flatcontact.structures.dense import relax
+
+    slab, provenance = load_shipped_dense_slab()
+    assert provenance["verification"]["dense"] and "CHGNet" in provenance["model"]
+    assert verify_dense_slab(slab)["dense"]
+    spec = PotentialSpec(intra=intra)
+    relax(slab, _single_slab_calculator(spec)(slab))
+    verdict = verify_dense_slab(slab)
+    assert verdict["dense"], verdict["failures"]
