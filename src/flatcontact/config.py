@@ -327,7 +327,9 @@ class RunConfig(_Section):
     preset: Literal["quick", "paper"] = Field(
         "quick", description="preset the values below were resolved from"
     )
-    structure: StructureConfig = Field(default_factory=StructureConfig)
+    structure: StructureConfig = Field(
+        default_factory=StructureConfig, description="the interface to build (stage build)"
+    )
     potential: PotentialSpec = Field(
         default_factory=PotentialSpec,
         description="intra-slab model + cross-interface TS-vdW LJ (flatcontact.potentials)",
@@ -336,12 +338,24 @@ class RunConfig(_Section):
         None, description="a whole-interface ASE calculator used instead of 'potential'"
     )
     scan: ScanConfig = Field(
-        default_factory=lambda: ScanConfig(p_range_gpa=PressureRange(lo_gpa=-0.5, hi_gpa=3.5, n=8))
+        default_factory=lambda: ScanConfig(
+            p_range_gpa=PressureRange(lo_gpa=-1.2, hi_gpa=4.5, n=12)
+        ),
+        description="the ISPES grid (stage scan)",
     )
-    analysis: AnalysisConfig = Field(default_factory=AnalysisConfig)
-    elastic: ElasticConfig = Field(default_factory=ElasticConfig)
-    contact: ContactConfig = Field(default_factory=ContactConfig)
-    report: ReportConfig = Field(default_factory=ReportConfig)
+    analysis: AnalysisConfig = Field(
+        default_factory=AnalysisConfig,
+        description="constant-pressure ISPES, paths, τ, σ and load laws (stages analyze, laws)",
+    )
+    elastic: ElasticConfig = Field(
+        default_factory=ElasticConfig, description="optional self-consistent E*, G* (stage elastic)"
+    )
+    contact: ContactConfig = Field(
+        default_factory=ContactConfig, description="modified Mindlin contact (stage contact)"
+    )
+    report: ReportConfig = Field(
+        default_factory=ReportConfig, description="the HTML report and figures (stage report)"
+    )
 
     @model_validator(mode="after")
     def _cross(self) -> RunConfig:

@@ -99,57 +99,72 @@ def _save_figure(fig, stem: Path, svg: bool) -> list[Path]:
 # --------------------------------------------------------------------------- figures of this module
 
 
+def _draw_atoms(
+    ax, xy: np.ndarray, symbols, depth: np.ndarray, palette: dict, scale: float
+) -> None:
+    """Atoms as circles in data units (covalent radius × ``scale``), far ones drawn first."""
+    from ase.data import atomic_numbers, covalent_radii
+    from matplotlib.patches import Circle
+
+    for i in np.argsort(depth):
+        r = scale * covalent_radii[atomic_numbers[symbols[i]]]
+        ax.add_patch(
+            Circle(xy[i], r, facecolor=palette.get(symbols[i], "#999999"), edgecolor="k", lw=0.5)
+        )
+
+
 def figure_interface(atoms):
-    """Fig. 1 style: (a) side view of the interface (3 cells wide) with surfaces 1–4 marked,
-    (b) top view of slab 1's inner face (surface 2) over 4×4 cells. Si blue, O red."""
+    """Fig. 1 style: (a) side view of the interface (3 cells along a1, seen along y) with
+    surfaces 1–4 marked, (b) top view of slab 1's inner face (surface 2) over 4×4 cells
+    with the primitive cell dashed. Si blue, O red (other elements grey)."""
     import matplotlib.pyplot as plt
-    from ase.data import covalent_radii
-    from ase.visualize.plot import plot_atoms
 
     palette = {"Si": "#3b6ea5", "O": "#d62728"}
-    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 5.2), gridspec_kw={"width_ratios": [1, 1.2]})
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 5.5), gridspec_kw={"width_ratios": [1, 1.3]})
+    cell = atoms.cell.array
     side = atoms.repeat((3, 1, 1))
-    colors = [palette.get(s, "#999999") for s in side.get_chemical_symbols()]
-    radii = 0.6 * covalent_radii[side.numbers]
-    plot_atoms(side, ax, rotation="-90x", colors=colors, radii=radii)
-    ax.set_title("(a) interface, side view (slab 1 below, slab 2 above)")
-    ax.set_xlabel("x (Å)")
-    ax.set_ylabel("z (Å)")
-    z = atoms.positions[:, 2]
+    pos = side.positions
+    _draw_atoms(ax, pos[:, [0, 2]], side.get_chemical_symbols(), -pos[:, 1], palette, 0.55)
     surface = atoms.arrays["surface"]
-    zmin = z.min() - radii.max()
-    for tag in (1, 2, 3, 4):
+    z = atoms.positions[:, 2]
+    x_lo, x_hi = pos[:, 0].min() - 1.5, pos[:, 0].max() + 1.5
+    for tag, color in ((1, "0.6"), (2, "tab:green"), (3, "tab:purple"), (4, "0.6")):
         sel = surface == tag
         if np.any(sel):
-            ax.annotate(
-                f"surface {tag}",
-                xy=(0, float(z[sel].mean() - zmin)),
-                xytext=(-6, 0),
-                textcoords="offset points",
-                ha="right",
+            zt = float(z[sel].mean())
+            ax.axhline(zt, color=color, lw=0.8, ls="--")
+            ax.text(
+                x_hi + 0.3,
+                zt,
+                f"surface {tag}" + (" (fixed)" if tag in (1, 4) else ""),
                 va="center",
                 fontsize=8,
+                color="k",
             )
+    ax.set_xlim(x_lo, x_hi + 7)
+    ax.set_ylim(z.min() - 2, z.max() + 2)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (Å)")
+    ax.set_ylabel("z (Å)")
+    ax.set_title("(a) side view: slab 1 below, slab 2 above")
     face = atoms[(atoms.arrays["slab"] == 1) & (surface == 2)]
     top = face.repeat((4, 4, 1))
-    colors = [palette.get(s, "#999999") for s in top.get_chemical_symbols()]
-    plot_atoms(top, bx, colors=colors, radii=0.6 * covalent_radii[top.numbers])
-    cell = atoms.cell.array
-    corners = np.array([[0, 0], cell[0][:2], cell[0][:2] + cell[1][:2], cell[1][:2], [0, 0]])
-    bx.plot(
-        corners[:, 0] - top.positions[:, 0].min() + 0.6 * covalent_radii.max(),
-        corners[:, 1] - top.positions[:, 1].min() + 0.6 * covalent_radii.max(),
-        "k--",
-        lw=0.8,
-    )
-    bx.set_title("(b) top view of the inner face of slab 1 (surface 2); dashed: primitive cell")
+    tp = top.positions
+    _draw_atoms(bx, tp[:, :2], top.get_chemical_symbols(), tp[:, 2], palette, 0.55)
+    a1, a2 = cell[0][:2], cell[1][:2]
+    origin = a1 + a2
+    corners = np.array([origin, origin + a1, origin + a1 + a2, origin + a2, origin])
+    bx.plot(corners[:, 0], corners[:, 1], "k--", lw=1.2, label="primitive cell")
+    bx.set_xlim(tp[:, 0].min() - 1.5, tp[:, 0].max() + 1.5)
+    bx.set_ylim(tp[:, 1].min() - 1.5, tp[:, 1].max() + 1.5)
+    bx.set_aspect("equal")
     bx.set_xlabel("x (Å)")
     bx.set_ylabel("y (Å)")
+    bx.set_title("(b) top view of the inner face of slab 1 (surface 2)")
     for key, col in palette.items():
         if key in atoms.get_chemical_symbols():
             bx.plot([], [], "o", color=col, label=key)
-    if bx.get_legend_handles_labels()[0]:
-        bx.legend(loc="upper right", fontsize=8)
+    bx.legend(loc="upper left", fontsize=8)
     fig.tight_layout()
     return fig
 
