@@ -1,0 +1,307 @@
+"""End to end on a tiny configuration (Vashishta α-quartz dense interface, 6×6×6 grid).
+
+One run (module fixture) goes through every stage; the tests check its files and
+their physical sanity, then rerun it: unchanged → every stage skipped; one setting
+changed → exactly the dependent stages rerun; kill -9 in the middle of the scan →
+the rerun keeps every finished point and matches the uninterrupted run; corrupt or
+foreign stores, records and run directories are refused with one line.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from flatcontact.config import build_config
+from flatcontact.errors import InputError
+from flatcontact.ispes.contract import open_ispes
+from flatcontact.pipeline import STAGES, Pipeline
+
+TINY = {
+    "structure": {"kind": "quartz-dense", "layers": 5, "source": "seed"},
+    "potential": {"intra": "vashishta"},
+    "scan": {
+        "grid": [6, 6],
+        "p_range_gpa": {"lo_gpa": -1.2, "hi_gpa": 3.5, "n": 6},
+        "executor": "serial",
+    },
+    "analysis": {"p_gpa": [0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0]},
+    "contact": {"p0_gpa": [0.5, 1.0, 2.0]},
+    "report": {"svg": False},
+}
+
+
+def _merge(base: dict, change: dict) -> dict:
+    out = json.loads(json.dumps(base))
+    for key, value in change.items():
+        out[key] = {**out.get(key, {}), **value} if isinstance(value, dict) else value
+    return out
+
+
+def _actions(pipe: Pipeline) -> dict[str, str]:
+    return {name: res.action for name, res in pipe.results.items()}
+
+
+@pytest.fixture(scope="module")
+def tiny_run(tmp_path_factory):
+    root = tmp_path_factory.mktemp("run") / "tiny"
+    with Pipeline(build_config(TINY), root) as pipe:
+        report = pipe.run()
+        actions = _actions(pipe)
+    return root, report, actions
+
+
+def test_every_stage_ran_and_wrote_its_files(tiny_run):
+    root, report, actions = tiny_run
+    assert actions == {n: "ran" for n in STAGES if n != "elastic"}
+    expected = {
+        "01-build": ["interface.extxyz", "build.json", "fig1_interface.png"],
+        "02-scan": ["points.db", "ispes.nc", "scan.json", "fig_scan_columns.png"],
+        "03-analyze": ["friction.csv", "friction.nc", "analyze.json", "fig2_p1gpa.png"],
+        "04-laws": ["laws.json", "fig3_laws.png"],
+        "06-contact": [
+            "contact.nc",
+            "summary.json",
+            "fig4_traction.png",
+            "fig5_force_stiffness.png",
+        ],
+        "07-report": ["report.html"],
+    }
+    for folder, files in expected.items():
+        for name in files:
+            assert (root / folder / name).is_file(), f"{folder}/{name}"
+        record = json.loads((root / folder / "stage.json").read_text())
+        assert record["state"] == "done"
+    for name in ("run.json", "config.yaml", "versions.json", "run.log", "report.html"):
+        assert (root / name).is_file()
+    assert report == root / "report.html"
+    log = (root / "run.log").read_text()
+    assert "stage scan: done" in log and "stage report: done" in log
+
+
+def test_scan_is_physical(tiny_run):
+    root, _, _ = tiny_run
+    ds = open_ispes(root / "02-scan" / "ispes.nc")
+    assert bool(ds["converged"].all())
+    assert np.all(np.isfinite(ds["energy"].values))
+    p = ds["normal_stress"].values  # (shift_a, shift_b, thickness), z ascending
+    assert np.all(np.diff(ds["thickness"].values) > 0)
+    # the load rises as the slabs are pressed together, at every stacking
+    assert np.all(np.diff(p, axis=-1) < 0)
+    assert p.max() > 3.0 and p.min() < 0.0
+    scan = json.loads((root / "02-scan" / "scan.json").read_text())
+    adh = scan["adhesion"]
+    assert adh["separated"]
+    # work of separation: energy difference and -∫p dz agree (both J/m², positive)
+    assert adh["work_of_separation_j_per_m2"] > 0
+    assert adh["work_of_separation_integral_j_per_m2"] == pytest.approx(
+        adh["work_of_separation_j_per_m2"], rel=0.02
+    )
+
+
+def test_friction_and_laws_are_physical(tiny_run):
+    root, _, _ = tiny_run
+    table = Pipeline(build_config(TINY), root).friction_table()
+    assert list(table["p_gpa"]) == TINY["analysis"]["p_gpa"]
+    tau, sigma = table["tau_mpa"].to_numpy(), table["sigma_mss_mpa"].to_numpy()
+    assert np.all(np.isfinite(tau)) and np.all(np.isfinite(sigma))
+    assert np.all(sigma > 0)
+    # static exceeds kinetic: the largest resisting force bounds the mean dissipated one
+    assert np.all(tau >= sigma)
+    laws = json.loads((root / "04-laws" / "laws.json").read_text())
+    for key in ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa"):
+        assert laws[key] is not None and np.isfinite(laws[key])
+    assert laws["n_points_tau"] == 7 and laws["p_max_gpa"] == 3.0
+    # the fitted lines pass through the data they were fitted to (least squares: mean residual 0)
+    p = table["p_gpa"].to_numpy()
+    resid = tau - (laws["k_mpa_per_gpa"] * p + laws["tau0_mpa"])
+    assert abs(resid.mean()) < 1e-6 * np.abs(tau).max()
+
+
+def test_contact_uses_the_fitted_laws(tiny_run):
+    root, _, _ = tiny_run
+    summary = json.loads((root / "06-contact" / "summary.json").read_text())
+    laws = json.loads((root / "04-laws" / "laws.json").read_text())
+    params, prov = summary["parameters"], summary["provenance"]
+    for key in ("k_mpa_per_gpa", "tau0_mpa", "sigma0_mpa"):
+        assert prov[key] == "fitted laws"
+        assert params[key] == pytest.approx(laws[key])
+    scan = json.loads((root / "02-scan" / "scan.json").read_text())
+    assert params["work_of_adhesion_j_m2"] == pytest.approx(
+        scan["adhesion"]["work_of_separation_j_per_m2"]
+    )
+    with xr.open_dataset(root / "06-contact" / "contact.nc", engine="h5netcdf") as ds:
+        assert list(ds["p0"].values) == TINY["contact"]["p0_gpa"]
+        q = ds["lateral_force"].values
+        assert np.all(np.isfinite(q)) and np.all(q >= 0)
+    for rec in summary["results"]:
+        # Q_peak/πa² lies between the slip friction at the edge and τ at the centre
+        p0 = rec["p0_gpa"]
+        tau_centre = params["k_mpa_per_gpa"] * p0 + params["tau0_mpa"]
+        assert params["sigma0_mpa"] < rec["effective_shear_strength_mpa"] < tau_centre
+
+
+def test_report_is_self_contained_and_compares_with_the_paper(tiny_run):
+    root, _, _ = tiny_run
+    html = (root / "report.html").read_text()
+    assert html.count("data:image/png;base64,") >= 7
+    assert "http://" not in html and "https://" not in html
+    for text in ("4.52", "26.7", "0.21", "11.1", "work of separation", "vashishta"):
+        assert text in html
+
+
+def test_rerun_skips_every_stage(tiny_run):
+    root, _, _ = tiny_run
+    before = {p: p.stat().st_mtime_ns for p in root.glob("0*/*") if p.is_file()}
+    with Pipeline(build_config(TINY), root) as pipe:
+        pipe.run()
+        assert set(_actions(pipe).values()) == {"skipped"}
+    after = {p: p.stat().st_mtime_ns for p in root.glob("0*/*") if p.is_file()}
+    assert before == after
+
+
+@pytest.mark.parametrize(
+    ("change", "rerun"),
+    [
+        ({"analysis": {"threshold_gpa": 2.0}}, {"laws", "contact", "report"}),
+        ({"contact": {"p0_gpa": [1.0, 1.77]}}, {"contact", "report"}),
+        ({"report": {"title": "another title"}}, {"report"}),
+        ({"scan": {"workers": 2, "executor": "processes"}}, set()),  # how, not what
+    ],
+)
+def test_a_change_reruns_exactly_the_dependent_stages(tiny_run, tmp_path, change, rerun):
+    import shutil
+
+    src, _, _ = tiny_run
+    root = tmp_path / "copy"
+    shutil.copytree(src, root)
+    with Pipeline(build_config(_merge(TINY, change)), root) as pipe:
+        pipe.run()
+        actions = _actions(pipe)
+    assert {n for n, a in actions.items() if a != "skipped"} == rerun
+    assert all(actions[n] == "ran" for n in rerun)
+
+
+def test_foreign_or_corrupt_run_directories_are_refused(tiny_run, tmp_path):
+    import shutil
+
+    cfg = build_config(TINY)
+    foreign = tmp_path / "foreign"
+    foreign.mkdir()
+    (foreign / "notes.txt").write_text("mine")
+    with pytest.raises(InputError, match="not a flatcontact run directory"):
+        Pipeline(cfg, foreign)
+    src, _, _ = tiny_run
+    root = tmp_path / "copy"
+    shutil.copytree(src, root)
+    (root / "run.json").write_text("{not json")
+    with pytest.raises(InputError, match="corrupt run marker"):
+        Pipeline(cfg, root)
+    (root / "run.json").write_text(json.dumps({"format": "flatcontact.run/1"}))
+    (root / "03-analyze" / "stage.json").write_text("garbage")
+    with Pipeline(cfg, root) as pipe, pytest.raises(InputError, match="corrupt stage record"):
+        pipe.run()
+
+
+def test_corrupt_or_foreign_point_store_is_refused(tiny_run, tmp_path):
+    import shutil
+
+    src, _, _ = tiny_run
+    cfg = build_config(TINY)
+    root = tmp_path / "copy"
+    shutil.copytree(src, root)
+    record = root / "02-scan" / "stage.json"
+    rec = json.loads(record.read_text())
+    rec["state"] = "running"  # as if interrupted: the next run resumes from the store
+    record.write_text(json.dumps(rec))
+    (root / "02-scan" / "points.db").write_bytes(b"this is not sqlite" * 100)
+    with Pipeline(cfg, root) as pipe, pytest.raises(InputError, match=r"points\.db") as info:
+        pipe.run()
+    assert "\n" not in str(info.value)
+    # a store from another grid, dropped into this run's scan folder
+    other = tmp_path / "other"
+    with Pipeline(build_config(_merge(TINY, {"scan": {"grid": [2, 2]}})), other) as pipe:
+        pipe.scan()
+    shutil.copyfile(other / "02-scan" / "points.db", root / "02-scan" / "points.db")
+    with (
+        Pipeline(cfg, root) as pipe,
+        pytest.raises(InputError, match="different settings") as info,
+    ):
+        pipe.run()
+    assert "grid" in str(info.value)
+
+
+def _rows(db: Path) -> int:
+    try:
+        with sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=0.1) as con:
+            return int(con.execute("select count(*) from systems").fetchone()[0])
+    except sqlite3.Error:
+        return 0
+
+
+def _points(db: Path) -> dict:
+    import ase.db
+
+    with ase.db.connect(str(db)) as con:
+        return {(r.i_a, r.i_b, r.i_z): (r.energy, r.normal_stress_gpa) for r in con.select()}
+
+
+def test_kill_9_mid_scan_then_rerun_loses_nothing(tiny_run, tmp_path):
+    src, _, _ = tiny_run
+    data = _merge(
+        TINY,
+        {"structure": {"kind": "file", "file": str(src / "01-build" / "interface.extxyz")}},
+    )
+    cfg_path = tmp_path / "run.yaml"
+    cfg_path.write_text(json.dumps(data))  # JSON is YAML
+    root = tmp_path / "killed"
+    code = (
+        "import sys; from flatcontact.cli import main; "
+        f"main(['run', {str(cfg_path)!r}, '--out', {str(root)!r}])"
+    )
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        env={**os.environ, "OMP_NUM_THREADS": "1"},
+    )
+    db = root / "02-scan" / "points.db"
+    total = 6 * 6 * 6
+    deadline = time.monotonic() + 120
+    while _rows(db) < total // 3 and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    stored = _points(db)
+    assert 0 < len(stored) < total, "the kill did not land in the middle of the scan"
+    assert json.loads((root / "02-scan" / "stage.json").read_text())["state"] == "running"
+
+    from flatcontact.config import load_config
+
+    with Pipeline(load_config(cfg_path), root) as pipe:
+        pipe.run()
+        actions = _actions(pipe)
+    assert actions["build"] == "skipped" and actions["scan"] == "resumed"
+    scan = json.loads((root / "02-scan" / "scan.json").read_text())
+    assert scan["points_computed_last_attempt"] == total - len(stored)  # nothing recomputed
+    after = _points(db)
+    assert {k: after[k] for k in stored} == stored  # nothing finished was lost or changed
+    ref = open_ispes(src / "02-scan" / "ispes.nc")
+    got = open_ispes(root / "02-scan" / "ispes.nc")
+    np.testing.assert_allclose(got["energy"].values, ref["energy"].values, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(
+        got["normal_stress"].values, ref["normal_stress"].values, rtol=0, atol=1e-5
+    )
+    laws_ref = json.loads((src / "04-laws" / "laws.json").read_text())
+    laws_got = json.loads((root / "04-laws" / "laws.json").read_text())
+    assert laws_got["tau0_mpa"] == pytest.approx(laws_ref["tau0_mpa"], abs=1e-3)
