@@ -18,9 +18,15 @@ Groups (``info["config_type"]``):
     snapshots of NVT MD with the Vashishta (1990) potential at 300-1500 K
     (bulk quartz 2x2x2 and stishovite), LAMMPS, 1 fs steps.
 ``slab``
-    (0001) quartz slabs (2 cells thick, 1x1 and 2x1 in-plane, 15 Å vacuum) cut
-    at every distinct height, Vashishta-annealed snapshots and frames of the
-    teacher's relaxation towards the dense reconstructed surface.
+    (0001) quartz slabs cut at each of the three distinct cleavage planes
+    (:mod:`flatcontact.structures.slab`, 6 layers 1x1 and 4 layers 2x1, 10 Å
+    vacuum): Vashishta-annealed snapshots (600, 1200 K) and frames of the teacher's
+    relaxations (bond-broken, under-coordinated surfaces).
+``dense_slab``
+    the dense reconstructed (0001) surface (:mod:`flatcontact.structures.dense`
+    seeds, Vashishta pre-relaxed and verified): teacher relaxation frames,
+    Vashishta MD snapshots at 300/600/900 K (1x1 and 2x2) with teacher relaxations
+    of them, and ±2 % in-plane strained slabs.
 ``defect``
     vacancies (non-stoichiometric, they also separate the Si and O reference
     energies), stretched/broken Si-O bonds (pairs pulled 0.2-1.0 Å apart; no
@@ -51,8 +57,10 @@ MIN_CONTACT_ANGSTROM = 1.35
 
 
 def alpha_quartz() -> Atoms:
-    """alpha-quartz unit cell (9 atoms)."""
-    return build_polymorph("alpha_quartz")
+    """alpha-quartz unit cell (9 atoms, :func:`flatcontact.structures.bulk.alpha_quartz`)."""
+    from flatcontact.structures.bulk import alpha_quartz as _alpha_quartz
+
+    return _alpha_quartz()
 
 
 def strain_cell(atoms: Atoms, voigt_strain: np.ndarray) -> Atoms:
@@ -66,32 +74,39 @@ def strain_cell(atoms: Atoms, voigt_strain: np.ndarray) -> Atoms:
     return out
 
 
-def quartz_slab(
-    shift: float, repeats: tuple[int, int] = (1, 1), cells: int = 2, vacuum: float = 15.0
-) -> Atoms:
-    """(0001) alpha-quartz slab cut at fractional height ``shift`` of the c axis.
+def quartz_slab(cut: int, layers: int = 6, repeats: tuple[int, int] = (1, 1)) -> Atoms:
+    """(0001) alpha-quartz slab (:func:`flatcontact.structures.slab.quartz_0001_slab`), periodic in z."""
+    from flatcontact.structures.slab import quartz_0001_slab
 
-    The slab is ``cells`` unit cells thick, ``repeats`` in-plane, with ``vacuum``
-    Å of vacuum along z (still periodic, as training frames must be).
-    """
-    q = alpha_quartz()
-    s = q.get_scaled_positions()
-    s[:, 2] = (s[:, 2] - shift) % 1.0
-    q.set_scaled_positions(s)
-    slab = q.repeat((repeats[0], repeats[1], cells))
-    cell = np.asarray(slab.cell).copy()
-    cell[2] = [0.0, 0.0, cell[2, 2] + vacuum]
-    slab.set_cell(cell, scale_atoms=False)
-    slab.positions[:, 2] += vacuum / 2
-    slab.wrap()
+    slab = quartz_0001_slab(layers=layers, cut=cut).repeat((*repeats, 1))
+    slab.pbc = True
     return slab
 
 
-def slab_cut_heights() -> list[float]:
-    """Fractional heights between consecutive distinct atomic planes of quartz along c."""
-    z = np.unique(np.round(alpha_quartz().get_scaled_positions()[:, 2] % 1.0, 4))
-    gaps = np.diff(np.append(z, z[0] + 1.0))
-    return [float((zi + g / 2) % 1.0) for zi, g in zip(z, gaps, strict=True)]
+def dense_slabs(calc_pre, max_distinct: int = 3, layers: int = 6) -> list[Atoms]:
+    """Seeded dense (0001) slabs that ``calc_pre`` relaxes to a verified dense surface.
+
+    Seeds: :func:`flatcontact.structures.dense.dense_candidates`; energies equal within
+    0.1 meV are symmetry duplicates and kept once.
+    """
+    from flatcontact.structures.build import SYMMETRIC_CUT
+    from flatcontact.structures.dense import dense_candidates, relax, verify_dense_slab
+    from flatcontact.structures.slab import quartz_0001_slab
+
+    out, energies = [], []
+    for _, seeded in dense_candidates(quartz_0001_slab(layers=layers, cut=SYMMETRIC_CUT)):
+        seeded.pbc = True
+        res = relax(seeded, calc_pre, fmax_ev_per_angstrom=0.02, steps=2000)
+        if not verify_dense_slab(seeded)["dense"]:
+            continue
+        if any(abs(res["energy_ev"] - e) < 1e-4 for e in energies):
+            continue
+        energies.append(res["energy_ev"])
+        seeded.calc = None
+        out.append(seeded)
+        if len(out) == max_distinct:
+            break
+    return out
 
 
 def vashishta_md(
@@ -227,16 +242,46 @@ def sio2_recipe(
 
     say("slab")
     frames = []
-    for k, h in enumerate(slab_cut_heights()):
-        slab = quartz_slab(h)
-        md = vashishta_md(slab, 1200.0, n_frames=2, stride=2000, seed=seed + 101 + k, equil=1000)
+    for cut in (0, 1, 2):
+        slab = quartz_slab(cut)
+        md = vashishta_md(slab, 1200.0, n_frames=2, stride=2000, seed=seed + 101 + cut, equil=1000)
         frames += md
         frames += _relax_frames(slab, calc, fmax=0.03, steps=250, every=25)
         frames += _relax_frames(md[-1], calc, fmax=0.03, steps=250, every=25)
-    for h in slab_cut_heights()[::2]:
-        slab = quartz_slab(h, repeats=(2, 1))
-        frames += vashishta_md(slab, 600.0, n_frames=2, stride=1000, seed=seed + 201, equil=500)
+        frames += vashishta_md(
+            quartz_slab(cut, layers=4, repeats=(2, 1)),
+            600.0,
+            n_frames=2,
+            stride=1000,
+            seed=seed + 201 + cut,
+            equil=500,
+        )
     add(frames, "slab")
+
+    say("dense_slab")
+    from flatcontact.training.lammps_bulk import vashishta_calculator
+
+    frames = []
+    starts = dense_slabs(vashishta_calculator())
+    relaxed = []
+    for start in starts:
+        traj = _relax_frames(start, calc, fmax=0.02, steps=300, every=20)
+        frames += traj
+        relaxed.append(traj[-1])
+    if relaxed:
+        d0 = relaxed[0]
+        for k, t in enumerate((300.0, 600.0, 900.0)):
+            md = vashishta_md(d0, t, n_frames=n(3), stride=500, seed=seed + 301 + k, equil=500)
+            frames += md
+            frames += _relax_frames(md[-1], calc, fmax=0.03, steps=200, every=25)
+        for e in (-0.02, 0.02):
+            frames += _relax_frames(
+                strain_cell(d0, np.array([e, e, 0, 0, 0, 0])), calc, fmax=0.02, steps=200, every=50
+            )
+        frames += vashishta_md(
+            d0.repeat((2, 2, 1)), 300.0, n_frames=n(3), stride=500, seed=seed + 401
+        )
+    add(frames, "dense_slab")
 
     say("defect")
     frames = []

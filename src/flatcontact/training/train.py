@@ -28,8 +28,19 @@ from flatcontact.training.snapfiles import write_snap_files
 from flatcontact.units import EV_PER_A3_TO_GPA
 
 ELEMENTS = ("Si", "O")
-#: Extra weight of the groups that carry bulk alpha-quartz elasticity and EOS.
-DEFAULT_GROUP_WEIGHTS = {"quartz_relaxed_strain": 3.0, "quartz_pressure": 2.0}
+#: Row weights per group: up for what the ISPES scan and the contact moduli rely on
+#: (bulk alpha-quartz elasticity and EOS, the dense surface, configurations the SNAP
+#: itself visits), down for the far-from-equilibrium groups that a linear SNAP cannot
+#: fit as well (annealed cut slabs, 1500 K MD, defects).
+DEFAULT_GROUP_WEIGHTS = {
+    "quartz_relaxed_strain": 3.0,
+    "quartz_pressure": 2.0,
+    "dense_slab": 2.0,
+    "active": 3.0,
+    "slab": 0.5,
+    "md": 0.7,
+    "defect": 0.5,
+}
 
 
 def package_versions() -> dict:
@@ -45,8 +56,8 @@ def package_versions() -> dict:
 
 def build_recipe_dataset(
     recipe: str, seed: int, label: str, scale: float, say: Callable[[str], None]
-) -> tuple[list, dict]:
-    """Generate and label the recipe's frames; return (frames, info with timings)."""
+) -> tuple[list, dict, object]:
+    """Generate and label the recipe's frames; return (frames, info with timings, teacher)."""
     from flatcontact.training.label import label_frames, teacher_calculator, teacher_info
     from flatcontact.training.recipe import RECIPES, sio2_recipe
 
@@ -66,6 +77,7 @@ def build_recipe_dataset(
 
     labelled = label_frames(frames, calc, progress=prog)
     t2 = time.perf_counter()
+    info_calc = calc
     info = {
         **teacher_info(label),
         "recipe": recipe,
@@ -74,7 +86,7 @@ def build_recipe_dataset(
         "recipe_s": t1 - t0,
         "labelling_s": t2 - t1,
     }
-    return labelled, info
+    return labelled, info, info_calc
 
 
 def parity_plot(result: FitResult, path: Path, split: str = "test") -> Path:
@@ -107,6 +119,55 @@ def parity_plot(result: FitResult, path: Path, split: str = "test") -> Path:
     return path
 
 
+def _active_learning(frames, result, teacher, settings_grid, seed, n_rounds, out, say):
+    """Rounds of probe -> label -> refit with the chosen descriptor hyper-parameters."""
+    import tempfile
+
+    from flatcontact.training.active import probe_frames
+    from flatcontact.training.fit import split_indices
+    from flatcontact.training.label import label_frames
+    from flatcontact.training.lammps_bulk import snap_calculator
+
+    frames = list(frames)
+    split = {k: list(v) for k, v in result.split.items()}
+    rounds = []
+    for r in range(n_rounds):
+        with tempfile.TemporaryDirectory(dir=out) as tmp:
+            coeff, param = write_snap_files(Path(tmp) / "round", result.coefficients)
+            t0 = time.perf_counter()
+            new = probe_frames(snap_calculator(coeff, param), seed=seed + 17 * (r + 1))
+        t1 = time.perf_counter()
+        new = label_frames(new, teacher)
+        t2 = time.perf_counter()
+        part = split_indices([a.info["config_type"] for a in new], seed + 31 * (r + 1))
+        for k, idx in part.items():
+            split[k] += [len(frames) + int(i) for i in idx]
+        frames += new
+        say(
+            f"active round {r + 1}: +{len(new)} frames (probe {t1 - t0:.0f} s, label {t2 - t1:.0f} s)"
+        )
+        result = fit_snap(
+            frames,
+            ELEMENTS,
+            [result.coefficients.hyper],
+            settings_grid,
+            split={k: np.array(sorted(v)) for k, v in split.items()},
+            progress=say,
+        )
+        rounds.append(
+            {
+                "round": r + 1,
+                "new_frames": len(new),
+                "probe_s": t1 - t0,
+                "label_s": t2 - t1,
+                "test_errors": {
+                    k: v for k, v in result.errors["test"].items() if k != "by_config_type"
+                },
+            }
+        )
+    return frames, result, rounds
+
+
 def train_snap(
     out: str | Path,
     data: str | Path | None = None,
@@ -118,11 +179,15 @@ def train_snap(
     hypers=None,
     settings_grid=None,
     quadratic: bool = False,
+    active_rounds: int = 2,
     command: str = "",
     progress: Callable[[str], None] | None = None,
 ) -> dict:
     """Train a SNAP from ``data`` (extxyz) or ``recipe`` labelled by ``label``; write ``out``.
 
+    With a recipe (a teacher at hand), ``active_rounds`` rounds of active learning
+    follow the first fit (:mod:`.active`): frames from the SNAP's own relaxations and
+    MD are labelled and added, and the SNAP is refitted with the chosen descriptor.
     Returns the fit report (also written to ``out/fit_report.json``).
     """
     say = progress or (lambda msg: None)
@@ -130,17 +195,25 @@ def train_snap(
         raise InputError("give exactly one of --data FILE.extxyz or --recipe NAME")
     out = Path(out)
     t_start = time.perf_counter()
+    teacher = None
     if data is not None:
         frames = read_dataset(data, ELEMENTS)
         info = {"dataset_file": str(data), "seed": seed}
         say(f"read {len(frames)} frames from {data}")
     else:
-        frames, info = build_recipe_dataset(recipe, seed, label, scale, say)
+        frames, info, teacher = build_recipe_dataset(recipe, seed, label, scale, say)
         write_dataset(frames, out / "dataset.extxyz")
     hypers = hypers or default_hypers(ELEMENTS, quadratic=quadratic)
     settings_grid = settings_grid or default_settings(DEFAULT_GROUP_WEIGHTS)
     t0 = time.perf_counter()
     result = fit_snap(frames, ELEMENTS, hypers, settings_grid, seed=seed, progress=say)
+    search = list(result.search)
+    rounds = []
+    if teacher is not None:
+        frames, result, rounds = _active_learning(
+            frames, result, teacher, settings_grid, seed, active_rounds, out, say
+        )
+        write_dataset(frames, out / "dataset.extxyz")
     fit_s = time.perf_counter() - t0
     header = f"flatcontact SNAP '{name}' for {' '.join(ELEMENTS)}; trained on {info.get('recipe') or info.get('dataset_file')}"
     coeff, param = write_snap_files(out / name, result.coefficients, header=header)
@@ -152,7 +225,8 @@ def train_snap(
         "settings": result.settings.as_dict(),
         "errors": result.errors,
         "split_sizes": {k: len(v) for k, v in result.split.items()},
-        "search": result.search,
+        "search": search,
+        "active_learning": rounds,
         "timings_s": {**result.timings, "fit_total_s": fit_s},
     }
     write_json_atomic(out / "fit_report.json", report)

@@ -253,7 +253,11 @@ def validate_potential(
 ) -> dict:
     """Run every check for ``calc`` (and ``reference_calc``); return a JSON-ready report."""
     say = progress or (lambda msg: None)
-    report: dict = {"potential_label": label, "reference_label": reference_label, "targets": TARGETS}
+    report: dict = {
+        "potential_label": label,
+        "reference_label": reference_label,
+        "targets": TARGETS,
+    }
     t0 = time.perf_counter()
     if frames:
         say(f"held-out errors on {len(frames)} frames")
