@@ -351,11 +351,18 @@ class Pipeline:
         say = self.console.print if self.console is not None else (lambda *a, **k: None)
         index = STAGES[name]
         say(f"[bold]{index}. {name}[/]", highlight=False)
-        if self.console is not None and name != "scan":
-            with self.console.status(f"{name} ..."):
+        try:
+            if self.console is not None and name != "scan":
+                with self.console.status(f"{name} ..."):
+                    result = self.rundir.run_stage(index, name, inputs, work)
+            else:
                 result = self.rundir.run_stage(index, name, inputs, work)
-        else:
-            result = self.rundir.run_stage(index, name, inputs, work)
+        except KeyboardInterrupt:
+            log.warning("stage %s: interrupted; rerun to resume", name)
+            raise
+        except Exception as exc:
+            log.error("stage %s: failed: %s", name, exc)
+            raise
         self.results[name] = result
         detail = {"skipped": "unchanged, skipped", "resumed": "resumed", "ran": "done"}[
             result.action
@@ -1044,14 +1051,22 @@ def build_report(pipe: Pipeline, path: Path) -> Path:
 
     # ---- interface
     rel = build.get("interface_relaxation", {})
+    checks = build.get("interface_verification") or {}
+    verified = bool(checks) and all(v.get("dense") for v in checks.values())
     sections.append(
         Section(
             "1. Interface",
             paragraphs=[
                 f"{build.get('n_atoms', '?')} atoms; reference thickness z = {_fmt(build.get('thickness_angstrom'))} Å"
                 + (
-                    f"; interface relaxed to {_fmt(rel.get('fmax_ev_per_angstrom', rel.get('max_force_ev_per_angstrom')))} eV/Å"
+                    f"; interface relaxation {'converged' if rel.get('converged') else 'NOT converged'}"
+                    f" in {rel.get('steps', '?')} steps to {cfg.structure.fmax_ev_per_angstrom:g} eV/Å"
                     if rel
+                    else ""
+                )
+                + (
+                    "; the dense surface verified on both slabs after the interface relaxation"
+                    if verified
                     else ""
                 )
                 + ". Surfaces 1 and 4 (outer faces) are held fixed during the scan; surfaces 2, 3 and the "
