@@ -18,7 +18,7 @@ $(STAMP): pyproject.toml | $(BIN)/python
 	touch $(STAMP)
 
 run: $(STAMP)
-	$(BIN)/flatcontact contact --out $(OUT)/contact
+	$(BIN)/flatcontact run --out $(OUT)
 
 test: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks
