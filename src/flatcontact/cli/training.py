@@ -26,6 +26,9 @@ def train_snap_cmd(
     seed: int = typer.Option(0, "--seed", help="Seed of the recipe and the data split."),
     scale: float = typer.Option(1.0, "--scale", help="Size factor of the recipe's random groups."),
     quadratic: bool = typer.Option(False, "--quadratic", help="Quadratic SNAP."),
+    active_rounds: int = typer.Option(
+        3, "--active-rounds", help="Active-learning rounds after the first fit (recipe runs only)."
+    ),
 ) -> None:
     """Fit a SNAP (LAMMPS .snapcoeff/.snapparam) to a dataset or a generated recipe."""
     from flatcontact.training.train import train_snap
@@ -40,6 +43,7 @@ def train_snap_cmd(
         name=name,
         scale=scale,
         quadratic=quadratic,
+        active_rounds=active_rounds,
         command=command,
         progress=_say,
     )

@@ -6,8 +6,9 @@ Groups (``info["config_type"]``):
     alpha-quartz cells (1x1x1, 2x1x1, 1x1x2) with every strain component drawn
     uniformly in ±4 % and atoms rattled (Gaussian, 0.01-0.05 Å per component).
 ``quartz_relaxed_strain``
-    alpha-quartz under single Voigt strains ±0.5 ... ±4 % with ions relaxed by
-    the teacher (these carry the relaxed-ion elastic response).
+    alpha-quartz under single Voigt strains ±0.5 ... ±4 % (unrelaxed and with ions
+    relaxed by the teacher) and under 20 random mixed strains within ±1 % (relaxed):
+    these carry the relaxed-ion elastic response.
 ``quartz_pressure``
     teacher relaxation (cell + ions) of alpha-quartz under hydrostatic
     pressure 0-10 GPa: trajectory frames and the end points.
@@ -201,6 +202,11 @@ def sio2_recipe(
             e[comp] = mag
             traj = _relax_frames(strain_cell(q0, e), calc, fmax=0.01, steps=200, every=15)
             frames += [traj[0], traj[-1]]
+    for _ in range(n(20)):  # mixed small strains, ions relaxed
+        traj = _relax_frames(
+            strain_cell(q0, rng.uniform(-0.01, 0.01, 6)), calc, fmax=0.01, steps=200, every=10**6
+        )
+        frames.append(traj[-1])
     add(frames, "quartz_relaxed_strain")
 
     say("quartz_pressure")

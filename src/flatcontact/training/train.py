@@ -33,13 +33,15 @@ ELEMENTS = ("Si", "O")
 #: itself visits), down for the far-from-equilibrium groups that a linear SNAP cannot
 #: fit as well (annealed cut slabs, 1500 K MD, defects).
 DEFAULT_GROUP_WEIGHTS = {
-    "quartz_relaxed_strain": 3.0,
-    "quartz_pressure": 2.0,
+    "quartz_relaxed_strain": 20.0,
+    "quartz_pressure": 3.0,
+    "quartz_strain": 1.0,
     "dense_slab": 2.0,
     "active": 3.0,
-    "slab": 0.5,
-    "md": 0.7,
-    "defect": 0.5,
+    "polymorph": 0.5,
+    "slab": 0.3,
+    "md": 0.5,
+    "defect": 0.3,
 }
 
 
@@ -179,7 +181,7 @@ def train_snap(
     hypers=None,
     settings_grid=None,
     quadratic: bool = False,
-    active_rounds: int = 2,
+    active_rounds: int = 3,
     command: str = "",
     progress: Callable[[str], None] | None = None,
 ) -> dict:
