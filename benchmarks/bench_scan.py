@@ -27,7 +27,7 @@ import numpy as np
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-SUBSET = (4, 4, 4)  # n_a, n_b, n_z measured here
+SUBSET = (4, 4, 8)  # n_a, n_b, n_z measured here
 TARGET = (12, 12, 8)  # the brief's target grid
 FMAX = 0.005
 
@@ -87,7 +87,7 @@ def scan_subset(reference, factory, order, workers, out):
 
     z0 = thickness(reference)
     grid = GridSpec(
-        SUBSET[0], SUBSET[1], thickness_angstrom=tuple(z0 + np.linspace(-0.4, 0.4, SUBSET[2]))
+        SUBSET[0], SUBSET[1], thickness_angstrom=tuple(z0 + np.linspace(-0.4, 0.3, SUBSET[2]))
     )
     ex = make_executor("processes", workers=workers)
     try:
@@ -99,6 +99,26 @@ def scan_subset(reference, factory, order, workers, out):
     finally:
         ex.close()
     return r, wall
+
+
+def _calls_by_start(db_path: Path) -> dict:
+    """Median force calls per point grouped by how the point was started."""
+    import ase.db
+
+    groups: dict[str, list[int]] = {}
+    rows = {(r.i_a, r.i_b, r.i_z): r for r in ase.db.connect(str(db_path)).select()}
+    for (ia, ib, _iz), row in rows.items():
+        start = tuple(int(x) for x in row.start.split(",")) if row.get("start") else None
+        if start is None:
+            kind = "cold"
+        elif start[:2] != (ia, ib):
+            kind = "lateral-parent"
+        else:
+            grand = rows[start].get("start")
+            grand = tuple(int(x) for x in grand.split(",")) if grand else None
+            kind = "z-extrapolated" if grand is not None and grand[:2] == (ia, ib) else "z-parent"
+        groups.setdefault(kind, []).append(row.force_calls)
+    return {k: f"{np.median(v):.0f} (n={len(v)})" for k, v in sorted(groups.items())}
 
 
 def main() -> None:
@@ -122,14 +142,16 @@ def main() -> None:
                 )
                 med = float(np.median(r.force_calls_computed))
                 medians[order] = med
+                by_start = _calls_by_start(Path(tmp) / f"{order}{workers}" / "points.db")
                 print(
                     f"vashishta {SUBSET[0]}x{SUBSET[1]}x{SUBSET[2]} order={order:7s} workers={workers}: "
                     f"{n_points / wall:.2f} points/s, median force calls/point {med:.0f}, "
-                    f"converged {int(r.dataset.converged.sum())}/{n_points}, wall {wall:.1f} s"
+                    f"converged {int(r.dataset.converged.sum())}/{n_points}, wall {wall:.1f} s; "
+                    f"median calls by start: {by_start}"
                 )
         print(
-            f"warm/cold median force calls: z-first {medians['z'] / medians['cold']:.2f}, "
-            f"lateral-first {medians['lateral'] / medians['cold']:.2f}"
+            f"warm/cold median force calls: columns {medians['columns'] / medians['cold']:.2f}, "
+            f"planes {medians['planes'] / medians['cold']:.2f}"
         )
         coeff = zero_snap_files(Path(tmp))
         snap = PotentialSpec(intra=f"snap:{coeff}")
