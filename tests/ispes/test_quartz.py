@@ -1,0 +1,53 @@
+"""The scan physics on an α-quartz (0001) interface with Vashishta + TS-LJ (LAMMPS engine).
+
+The interface is the relaxed cleaved 1×1 (0001) slab pair (not the verified "dense"
+reconstruction, which the builder owns); the checks are properties of the scan.
+"""
+
+import pytest
+
+from flatcontact.ispes.contract import cell_area
+from flatcontact.ispes.geometry import in_plane_vectors, thickness
+from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point
+from flatcontact.units import EV_PER_A3_TO_GPA
+
+TIGHT = RelaxSettings(fmax_ev_per_a=1e-4, optimizer="LBFGS", max_steps=5000)
+
+
+@pytest.fixture(scope="module")
+def quartz():
+    from ase.optimize import LBFGS
+
+    from flatcontact.potentials import PotentialSpec, make_calculator
+    from flatcontact.structures.interface import make_interface
+    from flatcontact.structures.slab import quartz_0001_slab
+
+    spec = PotentialSpec(intra="vashishta")
+    slab = quartz_0001_slab(layers=6, cut=0, a_angstrom=4.829, c_angstrom=5.309)
+    atoms = make_interface(slab, gap_angstrom=2.5, face_atoms=3)
+    calc = make_calculator(spec, atoms)
+    atoms.calc = calc
+    LBFGS(atoms, logfile=None).run(fmax=1e-3, steps=3000)
+    atoms.calc = None
+    return atoms, calc
+
+
+def test_quartz_load_is_minus_energy_derivative(quartz):
+    ref, calc = quartz
+    area = cell_area(*in_plane_vectors(ref))
+    z0, h = thickness(ref) - 0.2, 2e-3
+    lo, mid, hi = (
+        relax_point(ref, calc, PointTask((0, 0, 0), 0.3, 0.6, z0 + d), TIGHT) for d in (-h, 0.0, h)
+    )
+    fd_gpa = -(hi.energy_ev - lo.energy_ev) / (2 * h) / area * EV_PER_A3_TO_GPA
+    assert mid.converged and mid.normal_stress_gpa > 0.1  # compressed
+    assert mid.normal_stress_gpa == pytest.approx(fd_gpa, abs=0.01)
+
+
+def test_quartz_energy_is_periodic(quartz):
+    ref, calc = quartz
+    z = thickness(ref) - 0.1
+    a = relax_point(ref, calc, PointTask((0, 0, 0), 0.25, 0.5, z), TIGHT)
+    b = relax_point(ref, calc, PointTask((0, 0, 0), 1.25, -0.5, z), TIGHT)
+    assert a.energy_ev == pytest.approx(b.energy_ev, abs=1e-6)
+    assert a.normal_stress_gpa == pytest.approx(b.normal_stress_gpa, abs=1e-3)
