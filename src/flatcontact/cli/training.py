@@ -25,7 +25,11 @@ def train_snap_cmd(
     name: str = typer.Option("snap", "--name", help="Base name of the .snapcoeff/.snapparam."),
     seed: int = typer.Option(0, "--seed", help="Seed of the recipe and the data split."),
     scale: float = typer.Option(1.0, "--scale", help="Size factor of the recipe's random groups."),
-    quadratic: bool = typer.Option(False, "--quadratic", help="Quadratic SNAP."),
+    quadratic: bool = typer.Option(
+        None,
+        "--quadratic/--linear",
+        help="Only quadratic / only linear SNAPs (default: search both).",
+    ),
     active_rounds: int = typer.Option(
         3, "--active-rounds", help="Active-learning rounds after the first fit (recipe runs only)."
     ),

@@ -422,14 +422,23 @@ def _result(ds, elements, hyper, settings, beta, split, search, timings) -> FitR
     )
 
 
-def default_hypers(elements: Sequence[str], quadratic: bool = False) -> list[SnapHyper]:
-    """The default search grid: 2J in (6, 8), rcutfac in (4.5, 5.0), O weight in (0.6, 1.0)."""
+def default_hypers(elements: Sequence[str], quadratic: bool | None = None) -> list[SnapHyper]:
+    """The default search grid: rcutfac in (4.5, 5.0) x O weight in (0.6, 1.0) x descriptor.
+
+    Descriptors: linear 2J = 6 and 8 and quadratic 2J = 6 (``quadratic=None``, the
+    default), or only the quadratic (True) or only the linear ones (False).
+    """
+    kinds = {
+        None: [(6, False), (8, False), (6, True)],
+        True: [(6, True)],
+        False: [(6, False), (8, False)],
+    }
     out = []
-    for twoj, rc, wo in itertools.product((6, 8), (4.5, 5.0), (0.6, 1.0)):
+    for (twoj, quad), rc, wo in itertools.product(kinds[quadratic], (4.5, 5.0), (0.6, 1.0)):
         radii = dict.fromkeys(elements, 0.5)
         weights = {e: (wo if e == "O" else 1.0) for e in elements}
         out.append(
-            SnapHyper(twojmax=twoj, rcutfac=rc, radii=radii, weights=weights, quadratic=quadratic)
+            SnapHyper(twojmax=twoj, rcutfac=rc, radii=radii, weights=weights, quadratic=quad)
         )
     return out
 

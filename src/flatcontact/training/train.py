@@ -22,12 +22,15 @@ import numpy as np
 
 from flatcontact.errors import InputError
 from flatcontact.fileio import atomic_path, write_json_atomic
-from flatcontact.training.dataset import read_dataset, write_dataset
+from flatcontact.training.dataset import labels, read_dataset, write_dataset
 from flatcontact.training.fit import FitResult, default_hypers, default_settings, fit_snap
 from flatcontact.training.snapfiles import write_snap_files
 from flatcontact.units import EV_PER_A3_TO_GPA
 
 ELEMENTS = ("Si", "O")
+#: Active-learning frames whose teacher forces exceed this (eV/Å) are dropped: the
+#: probe went somewhere unphysical and the frame would only cost fit capacity.
+MAX_ACTIVE_FORCE = 10.0
 #: Row weights per group: up for what the ISPES scan and the contact moduli rely on
 #: (bulk alpha-quartz elasticity and EOS, the dense surface, configurations the SNAP
 #: itself visits), down for the far-from-equilibrium groups that a linear SNAP cannot
@@ -37,7 +40,7 @@ DEFAULT_GROUP_WEIGHTS = {
     "quartz_pressure": 3.0,
     "quartz_strain": 1.0,
     "dense_slab": 2.0,
-    "active": 3.0,
+    "active": 1.0,
     "polymorph": 0.5,
     "slab": 0.3,
     "md": 0.5,
@@ -139,7 +142,9 @@ def _active_learning(frames, result, teacher, settings_grid, seed, n_rounds, out
             t0 = time.perf_counter()
             new = probe_frames(snap_calculator(coeff, param), seed=seed + 17 * (r + 1))
         t1 = time.perf_counter()
-        new = label_frames(new, teacher)
+        new = [
+            a for a in label_frames(new, teacher) if np.abs(labels(a)[1]).max() <= MAX_ACTIVE_FORCE
+        ]
         t2 = time.perf_counter()
         part = split_indices([a.info["config_type"] for a in new], seed + 31 * (r + 1))
         for k, idx in part.items():
@@ -180,7 +185,7 @@ def train_snap(
     scale: float = 1.0,
     hypers=None,
     settings_grid=None,
-    quadratic: bool = False,
+    quadratic: bool | None = None,
     active_rounds: int = 3,
     command: str = "",
     progress: Callable[[str], None] | None = None,
