@@ -74,11 +74,17 @@ def validate_potential_cmd(
         "--reference",
         help="Reference model (chgnet) or a labelled extxyz of held-out frames.",
     ),
+    heldout: Path = typer.Option(
+        None,
+        "--heldout",
+        help="Labelled extxyz of held-out frames (e.g. DIR/test.extxyz of train-snap).",
+    ),
     json_out: bool = typer.Option(False, "--json", help="Print the report as JSON."),
     surface: bool = typer.Option(True, "--surface/--no-surface", help="Dense-surface checks."),
     out: Path = typer.Option(None, "--out", help="Also write the report to this JSON file."),
 ) -> None:
     """Held-out RMSEs, alpha-quartz lattice, Cij, EOS, dense surface; vs reference and experiment."""
+    from flatcontact.errors import InputError
     from flatcontact.fileio import write_json_atomic
     from flatcontact.training.dataset import read_dataset
     from flatcontact.training.potentials import bulk_calculator
@@ -86,8 +92,14 @@ def validate_potential_cmd(
 
     calc = bulk_calculator(potential)
     ref_calc, frames, ref_label = None, None, None
+    if heldout is not None:
+        frames = read_dataset(heldout, ["Si", "O"])
     if reference is not None:
         if Path(reference).suffix in (".extxyz", ".xyz"):
+            if heldout is not None:
+                raise InputError(
+                    "give held-out frames either as --reference FILE or as --heldout FILE"
+                )
             frames = read_dataset(reference, ["Si", "O"])
             ref_label = reference
         else:

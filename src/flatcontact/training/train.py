@@ -3,6 +3,7 @@
 Output directory layout (``train_snap(..., out=DIR)``)::
 
     DIR/dataset.extxyz          labelled frames (recipe runs only)
+    DIR/test.extxyz             the held-out test split (for validate-potential --heldout)
     DIR/<name>.snapcoeff        LAMMPS coefficients
     DIR/<name>.snapparam        LAMMPS descriptor parameters
     DIR/fit_report.json         hyper-parameters, RMSEs per split and group, search table
@@ -224,6 +225,7 @@ def train_snap(
     fit_s = time.perf_counter() - t0
     header = f"flatcontact SNAP '{name}' for {' '.join(ELEMENTS)}; trained on {info.get('recipe') or info.get('dataset_file')}"
     coeff, param = write_snap_files(out / name, result.coefficients, header=header)
+    write_dataset([frames[i] for i in result.split["test"]], out / "test.extxyz")
     parity_plot(result, out / "parity.png")
     report = {
         "name": name,
@@ -232,6 +234,7 @@ def train_snap(
         "settings": result.settings.as_dict(),
         "errors": result.errors,
         "split_sizes": {k: len(v) for k, v in result.split.items()},
+        "split_indices": {k: [int(i) for i in v] for k, v in result.split.items()},
         "search": search,
         "active_learning": rounds,
         "timings_s": {**result.timings, "fit_total_s": fit_s},
