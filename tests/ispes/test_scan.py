@@ -232,3 +232,36 @@ def test_bad_input_fails_before_any_work(tmp_path, toy_reference, toy_factory):
         DaskExecutor(address="tcp://127.0.0.1:9", timeout_s=2)
     with pytest.raises(InputError, match="optimizer"):
         RelaxSettings(optimizer="Newton")
+
+
+def test_stale_lock_file_of_a_killed_writer_does_not_block_a_rerun(
+    tmp_path, toy_reference, toy_factory
+):
+    grid = GridSpec(1, 1, thickness_angstrom=(thickness(toy_reference),))
+    first = run_scan(
+        toy_reference, toy_factory, grid, tmp_path, SETTINGS, executor=SerialExecutor()
+    )
+    # what a writer killed inside ASE's locked section leaves behind
+    (tmp_path / "points.db.lock").write_text("")
+    (tmp_path / "points.db.driver").write_text("")
+    again = run_scan(
+        toy_reference, toy_factory, grid, tmp_path, SETTINGS, executor=SerialExecutor()
+    )
+    assert again.points_computed == 0 and again.points_done == first.points_done
+
+
+def test_a_second_driver_on_the_same_store_is_refused(tmp_path, toy_reference, toy_factory):
+    from flatcontact.ispes.scan import POINTS_DB, scan_settings
+    from flatcontact.ispes.store import PointStore
+
+    grid = GridSpec(1, 1, thickness_angstrom=(thickness(toy_reference),))
+    settings = scan_settings(toy_reference, toy_factory, grid, SETTINGS)
+    with PointStore(tmp_path / POINTS_DB, settings, toy_reference):
+        with pytest.raises(InputError, match="another flatcontact scan is writing") as err:
+            run_scan(
+                toy_reference, toy_factory, grid, tmp_path, SETTINGS, executor=SerialExecutor()
+            )
+        assert "\n" not in str(err.value)
+    # released with the first driver: the scan now runs
+    done = run_scan(toy_reference, toy_factory, grid, tmp_path, SETTINGS, executor=SerialExecutor())
+    assert done.points_done == 1

@@ -14,11 +14,16 @@ refused with a line naming the first difference.
 
 Crash safety: only the driver process writes; every point is one SQLite transaction
 (ASE commits each ``write``), so a kill at any moment leaves every committed point
-intact and loses at most the points in flight.
+intact and loses at most the points in flight. ASE's own lock file is disabled: after a
+``kill -9`` inside a write it would stay behind and block every later run forever.
+Instead the driver holds an advisory ``flock`` on ``points.db.driver`` for as long as
+the store is open; the kernel releases it when the process dies, however it dies, and
+a second driver on the same store is refused with one line.
 """
 
 from __future__ import annotations
 
+import fcntl
 import hashlib
 import json
 import os
@@ -35,6 +40,22 @@ from flatcontact.ispes import contract
 from flatcontact.ispes.relax import Index, PointResult
 
 FORMAT = "flatcontact.points/1"
+
+
+def _acquire_driver_lock(path: Path):
+    """Hold an exclusive advisory lock on ``<path>.driver``; InputError if another driver has it."""
+    handle = open(
+        path.with_name(path.name + ".driver"), "a"
+    )  # the lock lives as long as the handle
+    try:
+        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        handle.close()
+        raise InputError(
+            f"{path}: another flatcontact scan is writing to this store; wait for it to finish "
+            "or use another --out"
+        ) from None
+    return handle
 
 
 def interface_hash(atoms: Atoms) -> str:
@@ -97,25 +118,30 @@ class PointStore:
         self.settings = json.loads(json.dumps(settings))
         self.reference = reference
         self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._driver_lock = _acquire_driver_lock(self.path)
         try:
-            self._db = ase.db.connect(str(self.path), type="db", append=True)
+            self._db = ase.db.connect(str(self.path), type="db", append=True, use_lock_file=False)
             n_rows = self._db.count()  # creates the tables of a new store
             meta = self._db.metadata
         except Exception as exc:  # sqlite3.DatabaseError, JSON errors
+            self.close()
             raise InputError(
                 f"{self.path}: not a readable points database ({exc.__class__.__name__}: {exc})"
             ) from None
         if meta.get("format") is not None and meta.get("format") != FORMAT:
+            self.close()
             raise InputError(
                 f"{self.path}: not a flatcontact point store (format {meta.get('format')!r})"
             )
         if "settings" in meta:
             diff = settings_difference(meta["settings"], self.settings)
             if diff is not None:
+                self.close()
                 raise InputError(
                     f"{self.path} was made with different settings ({diff}); use another --out or remove the store"
                 )
         elif n_rows:
+            self.close()
             raise InputError(
                 f"{self.path}: has {n_rows} rows but no flatcontact settings; refusing to mix"
             )
@@ -126,6 +152,18 @@ class PointStore:
         self._done: dict[Index, dict] = {}
         for row in self._db.select():
             self._done[(row.i_a, row.i_b, row.i_z)] = self._record(row)
+
+    def close(self) -> None:
+        """Release the driver lock (the database itself needs no closing)."""
+        if self._driver_lock is not None:
+            self._driver_lock.close()
+            self._driver_lock = None
+
+    def __enter__(self) -> PointStore:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.close()
 
     @staticmethod
     def _record(row) -> dict:
@@ -157,6 +195,10 @@ class PointStore:
     def done(self) -> dict[Index, dict]:
         """Finished points: index -> record (energy_ev, normal_stress_gpa, converged, ...)."""
         return dict(self._done)
+
+    def record(self, index: Index) -> dict:
+        """The record of one finished point (KeyError if it is not stored)."""
+        return self._done[tuple(index)]
 
     def __contains__(self, index: Index) -> bool:
         return tuple(index) in self._done
