@@ -1130,6 +1130,7 @@ def build_report(pipe: Pipeline, path: Path) -> Path:
         (
             _fmt(r.p_gpa),
             _fmt(r.tau_mpa),
+            _fmt(r.tau_period_mpa),
             _fmt(r.sigma_mss_mpa),
             _fmt(r.shear_stiffness_gpa_per_nm),
             str(r.tau_limited_by),
@@ -1142,7 +1143,10 @@ def build_report(pipe: Pipeline, path: Path) -> Path:
             "3. Constant-pressure ISPES, sliding path, τ and σ",
             paragraphs=[
                 f"Pulling direction {cfg.analysis.direction_deg:g}° from x; energy form "
-                f"'{cfg.analysis.energy_form}' (the paper's is 'internal')."
+                f"'{cfg.analysis.energy_form}' (the paper's is 'internal'). τ is the paper's "
+                "shear strength (largest force before leaving the initial minimum); τ_period is "
+                "the largest force over a whole period, the pull needed for sustained sliding "
+                "(always ≥ σ_MSS). The load laws use τ."
             ],
             notes=analyze.get("warnings", []),
             tables=[
@@ -1150,6 +1154,7 @@ def build_report(pipe: Pipeline, path: Path) -> Path:
                     (
                         "P (GPa)",
                         "τ (MPa)",
+                        "τ_period (MPa)",
                         "σ_MSS (MPa)",
                         "G_int (GPa/nm)",
                         "τ limited by",

@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.optimize import minimize_scalar
 
 from flatcontact.analysis import synthetic as syn
@@ -118,3 +120,49 @@ def test_path_that_does_not_close_warns_and_reports_tracked_length():
     with pytest.warns(PathNotPeriodicWarning, match="no minimum equivalent"):
         path = zero_perpendicular_force_path(surf, 0.0, max_length_angstrom=3.0)
     assert not path.periodic and path.length_angstrom == pytest.approx(3.0)
+
+
+def _ratchet(beta, phi, extra=()):
+    """Separable landscape: confinement across y, an asymmetric two-barrier profile along y."""
+    return syn.cosine_sum([(1, 0, -2.0), (0, 1, -1.0), (0, 2, -beta, phi), *extra])
+
+
+def _profile_reference(pattern, b, n=200_001):
+    """Force per area along y (at s_a = 0), sampled densely from the global minimum on."""
+    s_b = np.linspace(0.0, 1.0, n)
+    s = np.stack([np.zeros_like(s_b), s_b], -1)
+    g, grad, _ = pattern(s)
+    start = int(np.argmin(g))
+    order = (np.arange(n - 1) + start) % (n - 1)
+    return V * grad[order, 1] / b
+
+
+def test_period_shear_strength_exceeds_tau_when_the_second_barrier_is_harder():
+    a, b = 4.0, 6.0
+    a1, a2 = syn.rectangular_cell(a, b)
+    pattern = _ratchet(beta=0.9, phi=2.2)
+    fr = friction_along_path(zero_perpendicular_force_path(_surface(pattern, a1, a2), 90.0))
+    force = _profile_reference(pattern, b)
+    first_top = int(np.argmax(np.diff(np.sign(force)) < 0))  # first force zero going down
+    assert fr.tau_ev_per_a3 == pytest.approx(force[: first_top + 1].max(), rel=1e-6)
+    assert fr.tau_period_ev_per_a3 == pytest.approx(force.max(), rel=1e-6)
+    # the case is meaningful: escaping the global minimum is easier than crossing the period
+    assert fr.tau_period_ev_per_a3 > 1.2 * fr.tau_ev_per_a3
+    assert fr.tau_period_mpa == pytest.approx(fr.tau_period_ev_per_a3 * 160217.6634, rel=1e-9)
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    beta=st.floats(0.0, 1.5),
+    phi=st.floats(0.0, 2 * np.pi),
+    gamma=st.floats(0.0, 0.6),
+    psi=st.floats(0.0, 2 * np.pi),
+)
+def test_period_shear_strength_bounds_tau_and_sigma(beta, phi, gamma, psi):
+    a1, a2 = syn.rectangular_cell(4.0, 6.0)
+    pattern = _ratchet(beta, phi, extra=[(0, 3, -gamma, psi)])
+    fr = friction_along_path(zero_perpendicular_force_path(_surface(pattern, a1, a2), 90.0))
+    tol = 1e-9 * V
+    assert fr.tau_ev_per_a3 <= fr.tau_period_ev_per_a3 + tol
+    # each barrier is the integral of the force over a climb shorter than the minima spacing
+    assert fr.sigma_ev_per_a3 <= fr.tau_period_ev_per_a3 + tol

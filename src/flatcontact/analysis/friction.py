@@ -13,6 +13,13 @@ Conventions (paper, Fig. 2 and the equation for σ):
   initial minimum, i.e. on the way from the start to the first barrier top,
   or to the first jump (fold) if the branch ends before a top. The maximum is
   located where ``d f/dt = 0`` by root finding on the relaxed branch;
+- **period shear strength** ``τ_period``: the largest ``f`` anywhere on one
+  period of the path: the pull needed for sustained sliding. It equals ``τ``
+  when the first barrier out of the global minimum is the hardest to climb,
+  and exceeds it otherwise (a low first barrier followed by a higher one, as
+  coarse or asymmetric landscapes give). Always ``σ ≤ τ_period``, because each
+  barrier height is the integral of ``f`` over a climb shorter than the
+  distance between minima; ``τ`` (the paper's definition) can fall below ``σ``;
 - **MSS friction** ``σ = ΣΔU_i / ΣΔy_i``: ``ΔU_i`` the barrier heights, from
   each minimum to the next maximum in the pulling direction (a fold counts as
   the maximum of its climb), ``ΣΔy_i`` the distance between successive minima
@@ -56,6 +63,8 @@ class FrictionResult:
     tau_ev_per_a3: float
     tau_position_angstrom: float
     tau_limited_by: str  #: "barrier top", "jump" or "path end"
+    tau_period_ev_per_a3: float  #: largest resisting force per area over the whole path
+    tau_period_position_angstrom: float
     sigma_ev_per_a3: float
     barriers: tuple[Barrier, ...]
     minima_t_angstrom: tuple[float, ...]
@@ -66,6 +75,11 @@ class FrictionResult:
     def tau_mpa(self) -> float:
         """Shear strength τ (MPa)."""
         return self.tau_ev_per_a3 * units.EV_PER_A3_TO_MPA
+
+    @property
+    def tau_period_mpa(self) -> float:
+        """Period shear strength τ_period (MPa): the largest force over the whole path."""
+        return self.tau_period_ev_per_a3 * units.EV_PER_A3_TO_MPA
 
     @property
     def sigma_mss_mpa(self) -> float:
@@ -117,6 +131,22 @@ def _samples(path: SlidingPath, attr: str) -> np.ndarray:
     return path.force if attr == "force" else path.curvature
 
 
+def _largest_force(path: SlidingPath, f: np.ndarray, stop: int) -> tuple[float, float, bool]:
+    """Largest force over samples ``0..stop``, refined where the curvature changes sign.
+
+    Returns ``(force, t, at_stop)``; ``at_stop`` is true when the maximum is the last
+    sample considered (e.g. a fold, where the branch ends).
+    """
+    t = path.t_angstrom
+    j = int(np.argmax(f[: stop + 1]))
+    force, t_max = float(f[j]), float(t[j])
+    if 0 < j < stop and path.curvature[j] * path.curvature[j + 1] <= 0:
+        t_max, _, force = _refine(path, j + 1, "curvature")
+    elif 0 < j < stop and path.curvature[j - 1] * path.curvature[j] <= 0:
+        t_max, _, force = _refine(path, j, "curvature")
+    return force, t_max, j == stop
+
+
 def friction_along_path(path: SlidingPath) -> FrictionResult:
     """τ, σ_MSS and the shear stiffness of a zero-perpendicular-force path.
 
@@ -153,14 +183,10 @@ def friction_along_path(path: SlidingPath) -> FrictionResult:
     else:
         stop = int(np.searchsorted(t, first_max[1], side="right")) - 1
         limited = "jump" if first_max[3] else "barrier top"
-    j = int(np.argmax(f[: stop + 1]))
-    tau, tau_t = float(f[j]), float(t[j])
-    if 0 < j < stop and path.curvature[j] * path.curvature[j + 1] <= 0:
-        tau_t, _, tau = _refine(path, j + 1, "curvature")
-    elif 0 < j < stop and path.curvature[j - 1] * path.curvature[j] <= 0:
-        tau_t, _, tau = _refine(path, j, "curvature")
-    elif j == stop and first_max is not None and first_max[3]:
+    tau, tau_t, at_stop = _largest_force(path, f, stop)
+    if at_stop and first_max is not None and first_max[3]:
         limited = "jump"
+    tau_period, tau_period_t, _ = _largest_force(path, f, len(t) - 1)
 
     # σ: barriers from each minimum to the next maximum
     barriers: list[Barrier] = []
@@ -185,6 +211,8 @@ def friction_along_path(path: SlidingPath) -> FrictionResult:
         tau_ev_per_a3=tau,
         tau_position_angstrom=tau_t,
         tau_limited_by=limited,
+        tau_period_ev_per_a3=tau_period,
+        tau_period_position_angstrom=tau_period_t,
         sigma_ev_per_a3=float(sigma),
         barriers=tuple(barriers),
         minima_t_angstrom=tuple(minima),

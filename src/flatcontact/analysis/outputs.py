@@ -32,6 +32,7 @@ CSV_COLUMNS = (
     "shear_stiffness_gpa_per_nm",
     "tau_position_angstrom",
     "tau_limited_by",
+    "tau_period_mpa",
     "n_barriers",
     "n_jumps",
     "period_angstrom",
@@ -59,6 +60,7 @@ def per_pressure_rows(result: AnalysisResult) -> list[dict]:
                 "shear_stiffness_gpa_per_nm": fr.shear_stiffness_gpa_per_nm,
                 "tau_position_angstrom": fr.tau_position_angstrom,
                 "tau_limited_by": fr.tau_limited_by,
+                "tau_period_mpa": fr.tau_period_mpa,
                 "n_barriers": len(fr.barriers),
                 "n_jumps": len(path.jumps),
                 "period_angstrom": path.length_angstrom if path.periodic else float("nan"),
@@ -85,6 +87,7 @@ def summary_json(result: AnalysisResult) -> dict:
                     "sigma_mss_mpa",
                     "shear_stiffness_gpa_per_nm",
                     "tau_limited_by",
+                    "tau_period_mpa",
                     "n_jumps",
                     "periodic",
                 )
@@ -134,6 +137,7 @@ def friction_dataset(result: AnalysisResult) -> xr.Dataset:
     ds = xr.Dataset(
         {
             "tau_mpa": ("p_gpa", col("tau_mpa"), {"units": "MPa"}),
+            "tau_period_mpa": ("p_gpa", col("tau_period_mpa"), {"units": "MPa"}),
             "sigma_mss_mpa": ("p_gpa", col("sigma_mss_mpa"), {"units": "MPa"}),
             "shear_stiffness_gpa_per_nm": (
                 "p_gpa",
