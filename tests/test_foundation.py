@@ -72,3 +72,21 @@ def test_input_error_is_one_line_exit_2(capsys):
     err = capsys.readouterr().err
     assert err.strip() == "error: --radius-um: expected a positive number, got -1"
     assert "Traceback" not in err
+
+
+def test_atomic_write_leaves_usual_permissions_and_no_partial_file(tmp_path):
+    import os
+    import stat
+
+    from flatcontact.fileio import atomic_path, write_text_atomic
+
+    mask = os.umask(0o022)
+    try:
+        path = write_text_atomic(tmp_path / "out.txt", "x")
+        assert stat.S_IMODE(path.stat().st_mode) == 0o644
+        with pytest.raises(RuntimeError), atomic_path(tmp_path / "never.txt") as tmp:
+            tmp.write_text("half")
+            raise RuntimeError("interrupted")
+    finally:
+        os.umask(mask)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.txt"]
