@@ -1,7 +1,7 @@
 """The scan physics on an α-quartz (0001) interface with Vashishta + TS-LJ (LAMMPS engine).
 
-The interface is the relaxed cleaved 1×1 (0001) slab pair (not the verified "dense"
-reconstruction, which the builder owns); the checks are properties of the scan.
+The interface is the builder's verified dense (0001) interface (6 layers, the shipped
+CHGNet-relaxed slab re-relaxed with Vashishta), the one the default run scans.
 """
 
 import pytest
@@ -16,20 +16,14 @@ TIGHT = RelaxSettings(fmax_ev_per_a=1e-4, optimizer="LBFGS", max_steps=5000)
 
 @pytest.fixture(scope="module")
 def quartz():
-    from ase.optimize import LBFGS
-
     from flatcontact.potentials import PotentialSpec, make_calculator
-    from flatcontact.structures.interface import make_interface
-    from flatcontact.structures.slab import quartz_0001_slab
+    from flatcontact.structures.build import build_quartz_interface
 
     spec = PotentialSpec(intra="vashishta")
-    slab = quartz_0001_slab(layers=6, cut=0, a_angstrom=4.829, c_angstrom=5.309)
-    atoms = make_interface(slab, gap_angstrom=2.5, face_atoms=3)
-    calc = make_calculator(spec, atoms)
-    atoms.calc = calc
-    LBFGS(atoms, logfile=None).run(fmax=1e-3, steps=3000)
-    atoms.calc = None
-    return atoms, calc
+    atoms, _report = build_quartz_interface(
+        spec, layers=6, source="shipped"
+    )  # raises unless verified
+    return atoms, make_calculator(spec, atoms)
 
 
 def test_quartz_load_is_minus_energy_derivative(quartz):
