@@ -31,7 +31,7 @@ def train_snap_cmd(
         help="Only quadratic / only linear SNAPs (default: search both).",
     ),
     active_rounds: int = typer.Option(
-        3, "--active-rounds", help="Active-learning rounds after the first fit (recipe runs only)."
+        4, "--active-rounds", help="Active-learning rounds after the first fit (recipe runs only)."
     ),
 ) -> None:
     """Fit a SNAP (LAMMPS .snapcoeff/.snapparam) to a dataset or a generated recipe."""

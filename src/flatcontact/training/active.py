@@ -2,8 +2,8 @@
 
 A fitted SNAP is run through the same kinds of calculation that validation (and the
 ISPES scan) will run: zero-stress and high-pressure relaxations of alpha-quartz,
-ion relaxations under small strains, relaxation and a short 300 K MD of the dense
-(0001) slab. Frames along those trajectories are labelled by the teacher and added
+ion relaxations under small strains, relaxation and 300 K MD of the dense (0001)
+slab (1x1, and 2x2 for 1.5 ps), and 1 ps of 600 K MD of bulk quartz (2x2x2). Frames along those trajectories are labelled by the teacher and added
 to the training set (``config_type = "active"``), so the next fit is corrected
 exactly where the previous one wandered (e.g. towards a beta-quartz-like cell).
 """
@@ -47,7 +47,31 @@ def _trajectory(
     return frames
 
 
-def probe_frames(calc, seed: int, max_frames: int = 80) -> list[Atoms]:
+def _md_until_blowup(
+    atoms: Atoms, calc, temperature_k: float, steps: int, every: int, rng
+) -> list[Atoms]:
+    """Langevin MD snapshots every ``every`` steps, stopping when two atoms come closer
+    than :data:`MIN_PROBE_DISTANCE_ANGSTROM` (the frames before a collapse are the
+    informative ones)."""
+    md = atoms.copy()
+    md.calc = calc
+    MaxwellBoltzmannDistribution(md, temperature_K=temperature_k, rng=rng)
+    dyn = Langevin(
+        md, 1.0 * units.fs, temperature_K=temperature_k, friction=0.02, fixcm=False, rng=rng
+    )
+    out = []
+    try:
+        for _ in range(steps // every):
+            dyn.run(every)
+            if neighbor_list("d", md, MIN_PROBE_DISTANCE_ANGSTROM).size:
+                break
+            out.append(_bare(md))
+    except Exception:  # the potential blew up inside LAMMPS
+        pass
+    return out
+
+
+def probe_frames(calc, seed: int, max_frames: int = 100) -> list[Atoms]:
     """Frames from SNAP-driven relaxations and MD (see the module docstring), deduplicated."""
     from flatcontact.training.recipe import alpha_quartz, dense_slabs, strain_cell
     from flatcontact.training.validate import dense_start_slab
@@ -77,13 +101,15 @@ def probe_frames(calc, seed: int, max_frames: int = 80) -> list[Atoms]:
     md = traj[-1].copy()
     md.calc = calc
     MaxwellBoltzmannDistribution(md, temperature_K=300.0, rng=rng)
-    dyn = Langevin(md, 1.0 * units.fs, temperature_K=300.0, friction=0.02, rng=rng)
+    dyn = Langevin(md, 1.0 * units.fs, temperature_K=300.0, friction=0.02, fixcm=False, rng=rng)
     try:
         for _ in range(5):
             dyn.run(60)
             frames.append(_bare(md))
     except Exception:
         pass
+    frames += _md_until_blowup(traj[-1].repeat((2, 2, 1)), calc, 300.0, 1500, 100, rng)
+    frames += _md_until_blowup(q0.repeat((2, 2, 2)), calc, 600.0, 1000, 100, rng)
     good = [
         f
         for f in frames

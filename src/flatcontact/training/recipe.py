@@ -28,6 +28,9 @@ Groups (``info["config_type"]``):
     seeds, Vashishta pre-relaxed and verified): teacher relaxation frames,
     Vashishta MD snapshots at 300/600/900 K (1x1 and 2x2) with teacher relaxations
     of them, and ±2 % in-plane strained slabs.
+``close_contact``
+    alpha-quartz (2x1x1) and the dense slab with one O-O (1.1-2.2 Å), Si-O (1.2-1.5 Å)
+    or Si-Si (1.8-2.7 Å) pair pushed together: the short-range repulsion.
 ``defect``
     vacancies (non-stoichiometric, they also separate the Si and O reference
     energies), stretched/broken Si-O bonds (pairs pulled 0.2-1.0 Å apart; no
@@ -131,6 +134,30 @@ def vashishta_md(
         frames.append(snap)
     lmp.close()
     return frames
+
+
+def close_contact(atoms: Atoms, pair: tuple[str, str], distance: float, rng) -> Atoms | None:
+    """Copy of ``atoms`` with one random ``pair`` of nearby atoms moved to ``distance`` (Å).
+
+    Both atoms move symmetrically along their separation; small rattle. Teaches the
+    short-range repulsion a SNAP does not have by construction. None if another pair
+    ends up closer than 0.9 Å.
+    """
+    a = atoms.copy()
+    sym = np.array(a.get_chemical_symbols())
+    i = int(rng.choice(np.flatnonzero(sym == pair[0])))
+    js = np.flatnonzero(sym == pair[1])
+    js = js[js != i]
+    d = a.get_distances(i, js, mic=True)
+    j = int(js[np.argsort(d)[rng.integers(0, min(3, len(js)))]])
+    vec = a.get_distance(i, j, mic=True, vector=True)
+    r = np.linalg.norm(vec)
+    shift = 0.5 * (r - distance) * vec / r
+    a.positions[i] += shift
+    a.positions[j] -= shift
+    a.positions += rng.normal(0.0, 0.02, a.positions.shape)
+    close = neighbor_list("ij", a, 0.9)[0]
+    return None if close.size else a
 
 
 def _relax_frames(
@@ -319,4 +346,18 @@ def sio2_recipe(
         a.positions += rng.normal(0.0, 0.04, a.positions.shape)
         frames.append(a)
     add(frames, "defect")
+
+    say("close_contact")
+    frames = []
+    targets = {("O", "O"): (1.1, 2.2), ("Si", "O"): (1.2, 1.5), ("Si", "Si"): (1.8, 2.7)}
+    hosts = [q0.repeat((2, 1, 1))] + [d.copy() for d in relaxed[:1]]
+    n_made = 0
+    while n_made < n(36):
+        host = hosts[n_made % len(hosts)]
+        pair = list(targets)[n_made % len(targets)]
+        a = close_contact(host, pair, rng.uniform(*targets[pair]), rng)
+        if a is not None:
+            frames.append(a)
+            n_made += 1
+    add(frames, "close_contact")
     return out

@@ -31,7 +31,7 @@ from flatcontact.units import EV_PER_A3_TO_GPA
 ELEMENTS = ("Si", "O")
 #: Active-learning frames whose teacher forces exceed this (eV/Å) are dropped: the
 #: probe went somewhere unphysical and the frame would only cost fit capacity.
-MAX_ACTIVE_FORCE = 10.0
+MAX_ACTIVE_FORCE = 20.0
 #: Row weights per group: up for what the ISPES scan and the contact moduli rely on
 #: (bulk alpha-quartz elasticity and EOS, the dense surface, configurations the SNAP
 #: itself visits), down for the far-from-equilibrium groups that a linear SNAP cannot
@@ -42,6 +42,7 @@ DEFAULT_GROUP_WEIGHTS = {
     "quartz_strain": 1.0,
     "dense_slab": 2.0,
     "active": 1.0,
+    "close_contact": 0.5,
     "polymorph": 0.5,
     "slab": 0.3,
     "md": 0.5,
@@ -187,7 +188,7 @@ def train_snap(
     hypers=None,
     settings_grid=None,
     quadratic: bool | None = None,
-    active_rounds: int = 3,
+    active_rounds: int = 4,
     command: str = "",
     progress: Callable[[str], None] | None = None,
 ) -> dict:
