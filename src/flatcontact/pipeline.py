@@ -81,19 +81,10 @@ def file_sha256(path: str | Path) -> str:
 
 
 def _save_figure(fig, stem: Path, svg: bool) -> list[Path]:
-    """Save a matplotlib figure as ``stem.png`` (+ ``stem.svg``) atomically and close it."""
-    import matplotlib.pyplot as plt
+    """Save a figure as ``stem.png`` (+ ``stem.svg``) atomically and close it."""
+    from flatcontact.plots import save_figure
 
-    from flatcontact.fileio import atomic_path
-
-    out = []
-    for ext in ("png", "svg") if svg else ("png",):
-        target = stem.parent / f"{stem.name}.{ext}"
-        with atomic_path(target) as tmp:
-            fig.savefig(tmp, format=ext, dpi=150, bbox_inches="tight")
-        out.append(target)
-    plt.close(fig)
-    return out
+    return save_figure(fig, stem, ("png", "svg") if svg else ("png",))
 
 
 # --------------------------------------------------------------------------- figures of this module

@@ -237,7 +237,8 @@ def contact_command(
 
 
 def _write_outputs(out, doc, analysis, measured, fitted, exp_summary) -> None:
-    from flatcontact.fileio import atomic_path, write_json_atomic
+    from flatcontact.fileio import write_json_atomic
+    from flatcontact.plots import save_figure
     from flatcontact.plots.contact import fig4_traction, fig5_force_and_stiffness, fig6_overlay
 
     out.mkdir(parents=True, exist_ok=True)
@@ -259,9 +260,7 @@ def _write_outputs(out, doc, analysis, measured, fitted, exp_summary) -> None:
             measured_collapse_mpa=exp_summary["measured_collapse_stress_mpa"],
         )
     for name, fig in figs.items():
-        for ext in ("png", "svg"):
-            with atomic_path(out / f"{name}.{ext}") as tmp:
-                fig.savefig(tmp, format=ext, dpi=150)
+        save_figure(fig, out / name)
     analysis.write_netcdf(out / "contact.nc")
     write_json_atomic(out / "summary.json", doc)
 

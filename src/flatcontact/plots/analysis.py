@@ -21,20 +21,13 @@ import numpy as np
 
 from flatcontact import units
 from flatcontact.analysis.pipeline import AnalysisResult, PressureAnalysis
-from flatcontact.fileio import atomic_path
+from flatcontact.plots import save_figure
 
 MEV = units.EV_PER_A2_TO_MEV_PER_A2
 
 
-def _save(fig: plt.Figure, stem: Path, svg: bool) -> list[Path]:
-    out = []
-    for ext in ("png", "svg") if svg else ("png",):
-        target = stem.parent / f"{stem.name}.{ext}"
-        with atomic_path(target) as tmp:
-            fig.savefig(tmp, format=ext, dpi=150, bbox_inches="tight")
-        out.append(target)
-    plt.close(fig)
-    return out
+def _formats(svg: bool) -> tuple[str, ...]:
+    return ("png", "svg") if svg else ("png",)
 
 
 def figure_pressure(pa: PressureAnalysis, result: AnalysisResult) -> plt.Figure:
@@ -152,6 +145,6 @@ def write_figures(
     written = []
     for pa in result.pressures:
         stem = out / f"fig2_p{pa.p_gpa:g}gpa"
-        written += _save(figure_pressure(pa, result), stem, svg)
-    written += _save(figure_laws(result), out / "fig3_laws", svg)
+        written += save_figure(figure_pressure(pa, result), stem, _formats(svg))
+    written += save_figure(figure_laws(result), out / "fig3_laws", _formats(svg))
     return written
