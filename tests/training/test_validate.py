@@ -72,3 +72,16 @@ def test_cli_validate_with_reference_file(tmp_path, capsys):
     rep = json.loads(capsys.readouterr().out)
     assert rep["heldout_errors"]["force_rmse_mev_per_angstrom"] < 1e-3  # extxyz precision
     assert rep["reference_label"] == str(path)
+
+
+@pytest.mark.parametrize(
+    ("name", "a_ref", "c_ref"), [("vashishta", 4.829, 5.309), ("tersoff", 5.082, 5.528)]
+)
+def test_classical_potentials_relax_to_known_lattices(name, a_ref, c_ref):
+    """NOTES.md (LAMMPS box/relax): Vashishta 4.829/5.309 Å, Tersoff SiO 5.082/5.528 Å."""
+    from flatcontact.training.potentials import bulk_calculator
+    from flatcontact.training.validate import quartz_lattice
+
+    _, lat = quartz_lattice(bulk_calculator(name))
+    assert lat["a_angstrom"] == pytest.approx(a_ref, abs=2e-3)
+    assert lat["c_angstrom"] == pytest.approx(c_ref, abs=2e-3)

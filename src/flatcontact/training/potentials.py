@@ -6,7 +6,8 @@ Accepted forms:
   (``flatcontact/data/potentials/<name>/<name>.snapcoeff``);
 * a path to a ``.snapcoeff`` file (its ``.snapparam`` beside it) or to a
   directory holding exactly one ``.snapcoeff``;
-* ``vashishta`` (Vashishta et al. 1990, LAMMPS ``SiO.1990.vashishta``);
+* ``vashishta`` (Vashishta et al. 1990, LAMMPS ``SiO.1990.vashishta``) or ``tersoff``
+  (Munetoh et al. 2007, LAMMPS ``SiO.tersoff``);
 * ``chgnet`` (the r2SCAN CHGNet teacher; optional extra).
 """
 
@@ -17,7 +18,7 @@ from pathlib import Path
 
 from flatcontact.errors import InputError
 
-CLASSICAL = ("vashishta",)
+CLASSICAL = ("vashishta", "tersoff")
 TEACHERS = ("chgnet",)
 
 
@@ -57,10 +58,17 @@ def snapcoeff_path(name_or_path: str) -> Path | None:
 
 def bulk_calculator(name_or_path: str):
     """A single-body ASE calculator for ``name_or_path`` (see the module docstring)."""
-    from flatcontact.training.lammps_bulk import snap_calculator, vashishta_calculator
+    from flatcontact.training.lammps_bulk import (
+        LammpsBulkCalculator,
+        snap_calculator,
+        tersoff_pair_commands,
+        vashishta_calculator,
+    )
 
     if name_or_path == "vashishta":
         return vashishta_calculator()
+    if name_or_path == "tersoff":
+        return LammpsBulkCalculator(tersoff_pair_commands(), ["Si", "O"])
     if name_or_path == "chgnet":
         from flatcontact.training.label import teacher_calculator
 
