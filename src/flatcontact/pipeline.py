@@ -785,30 +785,16 @@ class Pipeline:
             }
             if c.experiment_csv:
                 measured = exp.load_stiffness_csv(c.experiment_csv)
-                p0e = c.experiment_p0_gpa * units.GPA_TO_PA
-                col = exp.collapse_stress(
-                    measured.stress_pa, measured.stiffness_n_per_m, fraction=c.collapse_fraction
-                )
-                model_col = exp.model_collapse_stress(
-                    p0e, params, fraction=c.collapse_fraction, measure=c.experiment_stress_measure
-                )
-                tau0_fit = exp.fit_tau0(
-                    col.stress_pa,
-                    p0e,
+                comparison = exp.compare_with_measurement(
+                    measured,
+                    c.experiment_p0_gpa,
                     params,
                     fraction=c.collapse_fraction,
                     measure=c.experiment_stress_measure,
                 )
-                fitted = params.replace(tau0_mpa=tau0_fit)
-                doc["experiment"] = {
-                    "source": measured.source,
-                    "p0_gpa": c.experiment_p0_gpa,
-                    "stress_measure": c.experiment_stress_measure,
-                    "collapse_fraction": c.collapse_fraction,
-                    "measured_collapse_stress_mpa": col.stress_pa / units.MPA_TO_PA,
-                    "model_collapse_stress_mpa": model_col / units.MPA_TO_PA,
-                    "fitted_tau0_mpa": tau0_fit,
-                }
+                tau0_fit = comparison.fitted_tau0_mpa
+                fitted = comparison.fitted_params
+                doc["experiment"] = comparison.to_json()
                 figs["fig6_experiment"] = fig6_overlay(
                     measured,
                     c.experiment_p0_gpa,

@@ -305,3 +305,40 @@ def test_kill_9_mid_scan_then_rerun_loses_nothing(tiny_run, tmp_path):
     laws_ref = json.loads((src / "04-laws" / "laws.json").read_text())
     laws_got = json.loads((root / "04-laws" / "laws.json").read_text())
     assert laws_got["tau0_mpa"] == pytest.approx(laws_ref["tau0_mpa"], abs=1e-3)
+
+
+def test_measured_stiffness_reruns_contact_and_report_and_recovers_tau0(tiny_run, tmp_path):
+    """A CSV made by the model with a known τ0 (others as fitted) gives that τ0 back (Fig. 6)."""
+    import shutil
+
+    from flatcontact.contact import experiment as exp
+    from flatcontact.contact.parameters import ContactParameters
+
+    src, _, _ = tiny_run
+    root = tmp_path / "copy"
+    shutil.copytree(src, root)
+    fitted = json.loads((root / "06-contact" / "summary.json").read_text())["parameters"]
+    truth = ContactParameters(**fitted).replace(tau0_mpa=1.5 * fitted["tau0_mpa"])
+    p0_pa = 1.77e9
+    collapse = exp.model_collapse_stress(p0_pa, truth)
+    # a ramp with dense points through the collapse, as a careful measurement would take
+    stress = np.sort(np.concatenate([np.linspace(0.02, 1.2, 60), 1 + 0.001 * np.arange(-10, 11)]))
+    stress = stress * collapse
+    stiffness = exp.model_stiffness_at_stress(stress, p0_pa, truth)
+    csv = tmp_path / "measured.csv"
+    rows = "\n".join(f"{s / 1e6:.9g},{k:.9g}" for s, k in zip(stress, stiffness, strict=True))
+    csv.write_text("mean_shear_stress_mpa,lateral_stiffness_n_per_m\n" + rows + "\n")
+
+    with Pipeline(
+        build_config(_merge(TINY, {"contact": {"experiment_csv": str(csv)}})), root
+    ) as pipe:
+        pipe.run()
+        actions = _actions(pipe)
+    assert {n for n, a in actions.items() if a != "skipped"} == {"contact", "report"}
+    summary = json.loads((root / "06-contact" / "summary.json").read_text())
+    assert summary["experiment"]["fitted_tau0_mpa"] == pytest.approx(truth.tau0_mpa, rel=2e-3)
+    assert (root / "06-contact" / "fig6_experiment.png").is_file()
+    assert (
+        "Fig. 6: measured stiffness (measured.csv)"
+        in (root / "07-report" / "report.html").read_text()
+    )

@@ -136,7 +136,6 @@ def contact_command(
     ] = False,
 ) -> None:
     """Hertz + adhesion + modified Mindlin: Q(u), peak and gross-sliding forces, oscillatory stiffness."""
-    from flatcontact import units
     from flatcontact.contact import experiment as exp
     from flatcontact.contact.mindlin import paper_shear_modulus_from_johnson
     from flatcontact.contact.parameters import ContactParameters, check_positive
@@ -188,31 +187,15 @@ def contact_command(
     exp_summary = None
     fitted = None
     if measured is not None:
-        p0e = experiment_p0_gpa * units.GPA_TO_PA
-        col = exp.collapse_stress(
-            measured.stress_pa, measured.stiffness_n_per_m, fraction=collapse_fraction
-        )
-        model_col = exp.model_collapse_stress(
-            p0e, params, fraction=collapse_fraction, measure=experiment_stress_measure
-        )
-        tau0_fit = exp.fit_tau0(
-            col.stress_pa,
-            p0e,
+        comparison = exp.compare_with_measurement(
+            measured,
+            experiment_p0_gpa,
             params,
             fraction=collapse_fraction,
             measure=experiment_stress_measure,
         )
-        fitted = params.replace(tau0_mpa=tau0_fit)
-        exp_summary = {
-            "source": measured.source,
-            "p0_gpa": experiment_p0_gpa,
-            "stress_measure": experiment_stress_measure,
-            "collapse_fraction": collapse_fraction,
-            "plateau_stiffness_n_per_m": col.plateau_n_per_m,
-            "measured_collapse_stress_mpa": col.stress_pa / units.MPA_TO_PA,
-            "model_collapse_stress_mpa": model_col / units.MPA_TO_PA,
-            "fitted_tau0_mpa": tau0_fit,
-        }
+        fitted = comparison.fitted_params
+        exp_summary = comparison.to_json()
 
     # ---- write -----------------------------------------------------------------------
     doc = {

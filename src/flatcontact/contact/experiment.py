@@ -320,3 +320,65 @@ def fit_tau0(
         hi *= 2.0
         require(hi <= tau0_max_mpa, f"measured collapse needs tau0 > {tau0_max_mpa:g} MPa")
     return float(brentq(resid, lo, hi, xtol=1e-10, rtol=1e-10))
+
+
+@dataclass(frozen=True)
+class MeasurementComparison:
+    """Measured stiffness data against the model at the data's p0, with the fitted τ0.
+
+    Stresses are in the measure the data use (``stress_measure``), in MPa.
+    ``fitted_params`` is ``params`` with τ0 replaced by the fitted value.
+    """
+
+    source: str
+    p0_gpa: float
+    stress_measure: str
+    collapse_fraction: float
+    plateau_stiffness_n_per_m: float
+    measured_collapse_stress_mpa: float
+    model_collapse_stress_mpa: float
+    fitted_tau0_mpa: float
+    fitted_params: ContactParameters
+
+    def to_json(self) -> dict:
+        """The summary as a JSON-ready dict (without ``fitted_params``)."""
+        return {
+            "source": self.source,
+            "p0_gpa": self.p0_gpa,
+            "stress_measure": self.stress_measure,
+            "collapse_fraction": self.collapse_fraction,
+            "plateau_stiffness_n_per_m": self.plateau_stiffness_n_per_m,
+            "measured_collapse_stress_mpa": self.measured_collapse_stress_mpa,
+            "model_collapse_stress_mpa": self.model_collapse_stress_mpa,
+            "fitted_tau0_mpa": self.fitted_tau0_mpa,
+        }
+
+
+def compare_with_measurement(
+    measured: MeasuredStiffness,
+    p0_gpa: float,
+    params: ContactParameters,
+    *,
+    fraction: float = 0.2,
+    measure: str = "amplitude",
+) -> MeasurementComparison:
+    """Collapse of the data and of the model (same criterion), and the τ0 that matches them.
+
+    The paper's inverse problem (Fig. 6): with every other parameter fixed, the τ0
+    whose predicted stiffness collapse at ``p0_gpa`` equals the measured one.
+    """
+    p0_pa = check_positive("p0_gpa", p0_gpa) * units.GPA_TO_PA
+    data = collapse_stress(measured.stress_pa, measured.stiffness_n_per_m, fraction=fraction)
+    model = model_collapse_stress(p0_pa, params, fraction=fraction, measure=measure)
+    tau0 = fit_tau0(data.stress_pa, p0_pa, params, fraction=fraction, measure=measure)
+    return MeasurementComparison(
+        source=measured.source,
+        p0_gpa=float(p0_gpa),
+        stress_measure=measure,
+        collapse_fraction=fraction,
+        plateau_stiffness_n_per_m=float(data.plateau_n_per_m),
+        measured_collapse_stress_mpa=data.stress_pa / units.MPA_TO_PA,
+        model_collapse_stress_mpa=model / units.MPA_TO_PA,
+        fitted_tau0_mpa=tau0,
+        fitted_params=params.replace(tau0_mpa=tau0),
+    )
