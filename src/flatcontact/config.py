@@ -179,6 +179,13 @@ class ScanConfig(_Section):
     )
     workers: int | None = Field(None, ge=1, description="worker processes (default: one per core)")
     dask_address: str | None = Field(None, description="address of a running Dask scheduler")
+    jobqueue: dict[str, Any] | None = Field(
+        None,
+        # left out of the dumped config while unset, so existing run fingerprints are unchanged
+        exclude_if=lambda value: value is None,
+        description="a dask-jobqueue cluster instead of local workers: {kind: slurm|pbs|sge|lsf|"
+        "htcondor|oar|moab, jobs: N, ...keyword arguments of the cluster class}",
+    )
 
     @field_validator("optimizer")
     @classmethod
@@ -415,7 +422,7 @@ def preset(name: str) -> dict:
             "structure": {"kind": "quartz-dense", "layers": 6, "source": _dense_slab_source()},
             "potential": default_potential(),
             "scan": {
-                "grid": [8, 8],
+                "grid": [12, 12],
                 "p_range_gpa": {"lo_gpa": -1.2, "hi_gpa": 4.5, "n": 12},
                 "fmax_ev_per_angstrom": 0.01,
             },

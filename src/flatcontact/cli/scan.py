@@ -1,22 +1,42 @@
 """``flatcontact scan``: the ISPES grid of an interface (resumable, parallel).
 
-Thin: builds a :class:`~flatcontact.ispes.config.ScanConfig` from a YAML file and flags,
-validates everything, runs :func:`flatcontact.ispes.scan.run_scan` and prints a summary.
+Thin: reads the run configuration (:func:`flatcontact.config.load_config`, the file
+``flatcontact run`` reads; its ``potential``/``calculator`` and ``scan`` sections), lays the
+flags over it, validates everything, runs :func:`flatcontact.ispes.scan.run_scan` and prints
+a summary.
 """
 
 from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
 from flatcontact.cli.app import app, console, err_console
 from flatcontact.errors import InputError
 
+#: Config field (dotted path) -> the flag that sets it, to name the flag in errors.
+_FLAG_OF = {
+    "potential": "--potential",
+    "potential.intra": "--potential",
+    "calculator": "--calculator",
+    "scan.grid": "--grid",
+    "scan.thickness_angstrom": "--thickness",
+    "scan.p_range_gpa": "--p-range-gpa",
+    "scan.fmax_ev_per_angstrom": "--fmax-ev-per-angstrom",
+    "scan.optimizer": "--optimizer",
+    "scan.max_steps": "--max-steps",
+    "scan.order": "--order",
+    "scan.executor": "--executor",
+    "scan.workers": "--workers",
+    "scan.dask_address": "--dask-address",
+}
+_FLAGS_SOURCE = "command-line flags"
 
-def _floats(values: list[str] | None, flag: str) -> tuple[float, ...] | None:
+
+def _floats(values: list[str] | None, flag: str) -> list[float] | None:
     if not values:
         return None
     out = []
@@ -26,34 +46,75 @@ def _floats(values: list[str] | None, flag: str) -> tuple[float, ...] | None:
                 out.append(float(item))
             except ValueError:
                 raise InputError(f"{flag}: {item!r} is not a number") from None
-    return tuple(out)
+    return out
 
 
-def potential_factory(potential: str, calculator: str | None):
-    """The calculator factory for ``--potential`` (NAME, .snapcoeff path, spec .json) or ``--calculator``."""
-    from flatcontact.ispes.calculators import CalculatorFactory, PotentialFactory
-
-    if calculator:
-        return CalculatorFactory.from_target(calculator)
-    from flatcontact.potentials import PotentialSpec
-
+def _potential_section(potential: str) -> dict[str, Any]:
+    """``--potential`` as a change of the config's ``potential`` section."""
     path = Path(potential).expanduser()
     if potential.endswith(".json"):
         if not path.is_file():
             raise InputError(f"--potential {potential}: no such potential spec file")
-        spec = PotentialSpec.model_validate_json(path.read_text())
-    elif potential.endswith(".snapcoeff"):
-        spec = PotentialSpec(intra=f"snap:{path}")
-    else:
-        spec = PotentialSpec(intra=potential)
-    return PotentialFactory.from_spec(spec)
+        try:
+            data = json.loads(path.read_text())
+        except ValueError:
+            raise InputError(f"--potential {potential}: not valid JSON") from None
+        if not isinstance(data, dict):
+            raise InputError(f"--potential {potential}: expected a JSON object (a PotentialSpec)")
+        return data
+    if potential.endswith(".snapcoeff"):
+        return {"intra": f"snap:{path}"}
+    return {"intra": potential}
+
+
+def _flag_error(exc: InputError) -> InputError:
+    """A validation error of the flags, with the flag named instead of the config path."""
+    text = str(exc).removeprefix(f"{_FLAGS_SOURCE}: ")
+    where, sep, msg = text.partition(": ")
+    field, sep2, rest = msg.partition(": ")  # a section validator naming its field first
+    if sep2 and f"{where}.{field}" in _FLAG_OF:
+        where, msg = f"{where}.{field}", rest
+    for key in sorted(_FLAG_OF, key=len, reverse=True):
+        if sep and where == key:
+            return InputError(f"{_FLAG_OF[key]}: {msg}")
+        if sep and where.startswith(key + "."):
+            return InputError(f"{_FLAG_OF[key]} ({where}): {msg}")
+    return InputError(f"{_FLAGS_SOURCE}: {text}")
+
+
+def resolve_config(config: Path | None, preset: str | None, flags: dict[str, Any]):
+    """The :class:`~flatcontact.config.RunConfig` of ``CONFIG`` (or the preset) with ``flags`` laid over.
+
+    ``flags`` holds the non-``None`` flag values as a nested mapping of config sections
+    (``{"scan": {"grid": [4, 4]}, "potential": {"intra": "vashishta"}}``). Errors in the file
+    name the file and ``scan.<field>``; errors in a flag name the flag.
+    """
+    from flatcontact.config import _merge, build_config, load_config
+
+    cfg = load_config(config, preset)
+    flags = {k: v for k, v in flags.items() if v != {}}
+    if not flags:
+        return cfg
+    merged = _merge(cfg.to_dict(), flags)
+    try:
+        return build_config(merged, source=_FLAGS_SOURCE)
+    except InputError as exc:
+        raise _flag_error(exc) from None
 
 
 @app.command("scan")
 def scan_command(
     config: Annotated[
         Path | None,
-        typer.Argument(help="YAML file with the same settings (top level or under 'scan:')."),
+        typer.Argument(
+            help="Run configuration (YAML), the same file 'flatcontact run' reads: its "
+            "potential/calculator and scan sections are used, flags override them. "
+            "Default: the built-in quick preset."
+        ),
+    ] = None,
+    preset: Annotated[
+        str | None,
+        typer.Option("--preset", help="quick (default) or paper: the defaults under CONFIG."),
     ] = None,
     interface: Annotated[
         str | None,
@@ -63,55 +124,75 @@ def scan_command(
         str | None,
         typer.Option(
             "--potential",
-            help="vashishta | tersoff | snap:NAME | path/X.snapcoeff | spec.json (default vashishta).",
+            help="potential.intra: vashishta | tersoff | snap:NAME | path/X.snapcoeff; or a "
+            "PotentialSpec .json whose fields replace the potential section's (default "
+            "snap:sio2-snap, "
+            "vashishta if that is not installed).",
         ),
     ] = None,
     calculator: Annotated[
         str | None,
         typer.Option(
-            "--calculator", help="Instead of --potential: an ASE calculator 'module:callable'."
+            "--calculator",
+            help="calculator.target: an ASE calculator 'module:callable' instead of --potential.",
         ),
     ] = None,
     grid: Annotated[
-        tuple[int, int] | None, typer.Option("--grid", help="Lateral points NA NB (default 12 12).")
+        tuple[int, int] | None,
+        typer.Option("--grid", help="scan.grid: lateral points NA NB (quick preset: 8 8)."),
     ] = None,
     thickness: Annotated[
         list[str] | None,
         typer.Option(
-            "--thickness", help="Thicknesses z in Å (surface 1 to 4); repeat or comma-separate."
+            "--thickness",
+            help="scan.thickness_angstrom: thicknesses z in Å (surface 1 to 4); repeat or "
+            "comma-separate. Replaces the pressure range.",
         ),
     ] = None,
     p_range_gpa: Annotated[
         tuple[float, float, int] | None,
         typer.Option(
-            "--p-range-gpa", help="Choose N thicknesses spanning loads LO..HI GPa (probe column)."
+            "--p-range-gpa",
+            help="scan.p_range_gpa: choose N thicknesses spanning loads LO..HI GPa "
+            "(quick preset: -1.2 4.5 12).",
         ),
     ] = None,
     workers: Annotated[
-        int | None, typer.Option("--workers", help="Worker processes (default: one per core).")
+        int | None,
+        typer.Option("--workers", help="scan.workers: worker processes (default: one per core)."),
     ] = None,
     executor: Annotated[
-        str | None, typer.Option("--executor", help="serial | processes (default) | dask.")
+        str | None,
+        typer.Option("--executor", help="scan.executor: serial | processes (default) | dask."),
     ] = None,
     dask_address: Annotated[
-        str | None, typer.Option("--dask-address", help="Address of a running Dask scheduler.")
+        str | None,
+        typer.Option("--dask-address", help="scan.dask_address: a running Dask scheduler."),
     ] = None,
-    fmax_ev_per_a: Annotated[
+    fmax_ev_per_angstrom: Annotated[
         float | None,
         typer.Option(
-            "--fmax-ev-per-a", help="Force tolerance on free atoms, eV/Å (default 0.005)."
+            "--fmax-ev-per-angstrom",
+            help="scan.fmax_ev_per_angstrom: force tolerance on free atoms, eV/Å "
+            "(quick preset: 0.01).",
         ),
     ] = None,
     optimizer: Annotated[
         str | None,
-        typer.Option("--optimizer", help="LBFGS (default), BFGS, FIRE, FIRE2, BFGSLineSearch."),
+        typer.Option(
+            "--optimizer",
+            help="scan.optimizer: LBFGS (default), BFGS, FIRE, FIRE2, BFGSLineSearch.",
+        ),
     ] = None,
     max_steps: Annotated[
-        int | None, typer.Option("--max-steps", help="Optimiser step cap (default 2000).")
+        int | None,
+        typer.Option("--max-steps", help="scan.max_steps: optimiser step cap (default 2000)."),
     ] = None,
     order: Annotated[
         str | None,
-        typer.Option("--order", help="Warm-start tree: columns (default), planes, cold."),
+        typer.Option(
+            "--order", help="scan.order: warm-start tree columns (default), planes, cold."
+        ),
     ] = None,
     out: Annotated[
         str | None, typer.Option("--out", help="Output directory (default ./ispes).")
@@ -120,63 +201,75 @@ def scan_command(
 ) -> None:
     """Relax every (shift_a, shift_b, z) point of the ISPES grid into OUT/points.db and OUT/ispes.nc.
 
-    Rerunning the same command continues an interrupted scan; a store made with other
-    settings is refused.
+    Settings come from CONFIG (a 'flatcontact run' configuration) or, without it, from the
+    quick preset (see 'flatcontact config --show-default'); flags override them. Rerunning
+    the same command continues an interrupted scan; a store made with other settings is
+    refused.
     """
-    from flatcontact.ispes.config import load_config
     from flatcontact.ispes.grid import GridSpec
     from flatcontact.ispes.relax import RelaxSettings
     from flatcontact.ispes.scan import ScanInterrupted, run_scan
     from flatcontact.structures.interface import read_interface
 
-    cfg = load_config(
-        config,
-        {
-            "interface": interface,
-            "potential": potential,
-            "calculator": calculator,
-            "grid": grid,
-            "thickness": _floats(thickness, "--thickness"),
-            "p_range_gpa": p_range_gpa,
-            "workers": workers,
-            "executor": executor,
-            "dask_address": dask_address,
-            "fmax_ev_per_a": fmax_ev_per_a,
-            "optimizer": optimizer,
-            "max_steps": max_steps,
-            "order": order,
-            "out": out,
-        },
-    )
-    if cfg.workers is not None and cfg.workers < 1:
-        raise InputError(f"--workers: expected at least 1, got {cfg.workers}")
-    if cfg.thickness is None and cfg.p_range_gpa is None:
-        raise InputError("give --thickness Z [Z ...] or --p-range-gpa LO HI N")
-    if cfg.thickness is not None and cfg.p_range_gpa is not None:
+    if thickness and p_range_gpa is not None:
         raise InputError("give either --thickness or --p-range-gpa, not both")
+    if potential is not None and calculator is not None:
+        raise InputError("give either --potential or --calculator, not both")
+    scan_flags = {
+        "grid": list(grid) if grid is not None else None,
+        "thickness_angstrom": _floats(thickness, "--thickness"),
+        "p_range_gpa": dict(zip(("lo_gpa", "hi_gpa", "n"), p_range_gpa, strict=True))
+        if p_range_gpa is not None
+        else None,
+        "fmax_ev_per_angstrom": fmax_ev_per_angstrom,
+        "optimizer": optimizer,
+        "max_steps": max_steps,
+        "order": order,
+        "executor": executor,
+        "workers": workers,
+        "dask_address": dask_address,
+    }
+    flags: dict[str, Any] = {"scan": {k: v for k, v in scan_flags.items() if v is not None}}
+    if potential is not None:
+        flags["potential"] = _potential_section(potential)
+        flags["calculator"] = None
+    if calculator is not None:
+        flags["calculator"] = {"target": calculator, "kwargs": {}}
+    cfg = resolve_config(config, preset, flags)
+    s = cfg.scan
     spec = GridSpec(
-        cfg.grid[0], cfg.grid[1], thickness_angstrom=cfg.thickness, p_range_gpa=cfg.p_range_gpa
+        s.grid[0],
+        s.grid[1],
+        thickness_angstrom=tuple(s.thickness_angstrom) if s.thickness_angstrom else None,
+        p_range_gpa=(s.p_range_gpa.lo_gpa, s.p_range_gpa.hi_gpa, s.p_range_gpa.n)
+        if s.p_range_gpa
+        else None,
     )
-    relax = RelaxSettings(cfg.fmax_ev_per_a, cfg.optimizer, cfg.max_steps)
-    reference = read_interface(cfg.interface)
-    factory = potential_factory(cfg.potential, cfg.calculator)
-    if hasattr(factory, "spec"):
+    relax = RelaxSettings(s.fmax_ev_per_angstrom, s.optimizer, s.max_steps)
+    reference = read_interface(interface or "interface.extxyz")
+    if cfg.calculator is not None:
+        from flatcontact.ispes.calculators import CalculatorFactory
+
+        factory = CalculatorFactory.from_target(cfg.calculator.target, **cfg.calculator.kwargs)
+    else:
+        from flatcontact.ispes.calculators import PotentialFactory
         from flatcontact.potentials import check_elements
 
-        check_elements(factory.spec(), reference)
+        check_elements(cfg.potential, reference)
+        factory = PotentialFactory.from_spec(cfg.potential)
     try:
         result = run_scan(
             reference,
             factory,
             spec,
-            cfg.out,
+            out or "ispes",
             relax,
-            order=cfg.order,
+            order=s.order,
             executor_options={
-                "kind": cfg.executor,
-                "workers": cfg.workers,
-                "dask_address": cfg.dask_address,
-                "jobqueue": cfg.jobqueue,
+                "kind": s.executor,
+                "workers": s.workers,
+                "dask_address": s.dask_address,
+                "jobqueue": s.jobqueue,
             },
             progress=not as_json,
             console=console,
