@@ -422,7 +422,7 @@ def preset(name: str) -> dict:
             "structure": {"kind": "quartz-dense", "layers": 6, "source": _dense_slab_source()},
             "potential": default_potential(),
             "scan": {
-                "grid": [12, 12],
+                "grid": [8, 8],
                 "p_range_gpa": {"lo_gpa": -1.2, "hi_gpa": 4.5, "n": 12},
                 "fmax_ev_per_angstrom": 0.01,
             },
