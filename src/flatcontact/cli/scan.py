@@ -139,7 +139,7 @@ def scan_command(
     ] = None,
     grid: Annotated[
         tuple[int, int] | None,
-        typer.Option("--grid", help="scan.grid: lateral points NA NB (quick preset: 8 8)."),
+        typer.Option("--grid", help="scan.grid: lateral points NA NB (default: the preset's)."),
     ] = None,
     thickness: Annotated[
         list[str] | None,
@@ -154,7 +154,7 @@ def scan_command(
         typer.Option(
             "--p-range-gpa",
             help="scan.p_range_gpa: choose N thicknesses spanning loads LO..HI GPa "
-            "(quick preset: -1.2 4.5 12).",
+            "(default: the preset's).",
         ),
     ] = None,
     workers: Annotated[
@@ -174,7 +174,7 @@ def scan_command(
         typer.Option(
             "--fmax-ev-per-angstrom",
             help="scan.fmax_ev_per_angstrom: force tolerance on free atoms, eV/Å "
-            "(quick preset: 0.01).",
+            "(default: the preset's).",
         ),
     ] = None,
     optimizer: Annotated[
