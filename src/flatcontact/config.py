@@ -422,7 +422,7 @@ def preset(name: str) -> dict:
             "structure": {"kind": "quartz-dense", "layers": 6, "source": _dense_slab_source()},
             "potential": default_potential(),
             "scan": {
-                "grid": [8, 8],
+                "grid": [12, 12],
                 "p_range_gpa": {"lo_gpa": -1.2, "hi_gpa": 4.5, "n": 12},
                 "fmax_ev_per_angstrom": 0.01,
             },
@@ -447,7 +447,7 @@ def preset(name: str) -> dict:
     raise InputError(f"preset: expected quick or paper, got {name!r}")
 
 
-def _merge(base: dict, over: dict) -> dict:
+def merge_config(base: dict, over: dict) -> dict:
     out = copy.deepcopy(base)
     for key, value in over.items():
         if isinstance(value, dict) and isinstance(out.get(key), dict) and key != "kwargs":
@@ -457,7 +457,7 @@ def _merge(base: dict, over: dict) -> dict:
                     out[key].pop("p_range_gpa", None)
                 if "p_range_gpa" in value:
                     out[key].pop("thickness_angstrom", None)
-            out[key] = _merge(out[key], value)
+            out[key] = merge_config(out[key], value)
         else:
             out[key] = copy.deepcopy(value)
     return out
@@ -526,7 +526,7 @@ def build_config(
     data.pop("preset", None)
     if name not in ("quick", "paper"):
         raise InputError(f"{source}: preset: expected quick or paper, got {_show(name)}")
-    merged = _merge(preset(name), data)
+    merged = merge_config(preset(name), data)
     try:
         return RunConfig.model_validate(merged)
     except ValidationError as exc:

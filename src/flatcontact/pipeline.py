@@ -72,7 +72,7 @@ STAGES = {
 RUN_MARKER = "run.json"
 RUN_FORMAT = "flatcontact.run/1"
 #: Scan settings that change how, not what, is computed (kept out of the fingerprint).
-EXECUTION_ONLY = ("executor", "workers", "dask_address")
+EXECUTION_ONLY = ("executor", "workers", "dask_address", "jobqueue")
 
 
 def file_sha256(path: str | Path) -> str:
@@ -465,6 +465,7 @@ class Pipeline:
                     "kind": s.executor,
                     "workers": s.workers,
                     "dask_address": s.dask_address,
+                    "jobqueue": s.jobqueue,
                 },
                 progress=self.console is not None,
                 console=self.console,

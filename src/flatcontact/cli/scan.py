@@ -89,13 +89,13 @@ def resolve_config(config: Path | None, preset: str | None, flags: dict[str, Any
     (``{"scan": {"grid": [4, 4]}, "potential": {"intra": "vashishta"}}``). Errors in the file
     name the file and ``scan.<field>``; errors in a flag name the flag.
     """
-    from flatcontact.config import _merge, build_config, load_config
+    from flatcontact.config import build_config, load_config, merge_config
 
     cfg = load_config(config, preset)
     flags = {k: v for k, v in flags.items() if v != {}}
     if not flags:
         return cfg
-    merged = _merge(cfg.to_dict(), flags)
+    merged = merge_config(cfg.to_dict(), flags)
     try:
         return build_config(merged, source=_FLAGS_SOURCE)
     except InputError as exc:
