@@ -424,7 +424,7 @@ def preset(name: str) -> dict:
             "scan": {
                 "grid": [12, 12],
                 "p_range_gpa": {"lo_gpa": -1.2, "hi_gpa": 4.5, "n": 12},
-                "fmax_ev_per_angstrom": 0.01,
+                "fmax_ev_per_angstrom": 0.005,
             },
             "analysis": {"p_gpa": [0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5]},
             "contact": {"p0_gpa": [0.5, 1.0, 1.77, 2.0, 3.0]},
