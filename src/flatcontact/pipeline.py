@@ -52,7 +52,7 @@ from typing import Any
 import numpy as np
 
 from flatcontact import __version__, units
-from flatcontact.config import PAPER_VALUES, RunConfig, to_yaml
+from flatcontact.config import BUNDLED_DIR, BUNDLED_SNAP, PAPER_VALUES, RunConfig, to_yaml
 from flatcontact.errors import InputError
 from flatcontact.fileio import write_json_atomic, write_text_atomic
 from flatcontact.rundir import RunDirectory, StageResult, package_versions
@@ -915,6 +915,28 @@ def _setup_differences(pipe: Pipeline) -> list[str]:
             "SNAP trained on DFT (Erhard et al. 2022). Its lattice constant, surface relaxation and "
             "interfacial corrugation differ, and τ and σ are differences of the corrugation "
             "energy, so they inherit these differences directly (Vashishta: a = 4.829 Å vs 4.916 Å)."
+        )
+    elif cfg.potential.intra == f"snap:{BUNDLED_SNAP}":
+        validation = json.loads((BUNDLED_DIR / BUNDLED_SNAP / "validation.json").read_text())
+        e_star = validation["potential"]["elastic"]["moduli_gpa"]["e_star"]
+        out.append(
+            f"The intra-slab SNAP is flatcontact's bundled {BUNDLED_SNAP}, trained on CHGNet "
+            "r2SCAN labels, not on the DFT data of Erhard et al. (2022) like the paper's; its "
+            f"α-quartz follows CHGNet's, softer than experiment: E* = {e_star:.1f} GPa from its "
+            "elastic constants (validation.json) vs the paper's 52.5 GPa."
+        )
+    else:
+        out.append(
+            f"The intra-slab SNAP '{cfg.potential.intra}' is not the paper's (trained on the DFT "
+            "data of Erhard et al. 2022)."
+        )
+    lj = cfg.potential.lj if cfg.calculator is None else None
+    if lj is not None and lj.c6_source == "ts" and not lj.volume_ratio and not lj.c6_ev_a6:
+        out.append(
+            "The cross-interface LJ uses Tkatchenko–Scheffler free-atom C6; the paper took C6 "
+            "from vdW-DFT of the solid, where Hirshfeld scaling (C6 ∝ (V_eff/V_free)²) makes "
+            "the C6 of cationic Si in SiO₂ much smaller. The adhesion and the corrugation the "
+            "LJ adds differ accordingly (set potential.lj.volume_ratio or c6_ev_a6)."
         )
     if cfg.structure.kind != "quartz-dense":
         out.append("The interface is not the paper's α-quartz (0001) dense interface.")
