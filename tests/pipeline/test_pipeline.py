@@ -33,6 +33,7 @@ TINY = {
     "scan": {
         "grid": [6, 6],
         "p_range_gpa": {"lo_gpa": -1.2, "hi_gpa": 3.5, "n": 6},
+        "fmax_ev_per_angstrom": 0.01,  # pinned: this file must not follow the quick preset
         "executor": "serial",
     },
     "analysis": {"p_gpa": [0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0]},
