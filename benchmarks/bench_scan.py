@@ -42,6 +42,8 @@ from pathlib import Path
 
 import numpy as np
 
+from flatcontact.training.snapfiles import n_bispectrum
+
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 SUBSET_LATERAL = (4, 4)
@@ -53,17 +55,6 @@ WORKERS = (1, 2)
 ORDERS = ("cold", "columns")
 POTENTIALS = ("snap:sio2-snap", "vashishta")
 SNAP_BUNDLED = "sio2-snap"
-
-
-def n_bispectrum(twojmax: int) -> int:
-    """Number of SNAP bispectrum components B_{j1 j2 j} for ``twojmax`` (LAMMPS ordering rule)."""
-    n = 0
-    for j1 in range(twojmax + 1):
-        for j2 in range(j1 + 1):
-            for j in range(j1 - j2, min(twojmax, j1 + j2) + 1, 2):
-                if j >= j1:
-                    n += 1
-    return n
 
 
 def n_snap_coefficients(twojmax: int, quadratic: bool) -> int:

@@ -40,6 +40,7 @@ from pydantic import (
 )
 
 from flatcontact.errors import InputError
+from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.order import PREFERENCES
 from flatcontact.ispes.relax import OPTIMIZERS, RelaxSettings
 from flatcontact.potentials.spec import BUNDLED_DIR, PotentialSpec
@@ -215,6 +216,20 @@ class ScanConfig(_Section):
             if not z or any(not v > 0 for v in z):
                 raise ValueError(f"thickness_angstrom: expected positive values in Å, got {z}")
         return self
+
+    def grid_spec(self) -> GridSpec:
+        """The scan grid of these settings (:class:`flatcontact.ispes.grid.GridSpec`)."""
+        r = self.p_range_gpa
+        return GridSpec(
+            self.grid[0],
+            self.grid[1],
+            thickness_angstrom=tuple(self.thickness_angstrom) if self.thickness_angstrom else None,
+            p_range_gpa=(r.lo_gpa, r.hi_gpa, r.n) if r else None,
+        )
+
+    def relax_settings(self) -> RelaxSettings:
+        """The per-point relaxation of these settings."""
+        return RelaxSettings(self.fmax_ev_per_angstrom, self.optimizer, self.max_steps)
 
 
 class AnalysisConfig(_Section):

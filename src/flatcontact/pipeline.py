@@ -434,21 +434,11 @@ class Pipeline:
         inputs = {"scan": scan_inputs, "model": self._model_inputs(), "build": build.fingerprint}
 
         def work(folder: Path) -> None:
-            from flatcontact.ispes.grid import GridSpec
-            from flatcontact.ispes.relax import RelaxSettings
             from flatcontact.ispes.scan import run_scan
             from flatcontact.structures.interface import read_interface
 
             s = cfg.scan
             reference = read_interface(build.folder / "interface.extxyz")
-            grid = GridSpec(
-                s.grid[0],
-                s.grid[1],
-                thickness_angstrom=tuple(s.thickness_angstrom) if s.thickness_angstrom else None,
-                p_range_gpa=(s.p_range_gpa.lo_gpa, s.p_range_gpa.hi_gpa, s.p_range_gpa.n)
-                if s.p_range_gpa
-                else None,
-            )
             factory = self._factory()
             if cfg.calculator is None:
                 from flatcontact.potentials import check_elements
@@ -457,9 +447,9 @@ class Pipeline:
             result = run_scan(
                 reference,
                 factory,
-                grid,
+                s.grid_spec(),
                 folder,
-                RelaxSettings(s.fmax_ev_per_angstrom, s.optimizer, s.max_steps),
+                s.relax_settings(),
                 order=s.order,
                 executor_options={
                     "kind": s.executor,

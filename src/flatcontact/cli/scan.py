@@ -206,8 +206,6 @@ def scan_command(
     the same command continues an interrupted scan; a store made with other settings is
     refused.
     """
-    from flatcontact.ispes.grid import GridSpec
-    from flatcontact.ispes.relax import RelaxSettings
     from flatcontact.ispes.scan import ScanInterrupted, run_scan
     from flatcontact.structures.interface import read_interface
 
@@ -237,15 +235,8 @@ def scan_command(
         flags["calculator"] = {"target": calculator, "kwargs": {}}
     cfg = resolve_config(config, preset, flags)
     s = cfg.scan
-    spec = GridSpec(
-        s.grid[0],
-        s.grid[1],
-        thickness_angstrom=tuple(s.thickness_angstrom) if s.thickness_angstrom else None,
-        p_range_gpa=(s.p_range_gpa.lo_gpa, s.p_range_gpa.hi_gpa, s.p_range_gpa.n)
-        if s.p_range_gpa
-        else None,
-    )
-    relax = RelaxSettings(s.fmax_ev_per_angstrom, s.optimizer, s.max_steps)
+    spec = s.grid_spec()
+    relax = s.relax_settings()
     reference = read_interface(interface or "interface.extxyz")
     if cfg.calculator is not None:
         from flatcontact.ispes.calculators import CalculatorFactory
