@@ -625,6 +625,13 @@ class Pipeline:
         """
         cfg = self.config
         if not cfg.elastic.enabled:
+            if self.console is not None:
+                self.console.print(
+                    f"[bold]{STAGES['elastic']}. elastic[/]\n   off: the contact model takes "
+                    f"E* = {cfg.contact.contact_modulus_gpa:g} GPa, G* = "
+                    f"{cfg.contact.shear_modulus_gpa:g} GPa from the configuration",
+                    highlight=False,
+                )
             return None
         inputs = {"elastic": cfg.section("elastic"), "model": self._model_inputs()}
 
