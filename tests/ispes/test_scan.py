@@ -265,3 +265,30 @@ def test_a_second_driver_on_the_same_store_is_refused(tmp_path, toy_reference, t
     # released with the first driver: the scan now runs
     done = run_scan(toy_reference, toy_factory, grid, tmp_path, SETTINGS, executor=SerialExecutor())
     assert done.points_done == 1
+
+
+def test_jobqueue_cluster_from_config_builds_the_batch_job():
+    """A SLURM cluster from the config's ``scan.jobqueue`` dict (no job submitted: jobs = 0)."""
+    pytest.importorskip("dask_jobqueue")
+    from flatcontact.ispes.executors import jobqueue_cluster
+
+    spec = {
+        "kind": "slurm",
+        "jobs": 0,
+        "cores": 4,
+        "memory": "8GB",
+        "processes": 1,
+        "queue": "short",
+        "walltime": "02:00:00",
+    }
+    cluster = jobqueue_cluster(spec)
+    try:
+        script = cluster.job_script()
+    finally:
+        cluster.close()
+    for line in ("#SBATCH -p short", "#SBATCH --cpus-per-task=4", "#SBATCH -t 02:00:00"):
+        assert line in script
+    with pytest.raises(InputError, match=r"jobqueue\.kind: expected one of slurm"):
+        jobqueue_cluster({"kind": "cloud"})
+    with pytest.raises(InputError, match="cannot build a SLURMCluster"):
+        jobqueue_cluster({"kind": "slurm", "jobs": 0, "cores": 1, "memory": "1GB", "bogus": 1})
