@@ -13,6 +13,7 @@ from scipy.optimize import brentq
 
 from flatcontact.contact import mindlin, oscillation
 from flatcontact.contact.parameters import ContactParameters
+from flatcontact.contact.quadrature import paper_integrals
 
 P = ContactParameters()
 P0 = 1.77e9
@@ -28,31 +29,9 @@ def _best(fn, repeat=5):
 
 
 def _q_direct(u, counter):
-    """The paper's two integrals by quad, c from q(c) = τ(c) by brentq."""
-    a = float(mindlin.contact_radius(P0, P))
-    q0 = P.shear_modulus_pa * u / (np.pi * a)
-
-    def mismatch(r):
-        counter[0] += 1
-        s = np.sqrt(1 - (r / a) ** 2)
-        return q0 / s - (P.k * P0 * s + P.tau0_pa)
-
-    if q0 == 0 or mismatch(a * (1 - 1e-15)) < 0:
-        c = a
-    elif mismatch(0.0) >= 0:
-        c = 0.0
-    else:
-        c = brentq(mismatch, 0.0, a * (1 - 1e-15), xtol=1e-16 * a)
-
-    def stick(r):
-        counter[1] += 1
-        return 2 * np.pi * r * q0 / np.sqrt(1 - (r / a) ** 2)
-
-    def slip(r):
-        counter[1] += 1
-        return 2 * np.pi * r * (P.mu * P0 * np.sqrt(max(1 - (r / a) ** 2, 0.0)) + P.sigma0_pa)
-
-    return quad(stick, 0, c)[0] + quad(slip, c, a)[0]
+    """The paper's two integrals by quad (scipy's default tolerance), c by brentq."""
+    _, stick, slip = paper_integrals(u, P0, P, counter=counter)
+    return stick + slip
 
 
 def _mean_u_direct(qmax, counter):

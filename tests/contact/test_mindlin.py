@@ -5,11 +5,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.integrate import quad
-from scipy.optimize import brentq
 
 from flatcontact import units
 from flatcontact.contact import mindlin as m
 from flatcontact.contact.parameters import ContactParameters
+from flatcontact.contact.quadrature import paper_integrals
 from flatcontact.errors import InputError
 
 P = ContactParameters()
@@ -51,30 +51,7 @@ def test_shear_modulus_conversion():
 
 def _paper_integrals(u, p0, prm):
     """The paper's Q_stick and Q_slip integrals by quadrature, c from q(c) = τ(c) by brentq."""
-    a = float(m.contact_radius(p0, prm))
-    q0 = prm.shear_modulus_pa * u / (np.pi * a)
-
-    def mismatch(r):
-        s = np.sqrt(1 - (r / a) ** 2)
-        return q0 / s - (prm.k * p0 * s + prm.tau0_pa)
-
-    if q0 == 0.0 or mismatch(a * (1 - 1e-15)) < 0:
-        c = a
-    elif mismatch(0.0) >= 0:
-        c = 0.0
-    else:
-        c = brentq(mismatch, 0.0, a * (1 - 1e-15), xtol=1e-16 * a)
-    stick = quad(
-        lambda r: 2 * np.pi * r * q0 / np.sqrt(1 - (r / a) ** 2), 0, c, epsabs=0, epsrel=1e-12
-    )[0]
-    slip = quad(
-        lambda r: 2 * np.pi * r * (prm.mu * p0 * np.sqrt(max(1 - (r / a) ** 2, 0)) + prm.sigma0_pa),
-        c,
-        a,
-        epsabs=0,
-        epsrel=1e-12,
-    )[0]
-    return c, stick, slip
+    return paper_integrals(u, p0, prm, epsabs=0.0, epsrel=1e-12)
 
 
 @pytest.mark.filterwarnings("ignore::scipy.integrate.IntegrationWarning")
