@@ -1,8 +1,9 @@
 """The whole study as stages over a run directory: build → scan → analyze → laws → (elastic) → contact → report.
 
 :class:`Pipeline` runs each stage through :meth:`flatcontact.rundir.RunDirectory.run_stage`
-with the stage's inputs = its configuration section + the fingerprints of the stages it
-reads, so that
+with the stage's inputs = its configuration section + the content of the files it reads
+(potential coefficients, structure and measurement files) + the digest of the source code
+that computes it (:data:`STAGE_CODE`) + the fingerprints of the stages it reads, so that
 
 - a rerun skips every stage whose inputs are unchanged;
 - an interrupted stage (Ctrl-C, kill -9) is resumed: the scan continues from its point
@@ -55,7 +56,7 @@ from flatcontact import __version__, units
 from flatcontact.config import BUNDLED_DIR, BUNDLED_SNAP, PAPER_VALUES, RunConfig, to_yaml
 from flatcontact.errors import InputError
 from flatcontact.fileio import write_json_atomic, write_text_atomic
-from flatcontact.rundir import RunDirectory, StageResult, package_versions
+from flatcontact.rundir import RunDirectory, StageResult, code_digest, package_versions
 
 log = logging.getLogger("flatcontact.run")
 
@@ -68,6 +69,20 @@ STAGES = {
     "elastic": 5,
     "contact": 6,
     "report": 7,
+}
+#: The flatcontact source each stage's numbers depend on (paths in the package, see
+#: :func:`flatcontact.rundir.code_digest`). Editing one of them reruns the stage and, through
+#: the fingerprints, every stage that reads it. The expensive stages (build, scan, elastic)
+#: list the sub-packages that compute them, so an edit of the analysis, the contact model,
+#: the plots or this module does not rerun a scan; the report takes the whole package.
+STAGE_CODE: dict[str, tuple[str, ...]] = {
+    "build": ("structures", "potentials", "ispes/toy.py", "units.py"),
+    "scan": ("ispes", "potentials", "structures", "units.py"),
+    "analyze": ("analysis", "ispes/contract.py", "plots", "pipeline.py", "units.py"),
+    "laws": ("analysis", "plots", "pipeline.py", "units.py"),
+    "elastic": ("elastic.py", "potentials", "structures", "units.py"),
+    "contact": ("contact", "plots", "pipeline.py", "units.py"),
+    "report": (".",),
 }
 RUN_MARKER = "run.json"
 RUN_FORMAT = "flatcontact.run/1"
@@ -323,7 +338,9 @@ class Pipeline:
         cfg = self.config
         if cfg.calculator is not None:
             return {"calculator": cfg.section("calculator")}
-        return {"potential": cfg.section("potential")}
+        # by content: retraining a bundled SNAP or editing a coefficient file reruns the scan
+        files = {Path(f).name: file_sha256(f) for f in cfg.potential.resolved.files}
+        return {"potential": cfg.section("potential"), "files_sha256": files}
 
     def _factory(self):
         from flatcontact.ispes.calculators import CalculatorFactory, PotentialFactory
@@ -341,6 +358,7 @@ class Pipeline:
     def _run(self, name: str, inputs: dict, work: Callable[[Path], None]) -> StageResult:
         say = self.console.print if self.console is not None else (lambda *a, **k: None)
         index = STAGES[name]
+        inputs = {**inputs, "code_sha256": code_digest(STAGE_CODE[name])}
         say(f"[bold]{index}. {name}[/]", highlight=False)
         try:
             if self.console is not None and name != "scan":

@@ -193,6 +193,59 @@ def test_a_change_reruns_exactly_the_dependent_stages(tiny_run, tmp_path, change
     assert all(actions[n] == "ran" for n in rerun)
 
 
+@pytest.mark.parametrize(
+    ("edited", "rerun"),
+    [
+        ("contact/mindlin.py", {"contact", "report"}),
+        ("analysis/friction.py", {"analyze", "laws", "contact", "report"}),
+        ("ispes/relax.py", {"scan", "analyze", "laws", "contact", "report"}),
+    ],
+)
+def test_a_code_edit_reruns_exactly_the_stages_it_can_change(
+    tiny_run, tmp_path, monkeypatch, edited, rerun
+):
+    """Editing a development install's source reruns what the edit can change (same settings)."""
+    import shutil
+
+    import flatcontact.pipeline as pipeline_module
+    from flatcontact.rundir import code_digest
+
+    def edited_digest(parts):
+        # the digest as if `edited` had new content: changed for every part that contains it
+        touched = any(
+            part == "." or edited == part or edited.startswith(part + "/") for part in parts
+        )
+        return code_digest(parts) + ("+edited" if touched else "")
+
+    src, _, _ = tiny_run
+    root = tmp_path / "copy"
+    shutil.copytree(src, root)
+    monkeypatch.setattr(pipeline_module, "code_digest", edited_digest)
+    with Pipeline(build_config(TINY), root) as pipe:
+        pipe.run()
+        actions = _actions(pipe)
+    assert {n for n, a in actions.items() if a != "skipped"} == rerun
+
+
+def test_a_retrained_potential_file_reruns_from_the_build(tmp_path):
+    """Coefficient files enter the fingerprint by content, not by name."""
+    from flatcontact.potentials.spec import BUNDLED_DIR
+
+    bundled = BUNDLED_DIR / "sio2-snap"
+    for suffix in (".snapcoeff", ".snapparam"):
+        shutil_copy = (tmp_path / f"my{suffix}").write_bytes
+        shutil_copy((bundled / f"sio2-snap{suffix}").read_bytes())
+    cfg = _merge(TINY, {"potential": {"intra": f"snap:{tmp_path / 'my.snapcoeff'}"}})
+    with Pipeline(build_config(cfg), tmp_path / "run") as pipe:
+        before = pipe._model_inputs()
+        coeff = tmp_path / "my.snapcoeff"
+        coeff.write_text(coeff.read_text() + "\n")
+        after = pipe._model_inputs()
+    assert before["potential"] == after["potential"]
+    assert before["files_sha256"]["my.snapparam"] == after["files_sha256"]["my.snapparam"]
+    assert before["files_sha256"]["my.snapcoeff"] != after["files_sha256"]["my.snapcoeff"]
+
+
 def test_foreign_or_corrupt_run_directories_are_refused(tiny_run, tmp_path):
     import shutil
 
