@@ -17,6 +17,11 @@ EV_PER_A3_TO_GPA = _EV_J * 1.0e30 / 1.0e9
 EV_PER_A3_TO_MPA = 1.0e3 * EV_PER_A3_TO_GPA
 #: eV/Å^2 -> J/m^2 (surface energy, work of adhesion / separation).
 EV_PER_A2_TO_J_PER_M2 = _EV_J * 1.0e20
+#: eV -> J and eV -> zJ (1 zJ = 1e-21 J; Hamaker constants of solids are tens of zJ).
+EV_TO_J = _EV_J
+EV_TO_ZJ = _EV_J * 1.0e21
+#: nm^-3 -> Å^-3 (number densities).
+PER_NM3_TO_PER_A3 = 1.0e-3
 #: eV/Å^2 -> meV/Å^2 (the paper's unit for ISPES energies per area).
 EV_PER_A2_TO_MEV_PER_A2 = 1.0e3
 

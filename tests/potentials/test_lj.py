@@ -103,3 +103,63 @@ def test_spec_is_frozen_picklable_hashable_and_validates():
         assert "\n" not in str(info.value)
     with pytest.raises(InputError, match="cutoff"):
         PotentialSpec(lj={"cutoff_angstrom": 0})
+
+
+def test_pairwise_hamaker_constant_by_hand():
+    """A = π² Σ_AB C6_AB ρ_A ρ_B (Hamaker 1937), checked term by term for α-quartz."""
+    from flatcontact.potentials.lj import (
+        ALPHA_QUARTZ_NUMBER_DENSITY_PER_NM3 as RHO,
+    )
+    from flatcontact.potentials.lj import pairwise_hamaker_constant_zj
+
+    t = lj_table(["O", "Si"], ["O", "Si"])
+    # α-quartz: 3 SiO2 in V = (√3/2)a²c = 113.1 Å³ → 26.5 Si and 53.0 O per nm³
+    assert RHO["Si"] == pytest.approx(26.52, abs=0.01)
+    assert RHO["O"] == pytest.approx(2 * RHO["Si"])
+    rho_si, rho_o = RHO["Si"] * 1e-3, RHO["O"] * 1e-3  # Å⁻³
+    by_hand_ev = np.pi**2 * (
+        t["Si-Si"].c6_ev_a6 * rho_si**2
+        + 2 * t["O-Si"].c6_ev_a6 * rho_si * rho_o
+        + t["O-O"].c6_ev_a6 * rho_o**2
+    )
+    a_zj = pairwise_hamaker_constant_zj(t, RHO)
+    assert a_zj == pytest.approx(by_hand_ev * 1.602176634e-19 * 1e21)
+    # free-atom C6 overbind quartz: ~4.7× the Lifshitz value (≈ 88 zJ, Bergström 1997)
+    assert 380 < a_zj < 440
+
+
+@given(st.floats(10.0, 1000.0))
+def test_hamaker_calibration_round_trip_keeps_sigma(target_zj):
+    from flatcontact.potentials.lj import (
+        ALPHA_QUARTZ_NUMBER_DENSITY_PER_NM3 as RHO,
+    )
+    from flatcontact.potentials.lj import hamaker_c6_scale, pairwise_hamaker_constant_zj
+
+    free = lj_table(["O", "Si"], ["O", "Si"])
+    scale = hamaker_c6_scale(free, RHO, target_zj)
+    scaled = lj_table(["O", "Si"], ["O", "Si"], c6_scale=scale)
+    assert pairwise_hamaker_constant_zj(scaled, RHO) == pytest.approx(target_zj, rel=1e-12)
+    for key in free:
+        assert scaled[key].sigma_angstrom == free[key].sigma_angstrom  # minima stay put
+        assert scaled[key].epsilon_ev == pytest.approx(scale * free[key].epsilon_ev)
+    # the spec route gives the same table
+    spec = LJSpec(hamaker_zj=target_zj, number_density_per_nm3=RHO)
+    via_spec = spec.table(["O", "Si"], ["O", "Si"])
+    for key in free:
+        assert via_spec[key].c6_ev_a6 == pytest.approx(scaled[key].c6_ev_a6, rel=1e-12)
+
+
+def test_hamaker_and_scale_are_validated():
+    from pydantic import ValidationError
+
+    with pytest.raises(ValidationError, match="number_density_per_nm3"):
+        LJSpec(hamaker_zj=88.0)
+    with pytest.raises(ValidationError, match="either c6_scale or hamaker_zj"):
+        LJSpec(hamaker_zj=88.0, c6_scale=0.5, number_density_per_nm3={"Si": 1.0, "O": 2.0})
+    with pytest.raises(ValidationError, match="expected > 0"):
+        LJSpec(c6_scale=0.0)
+    spec = LJSpec(hamaker_zj=88.0, number_density_per_nm3={"O": 53.0})
+    with pytest.raises(InputError, match=r"lacks the elements \['Si'\]"):
+        spec.table(["O", "Si"], ["O", "Si"])
+    half = LJSpec(c6_scale=0.5).table(["O"], ["O"])["O-O"]
+    assert half.c6_ev_a6 == pytest.approx(0.5 * lj_table(["O"], ["O"])["O-O"].c6_ev_a6)

@@ -19,6 +19,15 @@ Mapping C6 → (ε, σ) (our stated choice)
     σ_AB = 2^{-1/6}(R0_A + R0_B) and ε_AB = C6_AB / (4σ_AB⁶). User-given effective C6
     per pair replace C6_AB; σ still comes from the radii.
 
+Calibration to a Hamaker constant (optional)
+    Free-atom C6 ignore that atoms in a solid are less polarisable than free ones (for Si in
+    SiO₂, a cation, by far): with them the pairwise Hamaker constant of α-quartz,
+    A = π² Σ_AB C6_AB ρ_A ρ_B (Hamaker 1937; ρ = number densities), is ≈ 410 zJ, against
+    ≈ 88 zJ from Lifshitz theory with measured dielectric spectra (Bergström, Adv. Colloid
+    Interface Sci. 70, 125 (1997)). :func:`hamaker_c6_scale` gives the one factor on every
+    C6 that makes A equal a target value; σ (the radii) is unchanged, so the LJ minima stay
+    where they are and only their depths scale.
+
 Cutoff and shift
     U(r) = 4ε[(σ/r)¹² − (σ/r)⁶] − U_LJ(r_c) for r < r_c, 0 beyond (energy shifted to be
     continuous at r_c = ``cutoff_angstrom``; LAMMPS ``lj/cut`` with ``pair_modify shift yes``).
@@ -35,6 +44,7 @@ from ase import Atoms, units
 from ase.calculators.vdwcorrection import vdWDB_alphaC6
 from ase.neighborlist import neighbor_list
 
+from flatcontact import units as units_conv
 from flatcontact.errors import InputError
 
 #: Hartree·bohr⁶ → eV·Å⁶.
@@ -96,6 +106,51 @@ def lj_from_c6(c6_ev_a6: float, r0_a_angstrom: float, r0_b_angstrom: float) -> L
     return LJPair(epsilon_ev=c6_ev_a6 / (4.0 * sigma**6), sigma_angstrom=sigma, c6_ev_a6=c6_ev_a6)
 
 
+#: Number densities of α-quartz (nm⁻³) from the experimental cell (a = 4.916 Å,
+#: c = 5.405 Å, 3 SiO₂ per cell), for :func:`pairwise_hamaker_constant_zj`.
+ALPHA_QUARTZ_NUMBER_DENSITY_PER_NM3: dict[str, float] = {
+    "Si": 3.0 / (np.sqrt(3.0) / 2.0 * 4.916**2 * 5.405) * 1.0e3,
+    "O": 6.0 / (np.sqrt(3.0) / 2.0 * 4.916**2 * 5.405) * 1.0e3,
+}
+
+
+def pairwise_hamaker_constant_zj(
+    table: dict[str, LJPair], number_density_per_nm3: dict[str, float]
+) -> float:
+    """Hamaker's pairwise-summation constant of two identical bodies (zJ).
+
+    A = π² Σ_A Σ_B C6_AB ρ_A ρ_B (Hamaker, Physica 4, 1058 (1937)), the sum over ordered
+    element pairs of the body, with the C6 of ``table`` (eV·Å⁶) and the number densities
+    ρ (nm⁻³). The non-retarded interaction energy per area of two half-spaces at a gap D
+    is then −A/(12πD²).
+
+    Raises
+    ------
+    InputError
+        If a pair of the given elements is missing from ``table``.
+    """
+    total_ev = 0.0
+    for a, rho_a in number_density_per_nm3.items():
+        for b, rho_b in number_density_per_nm3.items():
+            key = pair_key(a, b)
+            if key not in table:
+                raise InputError(f"no LJ parameters for the element pair {key} (Hamaker sum)")
+            total_ev += table[key].c6_ev_a6 * rho_a * rho_b * units_conv.PER_NM3_TO_PER_A3**2
+    return float(np.pi**2 * total_ev * units_conv.EV_TO_ZJ)
+
+
+def hamaker_c6_scale(
+    table: dict[str, LJPair], number_density_per_nm3: dict[str, float], hamaker_zj: float
+) -> float:
+    """The factor on every C6 that makes the pairwise Hamaker constant equal ``hamaker_zj``.
+
+    A is linear in the C6, so the factor is ``hamaker_zj / pairwise_hamaker_constant_zj``.
+    """
+    if not hamaker_zj > 0:
+        raise InputError(f"hamaker_zj={hamaker_zj}: expected > 0 zJ")
+    return hamaker_zj / pairwise_hamaker_constant_zj(table, number_density_per_nm3)
+
+
 def lj_table(
     symbols_1: list[str] | tuple[str, ...],
     symbols_2: list[str] | tuple[str, ...],
@@ -103,12 +158,16 @@ def lj_table(
     c6_ev_a6: dict[str, float] | None = None,
     r0_angstrom: dict[str, float] | None = None,
     volume_ratio: dict[str, float] | None = None,
+    c6_scale: float = 1.0,
 ) -> dict[str, LJPair]:
     """LJ parameters for every element pair (A from slab 1, B from slab 2), keyed by :func:`pair_key`.
 
     ``c6_ev_a6`` overrides C6 for given pairs ("O-Si"); ``r0_angstrom`` overrides the free-atom
-    radius per element; ``volume_ratio`` applies the Hirshfeld scaling of TS 2009 Eqs. (7)–(9).
+    radius per element; ``volume_ratio`` applies the Hirshfeld scaling of TS 2009 Eqs. (7)–(9);
+    ``c6_scale`` multiplies every C6 last (e.g. :func:`hamaker_c6_scale`), leaving σ unchanged.
     """
+    if not c6_scale > 0:
+        raise InputError(f"c6_scale={c6_scale}: expected > 0")
     c6_user = {pair_key(*k.split("-")): v for k, v in (c6_ev_a6 or {}).items()}
     r0_user = dict(r0_angstrom or {})
     ratio = dict(volume_ratio or {})
@@ -135,7 +194,7 @@ def lj_table(
                 c6_b, alpha_b = ts_free_atom(b)
                 va, vb = ratio.get(a, 1.0), ratio.get(b, 1.0)
                 c6 = ts_combined_c6(va**2 * c6_a, va * alpha_a, vb**2 * c6_b, vb * alpha_b)
-            table[key] = lj_from_c6(c6, radius(a), radius(b))
+            table[key] = lj_from_c6(c6_scale * c6, radius(a), radius(b))
     return table
 
 

@@ -21,7 +21,7 @@ from functools import cached_property
 from pathlib import Path
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from flatcontact.errors import InputError
 
@@ -49,6 +49,16 @@ class LJSpec(BaseModel):
         vdW radius R0 per element (Å), overriding the TS free-atom radius.
     volume_ratio
         Hirshfeld volume ratio V_eff/V_free per element (TS 2009 Eqs. 7–9).
+    c6_scale
+        One factor on every C6 after the above (σ unchanged, so only the well depths scale).
+    hamaker_zj
+        Instead of ``c6_scale``: the Hamaker constant (zJ = 1e-21 J) the LJ must reproduce by
+        pairwise summation, A = π² Σ C6_AB ρ_A ρ_B; the factor on every C6 follows from it
+        (:func:`flatcontact.potentials.lj.hamaker_c6_scale`). Lifshitz theory gives ≈ 88 zJ
+        for α-quartz across vacuum (Bergström 1997), where free-atom TS C6 give ≈ 410 zJ.
+    number_density_per_nm3
+        Bulk number density per element (nm⁻³) for ``hamaker_zj``; α-quartz:
+        ``{Si: 26.52, O: 53.04}`` (:data:`flatcontact.potentials.lj.ALPHA_QUARTZ_NUMBER_DENSITY_PER_NM3`).
     cutoff_angstrom
         LJ cutoff r_c (Å); the energy is shifted to zero at r_c.
     """
@@ -59,6 +69,9 @@ class LJSpec(BaseModel):
     c6_ev_a6: dict[str, float] = Field(default_factory=dict)
     r0_angstrom: dict[str, float] = Field(default_factory=dict)
     volume_ratio: dict[str, float] = Field(default_factory=dict)
+    c6_scale: float = 1.0
+    hamaker_zj: float | None = None
+    number_density_per_nm3: dict[str, float] = Field(default_factory=dict)
     cutoff_angstrom: float = 10.0
 
     @field_validator("c6_ev_a6")
@@ -74,7 +87,47 @@ class LJSpec(BaseModel):
             out["-".join(sorted(parts))] = float(c6)
         return dict(sorted(out.items()))
 
-    @field_validator("r0_angstrom", "volume_ratio")
+    @field_validator("c6_scale", "hamaker_zj")
+    @classmethod
+    def _positive_scalar(cls, value: float | None) -> float | None:
+        if value is not None and not value > 0:
+            raise ValueError(f"expected > 0, got {value}")
+        return value
+
+    @model_validator(mode="after")
+    def _hamaker_needs_densities(self) -> LJSpec:
+        if self.hamaker_zj is not None:
+            if self.c6_scale != 1.0:
+                raise ValueError("give either c6_scale or hamaker_zj, not both")
+            if not self.number_density_per_nm3:
+                raise ValueError(
+                    "hamaker_zj needs number_density_per_nm3 (bulk number density per element, "
+                    "nm⁻³; α-quartz: {Si: 26.52, O: 53.04})"
+                )
+        return self
+
+    def effective_c6_scale(self, elements) -> float:
+        """The factor applied to every C6: ``c6_scale``, or the one that gives ``hamaker_zj``."""
+        if self.hamaker_zj is None:
+            return self.c6_scale
+        from flatcontact.potentials.lj import hamaker_c6_scale, lj_table
+
+        missing = sorted(set(elements) - set(self.number_density_per_nm3))
+        if missing:
+            raise InputError(
+                f"lj.number_density_per_nm3 lacks the elements {missing} needed for hamaker_zj"
+            )
+        species = sorted(self.number_density_per_nm3)
+        base = lj_table(
+            species,
+            species,
+            c6_ev_a6=self.c6_ev_a6,
+            r0_angstrom=self.r0_angstrom,
+            volume_ratio=self.volume_ratio,
+        )
+        return hamaker_c6_scale(base, self.number_density_per_nm3, self.hamaker_zj)
+
+    @field_validator("r0_angstrom", "volume_ratio", "number_density_per_nm3")
     @classmethod
     def _positive(cls, value: dict[str, float]) -> dict[str, float]:
         for key, v in value.items():
@@ -109,6 +162,7 @@ class LJSpec(BaseModel):
             c6_ev_a6=self.c6_ev_a6,
             r0_angstrom=self.r0_angstrom,
             volume_ratio=self.volume_ratio,
+            c6_scale=self.effective_c6_scale(set(symbols_1) | set(symbols_2)),
         )
 
 
@@ -161,6 +215,10 @@ class PotentialSpec(BaseModel):
             extra += ", user C6 " + ",".join(f"{k}={v:g}" for k, v in self.lj.c6_ev_a6.items())
         if self.lj.volume_ratio:
             extra += ", v=" + ",".join(f"{k}:{v:g}" for k, v in self.lj.volume_ratio.items())
+        if self.lj.hamaker_zj is not None:
+            extra += f", C6 scaled to A={self.lj.hamaker_zj:g} zJ"
+        elif self.lj.c6_scale != 1.0:
+            extra += f", C6×{self.lj.c6_scale:g}"
         return f"{self.intra}+LJ({self.lj.c6_source}{extra}, rc={self.lj.cutoff_angstrom:g} Å)"
 
 
