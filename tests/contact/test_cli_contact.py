@@ -107,7 +107,10 @@ def test_out_dir_and_experiment(tmp_path, capsys):
     [
         (["--radius-um", "-5"], "--radius-um"),
         (["--contact-modulus-gpa", "0"], "--contact-modulus-gpa"),
-        (["--k-mpa-per-gpa", "-1"], "--k-mpa-per-gpa"),
+        (["--k-mpa-per-gpa", "-1", "--tau0-mpa", "0"], "--k-mpa-per-gpa"),
+        # k < 0 is a law the model takes, but not at a p0 where τ(centre) = k·p0 + τ0 <= 0
+        (["--k-mpa-per-gpa", "-20", "--p0-gpa", "1,2"], "τ(centre)"),
+        (["--mu-mpa-per-gpa", "-10", "--p0-gpa", "2"], "σ(centre)"),
         (["--tau0-mpa", "nan"], "--tau0-mpa"),
         (["--p0-gpa", "0"], "--p0-gpa"),
         (["--p0-gpa", "abc"], "--p0-gpa"),

@@ -27,8 +27,10 @@ data: amplitude Q_max/(π a²) by default, or rms ⟨Q⟩/(π a²)) at which the
 stiffness falls to ``fraction`` of its zero-stress value k0. With the default
 0.2 this lies within ~1 % below the model's gross-sliding collapse at Q_peak
 (k falls to 0 only logarithmically as Q_max -> Q_peak). :func:`fit_tau0` finds the
-τ0 (others fixed) for which model and data collapse coincide (brentq; the
-criterion is monotone increasing in τ0, checked on the bracket).
+τ0 (others fixed) for which model and data collapse coincide (brentq on the
+admissible τ0, where τ > 0 on the contact; the criterion increases with τ0 once
+the peak is an overshoot, and is the τ0-independent Q_sat/(π a²)-based value
+below that).
 """
 
 from __future__ import annotations
@@ -291,14 +293,22 @@ def fit_tau0(
 ) -> float:
     """τ0 (MPa) for which the model collapse (same criterion and measure) equals the measured one.
 
+    The search runs over the τ0 for which τ > 0 on the whole contact: τ0 >= 0 for
+    k > 0, τ0 > 0 for k = 0, τ0 > |k|·p0 for k < 0. Where the model's peak is the
+    saturated force (no overshoot) the collapse does not depend on τ0 (Q_sat is
+    ∫σ dA); a measured collapse above that plateau has one τ0.
+
     Raises
     ------
     InputError
-        If the measured collapse is below what τ0 = 0 gives (or, with k = 0, what
-        τ0 -> 0 gives) or above what ``tau0_max_mpa`` gives.
+        If the measured collapse is below what the smallest admissible τ0 gives or
+        above what ``tau0_max_mpa`` gives, or σ < 0 in the contact at p0 (μ < 0).
     """
     target = check_positive("measured collapse stress (Pa)", measured_collapse_pa)
     p0 = check_positive("p0_pa", p0_pa)
+    # σ >= 0 at p0 does not depend on τ0: check it with a τ0 that keeps τ > 0
+    tau0_min = max(0.0, -params.k_mpa_per_gpa * p0 / units.GPA_TO_PA)
+    params.replace(tau0_mpa=max(params.tau0_mpa, 2.0 * tau0_min + 1.0)).check_p0_pa(p0)
 
     def resid(tau0_mpa: float) -> float:
         return (
@@ -308,14 +318,17 @@ def fit_tau0(
             - target
         )
 
-    lo = 0.0 if params.k_mpa_per_gpa > 0.0 else 1e-9
+    # τ > 0 on the contact: τ0 >= 0 (k > 0), τ0 > 0 (k = 0), τ0 > |k|·p0 (k < 0)
+    lo = 0.0 if params.k_mpa_per_gpa > 0.0 else tau0_min * (1.0 + 1e-9) + 1e-9
     r_lo = resid(lo)
     require(
         r_lo <= 0.0,
-        f"measured collapse {target / units.MPA_TO_PA:.4g} MPa is below the model's at tau0 = {lo:g} MPa "
-        f"({(r_lo + target) / units.MPA_TO_PA:.4g} MPa): no tau0 >= 0 fits",
+        f"measured collapse {target / units.MPA_TO_PA:.4g} MPa is below the model's at tau0 = {lo:.4g} MPa "
+        f"({(r_lo + target) / units.MPA_TO_PA:.4g} MPa): no tau0 "
+        + (f"> |k|·p0 = {tau0_min:.4g} MPa" if tau0_min > 0.0 else ">= 0")
+        + " fits",
     )
-    hi = max(1.0, 2.0 * params.tau0_mpa)
+    hi = max(1.0, 2.0 * params.tau0_mpa, 2.0 * lo)
     while resid(hi) < 0.0:
         hi *= 2.0
         require(hi <= tau0_max_mpa, f"measured collapse needs tau0 > {tau0_max_mpa:g} MPa")
@@ -367,7 +380,7 @@ def compare_with_measurement(
     The paper's inverse problem (Fig. 6): with every other parameter fixed, the τ0
     whose predicted stiffness collapse at ``p0_gpa`` equals the measured one.
     """
-    p0_pa = check_positive("p0_gpa", p0_gpa) * units.GPA_TO_PA
+    p0_pa = params.check_p0_gpa(p0_gpa, "experiment_p0_gpa")[0] * units.GPA_TO_PA
     data = collapse_stress(measured.stress_pa, measured.stiffness_n_per_m, fraction=fraction)
     model = model_collapse_stress(p0_pa, params, fraction=fraction, measure=measure)
     tau0 = fit_tau0(data.stress_pa, p0_pa, params, fraction=fraction, measure=measure)

@@ -64,10 +64,18 @@ def mean_displacement(
 ) -> tuple[FloatArray, FloatArray]:
     """⟨u⟩ (m) and d⟨u⟩/dQ_max (m/N) for amplitudes 0 < Q_max <= Q_peak (broadcasting).
 
+    The θ integral is split where u(Q_max sin θ) is not smooth
+    (:func:`flatcontact.contact.mindlin.rising_branch_breaks`: the kink where the centre
+    starts to slip for k < 0, a jump past a local maximum of Q(u) below the peak), each
+    part on Gauss–Legendre panels graded towards its upper end. A jump of u from u₋ to u₊
+    at Q_j moves with Q_max and adds the boundary term
+    (u₊² − u₋²)·Q_j/(Q_max √(Q_max² − Q_j²)) to d∫u²dθ/dQ_max.
+
     Raises
     ------
     InputError
-        If any Q_max is negative or exceeds the peak of Q(u) (no quasi-static oscillation).
+        If any Q_max is negative or exceeds the peak of Q(u) (no quasi-static oscillation),
+        or τ, σ are not positive on the contact at some p0.
     """
     qmax = np.asarray(q_max_n, dtype=float)
     p0 = np.asarray(p0_pa, dtype=float)
@@ -78,23 +86,45 @@ def mean_displacement(
         bool(np.all(qmax <= peak * (1.0 + 1e-12))),
         "q_max_n exceeds the peak lateral force: no quasi-static oscillation (gross sliding)",
     )
-    phi, w = _graded_nodes()
-    cosphi = np.cos(phi)
-    q = qmax[..., None] * cosphi  # Q = Q_max sin θ = Q_max cos φ
+    half = np.pi / 2.0
+    brk = mindlin.rising_branch_breaks(p0, params)
+    qm = qmax[..., None]
+    active = brk.force_n < qm
+    n_split = int(active.sum(axis=-1).max(initial=0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        theta = np.where(active, np.arcsin(np.minimum(brk.force_n / qm, 1.0)), half)
+    edges = np.concatenate(
+        [np.zeros_like(qm), theta[..., :n_split], np.full_like(qm, half)], axis=-1
+    )
+    lo, hi = edges[..., :-1, None], edges[..., 1:, None]  # (..., parts, 1)
+    phi, w = _graded_nodes()  # distance below each part's upper end, scaled to its length
+    span = (hi - lo) / half
+    psi = (half - hi) + phi * span  # π/2 − θ at the nodes (accurate near θ = π/2)
+    weights = (w * span).reshape(*qmax.shape, -1)
+    cospsi = np.cos(psi).reshape(*qmax.shape, -1)
+    q = qm * cospsi  # Q = Q_max sin θ
     pe = p0[..., None]
     s = mindlin.s_on_rising_branch(q, pe, params)
     u = mindlin.displacement_from_s(s, pe, params)
-    a = mindlin.contact_radius(pe, params)
-    a1, a2, a3 = mindlin.force_coefficients(pe, params)
-    dq_ds = 2.0 * np.pi * a**2 * ((3.0 * a3 * s + 2.0 * a2) * s + a1)
-    du_ds = np.pi * a * (2.0 * params.k * pe * s + params.tau0_pa) / params.shear_modulus_pa
+    dq_ds = mindlin.force_slope_s(s, pe, params)
+    du_ds = mindlin.displacement_slope_s(s, pe, params)
     with np.errstate(divide="ignore", invalid="ignore"):
         du_dq = np.where(s > 0.0, du_ds / dq_ds, 0.0)
     du_dq = np.where(np.isfinite(du_dq) & (du_dq >= 0.0), du_dq, np.inf)
     two_over_pi = 2.0 / np.pi
-    u2 = two_over_pi * np.sum(w * u**2, axis=-1)
+    u2 = two_over_pi * np.sum(weights * u**2, axis=-1)
     with np.errstate(invalid="ignore"):
-        du2 = two_over_pi * np.sum(np.where(u > 0.0, w * u * du_dq * cosphi, 0.0), axis=-1)
+        du2 = two_over_pi * np.sum(np.where(u > 0.0, weights * u * du_dq * cospsi, 0.0), axis=-1)
+    jump = active & (brk.displacement_above_m > brk.displacement_below_m)
+    if np.any(jump):
+        fj = np.where(jump, brk.force_n, 0.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            term = (
+                (brk.displacement_above_m**2 - brk.displacement_below_m**2)
+                * fj
+                / (qm * np.sqrt(qm**2 - fj**2))
+            )
+        du2 = du2 + two_over_pi * 0.5 * np.sum(np.where(jump, term, 0.0), axis=-1)
     mean_u = np.sqrt(u2)
     with np.errstate(divide="ignore", invalid="ignore"):
         dmean = np.where(
@@ -196,6 +226,7 @@ def amplitude_at_stiffness_fraction(
     (monotone Q(u): the stiffness then drops from a finite value to 0 at Q_peak)."""
     require(0.0 < fraction < 1.0, f"stiffness fraction must be in (0, 1), got {fraction!r}")
     p0 = check_positive("p0_pa", p0_pa)
+    params.check_p0_pa(p0)
     peak = mindlin.peak_force(p0, params)
     q_peak = float(peak.force_n)
     target = fraction * float(mindlin.initial_lateral_stiffness(p0, params))
@@ -235,6 +266,7 @@ def stiffness_curve(
         Amplitudes as fractions of Q_peak in [0, 1); default :func:`amplitude_grid`.
     """
     p0 = check_positive("p0_pa", p0_pa)
+    params.check_p0_pa(p0)
     require(0.0 < knee_fraction < 1.0, f"knee_fraction must be in (0, 1), got {knee_fraction!r}")
     frac = amplitude_grid() if q_max_over_peak is None else np.asarray(q_max_over_peak, dtype=float)
     require(bool(np.all((frac >= 0.0) & (frac < 1.0))), "q_max_over_peak must lie in [0, 1)")

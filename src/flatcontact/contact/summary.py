@@ -17,7 +17,7 @@ import numpy as np
 from flatcontact import __version__, units
 from flatcontact.contact import adhesion, mindlin
 from flatcontact.contact.oscillation import StiffnessCurve, stiffness_curve
-from flatcontact.contact.parameters import ContactParameters, check_p0_gpa
+from flatcontact.contact.parameters import ContactParameters
 from flatcontact.fileio import atomic_path
 
 #: Points of each Q(u) curve, on u in [0, 1.5·u_fs].
@@ -215,9 +215,17 @@ def analyse(
     *,
     maugis_lambda: float | None = None,
     knee_fraction: float = 0.5,
+    p0_name: str = "p0_gpa",
 ) -> ContactAnalysis:
-    """Evaluate Q(u), the peak, the stiffness curve and adhesion radii for each p0 (GPa)."""
-    p0_list = tuple(check_p0_gpa(p0_gpa))
+    """Evaluate Q(u), the peak, the stiffness curve and adhesion radii for each p0 (GPa).
+
+    Raises
+    ------
+    InputError
+        Before any work, if a p0 is not > 0 or puts τ <= 0 or σ < 0 somewhere in the
+        contact (k or μ < 0); the message names ``p0_name`` and the limit.
+    """
+    p0_list = tuple(params.check_p0_gpa(p0_gpa, p0_name))
     p0 = np.asarray(p0_list) * units.GPA_TO_PA
     peaks = mindlin.peak_force(p0, params)
     u = np.linspace(0.0, 1.5, N_DISPLACEMENT)[None, :] * peaks.full_slip_displacement_m[:, None]
