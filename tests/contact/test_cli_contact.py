@@ -132,3 +132,16 @@ def test_bad_csv_exit_2(tmp_path, capsys):
     f.write_text("stress,stiffness\n1,2\n2,3\n3,4\n4,5\n")
     code, _, err = _run(["contact", "--experiment", str(f)], capsys)
     assert code == 2 and "no unit" in err and len(err.strip().splitlines()) == 1
+
+
+def test_negative_slope_runs_and_reports_the_stick_annulus(capsys):
+    # k = −10 MPa/GPa: at 2 GPa (> τ0/(2|k|) = 1.335 GPa) the peak comes after the centre
+    # has slipped, with a stick annulus; at 1 GPa the stick zone is a disc
+    code, out, _ = _run(["contact", "--k-mpa-per-gpa", "-10", "--p0-gpa", "1,2", "--json"], capsys)
+    assert code in (0, None)
+    low, high = json.loads(out)["results"]
+    assert low["stick_inner_radius_at_peak_nm"] == 0.0
+    assert 0.0 < high["stick_inner_radius_at_peak_nm"] < high["stick_radius_at_peak_nm"]
+    for r in (low, high):
+        assert r["uniform_shear_strength_mpa"] == pytest.approx(26.7 - 10 * 2 / 3 * r["p0_gpa"])
+        assert 0.0 < r["knee_stress_amplitude_mpa"] < r["effective_shear_strength_mpa"]

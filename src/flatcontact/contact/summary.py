@@ -86,6 +86,9 @@ class ContactAnalysis:
                     "peak_lateral_force_un": float(pk.force_n[i] * units.N_TO_UN),
                     "displacement_at_peak_nm": float(pk.displacement_m[i] / units.NM_TO_M),
                     "stick_radius_at_peak_nm": float(pk.stick_radius_m[i] / units.NM_TO_M),
+                    "stick_inner_radius_at_peak_nm": float(
+                        pk.stick_inner_radius_m[i] / units.NM_TO_M
+                    ),
                     "saturated_lateral_force_un": float(pk.saturated_force_n[i] * units.N_TO_UN),
                     "full_slip_displacement_nm": float(
                         pk.full_slip_displacement_m[i] / units.NM_TO_M
