@@ -115,7 +115,9 @@ class LJSpec(BaseModel):
         missing = sorted(set(elements) - set(self.number_density_per_nm3))
         if missing:
             raise InputError(
-                f"lj.number_density_per_nm3 lacks the elements {missing} needed for hamaker_zj"
+                f"lj.number_density_per_nm3 lacks the elements {missing} needed for hamaker_zj "
+                "(give your material's densities and Hamaker constant, or set lj.hamaker_zj: null "
+                "for free-atom C6)"
             )
         species = sorted(self.number_density_per_nm3)
         base = lj_table(
