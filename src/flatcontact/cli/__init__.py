@@ -11,7 +11,7 @@ import sys
 
 from flatcontact import __version__
 from flatcontact.cli import commands as _commands  # noqa: F401  (registers the sub-commands)
-from flatcontact.cli.app import app, console, err_console
+from flatcontact.cli.app import app, console, print_error
 from flatcontact.errors import InputError
 
 __all__ = ["app", "main"]
@@ -33,5 +33,5 @@ def main(argv: list[str] | None = None) -> None:
     try:
         app(args=argv)
     except InputError as exc:
-        err_console.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
+        print_error(exc)
         sys.exit(2)

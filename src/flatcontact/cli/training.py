@@ -13,7 +13,7 @@ from flatcontact.cli.app import app, console, err_console
 
 
 def _say(msg: str) -> None:
-    err_console.print(f"[dim]{msg}[/dim]")
+    err_console.print(msg, style="dim")
 
 
 @app.command("train-snap")
