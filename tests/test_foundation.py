@@ -52,6 +52,33 @@ def test_contract_rejects_bad_grids(tmp_path):
         contract.open_ispes(tmp_path / "junk.nc")
 
 
+def test_contract_converts_declared_units_and_refuses_unknown_ones(tmp_path):
+    a1, a2 = _hex_vectors()
+    ds = contract.empty_grid(2, 2, [8.0, 9.0], a1, a2, potential="test")
+    rng = np.random.default_rng(1)
+    ds["energy"][:] = rng.normal(size=ds.energy.shape)
+    ds["normal_stress"][:] = rng.normal(size=ds.energy.shape)
+    foreign = ds.copy(deep=True)
+    foreign["normal_stress"] = foreign.normal_stress * 1000.0
+    foreign["normal_stress"].attrs["units"] = "MPa"
+    foreign["energy"] = foreign.energy * 1000.0
+    foreign["energy"].attrs["units"] = "meV"
+    foreign = foreign.assign_coords(thickness=foreign.thickness / 10.0)
+    foreign["thickness"].attrs["units"] = "nm"
+    foreign.to_netcdf(tmp_path / "foreign.nc", engine="h5netcdf")
+    back = contract.open_ispes(tmp_path / "foreign.nc")
+    np.testing.assert_allclose(back.normal_stress.values, ds.normal_stress.values, rtol=1e-12)
+    np.testing.assert_allclose(back.energy.values, ds.energy.values, rtol=1e-12)
+    np.testing.assert_allclose(back.thickness.values, ds.thickness.values, rtol=1e-12)
+    assert (
+        back.normal_stress.attrs["units"] == "GPa" and back.thickness.attrs["units"] == "angstrom"
+    )
+    odd = ds.copy(deep=True)
+    odd["energy"].attrs["units"] = "kJ/mol"
+    with pytest.raises(InputError, match="'energy' has units 'kJ/mol'"):
+        contract.validate_ispes(odd)
+
+
 def test_cli_version():
     result = CliRunner().invoke(app, ["version"])
     assert result.exit_code == 0

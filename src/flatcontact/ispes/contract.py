@@ -49,6 +49,14 @@ UNITS = {VAR_ENERGY: "eV", VAR_STRESS: "GPa", DIM_Z: "angstrom", DIM_A: "1", DIM
 
 _AREA_RTOL = 1e-6
 
+#: Accepted ``units`` attributes per variable and the factor to the contract's unit.
+#: A variable without a ``units`` attribute is taken to be in the contract's unit.
+UNIT_FACTORS: dict[str, dict[str, float]] = {
+    VAR_ENERGY: {"eV": 1.0, "meV": 1.0e-3},
+    VAR_STRESS: {"GPa": 1.0, "MPa": 1.0e-3, "kPa": 1.0e-6, "Pa": 1.0e-9},
+    DIM_Z: {"angstrom": 1.0, "Angstrom": 1.0, "Å": 1.0, "A": 1.0, "nm": 10.0},
+}
+
 
 def fractional_shifts(n: int) -> np.ndarray:
     """``n`` equally spaced fractional shifts in [0, 1), endpoint excluded."""
@@ -151,10 +159,37 @@ def validate_ispes(ds: xr.Dataset, source: str = "ISPES grid") -> xr.Dataset:
     z = np.asarray(ds[DIM_Z].values, dtype=float)
     if not np.all(np.isfinite(z)) or np.unique(z).size != z.size:
         raise InputError(f"{source}: coordinate 'thickness' must be finite and without repeats")
+    ds = _to_contract_units(ds, source)
     ds = ds.sortby([DIM_A, DIM_B, DIM_Z])
     if VAR_CONVERGED not in ds:
         ds[VAR_CONVERGED] = np.isfinite(ds[VAR_ENERGY]) & np.isfinite(ds[VAR_STRESS])
     ds = ds.transpose(*DIMS, ...)
+    return ds
+
+
+def _to_contract_units(ds: xr.Dataset, source: str) -> xr.Dataset:
+    """Convert energy, normal stress and thickness to the contract's units (see UNIT_FACTORS).
+
+    A unit that is not in :data:`UNIT_FACTORS` is refused rather than read as the contract's.
+    """
+    for name, factors in UNIT_FACTORS.items():
+        unit = ds[name].attrs.get("units")
+        if unit is None:
+            continue
+        unit = str(unit).strip()
+        if unit not in factors:
+            raise InputError(
+                f"{source}: '{name}' has units '{unit}'; expected one of {sorted(factors)} "
+                f"(the contract's is {UNITS[name]})"
+            )
+        if factors[unit] != 1.0:
+            attrs = {**ds[name].attrs, "units": UNITS[name]}
+            ds = (
+                ds.assign_coords({name: ds[name] * factors[unit]})
+                if name in ds.coords
+                else (ds.assign({name: ds[name] * factors[unit]}))
+            )
+            ds[name].attrs.update(attrs)
     return ds
 
 
