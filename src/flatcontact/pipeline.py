@@ -795,7 +795,7 @@ class Pipeline:
             }
             p0_fig4 = 1.0 if 1.0 in analysis.p0_gpa else analysis.p0_gpa[0]
             figs = {
-                "fig4_traction": fig4_traction(params, p0_fig4, 0.2),
+                "fig4_traction": fig4_traction(params, p0_fig4),
                 "fig5_force_stiffness": fig5_force_and_stiffness(analysis, "amplitude"),
                 "fig5_force_stiffness_rms": fig5_force_and_stiffness(analysis, "rms"),
             }
@@ -1250,7 +1250,8 @@ def build_report(pipe: Pipeline, path: Path) -> Path:
     contact_figs = [
         Figure(
             f_ct / "fig4_traction.png",
-            "Fig. 4: τ(r), σ(r) and the full-stick q(r) at u = 0.2 nm; stick and slip zones.",
+            "Fig. 4: τ(r), σ(r) and the full-stick q(r) at 60 % of the displacement at the peak "
+            "force (p0 = 1 GPa, or the first p0); stick and slip zones.",
         ),
         Figure(
             f_ct / "fig5_force_stiffness.png",

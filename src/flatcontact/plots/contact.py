@@ -15,13 +15,24 @@ from flatcontact.contact.experiment import MeasuredStiffness, model_stiffness_at
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.contact.summary import ContactAnalysis
 
+#: Fig. 4's default displacement as a fraction of the displacement at the peak force.
+FIG4_FRACTION_OF_PEAK = 0.6
+
 
 def fig4_traction(
-    params: ContactParameters, p0_gpa: float = 1.0, displacement_nm: float = 0.2
+    params: ContactParameters, p0_gpa: float = 1.0, displacement_nm: float | None = None
 ) -> Figure:
-    """Fig. 4(a,b): τ(r), σ(r) and the full-stick q(r) at u; stick zone (r < c) and slip annulus."""
+    """Fig. 4(a,b): τ(r), σ(r) and the full-stick q(r) at u; stick zone (r < c) and slip annulus.
+
+    ``displacement_nm`` None: u = :data:`FIG4_FRACTION_OF_PEAK` × the displacement at the
+    peak force, so that both zones are visible whatever the laws (a fixed u can leave the
+    slip annulus invisible, or the contact fully slipping).
+    """
     p0 = p0_gpa * units.GPA_TO_PA
     a = float(mindlin.contact_radius(p0, params))
+    if displacement_nm is None:
+        u_peak = float(mindlin.peak_force(p0, params).displacement_m)
+        displacement_nm = round(FIG4_FRACTION_OF_PEAK * u_peak / units.NM_TO_M, 3)
     u = displacement_nm * units.NM_TO_M
     resp = mindlin.lateral_force(u, p0, params)
     c = float(resp.stick_radius_m)
