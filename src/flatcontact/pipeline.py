@@ -929,7 +929,9 @@ def _setup_differences(pipe: Pipeline) -> list[str]:
             f"The intra-slab model is '{cfg.potential.intra}', a classical potential, not the paper's "
             "SNAP trained on DFT (Erhard et al. 2022). Its lattice constant, surface relaxation and "
             "interfacial corrugation differ, and τ and σ are differences of the corrugation "
-            "energy, so they inherit these differences directly (Vashishta: a = 4.829 Å vs 4.916 Å)."
+            "energy, so they inherit these differences directly (Vashishta: a = 4.829 Å vs 4.916 Å; "
+            "the interface's lateral cell is the experimental 4.916 Å, so Vashishta slabs carry "
+            "+1.8 % in-plane strain)."
         )
     elif cfg.potential.intra == f"snap:{BUNDLED_SNAP}":
         validation = json.loads((BUNDLED_DIR / BUNDLED_SNAP / "validation.json").read_text())
@@ -938,7 +940,11 @@ def _setup_differences(pipe: Pipeline) -> list[str]:
             f"The intra-slab SNAP is flatcontact's bundled {BUNDLED_SNAP}, trained on CHGNet "
             "r2SCAN labels, not on the DFT data of Erhard et al. (2022) like the paper's; its "
             f"α-quartz follows CHGNet's, softer than experiment: E* = {e_star:.1f} GPa from its "
-            "elastic constants (validation.json) vs the paper's 52.5 GPa."
+            "elastic constants (validation.json) vs the paper's 52.5 GPa. The interface's "
+            "lateral cell is the experimental a = 4.916 Å; the SNAP's own α-quartz has "
+            f"a = {validation['potential']['lattice']['a_angstrom']:.3f} Å, so the slabs carry "
+            f"{100 * (4.916 / validation['potential']['lattice']['a_angstrom'] - 1):+.1f} % "
+            "in-plane strain."
         )
     else:
         out.append(
