@@ -38,3 +38,91 @@ def test_error_keeps_lowercase_markup_lookalikes(capsys):
     err = capsys.readouterr().err
     assert "error: got [nan] and [bold]x[/bold] in [/tmp/a b]" in err
     assert "warning: [dim]kept[/dim]" in err
+
+
+# ---- 2: --out checked before any work, by one helper -----------------------------------
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["contact", "--p0-gpa", "1"],
+        ["build", "--potential", "vashishta"],
+        ["run"],
+        ["scan", "--potential", "vashishta", "--interface", "missing.extxyz"],
+        ["train-snap", "--data", "missing.extxyz"],
+    ],
+)
+@pytest.mark.parametrize("bad", ["proc", "file"])
+def test_unusable_out_is_one_line_before_work(tmp_path, monkeypatch, capsys, argv, bad):
+    monkeypatch.chdir(tmp_path)
+    if bad == "file":
+        target = tmp_path / "afile"
+        target.write_text("keep me\n")
+        expected = "exists and is not a directory"
+    else:
+        target = "/proc/flatcontact-forbidden/x"
+        expected = "cannot write there"
+    line = _one_error_line(*_run([*argv, "--out", str(target)], capsys)[::2])
+    assert line.startswith(f"error: --out '{target}'") and expected in line
+    if bad == "file":
+        assert (tmp_path / "afile").read_text() == "keep me\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == (["afile"] if bad == "file" else [])
+
+
+def test_check_out_dir_creates_nothing(tmp_path):
+    from flatcontact.cli.app import check_out_dir
+    from flatcontact.errors import InputError
+
+    assert check_out_dir(tmp_path / "a" / "b") == tmp_path / "a" / "b"
+    assert list(tmp_path.iterdir()) == []
+    (tmp_path / "f").write_text("")
+    with pytest.raises(InputError, match=r"'.*f' is not a directory"):
+        check_out_dir(tmp_path / "f" / "sub")
+
+
+@pytest.mark.parametrize(
+    ("flag", "value"),
+    [
+        ("--lj-cutoff-angstrom", "-3"),
+        ("--lj-cutoff-angstrom", "nan"),
+        ("--gap-angstrom", "0"),
+        ("--fmax-ev-per-angstrom", "0"),
+        ("--fmax-ev-per-angstrom", "-1"),
+        ("--fmax-ev-per-angstrom", "nan"),
+    ],
+)
+def test_build_refuses_bad_numbers_naming_the_flag(tmp_path, capsys, flag, value):
+    argv = ["build", "--potential", "vashishta", "--out", str(tmp_path / "b"), flag, value]
+    line = _one_error_line(*_run(argv, capsys)[::2])
+    assert line.startswith(f"error: {flag}: expected a finite value > 0")
+    assert not (tmp_path / "b").exists()
+
+
+# ---- 3: an unconverged build relaxation is said on the console --------------------------
+
+
+def test_build_warns_when_relaxation_does_not_converge(tmp_path, monkeypatch, capsys):
+    from flatcontact.structures import build as builder
+    from flatcontact.structures import dense
+
+    def few_steps(atoms, calc, fmax_ev_per_angstrom=0.01):
+        return dense.relax(atoms, calc, fmax_ev_per_angstrom, steps=3)
+
+    monkeypatch.setattr(builder, "relax", few_steps)
+    out = tmp_path / "b"
+    code, _, err = _run(["build", "--potential", "vashishta", "--out", str(out)], capsys)
+    assert code in (0, None)
+    warnings = [ln for ln in err.splitlines() if ln.startswith("warning: ")]
+    assert len(warnings) == 2 and all("did not converge" in w for w in warnings)
+    assert "slab relaxation" in warnings[0] and "interface relaxation" in warnings[1]
+    assert (out / "interface.extxyz").is_file()
+
+
+def test_relax_refuses_non_positive_fmax():
+    from flatcontact.errors import InputError
+    from flatcontact.structures.dense import relax
+
+    for bad in (0.0, -1.0, float("nan")):
+        with pytest.raises(InputError, match="fmax_ev_per_angstrom"):
+            relax(None, None, bad)

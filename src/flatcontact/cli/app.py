@@ -6,6 +6,8 @@ library and prints. Heavy imports happen inside the command functions so
 that ``flatcontact --help`` stays fast.
 """
 
+from pathlib import Path
+
 import typer
 from rich.console import Console
 from rich.text import Text
@@ -34,3 +36,56 @@ def print_error(message: object) -> None:
 def print_warning(message: object) -> None:
     """Print ``warning: <message>`` on stderr, the message verbatim (no rich markup)."""
     err_console.print(Text("warning: ", style="bold yellow") + Text(str(message)))
+
+
+def check_out_dir(path: str | Path, flag: str = "--out") -> Path:
+    """Refuse an output directory that cannot be used, before any work starts.
+
+    ``path`` must be an existing writable directory or one that can be created (its nearest
+    existing ancestor is a writable directory). The check really creates the missing
+    directories and a probe file and removes them again, so it holds for root and for
+    special file systems (``/proc``) where permission bits say nothing.
+
+    Returns
+    -------
+    Path
+        ``path`` as a :class:`~pathlib.Path` (not created).
+
+    Raises
+    ------
+    InputError
+        One line naming ``flag`` and the path: exists and is not a directory, or not creatable
+        / not writable (with the operating system's reason).
+    """
+    import os
+    import tempfile
+
+    from flatcontact.errors import InputError
+
+    out = Path(path).expanduser()
+    if out.exists() and not out.is_dir():
+        raise InputError(f"{flag} {str(out)!r}: exists and is not a directory")
+    created: list[Path] = []
+    probe = out
+    while not probe.exists():
+        created.append(probe)
+        probe = probe.parent
+    if not probe.is_dir():
+        raise InputError(f"{flag} {str(out)!r}: {str(probe)!r} is not a directory")
+    try:
+        for d in reversed(created):
+            d.mkdir()
+        fd, name = tempfile.mkstemp(prefix=".flatcontact-probe.", dir=out)
+        os.close(fd)
+        os.unlink(name)
+    except OSError as exc:
+        raise InputError(
+            f"{flag} {str(out)!r}: cannot write there ({exc.strerror or type(exc).__name__})"
+        ) from None
+    finally:
+        for d in created:  # innermost first; only what this check made
+            try:
+                d.rmdir()
+            except OSError:
+                pass
+    return out

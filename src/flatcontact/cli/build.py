@@ -6,7 +6,46 @@ from pathlib import Path
 
 import typer
 
-from flatcontact.cli.app import app, console
+from flatcontact.cli.app import app, check_out_dir, console, print_warning
+from flatcontact.errors import InputError
+
+
+def _positive_finite(value: float, flag: str, unit: str) -> float:
+    """``value`` if it is a finite number > 0, else a one-line :class:`InputError` naming ``flag``."""
+    import math
+
+    if not (math.isfinite(value) and value > 0):
+        raise InputError(f"{flag}: expected a finite value > 0 {unit}, got {value!r}")
+    return value
+
+
+def _potential_spec(potential: str, lj_cutoff_angstrom: float):
+    """The :class:`~flatcontact.potentials.PotentialSpec` of the flags; errors name the flag."""
+    from flatcontact.potentials import PotentialSpec
+
+    _positive_finite(lj_cutoff_angstrom, "--lj-cutoff-angstrom", "Å")
+    try:
+        return PotentialSpec(intra=potential, lj={"cutoff_angstrom": lj_cutoff_angstrom})
+    except InputError as exc:
+        text = str(exc)
+        if text.startswith("potential lj.cutoff_angstrom"):
+            raise InputError(f"--lj-cutoff-angstrom: {text.split(': ', 1)[-1]}") from None
+        raise InputError(f"--potential: {text.removeprefix('potential intra: ')}") from None
+
+
+def _warn_unconverged(report: dict, fmax_ev_per_angstrom: float) -> None:
+    """One warning line per relaxation of ``report`` that stopped before reaching fmax."""
+    for key in ("slab_relaxation", "interface_relaxation"):
+        outcome = report.get(key)
+        if isinstance(outcome, dict) and not outcome.get("converged", True):
+            what = key.replace("_", " ")
+            steps = outcome.get("steps", "?")
+            fmax = outcome.get("max_force_ev_per_angstrom")
+            got = f" (max force {fmax:.3g} eV/Å)" if isinstance(fmax, float) else ""
+            print_warning(
+                f"the {what} did not converge to {fmax_ev_per_angstrom:g} eV/Å in {steps} "
+                f"steps{got}; the interface is written but is not a relaxed reference"
+            )
 
 
 @app.command("build")
@@ -50,13 +89,15 @@ def build(
     """Build the interface: writes interface.extxyz, interface.png and build_report.json to --out."""
     import json
 
-    from flatcontact.errors import InputError
     from flatcontact.fileio import write_json_atomic
     from flatcontact.plots.structures import plot_interface
-    from flatcontact.potentials import LJSpec, PotentialSpec
     from flatcontact.structures import build as builder
     from flatcontact.structures.interface import write_interface
 
+    _positive_finite(fmax_ev_per_angstrom, "--fmax-ev-per-angstrom", "eV/Å")
+    _positive_finite(gap_angstrom, "--gap-angstrom", "Å")
+    if structure is not None:
+        _positive_finite(face_depth_angstrom, "--face-depth-angstrom", "Å")
     if regenerate_dense:
         provenance = builder.regenerate_shipped_dense_slab(
             layers=layers, fmax_ev_per_angstrom=fmax_ev_per_angstrom
@@ -65,7 +106,8 @@ def build(
             f"wrote {builder.SHIPPED_DENSE_SLAB} (CHGNet energy {provenance['energy_ev']:.4f} eV)"
         )
         return
-    spec = PotentialSpec(intra=potential, lj=LJSpec(cutoff_angstrom=lj_cutoff_angstrom))
+    spec = _potential_spec(potential, lj_cutoff_angstrom)
+    check_out_dir(out)
     if structure is not None:
         from ase.io import read
 
@@ -96,6 +138,7 @@ def build(
             fmax_ev_per_angstrom=fmax_ev_per_angstrom,
         )
         title = f"α-quartz (0001) dense, {layers} layers, {spec.label}"
+    _warn_unconverged(report, fmax_ev_per_angstrom)
     out.mkdir(parents=True, exist_ok=True)
     write_interface(interface, out / "interface.extxyz")
     plot_interface(interface, out / "interface.png", title=title)

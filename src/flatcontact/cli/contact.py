@@ -13,7 +13,7 @@ from typing import Annotated
 
 import typer
 
-from flatcontact.cli.app import app, console
+from flatcontact.cli.app import app, check_out_dir, console
 from flatcontact.errors import InputError, require
 
 _DEFAULT_HELP = "(default: the paper's value)"
@@ -177,9 +177,7 @@ def contact_command(
     check_positive("--experiment-p0-gpa", experiment_p0_gpa)
     measured = exp.load_stiffness_csv(experiment) if experiment is not None else None
     if out is not None:
-        require(
-            not out.exists() or out.is_dir(), f"--out {str(out)!r} exists and is not a directory"
-        )
+        check_out_dir(out)
 
     # ---- compute ---------------------------------------------------------------------
     analysis = analyse(p0_list, params, maugis_lambda=maugis_lambda, knee_fraction=knee_fraction)

@@ -12,7 +12,7 @@ from typing import Annotated
 
 import typer
 
-from flatcontact.cli.app import app, console, err_console
+from flatcontact.cli.app import app, check_out_dir, console, err_console
 
 _PRESET_HELP = "quick (default: minutes on a 2-core laptop) or paper (the paper's grids and loads)."
 
@@ -36,6 +36,7 @@ def run_command(
     from flatcontact.pipeline import Pipeline
 
     cfg = load_config(config, preset)
+    check_out_dir(out)
     with Pipeline(cfg, out, console=console) as pipe:
         model = cfg.calculator.target if cfg.calculator is not None else cfg.potential.label
         console.print(

@@ -14,7 +14,7 @@ from typing import Annotated, Any
 
 import typer
 
-from flatcontact.cli.app import app, console, err_console
+from flatcontact.cli.app import app, check_out_dir, console, err_console
 from flatcontact.errors import InputError
 
 #: Config field (dotted path) -> the flag that sets it, to name the flag in errors.
@@ -234,6 +234,7 @@ def scan_command(
     if calculator is not None:
         flags["calculator"] = {"target": calculator, "kwargs": {}}
     cfg = resolve_config(config, preset, flags)
+    out_dir = check_out_dir(out or "ispes")
     s = cfg.scan
     spec = s.grid_spec()
     relax = s.relax_settings()
@@ -253,7 +254,7 @@ def scan_command(
             reference,
             factory,
             spec,
-            out or "ispes",
+            out_dir,
             relax,
             order=s.order,
             executor_options={

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import typer
 
-from flatcontact.cli.app import app, console, err_console
+from flatcontact.cli.app import app, check_out_dir, console, err_console
 
 
 def _say(msg: str) -> None:
@@ -37,6 +37,7 @@ def train_snap_cmd(
     """Fit a SNAP (LAMMPS .snapcoeff/.snapparam) to a dataset or a generated recipe."""
     from flatcontact.training.train import train_snap
 
+    check_out_dir(out)
     command = "flatcontact " + " ".join(shlex.quote(a) for a in sys.argv[1:])
     report = train_snap(
         out,
@@ -90,6 +91,10 @@ def validate_potential_cmd(
     from flatcontact.training.potentials import bulk_calculator
     from flatcontact.training.validate import validate_potential
 
+    if out is not None:
+        if out.is_dir():
+            raise InputError(f"--out {str(out)!r}: is a directory, expected a JSON file path")
+        check_out_dir(out.parent)
     calc = bulk_calculator(potential)
     ref_calc, frames, ref_label = None, None, None
     if heldout is not None:

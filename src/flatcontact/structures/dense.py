@@ -23,6 +23,7 @@ import numpy as np
 from ase import Atoms
 from ase.optimize import FIRE
 
+from flatcontact.errors import require
 from flatcontact.structures.topology import bonds, coordination_defects, height_spread, ring_sizes
 
 #: Maximum height spread (Å) of the Si atoms of a face layer for it to count as flat.
@@ -106,14 +107,24 @@ def verify_dense_slab(
 
 
 def relax(atoms: Atoms, calc, fmax_ev_per_angstrom: float = 0.01, steps: int = 5000) -> dict:
-    """FIRE relaxation of ``atoms`` in place (lateral cell fixed); returns steps, converged, energy."""
+    """FIRE relaxation of ``atoms`` in place (lateral cell fixed).
+
+    Returns steps, converged, energy (eV) and the largest remaining force on an atom
+    (``max_force_ev_per_angstrom``). ``fmax_ev_per_angstrom`` must be finite and > 0.
+    """
+    require(
+        bool(np.isfinite(fmax_ev_per_angstrom)) and fmax_ev_per_angstrom > 0,
+        f"fmax_ev_per_angstrom={fmax_ev_per_angstrom!r}: expected a finite value > 0 eV/Å",
+    )
     atoms.calc = calc
     opt = FIRE(atoms, logfile=None)
     converged = bool(opt.run(fmax=fmax_ev_per_angstrom, steps=steps))
+    forces = atoms.get_forces(apply_constraint=True)
     return {
         "steps": int(opt.nsteps),
         "converged": converged,
         "energy_ev": float(atoms.get_potential_energy()),
+        "max_force_ev_per_angstrom": float(np.linalg.norm(forces, axis=1).max()),
     }
 
 
