@@ -60,7 +60,8 @@ PAPER_VALUES = {
 
 
 class _Section(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # every float of a run is finite: NaN or inf in the YAML is refused naming its path
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 def _positive_pair(value: Any, what: str) -> tuple[int, int]:
@@ -509,6 +510,7 @@ _MESSAGES = {
     "less_than_equal": "expected a value <= {le}",
     "float_parsing": "expected a number",
     "float_type": "expected a number",
+    "finite_number": "expected a finite number",
     "int_parsing": "expected an integer",
     "int_type": "expected an integer",
     "int_from_float": "expected an integer",
@@ -599,13 +601,22 @@ def load_config(path: str | Path | None = None, preset_name: str | None = None) 
         data = {}
     if not isinstance(data, dict):
         raise InputError(f"{path}: expected a mapping of sections, got {type(data).__name__}")
-    for section, key in (("structure", "file"), ("contact", "experiment_csv")):
+    for section, key in _FILE_FIELDS:
         block = data.get(section)
         if isinstance(block, dict) and isinstance(block.get(key), str):
             target = Path(block[key]).expanduser()
             if not target.is_absolute():
                 block[key] = str((path.parent / target).resolve())
-    return build_config(data, preset_name, str(path))
+    cfg = build_config(data, preset_name, str(path))
+    for section, key in _FILE_FIELDS:
+        value = getattr(getattr(cfg, section), key)
+        if value is not None and not Path(value).is_file():
+            raise InputError(f"{path}: {section}.{key}: file {value} not found")
+    return cfg
+
+
+#: Fields naming an input file (relative to the config file); they must exist.
+_FILE_FIELDS = (("structure", "file"), ("contact", "experiment_csv"))
 
 
 # --------------------------------------------------------------------------- YAML out

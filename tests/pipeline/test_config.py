@@ -70,6 +70,38 @@ def test_file_overlays_preset_and_resolves_paths(tmp_path):
         ("- 1\n- 2\n", "c.yaml: expected a mapping of sections"),
         ("scan: [1\n", "c.yaml: not valid YAML (line"),
         ("contact: 3\n", "c.yaml: contact: expected a mapping, got 3"),
+        # every float finite: NaN/inf refused naming the path, before any work
+        ("analysis: {p_gpa: [.nan, 1]}\n", "c.yaml: analysis.p_gpa.0: expected a finite number"),
+        ("analysis: {direction_deg: .nan}\n", "c.yaml: analysis.direction_deg: expected a finite"),
+        ("contact: {radius_um: .inf}\n", "c.yaml: contact.radius_um: expected a finite number"),
+        (
+            "scan: {thickness_angstrom: [17, .nan]}\n",
+            "scan.thickness_angstrom.1: expected a finite",
+        ),
+        (
+            "potential: {lj: {cutoff_angstrom: .inf}}\n",
+            "c.yaml: potential.lj.cutoff_angstrom: expected a finite number, got inf",
+        ),
+        (
+            "potential: {lj: {c6_scale: .nan}}\n",
+            "c.yaml: potential.lj.c6_scale: expected a finite number",
+        ),
+        # element symbols of the LJ dicts are real elements
+        (
+            "potential: {lj: {volume_ratio: {Xx: 0.5}}}\n",
+            "c.yaml: potential.lj.volume_ratio: key 'Xx': 'Xx' is not a chemical element symbol",
+        ),
+        (
+            "potential: {lj: {c6_ev_a6: {O-Qq: 30}}}\n",
+            "potential.lj.c6_ev_a6: c6_ev_a6 key 'O-Qq': 'Qq' is not a chemical element",
+        ),
+        (
+            "potential: {lj: {r0_angstrom: {si: 2.0}}}\n",
+            "'si' is not a chemical element symbol",
+        ),
+        # input files named by the config exist
+        ("contact: {experiment_csv: nothere.csv}\n", "c.yaml: contact.experiment_csv: file "),
+        ("structure: {kind: file, file: no.extxyz}\n", "c.yaml: structure.file: file "),
     ],
 )
 def test_bad_config_is_one_line_naming_the_path(tmp_path, text, message):
@@ -121,6 +153,27 @@ def test_cli_check_reports_one_line(tmp_path):
     with pytest.raises(SystemExit) as info:
         main(["config", "--check", str(path)])
     assert info.value.code == 2
+
+
+def test_cli_check_refuses_nan_and_missing_files(tmp_path, capsys):
+    from flatcontact.cli import main
+
+    for text, where in (
+        ("analysis: {p_gpa: [.nan, 1]}\n", "analysis.p_gpa.0"),
+        ("contact: {experiment_csv: missing.csv}\n", "contact.experiment_csv"),
+    ):
+        path = tmp_path / "c.yaml"
+        path.write_text(text)
+        with pytest.raises(SystemExit) as info:
+            main(["config", "--check", str(path)])
+        err = capsys.readouterr().err.strip()
+        assert info.value.code == 2 and err.count("\n") == 0
+        assert err.startswith(f"error: {path}: {where}: ")
+
+
+def test_lj_element_symbols_accepted():
+    cfg = build_config({"potential": {"lj": {"volume_ratio": {"Si": 0.8, "O": 1.1}}}})
+    assert cfg.potential.lj.volume_ratio == {"O": 1.1, "Si": 0.8}
 
 
 def test_preset_data_is_a_copy():

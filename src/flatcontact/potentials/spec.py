@@ -35,6 +35,14 @@ CLASSICAL = {
 }
 
 
+def _check_element(symbol: str, where: str) -> None:
+    """Refuse ``symbol`` unless it is a chemical element symbol (``ase.data.chemical_symbols``)."""
+    from ase.data import chemical_symbols
+
+    if symbol not in chemical_symbols[1:]:
+        raise ValueError(f"{where}: '{symbol}' is not a chemical element symbol (e.g. 'Si', 'O')")
+
+
 class LJSpec(BaseModel):
     """Cross-interface Lennard-Jones from vdW-DFT C6 (see :mod:`flatcontact.potentials.lj`).
 
@@ -63,7 +71,7 @@ class LJSpec(BaseModel):
         LJ cutoff r_c (Å); the energy is shifted to zero at r_c.
     """
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
+    model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
 
     c6_source: Literal["ts", "user"] = "ts"
     c6_ev_a6: dict[str, float] = Field(default_factory=dict)
@@ -82,6 +90,8 @@ class LJSpec(BaseModel):
             parts = key.split("-")
             if len(parts) != 2 or not all(parts):
                 raise ValueError(f"c6_ev_a6 key '{key}': expected an element pair like 'O-Si'")
+            for symbol in parts:
+                _check_element(symbol, f"c6_ev_a6 key '{key}'")
             if not c6 > 0:
                 raise ValueError(f"c6_ev_a6['{key}']={c6}: expected > 0 eV·Å⁶")
             out["-".join(sorted(parts))] = float(c6)
@@ -133,6 +143,7 @@ class LJSpec(BaseModel):
     @classmethod
     def _positive(cls, value: dict[str, float]) -> dict[str, float]:
         for key, v in value.items():
+            _check_element(key, f"key '{key}'")
             if not v > 0:
                 raise ValueError(f"value for '{key}' must be > 0, got {v}")
         return dict(sorted(value.items()))
@@ -171,7 +182,7 @@ class LJSpec(BaseModel):
 class PotentialSpec(BaseModel):
     """Intra-slab model + cross-interface LJ; frozen, picklable, hashable by its JSON form."""
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
+    model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
 
     intra: str = "vashishta"
     lj: LJSpec = Field(default_factory=LJSpec)
@@ -187,6 +198,8 @@ class PotentialSpec(BaseModel):
                 first = errors()[0]
                 where = ".".join(str(p) for p in first.get("loc", ()))
                 msg = first.get("msg", str(exc)).removeprefix("Value error, ")
+                if first.get("type") == "finite_number":
+                    msg = f"expected a finite number, got {first.get('input')!r}"
                 raise InputError(f"potential {where}: {msg}") from None
             raise InputError(f"potential: {exc}") from None
 
