@@ -126,3 +126,48 @@ def test_relax_refuses_non_positive_fmax():
     for bad in (0.0, -1.0, float("nan")):
         with pytest.raises(InputError, match="fmax_ev_per_angstrom"):
             relax(None, None, bad)
+
+
+# ---- 5: one resolver for every command ---------------------------------------------------
+
+
+@pytest.fixture()
+def snap_copy(tmp_path):
+    import shutil
+
+    from flatcontact.potentials.spec import BUNDLED_DIR
+
+    src = BUNDLED_DIR / "sio2-snap"
+    if not (src / "sio2-snap.snapcoeff").is_file():
+        pytest.skip("no bundled SNAP")
+    d = tmp_path / "p"
+    d.mkdir()
+    for ext in ("snapcoeff", "snapparam"):
+        shutil.copy(src / f"sio2-snap.{ext}", d / f"X.{ext}")
+    return d / "X.snapcoeff"
+
+
+def test_every_command_reads_every_spelling(snap_copy):
+    from flatcontact.cli.build import _potential_spec
+    from flatcontact.cli.scan import _potential_section, resolve_config
+    from flatcontact.cli.training import _bulk_potential
+
+    groups = {
+        "snap:sio2-snap": ["sio2-snap", "snap:sio2-snap"],
+        f"snap:{snap_copy}": [str(snap_copy), f"snap:{snap_copy}"],
+        "vashishta": ["vashishta"],
+    }
+    for canonical, spellings in groups.items():
+        for name in spellings:
+            scan_cfg = resolve_config(None, None, {"potential": _potential_section(name)})
+            assert scan_cfg.potential.intra == canonical, name
+            assert _potential_spec(name, 10.0).intra == canonical, name
+            bulk = _bulk_potential(name, "--potential")
+            expected = {"snap:sio2-snap": "sio2-snap", "vashishta": "vashishta"}
+            assert bulk == expected.get(canonical, str(snap_copy)), name
+
+
+def test_elastic_refuses_an_ase_factory(capsys):
+    code, _, err = _run(["elastic", "--potential", "ase:flatcontact.ispes.toy:toy"], capsys)
+    line = _one_error_line(code, err)
+    assert "--potential" in line and "expected a LAMMPS model" in line

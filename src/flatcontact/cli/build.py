@@ -56,7 +56,7 @@ def build(
     potential: str = typer.Option(
         "vashishta",
         "--potential",
-        help="vashishta | tersoff | snap:<name|path.snapcoeff> | ase:module:factory",
+        help="vashishta | tersoff | [snap:]NAME | [snap:]path/X.snapcoeff | ase:module:factory.",
     ),
     out: Path = typer.Option(Path("build"), "--out", help="Output directory."),
     source: str = typer.Option(

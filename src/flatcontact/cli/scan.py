@@ -62,9 +62,7 @@ def _potential_section(potential: str) -> dict[str, Any]:
         if not isinstance(data, dict):
             raise InputError(f"--potential {potential}: expected a JSON object (a PotentialSpec)")
         return data
-    if potential.endswith(".snapcoeff"):
-        return {"intra": f"snap:{path}"}
-    return {"intra": potential}
+    return {"intra": potential}  # any spelling: PotentialSpec normalizes it
 
 
 def _flag_error(exc: InputError) -> InputError:
@@ -124,7 +122,8 @@ def scan_command(
         str | None,
         typer.Option(
             "--potential",
-            help="potential.intra: vashishta | tersoff | snap:NAME | path/X.snapcoeff; or a "
+            help="potential.intra: vashishta | tersoff | [snap:]NAME | [snap:]path/X.snapcoeff | "
+            "ase:module:factory; or a "
             "PotentialSpec .json whose fields replace the potential section's (default "
             "snap:sio2-snap, "
             "vashishta if that is not installed).",

@@ -12,6 +12,30 @@ import typer
 from flatcontact.cli.app import app, check_out_dir, console, err_console
 
 
+def _bulk_potential(potential: str, flag: str) -> str:
+    """``potential`` in any spelling of :func:`~flatcontact.potentials.spec.normalize_potential_name`
+    as the name or ``.snapcoeff`` path that the bulk calculators take (``chgnet`` passes through).
+    """
+    from flatcontact.errors import InputError
+    from flatcontact.potentials.spec import normalize_potential_name, resolve_intra
+
+    if potential.strip() == "chgnet":
+        return "chgnet"
+    try:
+        resolved = resolve_intra(potential)
+    except InputError as exc:
+        raise InputError(f"{flag}: {exc}") from None
+    if resolved.style in ("vashishta", "tersoff"):
+        return resolved.style
+    if resolved.style == "snap":
+        name = Path(resolved.files[0]).stem
+        bundled = normalize_potential_name(potential) == f"snap:{name}"
+        return name if bundled else resolved.files[0]
+    raise InputError(
+        f"{flag} {potential!r}: expected a LAMMPS model (vashishta, tersoff, a SNAP) or chgnet"
+    )
+
+
 def _say(msg: str) -> None:
     err_console.print(msg, style="dim")
 
@@ -68,7 +92,8 @@ def train_snap_cmd(
 @app.command("validate-potential")
 def validate_potential_cmd(
     potential: str = typer.Argument(
-        ..., help="Bundled name (sio2-snap), .snapcoeff path, or vashishta."
+        ...,
+        help="vashishta | tersoff | [snap:]NAME (sio2-snap) | [snap:]path/X.snapcoeff | chgnet.",
     ),
     reference: str = typer.Option(
         None,
@@ -95,7 +120,7 @@ def validate_potential_cmd(
         if out.is_dir():
             raise InputError(f"--out {str(out)!r}: is a directory, expected a JSON file path")
         check_out_dir(out.parent)
-    calc = bulk_calculator(potential)
+    calc = bulk_calculator(_bulk_potential(potential, "POTENTIAL"))
     ref_calc, frames, ref_label = None, None, None
     if heldout is not None:
         frames = read_dataset(heldout, ["Si", "O"])
@@ -108,7 +133,7 @@ def validate_potential_cmd(
             frames = read_dataset(reference, ["Si", "O"])
             ref_label = reference
         else:
-            ref_calc = bulk_calculator(reference)
+            ref_calc = bulk_calculator(_bulk_potential(reference, "--reference"))
             ref_label = reference
     report = validate_potential(
         calc, potential, ref_calc, ref_label, frames=frames, surface=surface, progress=_say
@@ -172,7 +197,9 @@ def _print_validation(report: dict) -> None:
 @app.command("elastic")
 def elastic_cmd(
     potential: str = typer.Option(
-        "sio2-snap", "--potential", help="Bundled name, .snapcoeff path, vashishta or chgnet."
+        "sio2-snap",
+        "--potential",
+        help="vashishta | tersoff | [snap:]NAME | [snap:]path/X.snapcoeff | chgnet.",
     ),
     strain: float = typer.Option(0.005, "--strain", help="Finite strain amplitude (fraction)."),
     json_out: bool = typer.Option(False, "--json", help="Print JSON."),
@@ -180,7 +207,7 @@ def elastic_cmd(
     """alpha-quartz Cij (relaxed ions), Voigt-Reuss-Hill K, G, E, nu and contact moduli E*, G*."""
     from flatcontact.elastic import quartz_contact_moduli
 
-    res = quartz_contact_moduli(potential, strain=strain)
+    res = quartz_contact_moduli(_bulk_potential(potential, "--potential"), strain=strain)
     if json_out:
         print(json.dumps(res, indent=2))
         return

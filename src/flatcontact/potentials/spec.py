@@ -10,6 +10,11 @@
 - ``"ase:module:factory"``: ``module.factory()`` returns an ASE calculator, evaluated per slab;
 - ``"none"``: no intra-slab interaction (LJ across the interface only; for tests).
 
+Every command accepts the same spellings and turns them into these canonical forms with
+:func:`normalize_potential_name`: ``sio2-snap`` and ``snap:sio2-snap`` are the same model,
+as are ``/p/X.snapcoeff``, ``snap:/p/X.snapcoeff`` and a directory ``/p`` holding exactly one
+``.snapcoeff``. ``PotentialSpec.intra`` always holds the canonical form.
+
 The JSON form (``spec.model_dump_json()``) is canonical and is what the scan stores and
 compares; ``spec.label`` is a short human-readable description for file attributes.
 """
@@ -206,7 +211,7 @@ class PotentialSpec(BaseModel):
     @field_validator("intra")
     @classmethod
     def _intra(cls, value: str) -> str:
-        value = value.strip()
+        value = normalize_potential_name(value)
         resolve_intra(value)  # raises InputError on unknown names / missing files
         return value
 
@@ -248,9 +253,73 @@ class ResolvedIntra(BaseModel):
     factory: str | None = None
 
 
+#: The accepted spellings of a potential, for error messages and help texts.
+POTENTIAL_FORMS = (
+    "vashishta, tersoff, snap:<bundled name>, <bundled name>, snap:<path.snapcoeff>, "
+    "<path.snapcoeff>, ase:module:factory or none"
+)
+
+
+def bundled_snap_names() -> list[str]:
+    """Names of the bundled SNAPs (directories of :data:`BUNDLED_DIR` with a ``.snapcoeff``)."""
+    if not BUNDLED_DIR.is_dir():
+        return []
+    return sorted(p.name for p in BUNDLED_DIR.iterdir() if (p / f"{p.name}.snapcoeff").is_file())
+
+
+def normalize_potential_name(name: str) -> str:
+    """The canonical ``PotentialSpec.intra`` of any accepted spelling of a potential.
+
+    ==============================================  ======================================
+    given                                           canonical
+    ==============================================  ======================================
+    ``vashishta``, ``tersoff``, ``none``            unchanged
+    ``sio2-snap``, ``snap:sio2-snap`` (bundled)     ``snap:sio2-snap``
+    ``p/X.snapcoeff``, ``snap:p/X.snapcoeff``       ``snap:p/X.snapcoeff`` (``~`` expanded)
+    ``p/`` (a directory with one ``.snapcoeff``)    ``snap:p/X.snapcoeff``
+    ``ase:module:factory``                          unchanged
+    ==============================================  ======================================
+
+    Idempotent (a canonical name maps to itself). Files are not checked here (see
+    :func:`resolve_intra`), except that a directory must hold exactly one ``.snapcoeff``.
+
+    Raises
+    ------
+    InputError
+        One line naming ``name`` and the accepted forms when it is none of them.
+    """
+    text = str(name).strip()
+    if text in ("none", *CLASSICAL) or text.startswith("ase:"):
+        return text
+    target = text.removeprefix("snap:")
+    if not target:
+        raise InputError(f"potential '{text}': expected a bundled SNAP name or a .snapcoeff path")
+    if "/" not in target and not target.endswith(".snapcoeff"):
+        if target in bundled_snap_names() or text.startswith("snap:"):
+            return f"snap:{target}"  # resolve_intra lists the bundled names if it is unknown
+    path = Path(target).expanduser()
+    if path.is_dir():
+        found = sorted(path.glob("*.snapcoeff"))
+        if len(found) != 1:
+            raise InputError(
+                f"potential '{text}': the directory holds {len(found)} .snapcoeff files, expected one"
+            )
+        path = found[0]
+    if path.suffix == ".snapcoeff":
+        return f"snap:{path}"
+    if text.startswith("snap:"):
+        raise InputError(f"potential '{text}': a SNAP path must end in .snapcoeff")
+    raise InputError(f"unknown potential '{text}': expected {POTENTIAL_FORMS}")
+
+
 def resolve_intra(intra: str) -> ResolvedIntra:
-    """Parse ``PotentialSpec.intra``; one-line :class:`InputError` on anything unusable."""
+    """Parse ``PotentialSpec.intra`` (any spelling of :func:`normalize_potential_name`).
+
+    One-line :class:`InputError` on anything unusable (unknown name, missing files).
+    """
     from flatcontact.potentials.lammps_runtime import lammps_potential_file
+
+    intra = normalize_potential_name(intra)
 
     if intra == "none":
         return ResolvedIntra(style="none", elements=None)
@@ -296,9 +365,7 @@ def resolve_intra(intra: str) -> ResolvedIntra:
         if found is None:
             raise InputError(f"potential '{intra}': module '{parts[1]}' cannot be imported")
         return ResolvedIntra(style="ase", factory=intra.removeprefix("ase:"), elements=None)
-    raise InputError(
-        f"unknown potential '{intra}': expected vashishta, tersoff, snap:<name|path.snapcoeff>, ase:module:factory or none"
-    )
+    raise InputError(f"unknown potential '{intra}': expected {POTENTIAL_FORMS}")
 
 
 def snap_elements(coeff: Path) -> tuple[str, ...]:
