@@ -171,3 +171,32 @@ def test_elastic_refuses_an_ase_factory(capsys):
     code, _, err = _run(["elastic", "--potential", "ase:flatcontact.ispes.toy:toy"], capsys)
     line = _one_error_line(code, err)
     assert "--potential" in line and "expected a LAMMPS model" in line
+
+
+# ---- 6: build and scan chain with the run's model ----------------------------------------
+
+
+def test_build_then_scan_chain_with_the_run_model(tmp_path, monkeypatch, capsys):
+    import json
+
+    from flatcontact.config import load_config
+    from flatcontact.structures.interface import read_interface, thickness
+
+    monkeypatch.chdir(tmp_path)
+    code, _, err = _run(["build"], capsys)
+    assert code in (0, None) and "warning" not in err
+    reference = read_interface("build/interface.extxyz")
+    recipe = json.loads(reference.info["recipe"])
+    run_model = load_config(None).potential
+    assert recipe["potential_spec"] == json.loads(run_model.model_dump_json())
+    z = f"{thickness(reference):.3f}"
+    argv = ["scan", "--grid", "1", "1", "--thickness", z, "--executor", "serial", "--json"]
+    code, out, err = _run(argv, capsys)
+    assert code in (0, None) and "warning" not in err
+    assert json.loads(out)["points_done"] == 1 and (tmp_path / "ispes" / "ispes.nc").is_file()
+    # another model than the interface's: one warning line, the scan still runs
+    code, out, err = _run([*argv, "--potential", "vashishta", "--out", "iv"], capsys)
+    assert code in (0, None)
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("warning: build/interface.extxyz was built")
+    assert "this scan uses vashishta+LJ" in lines[0]

@@ -19,13 +19,26 @@ def _positive_finite(value: float, flag: str, unit: str) -> float:
     return value
 
 
-def _potential_spec(potential: str, lj_cutoff_angstrom: float):
-    """The :class:`~flatcontact.potentials.PotentialSpec` of the flags; errors name the flag."""
+def _potential_spec(potential: str | None, lj_cutoff_angstrom: float | None):
+    """The :class:`~flatcontact.potentials.PotentialSpec` of the flags; errors name the flag.
+
+    The run's default model (:func:`flatcontact.config.default_potential`: the bundled SNAP and
+    the Hamaker-calibrated TS-vdW LJ) with ``--potential`` replacing its intra-slab model and
+    ``--lj-cutoff-angstrom`` its LJ cutoff, so ``flatcontact build`` relaxes the interface with
+    the model that ``flatcontact run`` and ``flatcontact scan`` use.
+    """
+    from flatcontact.config import default_potential
     from flatcontact.potentials import PotentialSpec
 
-    _positive_finite(lj_cutoff_angstrom, "--lj-cutoff-angstrom", "Å")
+    section = default_potential()
+    if potential is not None:
+        section["intra"] = potential
+    if lj_cutoff_angstrom is not None:
+        section["lj"]["cutoff_angstrom"] = _positive_finite(
+            lj_cutoff_angstrom, "--lj-cutoff-angstrom", "Å"
+        )
     try:
-        return PotentialSpec(intra=potential, lj={"cutoff_angstrom": lj_cutoff_angstrom})
+        return PotentialSpec(**section)
     except InputError as exc:
         text = str(exc)
         if text.startswith("potential lj.cutoff_angstrom"):
@@ -54,11 +67,16 @@ def build(
         6, "--layers", help="O–Si–O layers per α-quartz (0001) slab (>= 4)."
     ),
     potential: str = typer.Option(
-        "vashishta",
+        None,
         "--potential",
-        help="vashishta | tersoff | [snap:]NAME | [snap:]path/X.snapcoeff | ase:module:factory.",
+        help="vashishta | tersoff | [snap:]NAME | [snap:]path/X.snapcoeff | ase:module:factory "
+        "(default: the run's default, snap:sio2-snap; vashishta if that is not installed).",
     ),
-    out: Path = typer.Option(Path("build"), "--out", help="Output directory."),
+    out: Path = typer.Option(
+        Path("build"),
+        "--out",
+        help="Output directory (default ./build, where 'flatcontact scan' looks by default).",
+    ),
     source: str = typer.Option(
         "auto", "--source", help="auto | shipped (CHGNet-relaxed 6-layer slab) | seed"
     ),
@@ -66,7 +84,7 @@ def build(
         3.0, "--gap-angstrom", help="Initial gap between the slabs (Å)."
     ),
     lj_cutoff_angstrom: float = typer.Option(
-        10.0, "--lj-cutoff-angstrom", help="Cross-interface LJ cutoff (Å)."
+        None, "--lj-cutoff-angstrom", help="Cross-interface LJ cutoff (Å; default the run's, 10)."
     ),
     fmax_ev_per_angstrom: float = typer.Option(
         0.01, "--fmax-ev-per-angstrom", help="Relaxation tolerance on the max force."

@@ -34,6 +34,8 @@ _FLAG_OF = {
     "scan.dask_address": "--dask-address",
 }
 _FLAGS_SOURCE = "command-line flags"
+#: Where ``flatcontact build`` writes the interface by default (``--out build``).
+DEFAULT_INTERFACE = "build/interface.extxyz"
 
 
 def _floats(values: list[str] | None, flag: str) -> list[float] | None:
@@ -116,7 +118,10 @@ def scan_command(
     ] = None,
     interface: Annotated[
         str | None,
-        typer.Option("--interface", help="interface.extxyz (default: ./interface.extxyz)."),
+        typer.Option(
+            "--interface",
+            help=f"interface.extxyz (default: {DEFAULT_INTERFACE}, what 'flatcontact build' writes).",
+        ),
     ] = None,
     potential: Annotated[
         str | None,
@@ -237,7 +242,8 @@ def scan_command(
     s = cfg.scan
     spec = s.grid_spec()
     relax = s.relax_settings()
-    reference = read_interface(interface or "interface.extxyz")
+    reference = read_interface(interface or DEFAULT_INTERFACE)
+    _warn_other_potential(reference, cfg, interface or DEFAULT_INTERFACE)
     if cfg.calculator is not None:
         from flatcontact.ispes.calculators import CalculatorFactory
 
@@ -274,6 +280,53 @@ def scan_command(
         )
         raise typer.Exit(130) from None
     _summary(result, as_json)
+
+
+def built_with_other_model(reference, cfg) -> str | None:
+    """The model an interface's recipe names when it is not the one of ``cfg``, else ``None``.
+
+    The recipe (``info["recipe"]``, written by :mod:`flatcontact.structures.build`) holds the
+    whole ``PotentialSpec`` (``potential_spec``; older files only its label ``potential``, of
+    which the intra-slab part is compared). A recipe naming no potential gives ``None``.
+    """
+    from flatcontact.potentials.spec import PotentialSpec, normalize_potential_name
+
+    try:
+        recipe = json.loads(reference.info.get("recipe", "{}") or "{}")
+    except (TypeError, ValueError):
+        return None
+    if not isinstance(recipe, dict):
+        return None
+    if isinstance(recipe.get("potential_spec"), dict):
+        try:
+            built = PotentialSpec(**recipe["potential_spec"])
+        except (InputError, TypeError):
+            return str(recipe["potential_spec"].get("intra", "an unknown model"))
+        same = cfg.calculator is None and built == cfg.potential
+        return None if same else built.label
+    label = recipe.get("potential")
+    if not isinstance(label, str) or not label:
+        return None
+    intra = label.split("+LJ(")[0]
+    try:
+        intra = normalize_potential_name(intra)
+    except InputError:
+        pass
+    same = cfg.calculator is None and intra == cfg.potential.intra
+    return None if same else label
+
+
+def _warn_other_potential(reference, cfg, where: str) -> None:
+    """One warning line when the interface was relaxed with another model than the scan's."""
+    from flatcontact.cli.app import print_warning
+
+    built_with = built_with_other_model(reference, cfg)
+    if built_with is not None:
+        model = cfg.calculator.target if cfg.calculator is not None else cfg.potential.label
+        print_warning(
+            f"{where} was built with {built_with}, this scan uses {model}: its reference "
+            "stacking and thickness are not the relaxed ones of the scan's model"
+        )
 
 
 def _summary(result, as_json: bool) -> None:

@@ -270,6 +270,7 @@ def build_quartz_interface(
         "layers": layers,
         "start": report["start"]["source"],
         "potential": spec.label,
+        "potential_spec": json.loads(spec.model_dump_json()),
         "face_atoms": DENSE_FACE_LAYERS * QUARTZ_ATOMS_PER_LAYER,
         "gap_angstrom": gap_angstrom,
         "fmax_ev_per_angstrom": fmax_ev_per_angstrom,
@@ -347,6 +348,7 @@ def interface_from_slab(
             "face_atoms": face_atoms,
             "face_depth_angstrom": face_depth_angstrom,
             "potential": spec.label,
+            "potential_spec": json.loads(spec.model_dump_json()),
             "gap_angstrom": gap_angstrom,
         },
     )
