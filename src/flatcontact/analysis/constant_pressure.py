@@ -35,14 +35,18 @@ from dataclasses import dataclass
 
 import numpy as np
 import xarray as xr
-from scipy.interpolate import CubicSpline
+from scipy.interpolate import CubicSpline, make_interp_spline
 
 from flatcontact import units
 from flatcontact.analysis.diagnostics import StressEnergyMismatchWarning, UnconvergedPointsWarning
+from flatcontact.analysis.noise import LoadNoise, load_noise
 from flatcontact.errors import InputError
 from flatcontact.ispes import contract
 
 FORMS = ("internal", "enthalpy")
+#: Where the load comes from: ``-(1/A) dU/dz`` of the energy spline, or the stored stress.
+LOAD_SOURCES = ("energy", "stress")
+DEFAULT_LOAD_SOURCE = "energy"
 #: Minimum number of thickness values per column (cubic splines, not-a-knot).
 MIN_THICKNESS_POINTS = 4
 #: Relative stress/energy mismatch (of the column's p range) above which we warn.
@@ -57,8 +61,12 @@ class ColumnInversion:
     thickness_angstrom: np.ndarray  #: z*(P), shape (n_p, n_col)
     energy_ev_per_a2: np.ndarray  #: U(z*)/A, shape (n_p, n_col)
     branch_p_range_ev_per_a3: np.ndarray  #: (n_col, 2): lowest and highest p on the branch
-    tail_start_angstrom: np.ndarray  #: (n_col,) z of maximum tension if a tail follows, else NaN
+    tail_start_angstrom: np.ndarray  #: (n_col,) z where the branch ends if a tail follows, else NaN
     mismatch: np.ndarray  #: (n_col,) max |p + (1/A)dU/dz| on the branch nodes / p range
+    slope_ev_per_a4: np.ndarray  #: dp/dz at z*(P) of the load used, shape (n_p, n_col)
+    mismatch_sq_sum: np.ndarray  #: (n_col,) Σ (p + (1/A)dU/dz)² over the interior branch nodes
+    derivative_spread_sq_sum: np.ndarray  #: (n_col,) Σ (U'_cubic - U'_quintic)²/A² (NaN if n_z < 6)
+    n_branch_nodes: np.ndarray  #: (n_col,) interior branch nodes in those sums (all if n_z < 6)
 
 
 def invert_columns(
@@ -67,6 +75,7 @@ def invert_columns(
     stress_ev_per_a3: np.ndarray,
     p_ev_per_a3: np.ndarray,
     labels: list[str] | None = None,
+    load_source: str = DEFAULT_LOAD_SOURCE,
 ) -> ColumnInversion:
     """Energy per area at fixed loads for columns sharing the thickness values ``z``.
 
@@ -82,12 +91,18 @@ def invert_columns(
         Target loads ``P`` (eV/Å³), shape ``(n_p,)``.
     labels
         Names of the columns for error messages.
+    load_source
+        ``"energy"``: the load is ``p(z) = -(1/A) dU/dz`` of the cubic spline of
+        ``U(z)``; ``"stress"``: the stored ``normal_stress``, splined. Either way
+        the repulsive branch runs up to the node of lowest ``p``.
 
     Raises
     ------
     InputError
         Non-monotonic repulsive branch, or a ``P`` outside a column's branch.
     """
+    if load_source not in LOAD_SOURCES:
+        raise InputError(f"load source: expected one of {LOAD_SOURCES}, got {load_source!r}")
     z = np.asarray(z, dtype=float)
     e = np.atleast_2d(np.asarray(energy_ev_per_a2, dtype=float))
     p = np.atleast_2d(np.asarray(stress_ev_per_a3, dtype=float))
@@ -97,50 +112,103 @@ def invert_columns(
     if n_z < MIN_THICKNESS_POINTS:
         raise InputError(
             f"{labels[0]}: {n_z} thickness values; at least {MIN_THICKNESS_POINTS} are needed "
-            "to interpolate U(z) and p(z)"
+            "for the cubic splines of U(z) and p(z)"
         )
     if not np.all(np.diff(z) > 0):
         raise InputError("thickness: values must be strictly increasing")
+    spline_e = CubicSpline(z, e.T, axis=0)
+    dedz = spline_e(z, 1).T  # (n_col, n_z)
+    if load_source == "energy":
+        inv = _invert_energy(z, spline_e, targets, labels)
+    else:
+        inv = _invert_stress(z, p, spline_e, targets, labels)
+    zstar, estar, p_lo, p_hi, z_end, slope = inv
 
-    # repulsive branch: samples 0..m with m the lowest p (maximum tension)
-    m = np.argmin(p, axis=1)
-    idx = np.arange(n_z - 1)
-    rising = (np.diff(p, axis=1) >= 0) & (idx[None, :] < m[:, None])
-    if np.any(m == 0):
-        j = int(np.flatnonzero(m == 0)[0])
-        raise InputError(
-            f"{labels[j]}: normal_stress rises with thickness from the first point "
-            f"(p = {p[j, 0] * units.EV_PER_A3_TO_GPA:.4g} GPa at z = {z[0]:.4g} Å); "
-            "no repulsive branch to invert"
-        )
-    if np.any(rising):
-        j, k = (int(v) for v in np.argwhere(rising)[0])
-        raise InputError(
-            f"{labels[j]}: normal_stress is not monotonic on the repulsive branch: "
-            f"p = {p[j, k] * units.EV_PER_A3_TO_GPA:.4g} GPa at z = {z[k]:.4g} Å, "
-            f"{p[j, k + 1] * units.EV_PER_A3_TO_GPA:.4g} GPa at z = {z[k + 1]:.4g} Å "
-            "(expected p to decrease with thickness up to the maximum tension)"
-        )
-    p_lo = p[np.arange(n_col), m]
-    p_hi = p[:, 0]
+    # diagnostics: tail and stress/energy consistency on the branch nodes
+    last = z_end < z[-1]
+    tail = np.where(last, z_end, np.nan)
+    span = np.maximum(p_hi - p_lo, np.finfo(float).tiny)
+    node_ok = z[None, :] <= z_end[:, None] * (1 + 1e-12)
+    diff = np.where(node_ok, p + dedz, 0.0)
+    mismatch = np.max(np.abs(diff), axis=1) / span
+    # rms estimates on the interior branch nodes: the end derivatives of a spline are its
+    # least accurate values and would measure the interpolant, not the data
+    inner = node_ok.copy()
+    inner[:, [0, -1]] = n_z < 6
+    if n_z >= 6:
+        quintic = make_interp_spline(z, e.T, k=5, axis=0).derivative()(z).T
+        spread = np.sum(np.where(inner, dedz - quintic, 0.0) ** 2, axis=1)
+    else:
+        spread = np.full(n_col, np.nan)
+    return ColumnInversion(
+        thickness_angstrom=zstar,
+        energy_ev_per_a2=estar,
+        branch_p_range_ev_per_a3=np.column_stack([p_lo, p_hi]),
+        tail_start_angstrom=tail,
+        mismatch=mismatch,
+        slope_ev_per_a4=slope,
+        mismatch_sq_sum=np.sum(np.where(inner, diff, 0.0) ** 2, axis=1),
+        derivative_spread_sq_sum=spread,
+        n_branch_nodes=np.sum(inner, axis=1),
+    )
+
+
+def _out_of_range(targets, p_lo, p_hi, z, z_end, labels) -> None:
     outside = (targets[:, None] < p_lo[None, :]) | (targets[:, None] > p_hi[None, :])
     if np.any(outside):
         i, j = (int(v) for v in np.argwhere(outside)[0])
         raise InputError(
             f"P = {targets[i] * units.EV_PER_A3_TO_GPA:.4g} GPa is outside the data of {labels[j]}: "
             f"its repulsive branch spans p = {p_lo[j] * units.EV_PER_A3_TO_GPA:.4g} .. "
-            f"{p_hi[j] * units.EV_PER_A3_TO_GPA:.4g} GPa (thickness {z[0]:.4g} .. {z[m[j]]:.4g} Å); "
+            f"{p_hi[j] * units.EV_PER_A3_TO_GPA:.4g} GPa (thickness {z[0]:.4g} .. {z_end[j]:.4g} Å); "
             "extend the scan in thickness or choose P inside that range"
         )
 
-    spline_p = CubicSpline(z, p.T, axis=0)
-    spline_e = CubicSpline(z, e.T, axis=0)
+
+def _branch(z, p, labels, what):
+    """Index ``m`` of the lowest node of ``p`` per column; InputError unless p falls up to it."""
+    n_z = p.shape[1]
+    m = np.argmin(p, axis=1)
+    idx = np.arange(n_z - 1)
+    rising = (np.diff(p, axis=1) >= 0) & (idx[None, :] < m[:, None])
+    if np.any(m == 0):
+        j = int(np.flatnonzero(m == 0)[0])
+        raise InputError(
+            f"{labels[j]}: {what} rises with thickness from the first point "
+            f"(p = {p[j, 0] * units.EV_PER_A3_TO_GPA:.4g} GPa at z = {z[0]:.4g} Å); "
+            "no repulsive branch to invert"
+        )
+    if np.any(rising):
+        j, k = (int(v) for v in np.argwhere(rising)[0])
+        raise InputError(
+            f"{labels[j]}: {what} is not monotonic on the repulsive branch: "
+            f"p = {p[j, k] * units.EV_PER_A3_TO_GPA:.4g} GPa at z = {z[k]:.4g} Å, "
+            f"{p[j, k + 1] * units.EV_PER_A3_TO_GPA:.4g} GPa at z = {z[k + 1]:.4g} Å "
+            "(expected p to decrease with thickness up to the maximum tension)"
+        )
+    return m
+
+
+def _invert(z, p_nodes, coef_p, spline_e, targets, labels, what):
+    """z*(P) on the repulsive branch of a load given at the nodes and as a piecewise cubic.
+
+    The branch runs from the first node to the node ``m`` of lowest ``p`` (the
+    maximum tension); on it the nodes must decrease strictly. ``z*`` lies in the
+    segment whose end nodes bracket ``P`` and is found there by bisection of the
+    piecewise polynomial ``coef_p`` (shape ``(4, n_z - 1, n_col)``, in ``z - z_k``).
+    Returns ``(z*, U(z*)/A, p_lo, p_hi, z_m, dp/dz at z*)``.
+    """
+    n_col, n_z = p_nodes.shape
+    m = _branch(z, p_nodes, labels, what)
+    p_lo = p_nodes[np.arange(n_col), m]
+    p_hi = p_nodes[:, 0]
+    _out_of_range(targets, p_lo, p_hi, z, z[m], labels)
     # segment k with p_k >= P >= p_{k+1}, k < m  (p strictly decreasing there)
     on_branch = np.arange(n_z)[None, None, :] <= m[None, :, None]
-    count = np.sum((p[None, :, :] >= targets[:, None, None]) & on_branch, axis=2)
+    count = np.sum((p_nodes[None, :, :] >= targets[:, None, None]) & on_branch, axis=2)
     k = np.clip(count - 1, 0, np.maximum(m - 1, 0)[None, :])  # (n_p, n_col)
     cols = np.broadcast_to(np.arange(n_col), k.shape)
-    coef = spline_p.c[:, k, cols]  # (4, n_p, n_col), polynomial in (zz - z_k)
+    coef = coef_p[:, k, cols]  # (4, n_p, n_col), polynomial in (zz - z_k)
     lo = np.zeros(k.shape)
     hi = z[k + 1] - z[k]
     rhs = targets[:, None]
@@ -153,20 +221,22 @@ def invert_columns(
     dz = 0.5 * (lo + hi)
     ce = spline_e.c[:, k, cols]
     e_star = ((ce[0] * dz + ce[1]) * dz + ce[2]) * dz + ce[3]
+    slope = (3 * coef[0] * dz + 2 * coef[1]) * dz + coef[2]
+    return z[k] + dz, e_star, p_lo, p_hi, z[m], slope
 
-    # diagnostics: tail and stress/energy consistency on the branch nodes
-    tail = np.where(m < n_z - 1, z[m], np.nan)
-    dedz = spline_e(z, 1).T  # (n_col, n_z)
-    span = np.maximum(p_hi - p_lo, np.finfo(float).tiny)
-    node_ok = np.arange(n_z)[None, :] <= m[:, None]
-    mismatch = np.max(np.where(node_ok, np.abs(p + dedz), 0.0), axis=1) / span
-    return ColumnInversion(
-        thickness_angstrom=z[k] + dz,
-        energy_ev_per_a2=e_star,
-        branch_p_range_ev_per_a3=np.column_stack([p_lo, p_hi]),
-        tail_start_angstrom=tail,
-        mismatch=mismatch,
-    )
+
+def _invert_stress(z, p, spline_e, targets, labels):
+    """Load = the stored stress, splined (not-a-knot cubic)."""
+    coef = CubicSpline(z, p.T, axis=0).c
+    return _invert(z, p, coef, spline_e, targets, labels, "normal_stress")
+
+
+def _invert_energy(z, spline_e, targets, labels):
+    """Load = -(1/A) dU/dz of the cubic spline of U: a piecewise quadratic."""
+    c = spline_e.c  # U/A = c0 x³ + c1 x² + c2 x + c3
+    coef = np.stack([np.zeros_like(c[0]), -3 * c[0], -2 * c[1], -c[2]])
+    p_nodes = -spline_e(z, 1).T
+    return _invert(z, p_nodes, coef, spline_e, targets, labels, "-(1/A) dU/dz")
 
 
 @dataclass(frozen=True)
@@ -190,6 +260,8 @@ class ConstantPressureISPES:
     branch_p_range_gpa: np.ndarray  #: (n_a, n_b, 2) invertible load range per column
     tail_start_angstrom: np.ndarray  #: (n_a, n_b), NaN where no adhesive tail is in the data
     stress_energy_mismatch: float  #: max over columns, relative to each column's p range
+    load_source: str = DEFAULT_LOAD_SOURCE  #: "energy" or "stress"
+    noise: LoadNoise | None = None  #: per-load noise estimate (:mod:`.noise`)
 
     @property
     def common_p_range_gpa(self) -> tuple[float, float]:
@@ -218,6 +290,7 @@ def constant_pressure(
     form: str = "internal",
     allow_missing: bool = False,
     source: str = "ISPES grid",
+    load_source: str = DEFAULT_LOAD_SOURCE,
 ) -> ConstantPressureISPES:
     """Constant-pressure ISPES of a contract grid at the loads ``p_gpa`` (GPa).
 
@@ -235,9 +308,14 @@ def constant_pressure(
         an error listing them.
     source
         Name of the grid in messages (usually the file name).
+    load_source
+        ``"energy"``: the load is ``-(1/A) dU/dz`` of the energy spline;
+        ``"stress"``: the stored ``normal_stress`` (see :func:`invert_columns`).
     """
     if form not in FORMS:
         raise InputError(f"energy form: expected one of {FORMS}, got {form!r}")
+    if load_source not in LOAD_SOURCES:
+        raise InputError(f"load source: expected one of {LOAD_SOURCES}, got {load_source!r}")
     targets_gpa = np.atleast_1d(np.asarray(p_gpa, dtype=float))
     if targets_gpa.size == 0 or not np.all(np.isfinite(targets_gpa)):
         raise InputError(f"p_gpa: expected finite pressures in GPa, got {targets_gpa.tolist()}")
@@ -275,6 +353,8 @@ def constant_pressure(
     prange = np.empty((n_col, 2))
     tail = np.empty(n_col)
     mismatch = np.empty(n_col)
+    slope = np.empty((targets.size, n_col))
+    sq = np.empty((3, n_col))  # mismatch Σ², derivative-spread Σ², branch node count
 
     def store(sel: np.ndarray, res: ColumnInversion) -> None:
         zstar[:, sel] = res.thickness_angstrom
@@ -282,11 +362,18 @@ def constant_pressure(
         prange[sel] = res.branch_p_range_ev_per_a3
         tail[sel] = res.tail_start_angstrom
         mismatch[sel] = res.mismatch
+        slope[:, sel] = res.slope_ev_per_a4
+        sq[:, sel] = [res.mismatch_sq_sum, res.derivative_spread_sq_sum, res.n_branch_nodes]
 
     full = np.all(fin_cols, axis=1)
     if np.any(full):
         sel = np.flatnonzero(full)
-        store(sel, invert_columns(z, e_cols[sel], p_cols[sel], targets, [labels[j] for j in sel]))
+        store(
+            sel,
+            invert_columns(
+                z, e_cols[sel], p_cols[sel], targets, [labels[j] for j in sel], load_source
+            ),
+        )
     for j in np.flatnonzero(~full):
         keep = fin_cols[j]
         if keep.sum() < MIN_THICKNESS_POINTS:
@@ -296,7 +383,9 @@ def constant_pressure(
             )
         store(
             np.array([j]),
-            invert_columns(z[keep], e_cols[j, keep], p_cols[j, keep], targets, [labels[j]]),
+            invert_columns(
+                z[keep], e_cols[j, keep], p_cols[j, keep], targets, [labels[j]], load_source
+            ),
         )
 
     worst = float(np.max(mismatch))
@@ -308,6 +397,22 @@ def constant_pressure(
             StressEnergyMismatchWarning,
             stacklevel=2,
         )
+    gpa = units.EV_PER_A3_TO_GPA
+    n_nodes = np.sum(sq[2])
+    mismatch_rms = float(np.sqrt(np.sum(sq[0]) / n_nodes)) * gpa
+    spread_rms = float(np.sqrt(np.sum(sq[1]) / n_nodes)) * gpa  # NaN if any column < 6 points
+    a1 = np.asarray(ds.attrs["a1"], dtype=float).ravel()[:2]
+    a2 = np.asarray(ds.attrs["a2"], dtype=float).ravel()[:2]
+    spacing = min(np.linalg.norm(a1) / n_a, np.linalg.norm(a2) / n_b)
+    noise = load_noise(
+        targets_gpa,
+        delta_p_gpa=spread_rms if load_source == "energy" else mismatch_rms,
+        mismatch_rms_gpa=mismatch_rms,
+        slope_gpa_per_angstrom=np.median(np.abs(slope), axis=1) * gpa,
+        grid_spacing_angstrom=spacing,
+        form=form,
+        load_source=load_source,
+    )
     internal = estar.reshape(targets.size, n_a, n_b)
     zmap = zstar.reshape(targets.size, n_a, n_b)
     chosen = internal + targets[:, None, None] * zmap if form == "enthalpy" else internal
@@ -316,8 +421,8 @@ def constant_pressure(
         form=form,
         shift_a=sa.astype(float),
         shift_b=sb.astype(float),
-        a1=np.asarray(ds.attrs["a1"], dtype=float).ravel()[:2],
-        a2=np.asarray(ds.attrs["a2"], dtype=float).ravel()[:2],
+        a1=a1,
+        a2=a2,
         area_angstrom2=area,
         energy_ev_per_a2=chosen,
         internal_ev_per_a2=internal,
@@ -325,4 +430,6 @@ def constant_pressure(
         branch_p_range_gpa=prange.reshape(n_a, n_b, 2) * units.EV_PER_A3_TO_GPA,
         tail_start_angstrom=tail.reshape(n_a, n_b),
         stress_energy_mismatch=worst,
+        load_source=load_source,
+        noise=noise,
     )

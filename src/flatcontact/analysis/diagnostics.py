@@ -24,3 +24,8 @@ class PathNotPeriodicWarning(AnalysisWarning):
 
 class LinearFitWarning(AnalysisWarning):
     """Too few points below the threshold for a load law with standard errors."""
+
+
+class LoadNoiseWarning(AnalysisWarning):
+    """The noise that the load's error puts into the constant-pressure ISPES is a sizeable
+    fraction of τ or of the barriers (see :mod:`flatcontact.analysis.noise`)."""

@@ -147,11 +147,56 @@ def _largest_force(path: SlidingPath, f: np.ndarray, stop: int) -> tuple[float, 
     return force, t_max, j == stop
 
 
-def friction_along_path(path: SlidingPath) -> FrictionResult:
+def merge_shallow_minima(
+    events: list[tuple[str, float, float, bool]], start_energy: float, min_barrier: float
+) -> list[tuple[str, float, float, bool]]:
+    """Drop minima whose dip is below ``min_barrier``, with the lower of their two maxima.
+
+    ``events`` are ``(kind, t, energy, at_jump)`` in path order after the start
+    minimum (energy ``start_energy``). The dip of a minimum is the smaller of the
+    drop from the maximum before it and the climb to the maximum after it (the
+    climb alone for a last minimum without a following maximum). The shallowest
+    dip is removed first, repeatedly (persistence simplification), so the
+    remaining minima and maxima alternate and every kept barrier exceeds
+    ``min_barrier``. ``min_barrier <= 0`` returns the events unchanged.
+    """
+    if not min_barrier > 0:
+        return list(events)
+    seq = [("min", 0.0, float(start_energy), False), *events]
+    while True:
+        best, best_dip = None, min_barrier
+        for i in range(1, len(seq)):
+            if seq[i][0] != "min":
+                continue
+            before = seq[i - 1][2] - seq[i][2] if seq[i - 1][0] == "max" else np.inf
+            after = (
+                seq[i + 1][2] - seq[i][2] if i + 1 < len(seq) and seq[i + 1][0] == "max" else np.inf
+            )
+            dip = min(before, after)
+            if dip < best_dip:
+                best, best_dip = i, dip
+        if best is None:
+            return seq[1:]
+        lower = [j for j in (best - 1, best + 1) if j < len(seq) and seq[j][0] == "max"]
+        drop = min(lower, key=lambda j: seq[j][2]) if len(lower) == 2 else lower[0]
+        seq = [ev for j, ev in enumerate(seq) if j not in (best, drop)]
+
+
+def friction_along_path(path: SlidingPath, min_barrier_ev_per_a2: float = 0.0) -> FrictionResult:
     """τ, σ_MSS and the shear stiffness of a zero-perpendicular-force path.
 
     The path's surface must be an energy per area in eV/Å² (then forces are
     eV/Å³ and the stiffness eV/Å⁴). See the module docstring for definitions.
+
+    Parameters
+    ----------
+    path
+        The sliding path.
+    min_barrier_ev_per_a2
+        Noise floor (eV/Å²): a minimum whose dip is shallower than this is not a
+        minimum (:func:`merge_shallow_minima`), so it neither splits a barrier in
+        σ_MSS nor ends the climb that sets τ. The analysis passes
+        ``BARRIER_NOISE_FACTOR`` × the energy-noise estimate (:mod:`.noise`).
     """
     t, e = path.t_angstrom, path.energy
     f = path.force.copy()
@@ -174,6 +219,8 @@ def friction_along_path(path: SlidingPath) -> FrictionResult:
         elif f[i - 1] < 0 <= f[i] and not (path.periodic and i == len(t) - 1):
             tt, ee, _ = _refine(path, i, "force")
             events.append(("min", tt, ee, False))
+
+    events = merge_shallow_minima(events, float(e[0]), min_barrier_ev_per_a2)
 
     # τ: largest force before the first maximum (barrier top or fold)
     first_max = next((ev for ev in events if ev[0] == "max"), None)

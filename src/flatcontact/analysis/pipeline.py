@@ -20,14 +20,24 @@ Finally the load laws (:mod:`.laws`). Timings per stage are recorded.
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 import xarray as xr
 
-from flatcontact.analysis.constant_pressure import FORMS, ConstantPressureISPES, constant_pressure
+from flatcontact import units
+from flatcontact.analysis.constant_pressure import (
+    DEFAULT_LOAD_SOURCE,
+    FORMS,
+    LOAD_SOURCES,
+    ConstantPressureISPES,
+    constant_pressure,
+)
+from flatcontact.analysis.diagnostics import LoadNoiseWarning
 from flatcontact.analysis.friction import FrictionResult, friction_along_path
 from flatcontact.analysis.laws import LoadLaws, fit_load_laws
+from flatcontact.analysis.noise import NOISE_WARN_FRACTION
 from flatcontact.analysis.path import (
     MinimumEnergyPath,
     SlidingPath,
@@ -37,8 +47,11 @@ from flatcontact.analysis.path import (
 from flatcontact.analysis.periodic import PeriodicSurface, lattice_vectors, rectangular_supercell
 from flatcontact.analysis.symmetry import SymmetryReport, symmetry_report
 from flatcontact.errors import InputError
+from flatcontact.ispes import contract
 
 ENERGY_ZEROS = ("lowest-p", "each", "none")
+#: Lateral points per axis: a periodic interpolant needs the first harmonic (k = -1, 0, 1).
+MIN_LATERAL_POINTS = 3
 
 
 @dataclass(frozen=True)
@@ -67,6 +80,12 @@ class AnalysisResult:
     energy_reference_ev_per_a2: float
     supercell: tuple[np.ndarray, np.ndarray] | None
     timings_s: dict[str, float] = field(default_factory=dict)
+    load_source: str = DEFAULT_LOAD_SOURCE
+
+    @property
+    def noise(self):
+        """Per-load noise estimate (:class:`flatcontact.analysis.noise.LoadNoise`)."""
+        return self.constant_pressure.noise
 
     @property
     def p_gpa(self) -> np.ndarray:
@@ -102,6 +121,7 @@ def analyze_ispes(
     with_symmetry: bool = True,
     max_length_angstrom: float | None = None,
     source: str = "ISPES grid",
+    load_source: str = DEFAULT_LOAD_SOURCE,
 ) -> AnalysisResult:
     """Analyse an ISPES grid at the loads ``p_gpa`` (see module docstring).
 
@@ -127,6 +147,12 @@ def analyze_ispes(
         Tracking limit of the path (default: see :func:`.path.default_max_length`).
     source
         Name of the grid in messages.
+    load_source
+        ``"energy"`` (default): the load is ``-(1/A) dU/dz`` of the energy spline
+        per column; ``"stress"``: the stored ``normal_stress``. Barriers below
+        ``BARRIER_NOISE_FACTOR`` × the energy-noise estimate of the chosen source
+        and form do not count (:mod:`.noise`); a :class:`LoadNoiseWarning` says
+        when that noise is a sizeable fraction of τ or of the largest barrier.
     """
     p = check_pressures(p_gpa)
     if not np.isfinite(direction_deg):
@@ -139,12 +165,26 @@ def analyze_ispes(
         )
     if not threshold_gpa > 0:
         raise InputError(f"--threshold-gpa: expected a positive pressure, got {threshold_gpa}")
+    if load_source not in LOAD_SOURCES:
+        raise InputError(
+            f"--load-source: expected one of {', '.join(LOAD_SOURCES)}, got {load_source!r}"
+        )
+    n_lateral = (ds.sizes.get(contract.DIM_A, 0), ds.sizes.get(contract.DIM_B, 0))
+    if min(n_lateral) < MIN_LATERAL_POINTS:
+        raise InputError(
+            f"{source}: lateral grid is {n_lateral[0]}×{n_lateral[1]} (shift_a × shift_b); "
+            f"the periodic interpolation and the sliding path need at least "
+            f"{MIN_LATERAL_POINTS} points per axis"
+        )
 
     timings = {"constant_pressure": 0.0, "interpolation": 0.0, "path": 0.0, "friction": 0.0}
     timings.update({"mep": 0.0} if with_mep else {})
     timings.update({"symmetry": 0.0} if with_symmetry else {})
     clock = time.perf_counter()
-    cp = constant_pressure(ds, p, form=form, allow_missing=allow_missing, source=source)
+    cp = constant_pressure(
+        ds, p, form=form, allow_missing=allow_missing, source=source, load_source=load_source
+    )
+    floor = cp.noise.barrier_threshold_ev_per_a2
     timings["constant_pressure"] = time.perf_counter() - clock
 
     a1, a2 = cp.a1, cp.a2
@@ -172,7 +212,7 @@ def analyze_ispes(
         )
         timings["path"] += time.perf_counter() - clock
         clock = time.perf_counter()
-        fr = friction_along_path(path)
+        fr = friction_along_path(path, min_barrier_ev_per_a2=float(floor[i]))
         timings["friction"] += time.perf_counter() - clock
         mep = None
         if with_mep:
@@ -190,6 +230,7 @@ def analyze_ispes(
             sym = symmetry_report(surf)
             timings["symmetry"] += time.perf_counter() - clock
         results.append(PressureAnalysis(float(pk), surf, r0, path, fr, mep, sym))
+        _warn_noise(cp, i, fr, source)
 
     clock = time.perf_counter()
     tau = np.array([r.friction.tau_mpa for r in results])
@@ -206,7 +247,27 @@ def analyze_ispes(
         energy_reference_ev_per_a2=float(refs[0]),
         supercell=rectangular_supercell(a1, a2),
         timings_s=timings,
+        load_source=load_source,
     )
+
+
+def _warn_noise(cp: ConstantPressureISPES, i: int, fr: FrictionResult, source: str) -> None:
+    """:class:`LoadNoiseWarning` if the load's noise is sizeable against τ or the barriers."""
+    nz = cp.noise
+    eps, force = nz.energy_noise_mev_per_a2[i], nz.force_noise_mpa[i]
+    barrier = max((b.height for b in fr.barriers), default=0.0) * units.EV_PER_A2_TO_MEV_PER_A2
+    big_force = np.isfinite(force) and force > NOISE_WARN_FRACTION * abs(fr.tau_mpa)
+    big_energy = np.isfinite(eps) and eps > NOISE_WARN_FRACTION * barrier
+    if big_force or big_energy:
+        warnings.warn(
+            f"{source} at P = {nz.p_gpa[i]:g} GPa ({nz.load_source} load, {nz.form} form): "
+            f"energy noise {eps:.3g} meV/Å² (largest barrier {barrier:.3g}), force noise "
+            f"{force:.3g} MPa (τ = {fr.tau_mpa:.4g} MPa) from δp = {nz.delta_p_gpa:.3g} GPa rms "
+            f"and |dp/dz| = {nz.slope_gpa_per_angstrom[i]:.3g} GPa/Å"
+            + ("; try --load-source energy" if nz.load_source == "stress" else ""),
+            LoadNoiseWarning,
+            stacklevel=3,
+        )
 
 
 def _shortest_forward_vector(a1: np.ndarray, a2: np.ndarray, direction_deg: float) -> np.ndarray:
