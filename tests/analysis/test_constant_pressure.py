@@ -191,7 +191,7 @@ def test_single_column_inversion_property(depth, alpha, p_frac, load_source):
     ustar = 0.5 * (1 + np.sqrt(1 + 2 * target / (alpha * depth)))
     # -dU/dz of the cubic spline is one order less accurate than the spline of p (h³ vs h⁴),
     # least so next to the ends (not-a-knot)
-    tol_z, tol_e = (2e-5, 1e-6) if load_source == "stress" else (2e-4, 1e-5)
+    tol_z, tol_e = (2e-5, 1e-6) if load_source == "stress" else (2e-4, 3e-5)
     assert res.thickness_angstrom[0, 0] == pytest.approx(-np.log(ustar) / alpha, abs=tol_z)
     exact = depth * (ustar**2 - 2 * ustar)
     assert res.energy_ev_per_a2[0, 0] == pytest.approx(exact, abs=tol_e * np.max(np.abs(e)))
