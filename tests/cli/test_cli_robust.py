@@ -200,3 +200,37 @@ def test_build_then_scan_chain_with_the_run_model(tmp_path, monkeypatch, capsys)
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("warning: build/interface.extxyz was built")
     assert "this scan uses vashishta+LJ" in lines[0]
+
+
+# ---- 7: a scan that fails before storing a point leaves nothing that blocks the rerun -----
+
+
+@pytest.mark.parametrize("existing_dir", [False, True])
+def test_failed_scan_leaves_no_store(tmp_path, monkeypatch, capsys, existing_dir):
+    from flatcontact.errors import InputError
+    from flatcontact.ispes import executors
+    from flatcontact.ispes.toy import toy_interface
+    from flatcontact.structures.interface import thickness, write_interface
+
+    reference = toy_interface(layers=3)
+    iface = str(write_interface(reference, tmp_path / "interface.extxyz"))
+    out = tmp_path / "os11"
+    if existing_dir:
+        out.mkdir()
+    z = f"{thickness(reference):.4f}"
+    argv = ["scan", "--interface", iface, "--calculator", "flatcontact.ispes.toy:toy_calculator"]
+    argv += ["--thickness", z, "--out", str(out)]
+    make_executor = executors.make_executor
+
+    def unreachable(**options):  # what a dead --dask-address gives, without its 5 s timeout
+        raise InputError("dask-address tcp://127.0.0.1:1: no Dask scheduler reachable (OSError)")
+
+    monkeypatch.setattr(executors, "make_executor", unreachable)
+    line = _one_error_line(*_run([*argv, "--grid", "1", "1"], capsys)[::2])
+    assert "no Dask scheduler reachable" in line
+    monkeypatch.setattr(executors, "make_executor", make_executor)
+    assert out.is_dir() == existing_dir
+    assert not out.exists() or list(out.iterdir()) == []
+    code, _, err = _run([*argv, "--grid", "2", "1", "--executor", "serial", "--json"], capsys)
+    assert code in (0, None), err
+    assert (out / "ispes.nc").is_file()

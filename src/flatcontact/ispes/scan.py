@@ -33,7 +33,7 @@ from flatcontact.ispes.relax import (
     run_task,
     worker_calculator,
 )
-from flatcontact.ispes.store import PointStore, interface_hash
+from flatcontact.ispes.store import PointStore, discard_store, interface_hash
 
 POINTS_DB = "points.db"
 ISPES_NC = "ispes.nc"
@@ -181,126 +181,145 @@ def run_scan(
     if grid.thickness_angstrom is not None:
         grid_mod.check_thicknesses(reference, grid, grid.thickness_angstrom)
     out_dir = Path(out_dir)
-    with PointStore(
-        out_dir / POINTS_DB, scan_settings(reference, factory, grid, relax), reference
-    ) as store:
-        own_executor = executor is None
-        if own_executor:
-            executor = make_executor(**(executor_options or {}))
-        notes: list[str] = []
-        interrupted = False
-        computed_calls: list[int] = []
-        try:
-            if store.resolved is None:
-                a1, a2 = in_plane_vectors(reference)
-                resolved = {"a1": a1.tolist(), "a2": a2.tolist(), "potential_label": factory.label}
-                if grid.thickness_angstrom is not None:
-                    resolved["thickness_angstrom"] = list(grid.thickness_angstrom)
-                else:
-                    extra, notes = _probe(reference, factory, grid, relax)
-                    resolved.update(extra)
-                store.set_resolved(resolved)
-            resolved = store.resolved
-            notes = list(resolved.get("notes", notes))
-            z = np.asarray(resolved["thickness_angstrom"], dtype=float)
-            if grid.thickness_angstrom is None:
-                grid_mod.check_thicknesses(reference, grid, z)
-            shape = (grid.n_a, grid.n_b, z.size)
-            sa, sb = grid.shifts()
-            root = (0, 0, int(np.argmin(np.abs(z - thickness(reference)))))
-            parent = search_tree(shape, root, order)
-            context = ScanContext(reference, factory, relax)
-            rank = {idx: k for k, idx in enumerate(parent)}
-            todo = [idx for idx in parent if idx not in store]
-            total = len(parent)
-            prog = None
-            if progress:
-                prog, ptask = _progress(console, total, len(store))
-                prog.start()
-            in_flight: dict[Any, tuple] = {}
-            cap = 2 * max(1, getattr(executor, "workers", 1))
-            pending = set(todo)
-
-            def ready(idx):
-                par = parent[idx]
-                return par is None or par in store
-
-            def converged(idx):
-                return idx is not None and idx in store and store.record(idx)["converged"]
-
-            def make_task(idx):
-                par = parent[idx]
-                ia, ib, iz = idx
-                if not converged(par):
-                    return PointTask(idx, float(sa[ia]), float(sb[ib]), float(z[iz]))
-                pa, pb, pz = par
-                grand = parent[par]
-                previous = {}
-                if converged(grand) and grand[:2] == par[:2] == idx[:2]:
-                    previous = {
-                        "previous_positions": store.positions(grand),
-                        "previous_thickness": float(z[grand[2]]),
-                    }
-                return PointTask(
-                    idx,
-                    float(sa[ia]),
-                    float(sb[ib]),
-                    float(z[iz]),
-                    store.positions(par),
-                    (float(sa[pa]), float(sb[pb])),
-                    float(z[pz]),
-                    par,
-                    **previous,
-                )
-
-            submitted = 0
+    store_path = out_dir / POINTS_DB
+    fresh_dir, fresh_store = not out_dir.exists(), not store_path.exists()
+    store = None
+    try:
+        with PointStore(
+            store_path, scan_settings(reference, factory, grid, relax), reference
+        ) as store:
+            own_executor = executor is None
+            if own_executor:
+                executor = make_executor(**(executor_options or {}))
+            notes: list[str] = []
+            interrupted = False
+            computed_calls: list[int] = []
             try:
-                while pending or in_flight:
-                    if max_new_points is not None and submitted >= max_new_points and not in_flight:
-                        break
-                    candidates = sorted((i for i in pending if ready(i)), key=rank.__getitem__)
-                    for idx in candidates:
-                        if len(in_flight) >= cap or (
-                            max_new_points is not None and submitted >= max_new_points
+                if store.resolved is None:
+                    a1, a2 = in_plane_vectors(reference)
+                    resolved = {
+                        "a1": a1.tolist(),
+                        "a2": a2.tolist(),
+                        "potential_label": factory.label,
+                    }
+                    if grid.thickness_angstrom is not None:
+                        resolved["thickness_angstrom"] = list(grid.thickness_angstrom)
+                    else:
+                        extra, notes = _probe(reference, factory, grid, relax)
+                        resolved.update(extra)
+                    store.set_resolved(resolved)
+                resolved = store.resolved
+                notes = list(resolved.get("notes", notes))
+                z = np.asarray(resolved["thickness_angstrom"], dtype=float)
+                if grid.thickness_angstrom is None:
+                    grid_mod.check_thicknesses(reference, grid, z)
+                shape = (grid.n_a, grid.n_b, z.size)
+                sa, sb = grid.shifts()
+                root = (0, 0, int(np.argmin(np.abs(z - thickness(reference)))))
+                parent = search_tree(shape, root, order)
+                context = ScanContext(reference, factory, relax)
+                rank = {idx: k for k, idx in enumerate(parent)}
+                todo = [idx for idx in parent if idx not in store]
+                total = len(parent)
+                prog = None
+                if progress:
+                    prog, ptask = _progress(console, total, len(store))
+                    prog.start()
+                in_flight: dict[Any, tuple] = {}
+                cap = 2 * max(1, getattr(executor, "workers", 1))
+                pending = set(todo)
+
+                def ready(idx):
+                    par = parent[idx]
+                    return par is None or par in store
+
+                def converged(idx):
+                    return idx is not None and idx in store and store.record(idx)["converged"]
+
+                def make_task(idx):
+                    par = parent[idx]
+                    ia, ib, iz = idx
+                    if not converged(par):
+                        return PointTask(idx, float(sa[ia]), float(sb[ib]), float(z[iz]))
+                    pa, pb, pz = par
+                    grand = parent[par]
+                    previous = {}
+                    if converged(grand) and grand[:2] == par[:2] == idx[:2]:
+                        previous = {
+                            "previous_positions": store.positions(grand),
+                            "previous_thickness": float(z[grand[2]]),
+                        }
+                    return PointTask(
+                        idx,
+                        float(sa[ia]),
+                        float(sb[ib]),
+                        float(z[iz]),
+                        store.positions(par),
+                        (float(sa[pa]), float(sb[pb])),
+                        float(z[pz]),
+                        par,
+                        **previous,
+                    )
+
+                submitted = 0
+                try:
+                    while pending or in_flight:
+                        if (
+                            max_new_points is not None
+                            and submitted >= max_new_points
+                            and not in_flight
                         ):
                             break
-                        handle = executor.submit(run_task, context, make_task(idx))
-                        in_flight[handle] = idx
-                        pending.discard(idx)
-                        submitted += 1
-                    if not in_flight:
-                        break
-                    done, _ = executor.wait_first(in_flight)
-                    for handle in done:
-                        idx = in_flight.pop(handle)
-                        result = executor.result(handle)
-                        store.write(result)
-                        computed_calls.append(result.force_calls)
-                        if prog is not None:
-                            prog.update(ptask, completed=len(store))
-            except KeyboardInterrupt:
-                interrupted = True
+                        candidates = sorted((i for i in pending if ready(i)), key=rank.__getitem__)
+                        for idx in candidates:
+                            if len(in_flight) >= cap or (
+                                max_new_points is not None and submitted >= max_new_points
+                            ):
+                                break
+                            handle = executor.submit(run_task, context, make_task(idx))
+                            in_flight[handle] = idx
+                            pending.discard(idx)
+                            submitted += 1
+                        if not in_flight:
+                            break
+                        done, _ = executor.wait_first(in_flight)
+                        for handle in done:
+                            idx = in_flight.pop(handle)
+                            result = executor.result(handle)
+                            store.write(result)
+                            computed_calls.append(result.force_calls)
+                            if prog is not None:
+                                prog.update(ptask, completed=len(store))
+                except KeyboardInterrupt:
+                    interrupted = True
+                finally:
+                    if prog is not None:
+                        prog.stop()
             finally:
-                if prog is not None:
-                    prog.stop()
-        finally:
-            if own_executor:
-                executor.close(cancel=True)
-        ds = store.assemble()
-        path = store.write_ispes(out_dir / ISPES_NC)
-        result = ScanResult(
-            dataset=ds,
-            ispes_path=path,
-            store_path=store.path,
-            points_total=int(np.prod(shape)),
-            points_done=len(store),
-            points_computed=len(computed_calls),
-            seconds=time.perf_counter() - t0,
-            force_calls_computed=computed_calls,
-            adhesion=resolved.get("adhesion"),
-            notes=notes,
-            interrupted=interrupted,
-        )
+                if own_executor:
+                    executor.close(cancel=True)
+            ds = store.assemble()
+            path = store.write_ispes(out_dir / ISPES_NC)
+            result = ScanResult(
+                dataset=ds,
+                ispes_path=path,
+                store_path=store.path,
+                points_total=int(np.prod(shape)),
+                points_done=len(store),
+                points_computed=len(computed_calls),
+                seconds=time.perf_counter() - t0,
+                force_calls_computed=computed_calls,
+                adhesion=resolved.get("adhesion"),
+                notes=notes,
+                interrupted=interrupted,
+            )
+    except Exception:
+        # a run that failed before storing a point (executor not reachable, probe error)
+        # leaves no store behind that would refuse the corrected rerun
+        if fresh_store and (store is None or len(store) == 0):
+            discard_store(store_path, remove_parent=fresh_dir)
+        raise
+
     if interrupted:
         raise ScanInterrupted(result)
     return result

@@ -96,6 +96,23 @@ def settings_difference(stored: dict, current: dict) -> str | None:
     return None
 
 
+def discard_store(path: str | os.PathLike[str], remove_parent: bool = False) -> None:
+    """Remove the store ``path`` and its side files (SQLite journals, ``.driver`` lock).
+
+    Used when a scan fails before storing any point, so that a corrected rerun (other grid,
+    other executor) is not refused as "made with different settings". ``remove_parent``
+    also removes the directory if it is then empty (the failed run created it).
+    """
+    path = Path(path)
+    for suffix in ("", "-wal", "-shm", "-journal", ".driver"):
+        path.with_name(path.name + suffix).unlink(missing_ok=True)
+    if remove_parent:
+        try:
+            path.parent.rmdir()
+        except OSError:
+            pass
+
+
 class PointStore:
     """A ``points.db`` opened for one set of settings (the driver's single writer).
 
