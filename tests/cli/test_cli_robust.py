@@ -234,3 +234,24 @@ def test_failed_scan_leaves_no_store(tmp_path, monkeypatch, capsys, existing_dir
     code, _, err = _run([*argv, "--grid", "2", "1", "--executor", "serial", "--json"], capsys)
     assert code in (0, None), err
     assert (out / "ispes.nc").is_file()
+
+
+# ---- 8: a scan with no compressed thickness says so ---------------------------------------
+
+
+def test_scan_warns_without_repulsive_branch(tmp_path, capsys):
+    from flatcontact.ispes.toy import toy_interface
+    from flatcontact.structures.interface import thickness, write_interface
+
+    reference = toy_interface(layers=3)
+    iface = str(write_interface(reference, tmp_path / "interface.extxyz"))
+    z0 = thickness(reference)
+    argv = ["scan", "--interface", iface, "--calculator", "flatcontact.ispes.toy:toy_calculator"]
+    argv += ["--grid", "1", "1", "--executor", "serial", "--json"]
+    separated = [*argv, "--thickness", f"{z0 + 1.0:.4f},{z0 + 1.5:.4f}", "--out", "far"]
+    code, _, err = _run([*separated[:-1], str(tmp_path / "far")], capsys)
+    assert code in (0, None)
+    assert err.strip().startswith("warning: no scanned thickness reached p > 0")
+    compressed = [*argv, "--thickness", f"{z0 - 0.3:.4f},{z0:.4f}", "--out", str(tmp_path / "n")]
+    code, _, err = _run(compressed, capsys)
+    assert code in (0, None) and "warning" not in err

@@ -279,7 +279,28 @@ def scan_command(
             highlight=False,
         )
         raise typer.Exit(130) from None
+    _warn_no_repulsive_branch(result)
     _summary(result, as_json)
+
+
+def _warn_no_repulsive_branch(result) -> None:
+    """One warning line when no scanned thickness is under compression (p > 0 nowhere).
+
+    Such a grid holds only the separated (tensile) branch; the constant-pressure analysis at
+    P >= 0 needs thicknesses where the slabs push back (p = normal_stress > 0, compressive).
+    """
+    import numpy as np
+
+    from flatcontact.cli.app import print_warning
+
+    p = np.asarray(result.dataset.normal_stress.values, dtype=float)
+    if p.size and not np.any(p[np.isfinite(p)] > 0):
+        z = [float(v) for v in result.dataset.thickness.values]
+        print_warning(
+            f"no scanned thickness reached p > 0 (max {np.nanmax(p):.3g} GPa at z = "
+            f"{min(z):g}..{max(z):g} Å): the interface is separated everywhere and "
+            "'flatcontact analyze' has no repulsive branch; scan smaller thicknesses"
+        )
 
 
 def built_with_other_model(reference, cfg) -> str | None:
