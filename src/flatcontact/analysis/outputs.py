@@ -22,6 +22,7 @@ import xarray as xr
 
 from flatcontact import __version__, units
 from flatcontact.analysis.friction import EV_PER_A4_TO_GPA_PER_NM
+from flatcontact.analysis.noise import BARRIER_NOISE_FACTOR
 from flatcontact.analysis.pipeline import AnalysisResult
 from flatcontact.fileio import atomic_path, write_json_atomic, write_text_atomic
 
@@ -38,6 +39,8 @@ CSV_COLUMNS = (
     "period_angstrom",
     "periodic",
     "mep_barrier_mev_per_a2",
+    "energy_noise_mev_per_a2",
+    "force_noise_mpa",
 )
 
 
@@ -50,7 +53,8 @@ def _clean(v: object) -> object:
 def per_pressure_rows(result: AnalysisResult) -> list[dict]:
     """One dict per load with the CSV columns (floats; NaN as None)."""
     rows = []
-    for pa in result.pressures:
+    nz = result.noise
+    for i, pa in enumerate(result.pressures):
         fr, path = pa.friction, pa.path
         rows.append(
             {
@@ -68,6 +72,8 @@ def per_pressure_rows(result: AnalysisResult) -> list[dict]:
                 "mep_barrier_mev_per_a2": (
                     pa.mep.barrier * units.EV_PER_A2_TO_MEV_PER_A2 if pa.mep else float("nan")
                 ),
+                "energy_noise_mev_per_a2": float(nz.energy_noise_mev_per_a2[i]),
+                "force_noise_mpa": float(nz.force_noise_mpa[i]),
             }
         )
     return [{k: _clean(v) for k, v in row.items()} for row in rows]
@@ -78,6 +84,8 @@ def summary_json(result: AnalysisResult) -> dict:
     out = {
         "direction_deg": result.direction_deg,
         "energy_form": result.form,
+        "load_source": result.load_source,
+        "noise": result.noise.to_json(),
         "pressures": [
             {
                 k: row[k]
@@ -90,6 +98,8 @@ def summary_json(result: AnalysisResult) -> dict:
                     "tau_period_mpa",
                     "n_jumps",
                     "periodic",
+                    "energy_noise_mev_per_a2",
+                    "force_noise_mpa",
                 )
             }
             for row in per_pressure_rows(result)
@@ -175,6 +185,16 @@ def friction_dataset(result: AnalysisResult) -> xr.Dataset:
                 padded(lambda pa: pa.path.curvature * EV_PER_A4_TO_GPA_PER_NM),
                 {"units": "GPa/nm"},
             ),
+            "energy_noise_mev_per_a2": (
+                "p_gpa",
+                col("energy_noise_mev_per_a2"),
+                {"units": "meV/angstrom^2", "long_name": "energy noise from the load's error"},
+            ),
+            "force_noise_mpa": (
+                "p_gpa",
+                col("force_noise_mpa"),
+                {"units": "MPa", "long_name": "energy noise / lateral grid spacing"},
+            ),
             "energy_map": (("p_gpa", "shift_a", "shift_b"), maps, {"units": "meV/angstrom^2"}),
             "thickness_at_p": (
                 ("p_gpa", "shift_a", "shift_b"),
@@ -194,11 +214,21 @@ def friction_dataset(result: AnalysisResult) -> xr.Dataset:
             "direction_deg": result.direction_deg,
             "energy_form": result.form,
             "energy_zero": result.energy_zero,
+            "load_source": result.load_source,
+            "load_noise_delta_p_gpa": _attr(result.noise.delta_p_gpa),
+            "stress_energy_mismatch_rms_gpa": _attr(result.noise.stress_energy_mismatch_rms_gpa),
+            "lateral_grid_spacing_angstrom": result.noise.grid_spacing_angstrom,
+            "barrier_noise_factor": BARRIER_NOISE_FACTOR,
             "force_sign": "path_force = de/dt, the resisting lateral stress (positive while climbing)",
             "flatcontact_version": __version__,
         },
     )
     return ds
+
+
+def _attr(v: float) -> float:
+    """netCDF attributes cannot be None: NaN stands for 'not estimated'."""
+    return float(v)
 
 
 def write_outputs(result: AnalysisResult, out_dir: str | os.PathLike[str]) -> dict[str, Path]:

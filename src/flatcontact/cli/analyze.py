@@ -71,6 +71,14 @@ def analyze_command(
         str,
         typer.Option("--energy", help="'internal' (paper: U at z*(P)) or 'enthalpy' (U + P·A·z*)."),
     ] = "internal",
+    load_source: Annotated[
+        str,
+        typer.Option(
+            "--load-source",
+            help="Where P comes from: 'energy' (-(1/A) dU/dz of the spline of U(z); default) "
+            "or 'stress' (the stored normal_stress).",
+        ),
+    ] = "energy",
     energy_zero: Annotated[
         str,
         typer.Option(
@@ -113,6 +121,7 @@ def analyze_command(
             pressures,
             direction_deg=direction_deg,
             form=energy,
+            load_source=load_source,
             energy_zero=energy_zero,
             allow_missing=allow_missing,
             threshold_gpa=threshold_gpa,
@@ -138,8 +147,18 @@ def analyze_command(
         return
     from rich.table import Table
 
-    table = Table(title=f"{path.name}: {energy} energy, pulling at {direction_deg:g}°")
-    for col in ("P (GPa)", "τ (MPa)", "σ_MSS (MPa)", "G_int (GPa/nm)", "τ limited by", "jumps"):
+    table = Table(
+        title=f"{path.name}: {energy} energy, {load_source} load, pulling at {direction_deg:g}°"
+    )
+    for col in (
+        "P (GPa)",
+        "τ (MPa)",
+        "σ_MSS (MPa)",
+        "G_int (GPa/nm)",
+        "τ limited by",
+        "jumps",
+        "noise (MPa)",
+    ):
         table.add_column(col, justify="right")
     for row in per_pressure_rows(result):
         table.add_row(
@@ -149,6 +168,7 @@ def analyze_command(
             _fmt(row["shear_stiffness_gpa_per_nm"]),
             str(row["tau_limited_by"]),
             str(row["n_jumps"]),
+            _fmt(row["force_noise_mpa"]),
         )
     console.print(table)
     laws = result.laws.to_json()
