@@ -156,9 +156,9 @@ def merge_shallow_minima(
     minimum (energy ``start_energy``). The dip of a minimum is the smaller of the
     drop from the maximum before it and the climb to the maximum after it (the
     climb alone for a last minimum without a following maximum). The shallowest
-    dip is removed first, repeatedly (persistence simplification), so the
-    remaining minima and maxima alternate and every kept barrier exceeds
-    ``min_barrier``. ``min_barrier <= 0`` returns the events unchanged.
+    dip is removed first, repeatedly (persistence simplification): between two
+    maxima it goes with the lower of them, so minima and maxima keep alternating;
+    a minimum at the end of the list goes alone. ``min_barrier <= 0`` returns the events unchanged.
     """
     if not min_barrier > 0:
         return list(events)
@@ -177,8 +177,9 @@ def merge_shallow_minima(
                 best, best_dip = i, dip
         if best is None:
             return seq[1:]
-        lower = [j for j in (best - 1, best + 1) if j < len(seq) and seq[j][0] == "max"]
-        drop = min(lower, key=lambda j: seq[j][2]) if len(lower) == 2 else lower[0]
+        both = [j for j in (best - 1, best + 1) if j < len(seq) and seq[j][0] == "max"]
+        # between two maxima: merge them, keeping the higher; at an end: drop the minimum only
+        drop = min(both, key=lambda j: seq[j][2]) if len(both) == 2 else best
         seq = [ev for j, ev in enumerate(seq) if j not in (best, drop)]
 
 
