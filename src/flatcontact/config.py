@@ -246,6 +246,12 @@ class AnalysisConfig(_Section):
     energy_form: Literal["internal", "enthalpy"] = Field(
         "internal", description="internal: U at z*(P) (the paper's); enthalpy: U + P·A·z*"
     )
+    load_source: Literal["energy", "stress"] = Field(
+        "energy",
+        description="normal load from -(1/A) dU/dz of each column's energy spline (energy: "
+        "consistent with U to second order in the relaxation residuals) or the stored "
+        "normal_stress (stress: first order)",
+    )
     energy_zero: Literal["lowest-p", "each", "none"] = Field(
         "lowest-p",
         description="energy zero of the maps: global minimum at the lowest P, each, none",

@@ -545,6 +545,7 @@ class Pipeline:
                     s.p_gpa,
                     direction_deg=s.direction_deg,
                     form=s.energy_form,
+                    load_source=s.load_source,
                     energy_zero=s.energy_zero,
                     allow_missing=s.allow_missing,
                     threshold_gpa=s.threshold_gpa,
@@ -579,6 +580,8 @@ class Pipeline:
                     "fig2": figures,
                     "symmetry": sym,
                     "energy_reference_ev_per_a2": result.energy_reference_ev_per_a2,
+                    "load_source": result.load_source,
+                    "noise": result.noise.to_json(),
                 },
             )
 

@@ -33,7 +33,11 @@ def test_stress_noise_leaves_the_energy_source_unchanged_and_moves_the_stress_so
     clean = MODEL.grid(12, 12, Z)
     noisy = MODEL.grid(12, 12, Z, stress_noise_gpa=SIGMA_GPA, seed=3)
     e_clean = constant_pressure(clean, P_GPA, load_source="energy")
-    e_noisy = constant_pressure(noisy, P_GPA, load_source="energy")
+    # the energy source reads the stored stress only at the end nodes (spline end slopes)
+    inner_noise = noisy.copy(deep=True)
+    ends = {"thickness": [0, -1]}
+    inner_noise["normal_stress"][ends] = clean["normal_stress"][ends]
+    e_noisy = constant_pressure(inner_noise, P_GPA, load_source="energy")
     np.testing.assert_array_equal(e_noisy.energy_ev_per_a2, e_clean.energy_ev_per_a2)
     exact = _exact(e_clean)
     err_energy = _rms_lateral(e_clean.energy_ev_per_a2 - exact)
@@ -57,7 +61,10 @@ def test_noise_estimate_recovers_the_injected_stress_noise():
             MODEL.grid(12, 12, Z, stress_noise_gpa=sigma, seed=5), P_GPA, load_source="energy"
         )
         assert e.noise.delta_p_gpa < 0.1 * sigma
-        assert e.noise.stress_energy_mismatch_rms_gpa == pytest.approx(res.noise.delta_p_gpa)
+        # same mismatch up to the spline used for dU/dz (clamped ends for the energy source)
+        assert e.noise.stress_energy_mismatch_rms_gpa == pytest.approx(
+            res.noise.delta_p_gpa, rel=0.05
+        )
 
 
 def test_enthalpy_noise_is_second_order():
@@ -126,3 +133,20 @@ def test_lateral_grid_too_small_is_named():
     ds = MODEL.grid(1, 6, Z)
     with pytest.raises(InputError, match=r"lateral grid is 1×6.*at least 3 points per axis"):
         analyze_ispes(ds, [1.0])
+
+
+def test_energy_source_is_accurate_at_a_widely_spaced_end_node():
+    """A coarse scan: dense thicknesses under load, one far node at low load (as the automatic
+    thickness choice makes). The energy source takes its end slopes from the stored stress,
+    so the branch reaches the stored p there and Ũ(P) near that end stays accurate."""
+    z = np.array([24.20, 24.30, 24.42, 24.56, 24.75, 25.30])
+    grid = MODEL.grid(6, 6, z)
+    p_end_gpa = float(grid.normal_stress.isel(thickness=-1).max())
+    p_read = np.array([p_end_gpa + 0.05, 1.0])
+    res = constant_pressure(grid, p_read, load_source="energy")
+    assert res.common_p_range_gpa[0] == pytest.approx(p_end_gpa, abs=1e-9)
+    s = np.stack(np.meshgrid(res.shift_a, res.shift_b, indexing="ij"), -1)
+    for i, p in enumerate(p_read / units.EV_PER_A3_TO_GPA):
+        err = _rms_lateral(res.energy_ev_per_a2[i : i + 1] - MODEL.landscape(s, p)[None])
+        corrugation = np.ptp(MODEL.landscape(s, p))
+        assert err[0] < 0.02 * corrugation

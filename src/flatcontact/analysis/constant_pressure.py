@@ -93,7 +93,8 @@ def invert_columns(
         Names of the columns for error messages.
     load_source
         ``"energy"``: the load is ``p(z) = -(1/A) dU/dz`` of the cubic spline of
-        ``U(z)``; ``"stress"``: the stored ``normal_stress``, splined. Either way
+        ``U(z)``, clamped at the first and last thickness by the stored stress (the only
+        place the stored stress enters); ``"stress"``: the stored ``normal_stress``, splined. Either way
         the repulsive branch runs up to the node of lowest ``p``.
 
     Raises
@@ -116,7 +117,13 @@ def invert_columns(
         )
     if not np.all(np.diff(z) > 0):
         raise InputError("thickness: values must be strictly increasing")
-    spline_e = CubicSpline(z, e.T, axis=0)
+    if load_source == "energy":
+        # clamped at the two end nodes by the stored stress (dU/dz = -A p): the energies
+        # alone cannot fix a spline's end slopes, and not-a-knot ends put p wrong by tenths
+        # of a GPa at a widely spaced last node (the maximum tension of a coarse scan)
+        spline_e = CubicSpline(z, e.T, axis=0, bc_type=((1, -p[:, 0]), (1, -p[:, -1])))
+    else:
+        spline_e = CubicSpline(z, e.T, axis=0)
     dedz = spline_e(z, 1).T  # (n_col, n_z)
     if load_source == "energy":
         inv = _invert_energy(z, spline_e, targets, labels)
