@@ -17,7 +17,7 @@ from typing import Annotated
 
 import typer
 
-from flatcontact.cli.app import app, console, err_console
+from flatcontact.cli.app import app, check_out_dir, console, err_console
 from flatcontact.errors import InputError
 
 
@@ -113,6 +113,8 @@ def analyze_command(
     from flatcontact.ispes.contract import open_ispes
 
     path, pressures = _split_arguments(items, p_gpa)
+    if out is not None:
+        check_out_dir(out)
     ds = open_ispes(path)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", AnalysisWarning)
