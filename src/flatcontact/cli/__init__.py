@@ -1,37 +1,82 @@
 """The ``flatcontact`` command line.
 
-``main`` runs the typer app and turns user mistakes (:class:`~flatcontact.errors.InputError`)
-into a single ``error: ...`` line on stderr with exit status 2, the same status
-click uses for usage errors. Tests call ``main([...])`` and catch ``SystemExit``.
+``main`` runs the typer app and turns every user mistake into a single ``error: ...`` line
+on stderr with exit status 2 (the status click uses for usage errors), never a traceback
+or a boxed multi-line message:
+
+- :class:`~flatcontact.errors.InputError` raised by a command (bad values, files, configs);
+- click's own usage errors (``--layers abc``, a missing argument, an unknown option),
+  printed as click's one-line message followed by where to find help.
+
+Tests call ``main([...])`` and catch ``SystemExit`` (0 on success, as in click's
+standalone mode).
 """
 
 from __future__ import annotations
 
 import sys
+from typing import Annotated
+
+import typer
 
 from flatcontact import __version__
 from flatcontact.cli import commands as _commands  # noqa: F401  (registers the sub-commands)
 from flatcontact.cli.app import app, console, print_error
 from flatcontact.errors import InputError
 
-__all__ = ["app", "main"]
+__all__ = ["app", "main", "usage_error_line"]
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        console.print(__version__, highlight=False)
+        raise typer.Exit()
 
 
 @app.callback()
-def _root() -> None:
+def _root(
+    version: Annotated[
+        bool,
+        typer.Option(
+            "--version",
+            help="Print the flatcontact version and exit.",
+            is_eager=True,
+            callback=_print_version,
+        ),
+    ] = False,
+) -> None:
     """Onset of sliding of a Hertzian asperity with an atomically flat crystalline contact."""
 
 
 @app.command("version")
 def version_command() -> None:
     """Print the flatcontact version."""
-    console.print(__version__)
+    console.print(__version__, highlight=False)
+
+
+def usage_error_line(exc: Exception) -> str:
+    """One line for a typer/click usage error: its message (whitespace collapsed) and where the help is."""
+    format_message = getattr(exc, "format_message", None)
+    message = " ".join((format_message() if callable(format_message) else str(exc)).split())
+    ctx = getattr(exc, "ctx", None)
+    if ctx is not None:
+        message += f" (see '{ctx.command_path} --help')"
+    return message
 
 
 def main(argv: list[str] | None = None) -> None:
     """Entry point of the ``flatcontact`` console script."""
     try:
-        app(args=argv)
+        rv = app(args=argv, standalone_mode=False, prog_name="flatcontact")
     except InputError as exc:
         print_error(exc)
         sys.exit(2)
+    except typer.TyperException as exc:  # typer's (vendored click's) usage errors
+        code = getattr(exc, "exit_code", 2)
+        if type(exc).__name__ != "NoArgsIsHelpError":  # that one has printed the help already
+            print_error(usage_error_line(exc))
+        sys.exit(code)
+    except typer.Abort:
+        print_error("aborted")
+        sys.exit(1)
+    sys.exit(rv if isinstance(rv, int) else 0)

@@ -17,22 +17,18 @@ from typing import Annotated
 
 import typer
 
-from flatcontact.cli.app import app, check_out_dir, console, err_console
+from flatcontact.cli.app import app, check_out_dir, console, err_console, split_list
 from flatcontact.errors import InputError
 
 
 def _split_arguments(items: list[str], p_values: list[str] | None) -> tuple[Path, list[float]]:
     """The ISPES path and the pressures from the positional items and ``--p-gpa`` values."""
     files, numbers = [], []
-    for token in list(p_values or []) + list(items):
-        for part in token.split(","):
-            part = part.strip()
-            if not part:
-                continue
-            try:
-                numbers.append(float(part))
-            except ValueError:
-                files.append(part)
+    for part in split_list(list(p_values or []) + list(items), "--p-gpa", whitespace=False):
+        try:
+            numbers.append(float(part))
+        except ValueError:
+            files.append(part)
     if len(files) != 1:
         raise InputError(
             f"analyze: expected one ISPES file and numeric --p-gpa values, got {files or 'no file'}"

@@ -89,3 +89,46 @@ def check_out_dir(path: str | Path, flag: str = "--out") -> Path:
             except OSError:
                 pass
     return out
+
+
+def split_list(values: list[str] | None, flag: str, *, whitespace: bool = True) -> list[str]:
+    """The items of a list flag: repeated flags, comma- and/or whitespace-separated tokens.
+
+    ``--p0-gpa 1,2 --p0-gpa 3`` and ``--p0-gpa '1 2 3'`` both give ``['1', '2', '3']``;
+    with ``whitespace=False`` only commas separate (items are stripped), for lists that
+    may hold paths with spaces.
+    An empty item (``1,,2``, ``1,``, ``,1``, an empty string) is refused: it is a typo, not a
+    value, and silently dropping it would run something the user did not ask for.
+
+    Raises
+    ------
+    InputError
+        One line naming ``flag`` and the token with the empty item.
+    """
+    from flatcontact.errors import InputError
+
+    items: list[str] = []
+    for token in values or []:
+        parts = token.split(",")
+        if any(not part.strip() for part in parts):
+            raise InputError(
+                f"{flag} {token!r}: empty item in the comma-separated list "
+                "(expected values separated by single commas, e.g. 0.5,1,2)"
+            )
+        for part in parts:
+            items.extend(part.split() if whitespace else [part.strip()])
+    return items
+
+
+def parse_floats(values: list[str] | None, flag: str, unit: str = "") -> list[float]:
+    """The numbers of a list flag (see :func:`split_list`); a non-number is one line naming ``flag``."""
+    from flatcontact.errors import InputError
+
+    out = []
+    for item in split_list(values, flag):
+        try:
+            out.append(float(item))
+        except ValueError:
+            what = f"a number{f' in {unit}' if unit else ''}"
+            raise InputError(f"{flag}: {item!r} is not {what}") from None
+    return out

@@ -13,7 +13,7 @@ from typing import Annotated
 
 import typer
 
-from flatcontact.cli.app import app, check_out_dir, console
+from flatcontact.cli.app import app, check_out_dir, console, parse_floats
 from flatcontact.errors import InputError, require
 
 _DEFAULT_HELP = "(default: the paper's value)"
@@ -24,16 +24,7 @@ def _parse_p0(values: list[str] | None) -> list[float]:
 
     if not values:
         return list(DEFAULT_P0_GPA)
-    out = []
-    for v in values:
-        for item in v.split(","):
-            item = item.strip()
-            if not item:
-                continue
-            try:
-                out.append(float(item))
-            except ValueError:
-                raise InputError(f"--p0-gpa: {item!r} is not a number") from None
+    out = parse_floats(values, "--p0-gpa", "GPa")
     return check_p0_gpa(out, "--p0-gpa")
 
 

@@ -14,7 +14,7 @@ from typing import Annotated, Any
 
 import typer
 
-from flatcontact.cli.app import app, check_out_dir, console, err_console
+from flatcontact.cli.app import app, check_out_dir, console, err_console, parse_floats
 from flatcontact.errors import InputError
 
 #: Config field (dotted path) -> the flag that sets it, to name the flag in errors.
@@ -39,16 +39,8 @@ DEFAULT_INTERFACE = "build/interface.extxyz"
 
 
 def _floats(values: list[str] | None, flag: str) -> list[float] | None:
-    if not values:
-        return None
-    out = []
-    for v in values:
-        for item in v.replace(",", " ").split():
-            try:
-                out.append(float(item))
-            except ValueError:
-                raise InputError(f"{flag}: {item!r} is not a number") from None
-    return out
+    """The numbers of a list flag, ``None`` when it is not given (empty items refused)."""
+    return parse_floats(values, flag, "Å") if values else None
 
 
 def _potential_section(potential: str) -> dict[str, Any]:
