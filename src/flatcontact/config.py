@@ -44,6 +44,7 @@ from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.order import PREFERENCES
 from flatcontact.ispes.relax import OPTIMIZERS, RelaxSettings
 from flatcontact.potentials.spec import BUNDLED_DIR, PotentialSpec
+from flatcontact.structures.build import MIN_LAYERS
 
 #: The bundled SNAP the default run uses when it is present.
 BUNDLED_SNAP = "sio2-snap"
@@ -95,7 +96,9 @@ class StructureConfig(_Section):
         "needs calculator.target flatcontact.ispes.toy:toy_calculator)",
     )
     layers: int = Field(
-        6, description="O-Si-O layers per slab (quartz-dense; >= 5) or atomic layers (toy-lj; >= 3)"
+        6,
+        description=f"O-Si-O layers per slab (quartz-dense; >= {MIN_LAYERS}) "
+        "or atomic layers (toy-lj; >= 3)",
     )
     source: Literal["auto", "shipped", "seed"] = Field(
         "auto",
@@ -117,8 +120,12 @@ class StructureConfig(_Section):
     def _consistent(self) -> StructureConfig:
         if self.kind == "file" and not self.file:
             raise ValueError("kind 'file' needs 'file: path/to/interface.extxyz'")
-        if self.kind == "quartz-dense" and self.layers < 5:
-            raise ValueError(f"layers={self.layers}: the dense quartz interface needs >= 5")
+        if self.kind == "quartz-dense" and self.layers < MIN_LAYERS:
+            raise ValueError(
+                f"layers={self.layers}: the dense quartz interface needs >= {MIN_LAYERS} "
+                "(a fixed outer and a sliding inner face layer of 2 units each, and at least "
+                "one inner layer between them)"
+            )
         if self.kind == "toy-lj" and self.layers < 3:
             raise ValueError(f"layers={self.layers}: the toy interface needs >= 3")
         return self

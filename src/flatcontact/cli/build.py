@@ -1,4 +1,8 @@
-"""``flatcontact build``: the relaxed, verified two-slab interface (interface.extxyz, picture, report)."""
+"""``flatcontact build``: the relaxed, verified two-slab interface.
+
+Writes the same files, under the same names, as the build stage of ``flatcontact run``
+(``01-build/``): ``interface.extxyz``, ``build.json`` and ``fig1_interface.png`` (+ ``.svg``).
+"""
 
 from __future__ import annotations
 
@@ -8,6 +12,10 @@ import typer
 
 from flatcontact.cli.app import app, check_out_dir, console, print_warning
 from flatcontact.errors import InputError
+
+#: File names shared with the build stage of ``flatcontact run`` (``01-build/``).
+BUILD_REPORT = "build.json"
+BUILD_FIGURE_STEM = "fig1_interface"
 
 
 def _positive_finite(value: float, flag: str, unit: str) -> float:
@@ -64,7 +72,11 @@ def _warn_unconverged(report: dict, fmax_ev_per_angstrom: float) -> None:
 @app.command("build")
 def build(
     layers: int = typer.Option(
-        6, "--layers", help="O–Si–O layers per α-quartz (0001) slab (>= 4)."
+        6,
+        "--layers",
+        help="O–Si–O layers per α-quartz (0001) slab, >= 5: a fixed outer and a sliding "
+        "inner dense face layer of 2 units each and at least one inner layer between them "
+        "(the scan relaxes 'surfaces 2, 3 and the inner atomic layers').",
     ),
     potential: str = typer.Option(
         None,
@@ -98,20 +110,27 @@ def build(
     face_depth_angstrom: float = typer.Option(
         2.0, "--face-depth-angstrom", help="With --structure: depth of each tagged face (Å)."
     ),
+    svg: bool = typer.Option(True, "--svg/--no-svg", help="Also write fig1_interface.svg."),
     regenerate_dense: bool = typer.Option(
         False,
         "--regenerate-dense",
         help="Regenerate the shipped dense slab with CHGNet r2SCAN and exit.",
     ),
 ) -> None:
-    """Build the interface: writes interface.extxyz, interface.png and build_report.json to --out."""
+    """Build the interface: writes interface.extxyz, build.json and fig1_interface.png to --out.
+
+    The same files as the build stage of 'flatcontact run' (its 01-build/ folder).
+    """
     import json
 
     from flatcontact.fileio import write_json_atomic
-    from flatcontact.plots.structures import plot_interface
+    from flatcontact.pipeline import figure_interface
+    from flatcontact.plots import save_figure
     from flatcontact.structures import build as builder
     from flatcontact.structures.interface import write_interface
 
+    if structure is None:
+        builder.check_layers(layers, "--layers")
     _positive_finite(fmax_ev_per_angstrom, "--fmax-ev-per-angstrom", "eV/Å")
     _positive_finite(gap_angstrom, "--gap-angstrom", "Å")
     if structure is not None:
@@ -146,7 +165,6 @@ def build(
             fmax_ev_per_angstrom=fmax_ev_per_angstrom,
             source=str(structure),
         )
-        title = f"{structure.name}, {spec.label}"
     else:
         interface, report = builder.build_quartz_interface(
             spec,
@@ -155,13 +173,16 @@ def build(
             gap_angstrom=gap_angstrom,
             fmax_ev_per_angstrom=fmax_ev_per_angstrom,
         )
-        title = f"α-quartz (0001) dense, {layers} layers, {spec.label}"
     _warn_unconverged(report, fmax_ev_per_angstrom)
     out.mkdir(parents=True, exist_ok=True)
     write_interface(interface, out / "interface.extxyz")
-    plot_interface(interface, out / "interface.png", title=title)
-    write_json_atomic(out / "build_report.json", json.loads(json.dumps(report, default=float)))
+    write_json_atomic(out / BUILD_REPORT, json.loads(json.dumps(report, default=float)))
+    figures = save_figure(
+        figure_interface(interface), out / BUILD_FIGURE_STEM, ("png", "svg") if svg else ("png",)
+    )
     console.print(
-        f"wrote {out / 'interface.extxyz'} ({len(interface)} atoms, thickness {report['thickness_angstrom']:.3f} Å), "
-        f"{out / 'interface.png'}, {out / 'build_report.json'}"
+        f"wrote {out / 'interface.extxyz'} ({len(interface)} atoms, thickness "
+        f"{report['thickness_angstrom']:.3f} Å), {out / BUILD_REPORT}, "
+        + ", ".join(str(f) for f in figures),
+        highlight=False,
     )

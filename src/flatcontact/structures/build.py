@@ -46,7 +46,25 @@ SYMMETRIC_CUT = 2
 DATA_DIR = Path(__file__).resolve().parent / "data"
 SHIPPED_DENSE_SLAB = DATA_DIR / "quartz_0001_dense_6L.extxyz"
 DEFAULT_GAP_ANGSTROM = 3.0
+#: Fewest O–Si–O layers per slab of the dense quartz interface. Each slab has two tagged face
+#: layers of ``DENSE_FACE_LAYERS`` units each: the outer one (surface 1 or 4) is held fixed
+#: during a scan, the inner one (surface 2 or 3) is the sliding surface; the paper fully relaxes
+#: "surfaces 2, 3 and the inner atomic layers", so at least one bulk-like unit must lie between
+#: the two face layers (with 4 units the fixed face would bond directly to the sliding face and
+#: there would be no inner layer to relax). Used by ``flatcontact build`` and the run config.
+MIN_LAYERS = 2 * DENSE_FACE_LAYERS + 1
 DEFAULT_FMAX_EV_PER_ANGSTROM = 0.01
+
+
+def check_layers(layers: object, name: str = "layers") -> int:
+    """``layers`` if it is an integer >= :data:`MIN_LAYERS`, else a one-line :class:`InputError`."""
+    require(
+        isinstance(layers, int) and not isinstance(layers, bool) and layers >= MIN_LAYERS,
+        f"{name}={layers!r}: expected an integer >= {MIN_LAYERS} O-Si-O layers per slab "
+        f"(a fixed outer and a sliding inner face layer of {DENSE_FACE_LAYERS} units each, "
+        "and at least one inner layer between them)",
+    )
+    return layers  # type: ignore[return-value]
 
 
 def _version(name: str) -> str | None:
@@ -128,6 +146,7 @@ def regenerate_shipped_dense_slab(layers: int = 6, fmax_ev_per_angstrom: float =
     from flatcontact.potentials import PotentialSpec
     from flatcontact.potentials.factories import chgnet_r2scan
 
+    check_layers(layers)
     vashishta = PotentialSpec(intra="vashishta")
     base = quartz_0001_slab(layers=layers, cut=SYMMETRIC_CUT)
     calc = chgnet_r2scan()
@@ -205,7 +224,8 @@ def build_quartz_interface(
     spec
         :class:`~flatcontact.potentials.PotentialSpec` used to relax slab and interface.
     layers
-        O–Si–O layers per slab (≥ 4: two dense face layers need two units each).
+        O–Si–O layers per slab, at least :data:`MIN_LAYERS` (5): two face layers of two
+        units each (outer one fixed in a scan, inner one sliding) and at least one inner unit.
     source
         ``"shipped"`` (the CHGNet-relaxed 6-layer slab), ``"seed"`` (seeded reconstruction
         relaxed directly with ``spec``) or ``"auto"`` (shipped when ``layers == 6``, else seed).
@@ -214,10 +234,7 @@ def build_quartz_interface(
     """
     from flatcontact.potentials import make_calculator
 
-    require(
-        isinstance(layers, int) and layers >= 2 * DENSE_FACE_LAYERS,
-        f"layers={layers}: expected an integer >= {2 * DENSE_FACE_LAYERS} (two dense face layers of 2 units each)",
-    )
+    check_layers(layers)
     require(
         source in ("auto", "shipped", "seed"), f"source='{source}': expected auto, shipped or seed"
     )
