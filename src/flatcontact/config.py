@@ -308,11 +308,15 @@ class ContactConfig(_Section):
         description="effective shear modulus G* (GPa) in the paper's q0 = G*·u/(π a) (= 4 × Johnson's G*_J)",
     )
     k_mpa_per_gpa: float | None = Field(
-        None, ge=0, description="override k of τ = k·P + τ0 (MPa/GPa); null: the fitted law"
+        None,
+        description="override k of τ = k·P + τ0 (MPa/GPa; may be < 0, then p0 < τ0/|k|); "
+        "null: the fitted law",
     )
     tau0_mpa: float | None = Field(None, ge=0, description="override τ0 (MPa); null: fitted")
     mu_mpa_per_gpa: float | None = Field(
-        None, ge=0, description="override μ of σ = μ·P + σ0 (MPa/GPa); null: fitted"
+        None,
+        description="override μ of σ = μ·P + σ0 (MPa/GPa; may be < 0, then p0 <= σ0/|μ|); "
+        "null: fitted",
     )
     sigma0_mpa: float | None = Field(None, ge=0, description="override σ0 (MPa); null: fitted")
     work_of_adhesion_j_m2: float | None = Field(

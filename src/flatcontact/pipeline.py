@@ -681,37 +681,19 @@ class Pipeline:
         laws = json.loads((self._upstream("laws").folder / "laws.json").read_text())
         provenance = {}
         values = {}
-        for key, err_key in (
-            ("k_mpa_per_gpa", "k_stderr_mpa_per_gpa"),
-            ("tau0_mpa", "tau0_stderr_mpa"),
-            ("mu_mpa_per_gpa", "mu_stderr_mpa_per_gpa"),
-            ("sigma0_mpa", "sigma0_stderr_mpa"),
-        ):
+        for key in ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa"):
             given = getattr(c, key)
             if given is not None:
                 values[key], provenance[key] = given, "config"
                 continue
-            fitted, err = laws.get(key), laws.get(err_key)
+            fitted = laws.get(key)
             if fitted is None:
                 why = "; ".join(laws.get("warnings", [])) or "too few loads"
                 raise InputError(
                     f"contact.{key}: the load law could not be fitted ({why}); give contact.{key}"
                 )
-            if fitted < 0 and err is not None and abs(fitted) <= 2 * err:
-                # statistically zero; ContactParameters takes coefficients >= 0
-                values[key] = 0.0
-                provenance[key] = (
-                    f"fitted {fitted:.3g} ± {err:.2g}, consistent with 0 within 2 standard "
-                    "errors; 0 used (the contact model takes coefficients >= 0)"
-                )
-                log.warning("contact: %s %s", key, provenance[key])
-                continue
-            if fitted < 0:
-                raise InputError(
-                    f"contact.{key}: the fitted value {fitted:.4g} ± {err if err is not None else float('nan'):.2g} "
-                    f"is significantly negative, which the contact model does not accept; check the "
-                    f"scan/analysis or give contact.{key}"
-                )
+            # negative slopes pass through: the model takes k < 0, μ < 0 wherever τ > 0
+            # and σ >= 0 on the contact, and refuses the p0 where they are not
             values[key], provenance[key] = fitted, "fitted laws"
         w = c.work_of_adhesion_j_m2
         provenance["work_of_adhesion_j_m2"] = "config"
@@ -729,13 +711,17 @@ class Pipeline:
         if moduli is not None:
             e_star, g_star = moduli["contact_modulus_gpa"], moduli["shear_modulus_gpa"]
             provenance["moduli"] = "elastic stage"
-        params = ContactParameters(
-            radius_um=c.radius_um,
-            contact_modulus_gpa=e_star,
-            shear_modulus_gpa=g_star,
-            work_of_adhesion_j_m2=float(w),
-            **values,
-        )
+        try:
+            params = ContactParameters(
+                radius_um=c.radius_um,
+                contact_modulus_gpa=e_star,
+                shear_modulus_gpa=g_star,
+                work_of_adhesion_j_m2=float(w),
+                **values,
+            )
+        except InputError as exc:  # e.g. a fitted τ0 < 0, or k < 0 with τ0 = 0
+            sources = ", ".join(f"{k} from {provenance[k]}" for k in values)
+            raise InputError(f"contact: {exc} ({sources})") from None
         return params, provenance
 
     def contact(self):
@@ -754,6 +740,12 @@ class Pipeline:
         laws = self._upstream("laws")
         scan = self._upstream("scan")
         elastic = self._upstream("elastic") if cfg.elastic.enabled else None
+        # before any work: with k < 0 or μ < 0 the model is defined only where τ > 0 and
+        # σ >= 0 on the whole contact (p0 < τ0/|k|, p0 <= σ0/|μ|)
+        params, _ = self.contact_parameters()
+        params.check_p0_gpa(cfg.contact.p0_gpa, "contact.p0_gpa")
+        if cfg.contact.experiment_csv:
+            params.check_p0_gpa(cfg.contact.experiment_p0_gpa, "contact.experiment_p0_gpa")
         inputs = {
             "contact": cfg.section("contact"),
             "laws": laws.fingerprint,
@@ -774,7 +766,9 @@ class Pipeline:
 
             c = cfg.contact
             params, provenance = self.contact_parameters()
-            analysis = analyse(c.p0_gpa, params, knee_fraction=c.knee_fraction)
+            analysis = analyse(
+                c.p0_gpa, params, knee_fraction=c.knee_fraction, p0_name="contact.p0_gpa"
+            )
             paper = analyse(
                 c.p0_gpa,
                 params.replace(

@@ -134,7 +134,8 @@ def test_contact_uses_the_fitted_laws(tiny_run):
     summary = json.loads((root / "06-contact" / "summary.json").read_text())
     laws = json.loads((root / "04-laws" / "laws.json").read_text())
     params, prov = summary["parameters"], summary["provenance"]
-    for key in ("k_mpa_per_gpa", "tau0_mpa", "sigma0_mpa"):
+    # every fitted coefficient is used as fitted, a negative slope included
+    for key in ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa"):
         assert prov[key] == "fitted laws"
         assert params[key] == pytest.approx(laws[key])
     scan = json.loads((root / "02-scan" / "scan.json").read_text())
@@ -145,11 +146,17 @@ def test_contact_uses_the_fitted_laws(tiny_run):
         assert list(ds["p0"].values) == TINY["contact"]["p0_gpa"]
         q = ds["lateral_force"].values
         assert np.all(np.isfinite(q)) and np.all(q >= 0)
+    k, tau0 = params["k_mpa_per_gpa"], params["tau0_mpa"]
+    mu, sigma0 = params["mu_mpa_per_gpa"], params["sigma0_mpa"]
     for rec in summary["results"]:
-        # Q_peak/πa² lies between the slip friction at the edge and τ at the centre
+        # Q_sat/πa² is the mean slip friction σ0 + (2/3)μ p0; Q_peak >= Q_sat, and Q_peak/πa²
+        # (a mean traction: < τ where stuck, σ where slipping) is below the largest local
+        # τ or σ, at the centre or the edge (either sign of k and μ)
         p0 = rec["p0_gpa"]
-        tau_centre = params["k_mpa_per_gpa"] * p0 + params["tau0_mpa"]
-        assert params["sigma0_mpa"] < rec["effective_shear_strength_mpa"] < tau_centre
+        eff = rec["effective_shear_strength_mpa"]
+        assert rec["gross_sliding_stress_mpa"] == pytest.approx(sigma0 + 2 / 3 * mu * p0)
+        assert rec["gross_sliding_stress_mpa"] <= eff * (1 + 1e-12)
+        assert eff < max(k * p0 + tau0, tau0, mu * p0 + sigma0, sigma0)
 
 
 def test_report_is_self_contained_and_compares_with_the_paper(tiny_run):
@@ -396,3 +403,33 @@ def test_measured_stiffness_reruns_contact_and_report_and_recovers_tau0(tiny_run
         "Fig. 6: measured stiffness (measured.csv)"
         in (root / "07-report" / "report.html").read_text()
     )
+
+
+def test_negative_slope_runs_and_a_p0_beyond_its_limit_is_refused(tiny_run, tmp_path):
+    """k < 0 (a shear strength falling with load) is taken as given; a p0 at which
+    τ(centre) = k·p0 + τ0 <= 0 is refused in one line naming contact.p0_gpa and the
+    limit τ0/|k|, before the contact stage runs (its previous output is kept)."""
+    import shutil
+
+    src, _, _ = tiny_run
+    root = tmp_path / "copy"
+    shutil.copytree(src, root)
+    tau0 = json.loads((root / "04-laws" / "laws.json").read_text())["tau0_mpa"]
+    k = -tau0 / 1.5  # τ(centre) > 0 below 1.5 GPa; the centre slips first above 0.75 GPa
+    good = _merge(TINY, {"contact": {"k_mpa_per_gpa": k, "p0_gpa": [0.5, 1.0]}})
+    with Pipeline(build_config(good), root) as pipe:
+        pipe.run()
+    summary = json.loads((root / "06-contact" / "summary.json").read_text())
+    assert summary["parameters"]["k_mpa_per_gpa"] == pytest.approx(k)
+    assert summary["provenance"]["k_mpa_per_gpa"] == "config"
+    for rec in summary["results"]:
+        assert rec["uniform_shear_strength_mpa"] == pytest.approx(k * 2 / 3 * rec["p0_gpa"] + tau0)
+        assert 0 < rec["peak_lateral_force_un"] and np.isfinite(rec["knee_stress_amplitude_mpa"])
+    before = (root / "06-contact" / "summary.json").read_text()
+    bad = _merge(TINY, {"contact": {"k_mpa_per_gpa": k, "p0_gpa": [0.5, 2.0]}})
+    with Pipeline(build_config(bad), root) as pipe, pytest.raises(InputError) as err:
+        pipe.run()
+    msg = str(err.value)
+    assert "\n" not in msg and msg.startswith("contact.p0_gpa = 2 GPa")
+    assert "τ0/|k| = 1.5 GPa" in msg
+    assert (root / "06-contact" / "summary.json").read_text() == before

@@ -61,13 +61,21 @@ def contact_command(
         ),
     ] = False,
     k_mpa_per_gpa: Annotated[
-        float, typer.Option("--k-mpa-per-gpa", help="k in τ = k·p + τ0 (MPa/GPa); default 4.52.")
+        float,
+        typer.Option(
+            "--k-mpa-per-gpa",
+            help="k in τ = k·p + τ0 (MPa/GPa; may be < 0, then p0 < τ0/|k|); default 4.52.",
+        ),
     ] = 4.52,
     tau0_mpa: Annotated[
         float, typer.Option("--tau0-mpa", help="τ0 in τ = k·p + τ0 (MPa); default 26.7.")
     ] = 26.7,
     mu_mpa_per_gpa: Annotated[
-        float, typer.Option("--mu-mpa-per-gpa", help="μ in σ = μ·p + σ0 (MPa/GPa); default 0.21.")
+        float,
+        typer.Option(
+            "--mu-mpa-per-gpa",
+            help="μ in σ = μ·p + σ0 (MPa/GPa; may be < 0, then p0 <= σ0/|μ|); default 0.21.",
+        ),
     ] = 0.21,
     sigma0_mpa: Annotated[
         float, typer.Option("--sigma0-mpa", help="σ0 in σ = μ·p + σ0 (MPa); default 11.1.")
@@ -146,6 +154,10 @@ def contact_command(
             sigma0_mpa=sigma0_mpa,
             work_of_adhesion_j_m2=0.0 if work_of_adhesion_j_m2 is None else work_of_adhesion_j_m2,
         )
+        # τ > 0 and σ >= 0 on the whole contact (limits p0 when k or μ < 0)
+        params.check_p0_gpa(p0_list, "--p0-gpa")
+        if experiment is not None:
+            params.check_p0_gpa(experiment_p0_gpa, "--experiment-p0-gpa")
     except InputError as e:
         msg = str(e)
         for field in ContactParameters.__dataclass_fields__:

@@ -22,7 +22,8 @@ FIG4_FRACTION_OF_PEAK = 0.6
 def fig4_traction(
     params: ContactParameters, p0_gpa: float = 1.0, displacement_nm: float | None = None
 ) -> Figure:
-    """Fig. 4(a,b): τ(r), σ(r) and the full-stick q(r) at u; stick zone (r < c) and slip annulus.
+    """Fig. 4(a,b): τ(r), σ(r) and the full-stick q(r) at u; the stick zone (the disc r < c, or
+    the annulus c_in < r < c once the centre slips, k < 0) and the slip zone.
 
     ``displacement_nm`` None: u = :data:`FIG4_FRACTION_OF_PEAK` × the displacement at the
     peak force, so that both zones are visible whatever the laws (a fixed u can leave the
@@ -36,6 +37,7 @@ def fig4_traction(
     u = displacement_nm * units.NM_TO_M
     resp = mindlin.lateral_force(u, p0, params)
     c = float(resp.stick_radius_m)
+    c_in = float(resp.stick_inner_radius_m)
     r = np.linspace(0.0, a, 600, endpoint=False)
     p = p0 * np.sqrt(1.0 - (r / a) ** 2)
     tau = mindlin.shear_strength(p, params)
@@ -48,16 +50,19 @@ def fig4_traction(
     ax.plot(rn, tau / mpa, label=r"shear strength $\tau(r)=k\,p(r)+\tau_0$")
     ax.plot(rn, sig / mpa, label=r"slip friction $\sigma(r)=\mu\,p(r)+\sigma_0$")
     ax.plot(rn, q / mpa, label=rf"full-stick $q(r)$, $u$ = {displacement_nm:g} nm")
-    actual = np.where(r < c, q, sig)
+    actual = np.where((r < c) & (r > c_in), q, sig)
     ax.plot(rn, actual / mpa, "k--", lw=1, label="traction of the model")
     ax.axvspan(
-        0,
+        c_in / units.NM_TO_M,
         c / units.NM_TO_M,
         color="tab:red",
         alpha=0.08,
-        label=f"stick, c = {c / units.NM_TO_M:.1f} nm",
+        label=f"stick, c = {c / units.NM_TO_M:.1f} nm"
+        + (f", c_in = {c_in / units.NM_TO_M:.1f} nm" if c_in > 0 else ""),
     )
     ax.axvspan(c / units.NM_TO_M, a / units.NM_TO_M, color="tab:blue", alpha=0.08, label="slip")
+    if c_in > 0:
+        ax.axvspan(0, c_in / units.NM_TO_M, color="tab:blue", alpha=0.08)
     ymax = 1.6 * float(np.max(tau)) / mpa
     ax.set_ylim(0, ymax)
     ax.set_xlim(0, a / units.NM_TO_M)
@@ -80,6 +85,10 @@ def fig4_traction(
         alpha=0.7,
         label="stick zone",
     )
+    if c_in > 0:  # the centre slips: the stick zone is an annulus
+        ring = (c_in * np.cos(th) / units.NM_TO_M, c_in * np.sin(th) / units.NM_TO_M)
+        ax2.fill(*ring, color="white")
+        ax2.fill(*ring, color="tab:blue", alpha=0.5)
     ax2.set_aspect("equal")
     ax2.set_xlabel("x (nm)")
     ax2.set_ylabel("y (nm)")
