@@ -480,7 +480,7 @@ def preset(name: str) -> dict:
             "potential": default_potential(),
             "scan": {
                 "grid": [12, 12],
-                "p_range_gpa": {"lo_gpa": -1.2, "hi_gpa": 4.5, "n": 12},
+                "p_range_gpa": {"lo_gpa": -0.3, "hi_gpa": 4.5, "n": 12},
                 "fmax_ev_per_angstrom": 0.005,
             },
             "analysis": {"p_gpa": [0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5]},
@@ -494,7 +494,7 @@ def preset(name: str) -> dict:
             "potential": default_potential(),
             "scan": {
                 "grid": [12, 12],
-                "p_range_gpa": {"lo_gpa": -1.2, "hi_gpa": 5.5, "n": 20},
+                "p_range_gpa": {"lo_gpa": -0.3, "hi_gpa": 5.5, "n": 20},
                 "fmax_ev_per_angstrom": 0.005,
             },
             "analysis": {"p_gpa": [0.0, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 4.5]},

@@ -990,7 +990,9 @@ def _lj_difference(lj) -> str:
         return (
             "The paper took the LJ C6 from vdW-DFT of the solid (Hirshfeld-scaled TS), which we "
             "cannot run here; flatcontact scales the Tkatchenko–Scheffler C6 instead so that "
-            f"{hamaker} (potential.lj.hamaker_zj). Free-atom C6 would give 411 zJ and about "
+            f"their pairwise Hamaker constant for α-quartz is {a_zj:.0f} zJ "
+            f"(potential.lj.hamaker_zj; Lifshitz theory: ≈ {QUARTZ_HAMAKER_ZJ:.0f} zJ, "
+            "Bergström 1997). Free-atom C6 would give 411 zJ and about "
             "4–5× the adhesion and τ0: τ0 follows the LJ well depth almost linearly "
             "(measurements in docs/run.md)."
         )
