@@ -105,9 +105,16 @@ def analyze_command(
     """Constant-pressure ISPES, sliding path, τ, σ_MSS, shear stiffness and load laws."""
     from flatcontact.analysis.diagnostics import AnalysisWarning
     from flatcontact.analysis.outputs import per_pressure_rows, summary_json, write_outputs
-    from flatcontact.analysis.pipeline import analyze_ispes
+    from flatcontact.analysis.pipeline import ENERGY_ZEROS, FORMS, LOAD_SOURCES, analyze_ispes
     from flatcontact.ispes.contract import open_ispes
 
+    for flag, value, allowed in (
+        ("--energy", energy, FORMS),
+        ("--load-source", load_source, LOAD_SOURCES),
+        ("--energy-zero", energy_zero, ENERGY_ZEROS),
+    ):  # before the file is opened (analyze_ispes checks them again for library callers)
+        if value not in allowed:
+            raise InputError(f"{flag}: expected one of {', '.join(allowed)}, got {value!r}")
     path, pressures = _split_arguments(items, p_gpa)
     if out is not None:
         check_out_dir(out)

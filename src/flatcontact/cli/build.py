@@ -185,4 +185,5 @@ def build(
         f"{report['thickness_angstrom']:.3f} Å), {out / BUILD_REPORT}, "
         + ", ".join(str(f) for f in figures),
         highlight=False,
+        soft_wrap=True,
     )
