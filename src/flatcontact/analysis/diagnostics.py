@@ -29,3 +29,9 @@ class LinearFitWarning(AnalysisWarning):
 class LoadNoiseWarning(AnalysisWarning):
     """The noise that the load's error puts into the constant-pressure ISPES is a sizeable
     fraction of τ or of the barriers (see :mod:`flatcontact.analysis.noise`)."""
+
+
+class DegenerateMinimaWarning(AnalysisWarning):
+    """The landscape has inequivalent minima within the noise of the global one, and τ differs
+    between them: the slider's τ depends on which of them it sits in (see
+    :mod:`flatcontact.analysis.starts`)."""

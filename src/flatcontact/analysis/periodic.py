@@ -177,6 +177,55 @@ class PeriodicSurface:
         )
         return res.x, float(res.fun)
 
+    def local_minima(self, refine: int = 2) -> list[tuple[np.ndarray, float]]:
+        """All inequivalent local minima of the interpolant in the cell, lowest first.
+
+        Starts from every periodic discrete minimum of the interpolant sampled on
+        a grid ``refine`` times finer than the data (so a minimum between two
+        data points is not missed), refines each with :meth:`local_minimum`
+        (analytic gradient and Hessian), keeps the stationary points whose
+        Hessian is positive definite, reduces them into the cell and drops
+        duplicates (points less than ``1e-6`` × the shortest lattice vector
+        apart modulo the lattice). Ordered by value, then by fractional
+        position (deterministic order for exact ties).
+
+        Returns
+        -------
+        list of ``(xy, value)``
+            Cartesian positions (Å) in the cell and the surface values there.
+        """
+        n_a, n_b = self.values.shape
+        f_a, f_b = max(1, refine) * n_a, max(1, refine) * n_b
+        v = self.sample(np.arange(f_a) / f_a, np.arange(f_b) / f_b)
+        is_min = np.ones(v.shape, bool)
+        for axis in (0, 1):
+            for shift in (1, -1):
+                is_min &= v <= np.roll(v, shift, axis=axis)
+        cand = np.argwhere(is_min)
+        scale = float(np.min(np.linalg.norm(self.lattice, axis=0)))
+        spread = max(float(np.ptp(self.values)), 1e-300)
+        found: list[tuple[np.ndarray, np.ndarray, float]] = []  # (s in cell, xy, value)
+        for i, j in cand:
+            xy, val = self.local_minimum(self.cartesian(np.array([i / f_a, j / f_b])))
+            sv = self.evaluate(xy)
+            if np.linalg.norm(sv.gradient) * scale > 1e-7 * spread:
+                continue  # not converged to a stationary point
+            if not np.all(np.linalg.eigvalsh(sv.hessian) > 0):
+                continue  # a flat direction or a saddle, not a minimum
+            s = self.fractional(xy)
+            s = s - np.floor(s)
+            dup = False
+            for s_known, _, _ in found:
+                ds = s - s_known
+                ds -= np.round(ds)
+                if np.linalg.norm(self.cartesian(ds)) < 1e-6 * scale:
+                    dup = True
+                    break
+            if not dup:
+                found.append((s, self.cartesian(s), float(val)))
+        found.sort(key=lambda m: (m[2], round(float(m[0][0]), 9), round(float(m[0][1]), 9)))
+        return [(xy, val) for _, xy, val in found]
+
     def global_minimum(self, n_starts: int = 4) -> tuple[np.ndarray, float]:
         """Lowest minimum of the interpolant, reduced into the cell (Å, value).
 

@@ -10,7 +10,9 @@ target load ``P``:
 2. its exact periodic interpolant (:mod:`.periodic`);
 3. the zero-perpendicular-force path from the global minimum along the pulling
    direction (:mod:`.path`) and, on request, the string-method MEP to the
-   equivalent minimum that the path reaches;
+   equivalent minimum that the path reaches; when other inequivalent minima
+   lie within the noise of the global one, from each of them, reporting the
+   largest τ (:mod:`.starts`, :class:`DegenerateMinimaWarning`);
 4. τ, σ_MSS and the shear stiffness (:mod:`.friction`);
 5. optionally the symmetry report (:mod:`.symmetry`).
 
@@ -35,16 +37,21 @@ from flatcontact.analysis.constant_pressure import (
     constant_pressure,
 )
 from flatcontact.analysis.diagnostics import LoadNoiseWarning
-from flatcontact.analysis.friction import FrictionResult, friction_along_path
+from flatcontact.analysis.friction import FrictionResult
 from flatcontact.analysis.laws import LoadLaws, fit_load_laws
 from flatcontact.analysis.noise import NOISE_WARN_FRACTION
 from flatcontact.analysis.path import (
     MinimumEnergyPath,
     SlidingPath,
     minimum_energy_path,
-    zero_perpendicular_force_path,
 )
 from flatcontact.analysis.periodic import PeriodicSurface, lattice_vectors, rectangular_supercell
+from flatcontact.analysis.starts import (
+    StartOutcome,
+    degeneracy_tolerance_ev_per_a2,
+    paths_from_near_degenerate_minima,
+    warn_if_tau_depends_on_start,
+)
 from flatcontact.analysis.symmetry import SymmetryReport, symmetry_report
 from flatcontact.errors import InputError
 from flatcontact.ispes import contract
@@ -56,7 +63,13 @@ MIN_LATERAL_POINTS = 3
 
 @dataclass(frozen=True)
 class PressureAnalysis:
-    """Everything computed at one load (surface and path energies in eV/Å²)."""
+    """Everything computed at one load (surface and path energies in eV/Å²).
+
+    ``minimum_xy_angstrom``, ``path`` and ``friction`` belong to the reported
+    start ``starts[selected_start]``; ``starts`` holds every near-degenerate
+    minimum's path and friction (one entry unless the landscape has
+    inequivalent minima within the degeneracy tolerance, :mod:`.starts`).
+    """
 
     p_gpa: float
     surface: PeriodicSurface
@@ -65,6 +78,9 @@ class PressureAnalysis:
     friction: FrictionResult
     mep: MinimumEnergyPath | None
     symmetry: SymmetryReport | None
+    starts: tuple[StartOutcome, ...] = ()
+    selected_start: int = 0
+    degeneracy_tolerance_ev_per_a2: float = float("nan")
 
 
 @dataclass(frozen=True)
@@ -205,15 +221,19 @@ def analyze_ispes(
 
     results = []
     for i, pk in enumerate(p):
-        surf, r0 = surfaces[i], minima[i][0]
+        surf = surfaces[i]
         clock = time.perf_counter()
-        path = zero_perpendicular_force_path(
-            surf, direction_deg, start_xy=r0, max_length_angstrom=max_length_angstrom
+        tol = degeneracy_tolerance_ev_per_a2(float(floor[i]))
+        starts, k = paths_from_near_degenerate_minima(
+            surf,
+            direction_deg,
+            tol,
+            min_barrier_ev_per_a2=float(floor[i]),
+            max_length_angstrom=max_length_angstrom,
         )
+        r0, path, fr = starts[k].xy_angstrom, starts[k].path, starts[k].friction
         timings["path"] += time.perf_counter() - clock
-        clock = time.perf_counter()
-        fr = friction_along_path(path, min_barrier_ev_per_a2=float(floor[i]))
-        timings["friction"] += time.perf_counter() - clock
+        warn_if_tau_depends_on_start(starts, k, float(pk), tol, source)
         mep = None
         if with_mep:
             clock = time.perf_counter()
@@ -229,7 +249,7 @@ def analyze_ispes(
             clock = time.perf_counter()
             sym = symmetry_report(surf)
             timings["symmetry"] += time.perf_counter() - clock
-        results.append(PressureAnalysis(float(pk), surf, r0, path, fr, mep, sym))
+        results.append(PressureAnalysis(float(pk), surf, r0, path, fr, mep, sym, starts, k, tol))
         _warn_noise(cp, i, fr, source)
 
     clock = time.perf_counter()

@@ -1,0 +1,198 @@
+"""Where the sliding path starts when the landscape has (nearly) degenerate inequivalent minima.
+
+The paper's shear strength τ is the largest resisting force on the way out of
+the *initial* minimum, the global minimum of the constant-pressure landscape.
+A landscape may have two or more inequivalent minima per cell (not related by
+a lattice vector) of equal or nearly equal depth: e.g. the two hollow sites of
+a hexagonal interface, which any inversion-symmetric landscape
+(``e(r) = e(-r)``) makes exactly degenerate. Which of them is "the global
+minimum" is then decided by round-off or by noise far below what the data
+resolve, while τ from each of them differs (pulling along ``+d`` from one
+hollow is pulling along ``-d`` from the other): τ flipped between 60.5 and
+180.4 MPa with the thickness grid on such a landscape.
+
+Rule (deterministic, independent of round-off):
+
+1. all inequivalent local minima in the cell are found on the exact periodic
+   interpolant (:meth:`.PeriodicSurface.local_minima`);
+2. minima within the **degeneracy tolerance** ``δ = max(2 ε(P),``
+   ``DEGENERACY_FLOOR_MEV_PER_A2)`` of the lowest are *near-degenerate*
+   (``ε(P)`` the energy noise of the load, :mod:`.noise`; the same ``2 ε``
+   below which a dip is not a minimum in σ_MSS). The data cannot tell which
+   of them is the ground state;
+3. the path and τ, σ_MSS and the shear stiffness are computed from each
+   near-degenerate start (``tau_by_start_mpa`` etc. in the outputs), the
+   starts ordered by their fractional position ``(s_a, s_b)`` in the cell;
+4. the reported τ is the **largest τ over the near-degenerate starts**: the
+   pull that sets the slider sliding out of its rest position whichever of
+   the indistinguishable minima it sits in. Equal τ (within ``1e-9``
+   relative) go to the lower minimum, then to the first in that order. The reported path, barriers,
+   σ_MSS and shear stiffness are those of that start. With a single
+   near-degenerate minimum (a clearly deeper global minimum) nothing changes:
+   the path starts from the global minimum as in the paper;
+5. a :class:`DegenerateMinimaWarning` gives every start's energy and τ when
+   the τ differ by more than ``TAU_SPREAD_RTOL`` of the largest.
+
+σ_MSS is a whole-period quantity: when the path out of one start passes
+through the others, one period from any start climbs the same barriers over
+the same distance, and σ is the same from every start (checked by the tests
+and reported per start). Only the order of the climbs differs, and τ (the
+first climb) with it; ``τ_period`` (the largest force over a period) is then
+the same from every start and equals the reported τ.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from flatcontact import units
+from flatcontact.analysis.diagnostics import DegenerateMinimaWarning
+from flatcontact.analysis.friction import FrictionResult, friction_along_path
+from flatcontact.analysis.path import SlidingPath, zero_perpendicular_force_path
+from flatcontact.analysis.periodic import PeriodicSurface
+
+#: Smallest degeneracy tolerance (meV/Å²), used where the energy noise is unknown or smaller.
+DEGENERACY_FLOOR_MEV_PER_A2 = 1.0e-4
+#: Warn when the τ of near-degenerate starts differ by more than this fraction of the largest.
+TAU_SPREAD_RTOL = 1.0e-3
+#: τ within this relative difference count as equal when choosing the start.
+TAU_TIE_RTOL = 1.0e-9
+
+
+@dataclass(frozen=True)
+class StartOutcome:
+    """The path and friction from one near-degenerate minimum (surface energies in eV/Å²)."""
+
+    xy_angstrom: np.ndarray  #: the minimum, Cartesian, reduced into the cell
+    energy_ev_per_a2: float  #: the landscape's value there
+    above_lowest_ev_per_a2: float  #: energy above the lowest minimum (>= 0)
+    path: SlidingPath
+    friction: FrictionResult
+
+    @property
+    def tau_mpa(self) -> float:
+        """τ from this start (MPa)."""
+        return self.friction.tau_mpa
+
+    @property
+    def above_lowest_mev_per_a2(self) -> float:
+        """Energy above the lowest minimum (meV/Å²)."""
+        return self.above_lowest_ev_per_a2 * units.EV_PER_A2_TO_MEV_PER_A2
+
+
+def degeneracy_tolerance_ev_per_a2(barrier_threshold_ev_per_a2: float) -> float:
+    """δ = max(2 ε(P), floor) in eV/Å²; ``barrier_threshold_ev_per_a2`` is 2 ε (0 or NaN if unknown)."""
+    floor = DEGENERACY_FLOOR_MEV_PER_A2 / units.EV_PER_A2_TO_MEV_PER_A2
+    thr = float(barrier_threshold_ev_per_a2)
+    return max(thr, floor) if np.isfinite(thr) else floor
+
+
+def near_degenerate_minima(
+    minima: list[tuple[np.ndarray, float]], tolerance_ev_per_a2: float
+) -> list[tuple[np.ndarray, float]]:
+    """The minima (sorted lowest first, as from ``local_minima``) within the tolerance of the lowest."""
+    if not minima:
+        return []
+    lowest = minima[0][1]
+    return [m for m in minima if m[1] - lowest <= tolerance_ev_per_a2]
+
+
+def _cell_order(surface: PeriodicSurface, xy: np.ndarray) -> tuple[float, float]:
+    """Sort key of a start: its fractional position in the cell, rounded (round-off proof)."""
+    s = np.round(surface.fractional(xy), 6) % 1.0
+    return float(s[0]), float(s[1])
+
+
+def choose_start(taus: np.ndarray, energies: np.ndarray) -> int:
+    """Index of the reported start: largest τ; equal τ → lower energy → first (see module doc)."""
+    taus = np.asarray(taus, float)
+    energies = np.asarray(energies, float)
+    top = float(np.max(taus))
+    tied = np.flatnonzero(taus >= top - TAU_TIE_RTOL * max(abs(top), 1e-300))
+    return int(tied[np.argmin(energies[tied])])
+
+
+def paths_from_near_degenerate_minima(
+    surface: PeriodicSurface,
+    direction_deg: float,
+    tolerance_ev_per_a2: float,
+    min_barrier_ev_per_a2: float = 0.0,
+    max_length_angstrom: float | None = None,
+) -> tuple[tuple[StartOutcome, ...], int]:
+    """Path and friction from every near-degenerate minimum, and the index of the reported one.
+
+    Warnings raised while tracking a path (e.g. :class:`PathNotPeriodicWarning`)
+    are passed on for the reported start only.
+
+    Parameters
+    ----------
+    surface
+        Constant-pressure landscape in eV/Å².
+    direction_deg
+        Pulling direction (degrees from x).
+    tolerance_ev_per_a2
+        Degeneracy tolerance δ (:func:`degeneracy_tolerance_ev_per_a2`).
+    min_barrier_ev_per_a2
+        Noise floor of :func:`.friction_along_path`.
+    max_length_angstrom
+        Tracking limit of the path.
+    """
+    minima = near_degenerate_minima(surface.local_minima(), tolerance_ev_per_a2)
+    if not minima:  # no isolated minimum found: fall back on the refined lowest sample
+        minima = [surface.global_minimum()]
+    minima.sort(key=lambda m: _cell_order(surface, m[0]))
+    lowest = min(m[1] for m in minima)
+    outcomes, caught_by_start = [], []
+    for xy, value in minima:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            path = zero_perpendicular_force_path(
+                surface, direction_deg, start_xy=xy, max_length_angstrom=max_length_angstrom
+            )
+            fr = friction_along_path(path, min_barrier_ev_per_a2=min_barrier_ev_per_a2)
+        caught_by_start.append(caught)
+        outcomes.append(StartOutcome(np.asarray(xy, float), float(value), value - lowest, path, fr))
+    k = choose_start(
+        np.array([o.friction.tau_ev_per_a3 for o in outcomes]),
+        np.array([o.energy_ev_per_a2 for o in outcomes]),
+    )
+    for w in caught_by_start[k]:
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return tuple(outcomes), k
+
+
+def warn_if_tau_depends_on_start(
+    outcomes: tuple[StartOutcome, ...],
+    selected: int,
+    p_gpa: float,
+    tolerance_ev_per_a2: float,
+    source: str,
+) -> None:
+    """:class:`DegenerateMinimaWarning` naming every start's τ if they differ noticeably."""
+    if len(outcomes) < 2:
+        return
+    taus = np.array([o.tau_mpa for o in outcomes])
+    if np.ptp(taus) <= TAU_SPREAD_RTOL * np.max(np.abs(taus)):
+        return
+    mev = units.EV_PER_A2_TO_MEV_PER_A2
+    surface = outcomes[0].path.frame.surface
+    parts = []
+    for o in outcomes:
+        s = surface.fractional(o.xy_angstrom)
+        parts.append(
+            f"τ = {o.tau_mpa:.4g} MPa from the minimum at s = ({s[0]:.3f}, {s[1]:.3f}) "
+            f"({o.above_lowest_mev_per_a2:.2g} meV/Å² above the lowest; σ_MSS = "
+            f"{o.friction.sigma_mss_mpa:.4g} MPa)"
+        )
+    warnings.warn(
+        f"{source} at P = {p_gpa:g} GPa: {len(outcomes)} inequivalent minima lie within "
+        f"{tolerance_ev_per_a2 * mev:.2g} meV/Å² of each other, so the slider's τ depends on "
+        f"which one it sits in: " + "; ".join(parts) + f". Reported τ = "
+        f"{outcomes[selected].tau_mpa:.4g} MPa, the largest (the pull that starts sliding from "
+        "either)",
+        DegenerateMinimaWarning,
+        stacklevel=3,
+    )
