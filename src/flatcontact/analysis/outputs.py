@@ -2,9 +2,15 @@
 
 - ``friction.csv``: one row per load: ``p_gpa``, ``tau_mpa``,
   ``sigma_mss_mpa``, ``shear_stiffness_gpa_per_nm`` and path diagnostics;
+  ``n_degenerate_minima`` (inequivalent minima within the degeneracy
+  tolerance of the global one, :mod:`.starts`) and ``tau_by_start_mpa`` (τ
+  from each of them, ``;``-separated, in the order of ``friction.nc``'s
+  ``start`` dimension);
 - ``friction.nc``: the same per load plus the paths (dims ``p_gpa``,
   ``sample``; NaN-padded), the constant-pressure maps (meV/Å², dims
-  ``p_gpa``, ``shift_a``, ``shift_b``) and ``z*`` (Å);
+  ``p_gpa``, ``shift_a``, ``shift_b``), ``z*`` (Å) and, on dims ``p_gpa``,
+  ``start`` (NaN-padded), each near-degenerate start's position, energy above
+  the lowest minimum, τ, σ_MSS and shear stiffness, with ``selected_start``;
 - ``laws.json``: ``k_mpa_per_gpa``, ``tau0_mpa``, ``mu_mpa_per_gpa``,
   ``sigma0_mpa``, their standard errors, ``p_max_gpa`` and the regime ends.
 """
@@ -24,6 +30,7 @@ from flatcontact import __version__, units
 from flatcontact.analysis.friction import EV_PER_A4_TO_GPA_PER_NM
 from flatcontact.analysis.noise import BARRIER_NOISE_FACTOR
 from flatcontact.analysis.pipeline import AnalysisResult
+from flatcontact.analysis.starts import TAU_START_RULE
 from flatcontact.fileio import atomic_path, write_json_atomic, write_text_atomic
 
 CSV_COLUMNS = (
@@ -41,10 +48,16 @@ CSV_COLUMNS = (
     "mep_barrier_mev_per_a2",
     "energy_noise_mev_per_a2",
     "force_noise_mpa",
+    "n_degenerate_minima",
+    "tau_by_start_mpa",
 )
+#: Separator of the per-start values in one ``friction.csv`` cell.
+LIST_SEPARATOR = ";"
 
 
 def _clean(v: object) -> object:
+    if isinstance(v, list):
+        return [_clean(x) for x in v]
     if isinstance(v, float | np.floating):
         return None if not math.isfinite(float(v)) else float(v)
     return v
@@ -74,6 +87,8 @@ def per_pressure_rows(result: AnalysisResult) -> list[dict]:
                 ),
                 "energy_noise_mev_per_a2": float(nz.energy_noise_mev_per_a2[i]),
                 "force_noise_mpa": float(nz.force_noise_mpa[i]),
+                "n_degenerate_minima": max(1, len(pa.starts)),
+                "tau_by_start_mpa": [o.tau_mpa for o in pa.starts] or [fr.tau_mpa],
             }
         )
     return [{k: _clean(v) for k, v in row.items()} for row in rows]
@@ -100,6 +115,8 @@ def summary_json(result: AnalysisResult) -> dict:
                     "periodic",
                     "energy_noise_mev_per_a2",
                     "force_noise_mpa",
+                    "n_degenerate_minima",
+                    "tau_by_start_mpa",
                 )
             }
             for row in per_pressure_rows(result)
@@ -114,13 +131,22 @@ def summary_json(result: AnalysisResult) -> dict:
     return out
 
 
+def _cell(v: object) -> object:
+    """A CSV cell: empty for undefined, ``;``-joined for a per-start list."""
+    if v is None:
+        return ""
+    if isinstance(v, list):
+        return LIST_SEPARATOR.join("" if x is None else repr(float(x)) for x in v)
+    return v
+
+
 def friction_csv_text(result: AnalysisResult) -> str:
     """``friction.csv`` content (empty cells for undefined values)."""
     buf = io.StringIO()
     writer = csv.DictWriter(buf, fieldnames=CSV_COLUMNS, lineterminator="\n")
     writer.writeheader()
     for row in per_pressure_rows(result):
-        writer.writerow({k: ("" if row[k] is None else row[k]) for k in CSV_COLUMNS})
+        writer.writerow({k: _cell(row[k]) for k in CSV_COLUMNS})
     return buf.getvalue()
 
 
@@ -143,6 +169,15 @@ def friction_dataset(result: AnalysisResult) -> xr.Dataset:
 
     def col(name: str) -> np.ndarray:
         return np.array([np.nan if r[name] is None else r[name] for r in rows], dtype=float)
+
+    n_start = max(max(len(pa.starts), 1) for pa in result.pressures)
+
+    def by_start(get) -> np.ndarray:
+        out = np.full((p.size, n_start), np.nan)
+        for i, pa in enumerate(result.pressures):
+            for j, o in enumerate(pa.starts):
+                out[i, j] = get(o, pa)
+        return out
 
     ds = xr.Dataset(
         {
@@ -195,6 +230,50 @@ def friction_dataset(result: AnalysisResult) -> xr.Dataset:
                 col("force_noise_mpa"),
                 {"units": "MPa", "long_name": "energy noise / lateral grid spacing"},
             ),
+            "n_degenerate_minima": ("p_gpa", col("n_degenerate_minima").astype(int)),
+            "selected_start": (
+                "p_gpa",
+                np.array([pa.selected_start for pa in result.pressures]),
+                {"long_name": "index along start of the reported path and tau"},
+            ),
+            "degeneracy_tolerance_mev_per_a2": (
+                "p_gpa",
+                np.array([pa.degeneracy_tolerance_ev_per_a2 for pa in result.pressures]) * mev,
+                {
+                    "units": "meV/angstrom^2",
+                    "long_name": "minima this close to the lowest are starts",
+                },
+            ),
+            "tau_by_start_mpa": (
+                ("p_gpa", "start"),
+                by_start(lambda o, pa: o.tau_mpa),
+                {"units": "MPa", "long_name": "tau from each near-degenerate minimum"},
+            ),
+            "sigma_mss_by_start_mpa": (
+                ("p_gpa", "start"),
+                by_start(lambda o, pa: o.friction.sigma_mss_mpa),
+                {"units": "MPa"},
+            ),
+            "shear_stiffness_by_start_gpa_per_nm": (
+                ("p_gpa", "start"),
+                by_start(lambda o, pa: o.friction.shear_stiffness_gpa_per_nm),
+                {"units": "GPa/nm"},
+            ),
+            "start_x": (
+                ("p_gpa", "start"),
+                by_start(lambda o, pa: o.xy_angstrom[0]),
+                {"units": "angstrom"},
+            ),
+            "start_y": (
+                ("p_gpa", "start"),
+                by_start(lambda o, pa: o.xy_angstrom[1]),
+                {"units": "angstrom"},
+            ),
+            "start_energy_above_lowest_mev_per_a2": (
+                ("p_gpa", "start"),
+                by_start(lambda o, pa: o.above_lowest_mev_per_a2),
+                {"units": "meV/angstrom^2"},
+            ),
             "energy_map": (("p_gpa", "shift_a", "shift_b"), maps, {"units": "meV/angstrom^2"}),
             "thickness_at_p": (
                 ("p_gpa", "shift_a", "shift_b"),
@@ -219,6 +298,7 @@ def friction_dataset(result: AnalysisResult) -> xr.Dataset:
             "stress_energy_mismatch_rms_gpa": _attr(result.noise.stress_energy_mismatch_rms_gpa),
             "lateral_grid_spacing_angstrom": result.noise.grid_spacing_angstrom,
             "barrier_noise_factor": BARRIER_NOISE_FACTOR,
+            "tau_start_rule": TAU_START_RULE,
             "force_sign": "path_force = de/dt, the resisting lateral stress (positive while climbing)",
             "flatcontact_version": __version__,
         },

@@ -58,6 +58,12 @@ from flatcontact.analysis.periodic import PeriodicSurface
 DEGENERACY_FLOOR_MEV_PER_A2 = 1.0e-4
 #: Warn when the τ of near-degenerate starts differ by more than this fraction of the largest.
 TAU_SPREAD_RTOL = 1.0e-3
+#: The rule, as stored with the outputs.
+TAU_START_RULE = (
+    "tau from the global minimum; if other inequivalent minima lie within the degeneracy "
+    "tolerance max(2 eps, floor) of it, the largest tau over those starts (equal tau: the lower "
+    "minimum)"
+)
 #: τ within this relative difference count as equal when choosing the start.
 TAU_TIE_RTOL = 1.0e-9
 
