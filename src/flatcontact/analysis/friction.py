@@ -12,7 +12,9 @@ Conventions (paper, Fig. 2 and the equation for σ):
 - **shear strength** ``τ``: the largest ``f`` before the slider leaves the
   initial minimum, i.e. on the way from the start to the first barrier top,
   or to the first jump (fold) if the branch ends before a top. The maximum is
-  located where ``d f/dt = 0`` by root finding on the relaxed branch;
+  located where ``d f/dt = 0`` by root finding on the relaxed branch. (When
+  inequivalent minima are degenerate within the noise, the analysis computes
+  this from each of them and reports the largest: :mod:`.starts`);
 - **period shear strength** ``τ_period``: the largest ``f`` anywhere on one
   period of the path: the pull needed for sustained sliding. It equals ``τ``
   when the first barrier out of the global minimum is the hardest to climb,
