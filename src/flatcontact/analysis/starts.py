@@ -43,6 +43,7 @@ the same from every start and equals the reported τ.
 
 from __future__ import annotations
 
+import time
 import warnings
 from dataclasses import dataclass
 
@@ -127,6 +128,7 @@ def paths_from_near_degenerate_minima(
     tolerance_ev_per_a2: float,
     min_barrier_ev_per_a2: float = 0.0,
     max_length_angstrom: float | None = None,
+    timings_s: dict[str, float] | None = None,
 ) -> tuple[tuple[StartOutcome, ...], int]:
     """Path and friction from every near-degenerate minimum, and the index of the reported one.
 
@@ -145,20 +147,29 @@ def paths_from_near_degenerate_minima(
         Noise floor of :func:`.friction_along_path`.
     max_length_angstrom
         Tracking limit of the path.
+    timings_s
+        If given, seconds spent are added to its ``"path"`` (minima search and
+        tracking) and ``"friction"`` entries.
     """
+    clock = time.perf_counter()
     minima = near_degenerate_minima(surface.local_minima(), tolerance_ev_per_a2)
     if not minima:  # no isolated minimum found: fall back on the refined lowest sample
         minima = [surface.global_minimum()]
     minima.sort(key=lambda m: _cell_order(surface, m[0]))
     lowest = min(m[1] for m in minima)
     outcomes, caught_by_start = [], []
+    spent = {"path": 0.0, "friction": 0.0}
     for xy, value in minima:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             path = zero_perpendicular_force_path(
                 surface, direction_deg, start_xy=xy, max_length_angstrom=max_length_angstrom
             )
+            spent["path"] += time.perf_counter() - clock
+            clock = time.perf_counter()
             fr = friction_along_path(path, min_barrier_ev_per_a2=min_barrier_ev_per_a2)
+            spent["friction"] += time.perf_counter() - clock
+            clock = time.perf_counter()
         caught_by_start.append(caught)
         outcomes.append(StartOutcome(np.asarray(xy, float), float(value), value - lowest, path, fr))
     k = choose_start(
@@ -167,6 +178,9 @@ def paths_from_near_degenerate_minima(
     )
     for w in caught_by_start[k]:
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    if timings_s is not None:
+        for key, value in spent.items():
+            timings_s[key] = timings_s.get(key, 0.0) + value
     return tuple(outcomes), k
 
 
