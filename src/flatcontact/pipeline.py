@@ -1005,6 +1005,52 @@ def _lj_difference(lj) -> str:
     )
 
 
+def _elastic_tables(pipe: Pipeline) -> list:
+    """The elastic stage's Cij and moduli (when it ran), for the contact section."""
+    from flatcontact.report import Table
+
+    path = pipe.folder("elastic") / "elastic.json"
+    if not pipe.config.elastic.enabled or not path.exists():
+        return []
+    doc = json.loads(path.read_text())
+    cij = doc.get("cij_gpa", {})
+    moduli = doc.get("moduli_gpa", {})
+    return [
+        Table(
+            ("α-quartz with the potential", "value"),
+            [
+                ("a, c (Å)", f"{_fmt(doc.get('a_angstrom'))}, {_fmt(doc.get('c_angstrom'))}"),
+                *((f"{k} (GPa)", _fmt(v)) for k, v in cij.items()),
+                *(
+                    (f"{k} (GPa)" if k != "poisson_ratio" else k, _fmt(v))
+                    for k, v in moduli.items()
+                ),
+            ],
+        )
+    ]
+
+
+_LOAD_SOURCE_TEXT = {
+    "energy": "−(1/A) dU/dz of each column's energy spline (analysis.load_source = energy)",
+    "stress": "the stored normal stress (analysis.load_source = stress)",
+}
+_ENERGY_ZERO_TEXT = {
+    "lowest-p": "the global minimum at the lowest load analysed",
+    "each": "the global minimum at each load",
+    "none": "none (energies as computed, per area)",
+}
+
+
+def _symmetry_rows(symmetry: dict) -> list[tuple[str, str, str]]:
+    """Rows (P, kept operations, all operations with their rms change) of analyze.json's
+    ``symmetry`` strings ("kept (<2%): C2; all: C6 99%, ...")."""
+    rows = []
+    for p, text in symmetry.items():
+        kept, _, every = str(text).partition("; all: ")
+        rows.append((p, kept.split(": ", 1)[-1], every))
+    return rows
+
+
 def build_report(pipe: Pipeline, path: Path) -> Path:
     """Assemble ``report.html`` from the stage folders of ``pipe`` (figures embedded)."""
     from flatcontact.report import Figure, Section, Table, write_report
@@ -1195,7 +1241,9 @@ def build_report(pipe: Pipeline, path: Path) -> Path:
                 f"'{cfg.analysis.energy_form}' (the paper's is 'internal'). τ is the paper's "
                 "shear strength (largest force before leaving the initial minimum); τ_period is "
                 "the largest force over a whole period, the pull needed for sustained sliding "
-                "(always ≥ σ_MSS). The load laws use τ."
+                "(always ≥ σ_MSS). The load laws use τ.",
+                f"Load at each z from {_LOAD_SOURCE_TEXT[analyze.get('load_source', 'stress')]}. "
+                f"Energy zero of the maps and profiles: {_ENERGY_ZERO_TEXT[cfg.analysis.energy_zero]}.",
             ],
             notes=analyze.get("warnings", []),
             tables=[
@@ -1210,7 +1258,11 @@ def build_report(pipe: Pipeline, path: Path) -> Path:
                         "jumps",
                     ),
                     rows,
-                )
+                ),
+                Table(
+                    ("P (GPa)", "symmetry operations of the cell kept (rms change < 2 %)", "all"),
+                    _symmetry_rows(analyze.get("symmetry", {})),
+                ),
             ],
             figures=figs,
         )
@@ -1292,7 +1344,10 @@ def build_report(pipe: Pipeline, path: Path) -> Path:
                 f"w = {params['work_of_adhesion_j_m2']:.3g} J/m² ({prov.get('work_of_adhesion_j_m2')}).",
             ],
             notes=notes,
-            tables=[Table(("quantity", *(f"p0 = {r['p0_gpa']:g} GPa" for r in res)), ct_rows)],
+            tables=[
+                Table(("quantity", *(f"p0 = {r['p0_gpa']:g} GPa" for r in res)), ct_rows),
+                *_elastic_tables(pipe),
+            ],
             figures=contact_figs,
         )
     )

@@ -433,3 +433,31 @@ def test_negative_slope_runs_and_a_p0_beyond_its_limit_is_refused(tiny_run, tmp_
     assert "\n" not in msg and msg.startswith("contact.p0_gpa = 2 GPa")
     assert "τ0/|k| = 1.5 GPa" in msg
     assert (root / "06-contact" / "summary.json").read_text() == before
+
+
+def test_elastic_stage_feeds_the_contact_model_and_the_report(tiny_run, tmp_path):
+    """elastic.enabled: E*, G* of the potential's α-quartz replace the configured moduli and
+    the report shows its Cij; the scan is not rerun."""
+    import shutil
+
+    src, _, _ = tiny_run
+    root = tmp_path / "copy"
+    shutil.copytree(src, root)
+    with Pipeline(build_config(_merge(TINY, {"elastic": {"enabled": True}})), root) as pipe:
+        pipe.run()
+        actions = _actions(pipe)
+        params, provenance = pipe.contact_parameters()
+    assert actions["scan"] == "skipped" and actions["elastic"] == "ran"
+    doc = json.loads((root / "05-elastic" / "elastic.json").read_text())
+    moduli = doc["moduli_gpa"]
+    assert provenance["moduli"] == "elastic stage"
+    assert params.contact_modulus_gpa == pytest.approx(moduli["e_star"])
+    # the paper's convention: G* = 4 G*_J
+    assert params.shear_modulus_gpa == pytest.approx(4 * moduli["g_star_johnson"])
+    # two identical bodies: 1/E* = 2(1 − ν²)/E; a mechanically stable crystal
+    e, nu = moduli["youngs_modulus"], moduli["poisson_ratio"]
+    assert moduli["e_star"] == pytest.approx(e / (2 * (1 - nu**2)), rel=1e-9)
+    tensor = np.array(doc["tensor_gpa"])
+    assert np.all(np.linalg.eigvalsh(0.5 * (tensor + tensor.T)) > 0)
+    html = (root / "report.html").read_text()
+    assert "α-quartz with the potential" in html and "C11 (GPa)" in html
