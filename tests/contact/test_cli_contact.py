@@ -65,6 +65,12 @@ def test_json_with_adhesion(capsys):
         < r["contact_radius_maugis_dugdale_nm"]
         < r["contact_radius_jkr_nm"]
     )
+    # pull-off: 2πwR (DMT) > Maugis–Dugdale (λ = 1) > 1.5πwR (JKR), in µN
+    w, radius = 0.2, 5e-6
+    assert r["pull_off_force_dmt_un"] == pytest.approx(2 * np.pi * w * radius * 1e6)
+    assert r["pull_off_force_jkr_un"] == pytest.approx(1.5 * np.pi * w * radius * 1e6)
+    assert r["pull_off_force_jkr_un"] < r["pull_off_force_maugis_dugdale_un"]
+    assert r["pull_off_force_maugis_dugdale_un"] < r["pull_off_force_dmt_un"]
 
 
 def test_out_dir_and_experiment(tmp_path, capsys):

@@ -67,6 +67,13 @@ class ContactAnalysis:
                     )
                     rec[f"contact_radius_{key}_nm"] = am / units.NM_TO_M
                     rec[f"contact_radius_change_{key}_percent"] = 100.0 * (am / a[i] - 1.0)
+                # pull-off (magnitude, load control): 2πwR (DMT), 1.5πwR (JKR)
+                rec["pull_off_force_dmt_un"] = float(
+                    adhesion.dmt_pull_off_force(w, pr.radius_m) * units.N_TO_UN
+                )
+                rec["pull_off_force_jkr_un"] = float(
+                    adhesion.jkr_pull_off_force(w, pr.radius_m) * units.N_TO_UN
+                )
                 if self.maugis_lambda is not None:
                     am = float(
                         adhesion.contact_radius_at_p0(
@@ -80,6 +87,10 @@ class ContactAnalysis:
                     )
                     rec["contact_radius_maugis_dugdale_nm"] = am / units.NM_TO_M
                     rec["contact_radius_change_maugis_dugdale_percent"] = 100.0 * (am / a[i] - 1.0)
+                    rec["pull_off_force_maugis_dugdale_un"] = float(
+                        adhesion.maugis_dugdale_pull_off_force(w, pr.radius_m, self.maugis_lambda)
+                        * units.N_TO_UN
+                    )
             pk = self.peaks
             rec.update(
                 {
