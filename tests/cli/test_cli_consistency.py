@@ -5,25 +5,12 @@ import json
 
 import numpy as np
 import pytest
+from cli_helpers import one_error_line, run_cli
 from hypothesis import given
 from hypothesis import strategies as st
 
-from flatcontact.cli import main
-
-
-def _run(argv, capsys):
-    with pytest.raises(SystemExit) as exit_info:
-        main(argv)
-    out, err = capsys.readouterr()
-    return exit_info.value.code, out, err
-
-
-def _one_error_line(code, err):
-    assert code == 2, err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: "), err
-    assert "Traceback" not in err and "╭" not in err
-    return lines[0]
+_run = run_cli
+_one_error_line = one_error_line
 
 
 # ---- empty items in comma lists ----------------------------------------------------------

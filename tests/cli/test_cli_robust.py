@@ -1,23 +1,10 @@
 """The command line's bad-input behaviour: one verbatim ``error:`` line, exit 2, before any work."""
 
 import pytest
+from cli_helpers import one_error_line, run_cli
 
-from flatcontact.cli import main
-
-
-def _run(argv, capsys):
-    with pytest.raises(SystemExit) as exit_info:
-        main(argv)
-    out, err = capsys.readouterr()
-    return exit_info.value.code, out, err
-
-
-def _one_error_line(code, err):
-    assert code == 2, err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: "), err
-    assert "Traceback" not in err
-    return lines[0]
+_run = run_cli
+_one_error_line = one_error_line
 
 
 # ---- 1: messages are printed verbatim (no rich markup eats '[...]') ----------------------
