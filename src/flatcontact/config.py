@@ -239,6 +239,15 @@ class ScanConfig(_Section):
         """The per-point relaxation of these settings."""
         return RelaxSettings(self.fmax_ev_per_angstrom, self.optimizer, self.max_steps)
 
+    def executor_options(self) -> dict[str, Any]:
+        """How the points are run (:func:`flatcontact.ispes.scan.run_scan`'s ``executor_options``)."""
+        return {
+            "kind": self.executor,
+            "workers": self.workers,
+            "dask_address": self.dask_address,
+            "jobqueue": self.jobqueue,
+        }
+
 
 class AnalysisConfig(_Section):
     """Constant-pressure ISPES, sliding paths, τ, σ and the load laws (stages ``analyze``, ``laws``)."""

@@ -469,12 +469,7 @@ class Pipeline:
                 folder,
                 s.relax_settings(),
                 order=s.order,
-                executor_options={
-                    "kind": s.executor,
-                    "workers": s.workers,
-                    "dask_address": s.dask_address,
-                    "jobqueue": s.jobqueue,
-                },
+                executor_options=s.executor_options(),
                 progress=self.console is not None,
                 console=self.console,
             )
@@ -568,7 +563,7 @@ class Pipeline:
                 figures.append(stem.name)
                 _save_figure(figure_pressure(pa, result), stem, cfg.report.svg)
             sym = {
-                f"{pa.p_gpa:g}": pa.symmetry.summary()
+                f"{pa.p_gpa:g}": pa.symmetry.to_json()
                 for pa in result.pressures
                 if pa.symmetry is not None
             }
@@ -1041,14 +1036,27 @@ _ENERGY_ZERO_TEXT = {
 }
 
 
-def _symmetry_rows(symmetry: dict) -> list[tuple[str, str, str]]:
-    """Rows (P, kept operations, all operations with their rms change) of analyze.json's
-    ``symmetry`` strings ("kept (<2%): C2; all: C6 99%, ...")."""
-    rows = []
-    for p, text in symmetry.items():
-        kept, _, every = str(text).partition("; all: ")
-        rows.append((p, kept.split(": ", 1)[-1], every))
-    return rows
+def _symmetry_table(symmetry: dict):
+    """Table of analyze.json's ``symmetry`` (per P: tolerance, kept operations, deviations)."""
+    from flatcontact.report import Table
+
+    tolerance = next(iter(symmetry.values()), {}).get("tolerance_percent", float("nan"))
+    rows = [
+        (
+            p,
+            ", ".join(doc["kept"]) or "none",
+            ", ".join(f"{name} {dev:.2g}%" for name, dev in doc["deviation_percent"].items()),
+        )
+        for p, doc in symmetry.items()
+    ]
+    return Table(
+        (
+            "P (GPa)",
+            f"symmetry operations of the cell kept (rms change < {tolerance:g} %)",
+            "rms change of every operation",
+        ),
+        rows,
+    )
 
 
 def build_report(pipe: Pipeline, path: Path) -> Path:
@@ -1259,10 +1267,7 @@ def build_report(pipe: Pipeline, path: Path) -> Path:
                     ),
                     rows,
                 ),
-                Table(
-                    ("P (GPa)", "symmetry operations of the cell kept (rms change < 2 %)", "all"),
-                    _symmetry_rows(analyze.get("symmetry", {})),
-                ),
+                _symmetry_table(analyze.get("symmetry", {})),
             ],
             figures=figs,
         )

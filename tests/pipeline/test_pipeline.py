@@ -89,6 +89,13 @@ def test_every_stage_ran_and_wrote_its_files(tiny_run):
     log = (root / "run.log").read_text()
     assert "stage scan: done" in log and "stage report: done" in log
 
+    # the symmetry of each constant-P surface, structured in analyze.json and tabled in the report
+    symmetry = json.loads((root / "03-analyze" / "analyze.json").read_text())["symmetry"]
+    for doc in symmetry.values():
+        assert set(doc["kept"]) <= set(doc["deviation_percent"])
+        assert all(doc["deviation_percent"][n] < doc["tolerance_percent"] for n in doc["kept"])
+    assert "symmetry operations of the cell kept" in (root / "report.html").read_text()
+
 
 def test_scan_is_physical(tiny_run):
     root, _, _ = tiny_run

@@ -61,6 +61,14 @@ class SymmetryReport:
         """Names of the operations broken beyond the tolerance."""
         return [op.name for op in self.operations if not op.kept]
 
+    def to_json(self) -> dict:
+        """JSON-ready form: tolerance, kept operations and every deviation (%)."""
+        return {
+            "tolerance_percent": 100 * self.tolerance,
+            "kept": self.kept,
+            "deviation_percent": {op.name: 100 * op.deviation for op in self.operations},
+        }
+
     def summary(self) -> str:
         """One line: kept and broken operations with their deviations (%)."""
         parts = [f"{op.name} {100 * op.deviation:.2g}%" for op in self.operations]

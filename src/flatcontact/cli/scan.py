@@ -254,12 +254,7 @@ def scan_command(
             out_dir,
             relax,
             order=s.order,
-            executor_options={
-                "kind": s.executor,
-                "workers": s.workers,
-                "dask_address": s.dask_address,
-                "jobqueue": s.jobqueue,
-            },
+            executor_options=s.executor_options(),
             progress=not as_json,
             console=console,
         )
