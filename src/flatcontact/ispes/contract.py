@@ -184,11 +184,7 @@ def _to_contract_units(ds: xr.Dataset, source: str) -> xr.Dataset:
             )
         if factors[unit] != 1.0:
             attrs = {**ds[name].attrs, "units": UNITS[name]}
-            ds = (
-                ds.assign_coords({name: ds[name] * factors[unit]})
-                if name in ds.coords
-                else (ds.assign({name: ds[name] * factors[unit]}))
-            )
+            ds = ds.assign({name: ds[name] * factors[unit]})
             ds[name].attrs.update(attrs)
     return ds
 
