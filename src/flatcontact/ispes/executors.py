@@ -184,8 +184,13 @@ class DaskExecutor(SerialExecutor):
             ) from None
         except ValueError as exc:
             raise InputError(f"dask-address {address!r}: not a scheduler address ({exc})") from None
+
+    @property
+    def workers(self) -> int:
+        """Worker threads the scheduler has now (asked each time: workers join and leave,
+        e.g. ``dask worker`` processes started after the client, or a batch job queue)."""
         info = self._client.scheduler_info()
-        self.workers = max(1, sum(w.get("nthreads", 1) for w in info.get("workers", {}).values()))
+        return max(1, sum(w.get("nthreads", 1) for w in info.get("workers", {}).values()))
 
     @classmethod
     def local(cls, workers: int = 2) -> DaskExecutor:
