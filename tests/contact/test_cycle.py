@@ -291,3 +291,24 @@ def test_records_and_dataset_merge_with_contact_nc():
     merged = xr.merge([analyse([1.0, 1.77], P).to_dataset(), ds])
     assert merged.sizes["p0"] == 2
     assert merged["cycle_loop_force"].attrs["units"] == "uN"
+
+
+def test_figures_draw_what_they_say(tmp_path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from flatcontact.plots import cycle as pc
+
+    fig = pc.fig_loops(P, p0_gpa=(1.0,), fractions=(0.3, 0.9))
+    (ax,) = fig.axes
+    lines = ax.get_lines()
+    # two loops, the loading branch, and the two axis lines
+    loops = [ln for ln in lines if ln.get_label().startswith("Q_amp")]
+    assert len(loops) == 2
+    u, q = loops[1].get_data()
+    assert np.max(u) == pytest.approx(-np.min(u))
+    assert np.max(q) == pytest.approx(-np.min(q))
+    fig2 = pc.fig_lockin_overlay(P, p0_gpa=(1.0, 2.0))
+    assert len(fig2.axes[0].get_lines()) == 4
+    fig2.savefig(tmp_path / "overlay.png", dpi=40)
+    assert (tmp_path / "overlay.png").stat().st_size > 0
