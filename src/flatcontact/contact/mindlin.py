@@ -57,7 +57,11 @@ not in between (see :func:`classical_limit_of_paper_model` and docs/contact.md).
 Classical Cattaneo–Mindlin (Johnson, *Contact Mechanics*, 1985, §7.2)
 --------------------------------------------------------------------
 c/a = (1 − Q/μP)^(1/3), δ = 3μP/(16 G*_J a)·[1 − (1 − Q/μP)^(2/3)] with
-1/G*_J = (2−ν1)/G1 + (2−ν2)/G2 (Johnson's convention; paper's G* = 4 G*_J).
+1/G*_J = (2−ν1)/G1 + (2−ν2)/G2 (Johnson's convention; paper's G* = 4 G*_J). The theory,
+with Mindlin–Deresiewicz unloading and the energy per cycle, is
+:mod:`flatcontact.contact.cattaneo_mindlin`; ``cattaneo_mindlin_*`` here are its loading
+functions under their old names. Unloading, reloading and the steady cycle of the
+modified model: :mod:`flatcontact.contact.cycle`.
 """
 
 from __future__ import annotations

@@ -119,10 +119,10 @@ def fig_fit(comparison: fit.ModelComparison) -> Figure:
         vals = res.params.as_dict()
         return ", ".join(f"{k} = {vals[k]:.4g} ± {res.standard_errors[k]:.2g}" for k in res.free)
 
-    ax.set_title(
+    fig.suptitle(
         f"modified (—): {text(mod)}; AICc {mod.aicc:.1f}\nclassical (⋯): {text(cla)}; "
         f"AICc {cla.aicc:.1f}",
-        fontsize=7,
+        fontsize=8,
     )
     ax.set_xlabel(f"mean shear stress, {mod.measure} (MPa)")
     ax.set_ylabel(f"lateral stiffness, {mod.stiffness} (N/m)")
