@@ -122,3 +122,20 @@ def test_parameter_names_fixed_and_freed():
         fit.fit_stiffness_curves(curves, TRUE, ("tau",))
     with pytest.raises(InputError, match=r"does not enter the classical model"):
         fit.fit_stiffness_curves(curves, TRUE, ("tau0_mpa",), model="classical")
+
+
+def test_fit_figure_shows_data_models_and_residuals():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from flatcontact.plots.cycle import fig_fit
+
+    curves, _ = _synthetic(TRUE, 0.01, seed=5, n=8)
+    cmp = fit.fit_and_compare(curves, TRUE, ("tau0_mpa",))
+    fig = fig_fit(cmp)
+    ax, bx = fig.axes
+    # per load: data, modified, classical; residuals of both models
+    assert len(ax.get_lines()) == 3 * len(LOADS)
+    assert len(bx.get_lines()) == 2 * len(LOADS) + 1
+    _, r = bx.get_lines()[0].get_data()
+    np.testing.assert_allclose(r, cmp.modified.residuals_n_per_m[0])

@@ -349,8 +349,14 @@ class SteadyCycle:
         return np.pi * self.force_amplitude_n * self.quadrature_displacement_m
 
 
-class _Model:
-    """Loading/unloading of one model at one p0, vectorised over amplitudes."""
+class CycleModel:
+    """Loading and unloading of one model at one p0, vectorised over amplitudes.
+
+    Attributes: ``a`` (Hertz radius, m), ``gross`` (the gross-sliding force, N: Q_peak or
+    μP), ``k0`` (initial stiffness, N/m). Methods give the loading displacement at an
+    amplitude, the unloading decrement Q_amp − Q at Δ, the energy per cycle and the paper's
+    d⟨Q⟩/d⟨u⟩. Raises InputError (one line) outside the model's domain.
+    """
 
     def __init__(self, model: str, p0_pa: float, params: ContactParameters):
         self.model = check_model(model)
@@ -452,7 +458,7 @@ def steady_cycle(
         An amplitude <= 0 or at/above gross sliding, a p0 outside the model's domain,
         σ > τ somewhere (modified), k <= 0 (classical).
     """
-    mdl = _Model(model, p0_pa, params)
+    mdl = CycleModel(model, p0_pa, params)
     qa = check_amplitudes(amplitude_n, mdl.gross, mdl.p0 / units.GPA_TO_PA, model)
     u_amp = np.asarray(mdl.amplitude_displacement(qa), dtype=float)
     delta, w = _phi_nodes(u_amp, mdl.delta_breaks(u_amp))
@@ -502,7 +508,7 @@ def loops(
     unloading force is not monotone in Δ the load-controlled path holds Q and jumps in u.
     """
     require(n_points >= 3, f"n_points must be >= 3, got {n_points!r}")
-    mdl = _Model(model, p0_pa, params)
+    mdl = CycleModel(model, p0_pa, params)
     qa = check_amplitudes(amplitude_n, mdl.gross, mdl.p0 / units.GPA_TO_PA, model)
     u_amp = np.asarray(mdl.amplitude_displacement(qa), dtype=float)
     phi = np.linspace(0.0, np.pi, n_points)
@@ -556,7 +562,7 @@ def validate_cycle_request(
     check_model(model)
     p0_list = params.check_p0_gpa(p0_gpa)
     for p in p0_list:
-        mdl = _Model(model, p * units.GPA_TO_PA, params)
+        mdl = CycleModel(model, p * units.GPA_TO_PA, params)
         _amplitudes_for(mdl.gross, amplitudes_un, amplitude_fractions, p, model)
     return p0_list
 
@@ -577,7 +583,7 @@ def cycles(
     out = []
     for p in p0_list:
         p0 = p * units.GPA_TO_PA
-        mdl = _Model(model, p0, params)
+        mdl = CycleModel(model, p0, params)
         qa = _amplitudes_for(mdl.gross, amplitudes_un, amplitude_fractions, p, model)
         out.append(steady_cycle(qa, p0, params, model))
     return tuple(out)
@@ -695,5 +701,5 @@ def lockin_curve(
     """The lock-in stiffness curve of one p0 over amplitudes (default: the paper curve's
     :func:`oscillation.amplitude_grid` without 0), for the Fig. 5b/6 overlays."""
     f = oscillation.amplitude_grid(120, 30, closest=1e-6)[1:] if fractions is None else fractions
-    mdl = _Model(model, p0_pa, params)
+    mdl = CycleModel(model, p0_pa, params)
     return steady_cycle(np.asarray(f) * mdl.gross, p0_pa, params, model)

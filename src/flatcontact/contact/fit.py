@@ -266,7 +266,7 @@ def model_stiffness(
     require(stiffness in STIFFNESS_KINDS, f"stiffness must be one of {STIFFNESS_KINDS}")
     factor = experiment._measure_factor(measure)
     p0 = curve.p0_gpa * units.GPA_TO_PA
-    mdl = cycle._Model(model, p0, params)
+    mdl = cycle.CycleModel(model, p0, params)
     qa = curve.stress_pa * np.pi * mdl.a**2 / factor
     inside = (qa > 0.0) & (qa < mdl.gross * (1.0 - 1e-12))
     out = np.zeros_like(qa)

@@ -45,7 +45,7 @@ def fig_loops(
             )
         # the loading branch from rest: the first quarter cycle
         q = np.linspace(0.0, cyc.force_amplitude_n[-1], 200)
-        u = cycle._Model(model, p0_pa, params).amplitude_displacement(q)
+        u = cycle.CycleModel(model, p0_pa, params).amplitude_displacement(q)
         ax.plot(np.asarray(u) / units.NM_TO_M, q * units.N_TO_UN, "k--", lw=0.8, label="loading")
         ax.axhline(0, color="0.7", lw=0.5)
         ax.axvline(0, color="0.7", lw=0.5)
