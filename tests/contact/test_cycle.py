@@ -235,6 +235,19 @@ def test_closed_forms_against_direct_time_stepping(prm, p0_gpa):
         )
 
 
+def test_slow_amplitude_ramp_reaches_the_same_steady_cycle():
+    # the experiment ramps the amplitude up; a sudden start and a ramp give the same loop
+    p0 = 1.77e9
+    c = cycle.cycles([1.77], P, amplitude_fractions=[0.8])[0]
+    ref = time_stepped_cycle(
+        c.force_amplitude_n[0], p0, P, n_elements=1500, steps=360, ramp_cycles=3
+    )
+    assert ref.dissipated_energy_j == pytest.approx(c.dissipated_energy_j[0], rel=1e-2)
+    assert ref.in_phase_displacement_m == pytest.approx(c.in_phase_displacement_m[0], rel=2e-3)
+    # and the loop is centred (no offset from the history)
+    assert np.max(ref.displacement_m) == pytest.approx(-np.min(ref.displacement_m), rel=2e-3)
+
+
 def test_lockin_limits_and_paper_construction():
     c = cycle.lockin_curve(1.0e9, P)
     k0 = c.initial_stiffness_n_per_m

@@ -52,8 +52,13 @@ def time_stepped_cycle(
     n_elements: int = 2000,
     steps: int = 720,
     cycles: int = 2,
+    ramp_cycles: int = 0,
 ) -> SteppedCycle:
-    """Simulate ``cycles`` cycles of Q = Q_amp sin θ from rest; return the last one."""
+    """Simulate ``cycles`` cycles of Q = Q_amp sin θ from rest; return the last one.
+
+    ``ramp_cycles`` > 0: the amplitude first grows linearly from 0 to Q_amp over that many
+    cycles (an experiment's slow ramp), then ``cycles`` cycles at Q_amp follow.
+    """
     a = float(mindlin.contact_radius(p0_pa, params))
     s = (np.arange(n_elements) + 0.5) / n_elements
     da = 2.0 * np.pi * a**2 * s / n_elements
@@ -83,11 +88,12 @@ def time_stepped_cycle(
     u_prev, q_prev = 0.0, 0.0
     us = np.zeros(steps)
     qs = amplitude_n * np.sin(theta)
-    for c in range(cycles):
+    for c in range(ramp_cycles + cycles):
         for j in range(steps):
             if c == 0 and j == 0:
                 continue
-            target = qs[j]
+            ramp = min(1.0, (c + j / steps) / ramp_cycles) if ramp_cycles > 0 else 1.0
+            target = ramp * qs[j]
 
             def mismatch(u, up=u_prev, t=target):
                 return float(np.dot(update(u, up)[0], da)) - t
