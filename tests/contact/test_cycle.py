@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import quad
 
@@ -113,6 +113,15 @@ def test_loading_branch_of_the_element_rule_is_the_paper_q_of_u(case):
 
 @settings(max_examples=40, deadline=None)
 @given(sigma_below_tau())
+@example(
+    (
+        ContactParameters(
+            k_mpa_per_gpa=-2.2e-309, tau0_mpa=1.0, mu_mpa_per_gpa=0.0, sigma0_mpa=0.0
+        ),
+        1.0,
+        0.5,
+    )
+)
 def test_energy_equals_pi_qamp_quadrature_for_any_laws(case):
     # W from every element's own loop (closed form) = ∮Q du = π Q_amp u''_1 of the loop
     prm, p0_gpa, frac = case

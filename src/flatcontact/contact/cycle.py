@@ -265,7 +265,7 @@ def _unloading_drive_breaks(x, p0, params: ContactParameters):
     t0, s0 = params.tau0_pa, params.sigma0_pa
     r1, r2 = _roots01(kp, t0, x)
     c2 = np.asarray(kp + mp, dtype=float)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # k + μ -> 0−
         v = np.where(c2 < 0.0, -(t0 + s0) / (2.0 * np.where(c2 < 0.0, c2, -1.0)), 1.0)
     v = np.clip(np.where(np.isfinite(v), v, 1.0), 0.0, 1.0)
     pts = [r1, r2, v, np.ones_like(r1)]
