@@ -43,6 +43,27 @@ def layer_ids(atoms, fallback_planes: bool = False) -> np.ndarray:
     return ids
 
 
+def plane_ids(z: np.ndarray, groups: np.ndarray, symbols: list[str]) -> list[int]:
+    """Index of the atomic plane of each atom among the atoms of its group and element.
+
+    Planes are found along the sorted z of those atoms, a new one after a gap > 1 Å (for
+    ``ilp/tmd``, whose normals use neighbours of the same LAMMPS type: the top and bottom
+    chalcogen planes of a TMD layer must be different types).
+    """
+    out = [0] * len(z)
+    sym = np.asarray(symbols)
+    for g in set(groups.tolist()):
+        for e in set(symbols):
+            idx = np.flatnonzero((groups == g) & (sym == e))
+            order = idx[np.argsort(z[idx])]
+            plane = 0
+            for k, i in enumerate(order):
+                if k and z[i] - z[order[k - 1]] > 1.0:
+                    plane += 1
+                out[i] = plane
+    return out
+
+
 def compile_setup(model, atoms, bulk: bool = False) -> LammpsSetup:
     """The :class:`LammpsSetup` of ``model`` for ``atoms`` (see the module docstring)."""
     from flatcontact.potentials.model import slab_ids
@@ -64,11 +85,21 @@ def compile_setup(model, atoms, bulk: bool = False) -> LammpsSetup:
     else:
         groups = slabs
     group_ids = sorted(set(groups.tolist()))
-    gindex = {g: k for k, g in enumerate(group_ids)}
-    eindex = {e: k for k, e in enumerate(elements)}
-    types = [gindex[g] * ne + eindex[s] + 1 for g, s in zip(groups.tolist(), symbols, strict=True)]
-    type_elements = [e for _ in group_ids for e in elements]
-    type_group = [g for g in group_ids for _ in elements]
+    if model.type_per_plane:
+        planes = plane_ids(atoms.positions[:, 2], groups, symbols)
+        keys = sorted({(g, s, p) for g, s, p in zip(groups.tolist(), symbols, planes, strict=True)})
+        index = {k: n + 1 for n, k in enumerate(keys)}
+        types = [index[k] for k in zip(groups.tolist(), symbols, planes, strict=True)]
+        type_elements = [k[1] for k in keys]
+        type_group = [k[0] for k in keys]
+    else:  # every group with every element (types stable across structures of one material)
+        gindex = {g: k for k, g in enumerate(group_ids)}
+        eindex = {e: k for k, e in enumerate(elements)}
+        types = [
+            gindex[g] * ne + eindex[s] + 1 for g, s in zip(groups.tolist(), symbols, strict=True)
+        ]
+        type_elements = [e for _ in group_ids for e in elements]
+        type_group = [g for g in group_ids for _ in elements]
     ntypes = len(type_elements)
     # the slab of each type (for LJ across slabs): groups never straddle slabs
     type_slab = [0] * ntypes
@@ -76,6 +107,7 @@ def compile_setup(model, atoms, bulk: bool = False) -> LammpsSetup:
         type_slab[t - 1] = s
 
     def element_map(style, group=None) -> str:
+        # types without atoms are mapped too: LAMMPS wants every type pair covered
         known = set(style.known_elements)
         return " ".join(
             e if e in known and (group is None or type_group[t] == group) else "NULL"
@@ -148,9 +180,22 @@ def compile_setup(model, atoms, bulk: bool = False) -> LammpsSetup:
             seen[name] = seen.get(name, 0) + 1
             index = f" {seen[name]}" if names.count(name) > 1 else ""
             commands.append(" ".join(f"pair_coeff * * {name}{index} {args} {mapping}".split()))
+        covered = set()
+        for _style, _args, mapping in instances:
+            on = [t + 1 for t, e in enumerate(mapping.split()) if e != "NULL"] if mapping else []
+            covered |= {(ti, tj) for ti in on for tj in on if ti <= tj}
         if lj_table is not None:
             commands += lj_coeffs("lj/cut ")
             commands.append("pair_modify pair lj/cut shift yes")
+            covered |= set(cross_pairs())
+        # type pairs no sub-style covers (e.g. different layers with coupling none) interact
+        # through nothing; LAMMPS wants them declared
+        commands += [
+            f"pair_coeff {ti} {tj} none"
+            for ti in range(1, ntypes + 1)
+            for tj in range(ti, ntypes + 1)
+            if (ti, tj) not in covered
+        ]
     return LammpsSetup(
         types=tuple(types),
         type_elements=tuple(type_elements),

@@ -142,7 +142,7 @@ class LJSpec(BaseModel):
             return self.c6_scale
         from flatcontact.potentials.lj import hamaker_c6_scale, lj_table
 
-        missing = sorted(set(elements) - set(self.number_density_per_nm3))
+        missing = sorted(str(e) for e in set(elements) - set(self.number_density_per_nm3))
         if missing:
             raise InputError(
                 f"lj.number_density_per_nm3 lacks the elements {missing} needed for hamaker_zj "
@@ -519,6 +519,10 @@ class InteractionModel(BaseModel):
         ``lj``, ``same``, ``interlayer`` or ``none`` (module docstring).
     interlayer
         The interlayer style for ``coupling: interlayer``.
+    type_per_plane
+        One LAMMPS type per atomic plane of each element within a group (``ilp/tmd`` takes
+        a TMD atom's normal from neighbours of its own type: the two chalcogen planes of a
+        layer must be different types).
     lj
         The LJ of ``coupling: lj`` (reset to its default for any other coupling).
     calculator
@@ -546,6 +550,11 @@ class InteractionModel(BaseModel):
     interlayer: LammpsStyle | None = Field(
         None, description="the interlayer LAMMPS style of coupling interlayer"
     )
+    type_per_plane: bool = Field(
+        False,
+        description="one LAMMPS type per atomic plane of each element within a group "
+        "(ilp/tmd needs the top and bottom chalcogen planes of a layer as different types)",
+    )
     lj: LJSpec = Field(default_factory=LJSpec, description="the LJ of coupling lj")
     calculator: AseCalculatorSpec | None = Field(
         None, description="an ASE calculator {target: module:callable, kwargs, scope} instead"
@@ -559,8 +568,13 @@ class InteractionModel(BaseModel):
         except ValueError as exc:  # pydantic ValidationError -> one line
             errors = getattr(exc, "errors", None)
             if callable(errors):
-                first = errors()[0]
-                where = ".".join(str(p) for p in first.get("loc", ()))
+                # of a union's alternatives, the error that got furthest names the real problem
+                first = max(errors(), key=lambda e: len(e.get("loc", ())))
+                where = ".".join(
+                    str(p)
+                    for p in first.get("loc", ())
+                    if not str(p).startswith(("str", "tuple[", "function-", "LammpsStyle"))
+                )
                 msg = first.get("msg", str(exc)).removeprefix("Value error, ")
                 if first.get("type") == "finite_number":
                     msg = f"expected a finite number, got {first.get('input')!r}"

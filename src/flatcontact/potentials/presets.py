@@ -77,6 +77,7 @@ PRESETS: dict[str, dict] = {
     "mos2-sw-ilp": {
         "intra": [{"pair_style": "sw/mod", "pair_coeff": ["tmd.sw.mod"], "elements": ["Mo", "S"]}],
         "intra_scope": "layer",
+        "type_per_plane": True,
         "coupling": "interlayer",
         "interlayer": {
             "pair_style": "ilp/tmd 16.0 1",
