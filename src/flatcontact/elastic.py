@@ -192,6 +192,18 @@ def _calculator(model, atoms: Atoms):
     return model  # already an ASE calculator
 
 
+def _relaxed_tensor(atoms: Atoms, model, strain: float) -> tuple[Atoms, np.ndarray]:
+    calc = _calculator(model, atoms)
+    relaxed = relax_cell(atoms, calc, fmax=1e-4)
+    return relaxed, elastic_tensor(relaxed, calc, strain=strain, relax_ions=True, fmax=2e-4)
+
+
+_CONVENTIONS = (
+    "Voigt (xx,yy,zz,yz,xz,xy), relaxed ions, Hill averages; "
+    "1/E* = 2(1-nu^2)/E, 1/G*_J = 2(2-nu)/G, G*_paper = 4 G*_J"
+)
+
+
 def crystal_contact_moduli(atoms: Atoms, model, strain: float = 0.005) -> dict:
     """Self-consistent contact moduli of any bulk crystal for any interaction model.
 
@@ -204,17 +216,13 @@ def crystal_contact_moduli(atoms: Atoms, model, strain: float = 0.005) -> dict:
     The Hill average treats the crystal as an isotropic polycrystal, which for strongly
     anisotropic (layered) crystals is a convention to state, not a property of the contact.
     """
-    calc = _calculator(model, atoms)
-    relaxed = relax_cell(atoms, calc, fmax=1e-4)
-    c = elastic_tensor(relaxed, calc, strain=strain, relax_ions=True, fmax=2e-4)
+    relaxed, c = _relaxed_tensor(atoms, model, strain)
     return {
         "cellpar": [float(v) for v in relaxed.cell.cellpar()],
         "strain": strain,
         "tensor_gpa": np.round(c, 3).tolist(),
         "moduli_gpa": isotropic_moduli(c).as_dict(),
-        "conventions": "Voigt (xx,yy,zz,yz,xz,xy), relaxed ions, Hill averages; "
-        "1/E* = 2(1-nu^2)/E, 1/G*_J = 2(2-nu)/G, G*_paper = 4 G*_J",
-        "_tensor": c,
+        "conventions": _CONVENTIONS,
     }
 
 
@@ -231,16 +239,15 @@ def quartz_contact_moduli(potential="sio2-snap", strain: float = 0.005) -> dict:
     """
     from flatcontact.structures.bulk import alpha_quartz
 
-    out = crystal_contact_moduli(alpha_quartz(), potential, strain)
-    c = out.pop("_tensor")
-    cellpar = out.pop("cellpar")
+    q, c = _relaxed_tensor(alpha_quartz(), potential, strain)
+    cp = q.cell.cellpar()
     return {
         "potential": potential if isinstance(potential, str) else potential.label,
-        "a_angstrom": cellpar[0],
-        "c_angstrom": cellpar[2],
+        "a_angstrom": float(cp[0]),
+        "c_angstrom": float(cp[2]),
         "strain": strain,
         "cij_gpa": {k: float(v) for k, v in trigonal_constants(c).items()},
-        "tensor_gpa": out["tensor_gpa"],
-        "moduli_gpa": out["moduli_gpa"],
-        "conventions": out["conventions"],
+        "tensor_gpa": np.round(c, 3).tolist(),
+        "moduli_gpa": isotropic_moduli(c).as_dict(),
+        "conventions": _CONVENTIONS,
     }
