@@ -173,3 +173,22 @@ def test_intralayer_instances_do_not_cross_the_layers():
     assert tool_energy(intra_only, close) == pytest.approx(tool_energy(intra_only, far), abs=1e-9)
     whole = InteractionModel(intra=model.intra, coupling="same")  # one REBO over both layers
     assert abs(tool_energy(whole, close) - tool_energy(whole, far)) > 0.1
+
+
+@pytest.mark.parametrize("preset", ["graphene-hbn-ilp", "mos2-sw-ilp"])
+def test_forces_are_minus_the_energy_gradient(preset):
+    """Rattled bilayers: the engine's forces equal central differences of its energy."""
+    atoms = CASES[preset][0](SHIFTS["SP"]).repeat((2, 2, 1))
+    atoms.rattle(0.05, seed=11)
+    atoms.calc = InteractionModel(preset=preset).interface_calculator(atoms)
+    forces = atoms.get_forces()
+    h = 1e-5
+    for index in (0, len(atoms) - 1):
+        for axis in range(3):
+            x0 = atoms.positions[index, axis]
+            atoms.positions[index, axis] = x0 + h
+            ep = atoms.get_potential_energy()
+            atoms.positions[index, axis] = x0 - h
+            em = atoms.get_potential_energy()
+            atoms.positions[index, axis] = x0
+            assert forces[index, axis] == pytest.approx(-(ep - em) / (2 * h), abs=1e-5)

@@ -225,3 +225,13 @@ def test_bad_model_data_is_one_line_naming_the_field():
         with pytest.raises(InputError, match=message) as info:
             InteractionModel(**data)
         assert "\n" not in str(info.value)
+
+
+def test_sio2_preset_is_todays_default_model(close_interface):
+    """The sio2-snap-lj preset is the default run's model: same data, same energy and forces."""
+    default = build_config({}).potential
+    preset = InteractionModel(preset="sio2-snap-lj")
+    assert preset.model_copy(update={"preset": None}) == default
+    e_default, f_default = energy(default, close_interface)
+    e_preset, f_preset = energy(preset, close_interface)
+    assert e_preset == e_default and np.array_equal(f_preset, f_default)

@@ -532,7 +532,9 @@ class InteractionModel(BaseModel):
     model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
 
     preset: str | None = Field(
-        None, description="a named model (flatcontact.potentials.presets); the fields override it"
+        None,
+        description=f"a named model ({', '.join(PRESETS)}; docs/potentials.md); "
+        "fields given beside it override the preset's",
     )
     intra: str | tuple[LammpsStyle, ...] = Field(
         "vashishta",
