@@ -83,10 +83,18 @@ CASES = {
     ),
     "hbn-tersoff-ilp": (
         *HBN,
-        [
-            "pair_style hybrid/overlay tersoff ilp/graphene/hbn 16.0 1",
+        [  # as in the LAMMPS example in.bilayer-hBN: Coulomb only across the layers
+            "pair_style hybrid/overlay tersoff ilp/graphene/hbn 16.0 1 coul/shield 16.0 1",
             f"pair_coeff * * tersoff {f('BNC.tersoff')} B N B N",
             f"pair_coeff * * ilp/graphene/hbn {f('BNCH.ILP')} B N B N",
+            "pair_coeff 1 3 coul/shield 0.70",
+            "pair_coeff 1 4 coul/shield 0.69498201415576216335",
+            "pair_coeff 2 3 coul/shield 0.69498201415576216335",
+            "pair_coeff 2 4 coul/shield 0.69",
+            "set type 1 charge 0.42",
+            "set type 3 charge 0.42",
+            "set type 2 charge -0.42",
+            "set type 4 charge -0.42",
         ],
     ),
     "graphene-hbn-ilp": (
@@ -94,10 +102,15 @@ CASES = {
         [1, 1, 2, 3],
         [1, 1, 2, 2],
         [
-            "pair_style hybrid/overlay rebo tersoff ilp/graphene/hbn 16.0 1",
+            "pair_style hybrid/overlay rebo tersoff ilp/graphene/hbn 16.0 1 coul/shield 16.0 1",
             f"pair_coeff * * rebo {f('CH.rebo')} C NULL NULL",
             f"pair_coeff * * tersoff {f('BNC.tersoff')} NULL B N",
             f"pair_coeff * * ilp/graphene/hbn {f('BNCH.ILP')} C B N",
+            "pair_coeff 2 2 coul/shield 0.70",
+            "pair_coeff 2 3 coul/shield 0.69498201415576216335",
+            "pair_coeff 3 3 coul/shield 0.69",
+            "set type 2 charge 0.42",
+            "set type 3 charge -0.42",
         ],
     ),
     "mos2-sw-ilp": (
