@@ -205,3 +205,27 @@ def test_forces_are_minus_the_energy_gradient(preset):
             em = atoms.get_potential_energy()
             atoms.positions[index, axis] = x0
             assert forces[index, axis] == pytest.approx(-(ep - em) / (2 * h), abs=1e-5)
+
+
+def test_bulk_graphite_binds_about_twice_the_bilayer():
+    """The bulk calculator of an interlayer model finds the layers of a crystal (atomic planes)
+    and keeps REBO per layer: AB graphite at c = 2d binds each atom to two neighbouring layers,
+    so its binding per atom is about twice the AB bilayer's (next-nearest layers add a few %)."""
+    model = InteractionModel(preset="graphene-rebo-kc")
+    a, d = 2.46, 3.4
+
+    def graphite(c):
+        cell = [[a, 0, 0], [a / 2, a * np.sqrt(3) / 2, 0], [0, 0, c]]
+        frac = [[0, 0, 0], [1 / 3, 1 / 3, 0], [0, 0, 0.5], [2 / 3, 2 / 3, 0.5]]
+        return Atoms("C4", scaled_positions=frac, cell=cell, pbc=True)
+
+    def bulk_energy(atoms):
+        atoms.calc = model.bulk_calculator(atoms)
+        return atoms.get_potential_energy() / len(atoms)
+
+    bulk_binding = bulk_energy(graphite(2 * d)) - bulk_energy(graphite(40.0))
+    build = CASES["graphene-rebo-kc"][0]
+    bilayer = (
+        tool_energy(model, build(SHIFTS["AB"])) - tool_energy(model, build(SHIFTS["AB"], 30.0))
+    ) / 4
+    assert 1.9 < bulk_binding / bilayer < 2.2

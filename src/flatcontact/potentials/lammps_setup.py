@@ -217,6 +217,8 @@ def compile_setup(model, atoms, bulk: bool = False) -> LammpsSetup:
             for tj in range(ti, ntypes + 1)
             if (ti, tj) not in covered
         ]
+    if interlayer:  # 16 Å interlayer cutoffs in small periodic cells: long neighbour lists
+        commands.append("neigh_modify one 20000 page 400000")
     return LammpsSetup(
         types=tuple(types),
         type_elements=tuple(type_elements),
