@@ -133,7 +133,7 @@ def orient(bulk: Atoms, miller, field_name: str = "miller") -> OrientedBulk:
         ) from None
     d = float(one.cell.array[2, 2])
     require(d > 1e-3, f"{field_name}={list(hkl)}: no slab (zero repeat along the normal)")
-    cuts = cleavage_heights(one, d)
+    cuts = _distinct_cuts(prim, hkl_p, cleavage_heights(one, d), d)
     return OrientedBulk(
         atoms=prim,
         miller=hkl,
@@ -148,6 +148,27 @@ def orient(bulk: Atoms, miller, field_name: str = "miller") -> OrientedBulk:
             "terminations": len(cuts),
         },
     )
+
+
+def _distinct_cuts(
+    prim: Atoms, hkl: tuple[int, int, int], cuts: np.ndarray, d: float
+) -> np.ndarray:
+    """Drop cuts that give the same one-layer slab as an earlier one (same heights and species
+    in the same order, e.g. the three cuts related by α-quartz's 3₂ screw axis)."""
+    two = ase_surface(prim, hkl, 2, periodic=False)
+    z = two.positions[:, 2]
+    seen, keep = set(), []
+    for cut in cuts:
+        inside = (z >= cut + 1e-6) & (z < cut + d + 1e-6)
+        zz = z[inside] - z[inside].min()
+        order = np.lexsort((two.numbers[inside], np.round(zz, 3)))
+        key = tuple(
+            zip(np.round(zz[order], 3).tolist(), two.numbers[inside][order].tolist(), strict=True)
+        )
+        if key not in seen:
+            seen.add(key)
+            keep.append(cut)
+    return np.asarray(keep)
 
 
 def crystal_slab(

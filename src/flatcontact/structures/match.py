@@ -110,7 +110,8 @@ def twist_match(a: np.ndarray, m: int, n: int, field: str = "twist") -> tuple[Ma
     v = np.array([[n, m], [-m, m + n]]) @ basis
     p1 = integer_matrix(t, a, field)
     p2 = integer_matrix(v, a, field)
-    theta = float(np.degrees(np.arctan2(np.cross(v[0], t[0]), v[0] @ t[0])))
+    cross = v[0, 0] * t[0, 1] - v[0, 1] * t[0, 0]
+    theta = float(np.degrees(np.arctan2(cross, v[0] @ t[0])))
     return Match(p1, p2, t, "twist"), theta
 
 
