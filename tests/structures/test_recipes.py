@@ -148,7 +148,7 @@ def test_flip_and_terminations_of_a_polar_crystal(tmp_path):
     plain, report = build_interface(base)
     assert report["recipe"]["slab1"]["terminations"] == 2
     sym = np.array(plain.get_chemical_symbols())
-    slab, layer = plain.arrays["slab"], plain.arrays["layer"]
+    layer = plain.arrays["layer"]
     for k in np.unique(layer):  # every layer is one Na and one Cl plane (stoichiometric)
         assert sorted(sym[layer == k]) == ["Cl", "Na"]
 
