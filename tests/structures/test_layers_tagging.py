@@ -8,7 +8,7 @@ from ase.build import bulk
 from ase.io import write
 
 from flatcontact.errors import InputError
-from flatcontact.structures.build import SHIPPED_DENSE_SLAB, load_shipped_dense_slab
+from flatcontact.structures.build import load_shipped_dense_slab
 from flatcontact.structures.dense import DENSE_FACE_LAYERS, QUARTZ_ATOMS_PER_LAYER
 from flatcontact.structures.interface import (
     face_tags,
@@ -19,7 +19,7 @@ from flatcontact.structures.interface import (
     validate_interface,
     write_interface,
 )
-from flatcontact.structures.layers import atomic_planes, sheet_layers
+from flatcontact.structures.layers import atomic_planes, chunk_layers, sheet_layers
 from flatcontact.structures.recipe import build_interface
 
 
@@ -106,9 +106,10 @@ def test_quartz_interface_tags_unchanged():
     1 and 4, the thickness the paper's, layers = the dense face (2 units) + O-Si-O units."""
     slab, _ = load_shipped_dense_slab()
     face = DENSE_FACE_LAYERS * QUARTZ_ATOMS_PER_LAYER
-    ref = make_interface(slab, 3.0, face_atoms=face)
+    ref = make_interface(
+        slab, 3.0, face_atoms=face, slab_layers=chunk_layers(slab, face, QUARTZ_ATOMS_PER_LAYER)
+    )
     tags = face_tags(slab, face_atoms=face)
-    n = len(slab)
     expected = np.concatenate(
         [np.select([tags == 1, tags == 2], [1, 2], 0), np.select([tags == 1, tags == 2], [3, 4], 0)]
     )
@@ -118,9 +119,28 @@ def test_quartz_interface_tags_unchanged():
     assert thickness(ref) == pytest.approx(z[s == 4].mean() - z[s == 1].mean(), abs=1e-12)
     layer = ref.arrays["layer"]
     counts = [int(np.sum(layer == k)) for k in range(1, layer.max() + 1)]
-    assert counts[0] == face and counts[-1] == face and sum(counts) == 2 * n
+    assert counts == [6, 3, 3, 6, 6, 3, 3, 6]  # 6 O-Si-O units per slab, dense face = 2 units
+    for k in range(1, 9):  # every unit and face layer is stoichiometric SiO2
+        sym = np.array(ref.get_chemical_symbols())[layer == k]
+        assert 2 * np.sum(sym == "Si") == np.sum(sym == "O")
     validate_interface(ref)
-    assert SHIPPED_DENSE_SLAB.is_file()
+
+
+def test_quartz_recipe_is_the_dense_builder():
+    """build_interface(quartz-dense) = build_quartz_interface (same positions, tags, thickness)."""
+    from flatcontact.potentials import PotentialSpec
+    from flatcontact.structures.build import QUARTZ_MATERIAL, build_quartz_interface
+
+    spec = PotentialSpec(intra="vashishta")
+    atoms, report = build_interface({"kind": "quartz-dense", "source": "shipped"}, potential=spec)
+    direct, _ = build_quartz_interface(spec, layers=6, source="shipped")
+    np.testing.assert_array_equal(atoms.positions, direct.positions)
+    np.testing.assert_array_equal(atoms.arrays["surface"], direct.arrays["surface"])
+    np.testing.assert_array_equal(atoms.arrays["held"], np.isin(atoms.arrays["surface"], (1, 4)))
+    assert atoms.info["material"] == QUARTZ_MATERIAL
+    assert report["thickness_angstrom"] == thickness(atoms)
+    with pytest.raises(InputError, match="needs a potential"):
+        build_interface({"kind": "quartz-dense"})
 
 
 def test_old_interface_file_gets_default_held_and_found_layers(tmp_path):

@@ -522,7 +522,6 @@ def build_interface(
             gap_angstrom=recipe.gap_angstrom,
             fmax_ev_per_angstrom=recipe.fmax_ev_per_angstrom,
         )
-        atoms.info["material"] = "SiO2 (alpha-quartz)"
         return atoms, report
     if isinstance(recipe, FileRecipe):
         from flatcontact.structures.crystal import file_record
