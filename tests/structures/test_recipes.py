@@ -239,3 +239,41 @@ def test_parse_recipe_names_the_field():
         parse_recipe({"kind": "nanotube"})
     recipe = parse_recipe({"kind": "quartz-dense"})
     assert recipe.layers == 6 and recipe.source == "auto" and recipe.gap_angstrom == 3.0
+
+
+def test_slab_files_monolayer_sheets_and_metal(tmp_path):
+    """A monolayer file (the case that once could not be tagged), a 3-sheet file, a Cu slab."""
+    from ase.build import fcc111, graphene
+
+    from flatcontact.structures.interface import validate_interface
+
+    mono = graphene(formula="C2", a=2.46, vacuum=8.0)
+    write(tmp_path / "g1.extxyz", mono)
+    atoms, report = build_interface(
+        {"kind": "slab", "file": str(tmp_path / "g1.extxyz"), "gap_angstrom": 3.35}
+    )
+    assert atoms.arrays["surface"].tolist() == [2, 2, 3, 3] and atoms.arrays["held"].all()
+    assert thickness(atoms) == pytest.approx(3.35, abs=1e-9)
+    validate_interface(atoms)
+    three, _ = build_interface(
+        {"kind": "sheets", "sheet": "graphene", "layers": 3, "stacking": "AB"}
+    )
+    write(tmp_path / "g3.extxyz", three[three.arrays["slab"] == 1])
+    atoms, report = build_interface({"kind": "slab", "file": str(tmp_path / "g3.extxyz")})
+    assert (
+        report["recipe"]["layer_rule"] == "bonded sheets"
+        and report["recipe"]["layers_per_slab"] == 3
+    )
+    assert atoms.arrays["layer"].tolist() == [1, 1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6]
+    cu = fcc111("Cu", size=(1, 1, 5), a=3.615, vacuum=6.0)
+    cu.info.clear()
+    write(tmp_path / "cu.extxyz", cu)
+    atoms, report = build_interface(
+        {"kind": "slab", "file": str(tmp_path / "cu.extxyz"), "held_layers": 2}
+    )
+    assert report["recipe"]["layer_rule"] == "atomic planes"
+    assert atoms.arrays["surface"].tolist() == [1, 1, 0, 0, 2, 3, 0, 0, 4, 4]
+    with pytest.raises(InputError, match="structure.held_layers"):
+        build_interface({"kind": "slab", "file": str(tmp_path / "cu.extxyz"), "held_layers": 5})
+    with pytest.raises(InputError, match="structure.file"):
+        build_interface({"kind": "slab", "file": str(tmp_path / "none.extxyz")})

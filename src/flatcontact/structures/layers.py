@@ -164,3 +164,18 @@ def interface_layers(atoms: Atoms) -> np.ndarray:
         out[idx] = numbered + offset
         offset += int(numbered.max())
     return out
+
+
+def slab_layers(atoms: Atoms, source: str = "slab") -> tuple[np.ndarray, str]:
+    """Layers (1..L from the bottom) of a slab of unknown kind, and the rule used.
+
+    Separate bonded pieces stacked along z → one layer per piece (``"bonded sheets"``);
+    otherwise one layer per atomic plane (``"atomic planes"``, heights within
+    :data:`PLANE_TOLERANCE_ANGSTROM`).
+    """
+    if bonded_components(atoms).max() > 0:
+        try:
+            return sheet_layers(atoms, source), "bonded sheets"
+        except InputError:
+            pass
+    return atomic_planes(atoms.positions[:, 2]) + 1, "atomic planes"

@@ -4,6 +4,7 @@ One pydantic model per ``kind`` (:data:`StructureRecipe`, discriminated by ``kin
 
 ``quartz-dense``  the paper's α-quartz (0001) dense interface (today's numbers);
 ``file``          a prepared ``interface.extxyz`` following the contract;
+``slab``          a prepared slab file, two copies facing each other (layers found from it);
 ``toy-lj``        the two-slab Lennard-Jones toy (tests and demos);
 ``sheets``        2D monolayers (built-in graphene, h-BN, MoS2 or a file), N per slab;
 ``crystal``       a bulk crystal file (CIF, POSCAR, extxyz, ...) + Miller index + termination;
@@ -186,6 +187,23 @@ class FileRecipe(_Model):
     file: str = Field(description="path of an interface.extxyz")
 
 
+class SlabFileRecipe(_Model):
+    """A prepared slab file: two copies facing each other, layers found from the structure."""
+
+    kind: Literal["slab"] = "slab"
+    file: str = Field(
+        description="slab file (any format ASE reads), periodic along cell vectors 1, 2"
+    )
+    gap_angstrom: float = Field(
+        3.0, gt=0, description="highest atom of slab 1 to lowest of slab 2 (Å)"
+    )
+    held_layers: int = Field(1, ge=1, description="outer layers held (rigid) per slab")
+    flip: bool = Field(False, description="slab 2 = slab 1 upside down (rotated 180° about a1)")
+    fmax_ev_per_angstrom: float = Field(
+        0.01, gt=0, description="force tolerance of the reference relaxation (when a calculator is given)"
+    )
+
+
 class ToyRecipe(_Model):
     """The toy two-slab Lennard-Jones interface (flatcontact.ispes.toy)."""
 
@@ -197,11 +215,17 @@ class ToyRecipe(_Model):
 
 
 StructureRecipe = Annotated[
-    QuartzDenseRecipe | FileRecipe | ToyRecipe | SheetsRecipe | CrystalRecipe | Fcc111Recipe,
+    QuartzDenseRecipe
+    | FileRecipe
+    | SlabFileRecipe
+    | ToyRecipe
+    | SheetsRecipe
+    | CrystalRecipe
+    | Fcc111Recipe,
     Field(discriminator="kind"),
 ]
 _ADAPTER: TypeAdapter = TypeAdapter(StructureRecipe)
-KINDS = ("quartz-dense", "file", "toy-lj", "sheets", "crystal", "fcc111")
+KINDS = ("quartz-dense", "file", "slab", "toy-lj", "sheets", "crystal", "fcc111")
 
 #: (dotted field path, recipe kind) of every field that names a file, for path resolution.
 FILE_FIELDS = ("file", "bulk", "slab2.bulk", "sheet", "slab2.sheet")
@@ -382,6 +406,52 @@ def _flip(slab: Atoms, field: str) -> Atoms:
     return out
 
 
+def build_from_slab_file(recipe: SlabFileRecipe) -> tuple[Atoms, dict]:
+    """Two copies of a slab file facing each other (slab 2 translated, or flipped)."""
+    from ase.io import read
+
+    from flatcontact.structures.assemble import finish_interface, stack_pair
+    from flatcontact.structures.cell2d import standard_slab
+    from flatcontact.structures.crystal import file_record
+    from flatcontact.structures.layers import slab_layers
+
+    path = Path(recipe.file)
+    require(path.is_file(), f"{_FIELD}.file: '{path}' not found")
+    try:
+        raw = read(path)
+    except Exception as exc:  # any reader error
+        raise InputError(
+            f"{_FIELD}.file: '{path}' is not a structure file ASE can read ({type(exc).__name__}: {exc})"
+        ) from None
+    raw.pbc = (True, True, False)
+    try:
+        slab = standard_slab(raw)
+    except InputError as exc:
+        raise InputError(f"{_FIELD}.file '{path.name}': {exc}") from None
+    layers, rule = slab_layers(slab, f"{_FIELD}.file '{path.name}'")
+    slab.arrays["layer"] = layers
+    count = int(layers.max())
+    require(
+        count == 1 or count >= recipe.held_layers + 1,
+        f"{_FIELD}.held_layers={recipe.held_layers}: the slab has {count} layers ({rule})",
+    )
+    upper = _flip(slab, _FIELD) if recipe.flip else slab.copy()
+    atoms = stack_pair(slab, upper, recipe.gap_angstrom, by="atoms")
+    material = slab.get_chemical_formula(mode="hill", empirical=True)
+    record = {
+        "kind": "slab",
+        **file_record(path),
+        "layers_per_slab": count,
+        "layer_rule": rule,
+        "held_layers": recipe.held_layers,
+        "gap_angstrom": recipe.gap_angstrom,
+        "slab2_operation": "flipped upside down (180° about a1)"
+        if recipe.flip
+        else "translated copy",
+    }
+    return finish_interface(atoms, recipe.held_layers, material, record), record
+
+
 def build_generic(recipe) -> tuple[Atoms, dict]:
     """Interface of a ``sheets``, ``crystal`` or ``fcc111`` recipe (unrelaxed) and its report."""
     from flatcontact.structures.assemble import finish_interface, split_stack, stack_pair
@@ -498,7 +568,7 @@ def build_interface(
         ``quartz-dense`` only: the potential spec the dense slabs are relaxed and
         verified with (:func:`flatcontact.structures.build.build_quartz_interface`).
     relax_calculator
-        ``sheets``/``crystal``/``fcc111``: an ASE calculator or a callable(atoms) → calculator;
+        ``sheets``/``crystal``/``fcc111``/``slab``: an ASE calculator or a callable(atoms) → calculator;
         when given, the whole interface is relaxed once (no atom held, FIRE to the recipe's
         ``fmax_ev_per_angstrom``), as the quartz builder does; without it the interface is the
         ideal stacking.
@@ -546,7 +616,10 @@ def build_interface(
             "n_atoms": len(atoms),
             "thickness_angstrom": thickness(atoms),
         }
-    atoms, record = build_generic(recipe)
+    if isinstance(recipe, SlabFileRecipe):
+        atoms, record = build_from_slab_file(recipe)
+    else:
+        atoms, record = build_generic(recipe)
     report: dict[str, Any] = {
         "recipe": record,
         "n_atoms": len(atoms),
