@@ -273,7 +273,7 @@ def test_slab_files_monolayer_sheets_and_metal(tmp_path):
     )
     assert report["recipe"]["layer_rule"] == "atomic planes"
     assert atoms.arrays["surface"].tolist() == [1, 1, 0, 0, 2, 3, 0, 0, 4, 4]
-    with pytest.raises(InputError, match="structure.held_layers"):
+    with pytest.raises(InputError, match=r"structure\.held_layers"):
         build_interface({"kind": "slab", "file": str(tmp_path / "cu.extxyz"), "held_layers": 5})
-    with pytest.raises(InputError, match="structure.file"):
+    with pytest.raises(InputError, match=r"structure\.file"):
         build_interface({"kind": "slab", "file": str(tmp_path / "none.extxyz")})
