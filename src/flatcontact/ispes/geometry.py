@@ -84,7 +84,8 @@ def warm_start_positions(
     thickness_neighbour, thickness_new
         Thicknesses z (Å) of the two points.
     fixed
-        Boolean mask of the fixed atoms (surfaces 1 and 4).
+        Boolean mask of the held atoms (``fixed_mask``: ``arrays["held"]``, default surfaces 1
+        and 4).
     """
     a1, a2 = in_plane_vectors(placed)
     d = lateral_displacement(shift_neighbour, shift_new, a1, a2)
