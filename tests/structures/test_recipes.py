@@ -207,7 +207,10 @@ def test_flip_and_terminations_of_a_polar_crystal(tmp_path):
             "structure.slab2",
         ),
         ({"kind": "sheets", "sheet": "graphene", "rotate_deg": 17}, "structure.rotate_deg"),
-        ({"kind": "fcc111", "element": "Cu", "layers": 3, "held_layers": 3}, "held_layers"),
+        (
+            {"kind": "fcc111", "element": "Cu", "layers": 3, "held_layers": 3},
+            "structure.held_layers",
+        ),
     ],
 )
 def test_bad_input_is_one_line_naming_the_field_before_any_work(recipe, field, tmp_path):

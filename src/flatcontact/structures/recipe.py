@@ -200,7 +200,9 @@ class SlabFileRecipe(_Model):
     held_layers: int = Field(1, ge=1, description="outer layers held (rigid) per slab")
     flip: bool = Field(False, description="slab 2 = slab 1 upside down (rotated 180° about a1)")
     fmax_ev_per_angstrom: float = Field(
-        0.01, gt=0, description="force tolerance of the reference relaxation (when a calculator is given)"
+        0.01,
+        gt=0,
+        description="force tolerance of the reference relaxation (when a calculator is given)",
     )
 
 
@@ -465,6 +467,12 @@ def build_generic(recipe) -> tuple[Atoms, dict]:
     from flatcontact.structures.sheets import rotate_in_plane, rotation_centre
 
     s1, s2, n1, n2 = _sources(recipe)
+    for which, n in ((1, n1), (2, n2)):
+        require(
+            n == 1 or n >= recipe.held_layers + 1,
+            f"{_FIELD}.held_layers={recipe.held_layers}: slab {which} has {n} layers; expected "
+            "one layer (held whole) or at least held_layers + 1 (a free face layer)",
+        )
     spacing, by = _spacing(recipe, s1, s2)
     bounds = recipe.match
     flip = getattr(recipe, "flip", False)
