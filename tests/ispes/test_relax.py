@@ -233,3 +233,25 @@ def test_normal_mode_load_is_minus_energy_derivative(toy_reference):
 def test_unknown_mode_is_refused():
     with pytest.raises(InputError, match="mode: 'relaxed'"):
         RelaxSettings(mode="relaxed")
+
+
+def test_mode_enters_the_store_fingerprint_only_when_not_full():
+    from flatcontact.ispes.store import interface_hash
+
+    assert "mode" not in RelaxSettings().as_dict()  # stores written before the modes stay valid
+    assert RelaxSettings(mode="normal").as_dict()["mode"] == "normal"
+    ref = _sheets(1)  # held monolayers tagged 2 / 3: the held atoms are not the default
+    other = ref.copy()
+    other.arrays["held"] = np.isin(other.arrays["surface"], (1, 4))
+    assert interface_hash(ref) != interface_hash(other)
+    plain = ref.copy()
+    del plain.arrays["held"]
+    assert interface_hash(plain) == interface_hash(other)
+
+
+def test_a_bilayer_of_held_monolayers_is_a_valid_scan_interface():
+    from flatcontact.ispes.scan import check_interface
+
+    ref = _sheets(1)
+    assert fixed_mask(ref).all()
+    check_interface(ref)  # nothing to relax is a rigid scan, not an error

@@ -117,7 +117,12 @@ class RelaxSettings:
             raise InputError(f"mode: '{self.mode}' is not one of {', '.join(RELAX_MODES)}")
 
     def as_dict(self) -> dict[str, Any]:
-        return dataclasses.asdict(self)
+        """The settings for the store fingerprint; ``mode`` only when it is not the default
+        ``full`` (a store written before the modes existed stays valid: same numbers)."""
+        out = dataclasses.asdict(self)
+        if self.mode == "full":
+            del out["mode"]
+        return out
 
 
 @dataclasses.dataclass(frozen=True)
