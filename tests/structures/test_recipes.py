@@ -280,3 +280,20 @@ def test_slab_files_monolayer_sheets_and_metal(tmp_path):
         build_interface({"kind": "slab", "file": str(tmp_path / "cu.extxyz"), "held_layers": 5})
     with pytest.raises(InputError, match=r"structure\.file"):
         build_interface({"kind": "slab", "file": str(tmp_path / "none.extxyz")})
+
+
+def test_reference_relaxation_with_a_calculator_or_a_factory():
+    """With a calculator the interface is relaxed once (nothing held); the recipe records the
+    relaxed thickness. The toy LJ minimum (2^(1/6)·2.5 Å) is wider than Cu's spacing."""
+    from flatcontact.ispes.toy import ToyPairCalculator, toy_calculator
+
+    recipe = {"kind": "fcc111", "element": "Cu", "layers": 3, "fmax_ev_per_angstrom": 1e-3}
+    ideal, _ = build_interface(recipe)
+    for calc in (ToyPairCalculator(), toy_calculator):
+        atoms, report = build_interface(recipe, relax_calculator=calc)
+        relaxation = report["interface_relaxation"]
+        assert relaxation["converged"] and relaxation["max_force_ev_per_angstrom"] < 1e-3
+        assert thickness(atoms) > thickness(ideal) + 0.1
+        assert json.loads(atoms.info["recipe"])["thickness_angstrom"] == thickness(atoms)
+        assert atoms.calc is None
+        np.testing.assert_array_equal(atoms.arrays["held"], ideal.arrays["held"])
