@@ -238,8 +238,9 @@ def test_parse_recipe_names_the_field():
         parse_recipe({"kind": "crystal", "bulk": "x.cif", "miller": [1, 1]})
     with pytest.raises(InputError, match=r"^structure\.match\.max_strain_percent"):
         parse_recipe({"kind": "sheets", "sheet": "graphene", "match": {"max_strain_percent": -1}})
-    with pytest.raises(InputError, match=r"structure\.kind|structure"):
-        parse_recipe({"kind": "nanotube"})
+    for data in ({"kind": "nanotube"}, {"sheet": "graphene"}):
+        with pytest.raises(InputError, match=r"^structure\.kind=.*expected one of quartz-dense"):
+            parse_recipe(data)
     recipe = parse_recipe({"kind": "quartz-dense"})
     assert recipe.layers == 6 and recipe.source == "auto" and recipe.gap_angstrom == 3.0
 

@@ -239,6 +239,10 @@ def parse_recipe(data: dict[str, Any], field: str = _FIELD) -> Any:
         return _ADAPTER.validate_python(data)
     except ValidationError as exc:
         err = exc.errors()[0]
+        if err["type"] in ("union_tag_not_found", "union_tag_invalid"):
+            raise InputError(
+                f"{field}.kind={data.get('kind')!r}: expected one of {', '.join(KINDS)}"
+            ) from None
         parts = [str(p) for p in err["loc"]]
         if parts and parts[0] in KINDS:  # the union's tag, not a field
             parts = parts[1:]
