@@ -298,3 +298,23 @@ def test_reference_relaxation_with_a_calculator_or_a_factory():
         assert json.loads(atoms.info["recipe"])["thickness_angstrom"] == thickness(atoms)
         assert atoms.calc is None
         np.testing.assert_array_equal(atoms.arrays["held"], ideal.arrays["held"])
+
+
+def test_sheet_from_a_poscar_equals_the_built_in(tmp_path):
+    from ase.build import graphene
+
+    sheet = graphene(formula="C2", a=A_GRAPHENE, vacuum=10.0)
+    sheet.pbc = True
+    write(tmp_path / "POSCAR", sheet, format="vasp")
+    recipe = {"kind": "sheets", "layers": 2, "stacking": "AB", "interlayer_angstrom": 3.35}
+    from_file, report = build_interface({**recipe, "sheet": str(tmp_path / "POSCAR")})
+    built_in, _ = build_interface({**recipe, "sheet": "graphene"})
+    np.testing.assert_allclose(from_file.positions, built_in.positions, atol=1e-6)
+    np.testing.assert_array_equal(from_file.arrays["layer"], built_in.arrays["layer"])
+    assert report["recipe"]["slab1"]["file"] == "POSCAR"
+    with pytest.raises(InputError, match=r"structure\.interlayer_angstrom: required"):
+        build_interface({"kind": "sheets", "sheet": str(tmp_path / "POSCAR")})
+    two = built_in[built_in.arrays["slab"] == 1]  # two sheets in one file: not a monolayer
+    write(tmp_path / "two.extxyz", two)
+    with pytest.raises(InputError, match="2 separate bonded pieces"):
+        build_interface({**recipe, "sheet": str(tmp_path / "two.extxyz")})
