@@ -9,6 +9,7 @@ from ase.io import write
 
 from flatcontact.errors import InputError
 from flatcontact.structures.build import load_shipped_dense_slab
+from flatcontact.structures.construct import build_interface
 from flatcontact.structures.dense import DENSE_FACE_LAYERS, QUARTZ_ATOMS_PER_LAYER
 from flatcontact.structures.interface import (
     face_tags,
@@ -20,7 +21,6 @@ from flatcontact.structures.interface import (
     write_interface,
 )
 from flatcontact.structures.layers import atomic_planes, chunk_layers, sheet_layers
-from flatcontact.structures.recipe import build_interface
 
 
 def test_graphene_bilayer_of_monolayers_is_one_held_layer_per_slab():

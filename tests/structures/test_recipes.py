@@ -9,9 +9,10 @@ from ase.io import write
 from ase.neighborlist import neighbor_list
 
 from flatcontact.errors import InputError
+from flatcontact.structures.construct import build_interface
 from flatcontact.structures.interface import thickness
 from flatcontact.structures.match import twist_angle_deg
-from flatcontact.structures.recipe import build_interface, parse_recipe
+from flatcontact.structures.recipe import parse_recipe
 
 A_GRAPHENE, A_HBN = 2.46, 2.504
 
