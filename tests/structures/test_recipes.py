@@ -319,3 +319,29 @@ def test_sheet_from_a_poscar_equals_the_built_in(tmp_path):
     write(tmp_path / "two.extxyz", two)
     with pytest.raises(InputError, match="2 separate bonded pieces"):
         build_interface({**recipe, "sheet": str(tmp_path / "two.extxyz")})
+
+
+def test_resolve_paths_and_input_files(tmp_path):
+    from flatcontact.structures.recipe import input_files, resolve_paths
+
+    write(tmp_path / "Cu.cif", bulk("Cu", "fcc", a=3.615, cubic=True))
+    write(tmp_path / "Ni.cif", bulk("Ni", "fcc", a=3.52, cubic=True))
+    recipe = parse_recipe(
+        {
+            "kind": "crystal",
+            "bulk": "Cu.cif",
+            "miller": [1, 1, 1],
+            "layers": 2,
+            "slab2": {"bulk": "Ni.cif", "miller": [1, 1, 1], "layers": 2},
+        }
+    )
+    resolved = resolve_paths(recipe, tmp_path)
+    assert input_files(resolved) == [tmp_path / "Cu.cif", tmp_path / "Ni.cif"]
+    atoms, report = build_interface(resolved)
+    assert atoms.info["material"] == "Cu(111)/Ni(111)"
+    a_cu, a_ni = 3.615 / np.sqrt(2), 3.52 / np.sqrt(2)
+    np.testing.assert_allclose(
+        report["recipe"]["match"]["slab2_strain_percent"], 100 * (a_cu / a_ni - 1), atol=1e-5
+    )
+    sheets = parse_recipe({"kind": "sheets", "sheet": "graphene", "slab2": {"sheet": "h-BN"}})
+    assert input_files(resolve_paths(sheets, tmp_path)) == []
