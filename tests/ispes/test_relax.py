@@ -161,7 +161,7 @@ def test_sheet_toy_forces_are_minus_energy_gradient():
     )
 
 
-@pytest.mark.parametrize("mode", ["full", "normal", "rigid"])
+@pytest.mark.parametrize("mode", ["full", "normal", "rigid-layers", "rigid"])
 def test_AB_and_BA_bilayer_are_equal_in_every_mode(mode):
     """Bilayer of monolayers, each held whole: AB (2/3, 1/3) and BA (1/3, 2/3) from AA."""
     ref = _sheets(1)
@@ -176,7 +176,7 @@ def test_AB_and_BA_bilayer_are_equal_in_every_mode(mode):
     assert ab.steps == 0 and ab.converged  # every atom held: nothing relaxes
 
 
-@pytest.mark.parametrize("mode", ["full", "normal", "rigid"])
+@pytest.mark.parametrize("mode", ["full", "normal", "rigid-layers", "rigid"])
 def test_mirror_related_shifts_stay_equal_with_free_layers(mode):
     """AA-stacked two-sheet slabs: the mirror z -> -z maps shift s onto -s, so U(s) = U(-s)
     (AB = BA included) in every mode, with the inner sheets free and the outer ones held."""
@@ -193,41 +193,53 @@ def test_mirror_related_shifts_stay_equal_with_free_layers(mode):
 
 
 def test_modes_are_nested_minimisations():
-    """More freedom, lower energy: U_full <= U_normal <= U_rigid at the same point; the normal
-    mode moves atoms along z only and the rigid mode moves nothing."""
+    """More freedom, lower energy: U_full <= U_normal <= U_rigid-layers < U_rigid at the same
+    point; normal moves atoms along z only, rigid-layers moves whole layers along z, rigid
+    moves nothing."""
     ref = _sheets(2)
     z = thickness(ref) - 0.4
     energies = {}
     placed = place_slab2(ref, 0.23, 0.11, z)
     free = ~fixed_mask(ref)
-    for mode in ("rigid", "normal", "full"):
+    layer = ref.arrays["layer"]
+    for mode in ("rigid", "rigid-layers", "normal", "full"):
         settings = RelaxSettings(fmax_ev_per_a=1e-6, optimizer="BFGS", max_steps=5000, mode=mode)
         r = relaxed(ref, 0.23, 0.11, z, settings, SheetPairCalculator())
+        assert r.converged
         energies[mode] = r.energy_ev
+        moved = r.positions - placed.positions
         if mode == "rigid":
             np.testing.assert_array_equal(r.positions, placed.positions)
             assert r.steps == 0 and r.force_calls == 1
             single = placed.copy()
             single.calc = SheetPairCalculator()
             assert r.energy_ev == single.get_potential_energy()
+        if mode == "rigid-layers":
+            np.testing.assert_array_equal(moved[:, :2], 0.0)
+            for k in (2, 3):  # each free sheet shifted as a whole along z
+                dz = moved[layer == k, 2]
+                assert np.ptp(dz) < 1e-12 and abs(dz[0]) > 1e-4
         if mode == "normal":
-            np.testing.assert_array_equal(r.positions[:, :2], placed.positions[:, :2])
-            assert np.abs(r.positions[free, 2] - placed.positions[free, 2]).max() > 1e-3
+            np.testing.assert_array_equal(moved[:, :2], 0.0)
+            assert np.abs(moved[free, 2]).max() > 1e-3
         if mode == "full":
-            assert np.abs(r.positions[free, :2] - placed.positions[free, :2]).max() > 1e-5
+            assert np.abs(moved[free, :2]).max() > 1e-5
     assert energies["full"] <= energies["normal"] + 1e-10
-    assert energies["normal"] < energies["rigid"] - 1e-4
+    assert energies["normal"] <= energies["rigid-layers"] + 1e-10
+    assert energies["rigid-layers"] < energies["rigid"] - 1e-5
 
 
-def test_normal_mode_load_is_minus_energy_derivative(toy_reference):
-    """The envelope theorem holds for the constrained (z-only) minimum too."""
+@pytest.mark.parametrize("mode", ["normal", "rigid-layers"])
+def test_constrained_modes_load_is_minus_energy_derivative(toy_reference, mode):
+    """The envelope theorem holds for the constrained (z-only, rigid-layer) minima too."""
     a1, a2 = in_plane_vectors(toy_reference)
     area = cell_area(a1, a2)
     z0, h = thickness(toy_reference) - 0.2, 2e-3
-    settings = RelaxSettings(fmax_ev_per_a=1e-6, optimizer="BFGS", max_steps=5000, mode="normal")
+    settings = RelaxSettings(fmax_ev_per_a=1e-6, optimizer="BFGS", max_steps=5000, mode=mode)
     lo, mid, hi = (relaxed(toy_reference, 0.21, 0.43, z0 + d, settings) for d in (-h, 0.0, h))
     fd_gpa = -(hi.energy_ev - lo.energy_ev) / (2 * h) / area * EV_PER_A3_TO_GPA
     assert mid.normal_stress_gpa == pytest.approx(fd_gpa, abs=2e-3)
+    assert mid.steps >= 1
 
 
 def test_unknown_mode_is_refused():
@@ -255,3 +267,28 @@ def test_a_bilayer_of_held_monolayers_is_a_valid_scan_interface():
     ref = _sheets(1)
     assert fixed_mask(ref).all()
     check_interface(ref)  # nothing to relax is a rigid scan, not an error
+
+
+@pytest.mark.parametrize("mode", ["normal", "rigid-layers"])
+def test_warm_start_keeps_the_mode_constraints(mode):
+    """A warm start from a fully relaxed neighbour lands on the same constrained minimum."""
+    ref = _sheets(2)
+    z = thickness(ref) - 0.3
+    tight = RelaxSettings(fmax_ev_per_a=1e-6, optimizer="BFGS", max_steps=5000, mode=mode)
+    full = RelaxSettings(fmax_ev_per_a=1e-6, optimizer="BFGS", max_steps=5000)
+    calc = SheetPairCalculator()
+    neighbour = relax_point(ref, calc, PointTask((0, 0, 0), 0.2, 0.1, z), full)
+    cold = relax_point(ref, calc, PointTask((1, 0, 0), 0.3, 0.1, z), tight)
+    warm = relax_point(
+        ref,
+        calc,
+        PointTask((1, 0, 0), 0.3, 0.1, z, neighbour.positions, (0.2, 0.1), z, (0, 0, 0)),
+        tight,
+    )
+    assert warm.energy_ev == pytest.approx(cold.energy_ev, abs=1e-9)
+    placed = place_slab2(ref, 0.3, 0.1, z)
+    np.testing.assert_array_equal(warm.positions[:, :2], placed.positions[:, :2])
+    if mode == "rigid-layers":
+        layer = ref.arrays["layer"]
+        for k in (2, 3):
+            assert np.ptp(warm.positions[layer == k, 2] - placed.positions[layer == k, 2]) < 1e-12

@@ -24,12 +24,18 @@ Relaxation modes (:attr:`RelaxSettings.mode`)
     The free atoms relax along z only; their lateral positions are those of the rigidly
     placed reference (the generalized-stacking-fault convention: Vitek, Phil. Mag. 18,
     773 (1968)).
+``rigid-layers``
+    Every layer keeps its reference shape and lateral position; each non-held layer
+    (``arrays["layer"]``) is a rigid body that moves along z only, until the mean z-force
+    per atom of every free layer, |Σ_layer F_z|/n_layer, is below ``fmax`` (interlayer
+    spacings relax, nothing inside a layer does).
 ``rigid``
     Nothing relaxes: both slabs keep the reference geometry (every layer its shape and
     its spacing), slab 2 is translated rigidly to the grid point, and U and p are those
     of that configuration (the rigid-layer scans of interlayer-potential papers). The
     point is reported converged with zero optimiser steps; ``max_force_ev_per_a`` is the
     largest force on a non-held atom, for information.
+The modes are nested minimisations: U_full ≤ U_normal ≤ U_rigid-layers ≤ U_rigid.
 An interface whose atoms are all held (a bilayer of monolayers) has nothing to relax:
 every mode gives the rigid scan.
 
@@ -61,7 +67,7 @@ from typing import Any, Literal
 
 import numpy as np
 from ase import Atoms
-from ase.constraints import FixAtoms, FixCartesian
+from ase.constraints import FixAtoms, FixCartesian, FixConstraint
 
 from flatcontact.errors import InputError
 from flatcontact.ispes.calculators import count_force_calls
@@ -76,8 +82,8 @@ from flatcontact.units import EV_PER_A3_TO_GPA
 
 Optimizer = Literal["FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch"]
 OPTIMIZERS: tuple[str, ...] = ("FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch")
-RelaxMode = Literal["full", "normal", "rigid"]
-RELAX_MODES: tuple[str, ...] = ("full", "normal", "rigid")
+RelaxMode = Literal["full", "normal", "rigid-layers", "rigid"]
+RELAX_MODES: tuple[str, ...] = ("full", "normal", "rigid-layers", "rigid")
 
 Index = tuple[int, int, int]
 
@@ -95,8 +101,9 @@ class RelaxSettings:
     max_steps
         Optimiser step cap; a point that hits it is stored with ``converged=False``.
     mode
-        ``full`` (free atoms relax in 3D), ``normal`` (along z only) or ``rigid`` (no
-        relaxation); see the module docstring.
+        ``full`` (free atoms relax in 3D), ``normal`` (along z only), ``rigid-layers``
+        (each free layer a rigid body moving along z) or ``rigid`` (no relaxation); see the
+        module docstring.
     """
 
     fmax_ev_per_a: float = 0.005
@@ -220,15 +227,22 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
         )
         if task.previous_positions is not None:
             atoms.positions = extrapolated_start(atoms, task, fixed)
-        if settings.mode == "normal":
+        if settings.mode in ("normal", "rigid-layers"):
             pos = atoms.positions
             pos[:, :2] = placed[:, :2]
+            if settings.mode == "rigid-layers":  # keep each layer's shape: its mean z shift only
+                for group in free_layer_groups(atoms, free):
+                    dz = float(np.mean(pos[group, 2] - placed[group, 2]))
+                    pos[group, 2] = placed[group, 2] + dz
             atoms.positions = pos
     fixed_positions = atoms.positions[fixed].copy()
     lateral_positions = atoms.positions[:, :2].copy()
     constraints = [FixAtoms(mask=fixed)]
+    groups = free_layer_groups(atoms, free) if settings.mode == "rigid-layers" else []
     if settings.mode == "normal" and free.any():
         constraints.append(FixCartesian(np.flatnonzero(free), mask=(True, True, False)))
+    if groups:
+        constraints.append(RigidLayersAlongZ(groups))
     atoms.set_constraint(constraints)
     calc = count_force_calls(calc)
     calls0 = calc.force_calls
@@ -242,17 +256,16 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
     energy = float(atoms.get_potential_energy())
     if settings.mode == "normal":
         max_force = float(np.abs(forces[free, 2]).max()) if free.any() else 0.0
+    elif settings.mode == "rigid-layers":
+        max_force = max((abs(float(forces[g, 2].mean())) for g in groups), default=0.0)
     else:
         max_force = float(np.linalg.norm(forces[free], axis=1).max()) if free.any() else 0.0
     if not np.array_equal(atoms.positions[fixed], fixed_positions):  # pragma: no cover - a guard
         raise RuntimeError("held atoms moved during the relaxation")
-    if (
-        settings.mode == "normal"
-        and not np.array_equal(  # pragma: no cover - a guard
-            atoms.positions[:, :2], lateral_positions
-        )
-    ):
-        raise RuntimeError("atoms moved laterally in a normal-only relaxation")
+    if settings.mode in ("normal", "rigid-layers") and not np.array_equal(
+        atoms.positions[:, :2], lateral_positions
+    ):  # pragma: no cover - a guard
+        raise RuntimeError(f"atoms moved laterally in a {settings.mode} relaxation")
     result = PointResult(
         index=tuple(int(i) for i in task.index),
         shift_a=float(task.shift_a),
@@ -271,6 +284,53 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
     )
     atoms.calc = None
     return result
+
+
+def free_layer_groups(atoms: Atoms, free: np.ndarray) -> list[np.ndarray]:
+    """Indices of the atoms of each non-held layer (``arrays["layer"]``; found from the
+    structure if the interface has none)."""
+    if "layer" in atoms.arrays:
+        layer = np.asarray(atoms.arrays["layer"])
+    else:
+        from flatcontact.structures.layers import interface_layers
+
+        layer = interface_layers(atoms)
+    return [np.flatnonzero(free & (layer == k)) for k in np.unique(layer[free])]
+
+
+class RigidLayersAlongZ(FixConstraint):
+    """Each group of atoms (a layer) moves as a rigid body along z only.
+
+    Positions: a proposed step keeps only each group's mean z displacement. Forces: each
+    atom of a group gets the group's mean z-force (the generalised force on its height per
+    atom), x and y zero, so an optimiser's step is the same for every atom of the group and
+    ``fmax`` is |Σ_group F_z| / n_group.
+    """
+
+    def __init__(self, groups: list[np.ndarray]):
+        self.groups = [np.asarray(g, dtype=int) for g in groups]
+
+    def get_removed_dof(self, atoms: Atoms) -> int:
+        return sum(3 * len(g) - 1 for g in self.groups)
+
+    def adjust_positions(self, atoms: Atoms, new: np.ndarray) -> None:
+        old = atoms.positions
+        for g in self.groups:
+            dz = float(np.mean(new[g, 2] - old[g, 2]))
+            new[g] = old[g]
+            new[g, 2] += dz
+
+    def adjust_forces(self, atoms: Atoms, forces: np.ndarray) -> None:
+        for g in self.groups:
+            fz = float(np.mean(forces[g, 2]))
+            forces[g] = 0.0
+            forces[g, 2] = fz
+
+    def todict(self) -> dict:
+        return {
+            "name": "RigidLayersAlongZ",
+            "kwargs": {"groups": [g.tolist() for g in self.groups]},
+        }
 
 
 def extrapolated_start(placed: Atoms, task: PointTask, fixed: np.ndarray) -> np.ndarray:
