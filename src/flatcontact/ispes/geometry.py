@@ -12,7 +12,10 @@ Conventions
 Shifts ``(shift_a, shift_b)`` are fractions of the in-plane primitive vectors
 ``a1``, ``a2``; slab 2 is displaced laterally by ``shift_a * a1 + shift_b * a2``
 relative to the reference interface. The thickness ``z`` (Å) is the distance between
-the mean planes of surface 1 and surface 4 (the paper's z, Fig. 1).
+the mean planes of the held layers of slab 1 and slab 2 (surfaces 1 and 4 by default: the
+paper's z, Fig. 1; the interlayer distance of a bilayer of held monolayers). ``fixed_mask``
+is the contract's ``arrays["held"]`` (default surfaces 1 and 4): whole layers, each a rigid
+body placed by ``place_slab2``.
 """
 
 from __future__ import annotations
@@ -84,7 +87,8 @@ def warm_start_positions(
     thickness_neighbour, thickness_new
         Thicknesses z (Å) of the two points.
     fixed
-        Boolean mask of the fixed atoms (surfaces 1 and 4).
+        Boolean mask of the held atoms (``fixed_mask``: ``arrays["held"]``, default surfaces 1
+        and 4).
     """
     a1, a2 = in_plane_vectors(placed)
     d = lateral_displacement(shift_neighbour, shift_new, a1, a2)

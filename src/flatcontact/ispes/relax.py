@@ -1,11 +1,43 @@
 """One ISPES grid point: place slab 2, relax the free atoms, measure energy and load.
 
 At a point (shift_a, shift_b, z) slab 2 of the reference interface is placed by
-``place_slab2``; every atom except the fixed outer layers (surfaces 1 and 4) is
-relaxed until the largest force on a free atom is below ``fmax`` (paper,
-"Interfacial sliding potential energy surface": "the atoms in the surfaces 1 and 4
+``place_slab2``; every atom except the held outer layers (``arrays["held"]``, by default
+surfaces 1 and 4) is relaxed until the largest force on a free atom is below ``fmax``
+(paper, "Interfacial sliding potential energy surface": "the atoms in the surfaces 1 and 4
 are held fixed ... those on surface 2, 3 and the inner atomic layers are fully
 relaxed").
+
+Held layers
+-----------
+A held layer is a rigid body whose lateral shift and height are imposed (slab 1's at the
+reference, slab 2's at (shift_a, shift_b, z)); an infinite periodic layer cannot rotate,
+so the rigid body is fully fixed by these three translations and every one of its atoms
+keeps its reference position relative to the layer. Held layers are always held whole
+(``validate_interface`` refuses a partly held layer), so stackings related by a symmetry
+of the two slabs stay equivalent to round-off.
+
+Relaxation modes (:attr:`RelaxSettings.mode`)
+---------------------------------------------
+``full`` (default, the paper's)
+    The free atoms relax in 3D.
+``normal``
+    The free atoms relax along z only; their lateral positions are those of the rigidly
+    placed reference (the generalized-stacking-fault convention: Vitek, Phil. Mag. 18,
+    773 (1968)).
+``rigid-layers``
+    Every layer keeps its reference shape and lateral position; each non-held layer
+    (``arrays["layer"]``) is a rigid body that moves along z only, until the mean z-force
+    per atom of every free layer, |Σ_layer F_z|/n_layer, is below ``fmax`` (interlayer
+    spacings relax, nothing inside a layer does).
+``rigid``
+    Nothing relaxes: both slabs keep the reference geometry (every layer its shape and
+    its spacing), slab 2 is translated rigidly to the grid point, and U and p are those
+    of that configuration (the rigid-layer scans of interlayer-potential papers). The
+    point is reported converged with zero optimiser steps; ``max_force_ev_per_a`` is the
+    largest force on a non-held atom, for information.
+The modes are nested minimisations: U_full ≤ U_normal ≤ U_rigid-layers ≤ U_rigid.
+An interface whose atoms are all held (a bilayer of monolayers) has nothing to relax:
+every mode gives the rigid scan.
 
 Normal load
 -----------
@@ -35,7 +67,7 @@ from typing import Any, Literal
 
 import numpy as np
 from ase import Atoms
-from ase.constraints import FixAtoms
+from ase.constraints import FixAtoms, FixCartesian, FixConstraint
 
 from flatcontact.errors import InputError
 from flatcontact.ispes.calculators import count_force_calls
@@ -50,6 +82,8 @@ from flatcontact.units import EV_PER_A3_TO_GPA
 
 Optimizer = Literal["FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch"]
 OPTIMIZERS: tuple[str, ...] = ("FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch")
+RelaxMode = Literal["full", "normal", "rigid-layers", "rigid"]
+RELAX_MODES: tuple[str, ...] = ("full", "normal", "rigid-layers", "rigid")
 
 Index = tuple[int, int, int]
 
@@ -66,11 +100,16 @@ class RelaxSettings:
         ASE optimiser name (see :data:`OPTIMIZERS`).
     max_steps
         Optimiser step cap; a point that hits it is stored with ``converged=False``.
+    mode
+        ``full`` (free atoms relax in 3D), ``normal`` (along z only), ``rigid-layers``
+        (each free layer a rigid body moving along z) or ``rigid`` (no relaxation); see the
+        module docstring.
     """
 
     fmax_ev_per_a: float = 0.005
     optimizer: str = "LBFGS"
     max_steps: int = 2000
+    mode: str = "full"
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.fmax_ev_per_a) and self.fmax_ev_per_a > 0):
@@ -81,9 +120,16 @@ class RelaxSettings:
             raise InputError(f"optimizer: '{self.optimizer}' is not one of {', '.join(OPTIMIZERS)}")
         if self.max_steps < 1:
             raise InputError(f"max_steps: expected at least 1 optimiser step, got {self.max_steps}")
+        if self.mode not in RELAX_MODES:
+            raise InputError(f"mode: '{self.mode}' is not one of {', '.join(RELAX_MODES)}")
 
     def as_dict(self) -> dict[str, Any]:
-        return dataclasses.asdict(self)
+        """The settings for the store fingerprint; ``mode`` only when it is not the default
+        ``full`` (a store written before the modes existed stays valid: same numbers)."""
+        out = dataclasses.asdict(self)
+        if self.mode == "full":
+            del out["mode"]
+        return out
 
 
 @dataclasses.dataclass(frozen=True)
@@ -159,12 +205,17 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
     The structure is ``place_slab2(reference, task.shift_a, task.shift_b,
     task.thickness)``; with ``task.start_positions`` the free atoms start from the
     neighbour's relaxed structure translated to this point
-    (:func:`~flatcontact.ispes.geometry.warm_start_positions`). Fixed atoms never move.
+    (:func:`~flatcontact.ispes.geometry.warm_start_positions`; in ``normal`` mode only
+    their heights are taken from it). Held atoms never move. ``settings.mode`` selects
+    full, normal-only or no relaxation (module docstring).
     """
     t0 = time.perf_counter()
     atoms = place_slab2(reference, task.shift_a, task.shift_b, task.thickness)
     fixed = fixed_mask(atoms)
-    if task.start_positions is not None:
+    free = ~fixed
+    relaxing = settings.mode != "rigid" and bool(free.any())
+    if relaxing and task.start_positions is not None:
+        placed = atoms.positions.copy()
         atoms.positions = warm_start_positions(
             atoms,
             task.start_positions,
@@ -176,18 +227,45 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
         )
         if task.previous_positions is not None:
             atoms.positions = extrapolated_start(atoms, task, fixed)
+        if settings.mode in ("normal", "rigid-layers"):
+            pos = atoms.positions
+            pos[:, :2] = placed[:, :2]
+            if settings.mode == "rigid-layers":  # keep each layer's shape: its mean z shift only
+                for group in free_layer_groups(atoms, free):
+                    dz = float(np.mean(pos[group, 2] - placed[group, 2]))
+                    pos[group, 2] = placed[group, 2] + dz
+            atoms.positions = pos
     fixed_positions = atoms.positions[fixed].copy()
-    atoms.set_constraint(FixAtoms(mask=fixed))
+    lateral_positions = atoms.positions[:, :2].copy()
+    constraints = [FixAtoms(mask=fixed)]
+    groups = free_layer_groups(atoms, free) if settings.mode == "rigid-layers" else []
+    if settings.mode == "normal" and free.any():
+        constraints.append(FixCartesian(np.flatnonzero(free), mask=(True, True, False)))
+    if groups:
+        constraints.append(RigidLayersAlongZ(groups))
+    atoms.set_constraint(constraints)
     calc = count_force_calls(calc)
     calls0 = calc.force_calls
     atoms.calc = calc
-    opt = _optimizer_class(settings.optimizer)(atoms, logfile=None)
-    opt.run(fmax=settings.fmax_ev_per_a, steps=settings.max_steps)
+    steps = 0
+    if relaxing:
+        opt = _optimizer_class(settings.optimizer)(atoms, logfile=None)
+        opt.run(fmax=settings.fmax_ev_per_a, steps=settings.max_steps)
+        steps = int(opt.nsteps)
     forces = atoms.get_forces(apply_constraint=False)
     energy = float(atoms.get_potential_energy())
-    max_force = float(np.linalg.norm(forces[~fixed], axis=1).max()) if (~fixed).any() else 0.0
+    if settings.mode == "normal":
+        max_force = float(np.abs(forces[free, 2]).max()) if free.any() else 0.0
+    elif settings.mode == "rigid-layers":
+        max_force = max((abs(float(forces[g, 2].mean())) for g in groups), default=0.0)
+    else:
+        max_force = float(np.linalg.norm(forces[free], axis=1).max()) if free.any() else 0.0
     if not np.array_equal(atoms.positions[fixed], fixed_positions):  # pragma: no cover - a guard
-        raise RuntimeError("fixed atoms moved during the relaxation")
+        raise RuntimeError("held atoms moved during the relaxation")
+    if settings.mode in ("normal", "rigid-layers") and not np.array_equal(
+        atoms.positions[:, :2], lateral_positions
+    ):  # pragma: no cover - a guard
+        raise RuntimeError(f"atoms moved laterally in a {settings.mode} relaxation")
     result = PointResult(
         index=tuple(int(i) for i in task.index),
         shift_a=float(task.shift_a),
@@ -197,8 +275,8 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
         normal_stress_gpa=normal_stress_gpa(atoms, forces),
         reaction_stress_gpa=reaction_stress_gpa(atoms, forces, fixed),
         force_calls=int(calc.force_calls - calls0),
-        steps=int(opt.nsteps),
-        converged=bool(max_force < settings.fmax_ev_per_a),
+        steps=steps,
+        converged=bool(not relaxing or max_force < settings.fmax_ev_per_a),
         max_force_ev_per_a=max_force,
         seconds=time.perf_counter() - t0,
         positions=atoms.positions.copy(),
@@ -206,6 +284,53 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
     )
     atoms.calc = None
     return result
+
+
+def free_layer_groups(atoms: Atoms, free: np.ndarray) -> list[np.ndarray]:
+    """Indices of the atoms of each non-held layer (``arrays["layer"]``; found from the
+    structure if the interface has none)."""
+    if "layer" in atoms.arrays:
+        layer = np.asarray(atoms.arrays["layer"])
+    else:
+        from flatcontact.structures.layers import interface_layers
+
+        layer = interface_layers(atoms)
+    return [np.flatnonzero(free & (layer == k)) for k in np.unique(layer[free])]
+
+
+class RigidLayersAlongZ(FixConstraint):
+    """Each group of atoms (a layer) moves as a rigid body along z only.
+
+    Positions: a proposed step keeps only each group's mean z displacement. Forces: each
+    atom of a group gets the group's mean z-force (the generalised force on its height per
+    atom), x and y zero, so an optimiser's step is the same for every atom of the group and
+    ``fmax`` is |Σ_group F_z| / n_group.
+    """
+
+    def __init__(self, groups: list[np.ndarray]):
+        self.groups = [np.asarray(g, dtype=int) for g in groups]
+
+    def get_removed_dof(self, atoms: Atoms) -> int:
+        return sum(3 * len(g) - 1 for g in self.groups)
+
+    def adjust_positions(self, atoms: Atoms, new: np.ndarray) -> None:
+        old = atoms.positions
+        for g in self.groups:
+            dz = float(np.mean(new[g, 2] - old[g, 2]))
+            new[g] = old[g]
+            new[g, 2] += dz
+
+    def adjust_forces(self, atoms: Atoms, forces: np.ndarray) -> None:
+        for g in self.groups:
+            fz = float(np.mean(forces[g, 2]))
+            forces[g] = 0.0
+            forces[g, 2] = fz
+
+    def todict(self) -> dict:
+        return {
+            "name": "RigidLayersAlongZ",
+            "kwargs": {"groups": [g.tolist() for g in self.groups]},
+        }
 
 
 def extrapolated_start(placed: Atoms, task: PointTask, fixed: np.ndarray) -> np.ndarray:

@@ -59,7 +59,8 @@ def _acquire_driver_lock(path: Path):
 
 
 def interface_hash(atoms: Atoms) -> str:
-    """SHA-256 of what defines an interface: species, positions, cell, pbc, slab/surface tags.
+    """SHA-256 of what defines an interface: species, positions, cell, pbc, slab/surface tags,
+    and the held atoms when they differ from the default (surfaces 1 and 4).
 
     Positions and cell are rounded to 1e-6 Å so that a file round trip gives the same hash.
     """
@@ -70,6 +71,10 @@ def interface_hash(atoms: Atoms) -> str:
     h.update(np.asarray(atoms.pbc, dtype=np.int8).tobytes())
     for key in ("slab", "surface"):
         h.update(np.asarray(atoms.arrays[key], dtype=np.int64).tobytes())
+    held = np.asarray(atoms.arrays.get("held", np.isin(atoms.arrays["surface"], (1, 4))), bool)
+    if not np.array_equal(held, np.isin(atoms.arrays["surface"], (1, 4))):
+        h.update(b"held")  # held atoms other than the default surfaces 1 and 4
+        h.update(held.astype(np.int8).tobytes())
     return h.hexdigest()
 
 

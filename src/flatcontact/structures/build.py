@@ -37,6 +37,7 @@ from flatcontact.structures.dense import (
     verify_dense_slab,
 )
 from flatcontact.structures.interface import make_interface, thickness
+from flatcontact.structures.layers import chunk_layers
 from flatcontact.structures.slab import quartz_0001_slab
 
 #: Index (in :func:`~flatcontact.structures.slab.cleavage_heights` order) of the cut between
@@ -54,6 +55,8 @@ DEFAULT_GAP_ANGSTROM = 3.0
 #: there would be no inner layer to relax). Used by ``flatcontact build`` and the run config.
 MIN_LAYERS = 2 * DENSE_FACE_LAYERS + 1
 DEFAULT_FMAX_EV_PER_ANGSTROM = 0.01
+#: ``info["material"]`` of the quartz interface.
+QUARTZ_MATERIAL = "SiO2 (alpha-quartz)"
 
 
 def check_layers(layers: object, name: str = "layers") -> int:
@@ -293,8 +296,14 @@ def build_quartz_interface(
         "fmax_ev_per_angstrom": fmax_ev_per_angstrom,
         "flatcontact_version": _version("flatcontact"),
     }
+    face = DENSE_FACE_LAYERS * QUARTZ_ATOMS_PER_LAYER
     interface = make_interface(
-        slab, gap_angstrom, face_atoms=DENSE_FACE_LAYERS * QUARTZ_ATOMS_PER_LAYER, recipe=recipe
+        slab,
+        gap_angstrom,
+        face_atoms=face,
+        recipe=recipe,
+        slab_layers=chunk_layers(slab, face, QUARTZ_ATOMS_PER_LAYER),
+        material=QUARTZ_MATERIAL,
     )
     outcome = relax(
         interface, make_calculator(spec, interface), fmax_ev_per_angstrom=fmax_ev_per_angstrom

@@ -9,11 +9,22 @@ Conventions (paper, Fig. 1):
 - ``atoms.arrays["surface"]`` ∈ {0, 1, 2, 3, 4}: 0 inner atoms, 1 outer (bottom)
   face of slab 1, 2 inner face of slab 1, 3 inner face of slab 2, 4 outer (top)
   face of slab 2.
+- ``atoms.arrays["layer"]`` int ≥ 1: one id per physical layer across the whole
+  interface, numbered from the bottom (slab 1's layers first); the molecule IDs of
+  interlayer potentials and the unit of rigid-layer relaxation
+  (:mod:`flatcontact.structures.layers` finds them from the structure).
+- ``atoms.arrays["held"]`` bool (optional; default surface ∈ {1, 4}): the outer layers
+  held by the scan. A held layer moves as a rigid body: its lateral shift and height are
+  imposed and its shape is that of the reference, so whole layers are held, never some
+  atoms of a layer. A one-layer slab (a 2D monolayer) is tagged 2 (slab 1) or 3 (slab 2)
+  and held.
 - ``atoms.info["a1"]``, ``atoms.info["a2"]``: in-plane primitive vectors (Å,
-  2-vectors); ``atoms.info["recipe"]``: JSON string of how it was built.
-- The thickness z is mean z(surface 4) − mean z(surface 1) (Å), the paper's
-  "distance between surface 1 and 4".
-- Atoms of surfaces 1 and 4 are held fixed during a scan (``fixed_mask``).
+  2-vectors); ``atoms.info["recipe"]``: JSON string of how it was built;
+  ``atoms.info["material"]``: short name of the slab material(s).
+- The thickness z is mean z(held atoms of slab 2) − mean z(held atoms of slab 1) (Å):
+  the paper's "distance between surface 1 and 4" for the quartz slabs, the interlayer
+  distance for a bilayer of monolayers.
+- Held atoms never move during a scan (``fixed_mask``).
 """
 
 from __future__ import annotations
@@ -89,15 +100,79 @@ def in_plane_vectors(atoms: Atoms) -> tuple[np.ndarray, np.ndarray]:
 
 
 def thickness(atoms: Atoms) -> float:
-    """The paper's z: mean z of the surface-4 atoms minus mean z of the surface-1 atoms (Å)."""
-    surface = _array(atoms, "surface")
+    """The paper's z (Å): mean z of slab 2's held atoms minus mean z of slab 1's held atoms.
+
+    With the default held atoms (surfaces 1 and 4) this is mean z(surface 4) − mean
+    z(surface 1); for a bilayer of monolayers (each layer held) the interlayer distance.
+    """
+    held = fixed_mask(atoms)
+    slab = _array(atoms, "slab")
     z = atoms.positions[:, 2]
-    return float(z[surface == SURFACE_OUTER_2].mean() - z[surface == SURFACE_OUTER_1].mean())
+    return float(z[held & (slab == 2)].mean() - z[held & (slab == 1)].mean())
 
 
 def fixed_mask(atoms: Atoms) -> np.ndarray:
-    """Boolean mask of the atoms held fixed during a scan: surfaces 1 and 4."""
+    """Boolean mask of the atoms held during a scan: ``arrays["held"]``, else surfaces 1 and 4."""
+    if "held" in atoms.arrays:
+        return np.asarray(atoms.arrays["held"]).astype(bool)
     return np.isin(_array(atoms, "surface"), FIXED_SURFACES)
+
+
+def tag_interface(
+    slab_of_atom: np.ndarray, layer_in_slab: np.ndarray, held_layers: int = 1
+) -> dict[str, np.ndarray]:
+    """The contract's arrays ``slab``, ``surface``, ``layer``, ``held`` from per-slab layers.
+
+    Parameters
+    ----------
+    slab_of_atom
+        1 or 2 per atom (slab 1 below slab 2).
+    layer_in_slab
+        Layer index of each atom within its own slab, 1..L from the bottom.
+    held_layers
+        Outer layers held per slab (surface 1 = the ``held_layers`` lowest layers of slab
+        1, surface 4 = the highest of slab 2); the layer facing the other slab is surface
+        2 (slab 1) or 3 (slab 2), the rest 0. A one-layer slab is its own inner face
+        (2 or 3) and is held. A slab of more layers needs ``L >= held_layers + 1``.
+    """
+    slab_of_atom = np.asarray(slab_of_atom, dtype=int)
+    layer_in_slab = np.asarray(layer_in_slab, dtype=int)
+    n = slab_of_atom.size
+    surface = np.zeros(n, dtype=int)
+    held = np.zeros(n, dtype=bool)
+    layer = np.zeros(n, dtype=int)
+    offset = 0
+    for which, inner_tag, outer_tag in (
+        (1, SURFACE_INNER_1, SURFACE_OUTER_1),
+        (2, SURFACE_INNER_2, SURFACE_OUTER_2),
+    ):
+        mine = slab_of_atom == which
+        require(bool(mine.any()), f"slab {which} has no atoms")
+        k = layer_in_slab[mine]
+        count = int(k.max())
+        require(
+            set(np.unique(k).tolist()) == set(range(1, count + 1)),
+            f"slab {which}: layer indices must be 1..{count} without gaps",
+        )
+        layer[mine] = k + offset
+        offset += count
+        if count == 1:
+            surface[mine] = inner_tag
+            held[mine] = True
+            continue
+        require(
+            count >= held_layers + 1,
+            f"slab {which}: {count} layers cannot hold {held_layers} outer layer(s) and keep a "
+            "free face layer; use one layer or at least held_layers + 1",
+        )
+        outer = k <= held_layers if which == 1 else k > count - held_layers
+        inner = k == count if which == 1 else k == 1
+        tags = np.zeros(k.size, dtype=int)
+        tags[outer] = outer_tag
+        tags[inner] = inner_tag
+        surface[mine] = tags
+        held[mine] = outer
+    return {"slab": slab_of_atom.copy(), "surface": surface, "layer": layer, "held": held}
 
 
 def interslab_min_distance(atoms: Atoms, cutoff_angstrom: float = 4.0) -> float:
@@ -120,6 +195,8 @@ def make_interface(
     face_depth_angstrom: float | None = None,
     vacuum_angstrom: float = DEFAULT_VACUUM_ANGSTROM,
     recipe: dict | None = None,
+    slab_layers: np.ndarray | None = None,
+    material: str = "",
 ) -> Atoms:
     """Two identical slabs facing each other: slab 2 is slab 1 translated along z.
 
@@ -137,10 +214,19 @@ def make_interface(
         Vacuum kept below and above along z in the stored cell.
     recipe
         JSON-serialisable record of how the slab was built; stored in ``info["recipe"]``.
+    slab_layers
+        Layer index (1..L from the bottom) of each atom of ``slab`` (``arrays["layer"]``);
+        default: the bottom face is layer 1, the top face layer L, and each atomic plane
+        between (heights within 0.3 Å) a layer. The bottom face of slab 1 and the top
+        face of slab 2 are held (``arrays["held"]`` = surfaces 1 and 4).
+    material
+        Short name of the slab material, stored in ``info["material"]``.
     """
     _require_in_plane_cell(slab, "slab")
     require(gap_angstrom > 0, f"gap_angstrom must be > 0, got {gap_angstrom}")
     tags = face_tags(slab, face_atoms=face_atoms, face_depth_angstrom=face_depth_angstrom)
+    if slab_layers is None:
+        slab_layers = _layers_from_faces(slab, tags)
     lower = slab.copy()
     lower.positions[:, 2] -= lower.positions[:, 2].min()
     height = float(lower.positions[:, 2].max())
@@ -155,13 +241,36 @@ def make_interface(
     surface[n:][tags == 1] = SURFACE_INNER_2
     surface[n:][tags == 2] = SURFACE_OUTER_2
     atoms.arrays["surface"] = surface
+    slab_layers = np.asarray(slab_layers, dtype=int)
+    atoms.arrays["layer"] = np.concatenate([slab_layers, slab_layers + slab_layers.max()])
+    atoms.arrays["held"] = np.isin(surface, FIXED_SURFACES)
     for key in ("tags", "momenta", "initial_magmoms", "initial_charges"):
         atoms.arrays.pop(key, None)
     atoms.positions[:, 2] += vacuum_angstrom
     _set_vertical_cell(atoms, vacuum_angstrom)
     a1, a2 = in_plane_vectors(atoms)
-    atoms.info = {"a1": a1, "a2": a2, "recipe": json.dumps(recipe or {}, sort_keys=True)}
+    atoms.info = {
+        "a1": a1,
+        "a2": a2,
+        "recipe": json.dumps(recipe or {}, sort_keys=True),
+        "material": material,
+    }
     return atoms
+
+
+def _layers_from_faces(slab: Atoms, tags: np.ndarray) -> np.ndarray:
+    """Layers of a slab tagged by faces: bottom face 1, each inner atomic plane, top face last."""
+    from flatcontact.structures.layers import atomic_planes
+
+    layers = np.ones(len(slab), dtype=int)
+    inner = tags == 0
+    count = 1
+    if inner.any():
+        planes = atomic_planes(slab.positions[inner, 2])
+        layers[inner] = planes + 2
+        count = int(planes.max()) + 2
+    layers[tags == 2] = count + 1
+    return layers
 
 
 def place_slab2(
@@ -210,7 +319,12 @@ def place_slab2(
 
 # --------------------------------------------------------------------------- I/O and validation
 def validate_interface(atoms: Atoms, source: str = "interface") -> None:
-    """Check the interface contract; raise a one-line :class:`InputError` naming ``source``."""
+    """Check the interface contract; raise a one-line :class:`InputError` naming ``source``.
+
+    Surfaces 2 and 3 must be present; each slab must have held atoms (surface 1/4, or
+    ``arrays["held"]``); when ``arrays["layer"]`` is given, slab 1's layers lie below slab
+    2's and a held layer is held whole (never some of its atoms).
+    """
     for key in ("slab", "surface"):
         require(key in atoms.arrays, f"{source}: missing per-atom array '{key}'")
     slab = np.asarray(atoms.arrays["slab"])
@@ -222,11 +336,38 @@ def validate_interface(atoms: Atoms, source: str = "interface") -> None:
     )
     for tag, owner in ((1, 1), (2, 1), (3, 2), (4, 2)):
         members = surface == tag
-        require(bool(np.any(members)), f"{source}: no atoms tagged surface={tag}")
+        require(tag in (1, 4) or bool(np.any(members)), f"{source}: no atoms tagged surface={tag}")
         require(
             bool(np.all(slab[members] == owner)),
             f"{source}: surface={tag} atoms must belong to slab {owner}",
         )
+    if "held" in atoms.arrays:
+        held = np.asarray(atoms.arrays["held"])
+        require(
+            held.dtype == bool or bool(np.all(np.isin(held, (0, 1)))),
+            f"{source}: array 'held' must be boolean",
+        )
+    held = fixed_mask(atoms)
+    for which, outer in ((1, 1), (2, 4)):
+        require(
+            bool(np.any(held & (slab == which))),
+            f"{source}: slab {which} has no held atoms (surface={outer} or array 'held')",
+        )
+    if "layer" in atoms.arrays:
+        layer = np.asarray(atoms.arrays["layer"])
+        require(
+            np.issubdtype(layer.dtype, np.integer) and bool(np.all(layer >= 1)),
+            f"{source}: array 'layer' must hold integers >= 1",
+        )
+        require(
+            layer[slab == 1].max() < layer[slab == 2].min(),
+            f"{source}: array 'layer': slab 1's layers must be numbered below slab 2's",
+        )
+        for k in np.unique(layer[held]):
+            require(
+                bool(np.all(held[layer == k])),
+                f"{source}: layer {k} is partly held; a held layer is held whole (rigid body)",
+            )
     require(bool(atoms.pbc[0] and atoms.pbc[1]), f"{source}: must be periodic in x and y")
     _require_in_plane_cell(atoms, source)
     z = atoms.positions[:, 2]
@@ -244,15 +385,26 @@ def write_interface(atoms: Atoms, path: str | os.PathLike[str]) -> Path:
         "a2": np.asarray(a2, dtype=float),
         "recipe": str(atoms.info.get("recipe", "{}")),
     }
+    if atoms.info.get("material"):
+        out.info["material"] = str(atoms.info["material"])
     out.arrays["slab"] = np.asarray(out.arrays["slab"], dtype=int)
     out.arrays["surface"] = np.asarray(out.arrays["surface"], dtype=int)
+    if "layer" in out.arrays:
+        out.arrays["layer"] = np.asarray(out.arrays["layer"], dtype=int)
+    if "held" in out.arrays:
+        out.arrays["held"] = np.asarray(out.arrays["held"], dtype=bool)
     with atomic_path(path) as tmp:
         write(tmp, out, format="extxyz")
     return Path(path)
 
 
 def read_interface(path: str | os.PathLike[str]) -> Atoms:
-    """Read an ``interface.extxyz`` and validate it (one-line :class:`InputError` if not valid)."""
+    """Read an ``interface.extxyz`` and validate it (one-line :class:`InputError` if not valid).
+
+    A file without ``layer`` gets one found from the structure
+    (:func:`flatcontact.structures.layers.interface_layers`); without ``held`` the
+    contract's default (surfaces 1 and 4) is stored explicitly.
+    """
     path = Path(path)
     require(path.is_file(), f"{path}: interface file not found")
     try:
@@ -264,11 +416,22 @@ def read_interface(path: str | os.PathLike[str]) -> Atoms:
     validate_interface(atoms, str(path))
     atoms.arrays["slab"] = np.asarray(atoms.arrays["slab"], dtype=int)
     atoms.arrays["surface"] = np.asarray(atoms.arrays["surface"], dtype=int)
+    atoms.arrays["held"] = fixed_mask(atoms)
+    if "layer" in atoms.arrays:
+        atoms.arrays["layer"] = np.asarray(atoms.arrays["layer"], dtype=int)
+    else:
+        from flatcontact.structures.layers import interface_layers
+
+        atoms.arrays["layer"] = interface_layers(atoms)
+        validate_interface(atoms, str(path))
     a1, a2 = in_plane_vectors(atoms)
     recipe = atoms.info.get("recipe", "{}")
     if not isinstance(recipe, str):
         recipe = json.dumps(recipe)
-    atoms.info = {"a1": a1, "a2": a2, "recipe": recipe}
+    info = {"a1": a1, "a2": a2, "recipe": recipe}
+    if atoms.info.get("material"):
+        info["material"] = str(atoms.info["material"])
+    atoms.info = info
     return atoms
 
 

@@ -1,0 +1,398 @@
+"""Building the interface of a recipe (:mod:`flatcontact.structures.recipe`).
+
+:func:`build_interface` is the build stage's entry point for every ``kind``: the quartz
+builder for ``quartz-dense``, the contract reader for ``file``, the toy for ``toy-lj``, and
+for ``sheets``, ``crystal``, ``fcc111`` and ``slab`` the slab sources
+(:mod:`~flatcontact.structures.sources`), the common in-plane cell
+(:mod:`~flatcontact.structures.match`) and the tagging
+(:mod:`~flatcontact.structures.assemble`). Every check of the input runs before any
+relaxation.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from ase import Atoms
+
+from flatcontact.errors import InputError, require
+from flatcontact.structures.recipe import (
+    SECTION,
+    CrystalRecipe,
+    FileRecipe,
+    QuartzDenseRecipe,
+    SheetsRecipe,
+    SlabFileRecipe,
+    ToyRecipe,
+    parse_recipe,
+)
+
+
+# --------------------------------------------------------------------------- sources
+def _sheet_source(sheet: str, stacking: str, interlayer: float | None, field: str):
+    from flatcontact.structures.crystal import file_record
+    from flatcontact.structures.sheets import BUILTIN_SHEETS, builtin_sheet, check_sheet
+    from flatcontact.structures.sources import sheet_source
+
+    if sheet in BUILTIN_SHEETS:
+        atoms = builtin_sheet(sheet)
+        record = {"sheet": sheet, "a_angstrom": BUILTIN_SHEETS[sheet].a_angstrom}
+        interlayer = interlayer or BUILTIN_SHEETS[sheet].interlayer_angstrom
+        material = sheet
+    else:
+        from ase.io import read
+
+        path = Path(sheet)
+        require(
+            path.is_file(),
+            f"{field}.sheet: '{sheet}' is neither a built-in sheet ({', '.join(BUILTIN_SHEETS)}) nor a file",
+        )
+        try:
+            raw = read(path)
+        except Exception as exc:  # any reader error
+            raise InputError(
+                f"{field}.sheet: '{path}' is not a structure file ASE can read ({type(exc).__name__}: {exc})"
+            ) from None
+        atoms = check_sheet(raw, f"{field}.sheet '{path.name}'")
+        require(
+            interlayer is not None,
+            f"{field}.interlayer_angstrom: required for a sheet read from a file",
+        )
+        record = file_record(path)
+        material = atoms.get_chemical_formula(mode="hill")
+    record = {**record, "stacking": stacking, "interlayer_angstrom": interlayer}
+    return sheet_source(atoms, material, stacking, interlayer, record, f"{field}.stacking")
+
+
+def _crystal_source(bulk: str, miller, termination: int, field: str):
+    from flatcontact.structures.crystal import file_record, orient, read_bulk
+    from flatcontact.structures.sources import crystal_source
+
+    atoms = read_bulk(bulk, f"{field}.bulk")
+    oriented = orient(atoms, miller, f"{field}.miller")
+    material = f"{atoms.get_chemical_formula(mode='hill', empirical=True)}({''.join(str(v) for v in oriented.miller)})"
+    record = {**file_record(bulk), **oriented.record, "termination": termination}
+    n = len(oriented.cuts_angstrom)
+    require(
+        termination < n,
+        f"{field}.termination={termination}: expected 0..{n - 1} ({n} distinct terminations)",
+    )
+    return crystal_source(oriented, termination, material, record, f"{field}.termination")
+
+
+def _sources(recipe) -> tuple[Any, Any | None, int, int]:
+    """(source of slab 1, source of slab 2 or None for the same material, layers 1, layers 2)."""
+    from flatcontact.structures.sources import fcc111_source
+
+    if isinstance(recipe, SheetsRecipe):
+        s1 = _sheet_source(recipe.sheet, recipe.stacking, recipe.interlayer_angstrom, SECTION)
+        s2 = None
+        n2 = recipe.layers
+        if recipe.slab2 is not None:
+            s2 = _sheet_source(
+                recipe.slab2.sheet,
+                recipe.slab2.stacking,
+                recipe.slab2.interlayer_angstrom,
+                f"{SECTION}.slab2",
+            )
+            n2 = recipe.slab2.layers
+        return s1, s2, recipe.layers, n2
+    if isinstance(recipe, CrystalRecipe):
+        s1 = _crystal_source(recipe.bulk, recipe.miller, recipe.termination, SECTION)
+        if recipe.slab2 is None:
+            return s1, None, recipe.layers, recipe.layers
+        s2 = _crystal_source(
+            recipe.slab2.bulk, recipe.slab2.miller, recipe.slab2.termination, f"{SECTION}.slab2"
+        )
+        return s1, s2, recipe.layers, recipe.slab2.layers
+    s1 = fcc111_source(recipe.element, recipe.a_angstrom, {"element": recipe.element})
+    if recipe.slab2 is None:
+        return s1, None, recipe.layers, recipe.layers
+    e2 = recipe.slab2
+    return (
+        s1,
+        fcc111_source(e2.element, e2.a_angstrom, {"element": e2.element}),
+        recipe.layers,
+        e2.layers,
+    )
+
+
+# --------------------------------------------------------------------------- assembly
+def _spacing(recipe, s1, s2) -> tuple[float, str]:
+    """Distance across the interface and how it is measured (planes | atoms)."""
+    default = (
+        s1.spacing_angstrom if s2 is None else 0.5 * (s1.spacing_angstrom + s2.spacing_angstrom)
+    )
+    if isinstance(recipe, SheetsRecipe):
+        return recipe.interface_spacing_angstrom or default, "planes"
+    if isinstance(recipe, CrystalRecipe):
+        return recipe.gap_angstrom or default, "atoms"
+    return recipe.gap_angstrom or default, "planes"
+
+
+def _flip(slab: Atoms, field: str) -> Atoms:
+    """``slab`` rotated by 180° about the x axis (a1): z → −z, y → −y, layers renumbered."""
+    from flatcontact.structures.cell2d import lattice_is_invariant
+
+    require(
+        lattice_is_invariant(slab.cell.array[:2, :2], np.diag([1.0, -1.0])),
+        f"{field}.flip: the in-plane lattice is not symmetric under y -> -y; slab 2 cannot be "
+        "flipped onto the same cell",
+    )
+    out = slab.copy()
+    out.positions[:, 1] *= -1.0
+    out.positions[:, 2] = (
+        out.positions[:, 2].max() + out.positions[:, 2].min() - out.positions[:, 2]
+    )
+    layer = np.asarray(out.arrays["layer"])
+    out.arrays["layer"] = layer.max() + 1 - layer
+    out.wrap()
+    return out
+
+
+def build_from_slab_file(recipe: SlabFileRecipe) -> tuple[Atoms, dict]:
+    """Two copies of a slab file facing each other (slab 2 translated, or flipped)."""
+    from ase.io import read
+
+    from flatcontact.structures.assemble import finish_interface, stack_pair
+    from flatcontact.structures.cell2d import standard_slab
+    from flatcontact.structures.crystal import file_record
+    from flatcontact.structures.layers import slab_layers
+
+    path = Path(recipe.file)
+    require(path.is_file(), f"{SECTION}.file: '{path}' not found")
+    try:
+        raw = read(path)
+    except Exception as exc:  # any reader error
+        raise InputError(
+            f"{SECTION}.file: '{path}' is not a structure file ASE can read ({type(exc).__name__}: {exc})"
+        ) from None
+    raw.pbc = (True, True, False)
+    try:
+        slab = standard_slab(raw)
+    except InputError as exc:
+        raise InputError(f"{SECTION}.file '{path.name}': {exc}") from None
+    layers, rule = slab_layers(slab, f"{SECTION}.file '{path.name}'")
+    slab.arrays["layer"] = layers
+    count = int(layers.max())
+    require(
+        count == 1 or count >= recipe.held_layers + 1,
+        f"{SECTION}.held_layers={recipe.held_layers}: the slab has {count} layers ({rule})",
+    )
+    upper = _flip(slab, SECTION) if recipe.flip else slab.copy()
+    atoms = stack_pair(slab, upper, recipe.gap_angstrom, by="atoms")
+    material = slab.get_chemical_formula(mode="hill", empirical=True)
+    record = {
+        "kind": "slab",
+        **file_record(path),
+        "layers_per_slab": count,
+        "layer_rule": rule,
+        "held_layers": recipe.held_layers,
+        "gap_angstrom": recipe.gap_angstrom,
+        "slab2_operation": "flipped upside down (180° about a1)"
+        if recipe.flip
+        else "translated copy",
+    }
+    return finish_interface(atoms, recipe.held_layers, material, record), record
+
+
+def build_generic(recipe) -> tuple[Atoms, dict]:
+    """Interface of a ``sheets``, ``crystal`` or ``fcc111`` recipe (unrelaxed) and its report."""
+    from flatcontact.structures.assemble import finish_interface, split_stack, stack_pair
+    from flatcontact.structures.match import (
+        apply_supercell,
+        atom_count,
+        coincidence_match,
+        identity_match,
+        twist_match,
+    )
+    from flatcontact.structures.sheets import rotate_in_plane, rotation_centre
+
+    s1, s2, n1, n2 = _sources(recipe)
+    for which, n in ((1, n1), (2, n2)):
+        require(
+            n == 1 or n >= recipe.held_layers + 1,
+            f"{SECTION}.held_layers={recipe.held_layers}: slab {which} has {n} layers; expected "
+            "one layer (held whole) or at least held_layers + 1 (a free face layer)",
+        )
+    spacing, by = _spacing(recipe, s1, s2)
+    bounds = recipe.match
+    flip = getattr(recipe, "flip", False)
+    record: dict[str, Any] = {
+        "kind": recipe.kind,
+        "slab1": {**s1.record, "material": s1.material, "layers": n1},
+        "slab2": {**(s2 or s1).record, "material": (s2 or s1).material, "layers": n2},
+        "held_layers": recipe.held_layers,
+        "interface_spacing_angstrom": spacing,
+        "spacing_measured_between": "mean planes" if by == "planes" else "closest atoms",
+    }
+    material = s1.material if s2 is None else f"{s1.material}/{s2.material}"
+    if recipe.twist is not None and s2 is not None:
+        raise InputError(
+            f"{SECTION}.twist: a twist needs the same material in both slabs (no slab2)"
+        )
+    continuation = s2 is None and recipe.twist is None and recipe.rotate_deg == 0 and not flip
+    if continuation:
+        match = identity_match(s1.cell2)
+        require(
+            atom_count(match, n1 * s1.atoms_per_layer, n2 * s1.atoms_per_layer) <= bounds.max_atoms,
+            f"{SECTION}.match.max_atoms={bounds.max_atoms}: the interface has "
+            f"{(n1 + n2) * s1.atoms_per_layer} atoms",
+        )
+        stack = s1.make(n1 + n2)
+        from flatcontact.structures.assemble import layer_plane
+
+        if by == "planes":
+            natural = layer_plane(stack, n1 + 1) - layer_plane(stack, n1)
+        else:
+            layer, z = np.asarray(stack.arrays["layer"]), stack.positions[:, 2]
+            natural = float(z[layer == n1 + 1].min() - z[layer == n1].max())
+        atoms = split_stack(stack, n1, spacing - natural)
+        record["slab2_operation"] = "continuation of slab 1's stacking"
+        record["match"] = match.report(
+            s1.cell2, s1.cell2, n1 * s1.atoms_per_layer, n2 * s1.atoms_per_layer
+        )
+        return finish_interface(atoms, recipe.held_layers, material, record), record
+    src2 = s2 or s1
+    slab1 = s1.make(n1)
+    slab2 = src2.make(n2)
+    operations = []
+    if flip:
+        slab2 = _flip(slab2, SECTION)
+        operations.append("flipped upside down (180° about a1)")
+    if recipe.rotate_deg:
+        centre = rotation_centre(slab2[np.asarray(slab2.arrays["layer"]) == 1])
+        try:
+            slab2 = rotate_in_plane(slab2, recipe.rotate_deg, centre)
+        except InputError as exc:
+            raise InputError(f"{SECTION}.rotate_deg: {exc}") from None
+        operations.append(
+            f"rotated {recipe.rotate_deg:g}° about z through ({centre[0]:.4f}, {centre[1]:.4f}) Å"
+        )
+    na1, na2 = n1 * s1.atoms_per_layer, n2 * src2.atoms_per_layer
+    if recipe.twist is not None:
+        match, theta = twist_match(s1.cell2, *recipe.twist, field=f"{SECTION}.twist")
+        operations.append(f"twisted by {theta:.6f}° (commensurate (m, n) = {list(recipe.twist)})")
+        record["twist_angle_deg"] = theta
+    elif s2 is not None and not np.allclose(s1.cell2, s2.cell2, atol=1e-6):
+        match = coincidence_match(
+            s1.cell2,
+            s2.cell2,
+            na1,
+            na2,
+            max_strain=bounds.max_strain_percent / 100.0,
+            max_atoms=bounds.max_atoms,
+            strain_on=bounds.strain_on,
+            field=f"{SECTION}.slab2",
+        )
+    else:
+        match = identity_match(s1.cell2)
+    n_atoms = atom_count(match, na1, na2)
+    require(
+        n_atoms <= bounds.max_atoms,
+        f"{SECTION}.match.max_atoms={bounds.max_atoms}: the interface has {n_atoms} atoms",
+    )
+    record["slab2_operation"] = "; ".join(operations) or "none (another material)"
+    record["match"] = match.report(s1.cell2, src2.cell2, na1, na2)
+    slab1 = apply_supercell(slab1, match.p1, match.cell)
+    slab2 = apply_supercell(slab2, match.p2, match.cell)
+    atoms = stack_pair(slab1, slab2, spacing, by=by)
+    return finish_interface(atoms, recipe.held_layers, material, record), record
+
+
+# --------------------------------------------------------------------------- entry point
+def build_interface(
+    recipe: Any,
+    *,
+    potential: Any = None,
+    relax_calculator: Any = None,
+) -> tuple[Atoms, dict]:
+    """The reference interface of ``recipe`` and a JSON-ready report (build stage).
+
+    Parameters
+    ----------
+    recipe
+        A model of :data:`StructureRecipe` (or a dict, parsed with :func:`parse_recipe`),
+        file paths already resolved (:func:`resolve_paths`).
+    potential
+        ``quartz-dense`` only: the potential spec the dense slabs are relaxed and
+        verified with (:func:`flatcontact.structures.build.build_quartz_interface`).
+    relax_calculator
+        ``sheets``/``crystal``/``fcc111``/``slab``: an ASE calculator or a callable(atoms) → calculator;
+        when given, the whole interface is relaxed once (no atom held, FIRE to the recipe's
+        ``fmax_ev_per_angstrom``), as the quartz builder does; without it the interface is the
+        ideal stacking.
+
+    Every check of the input (files, Miller index, terminations, match bounds, atom count)
+    runs before any relaxation; a bad value is a one-line InputError naming the field.
+    """
+    if isinstance(recipe, dict):
+        recipe = parse_recipe(recipe)
+    if isinstance(recipe, QuartzDenseRecipe):
+        from flatcontact.structures.build import build_quartz_interface
+
+        require(
+            potential is not None,
+            f"{SECTION}.kind=quartz-dense needs a potential to relax the dense slabs",
+        )
+        atoms, report = build_quartz_interface(
+            potential,
+            recipe.layers,
+            source=recipe.source,
+            gap_angstrom=recipe.gap_angstrom,
+            fmax_ev_per_angstrom=recipe.fmax_ev_per_angstrom,
+        )
+        return atoms, report
+    if isinstance(recipe, FileRecipe):
+        from flatcontact.structures.crystal import file_record
+        from flatcontact.structures.interface import read_interface, thickness
+
+        atoms = read_interface(recipe.file)
+        return atoms, {
+            "source": file_record(recipe.file),
+            "n_atoms": len(atoms),
+            "thickness_angstrom": thickness(atoms),
+        }
+    if isinstance(recipe, ToyRecipe):
+        from flatcontact.ispes.toy import toy_interface
+        from flatcontact.structures.interface import thickness
+
+        atoms = toy_interface(recipe.layers, **recipe.params)
+        atoms.arrays["held"] = np.isin(atoms.arrays["surface"], (1, 4))
+        atoms.arrays["layer"] = np.arange(1, len(atoms) + 1)
+        atoms.info["material"] = "toy LJ fcc(111)"
+        return atoms, {
+            "source": "flatcontact.ispes.toy",
+            "n_atoms": len(atoms),
+            "thickness_angstrom": thickness(atoms),
+        }
+    if isinstance(recipe, SlabFileRecipe):
+        atoms, record = build_from_slab_file(recipe)
+    else:
+        atoms, record = build_generic(recipe)
+    report: dict[str, Any] = {
+        "recipe": record,
+        "n_atoms": len(atoms),
+        "material": atoms.info["material"],
+    }
+    if relax_calculator is not None:
+        from flatcontact.structures.dense import relax
+
+        calc = (
+            relax_calculator(atoms)
+            if callable(relax_calculator) and not hasattr(relax_calculator, "get_potential_energy")
+            else relax_calculator
+        )
+        report["interface_relaxation"] = relax(
+            atoms, calc, fmax_ev_per_angstrom=recipe.fmax_ev_per_angstrom
+        )
+        atoms.calc = None
+    from flatcontact.structures.interface import thickness
+
+    record["thickness_angstrom"] = thickness(atoms)
+    atoms.info["recipe"] = json.dumps(record, sort_keys=True)
+    report["thickness_angstrom"] = thickness(atoms)
+    return atoms, report

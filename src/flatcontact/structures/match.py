@@ -1,0 +1,231 @@
+"""Common in-plane cells of two slabs: identity, commensurate twist, coincidence lattice (ZSL).
+
+A :class:`Match` gives integer supercell matrices P1, P2 (rows: supercell vectors in the
+slab's own in-plane basis, T_i = P_i·A_i) and the common cell C. Each slab's supercell
+is mapped onto C by the linear map F_i (C = T_i·F_iᵀ); F_i = R_i·U_i (polar
+decomposition): R_i a rotation (the twist put on slab i), U_i − 1 the strain put on it
+(principal values reported, in %).
+
+- Same lattice, no twist: P1 = P2 = 1, F = 1.
+- Commensurate twist (m, n) of a hexagonal lattice (Lopes dos Santos, Peres & Castro
+  Neto, PRL 99, 256802 (2007); Shallcross et al., PRB 81, 165105 (2010)): with the 60°
+  basis b1 = a1, b2 = a1 + a2, slab 1's supercell is T1 = m·b1 + n·b2, T2 = R60·T1, and
+  slab 2 (rotated by θ) uses n·b1 + m·b2: cos θ = (m² + 4mn + n²) / (2(m² + mn + n²)),
+  m² + mn + n² primitive cells per layer, no strain. (1, 2): θ = 21.787°, 7 cells.
+- Hetero-interfaces: Zur & McGill coincidence lattices (J. Appl. Phys. 55, 378 (1984)),
+  ``pymatgen.analysis.interfaces.zsl.ZSLGenerator``; the smallest match (fewest atoms,
+  then least strain) whose strains and atom count are within the bounds. The strain is
+  put on slab 2 (``strain_on="slab2"``: slab 1 keeps its lattice) or shared
+  (``"both"``: C is the mean of the two aligned supercells).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from ase import Atoms
+from ase.build import make_supercell
+
+from flatcontact.errors import InputError
+from flatcontact.structures.cell2d import integer_matrix, is_hexagonal, rotation
+
+
+@dataclass(frozen=True)
+class Match:
+    """Supercells of the two slabs on one common in-plane cell (see module docstring)."""
+
+    p1: np.ndarray  # 2×2 int
+    p2: np.ndarray  # 2×2 int
+    cell: np.ndarray  # 2×2 common cell (rows), Å
+    kind: str  # "identity" | "twist" | "coincidence"
+
+    def deformation(self, which: int, a: np.ndarray) -> np.ndarray:
+        """F_i (2×2, column convention) with C = T_i·F_iᵀ for slab ``which`` of in-plane cell ``a``."""
+        p = self.p1 if which == 1 else self.p2
+        t = p @ np.asarray(a, float)[:, :2]
+        return np.linalg.solve(t, self.cell).T
+
+    def report(self, a1: np.ndarray, a2: np.ndarray, n1: int, n2: int) -> dict:
+        """JSON-ready record: matrices, common cell, strain and rotation per slab, atom count."""
+        out = {
+            "kind": self.kind,
+            "slab1_supercell": self.p1.tolist(),
+            "slab2_supercell": self.p2.tolist(),
+            "common_cell_angstrom": np.round(self.cell, 6).tolist(),
+            "n_atoms": atom_count(self, n1, n2),
+        }
+        for which, a in ((1, a1), (2, a2)):
+            strains, angle = strain_and_rotation(self.deformation(which, a))
+            out[f"slab{which}_strain_percent"] = [round(100 * s, 6) for s in strains]
+            out[f"slab{which}_rotation_deg"] = round(angle, 6)
+        return out
+
+
+def strain_and_rotation(f: np.ndarray) -> tuple[list[float], float]:
+    """Principal strains (U − 1 eigenvalues, ascending) and rotation angle (deg) of F = R·U."""
+    u_sq = f.T @ f
+    w, v = np.linalg.eigh(u_sq)
+    u = v @ np.diag(np.sqrt(w)) @ v.T
+    r = f @ np.linalg.inv(u)
+    return [float(s) - 1.0 for s in np.sqrt(w)], float(np.degrees(np.arctan2(r[1, 0], r[0, 0])))
+
+
+def atom_count(match: Match, n1: int, n2: int) -> int:
+    """Atoms of the interface: n_i atoms per primitive cell of slab i times det P_i."""
+    return round(float(n1 * abs(np.linalg.det(match.p1)) + n2 * abs(np.linalg.det(match.p2))))
+
+
+def identity_match(a: np.ndarray) -> Match:
+    """Both slabs on the same primitive cell."""
+    eye = np.eye(2, dtype=int)
+    return Match(eye, eye.copy(), np.asarray(a, float)[:, :2].copy(), "identity")
+
+
+def twist_angle_deg(m: int, n: int) -> float:
+    """Commensurate twist angle of a hexagonal bilayer: cos θ = (m² + 4mn + n²)/(2(m² + mn + n²))."""
+    return float(
+        np.degrees(np.arccos((m * m + 4 * m * n + n * n) / (2.0 * (m * m + m * n + n * n))))
+    )
+
+
+def twist_match(a: np.ndarray, m: int, n: int, field: str = "twist") -> tuple[Match, float]:
+    """The commensurate (m, n) twist of a hexagonal lattice ``a`` (rows, 120° convention).
+
+    Returns the match (slab 2's supercell maps onto slab 1's by a pure rotation θ) and θ in
+    degrees (counter-clockwise rotation of slab 2).
+    """
+    a = np.asarray(a, float)[:, :2]
+    if not is_hexagonal(a):
+        raise InputError(f"{field}: a commensurate twist needs a hexagonal in-plane lattice")
+    if not (
+        isinstance(m, int) and isinstance(n, int) and m >= 0 and n >= 0 and m != n and m + n > 0
+    ):
+        raise InputError(f"{field}=[{m}, {n}]: expected two different non-negative integers")
+    b1, b2 = a[0], a[0] + a[1]
+    if abs(np.degrees(np.arccos(b1 @ b2 / (b1 @ b1))) - 60.0) > 1e-4:
+        b2 = a[1]  # the cell was given in the 60° convention already
+    basis = np.array([b1, b2])
+    t = np.array([[m, n], [-n, m + n]]) @ basis
+    v = np.array([[n, m], [-m, m + n]]) @ basis
+    p1 = integer_matrix(t, a, field)
+    p2 = integer_matrix(v, a, field)
+    cross = v[0, 0] * t[0, 1] - v[0, 1] * t[0, 0]
+    theta = float(np.degrees(np.arctan2(cross, v[0] @ t[0])))
+    return Match(p1, p2, t, "twist"), theta
+
+
+def coincidence_match(
+    a1: np.ndarray,
+    a2: np.ndarray,
+    n1: int,
+    n2: int,
+    *,
+    max_strain: float,
+    max_atoms: int,
+    strain_on: str = "slab2",
+    field: str = "slab2",
+) -> Match:
+    """The smallest coincidence lattice of slabs with in-plane cells ``a1`` (below) and ``a2``.
+
+    ``n1``, ``n2``: atoms per primitive in-plane cell of each slab (all its layers). The
+    accepted match has every principal strain of both slabs ≤ ``max_strain`` (a fraction)
+    and at most ``max_atoms`` atoms. InputError naming ``field`` when none exists.
+    """
+    from pymatgen.analysis.interfaces.zsl import ZSLGenerator
+
+    if strain_on not in ("slab2", "both"):
+        raise InputError(f"strain_on='{strain_on}': expected slab2 or both")
+    a1 = np.asarray(a1, float)[:, :2]
+    a2 = np.asarray(a2, float)[:, :2]
+    area1, area2 = abs(np.linalg.det(a1)), abs(np.linalg.det(a2))
+    density = n1 / area1 + n2 / area2
+    max_area = max_atoms / density * (1.0 + max_strain) ** 2
+    gen = ZSLGenerator(
+        max_area_ratio_tol=(1.0 + max_strain) ** 2 - 1.0,
+        max_area=max_area,
+        max_length_tol=max_strain,
+        max_angle_tol=max_strain,
+    )
+    pad = np.zeros((2, 1))
+    best: tuple | None = None
+    best_area = None
+    for zm in gen(np.hstack([a2, pad]), np.hstack([a1, pad])):
+        area = float(zm.match_area)
+        if best_area is not None and area > best_area * (1.0 + 1e-6):
+            break
+        f = np.asarray(zm.film_sl_vectors, float)[:, :2]
+        s = np.asarray(zm.substrate_sl_vectors, float)[:, :2]
+        if np.linalg.det(f) * np.linalg.det(s) <= 0:
+            continue  # opposite handedness: the map would be a reflection
+        if np.linalg.det(s) < 0:
+            f, s = f[::-1], s[::-1]
+        try:
+            p1 = integer_matrix(s, a1, field)
+            p2 = integer_matrix(f, a2, field)
+        except InputError:
+            continue
+        if strain_on == "slab2":
+            cell = s
+        else:
+            rot, _ = _polar(np.linalg.solve(f, s).T)
+            cell = 0.5 * (s + f @ rot.T)
+        match = Match(p1, p2, cell, "coincidence")
+        worst = max(
+            max(abs(x) for x in strain_and_rotation(match.deformation(k, a))[0])
+            for k, a in ((1, a1), (2, a2))
+        )
+        n_atoms = atom_count(match, n1, n2)
+        if worst > max_strain + 1e-12 or n_atoms > max_atoms:
+            continue
+        rotation_deg = abs(strain_and_rotation(match.deformation(2, a2))[1])
+        key = (n_atoms, round(worst, 9), round(rotation_deg, 6))
+        if best is None or key < best[0]:
+            best, best_area = (key, match), area
+    if best is None:
+        raise InputError(
+            f"{field}: no coincidence lattice with strain <= {100 * max_strain:g}% on each slab "
+            f"and <= {max_atoms} atoms (raise match.max_strain or match.max_atoms)"
+        )
+    return _without_lattice_rotation(best[1], a2, field)
+
+
+def _without_lattice_rotation(match: Match, a2: np.ndarray, field: str) -> Match:
+    """The same match with slab 2's supercell re-chosen so that it is not rotated, when the
+    rotation the match puts on slab 2 is a symmetry of slab 2's lattice (e.g. 60° hexagonal)."""
+    from flatcontact.structures.cell2d import lattice_is_invariant
+
+    angle = strain_and_rotation(match.deformation(2, a2))[1]
+    if abs(angle) < 1e-6 or not lattice_is_invariant(a2, rotation(angle)):
+        return match
+    t2 = match.p2 @ a2
+    p2 = integer_matrix(t2 @ rotation(angle).T, a2, field)
+    return Match(match.p1, p2, match.cell, match.kind)
+
+
+def _polar(f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    u_sq = f.T @ f
+    w, v = np.linalg.eigh(u_sq)
+    u = v @ np.diag(np.sqrt(w)) @ v.T
+    return f @ np.linalg.inv(u), u
+
+
+def apply_supercell(slab: Atoms, p: np.ndarray, cell: np.ndarray) -> Atoms:
+    """``slab``'s supercell P (2×2 int) mapped onto the common in-plane ``cell`` (fractions kept).
+
+    Heights are unchanged; per-atom arrays are kept.
+    """
+    p3 = np.eye(3, dtype=int)
+    p3[:2, :2] = p
+    big = make_supercell(slab, p3, wrap=True)
+    new = big.cell.array.copy()
+    new[0, :2], new[1, :2] = cell[0], cell[1]
+    new[0, 2] = new[1, 2] = 0.0
+    big.set_cell(new, scale_atoms=True)
+    big.wrap()
+    return big
+
+
+def rotated_cell(a: np.ndarray, angle_deg: float) -> np.ndarray:
+    """Rows of ``a`` rotated counter-clockwise by ``angle_deg``."""
+    return np.asarray(a, float)[:, :2] @ rotation(angle_deg).T

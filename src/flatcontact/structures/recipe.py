@@ -1,0 +1,289 @@
+"""The ``structure:`` section of a run: recipes for the interface and :func:`build_interface`.
+
+One pydantic model per ``kind`` (:data:`StructureRecipe`, discriminated by ``kind``):
+
+``quartz-dense``  the paper's α-quartz (0001) dense interface (today's numbers);
+``file``          a prepared ``interface.extxyz`` following the contract;
+``slab``          a prepared slab file, two copies facing each other (layers found from it);
+``toy-lj``        the two-slab Lennard-Jones toy (tests and demos);
+``sheets``        2D monolayers (built-in graphene, h-BN, MoS2 or a file), N per slab;
+``crystal``       a bulk crystal file (CIF, POSCAR, extxyz, ...) + Miller index + termination;
+``fcc111``        fcc(111) metal slabs (Cu, Ni, Al, ...) by element.
+
+For ``sheets``, ``crystal`` and ``fcc111`` slab 2 is by default the continuation of slab 1
+(the stacking sequence of sheets, the bulk crystal across the cut), or: another material
+(``slab2``, on a coincidence lattice within ``match`` bounds), the same one rotated
+(``rotate_deg``, a symmetry of its lattice, e.g. 180° for h-BN AA′), twisted
+(``twist: [m, n]``, commensurate), or flipped upside down (``flip``, crystals). The
+choice, strains, rotation and atom count are recorded in ``info["recipe"]``.
+
+Entry points: :func:`parse_recipe` (dict → model, one-line InputError naming the field),
+:func:`resolve_paths`, :func:`input_files`; the interface itself:
+:func:`flatcontact.structures.construct.build_interface` (model → tagged interface + report).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationError, model_validator
+
+from flatcontact.errors import InputError
+
+#: Name of the config section, the prefix of every field named in an error.
+SECTION = "structure"
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+
+class MatchSettings(_Model):
+    """Bounds of the coincidence-lattice search (hetero-interfaces) and of the atom count."""
+
+    max_strain_percent: float = Field(
+        3.0, gt=0, le=20, description="largest principal strain put on either slab (%)"
+    )
+    max_atoms: int = Field(400, ge=2, description="largest number of atoms of the interface")
+    strain_on: Literal["slab2", "both"] = Field(
+        "slab2",
+        description="slab2: slab 1 keeps its lattice, slab 2 takes the strain; "
+        "both: the common cell is the mean of the two",
+    )
+
+
+class _PairOptions(_Model):
+    held_layers: int = Field(1, ge=1, description="outer layers held (rigid) per slab")
+    rotate_deg: float = Field(
+        0.0,
+        description="slab 2 rotated about z by this angle (a symmetry of its lattice, e.g. 180); "
+        "for sheets about the midpoint of the shortest unlike bond",
+    )
+    twist: tuple[int, int] | None = Field(
+        None,
+        description="commensurate twist (m, n) of a hexagonal lattice: slab 2 rotated by "
+        "acos((m²+4mn+n²)/(2(m²+mn+n²))), (1, 2) → 21.787°",
+    )
+    match: MatchSettings = Field(default_factory=MatchSettings)
+    fmax_ev_per_angstrom: float = Field(
+        0.01,
+        gt=0,
+        description="force tolerance of the reference relaxation (when a calculator is given)",
+    )
+
+
+class SheetSlab(_Model):
+    """One slab of 2D sheets."""
+
+    sheet: str = Field(description="built-in graphene | h-BN | MoS2, or a monolayer file")
+    layers: int = Field(1, ge=1, description="sheets in this slab")
+    stacking: str = Field("AB", description="stacking letters of this slab (see docs)")
+    interlayer_angstrom: float | None = Field(
+        None,
+        gt=0,
+        description="distance between adjacent sheets (mean planes); built-ins: bulk value",
+    )
+
+
+class SheetsRecipe(_PairOptions):
+    """2D monolayers stacked into two slabs."""
+
+    kind: Literal["sheets"] = "sheets"
+    sheet: str = Field(description="built-in graphene | h-BN | MoS2, or a monolayer file")
+    layers: int = Field(1, ge=1, description="sheets per slab")
+    stacking: str = Field(
+        "AB",
+        description="letters A, B, C (optionally primed) for the whole stack, slab 1 then slab 2, "
+        "repeated: AB = Bernal, AA' = h-BN AA′ / 2H-MoS2",
+    )
+    interlayer_angstrom: float | None = Field(
+        None, gt=0, description="distance between adjacent sheets"
+    )
+    interface_spacing_angstrom: float | None = Field(
+        None,
+        gt=0,
+        description="distance between the facing sheets of the two slabs (default: the interlayer distance, mean of the two materials)",
+    )
+    slab2: SheetSlab | None = Field(None, description="another material for slab 2")
+
+
+class CrystalSlab(_Model):
+    """One slab cut from a bulk crystal file."""
+
+    bulk: str = Field(description="bulk crystal file, any format ASE reads (CIF, POSCAR, extxyz)")
+    miller: tuple[int, int, int] = Field(description="Miller index in the file's cell")
+    layers: int = Field(3, ge=1, description="bulk repeats along the normal")
+    termination: int = Field(
+        0, ge=0, description="which cut (0 = widest gap between atomic planes)"
+    )
+
+
+class CrystalRecipe(_PairOptions):
+    """Slabs cut from a bulk crystal."""
+
+    kind: Literal["crystal"] = "crystal"
+    bulk: str = Field(description="bulk crystal file, any format ASE reads (CIF, POSCAR, extxyz)")
+    miller: tuple[int, int, int] = Field(description="Miller index in the file's cell")
+    layers: int = Field(6, ge=1, description="bulk repeats (layers) per slab")
+    termination: int = Field(
+        0, ge=0, description="which cut (0 = widest gap between atomic planes)"
+    )
+    gap_angstrom: float | None = Field(
+        None, gt=0, description="highest atom of slab 1 to lowest of slab 2 (default: the bulk's)"
+    )
+    flip: bool = Field(False, description="slab 2 = slab 1 upside down (rotated 180° about a1)")
+    slab2: CrystalSlab | None = Field(None, description="another crystal for slab 2")
+
+
+class Fcc111Slab(_Model):
+    element: str
+    a_angstrom: float | None = Field(None, gt=0)
+    layers: int = Field(6, ge=1)
+
+
+class Fcc111Recipe(_PairOptions):
+    """fcc(111) metal slabs (ase.build.fcc111), one close-packed plane per layer."""
+
+    kind: Literal["fcc111"] = "fcc111"
+    element: str = Field(description="Cu, Ni, Al, ... (fcc)")
+    a_angstrom: float | None = Field(
+        None, gt=0, description="lattice constant (default: ASE's reference)"
+    )
+    layers: int = Field(6, ge=1, description="close-packed planes per slab")
+    gap_angstrom: float | None = Field(
+        None,
+        gt=0,
+        description="distance between the facing planes (default a/√3: the perfect crystal)",
+    )
+    slab2: Fcc111Slab | None = Field(None, description="another fcc metal for slab 2")
+
+
+class QuartzDenseRecipe(_Model):
+    """The paper's α-quartz (0001) dense interface (flatcontact.structures.build)."""
+
+    kind: Literal["quartz-dense"] = "quartz-dense"
+    layers: int = Field(6, description="O-Si-O layers per slab (>= 5)")
+    source: Literal["auto", "shipped", "seed"] = "auto"
+    gap_angstrom: float = Field(3.0, gt=0)
+    fmax_ev_per_angstrom: float = Field(0.01, gt=0)
+
+    @model_validator(mode="after")
+    def _layers(self) -> QuartzDenseRecipe:
+        from flatcontact.structures.build import MIN_LAYERS
+
+        if self.layers < MIN_LAYERS:
+            raise ValueError(
+                f"layers={self.layers}: the dense quartz interface needs >= {MIN_LAYERS}"
+            )
+        return self
+
+
+class FileRecipe(_Model):
+    """A prepared interface.extxyz following the contract."""
+
+    kind: Literal["file"] = "file"
+    file: str = Field(description="path of an interface.extxyz")
+
+
+class SlabFileRecipe(_Model):
+    """A prepared slab file: two copies facing each other, layers found from the structure."""
+
+    kind: Literal["slab"] = "slab"
+    file: str = Field(
+        description="slab file (any format ASE reads), periodic along cell vectors 1, 2"
+    )
+    gap_angstrom: float = Field(
+        3.0, gt=0, description="highest atom of slab 1 to lowest of slab 2 (Å)"
+    )
+    held_layers: int = Field(1, ge=1, description="outer layers held (rigid) per slab")
+    flip: bool = Field(False, description="slab 2 = slab 1 upside down (rotated 180° about a1)")
+    fmax_ev_per_angstrom: float = Field(
+        0.01,
+        gt=0,
+        description="force tolerance of the reference relaxation (when a calculator is given)",
+    )
+
+
+class ToyRecipe(_Model):
+    """The toy two-slab Lennard-Jones interface (flatcontact.ispes.toy)."""
+
+    kind: Literal["toy-lj"] = "toy-lj"
+    layers: int = Field(3, ge=3)
+    params: dict[str, float] = Field(
+        default_factory=dict, description="ToyPairCalculator parameters"
+    )
+
+
+StructureRecipe = Annotated[
+    QuartzDenseRecipe
+    | FileRecipe
+    | SlabFileRecipe
+    | ToyRecipe
+    | SheetsRecipe
+    | CrystalRecipe
+    | Fcc111Recipe,
+    Field(discriminator="kind"),
+]
+_ADAPTER: TypeAdapter = TypeAdapter(StructureRecipe)
+KINDS = ("quartz-dense", "file", "slab", "toy-lj", "sheets", "crystal", "fcc111")
+
+#: (dotted field path, recipe kind) of every field that names a file, for path resolution.
+FILE_FIELDS = ("file", "bulk", "slab2.bulk", "sheet", "slab2.sheet")
+
+
+def parse_recipe(data: dict[str, Any], field: str = SECTION) -> Any:
+    """A recipe model from a dict; one-line InputError naming the first bad field."""
+    try:
+        return _ADAPTER.validate_python(data)
+    except ValidationError as exc:
+        err = exc.errors()[0]
+        if err["type"] in ("union_tag_not_found", "union_tag_invalid"):
+            raise InputError(
+                f"{field}.kind={data.get('kind')!r}: expected one of {', '.join(KINDS)}"
+            ) from None
+        parts = [str(p) for p in err["loc"]]
+        if parts and parts[0] in KINDS:  # the union's tag, not a field
+            parts = parts[1:]
+        loc = ".".join(parts)
+        raise InputError(
+            f"{field}.{loc}: {err['msg']}" if loc else f"{field}: {err['msg']}"
+        ) from None
+
+
+def input_files(recipe: Any) -> list[Path]:
+    """Files whose content enters the interface (for fingerprints): bulk, sheet and interface files."""
+    from flatcontact.structures.sheets import BUILTIN_SHEETS
+
+    out = []
+    for dotted in FILE_FIELDS:
+        obj = recipe
+        for part in dotted.split("."):
+            obj = getattr(obj, part, None)
+            if obj is None:
+                break
+        if isinstance(obj, str) and obj not in BUILTIN_SHEETS:
+            out.append(Path(obj))
+    return out
+
+
+def resolve_paths(recipe: Any, base_dir: str | Path) -> Any:
+    """A copy of ``recipe`` with relative file fields made relative to ``base_dir``."""
+    from flatcontact.structures.sheets import BUILTIN_SHEETS
+
+    base = Path(base_dir)
+
+    def fix(value: str) -> str:
+        if value in BUILTIN_SHEETS or Path(value).is_absolute():
+            return value
+        return str(base / value)
+
+    data = recipe.model_dump()
+    for dotted in FILE_FIELDS:
+        parts = dotted.split(".")
+        holder = data
+        for part in parts[:-1]:
+            holder = holder.get(part) if isinstance(holder, dict) else None
+        if isinstance(holder, dict) and isinstance(holder.get(parts[-1]), str):
+            holder[parts[-1]] = fix(holder[parts[-1]])
+    return parse_recipe(data)
