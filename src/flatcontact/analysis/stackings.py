@@ -23,7 +23,8 @@ For any 2-D lattice, from the exact periodic interpolant (:mod:`.periodic`):
    ``AA + 2(a + b)/3`` (``a``, ``b`` the primitive vectors taken 60° apart, ``a``
    the cell's first vector) are ``AB`` and ``BA``; those at the three two-fold
    sites (half lattice vectors from AA) are ``SP`` (``SP1``..``SP3`` by energy if
-   they are not one class). Site positions are matched within
+   they are not one class). A name is given only to a point of the expected kind
+   (AB/BA minima, SP saddles) at the site; positions are matched within
    ``SITE_TOLERANCE`` × the lattice constant. Every other class is named by kind
    and energy rank, ``min1``, ``saddle1``, ``max1``, ... (lowest first). This is
    the bilayer convention of graphene/h-BN derived from the lattice alone, not
@@ -210,54 +211,77 @@ def _same_site(surface: PeriodicSurface, s1: np.ndarray, s2: np.ndarray, tol: fl
     return bool(np.linalg.norm(surface.cartesian(ds)) < tol)
 
 
-def stationary_points(surface: PeriodicSurface, refine: int = 3) -> list[tuple]:
+def stationary_points(surface: PeriodicSurface, refine: int = 2) -> list[tuple]:
     """All inequivalent stationary points ``(s, xy, value, eigenvalues, kind)`` in the cell.
 
-    See the module docstring (step 1). Points whose Hessian has an eigenvalue within
-    ``1e-8`` of the largest magnitude (degenerate) are dropped.
+    Newton's method on ``∇e = 0`` (steps capped at 0.05 × the shortest lattice
+    vector), vectorised, from the points of a grid ``refine`` times finer than the
+    data where ``|∇e|²`` is a local minimum among its 8 neighbours; if the points
+    found break the Morse relation (#min − #saddle + #max = 0 on the torus), from
+    *every* point of that grid (each non-degenerate stationary point has a Newton
+    basin wider than the grid spacing of a band-limited surface). Converged points
+    (``|∇e|·a ≤ 1e-9 × range``) are reduced into the cell and deduplicated
+    (1e-6 × a); points with a Hessian eigenvalue below ``1e-8`` of the largest
+    magnitude (degenerate) are dropped.
     """
     n_a, n_b = surface.values.shape
     f_a, f_b = max(1, refine) * max(n_a, 4), max(1, refine) * max(n_b, 4)
     sa, sb = np.meshgrid(np.arange(f_a) / f_a, np.arange(f_b) / f_b, indexing="ij")
-    xy = surface.cartesian(np.stack([sa, sb], -1))
-    sv = surface.evaluate(xy)
+    x = surface.cartesian(np.stack([sa, sb], -1))
+    sv = surface.evaluate(x)
+    hmax = float(np.max(np.abs(np.linalg.eigvalsh(sv.hessian)))) or 1.0
     g2 = np.sum(sv.gradient**2, -1)
     is_min = np.ones(g2.shape, bool)
     for da in (-1, 0, 1):
         for db in (-1, 0, 1):
             if da or db:
                 is_min &= g2 <= np.roll(np.roll(g2, da, 0), db, 1)
-    seeds = xy[is_min]
+    found = _newton_points(surface, x[is_min], hmax)
+    if not _euler_ok(found):
+        found = _newton_points(surface, x.reshape(-1, 2), hmax)
+    return found
+
+
+def _euler_ok(found: list[tuple]) -> bool:
+    counts = {k: sum(f[4] == k for f in found) for k in KINDS}
+    return counts["minimum"] - counts["saddle"] + counts["maximum"] == 0
+
+
+def _newton_points(surface: PeriodicSurface, x: np.ndarray, hmax: float) -> list[tuple]:
+    """Newton from every row of ``x``; the distinct non-degenerate stationary points reached."""
+    x = np.array(x, float)
     scale = _scale(surface)
     spread = max(float(np.ptp(surface.values)), 1e-300)
-    hmax = float(np.max(np.abs(np.linalg.eigvalsh(sv.hessian)))) or 1.0
+    cap = 0.05 * scale
+    active = np.ones(len(x), bool)
+    for _ in range(80):
+        idx = np.flatnonzero(active)
+        if idx.size == 0:
+            break
+        sv = surface.evaluate(x[idx])
+        good = np.abs(np.linalg.det(sv.hessian)) > 1e-300
+        step = np.zeros((idx.size, 2))
+        step[good] = np.linalg.solve(sv.hessian[good], sv.gradient[good][..., None])[..., 0]
+        norm = np.linalg.norm(step, axis=-1, keepdims=True)
+        step = np.where(norm > cap, step * cap / np.maximum(norm, 1e-300), step)
+        x[idx] -= step
+        active[idx[(np.linalg.norm(step, axis=-1) < 1e-13 * scale) | ~good]] = False
+    sv = surface.evaluate(x)
+    converged = np.linalg.norm(sv.gradient, axis=-1) * scale <= 1e-9 * spread
+    # deduplicate modulo the lattice: round the reduced fractional coordinates
+    frac = surface.fractional(x[converged])
+    frac = np.round(frac - np.floor(frac), 6) % 1.0
+    _, first = np.unique(frac, axis=0, return_index=True)
     found: list[tuple] = []
-    for x in seeds:
-        x = np.array(x, float)
-        ok = False
-        for _ in range(60):
-            v = surface.evaluate(x)
-            if np.linalg.norm(v.gradient) * scale <= 1e-11 * spread:
-                ok = True
-                break
-            try:
-                step = np.linalg.solve(v.hessian, v.gradient)
-            except np.linalg.LinAlgError:
-                break
-            norm = np.linalg.norm(step)
-            if norm > 0.05 * scale:
-                step *= 0.05 * scale / norm
-            x = x - step
-        v = surface.evaluate(x)
-        if not ok and np.linalg.norm(v.gradient) * scale > 1e-8 * spread:
+    for xi in x[converged][np.sort(first)]:
+        s = _reduce(surface, xi)
+        if any(_same_site(surface, s, f[0], 1e-6 * scale) for f in found):
             continue
+        v = surface.evaluate(surface.cartesian(s))
         lam = np.linalg.eigvalsh(v.hessian)
         if np.min(np.abs(lam)) < 1e-8 * hmax:
             continue
         kind = "minimum" if lam[0] > 0 else ("maximum" if lam[1] < 0 else "saddle")
-        s = _reduce(surface, x)
-        if any(_same_site(surface, s, f[0], 1e-6 * scale) for f in found):
-            continue
         found.append((s, surface.cartesian(s), float(v.value), lam, kind))
     found.sort(key=lambda f: (KINDS.index(f[4]), f[2], round(f[0][0], 9), round(f[0][1], 9)))
     return found
@@ -350,13 +374,17 @@ def _names(surface: PeriodicSurface, found: list[tuple], classes: list[int], lat
         for name, site in sites.items():
             s_site = _reduce(surface, site)
             for i, f in enumerate(found):
-                if names[i] is None and _same_site(surface, f[0], s_site, tol):
+                if (
+                    names[i] is None
+                    and f[4] == "minimum"
+                    and _same_site(surface, f[0], s_site, tol)
+                ):
                     names[i] = name
         sp = []
         for half in (a / 2, b / 2, (b - a) / 2):
             s_site = _reduce(surface, aa + half)
             for i, f in enumerate(found):
-                if names[i] is None and _same_site(surface, f[0], s_site, tol):
+                if names[i] is None and f[4] == "saddle" and _same_site(surface, f[0], s_site, tol):
                     sp.append(i)
         if sp:
             if len({classes[i] for i in sp}) == 1:
@@ -569,8 +597,7 @@ def analyze_stackings(surface: PeriodicSurface, tolerance: float = SYMMETRY_TOLE
     lattice = lattice_kind(surface.a1, surface.a2)
     names = _names(surface, found, classes, lattice)
     start = minima[0]
-    counts = {k: sum(f[4] == k for f in found) for k in KINDS}
-    euler_ok = counts["minimum"] - counts["saddle"] + counts["maximum"] == 0
+    euler_ok = _euler_ok(found)
     first, history = _barrier_graph(surface, found, start, classes)
     points = tuple(
         StationaryPoint(names[i], f[4], f[1], f[0], f[2], f[3], classes[i])
