@@ -284,3 +284,84 @@ def test_a_pinning_like_splitting_of_ab_and_ba_keeps_the_start_rule_stable():
     assert max(old) / min(old) > 2  # the old rule flips (τ from AB vs BA along y)
     assert max(new) / min(new) < 1.05  # the new rule reports the same start's τ
     assert len(set(chosen)) == 1
+
+
+def test_outputs_carry_the_stackings_barriers_and_rules(tmp_path):
+    """friction.csv/.nc and the JSON summary: named energies (closed form), barrier, rules."""
+    import csv
+    import json
+
+    import xarray as xr
+
+    from flatcontact.analysis.outputs import CSV_COLUMNS, summary_json, write_outputs
+
+    v = 1e-4
+    a1, a2 = syn.hexagonal_cell(2.46)
+    model = syn.SyntheticInterface(a1, a2, syn.three_cosine(a1, a2), corrugation_ev_per_a2=v)
+    ds = model.grid(9, 9, np.linspace(24.3, 25.6, 12))
+    res = analyze_ispes(ds, [0.5, 1.0], direction_deg="auto", energy_zero="each")
+    write_outputs(res, tmp_path)
+    mev = 1e3
+    with open(tmp_path / "friction.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    assert list(rows[0]) == list(CSV_COLUMNS)
+    for row in rows:
+        named = dict(item.split("=") for item in row["stacking_energies_mev_per_a2"].split(";"))
+        assert float(named["AA"]) - float(named["AB"]) == pytest.approx(4.5 * v * mev, rel=1e-6)
+        assert float(named["SP"]) - float(named["BA"]) == pytest.approx(0.5 * v * mev, rel=1e-6)
+        assert float(row["lowest_barrier_mev_per_a2"]) == pytest.approx(0.5 * v * mev, rel=1e-6)
+        assert float(row["direction_deg"]) == 0.0 == float(row["lowest_barrier_direction_deg"])
+        assert row["start_stacking"] in ("AB", "BA")
+    assert len({row["start_stacking"] for row in rows}) == 1
+    nc = xr.open_dataset(tmp_path / "friction.nc")
+    assert sorted(nc.stacking.values.tolist()) == ["AA", "AB", "BA", "SP"]
+    kinds = dict(zip(nc.stacking.values.tolist(), nc.stacking_kind.values.tolist(), strict=True))
+    assert kinds == {"AA": "maximum", "AB": "minimum", "BA": "minimum", "SP": "saddle"}
+    e = nc.stacking_energy_mev_per_a2.sel(stacking="AA") - nc.stacking_energy_mev_per_a2.sel(
+        stacking="AB"
+    )
+    np.testing.assert_allclose(e.values, 4.5 * v * mev, rtol=1e-6)
+    assert nc.attrs["direction_rule"].startswith("lowest-barrier")
+    assert "symmetry-equivalent" in nc.attrs["tau_start_rule"]
+    summary = json.loads(json.dumps(summary_json(res)))  # JSON-serialisable
+    assert summary["direction_rule"] == res.direction_rule
+    first = summary["pressures"][0]
+    assert first["stackings"]["SP"]["multiplicity"] == 3
+    assert first["stackings"]["AA"]["kind"] == "maximum"
+    assert first["barrier_along_direction_mev_per_a2"] == pytest.approx(0.5 * v * mev, rel=1e-6)
+
+
+@pytest.mark.parametrize("bad", ["north", "Auto"])
+def test_an_unknown_direction_word_is_a_one_line_error(bad):
+    from flatcontact.errors import InputError
+
+    a1, a2 = syn.hexagonal_cell(2.46)
+    ds = syn.SyntheticInterface(a1, a2, syn.three_cosine(a1, a2)).grid(
+        4, 4, np.linspace(24.3, 25.6, 8)
+    )
+    with pytest.raises(InputError, match="--direction-deg") as err:
+        analyze_ispes(ds, [1.0], direction_deg=bad)
+    assert "\n" not in str(err.value)
+
+
+def test_without_equivalent_minima_the_results_are_those_of_the_old_rule():
+    """A quartz-like landscape (hexagonal cell, no kept operation relating its minima):
+    τ, σ_MSS, G_int and the start are bit-for-bit those of the analysis without stackings."""
+    a1, a2 = syn.hexagonal_cell(4.916)
+    pattern = syn.cosine_sum(
+        [(1, 0, 1.0), (0, 1, 0.9), (-1, 1, 1.1), (1, 0, 0.3, -np.pi / 2), (1, 1, 0.2, 0.4)]
+    )
+    model = syn.SyntheticInterface(
+        a1, a2, pattern, corrugation_ev_per_a2=-2e-4, gap_modulation_angstrom=-0.02
+    )
+    ds = model.grid(12, 12, np.linspace(24.3, 25.6, 12))
+    p = [0.0, 1.0, 2.0, 3.0]
+    new = analyze_ispes(ds, p)
+    old = analyze_ispes(ds, p, with_stackings=False)
+    for name in ("tau_mpa", "sigma_mss_mpa", "shear_stiffness_gpa_per_nm"):
+        np.testing.assert_array_equal(new.column(name), old.column(name))
+    for a, b in zip(new.pressures, old.pressures, strict=True):
+        np.testing.assert_array_equal(a.minimum_xy_angstrom, b.minimum_xy_angstrom)
+        assert len(a.starts) == len(b.starts)
+        assert a.stackings.euler_ok and np.isfinite(a.stackings.barrier)
+    assert new.direction_deg == 90.0 and new.direction_rule == "given"
