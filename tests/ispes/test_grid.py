@@ -153,8 +153,9 @@ def test_thicknesses_bracket_the_loads_at_every_stacking(toy_reference, delta, l
     cols = s.reshape(-1, 1, 2)
     pz = p_of(cols, zz[None, :])
     tol = 0.25**2 / 8 * np.max(np.abs(np.gradient(np.gradient(pz, zz, axis=1), zz, axis=1)))
-    assert np.all(p_of(cols[:, 0], z.min()) >= hi - tol)
-    assert np.all(p_of(cols[:, 0], z.max()) <= max(lo, tension) + tol)
+    slack = 0.01 * (hi - max(lo, tension))  # grid.BRACKET_RTOL of the load range
+    assert np.all(p_of(cols[:, 0], z.min()) >= hi - tol - slack)
+    assert np.all(p_of(cols[:, 0], z.max()) <= max(lo, tension) + tol + slack)
     # the first n thicknesses are today's rule at the lowest-energy column, unchanged
     low, _ = extreme_stackings(rigid.energy_ev, grid)
     z_old, _ = thicknesses_for_pressures(probe_column(relax, toy_reference, low, hi), lo, hi, n)
@@ -197,5 +198,6 @@ def test_toy_lj_every_extreme_column_reaches_the_requested_loads(toy_reference, 
         shift = tuple(probe["shift"])
         p = np.asarray(probe["normal_stress_gpa"])
         tol = np.max(np.abs(np.diff(p[: np.argmin(p) + 1], 2))) / 8 + 1e-3  # + fmax noise
-        assert relax(*shift, z.min(), None, None)[1] >= hi - tol
-        assert relax(*shift, z.max(), None, None)[1] <= max(lo, p.min()) + tol
+        slack = 0.01 * (hi - max(lo, p.min()))  # grid.BRACKET_RTOL of the load range
+        assert relax(*shift, z.min(), None, None)[1] >= hi - tol - slack
+        assert relax(*shift, z.max(), None, None)[1] <= max(lo, p.min()) + tol + slack

@@ -415,6 +415,11 @@ def _repulsive_branch(probe: ColumnProbe) -> tuple[np.ndarray, np.ndarray]:
     return zb, pb
 
 
+#: A probed column whose load at the end thickness misses its target by less than this
+#: fraction of the requested load range (HI - LO) counts as bracketed (no extra thickness).
+BRACKET_RTOL = 0.01
+
+
 def thicknesses_spanning_columns(
     probes: Sequence[ColumnProbe], lo_gpa: float, hi_gpa: float, n: int
 ) -> tuple[np.ndarray, list[str]]:
@@ -428,13 +433,18 @@ def thicknesses_spanning_columns(
     the smallest thickness at least ``hi``. Where it is not, thicknesses are appended
     beyond the largest (or prepended below the smallest) with the mean spacing of the
     first probe's thicknesses, the last one exactly at the z where ``p_c = lo_c``
-    (or ``hi``), each by linear inversion of the probe's ``p_c(z)``. When the first
-    column already brackets every other one, the result is that of
-    :func:`thicknesses_for_pressures` unchanged. Notes name every extension.
+    (or ``hi``), each by linear inversion of the probe's ``p_c(z)``. ``lo`` here is
+    the first column's (raised to its maximum tension if below). A miss smaller than
+    ``BRACKET_RTOL`` × (HI − LO) is not extended (e.g. two columns whose tensile
+    maxima differ by a few MPa). When the first column already brackets every other
+    one, the result is that of :func:`thicknesses_for_pressures` unchanged. Notes
+    name every extension.
     """
     if not probes:
         raise InputError("probe column: no probed column to choose thicknesses from")
     z, notes = thicknesses_for_pressures(probes[0], lo_gpa, hi_gpa, n)
+    lo_gpa = max(lo_gpa, float(_repulsive_branch(probes[0])[1][-1]))
+    slack = BRACKET_RTOL * (hi_gpa - lo_gpa)
     dz = float(np.ptp(z)) / max(n - 1, 1)
     for probe in probes[1:]:
         zb, pb = _repulsive_branch(probe)
@@ -447,7 +457,7 @@ def thicknesses_spanning_columns(
         z_lo_c = float(np.interp(lo_c, pb[::-1], zb[::-1]))  # thickness where p_c = lo_c
         z_hi_c = float(np.interp(hi_gpa, pb[::-1], zb[::-1]))  # thickness where p_c = hi
         top, bottom = float(z.max()), float(z.min())
-        if z_lo_c > top + 1e-9:
+        if z_lo_c > top + 1e-9 and float(np.interp(top, zb, pb)) > lo_c + slack:
             m = max(1, int(np.ceil((z_lo_c - top) / dz - 1e-9))) if dz > 0 else 1
             extra = np.linspace(top, z_lo_c, m + 1)[1:]
             z = np.concatenate([z, extra])
@@ -456,7 +466,7 @@ def thicknesses_spanning_columns(
                 f"is still at {float(np.interp(top, zb, pb)):.3g} GPa at z = {top:.4g} Å; added "
                 f"{m} thickness(es) up to {z_lo_c:.4g} Å where its load is {lo_c:.4g} GPa"
             )
-        if z_hi_c < bottom - 1e-9:
+        if z_hi_c < bottom - 1e-9 and float(np.interp(bottom, zb, pb)) < hi_gpa - slack:
             m = max(1, int(np.ceil((bottom - z_hi_c) / dz - 1e-9))) if dz > 0 else 1
             extra = np.linspace(bottom, z_hi_c, m + 1)[1:]
             z = np.concatenate([z, extra])
