@@ -201,3 +201,22 @@ def test_toy_lj_every_extreme_column_reaches_the_requested_loads(toy_reference, 
         slack = 0.01 * (hi - max(lo, p.min()))  # grid.BRACKET_RTOL of the load range
         assert relax(*shift, z.min(), None, None)[1] >= hi - tol - slack
         assert relax(*shift, z.max(), None, None)[1] <= max(lo, p.min()) + tol + slack
+
+
+def test_bracket_all_stackings_false_is_the_lowest_column_rule(toy_reference):
+    grid = GridSpec(6, 6, p_range_gpa=(-0.5, 2.0, 5), bracket_all_stackings=False)
+    _, relax, _, rigid, _ = _morse_columns(toy_reference, 0.2, grid)
+    resolved, notes = probe_thicknesses(relax, toy_reference, rigid, grid)
+    low, _ = extreme_stackings(rigid.energy_ev, grid)
+    z_old, old_notes = thicknesses_for_pressures(
+        probe_column(relax, toy_reference, low, 2.0), -0.5, 2.0, 5
+    )
+    np.testing.assert_array_equal(resolved["thickness_angstrom"], z_old)
+    assert notes == old_notes and len(resolved["probes"]) == 1
+    assert grid.as_dict()["bracket_all_stackings"] is False
+    assert "bracket_all_stackings" not in GridSpec(6, 6, p_range_gpa=(-0.5, 2.0, 5)).as_dict()
+    # with the default the wide-gap column forces more thicknesses on the same model
+    full, _ = probe_thicknesses(
+        relax, toy_reference, rigid, GridSpec(6, 6, p_range_gpa=(-0.5, 2.0, 5))
+    )
+    assert len(full["thickness_angstrom"]) > 5

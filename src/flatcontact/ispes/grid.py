@@ -32,14 +32,19 @@ class GridSpec:
     """Which points to compute.
 
     Exactly one of ``thickness_angstrom`` (explicit z list, Å) and ``p_range_gpa``
-    (``(lo, hi, n)``: n thicknesses whose loads at the probe stacking are evenly
-    spaced from lo to hi GPa) is given.
+    (``(lo, hi, n)``: n thicknesses whose loads at the lowest-energy stacking are
+    evenly spaced from lo to hi GPa) is given. With ``bracket_all_stackings`` (default)
+    the extreme stackings are probed too and thicknesses are added until every one of
+    them brackets the loads (:func:`probe_thicknesses`); ``False`` probes the
+    lowest-energy stacking only (the rule before; it enters the store fingerprint only
+    when ``False``).
     """
 
     n_a: int
     n_b: int
     thickness_angstrom: tuple[float, ...] | None = None
     p_range_gpa: tuple[float, float, int] | None = None
+    bracket_all_stackings: bool = True
 
     def __post_init__(self) -> None:
         for name in ("n_a", "n_b"):
@@ -86,6 +91,8 @@ class GridSpec:
             d["thickness_angstrom"] = list(self.thickness_angstrom)
         else:
             d["p_range_gpa"] = list(self.p_range_gpa)
+            if not self.bracket_all_stackings:
+                d["bracket_all_stackings"] = False
         return d
 
 
@@ -501,6 +508,8 @@ def probe_thicknesses(
     """
     lo, hi, n = grid.p_range_gpa
     columns = probed_stackings(rigid, grid)
+    if not grid.bracket_all_stackings:
+        columns = columns[:1]
     probes = [
         probe_column(relax, reference, shift, hi, stop_at_gpa=None if k == 0 else lo)
         for k, (_, shift) in enumerate(columns)
