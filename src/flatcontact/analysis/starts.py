@@ -306,8 +306,9 @@ def warn_if_tau_depends_on_start(
             f"{o.friction.sigma_mss_mpa:.4g} MPa)"
         )
     warnings.warn(
-        f"{source} at P = {p_gpa:g} GPa: {len(outcomes)} inequivalent minima lie within "
-        f"{tolerance_ev_per_a2 * mev:.2g} meV/Å² of each other, so the slider's τ depends on "
+        f"{source} at P = {p_gpa:g} GPa: {len(outcomes)} minima lie within "
+        f"{tolerance_ev_per_a2 * mev:.2g} meV/Å² of each other or are symmetry-equivalent, "
+        "so the slider's τ depends on "
         f"which one it sits in: " + "; ".join(parts) + f". Reported τ = "
         f"{outcomes[selected].tau_mpa:.4g} MPa, the largest (the pull that starts sliding from "
         "either)",
