@@ -47,11 +47,11 @@ Energies per area in the surface's units (eV/Å² in the analysis), positions in
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from flatcontact.analysis.barrier_graph import angle_deg, barrier_graph, member, shortest_vector
 from flatcontact.analysis.periodic import PeriodicSurface, lattice_vectors, rectangular_supercell
 from flatcontact.analysis.symmetry import lattice_point_operations
 
@@ -113,7 +113,7 @@ class Stackings:
     def barrier_direction_deg(self) -> float:
         """Angle from x of :attr:`barrier_vector_angstrom` (degrees in [0, 360)); NaN if none."""
         v = self.barrier_vector_angstrom
-        return float("nan") if v is None else _angle_deg(v)
+        return float("nan") if v is None else angle_deg(v)
 
     def energies(self) -> dict[str, float]:
         """Energy per named class (first member's name for hexagonal sites, class name else)."""
@@ -145,7 +145,7 @@ class Stackings:
         m = np.rint(self._inverse @ np.asarray(vector_angstrom, float)).astype(int)
         e0 = self.points[self.start_index].energy
         for energy, basis in self._basis_history:
-            if _member(basis, m):
+            if member(basis, m):
                 return float(energy - e0)
         return float("nan")
 
@@ -165,11 +165,6 @@ class Stackings:
             )
             entry["multiplicity"] += 1
         return out
-
-
-def _angle_deg(v: np.ndarray) -> float:
-    a = math.degrees(math.atan2(float(v[1]), float(v[0]))) % 360.0
-    return 0.0 if abs(a - 360.0) < 1e-9 else round(a, 9)
 
 
 def lattice_kind(a1: np.ndarray, a2: np.ndarray) -> str:
@@ -407,178 +402,6 @@ def _names(surface: PeriodicSurface, found: list[tuple], classes: list[int], lat
     return names
 
 
-# ---------------------------------------------------------------------------- barrier graph
-
-
-def _descend(surface: PeriodicSurface, x: np.ndarray, iterations: int = 4000) -> np.ndarray:
-    """Steepest descent (vectorised over rows of ``x``), Newton once the Hessian is positive."""
-    x = np.array(x, float)
-    scale = _scale(surface)
-    c = np.abs(surface.coefficients)
-    kk, ll = np.meshgrid(surface.k, surface.l, indexing="ij")
-    g = 2 * np.pi * np.stack([kk, ll], -1) @ surface.inverse  # Cartesian reciprocal vectors
-    lip = float(np.sum(c * np.sum(g**2, -1))) or 1.0  # bound on the Hessian's norm
-    spread = max(float(np.ptp(surface.values)), 1e-300)
-    for _ in range(iterations):
-        sv = surface.evaluate(x)
-        grad, hess = sv.gradient, sv.hessian
-        done = np.linalg.norm(grad, axis=-1) * scale <= 1e-11 * spread
-        if np.all(done):
-            break
-        lam = np.linalg.eigvalsh(hess)
-        step = grad / lip
-        pd = lam[:, 0] > 0
-        if np.any(pd):
-            newton = np.linalg.solve(hess[pd], grad[pd][..., None])[..., 0]
-            n = np.linalg.norm(newton, axis=-1, keepdims=True)
-            newton = np.where(
-                n > 0.02 * scale, newton * 0.02 * scale / np.maximum(n, 1e-300), newton
-            )
-            step[pd] = newton
-        step[done] = 0.0
-        x = x - step
-    return x
-
-
-def _egcd(a: int, b: int) -> tuple[int, int, int]:
-    if b == 0:
-        return (abs(a), 1 if a >= 0 else -1, 0)
-    g, x, y = _egcd(b, a % b)
-    return g, y, x - (a // b) * y
-
-
-def _hnf(gens: list[tuple[int, int]]) -> tuple:
-    """Basis ``(pivot or None, g2)`` of the integer sub-lattice spanned by ``gens``."""
-    pivot = None
-    g2 = 0
-    for v in gens:
-        v = (int(v[0]), int(v[1]))
-        if v[0] == 0:
-            g2 = math.gcd(g2, abs(v[1]))
-            continue
-        if pivot is None:
-            pivot = v
-            continue
-        g, x, y = _egcd(pivot[0], v[0])
-        new = (x * pivot[0] + y * v[0], x * pivot[1] + y * v[1])
-        other = (v[0] // g) * pivot[1] - (pivot[0] // g) * v[1]
-        pivot = new
-        g2 = math.gcd(g2, abs(other))
-    if pivot is not None and pivot[0] < 0:
-        pivot = (-pivot[0], -pivot[1])
-    if pivot is not None and g2:
-        pivot = (pivot[0], pivot[1] % g2)
-    return (pivot, g2)
-
-
-def _member(basis: tuple, m: np.ndarray) -> bool:
-    pivot, g2 = basis
-    m0, m1 = int(m[0]), int(m[1])
-    if m0 == 0 and m1 == 0:
-        return True
-    if pivot is None:
-        return m0 == 0 and g2 != 0 and m1 % g2 == 0
-    if m0 % pivot[0]:
-        return False
-    r = m1 - (m0 // pivot[0]) * pivot[1]
-    return r == 0 if g2 == 0 else r % g2 == 0
-
-
-def _shortest(basis: tuple, lattice: np.ndarray) -> np.ndarray | None:
-    pivot, g2 = basis
-    vecs = []
-    if pivot is not None:
-        vecs.append(np.array(pivot, float))
-    if g2:
-        vecs.append(np.array([0.0, g2]))
-    if not vecs:
-        return None
-    best = None
-    rng = range(-6, 7)
-    for c1 in rng:
-        for c2 in rng if len(vecs) > 1 else [0]:
-            m = c1 * vecs[0] + (c2 * vecs[1] if len(vecs) > 1 else 0)
-            if not np.any(m):
-                continue
-            v = lattice @ m
-            key = (round(float(np.linalg.norm(v)), 9), _angle_deg(v))
-            if best is None or key < best[0]:
-                best = (key, v)
-    return None if best is None else best[1]
-
-
-def _barrier_graph(surface: PeriodicSurface, found: list[tuple], start: int, classes: list[int]):
-    """Mountain-pass barriers of the start minimum to its lattice images (module step 4).
-
-    Symmetry-equivalent saddles open together, at the lowest energy of their class
-    (a round-off or pinning splitting of equivalent saddles does not pick a direction).
-    """
-    minima = [i for i, f in enumerate(found) if f[4] == "minimum"]
-    saddles = [i for i, f in enumerate(found) if f[4] == "saddle"]
-    scale = _scale(surface)
-    edges = []
-    if saddles:
-        starts = []
-        for i in saddles:
-            hess = surface.evaluate(found[i][1]).hessian
-            _, vec = np.linalg.eigh(hess)
-            v = vec[:, 0]
-            for sign in (1.0, -1.0):
-                starts.append(found[i][1] + sign * 1e-3 * scale * v)
-        ends = _descend(surface, np.array(starts))
-        for k, i in enumerate(saddles):
-            sides = []
-            for x in ends[2 * k : 2 * k + 2]:
-                s = surface.fractional(x)
-                match = None
-                for j in minima:
-                    ds = s - found[j][0]
-                    off = np.round(ds)
-                    if np.linalg.norm(surface.cartesian(ds - off)) < 1e-4 * scale:
-                        match = (j, off.astype(int))
-                        break
-                sides.append(match)
-            if None not in sides:
-                (ja, ta), (jb, tb) = sides
-                level = min(f[2] for f, c in zip(found, classes, strict=True) if c == classes[i])
-                edges.append((level, ja, jb, tb - ta, i))
-    edges.sort(key=lambda e: (e[0], e[4]))
-    parent = {j: j for j in minima}
-    offset = {j: np.zeros(2, int) for j in minima}
-    gens: dict[int, list] = {j: [] for j in minima}
-
-    def find(j: int) -> tuple[int, np.ndarray]:
-        total = np.zeros(2, int)
-        while parent[j] != j:
-            total = total + offset[j]
-            j = parent[j]
-        return j, total
-
-    history = []
-    first = None
-    for k, (energy, ja, jb, t, si) in enumerate(edges):
-        ra, oa = find(ja)
-        rb, ob = find(jb)
-        # image(ja, 0) = image(ra, oa); image(jb, t) = image(rb, t + ob)
-        if ra != rb:
-            parent[rb] = ra
-            offset[rb] = oa - t - ob
-            gens[ra] = gens[ra] + gens.pop(rb)
-        else:
-            cycle = t + ob - oa
-            if np.any(cycle):
-                gens[ra].append(tuple(int(c) for c in cycle))
-        if k + 1 < len(edges) and edges[k + 1][0] == energy:
-            continue  # the rest of this class opens at the same level
-        root, _ = find(start)
-        basis = _hnf(gens[root])
-        if basis != (None, 0) and (not history or history[-1][1] != basis):
-            history.append((energy, basis))
-            if first is None:
-                first = (energy, basis, si)
-    return first, tuple(history)
-
-
 # ---------------------------------------------------------------------------- entry point
 
 
@@ -598,7 +421,7 @@ def analyze_stackings(surface: PeriodicSurface, tolerance: float = SYMMETRY_TOLE
     names = _names(surface, found, classes, lattice)
     start = minima[0]
     euler_ok = _euler_ok(found)
-    first, history = _barrier_graph(surface, found, start, classes)
+    first, history = barrier_graph(surface, found, start, classes)
     points = tuple(
         StationaryPoint(names[i], f[4], f[1], f[0], f[2], f[3], classes[i])
         for i, f in enumerate(found)
@@ -607,7 +430,7 @@ def analyze_stackings(surface: PeriodicSurface, tolerance: float = SYMMETRY_TOLE
         barrier, vec, saddle = float("nan"), None, None
     else:
         barrier = float(first[0] - found[start][2])
-        vec = _shortest(first[1], surface.lattice)
+        vec = shortest_vector(first[1], surface.lattice)
         saddle = first[2]
     return Stackings(
         lattice=lattice,
