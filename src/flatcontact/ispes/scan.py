@@ -81,23 +81,14 @@ def _probe(
     reference: Atoms, factory: Any, grid: grid_mod.GridSpec, relax: RelaxSettings
 ) -> tuple[dict, list[str]]:
     calc = worker_calculator(factory, reference)
-    shift = grid_mod.lowest_energy_stacking(reference, calc, grid)
 
     def relax_one(a, b, z, start, start_z):
         task = PointTask((0, 0, 0), a, b, z, start, (a, b) if start is not None else None, start_z)
         r = relax_point(reference, calc, task, relax)
         return r.energy_ev, r.normal_stress_gpa, r.force_calls, r.positions
 
-    lo, hi, n = grid.p_range_gpa
-    probe = grid_mod.probe_column(relax_one, reference, shift, hi)
-    adh = grid_mod.adhesion(probe)
-    z, notes = grid_mod.thicknesses_for_pressures(probe, lo, hi, n)
-    return {
-        "thickness_angstrom": z.tolist(),
-        "probe": probe.as_dict(),
-        "adhesion": adh.as_dict(),
-        "notes": notes,
-    }, notes
+    rigid = grid_mod.rigid_stackings(reference, calc, grid)
+    return grid_mod.probe_thicknesses(relax_one, reference, rigid, grid)
 
 
 def _progress(console, total: int, done: int):
