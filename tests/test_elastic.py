@@ -137,3 +137,26 @@ def test_quartz_vashishta_trigonal_and_relaxation_softens():
     diff = 0.5 * ((clamped - relaxed) + (clamped - relaxed).T)
     assert np.linalg.eigvalsh(diff).min() > -tol  # clamped - relaxed is positive semidefinite
     assert clamped[0, 0] > relaxed[0, 0] + 5.0  # quartz has a large internal relaxation
+
+
+def test_any_crystal_any_model_cu_eam_gives_mishins_elastic_constants():
+    """Cu with the cu-eam preset (Mishin et al. 2001, EAM1): C11 = 169.9, C12 = 122.6,
+    C44 = 76.2 GPa and a = 3.615 Å, the values the potential reproduces by construction."""
+    from ase.build import bulk
+
+    from flatcontact.elastic import crystal_contact_moduli
+    from flatcontact.potentials import InteractionModel
+
+    out = crystal_contact_moduli(
+        bulk("Cu", "fcc", a=3.60, cubic=True), InteractionModel(preset="cu-eam")
+    )
+    c = np.array(out["tensor_gpa"])
+    assert out["cellpar"][0] == pytest.approx(3.615, abs=2e-3)
+    assert c[0, 0] == pytest.approx(169.9, abs=1.0)
+    assert c[0, 1] == pytest.approx(122.6, abs=1.0)
+    assert c[3, 3] == pytest.approx(76.2, abs=1.0)
+    # cubic symmetry; the moduli follow from the (rounded, 1e-3 GPa) tensor by Hill averages
+    assert c[1, 1] == pytest.approx(c[0, 0], abs=0.01) and c[5, 5] == pytest.approx(
+        c[3, 3], abs=0.01
+    )
+    assert out["moduli_gpa"]["e_star"] == pytest.approx(isotropic_moduli(c).e_star, rel=1e-5)

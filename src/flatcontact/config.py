@@ -43,7 +43,8 @@ from flatcontact.errors import InputError
 from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.order import PREFERENCES
 from flatcontact.ispes.relax import OPTIMIZERS, RelaxSettings
-from flatcontact.potentials.spec import BUNDLED_DIR, PotentialSpec
+from flatcontact.potentials.files import BUNDLED_DIR
+from flatcontact.potentials.model import InteractionModel
 from flatcontact.reference import (
     DEFAULT_P0_GPA,
     PAPER,
@@ -148,7 +149,11 @@ class StructureConfig(_Section):
 
 
 class CalculatorConfig(_Section):
-    """A whole-interface ASE calculator replacing ``potential`` (optional)."""
+    """A whole-interface ASE calculator (the earlier top-level ``calculator:`` section).
+
+    Still read from YAML and turned into ``potential: {calculator: {target, kwargs}}``;
+    ``RunConfig.calculator`` gives this view of such a model.
+    """
 
     target: str = Field(
         description="'module:callable'; callable(atoms, **kwargs) returns an ASE calculator "
@@ -315,7 +320,8 @@ class ElasticConfig(_Section):
     enabled: bool = Field(
         False,
         description="compute E* and G* (paper's convention) of bulk alpha-quartz with the "
-        "potential (vashishta or snap); otherwise contact.contact_modulus_gpa/shear_modulus_gpa",
+        "run's interaction model as a single crystal (it must know Si and O); otherwise "
+        "contact.contact_modulus_gpa/shear_modulus_gpa",
     )
 
 
@@ -407,12 +413,11 @@ class RunConfig(_Section):
     structure: StructureConfig = Field(
         default_factory=StructureConfig, description="the interface to build (stage build)"
     )
-    potential: PotentialSpec = Field(
-        default_factory=PotentialSpec,
-        description="intra-slab model + cross-interface TS-vdW LJ (flatcontact.potentials)",
-    )
-    calculator: CalculatorConfig | None = Field(
-        None, description="a whole-interface ASE calculator used instead of 'potential'"
+    potential: InteractionModel = Field(
+        default_factory=InteractionModel,
+        description="the interaction model (flatcontact.potentials.InteractionModel): a preset, "
+        "LAMMPS pair styles inside the slabs with a coupling across (lj, same, interlayer, "
+        "none), or an ASE calculator (potential.calculator)",
     )
     scan: ScanConfig = Field(
         default_factory=lambda: ScanConfig(
@@ -433,6 +438,27 @@ class RunConfig(_Section):
     report: ReportConfig = Field(
         default_factory=ReportConfig, description="the HTML report and figures (stage report)"
     )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _calculator_section(cls, data: Any) -> Any:
+        """The earlier top-level ``calculator: {target, kwargs}`` becomes the model's."""
+        if isinstance(data, dict) and "calculator" in data:
+            data = dict(data)
+            calc = data.pop("calculator")
+            if calc is not None:
+                if not isinstance(calc, dict):
+                    raise ValueError(f"calculator: expected a mapping, got {_show(calc)}")
+                data["potential"] = {"calculator": {**calc, "scope": "interface"}}
+        return data
+
+    @property
+    def calculator(self) -> CalculatorConfig | None:
+        """The whole-interface ASE calculator of the model, if it is one (earlier section)."""
+        calc = self.potential.calculator
+        if calc is None or calc.scope != "interface":
+            return None
+        return CalculatorConfig(target=calc.target, kwargs=calc.kwargs)
 
     @model_validator(mode="after")
     def _cross(self) -> RunConfig:
@@ -616,7 +642,10 @@ def build_config(
     data.pop("preset", None)
     if name not in ("quick", "paper"):
         raise InputError(f"{source}: preset: expected quick or paper, got {_show(name)}")
-    merged = merge_config(preset(name), data)
+    base = preset(name)
+    if _replaces_model(data.get("potential")):
+        base.pop("potential")  # a preset, a calculator or new styles: not the default's LJ
+    merged = merge_config(base, data)
     try:
         return RunConfig.model_validate(merged)
     except ValidationError as exc:
@@ -626,6 +655,25 @@ def build_config(
         if text.startswith("potential "):
             text = "potential." + text.removeprefix("potential ")
         raise InputError(f"{source}: {text}") from None
+
+
+def _replaces_model(section: Any) -> bool:
+    """Whether a ``potential`` section defines a whole model rather than editing the default.
+
+    A preset (``preset:`` or a preset name as ``intra``), a calculator, a coupling or
+    LAMMPS styles replace the default model; ``intra: vashishta`` or ``lj: {...}`` alone
+    edit it (they keep the quartz default's Hamaker-calibrated LJ).
+    """
+    from flatcontact.potentials.presets import PRESETS
+
+    if not isinstance(section, dict):
+        return False
+    intra = section.get("intra")
+    return (
+        any(k in section for k in ("preset", "calculator", "coupling", "interlayer"))
+        or (isinstance(intra, str) and intra.strip() in PRESETS)
+        or (intra is not None and not isinstance(intra, str))
+    )
 
 
 def load_config(path: str | Path | None = None, preset_name: str | None = None) -> RunConfig:
@@ -679,8 +727,7 @@ def _section_model(name: str) -> type[BaseModel] | None:
     ann = RunConfig.model_fields[name].annotation
     for cand in (
         StructureConfig,
-        PotentialSpec,
-        CalculatorConfig,
+        InteractionModel,
         ScanConfig,
         AnalysisConfig,
         ElasticConfig,
@@ -721,9 +768,15 @@ def to_yaml(config: RunConfig, comments: bool = True) -> str:
         desc = _descriptions(model) if model is not None else {}
         if key == "potential":
             desc = {
+                "preset": "a named model (graphene-rebo-kc, cu-eam, sio2-snap-lj, ...; "
+                "docs/potentials.md); the fields below override it",
                 "intra": "intra-slab model: vashishta, tersoff, snap:<name|path.snapcoeff>, "
-                "ase:module:factory",
+                "ase:module:factory, none, or LAMMPS styles [{pair_style, pair_coeff}]",
+                "intra_scope": "one instance of each intra style per slab or per layer",
+                "coupling": "across the interface: lj, same (bonded/metallic), interlayer, none",
+                "interlayer": "the interlayer style of coupling interlayer (KC, ILP)",
                 "lj": "cross-interface Lennard-Jones (c6_source ts = Tkatchenko-Scheffler)",
+                "calculator": "an ASE calculator {target: module:callable, kwargs, scope}",
             }
         for sub, subval in value.items():
             if comments and desc.get(sub):

@@ -181,31 +181,73 @@ def isotropic_moduli(c: np.ndarray) -> IsotropicModuli:
     return IsotropicModuli(kv, kr, gv, gr, k, g, e, nu, e_star, g_j, g_p)
 
 
-def quartz_contact_moduli(potential: str = "sio2-snap", strain: float = 0.005) -> dict:
-    """Self-consistent contact moduli of alpha-quartz for a potential (name or .snapcoeff path).
+def _calculator(model, atoms: Atoms):
+    """A bulk calculator from a model (InteractionModel, its name) or an ASE calculator."""
+    if isinstance(model, str):
+        from flatcontact.training.potentials import bulk_calculator
 
-    Relaxes alpha-quartz (cell and ions) with the potential, computes the relaxed-ion
-    Cij by ±``strain`` finite strains, and returns a JSON-ready dict with ``a_angstrom``,
+        return bulk_calculator(model, atoms)
+    if hasattr(model, "bulk_calculator"):
+        return model.bulk_calculator(atoms)
+    return model  # already an ASE calculator
+
+
+def _relaxed_tensor(atoms: Atoms, model, strain: float) -> tuple[Atoms, np.ndarray]:
+    calc = _calculator(model, atoms)
+    relaxed = relax_cell(atoms, calc, fmax=1e-4)
+    return relaxed, elastic_tensor(relaxed, calc, strain=strain, relax_ions=True, fmax=2e-4)
+
+
+_CONVENTIONS = (
+    "Voigt (xx,yy,zz,yz,xz,xy), relaxed ions, Hill averages; "
+    "1/E* = 2(1-nu^2)/E, 1/G*_J = 2(2-nu)/G, G*_paper = 4 G*_J"
+)
+
+
+def crystal_contact_moduli(atoms: Atoms, model, strain: float = 0.005) -> dict:
+    """Self-consistent contact moduli of any bulk crystal for any interaction model.
+
+    ``model`` is an :class:`~flatcontact.potentials.InteractionModel` (its
+    ``bulk_calculator``), a potential name (:func:`flatcontact.training.potentials.bulk_calculator`)
+    or an ASE calculator. Relaxes cell and ions, computes the relaxed-ion C_ij by
+    ±``strain`` central differences and returns a JSON-ready dict: ``cellpar`` (a, b, c in Å,
+    angles in degrees), ``tensor_gpa`` and ``moduli_gpa`` (Hill K, G, E, nu; E*, G*_Johnson,
+    G*_paper = 4 G*_Johnson for two identical isotropic bodies; see the module docstring).
+    The Hill average treats the crystal as an isotropic polycrystal, which for strongly
+    anisotropic (layered) crystals is a convention to state, not a property of the contact.
+    """
+    relaxed, c = _relaxed_tensor(atoms, model, strain)
+    return {
+        "cellpar": [float(v) for v in relaxed.cell.cellpar()],
+        "strain": strain,
+        "tensor_gpa": np.round(c, 3).tolist(),
+        "moduli_gpa": isotropic_moduli(c).as_dict(),
+        "conventions": _CONVENTIONS,
+    }
+
+
+def quartz_contact_moduli(potential="sio2-snap", strain: float = 0.005) -> dict:
+    """Self-consistent contact moduli of alpha-quartz for a potential.
+
+    ``potential``: a name or .snapcoeff path, or an :class:`~flatcontact.potentials.InteractionModel`.
+    Relaxes alpha-quartz (cell and ions) with the potential, computes the relaxed-ion Cij by
+    ±``strain`` finite strains, and returns a JSON-ready dict with ``a_angstrom``,
     ``c_angstrom``, ``cij_gpa`` (trigonal set), ``tensor_gpa`` and ``moduli_gpa`` (Hill
     K, G, E, nu; E*, G*_Johnson, G*_paper = 4 G*_Johnson for two identical bodies).
     These replace the paper's E* = 52.5 GPa and G* = 29 GPa when self-consistent moduli
     are asked for.
     """
     from flatcontact.structures.bulk import alpha_quartz
-    from flatcontact.training.potentials import bulk_calculator
 
-    calc = bulk_calculator(potential)
-    q = relax_cell(alpha_quartz(), calc, fmax=1e-4)
-    c = elastic_tensor(q, calc, strain=strain, relax_ions=True, fmax=2e-4)
+    q, c = _relaxed_tensor(alpha_quartz(), potential, strain)
     cp = q.cell.cellpar()
     return {
-        "potential": potential,
+        "potential": potential if isinstance(potential, str) else potential.label,
         "a_angstrom": float(cp[0]),
         "c_angstrom": float(cp[2]),
         "strain": strain,
         "cij_gpa": {k: float(v) for k, v in trigonal_constants(c).items()},
         "tensor_gpa": np.round(c, 3).tolist(),
         "moduli_gpa": isotropic_moduli(c).as_dict(),
-        "conventions": "Voigt (xx,yy,zz,yz,xz,xy), relaxed ions, Hill averages; "
-        "1/E* = 2(1-nu^2)/E, 1/G*_J = 2(2-nu)/G, G*_paper = 4 G*_J",
+        "conventions": _CONVENTIONS,
     }

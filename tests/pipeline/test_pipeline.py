@@ -300,7 +300,7 @@ def test_a_retrained_potential_file_reruns_from_the_build(tmp_path):
         coeff = tmp_path / "my.snapcoeff"
         coeff.write_text(coeff.read_text() + "\n")
         after = pipe._model_inputs()
-    assert before["potential"] == after["potential"]
+    assert before["model"] == after["model"]
     assert before["files_sha256"]["my.snapparam"] == after["files_sha256"]["my.snapparam"]
     assert before["files_sha256"]["my.snapcoeff"] != after["files_sha256"]["my.snapcoeff"]
 

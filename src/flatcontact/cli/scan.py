@@ -24,6 +24,7 @@ _FLAG_OF = {
     "potential": "--potential",
     "potential.intra": "--potential",
     "calculator": "--calculator",
+    "potential.calculator": "--calculator",
     "scan.grid": "--grid",
     "scan.thickness_angstrom": "--thickness",
     "scan.p_range_gpa": "--p-range-gpa",
@@ -200,8 +201,8 @@ def scan_command(
     }
     flags: dict[str, Any] = {"scan": {k: v for k, v in scan_flags.items() if v is not None}}
     if potential is not None:
-        flags["potential"] = _potential_section(potential)
-        flags["calculator"] = None
+        # an intra-slab model in place of the configured model's (its LJ kept), not a calculator
+        flags["potential"] = {**_potential_section(potential), "calculator": None}
     if calculator is not None:
         flags["calculator"] = {"target": calculator, "kwargs": {}}
     cfg = resolve_config(config, preset, flags)

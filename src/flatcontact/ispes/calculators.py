@@ -5,31 +5,34 @@ grid point it relaxes. A factory is a small frozen object that pickles to any
 worker process (local pool or Dask) and has a JSON ``fingerprint`` that the point
 store records, so a store is never mixed across interaction models.
 
-Two kinds:
+The factory of every interaction model is ``model.calculator_factory()``
+(:class:`flatcontact.potentials.factory.ModelFactory`). Earlier names kept here:
 
-- :class:`PotentialFactory`: a :class:`flatcontact.potentials.PotentialSpec`
-  (LAMMPS SNAP / classical per slab + cross-interface LJ, or an ASE model per slab),
-  built with :func:`flatcontact.potentials.make_calculator`.
-- :class:`CalculatorFactory`: any ASE calculator given as ``"module:callable"``
-  plus JSON keyword arguments; ``callable(atoms, **kwargs)`` returns the calculator.
+- :class:`PotentialFactory`: ``PotentialFactory.from_spec(model)``, the same factory;
+- :class:`CalculatorFactory`: a whole-interface ASE calculator ``"module:callable"`` plus
+  JSON keyword arguments (the model ``{calculator: {target, kwargs}}``).
 """
 
 from __future__ import annotations
 
 import dataclasses
-import importlib
 import json
 from typing import Any
 
 from ase import Atoms
 from ase.calculators.calculator import Calculator
 
-from flatcontact.errors import InputError
+from flatcontact.potentials.factory import ModelFactory
 
 
 @dataclasses.dataclass(frozen=True)
 class CalculatorFactory:
-    """Build ``callable(atoms, **kwargs)`` from ``target = "module:callable"``."""
+    """Build ``callable(**kwargs)`` from ``target = "module:callable"`` (a whole-interface model).
+
+    Kept for callers of the earlier API; the same as the factory of
+    ``InteractionModel(calculator={"target": target, "kwargs": kwargs})`` (one loader:
+    :func:`flatcontact.potentials.loader.call_factory`).
+    """
 
     target: str
     kwargs_json: str = "{}"
@@ -41,67 +44,38 @@ class CalculatorFactory:
         return factory
 
     def resolve(self):
-        module_name, _, attr = self.target.partition(":")
-        if not module_name or not attr:
-            raise InputError(
-                f"calculator '{self.target}': expected 'module:callable' returning an ASE calculator"
-            )
-        try:
-            obj = importlib.import_module(module_name)
-        except ImportError as exc:
-            raise InputError(
-                f"calculator '{self.target}': cannot import {module_name} ({exc})"
-            ) from None
-        for part in attr.split("."):
-            if not hasattr(obj, part):
-                raise InputError(f"calculator '{self.target}': {module_name} has no '{attr}'")
-            obj = getattr(obj, part)
-        if not callable(obj):
-            raise InputError(f"calculator '{self.target}': '{attr}' is not callable")
-        return obj
+        from flatcontact.potentials.loader import load_callable
+
+        return load_callable(self.target, "calculator")
 
     def __call__(self, atoms: Atoms) -> Calculator:
-        return self.resolve()(atoms, **json.loads(self.kwargs_json))
+        from flatcontact.potentials.loader import call_factory
+
+        return call_factory(self.target, atoms, json.loads(self.kwargs_json))
+
+    def model(self):
+        """The equivalent :class:`~flatcontact.potentials.model.InteractionModel`."""
+        from flatcontact.potentials import InteractionModel
+
+        return InteractionModel(
+            calculator={"target": self.target, "kwargs": json.loads(self.kwargs_json)}
+        )
 
     @property
     def fingerprint(self) -> str:
-        return json.dumps(
-            {"calculator": self.target, "kwargs": json.loads(self.kwargs_json)}, sort_keys=True
-        )
+        return self.model().calculator_factory().fingerprint
 
     @property
     def label(self) -> str:
         return f"{self.target} {self.kwargs_json}"
 
 
-@dataclasses.dataclass(frozen=True)
-class PotentialFactory:
-    """Build :func:`flatcontact.potentials.make_calculator` from a spec's JSON form."""
-
-    spec_json: str
+class PotentialFactory(ModelFactory):
+    """The factory of an interaction model (earlier name of :class:`ModelFactory`)."""
 
     @classmethod
     def from_spec(cls, spec: Any) -> PotentialFactory:
         return cls(spec.model_dump_json())
-
-    def spec(self):
-        from flatcontact.potentials import PotentialSpec
-
-        return PotentialSpec.model_validate_json(self.spec_json)
-
-    def __call__(self, atoms: Atoms) -> Calculator:
-        from flatcontact.potentials import make_calculator
-
-        return make_calculator(self.spec(), atoms)
-
-    @property
-    def fingerprint(self) -> str:
-        return json.dumps({"potential": json.loads(self.spec_json)}, sort_keys=True)
-
-    @property
-    def label(self) -> str:
-        spec = self.spec()
-        return str(getattr(spec, "label", self.spec_json))
 
 
 def count_force_calls(calc: Calculator) -> Calculator:

@@ -1,11 +1,38 @@
-"""flatcontact.potentials: interaction models behind one interface.
+"""flatcontact.potentials: one interaction model behind every stage.
 
-- :class:`PotentialSpec`, :class:`LJSpec`: what to use (intra-slab model, cross-interface LJ).
-- :func:`make_calculator`: an ASE calculator for an interface (LAMMPS or ASE-calculator engine).
-- :func:`check_elements`: element compatibility of a spec and a structure.
+- :class:`InteractionModel` (alias :class:`PotentialSpec`): the run configuration's
+  ``potential:`` section — LAMMPS pair styles as data (:class:`LammpsStyle`) with a coupling
+  across the interface (``lj`` | ``same`` | ``interlayer`` | ``none``), named presets
+  (:data:`PRESETS`), or an ASE calculator ``module:callable`` (:class:`AseCalculatorSpec`).
+- :class:`LJSpec`: the cross-interface Lennard-Jones from Tkatchenko–Scheffler C6.
+- :func:`make_calculator`, :func:`check_elements`: earlier entry points, now
+  ``model.calculator(atoms)`` and ``model.check_atoms(atoms)``.
+- :func:`parse_kwargs`: CLI ``key=value`` keyword arguments of an ASE calculator.
 """
 
 from flatcontact.potentials.calculator import check_elements, make_calculator
-from flatcontact.potentials.spec import LJSpec, PotentialSpec
+from flatcontact.potentials.loader import call_factory, load_callable, parse_kwargs
+from flatcontact.potentials.model import (
+    AseCalculatorSpec,
+    InteractionModel,
+    LammpsStyle,
+    LJSpec,
+)
+from flatcontact.potentials.presets import PRESETS
 
-__all__ = ["LJSpec", "PotentialSpec", "check_elements", "make_calculator"]
+#: The earlier name of :class:`InteractionModel`.
+PotentialSpec = InteractionModel
+
+__all__ = [
+    "PRESETS",
+    "AseCalculatorSpec",
+    "InteractionModel",
+    "LJSpec",
+    "LammpsStyle",
+    "PotentialSpec",
+    "call_factory",
+    "check_elements",
+    "load_callable",
+    "make_calculator",
+    "parse_kwargs",
+]

@@ -1,15 +1,18 @@
-"""ASE calculators for an interface: :func:`make_calculator` (LAMMPS or ASE-calculator engine).
+"""ASE calculators of an :class:`~flatcontact.potentials.model.InteractionModel`.
 
-Both give the energy (eV) and forces (eV/Å) of the whole interface: the intra-slab model
-inside each slab (slab 1 and slab 2 never interact through it) and LJ only between atoms
-of different slabs. They are created once per worker and reused: a call on Atoms with the
-same species, order, slab labels, cell and pbc only updates positions; anything else
-rebuilds the engine. ``calc.force_calls`` counts energy+force evaluations (cumulative).
+- :class:`LammpsInterfaceCalculator`: the LAMMPS engine with the model's compiled setup
+  (:mod:`flatcontact.potentials.lammps_setup`); also the bulk calculator (energy, forces,
+  stress of a 3D-periodic crystal).
+- :class:`AseInterfaceCalculator`: an ASE calculator per slab (each slab as its own Atoms,
+  keeping the interface cell and pbc) + vectorised numpy LJ across (``coupling: lj``).
+- a whole-interface ASE calculator is the user's calculator itself.
+
+The first two are created once per worker and reused: a call on Atoms with the same species,
+order, slab/layer labels, cell and pbc only updates positions; anything else rebuilds the
+engine. ``calc.force_calls`` counts energy+force evaluations (cumulative).
 """
 
 from __future__ import annotations
-
-import importlib
 
 import numpy as np
 from ase import Atoms
@@ -18,38 +21,24 @@ from ase.calculators.calculator import Calculator, all_changes
 from flatcontact.errors import InputError
 from flatcontact.potentials.lammps_engine import LammpsEngine
 from flatcontact.potentials.lj import lj_cross_energy_forces
-from flatcontact.potentials.spec import PotentialSpec
+from flatcontact.potentials.loader import call_factory
+from flatcontact.potentials.model import InteractionModel, slab_ids
 
 
-def _groups(atoms: Atoms) -> np.ndarray:
-    if "slab" in atoms.arrays:
-        return np.asarray(atoms.arrays["slab"], dtype=int)
-    return np.ones(len(atoms), dtype=int)
+def _signature(atoms: Atoms) -> tuple:
+    layer = atoms.arrays.get("layer")
+    return (
+        tuple(atoms.numbers.tolist()),
+        tuple(slab_ids(atoms).tolist()),
+        tuple(np.asarray(layer).tolist()) if layer is not None else None,
+        tuple(np.round(atoms.cell.array, 10).ravel().tolist()),
+        tuple(bool(p) for p in atoms.pbc),
+    )
 
 
-def check_elements(spec: PotentialSpec, atoms: Atoms) -> None:
-    """Raise :class:`InputError` if the spec's intra model or LJ lacks an element of ``atoms``."""
-    symbols = set(atoms.get_chemical_symbols())
-    known = spec.resolved.elements
-    if known is not None and not symbols <= set(known):
-        raise InputError(
-            f"potential '{spec.intra}' knows elements {list(known)}, but the structure has {sorted(symbols - set(known))}"
-        )
-    groups = _groups(atoms)
-    if len(set(groups.tolist())) > 1:
-        sym = np.array(atoms.get_chemical_symbols())
-        spec.lj.table(sorted(set(sym[groups == 1])), sorted(set(sym[groups != 1])))
-
-
-class _Signature:
-    @staticmethod
-    def of(atoms: Atoms) -> tuple:
-        return (
-            tuple(atoms.numbers.tolist()),
-            tuple(_groups(atoms).tolist()),
-            tuple(np.round(atoms.cell.array, 10).ravel().tolist()),
-            tuple(bool(p) for p in atoms.pbc),
-        )
+def check_elements(model: InteractionModel, atoms: Atoms) -> None:
+    """``model.check_atoms(atoms)`` (kept for callers of the earlier API)."""
+    model.check_atoms(atoms)
 
 
 class InterfaceCalculator(Calculator):
@@ -57,59 +46,67 @@ class InterfaceCalculator(Calculator):
 
     implemented_properties = ("energy", "free_energy", "forces")
 
-    def __init__(self, spec: PotentialSpec, atoms: Atoms | None = None, **kwargs):
+    def __init__(
+        self, spec: InteractionModel, atoms: Atoms | None = None, bulk: bool = False, **kwargs
+    ):
         super().__init__(**kwargs)
         self.spec = spec
+        self.bulk = bulk
         self.force_calls = 0
         self._signature = None
+        if bulk:  # the stress of a 3D-periodic crystal
+            self.implemented_properties = ("energy", "free_energy", "forces", "stress")
         if atoms is not None:  # otherwise built lazily on the first call
-            check_elements(spec, atoms)
+            self._check(atoms)
             self._build(atoms)
+
+    def _check(self, atoms: Atoms) -> None:
+        if self.bulk:
+            known = self.spec.elements
+            missing = sorted(set(atoms.get_chemical_symbols()) - known) if known is not None else []
+            if missing:
+                raise InputError(
+                    f"potential '{self.spec.name}' has no parameters for element(s) {missing} "
+                    f"of the structure (it knows {sorted(known)})"
+                )
+        else:
+            self.spec.check_atoms(atoms)
 
     def _build(self, atoms: Atoms) -> None:
         raise NotImplementedError
 
-    def _evaluate(self, atoms: Atoms) -> tuple[float, np.ndarray]:
+    def _evaluate(self, atoms: Atoms, stress: bool):
         raise NotImplementedError
 
     def calculate(self, atoms=None, properties=("energy",), system_changes=all_changes):
         super().calculate(atoms, properties, system_changes)
-        signature = _Signature.of(self.atoms)
+        signature = _signature(self.atoms)
         if signature != self._signature:
-            check_elements(self.spec, self.atoms)
+            self._check(self.atoms)
             self.close()
             self._build(self.atoms)
-        energy, forces = self._evaluate(self.atoms)
+            self._signature = signature
+        want_stress = "stress" in properties
+        out = self._evaluate(self.atoms, want_stress)
         self.force_calls += 1
-        self.results = {"energy": energy, "free_energy": energy, "forces": forces}
+        self.results = {"energy": out[0], "free_energy": out[0], "forces": out[1]}
+        if want_stress or (self.bulk and len(out) > 2):
+            self.results["stress"] = out[2]
 
     def close(self) -> None:
         """Release engine resources (LAMMPS instances)."""
 
 
 class LammpsInterfaceCalculator(InterfaceCalculator):
-    """LAMMPS engine: intra-slab style per slab (hybrid/overlay, NULL-mapped) + lj/cut across."""
+    """The LAMMPS engine with the model's setup (see :mod:`flatcontact.potentials.lammps_setup`)."""
 
     def _build(self, atoms: Atoms) -> None:
-        groups = _groups(atoms)
-        symbols = atoms.get_chemical_symbols()
-        sym = np.array(symbols)
-        table = None
-        if len(set(groups.tolist())) > 1:
-            table = self.spec.lj.table(sorted(set(sym[groups == 1])), sorted(set(sym[groups != 1])))
-        self.engine = LammpsEngine(
-            self.spec.resolved,
-            symbols,
-            groups,
-            atoms.cell.array,
-            atoms.pbc,
-            lj_table=table,
-            lj_cutoff_angstrom=self.spec.lj.cutoff_angstrom,
-        )
-        self._signature = _Signature.of(atoms)
+        setup = self.spec.lammps_setup(atoms, bulk=self.bulk)
+        self.engine = LammpsEngine(setup, atoms.cell.array, atoms.pbc, label=self.spec.label)
+        self._signature = _signature(atoms)
 
-    def _evaluate(self, atoms: Atoms) -> tuple[float, np.ndarray]:
-        return self.engine.compute(atoms.positions)
+    def _evaluate(self, atoms: Atoms, stress: bool):
+        return self.engine.compute(atoms.positions, stress=self.bulk and all(atoms.pbc))
 
     def close(self) -> None:
         engine = getattr(self, "engine", None)
@@ -118,49 +115,40 @@ class LammpsInterfaceCalculator(InterfaceCalculator):
             self.engine = None
 
 
-def load_factory(path: str):
-    """Import ``module:factory`` and return the callable (one-line InputError otherwise)."""
-    module_name, _, attr = path.partition(":")
-    try:
-        module = importlib.import_module(module_name)
-    except ImportError as exc:
-        raise InputError(f"ASE calculator factory '{path}': cannot import module ({exc})") from None
-    factory = getattr(module, attr, None)
-    if not callable(factory):
-        raise InputError(
-            f"ASE calculator factory '{path}': '{attr}' is not a callable in {module_name}"
-        )
-    return factory
-
-
 class AseInterfaceCalculator(InterfaceCalculator):
-    """ASE engine: an ASE calculator per slab (each slab as its own Atoms) + vectorised numpy LJ across.
+    """An ASE calculator per slab (each slab as its own Atoms) + vectorised numpy LJ across.
 
-    The factory is called once per slab (two independent calculator instances); each slab's
-    Atoms keeps the interface cell and pbc, so lateral periodic images are included.
+    The factory is called once per slab (independent calculator instances); each slab's Atoms
+    keeps the interface cell and pbc, so lateral periodic images are included.
     """
 
+    def _factory(self):
+        spec = self.spec
+        if spec.calculator is not None:
+            return lambda: call_factory(spec.calculator.target, None, spec.calculator.kwargs)
+        target = spec.intra.removeprefix("ase:")
+        return lambda: call_factory(target, None, {}, what="ASE calculator factory")
+
     def _build(self, atoms: Atoms) -> None:
-        factory = load_factory(self.spec.resolved.factory)
-        groups = _groups(atoms)
-        self._group_ids = sorted(set(groups.tolist()))
-        self._members = [np.flatnonzero(groups == g) for g in self._group_ids]
+        make = self._factory()
+        groups = slab_ids(atoms)
+        self._members = [np.flatnonzero(groups == g) for g in sorted(set(groups.tolist()))]
         self._slabs = []
         for idx in self._members:
             part = Atoms(
                 atoms.numbers[idx], positions=atoms.positions[idx], cell=atoms.cell, pbc=atoms.pbc
             )
-            part.calc = factory()
+            part.calc = make()
             self._slabs.append(part)
         sym = np.array(atoms.get_chemical_symbols())
         self._table = None
-        if len(self._group_ids) > 1:
+        if len(self._members) > 1 and self.spec.coupling == "lj":
             self._table = self.spec.lj.table(
                 sorted(set(sym[groups == 1])), sorted(set(sym[groups != 1]))
             )
-        self._signature = _Signature.of(atoms)
+        self._signature = _signature(atoms)
 
-    def _evaluate(self, atoms: Atoms) -> tuple[float, np.ndarray]:
+    def _evaluate(self, atoms: Atoms, stress: bool):
         energy = 0.0
         forces = np.zeros((len(atoms), 3))
         for idx, part in zip(self._members, self._slabs, strict=True):
@@ -169,19 +157,39 @@ class AseInterfaceCalculator(InterfaceCalculator):
             forces[idx] = part.get_forces()
         if self._table is not None:
             e_lj, f_lj = lj_cross_energy_forces(
-                atoms, _groups(atoms), self._table, self.spec.lj.cutoff_angstrom
+                atoms, slab_ids(atoms), self._table, self.spec.lj.cutoff_angstrom
             )
             energy += e_lj
             forces += f_lj
         return energy, forces
 
 
-def make_calculator(spec: PotentialSpec, atoms: Atoms) -> InterfaceCalculator:
-    """The calculator for ``spec`` on an interface (or, without a ``slab`` array, a single slab/bulk).
+def model_calculator(model: InteractionModel, atoms: Atoms):
+    """The calculator of ``model`` for ``atoms`` (InputError on an element mismatch first)."""
+    if model.engine == "ase-interface":
+        model.check_atoms(atoms)
+        c = model.calculator
+        return call_factory(c.target, atoms, c.kwargs)
+    if model.engine == "ase-slab":
+        return AseInterfaceCalculator(model, atoms)
+    return LammpsInterfaceCalculator(model, atoms)
 
-    Uses the ``slab`` array to give each slab its own atom types; raises :class:`InputError`
-    on an element mismatch before any LAMMPS instance is created.
+
+def bulk_model_calculator(model: InteractionModel, atoms: Atoms):
+    """Energy, forces and stress of a single crystal with ``model`` (no coupling, no slabs)."""
+    if model.calculator is not None:
+        c = model.calculator
+        return call_factory(c.target, atoms, c.kwargs)
+    if model.engine == "ase-slab":
+        return call_factory(model.intra.removeprefix("ase:"), None, {})
+    if not model.intra_styles:
+        raise InputError(f"potential {model.label}: no intra model to compute a bulk crystal with")
+    return LammpsInterfaceCalculator(model, atoms, bulk=True)
+
+
+def make_calculator(spec: InteractionModel, atoms: Atoms):
+    """The calculator for ``spec`` on an interface (or, without a ``slab`` array, a single body).
+
+    Raises :class:`InputError` on an element mismatch before any LAMMPS instance is created.
     """
-    if spec.kind == "ase":
-        return AseInterfaceCalculator(spec, atoms)
-    return LammpsInterfaceCalculator(spec, atoms)
+    return model_calculator(spec, atoms)

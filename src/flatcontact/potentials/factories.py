@@ -12,29 +12,21 @@ Each factory takes no arguments and returns a fresh ASE calculator for a single 
 from __future__ import annotations
 
 from flatcontact.potentials.calculator import LammpsInterfaceCalculator
-from flatcontact.potentials.spec import PotentialSpec
+from flatcontact.potentials.model import InteractionModel
 
 
 def vashishta():
     """Vashishta 1990 SiO₂ via the LAMMPS engine (single slab: no LJ)."""
-    return LammpsInterfaceCalculator(PotentialSpec(intra="vashishta"))
+    return LammpsInterfaceCalculator(InteractionModel(intra="vashishta"))
 
 
 def tersoff():
     """Tersoff Si–O (Munetoh 2007) via the LAMMPS engine (single slab: no LJ)."""
-    return LammpsInterfaceCalculator(PotentialSpec(intra="tersoff"))
+    return LammpsInterfaceCalculator(InteractionModel(intra="tersoff"))
 
 
 def chgnet_r2scan():
-    """CHGNet with the r2SCAN weights, CPU, deterministic; raises InputError if not installed."""
-    from flatcontact.errors import InputError
+    """CHGNet with the r2SCAN weights, CPU; raises InputError if not installed."""
+    from flatcontact.potentials.chgnet import chgnet_calculator
 
-    try:
-        from chgnet.model import CHGNet
-        from chgnet.model.dynamics import CHGNetCalculator
-    except ImportError as exc:
-        raise InputError(
-            f"CHGNet is not installed ({exc}); install torch==2.13.0 (CPU) and then 'chgnet'"
-        ) from None
-    model = CHGNet.load(model_name="r2scan", use_device="cpu", verbose=False)
-    return CHGNetCalculator(model=model, use_device="cpu", on_isolated_atoms="ignore")
+    return chgnet_calculator("r2scan", on_isolated_atoms="ignore")

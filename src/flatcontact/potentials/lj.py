@@ -4,7 +4,8 @@ Free-atom reference data
     C6 (Hartree·bohr⁶) and static dipole polarisability α (bohr³) from Chu & Dalgarno,
     J. Chem. Phys. 121, 4083 (2004), as tabulated by Tkatchenko & Scheffler, PRL 102,
     073005 (2009) (taken from ``ase.calculators.vdwcorrection.vdWDB_alphaC6``); free-atom
-    van der Waals radii R0 (bohr) from the TS 2009 table (:data:`TS_R0_BOHR`).
+    van der Waals radii R0 (bohr) from the TS 2009 table; every element H–Ba, Hf–Rn in
+    :data:`TS_FREE_ATOM`.
 
 Effective (in-material) values, TS 2009 Eqs. (7)–(9)
     With a Hirshfeld volume ratio v = V_eff/V_free per element:
@@ -52,19 +53,47 @@ HARTREE_BOHR6_TO_EV_A6 = units.Hartree * units.Bohr**6
 #: bohr → Å.
 BOHR_TO_ANGSTROM = units.Bohr
 
-#: TS 2009 free-atom vdW radii R0 (bohr) (Tkatchenko & Scheffler, PRL 102, 073005 (2009),
-#: reference table; same values as VASP IVDW=2 / FHI-aims). Others: give ``r0_angstrom``.
-TS_R0_BOHR: dict[str, float] = {
-    "H": 3.10,
-    "C": 3.59,
-    "N": 3.34,
-    "O": 3.19,
-    "F": 3.04,
-    "Si": 4.20,
-    "P": 4.01,
-    "S": 3.86,
-    "Cl": 3.71,
-}
+#: Tkatchenko–Scheffler free-atom reference data per element, (α in bohr³, C6 in
+#: Hartree·bohr⁶, R0 in bohr): α and C6 from Chu & Dalgarno, J. Chem. Phys. 121, 4083 (2004)
+#: (TS 2009 reference table, the values of ASE's ``vdWDB_alphaC6`` where it has them), R0 from
+#: TS, PRL 102, 073005 (2009); 4d/5d metals from the extended TS table used by FHI-aims,
+#: VASP (IVDW=2) and libmbd. H–Ba and Hf–Rn (no lanthanides); others: give ``c6_ev_a6`` and
+#: ``r0_angstrom``.
+TS_FREE_ATOM: dict[str, tuple[float, float, float]] = {
+    "H": (4.5, 6.5, 3.1), "He": (1.38, 1.46, 2.65), "Li": (164.2, 1387.0, 4.16),
+    "Be": (38.0, 214.0, 4.17), "B": (21.0, 99.5, 3.89), "C": (12.0, 46.6, 3.59),
+    "N": (7.4, 24.2, 3.34), "O": (5.4, 15.6, 3.19), "F": (3.8, 9.52, 3.04),
+    "Ne": (2.67, 6.38, 2.91), "Na": (162.7, 1556.0, 3.73), "Mg": (71.0, 627.0, 4.27),
+    "Al": (60.0, 528.0, 4.33), "Si": (37.0, 305.0, 4.2), "P": (25.0, 185.0, 4.01),
+    "S": (19.6, 134.0, 3.86), "Cl": (15.0, 94.6, 3.71), "Ar": (11.1, 64.3, 3.55),
+    "K": (292.9, 3897.0, 3.71), "Ca": (160.0, 2221.0, 4.65), "Sc": (120.0, 1383.0, 4.59),
+    "Ti": (98.0, 1044.0, 4.51), "V": (84.0, 832.0, 4.44), "Cr": (78.0, 602.0, 3.99),
+    "Mn": (63.0, 552.0, 3.97), "Fe": (56.0, 482.0, 4.23), "Co": (50.0, 408.0, 4.18),
+    "Ni": (48.0, 373.0, 3.82), "Cu": (42.0, 253.0, 3.76), "Zn": (40.0, 284.0, 4.02),
+    "Ga": (60.0, 498.0, 4.19), "Ge": (41.0, 354.0, 4.2), "As": (29.0, 246.0, 4.11),
+    "Se": (25.0, 210.0, 4.04), "Br": (20.0, 162.0, 3.93), "Kr": (16.8, 129.6, 3.82),
+    "Rb": (319.2, 4691.0, 3.72), "Sr": (199.0, 3170.0, 4.54), "Y": (126.737, 1968.58, 4.8151),
+    "Zr": (119.97, 1677.91, 4.53), "Nb": (101.603, 1263.61, 4.2365),
+    "Mo": (88.4225785, 1028.73, 4.099), "Tc": (80.083, 1390.87, 4.076),
+    "Ru": (65.895, 609.754, 3.9953), "Rh": (56.1, 469.0, 3.95), "Pd": (23.68, 157.5, 3.66),
+    "Ag": (50.6, 339.0, 3.82), "Cd": (39.7, 452.0, 3.99), "In": (70.22, 707.046, 4.23198),
+    "Sn": (55.95, 587.417, 4.303), "Sb": (43.67197, 459.322, 4.276), "Te": (37.65, 396.0, 4.22),
+    "I": (35.0, 385.0, 4.17), "Xe": (27.3, 285.9, 4.08), "Cs": (427.12, 6582.08, 3.78),
+    "Ba": (275.0, 5727.0, 4.77), "Hf": (99.52, 1274.8, 4.21), "Ta": (82.53, 1019.92, 4.15),
+    "W": (71.041, 847.93, 4.08), "Re": (63.04, 710.2, 4.02), "Os": (55.055, 596.67, 3.84),
+    "Ir": (42.51, 359.1, 4.0), "Pt": (39.68, 347.1, 3.92), "Au": (36.5, 298.0, 3.86),
+    "Hg": (33.9, 392.0, 3.98), "Tl": (69.92, 717.44, 3.91), "Pb": (61.8, 697.0, 4.31),
+    "Bi": (49.02, 571.0, 4.32), "Po": (45.013, 530.92, 4.097), "At": (38.93, 457.53, 4.07),
+    "Rn": (33.54, 390.63, 4.23),
+}  # fmt: skip
+
+#: TS 2009 free-atom vdW radii R0 (bohr), from :data:`TS_FREE_ATOM`.
+TS_R0_BOHR: dict[str, float] = {k: v[2] for k, v in TS_FREE_ATOM.items()}
+
+
+def ts_elements() -> frozenset[str]:
+    """The elements with Tkatchenko–Scheffler free-atom C6, α and R0."""
+    return frozenset(TS_FREE_ATOM)
 
 
 @dataclass(frozen=True)
@@ -83,11 +112,14 @@ def pair_key(a: str, b: str) -> str:
 
 def ts_free_atom(symbol: str) -> tuple[float, float]:
     """Free-atom (C6 in eV·Å⁶, α in bohr³) of ``symbol`` from the TS/Chu–Dalgarno table."""
-    if symbol not in vdWDB_alphaC6:
+    if symbol in vdWDB_alphaC6:
+        alpha, c6 = vdWDB_alphaC6[symbol]
+    elif symbol in TS_FREE_ATOM:
+        alpha, c6, _ = TS_FREE_ATOM[symbol]
+    else:
         raise InputError(
             f"element '{symbol}' has no Tkatchenko–Scheffler C6 reference value; give c6_ev_a6 for its pairs"
         )
-    alpha, c6 = vdWDB_alphaC6[symbol]
     return c6 * HARTREE_BOHR6_TO_EV_A6, float(alpha)
 
 

@@ -83,7 +83,7 @@ def run_build(settings, inputs: BuildInputs, folder: Path | None, progress=None)
         from flatcontact.structures.build import build_quartz_interface
 
         atoms, report = build_quartz_interface(
-            _calculator.builder_model(settings),
+            _calculator.model(settings),
             s.layers,
             source=s.source,
             gap_angstrom=s.gap_angstrom,
@@ -94,7 +94,7 @@ def run_build(settings, inputs: BuildInputs, folder: Path | None, progress=None)
 
         atoms, report = interface_from_slab(
             _read_slab(s.file),
-            _calculator.builder_model(settings),
+            _calculator.model(settings),
             normal_axis=2 if s.normal_axis is None else s.normal_axis,
             face_depth_angstrom=(
                 SLAB_FACE_DEPTH_ANGSTROM if s.face_depth_angstrom is None else s.face_depth_angstrom

@@ -48,12 +48,12 @@ class ElasticResult:
 def run_elastic(
     settings, inputs: ElasticInputs, folder: Path | None, progress=None
 ) -> ElasticResult:
-    """Cij of relaxed α-quartz by finite strains (``elastic.strain``) and its contact moduli."""
+    """Cij of relaxed α-quartz by finite strains (``elastic.strain``) and its contact moduli,
+    with the run's model as a single crystal (:meth:`InteractionModel.bulk_calculator`)."""
     from flatcontact.elastic import quartz_contact_moduli
 
-    doc = quartz_contact_moduli(
-        _calculator.elastic_potential(settings), strain=settings.elastic.strain
-    )
+    _calculator.check_elastic(settings)
+    doc = quartz_contact_moduli(_calculator.model(settings), strain=settings.elastic.strain)
     result = ElasticResult(doc)
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)

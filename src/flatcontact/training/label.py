@@ -9,8 +9,6 @@ module imports it only when asked. Any ASE calculator can label instead.
 
 from __future__ import annotations
 
-import contextlib
-import sys
 from collections.abc import Callable, Sequence
 
 from ase import Atoms
@@ -24,31 +22,18 @@ TEACHERS = ("chgnet",)
 
 def chgnet_available() -> bool:
     """Whether CHGNet (and torch) can be imported."""
-    try:
-        import chgnet  # noqa: F401
-        import torch  # noqa: F401
-    except ImportError:
-        return False
-    return True
+    from flatcontact.potentials.chgnet import chgnet_available as available
+
+    return available()
 
 
 def teacher_calculator(name: str = "chgnet", model_name: str = "r2scan", threads: int = 1):
     """An ASE calculator for the teacher ``name`` (``"chgnet"``: CHGNet ``model_name``)."""
+    from flatcontact.potentials.chgnet import chgnet_calculator
+
     if name not in TEACHERS:
         raise InputError(f"--label {name!r}: expected one of {list(TEACHERS)}")
-    if not chgnet_available():
-        raise InputError(
-            "the chgnet teacher needs the optional extra: pip install torch==2.13.0 && "
-            "pip install 'flatcontact[teacher]'"
-        )
-    import torch
-    from chgnet.model import CHGNet
-    from chgnet.model.dynamics import CHGNetCalculator
-
-    torch.set_num_threads(threads)
-    with contextlib.redirect_stdout(sys.stderr):  # CHGNet prints banners on stdout
-        model = CHGNet.load(model_name=model_name, verbose=False)
-        return CHGNetCalculator(model=model, use_device="cpu")
+    return chgnet_calculator(model_name, threads=threads)
 
 
 def teacher_info(name: str = "chgnet", model_name: str = "r2scan") -> dict:

@@ -1,0 +1,205 @@
+"""Compile an :class:`~flatcontact.potentials.model.InteractionModel` into LAMMPS commands.
+
+Given the atoms (their elements and the ``slab``/``layer`` arrays) this decides the atom
+types, the molecule ids and the ``pair_style``/``pair_coeff`` commands (the typing and
+``NULL``-mapping rules are in :mod:`flatcontact.potentials.model`'s docstring):
+
+- **intra**: each intra style gets one ``hybrid/overlay`` instance per group (slab or layer;
+  a single instance over all types for ``coupling: same`` or a bulk crystal), its element map
+  naming the element on that group's types it has parameters for and ``NULL`` elsewhere;
+- **lj**: ``lj/cut`` with ``pair_modify shift yes`` on the type pairs of different slabs only;
+- **interlayer**: one instance of the interlayer style over all types, ``atom_style full``
+  with molecule id = layer (interlayer styles act between different molecule ids only).
+A single instance and no coupling is written as a plain ``pair_style`` (no hybrid).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from flatcontact.errors import InputError
+from flatcontact.potentials.lammps_engine import LammpsSetup
+from flatcontact.potentials.lj import LJPair, pair_key
+
+
+def layer_ids(atoms, fallback_planes: bool = False) -> np.ndarray:
+    """``atoms.arrays["layer"]``; else the slab ids; else (``fallback_planes``) z-planes.
+
+    The plane fallback (bulk crystals of layered materials) groups atoms whose z differ by
+    less than 1 Å along the sorted z coordinates.
+    """
+    if "layer" in atoms.arrays:
+        return np.asarray(atoms.arrays["layer"], dtype=int)
+    if "slab" in atoms.arrays and not fallback_planes:
+        return np.asarray(atoms.arrays["slab"], dtype=int)
+    z = atoms.positions[:, 2]
+    order = np.argsort(z)
+    ids = np.empty(len(atoms), dtype=int)
+    current = 1
+    for k, i in enumerate(order):
+        if k and z[i] - z[order[k - 1]] > 1.0:
+            current += 1
+        ids[i] = current
+    return ids
+
+
+def plane_ids(z: np.ndarray, groups: np.ndarray, symbols: list[str]) -> list[int]:
+    """Index of the atomic plane of each atom among the atoms of its group and element.
+
+    Planes are found along the sorted z of those atoms, a new one after a gap > 1 Å (for
+    ``ilp/tmd``, whose normals use neighbours of the same LAMMPS type: the top and bottom
+    chalcogen planes of a TMD layer must be different types).
+    """
+    out = [0] * len(z)
+    sym = np.asarray(symbols)
+    for g in set(groups.tolist()):
+        for e in set(symbols):
+            idx = np.flatnonzero((groups == g) & (sym == e))
+            order = idx[np.argsort(z[idx])]
+            plane = 0
+            for k, i in enumerate(order):
+                if k and z[i] - z[order[k - 1]] > 1.0:
+                    plane += 1
+                out[i] = plane
+    return out
+
+
+def compile_setup(model, atoms, bulk: bool = False) -> LammpsSetup:
+    """The :class:`LammpsSetup` of ``model`` for ``atoms`` (see the module docstring)."""
+    from flatcontact.potentials.model import slab_ids
+
+    symbols = atoms.get_chemical_symbols()
+    elements = sorted(set(symbols))
+    ne = len(elements)
+    slabs = slab_ids(atoms) if not bulk else np.ones(len(atoms), dtype=int)
+    interlayer = model.coupling == "interlayer"
+    layers = (
+        layer_ids(atoms, fallback_planes=bulk)
+        if interlayer or model.intra_scope == "layer"
+        else None
+    )
+    if bulk or model.coupling == "same":
+        groups = np.ones(len(atoms), dtype=int)
+    elif model.intra_scope == "layer":
+        groups = layers
+    else:
+        groups = slabs
+    group_ids = sorted(set(groups.tolist()))
+    if model.type_per_plane:
+        planes = plane_ids(atoms.positions[:, 2], groups, symbols)
+        keys = sorted({(g, s, p) for g, s, p in zip(groups.tolist(), symbols, planes, strict=True)})
+        index = {k: n + 1 for n, k in enumerate(keys)}
+        types = [index[k] for k in zip(groups.tolist(), symbols, planes, strict=True)]
+        type_elements = [k[1] for k in keys]
+        type_group = [k[0] for k in keys]
+    else:  # every group with every element (types stable across structures of one material)
+        gindex = {g: k for k, g in enumerate(group_ids)}
+        eindex = {e: k for k, e in enumerate(elements)}
+        types = [
+            gindex[g] * ne + eindex[s] + 1 for g, s in zip(groups.tolist(), symbols, strict=True)
+        ]
+        type_elements = [e for _ in group_ids for e in elements]
+        type_group = [g for g in group_ids for _ in elements]
+    ntypes = len(type_elements)
+    # the slab of each type (for LJ across slabs): groups never straddle slabs
+    type_slab = [0] * ntypes
+    for t, s in zip(types, slabs.tolist(), strict=True):
+        type_slab[t - 1] = s
+
+    def element_map(style, group=None) -> str:
+        # types without atoms are mapped too: LAMMPS wants every type pair covered
+        known = set(style.known_elements)
+        return " ".join(
+            e if e in known and (group is None or type_group[t] == group) else "NULL"
+            for t, e in enumerate(type_elements)
+        )
+
+    instances: list[tuple[str, str, str]] = []  # (pair_style, coeff args, map)
+    single = bulk or model.coupling == "same"
+    for style in model.intra_styles:
+        if not style.map_elements:
+            instances.append((style.pair_style, style.coeff_args(), ""))
+            continue
+        for g in [None] if single else group_ids:
+            mapping = element_map(style, g)
+            if set(mapping.split()) != {"NULL"}:
+                instances.append((style.pair_style, style.coeff_args(), mapping))
+    if interlayer:
+        style = model.interlayer
+        instances.append((style.pair_style, style.coeff_args(), element_map(style)))
+    lj_table = None
+    if model.coupling == "lj" and not bulk and len(set(slabs.tolist())) > 1:
+        sym = np.array(symbols)
+        lj_table = model.lj.table(sorted(set(sym[slabs == 1])), sorted(set(sym[slabs != 1])))
+    if not instances and lj_table is None:
+        raise InputError(
+            f"potential {model.label}: nothing to compute (no intra model and no cross-slab LJ)"
+        )
+    cutoff = model.lj.cutoff_angstrom
+    commands: list[str] = []
+
+    def cross_pairs():
+        for ti in range(1, ntypes + 1):
+            for tj in range(ti + 1, ntypes + 1):
+                if (
+                    type_slab[ti - 1]
+                    and type_slab[tj - 1]
+                    and type_slab[ti - 1] != type_slab[tj - 1]
+                ):
+                    yield ti, tj
+
+    def lj_coeffs(substyle: str) -> list[str]:
+        out = []
+        for ti, tj in cross_pairs():
+            p: LJPair = lj_table[pair_key(type_elements[ti - 1], type_elements[tj - 1])]
+            out.append(
+                f"pair_coeff {ti} {tj} {substyle}{p.epsilon_ev:.17g} {p.sigma_angstrom:.17g}"
+            )
+        return out
+
+    if not instances:  # LJ only: plain lj/cut, zero within each slab
+        commands.append(f"pair_style lj/cut {cutoff:.17g}")
+        for ti in range(1, ntypes + 1):
+            for tj in range(ti, ntypes + 1):
+                if type_slab[ti - 1] == type_slab[tj - 1] or not (
+                    type_slab[ti - 1] and type_slab[tj - 1]
+                ):
+                    commands.append(f"pair_coeff {ti} {tj} 0.0 1.0")
+        commands += lj_coeffs("")
+        commands.append("pair_modify shift yes")
+    elif len(instances) == 1 and lj_table is None:
+        style, args, mapping = instances[0]
+        commands.append(f"pair_style {style}")
+        commands.append(" ".join(f"pair_coeff * * {args} {mapping}".split()))
+    else:
+        names = [s.split()[0] for s, _, _ in instances]
+        substyles = [s for s, _, _ in instances] + ([f"lj/cut {cutoff:.17g}"] if lj_table else [])
+        commands.append("pair_style hybrid/overlay " + " ".join(substyles))
+        seen: dict[str, int] = {}
+        for (_style, args, mapping), name in zip(instances, names, strict=True):
+            seen[name] = seen.get(name, 0) + 1
+            index = f" {seen[name]}" if names.count(name) > 1 else ""
+            commands.append(" ".join(f"pair_coeff * * {name}{index} {args} {mapping}".split()))
+        covered = set()
+        for _style, _args, mapping in instances:
+            on = [t + 1 for t, e in enumerate(mapping.split()) if e != "NULL"] if mapping else []
+            covered |= {(ti, tj) for ti in on for tj in on if ti <= tj}
+        if lj_table is not None:
+            commands += lj_coeffs("lj/cut ")
+            commands.append("pair_modify pair lj/cut shift yes")
+            covered |= set(cross_pairs())
+        # type pairs no sub-style covers (e.g. different layers with coupling none) interact
+        # through nothing; LAMMPS wants them declared
+        commands += [
+            f"pair_coeff {ti} {tj} none"
+            for ti in range(1, ntypes + 1)
+            for tj in range(ti, ntypes + 1)
+            if (ti, tj) not in covered
+        ]
+    return LammpsSetup(
+        types=tuple(types),
+        type_elements=tuple(type_elements),
+        commands=tuple(commands),
+        atom_style="full" if interlayer else "atomic",
+        molecules=tuple(int(v) for v in layers) if interlayer else None,
+    )
