@@ -291,7 +291,11 @@ def _warn_noise(cp: ConstantPressureISPES, i: int, fr: FrictionResult, source: s
             f"energy noise {eps:.3g} meV/Å² (largest barrier {barrier:.3g}), force noise "
             f"{force:.3g} MPa (τ = {fr.tau_mpa:.4g} MPa) from δp = {nz.delta_p_gpa:.3g} GPa rms "
             f"and |dp/dz| = {nz.slope_gpa_per_angstrom[i]:.3g} GPa/Å"
-            + ("; try --load-source energy" if nz.load_source == "stress" else ""),
+            + (
+                "; try the energy load source (--load-source energy, analysis.load_source: energy)"
+                if nz.load_source == "stress"
+                else ""
+            ),
             LoadNoiseWarning,
             stacklevel=3,
         )

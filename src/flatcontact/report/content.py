@@ -29,7 +29,8 @@ from flatcontact.stages import _calculator
 A_EXP = QUARTZ_LATTICE_EXPERIMENT_ANGSTROM["a"]
 
 
-def _fmt(value: Any, digits: int = 4) -> str:
+def fmt(value: Any, digits: int = 4) -> str:
+    """A number for a table cell (4 significant digits; 'n/a' for None and non-finite)."""
     if value is None or (isinstance(value, float) and not np.isfinite(value)):
         return "n/a"
     if isinstance(value, float):
@@ -43,7 +44,7 @@ def _pm(value: float | None, err: float | None) -> str:
     return f"{value:.3g} ± {err:.2g}" if err is not None else f"{value:.3g}"
 
 
-def compare_with_paper(laws: dict, config=None) -> list[tuple[str, str, str, str, str]]:
+def compare_with_paper(laws: dict) -> list[tuple[str, str, str, str, str]]:
     """Rows (quantity, this run ± s.e., paper, difference, reading) for k, τ0, μ, σ0.
 
     The reading says whether the difference is within two standard errors of the fit
@@ -182,12 +183,9 @@ def _elastic_tables(cfg, folder: Path | None) -> list:
         Table(
             ("α-quartz with the potential", "value"),
             [
-                ("a, c (Å)", f"{_fmt(doc.get('a_angstrom'))}, {_fmt(doc.get('c_angstrom'))}"),
-                *((f"{k} (GPa)", _fmt(v)) for k, v in cij.items()),
-                *(
-                    (f"{k} (GPa)" if k != "poisson_ratio" else k, _fmt(v))
-                    for k, v in moduli.items()
-                ),
+                ("a, c (Å)", f"{fmt(doc.get('a_angstrom'))}, {fmt(doc.get('c_angstrom'))}"),
+                *((f"{k} (GPa)", fmt(v)) for k, v in cij.items()),
+                *((f"{k} (GPa)" if k != "poisson_ratio" else k, fmt(v)) for k, v in moduli.items()),
             ],
         )
     ]
@@ -279,12 +277,12 @@ def build_sections(
     )
 
     # ---- comparison with the paper
-    rows = compare_with_paper(laws, cfg)
+    rows = compare_with_paper(laws)
     w = (scan.get("adhesion") or {}).get("work_of_separation_j_per_m2")
     rows.append(
         (
             "work of separation W (J/m²)",
-            _fmt(w),
+            fmt(w),
             "not reported",
             "",
             "from the probe column: [U(separated) − U(z_eq)]/A",
@@ -296,8 +294,8 @@ def build_sections(
         rows.append(
             (
                 f"effective shear strength Q_peak/πa² at p0 = {r_run['p0_gpa']:g} GPa (MPa)",
-                _fmt(r_run["effective_shear_strength_mpa"]),
-                _fmt(r_pap["effective_shear_strength_mpa"]),
+                fmt(r_run["effective_shear_strength_mpa"]),
+                fmt(r_pap["effective_shear_strength_mpa"]),
                 f"{r_run['effective_shear_strength_mpa'] - r_pap['effective_shear_strength_mpa']:+.3g}",
                 "paper column: the same contact model with the paper's k, τ0, μ, σ0",
             )
@@ -324,7 +322,7 @@ def build_sections(
         Section(
             "1. Interface",
             paragraphs=[
-                f"{build.get('n_atoms', '?')} atoms; reference thickness z = {_fmt(build.get('thickness_angstrom'))} Å"
+                f"{build.get('n_atoms', '?')} atoms; reference thickness z = {fmt(build.get('thickness_angstrom'))} Å"
                 + (
                     f"; interface relaxation {'converged' if rel.get('converged') else 'NOT converged'}"
                     f" in {rel.get('steps', '?')} steps to {cfg.structure.fmax_ev_per_angstrom:g} eV/Å"
@@ -363,7 +361,7 @@ def build_sections(
         ("work_of_separation_integral_j_per_m2", "work of separation, −∫p dz (J/m²)"),
     ):
         if key in adh:
-            scan_rows.append((label, _fmt(adh[key])))
+            scan_rows.append((label, fmt(adh[key])))
     sections.append(
         Section(
             "2. ISPES scan",
@@ -395,11 +393,11 @@ def build_sections(
     ]
     rows = [
         (
-            _fmt(r.p_gpa),
-            _fmt(r.tau_mpa),
-            _fmt(r.tau_period_mpa),
-            _fmt(r.sigma_mss_mpa),
-            _fmt(r.shear_stiffness_gpa_per_nm),
+            fmt(r.p_gpa),
+            fmt(r.tau_mpa),
+            fmt(r.tau_period_mpa),
+            fmt(r.sigma_mss_mpa),
+            fmt(r.shear_stiffness_gpa_per_nm),
             str(r.tau_limited_by),
             str(r.n_jumps),
         )
@@ -446,8 +444,8 @@ def build_sections(
                 f"({_pm(laws.get('tau0_mpa'), laws.get('tau0_stderr_mpa'))}) MPa; "
                 f"σ = ({_pm(laws.get('mu_mpa_per_gpa'), laws.get('mu_stderr_mpa_per_gpa'))}) MPa/GPa · P + "
                 f"({_pm(laws.get('sigma0_mpa'), laws.get('sigma0_stderr_mpa'))}) MPa, fitted on P ≤ "
-                f"{_fmt(laws.get('p_max_gpa'))} GPa (± one standard error). τ linear up to "
-                f"{_fmt(laws.get('tau_linear_until_gpa'))} GPa, σ up to {_fmt(laws.get('sigma_linear_until_gpa'))} GPa.",
+                f"{fmt(laws.get('p_max_gpa'))} GPa (± one standard error). τ linear up to "
+                f"{fmt(laws.get('tau_linear_until_gpa'))} GPa, σ up to {fmt(laws.get('sigma_linear_until_gpa'))} GPa.",
             ],
             notes=laws.get("warnings", []),
             figures=[
@@ -472,7 +470,7 @@ def build_sections(
         ("knee_stress_amplitude_mpa", "stiffness knee, amplitude stress (MPa)"),
     ]
     keys = [k for k in keys if k[0] in res[0]]
-    ct_rows = [(label, *(_fmt(r[k]) for r in res)) for k, label in keys]
+    ct_rows = [(label, *(fmt(r[k]) for r in res)) for k, label in keys]
     contact_figs = [
         Figure(
             f_ct / "fig4_traction.png",

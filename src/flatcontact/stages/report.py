@@ -32,7 +32,7 @@ class ReportResult:
 
 
 def _stage_rows(folders: dict[str, Path]) -> list[tuple[str, str, str, str]]:
-    from flatcontact.report.content import _fmt
+    from flatcontact.report.content import fmt
     from flatcontact.rundir import RunDirectory
 
     rows = []
@@ -40,9 +40,7 @@ def _stage_rows(folders: dict[str, Path]) -> list[tuple[str, str, str, str]]:
         rec = RunDirectory.read_record(folder) if folder.exists() else None
         if rec is None or name == "report":
             continue
-        rows.append(
-            (name, rec.get("state", "?"), _fmt(rec.get("seconds")), rec.get("finished", ""))
-        )
+        rows.append((name, rec.get("state", "?"), fmt(rec.get("seconds")), rec.get("finished", "")))
     return rows
 
 
