@@ -1,8 +1,11 @@
 """Contact model: closed forms vs direct numerical integration (scipy quad + brentq).
 
 Q(u) at 10⁴ displacements and the oscillatory stiffness curve for one load
-(p0 = 1.77 GPa, the paper's parameters). Prints seconds, function-evaluation
-counts and ratios; the direct versions run on a subset and are scaled.
+(p0 = 1.77 GPa, the paper's parameters); the steady cycle: a loop at 10⁴ points and a
+full lock-in stiffness curve per load (closed forms, :mod:`flatcontact.contact.cycle`)
+against direct time-stepping of the cycle (:mod:`flatcontact.contact.cycle_reference`).
+Prints seconds, function-evaluation counts and ratios; the direct versions run on a
+subset and are scaled.
 """
 
 import time
@@ -11,7 +14,8 @@ import numpy as np
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
-from flatcontact.contact import mindlin, oscillation
+from flatcontact.contact import cycle, mindlin, oscillation
+from flatcontact.contact.cycle_reference import time_stepped_cycle
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.contact.quadrature import paper_integrals
 
@@ -89,6 +93,48 @@ def main() -> None:
         f"(two <u> per finite-difference stiffness); ratio ~{t_one * nq * 2 / t_curve:.0f}x; "
         f"max rel. diff of <u> = {np.max(np.abs(ours / ref - 1)):.1e}"
     )
+
+    cycle_benchmark()
+
+
+def cycle_benchmark() -> None:
+    """The steady cycle: closed forms vs direct time-stepping (2000 rings, brentq per step)."""
+    q_peak = float(mindlin.peak_force(P0, P).force_n)
+    qa = 0.9 * q_peak
+    loop, t_loop = _best(lambda: cycle.loops(qa, P0, P, n_points=5001)[0])
+    n_loop = loop.force_n.size
+    steps = 360
+    t = time.perf_counter()
+    ref = time_stepped_cycle(qa, P0, P, n_elements=2000, steps=steps, cycles=2)
+    t_ref = time.perf_counter() - t
+    scale = n_loop / (2 * steps)  # 2 cycles were stepped; one cycle of n_loop points wanted
+    closed = cycle.steady_cycle(qa, P0, P)
+    print(
+        f"steady loop at Q_amp = 0.9 Q_peak, {n_loop} points: closed form {t_loop * 1e3:.2f} ms; "
+        f"direct time-stepping {t_ref * scale:.1f} s (scaled from 2 x {steps} steps), "
+        f"{int(ref.force_evaluations * scale)} Q(u) evaluations x 2000 rings; "
+        f"ratio {t_ref * scale / t_loop:.0f}x"
+    )
+    print(
+        f"  agreement (2000 rings, {steps} steps): W {ref.dissipated_energy_j / closed.dissipated_energy_j[0] - 1:+.1e}, "
+        f"u'_1 {ref.in_phase_displacement_m / closed.in_phase_displacement_m[0] - 1:+.1e}, "
+        f"u''_1 {ref.quadrature_displacement_m / closed.quadrature_displacement_m[0] - 1:+.1e} (relative)"
+    )
+    for p0_gpa in (1.0, 1.77, 3.0):
+        p0 = p0_gpa * 1e9
+        curve, t_curve = _best(lambda p0=p0: cycle.lockin_curve(p0, P), repeat=3)
+        n_amp = curve.force_amplitude_n.size
+        t = time.perf_counter()
+        one = time_stepped_cycle(
+            0.5 * float(curve.gross_sliding_force_n), p0, P, n_elements=2000, steps=steps
+        )
+        t_one = time.perf_counter() - t
+        print(
+            f"lock-in curve at p0 = {p0_gpa:g} GPa, {n_amp} amplitudes: closed form "
+            f"{t_curve * 1e3:.1f} ms; direct {t_one:.2f} s per amplitude "
+            f"({one.force_evaluations} Q(u) evaluations), ~{t_one * n_amp:.0f} s per curve; "
+            f"ratio ~{t_one * n_amp / t_curve:.0f}x"
+        )
 
 
 if __name__ == "__main__":

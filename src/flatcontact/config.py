@@ -670,7 +670,7 @@ def _replaces_model(section: Any) -> bool:
         return False
     intra = section.get("intra")
     return (
-        any(k in section for k in ("preset", "calculator", "coupling", "interlayer"))
+        any(section.get(k) is not None for k in ("preset", "calculator", "coupling", "interlayer"))
         or (isinstance(intra, str) and intra.strip() in PRESETS)
         or (intra is not None and not isinstance(intra, str))
     )
@@ -766,18 +766,6 @@ def to_yaml(config: RunConfig, comments: bool = True) -> str:
         lines.append(f"{key}:")
         model = _section_model(key)
         desc = _descriptions(model) if model is not None else {}
-        if key == "potential":
-            desc = {
-                "preset": "a named model (graphene-rebo-kc, cu-eam, sio2-snap-lj, ...; "
-                "docs/potentials.md); the fields below override it",
-                "intra": "intra-slab model: vashishta, tersoff, snap:<name|path.snapcoeff>, "
-                "ase:module:factory, none, or LAMMPS styles [{pair_style, pair_coeff}]",
-                "intra_scope": "one instance of each intra style per slab or per layer",
-                "coupling": "across the interface: lj, same (bonded/metallic), interlayer, none",
-                "interlayer": "the interlayer style of coupling interlayer (KC, ILP)",
-                "lj": "cross-interface Lennard-Jones (c6_source ts = Tkatchenko-Scheffler)",
-                "calculator": "an ASE calculator {target: module:callable, kwargs, scope}",
-            }
         for sub, subval in value.items():
             if comments and desc.get(sub):
                 lines.append(f"  # {desc[sub]}")

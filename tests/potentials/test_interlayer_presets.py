@@ -83,10 +83,18 @@ CASES = {
     ),
     "hbn-tersoff-ilp": (
         *HBN,
-        [
-            "pair_style hybrid/overlay tersoff ilp/graphene/hbn 16.0 1",
+        [  # as in the LAMMPS example in.bilayer-hBN: Coulomb only across the layers
+            "pair_style hybrid/overlay tersoff ilp/graphene/hbn 16.0 1 coul/shield 16.0 1",
             f"pair_coeff * * tersoff {f('BNC.tersoff')} B N B N",
             f"pair_coeff * * ilp/graphene/hbn {f('BNCH.ILP')} B N B N",
+            "pair_coeff 1 3 coul/shield 0.70",
+            "pair_coeff 1 4 coul/shield 0.69498201415576216335",
+            "pair_coeff 2 3 coul/shield 0.69498201415576216335",
+            "pair_coeff 2 4 coul/shield 0.69",
+            "set type 1 charge 0.42",
+            "set type 3 charge 0.42",
+            "set type 2 charge -0.42",
+            "set type 4 charge -0.42",
         ],
     ),
     "graphene-hbn-ilp": (
@@ -94,10 +102,15 @@ CASES = {
         [1, 1, 2, 3],
         [1, 1, 2, 2],
         [
-            "pair_style hybrid/overlay rebo tersoff ilp/graphene/hbn 16.0 1",
+            "pair_style hybrid/overlay rebo tersoff ilp/graphene/hbn 16.0 1 coul/shield 16.0 1",
             f"pair_coeff * * rebo {f('CH.rebo')} C NULL NULL",
             f"pair_coeff * * tersoff {f('BNC.tersoff')} NULL B N",
             f"pair_coeff * * ilp/graphene/hbn {f('BNCH.ILP')} C B N",
+            "pair_coeff 2 2 coul/shield 0.70",
+            "pair_coeff 2 3 coul/shield 0.69498201415576216335",
+            "pair_coeff 3 3 coul/shield 0.69",
+            "set type 2 charge 0.42",
+            "set type 3 charge -0.42",
         ],
     ),
     "mos2-sw-ilp": (
@@ -173,3 +186,46 @@ def test_intralayer_instances_do_not_cross_the_layers():
     assert tool_energy(intra_only, close) == pytest.approx(tool_energy(intra_only, far), abs=1e-9)
     whole = InteractionModel(intra=model.intra, coupling="same")  # one REBO over both layers
     assert abs(tool_energy(whole, close) - tool_energy(whole, far)) > 0.1
+
+
+@pytest.mark.parametrize("preset", ["graphene-hbn-ilp", "mos2-sw-ilp"])
+def test_forces_are_minus_the_energy_gradient(preset):
+    """Rattled bilayers: the engine's forces equal central differences of its energy."""
+    atoms = CASES[preset][0](SHIFTS["SP"]).repeat((2, 2, 1))
+    atoms.rattle(0.05, seed=11)
+    atoms.calc = InteractionModel(preset=preset).interface_calculator(atoms)
+    forces = atoms.get_forces()
+    h = 1e-5
+    for index in (0, len(atoms) - 1):
+        for axis in range(3):
+            x0 = atoms.positions[index, axis]
+            atoms.positions[index, axis] = x0 + h
+            ep = atoms.get_potential_energy()
+            atoms.positions[index, axis] = x0 - h
+            em = atoms.get_potential_energy()
+            atoms.positions[index, axis] = x0
+            assert forces[index, axis] == pytest.approx(-(ep - em) / (2 * h), abs=1e-5)
+
+
+def test_bulk_graphite_binds_about_twice_the_bilayer():
+    """The bulk calculator of an interlayer model finds the layers of a crystal (atomic planes)
+    and keeps REBO per layer: AB graphite at c = 2d binds each atom to two neighbouring layers,
+    so its binding per atom is about twice the AB bilayer's (next-nearest layers add a few %)."""
+    model = InteractionModel(preset="graphene-rebo-kc")
+    a, d = 2.46, 3.4
+
+    def graphite(c):
+        cell = [[a, 0, 0], [a / 2, a * np.sqrt(3) / 2, 0], [0, 0, c]]
+        frac = [[0, 0, 0], [1 / 3, 1 / 3, 0], [0, 0, 0.5], [2 / 3, 2 / 3, 0.5]]
+        return Atoms("C4", scaled_positions=frac, cell=cell, pbc=True)
+
+    def bulk_energy(atoms):
+        atoms.calc = model.bulk_calculator(atoms)
+        return atoms.get_potential_energy() / len(atoms)
+
+    bulk_binding = bulk_energy(graphite(2 * d)) - bulk_energy(graphite(40.0))
+    build = CASES["graphene-rebo-kc"][0]
+    bilayer = (
+        tool_energy(model, build(SHIFTS["AB"])) - tool_energy(model, build(SHIFTS["AB"], 30.0))
+    ) / 4
+    assert 1.9 < bulk_binding / bilayer < 2.2

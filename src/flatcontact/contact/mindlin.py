@@ -57,7 +57,11 @@ not in between (see :func:`classical_limit_of_paper_model` and docs/contact.md).
 Classical Cattaneo–Mindlin (Johnson, *Contact Mechanics*, 1985, §7.2)
 --------------------------------------------------------------------
 c/a = (1 − Q/μP)^(1/3), δ = 3μP/(16 G*_J a)·[1 − (1 − Q/μP)^(2/3)] with
-1/G*_J = (2−ν1)/G1 + (2−ν2)/G2 (Johnson's convention; paper's G* = 4 G*_J).
+1/G*_J = (2−ν1)/G1 + (2−ν2)/G2 (Johnson's convention; paper's G* = 4 G*_J). The theory,
+with Mindlin–Deresiewicz unloading and the energy per cycle, is
+:mod:`flatcontact.contact.cattaneo_mindlin`; ``cattaneo_mindlin_*`` here are its loading
+functions under their old names. Unloading, reloading and the steady cycle of the
+modified model: :mod:`flatcontact.contact.cycle`.
 """
 
 from __future__ import annotations
@@ -67,6 +71,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from flatcontact.contact import cattaneo_mindlin as _cm
 from flatcontact.contact.hertz import hertz_contact_radius
 from flatcontact.contact.parameters import ContactParameters
 
@@ -718,40 +723,11 @@ def initial_lateral_stiffness(p0_pa: ArrayLike, params: ContactParameters) -> Fl
 # classical Cattaneo–Mindlin
 
 
-def cattaneo_mindlin_stick_radius(
-    lateral_force_n: ArrayLike, friction_limit_n: ArrayLike, contact_radius_m: ArrayLike
-) -> FloatArray:
-    """c = a (1 − Q/μP)^(1/3) (m), Johnson (1985) Eq. 7.43; ``friction_limit_n`` = μP."""
-    ratio = np.clip(
-        np.asarray(lateral_force_n, dtype=float) / np.asarray(friction_limit_n), 0.0, 1.0
-    )
-    return np.asarray(contact_radius_m, dtype=float) * np.cbrt(1.0 - ratio)
-
-
-def cattaneo_mindlin_displacement(
-    lateral_force_n: ArrayLike,
-    friction_limit_n: ArrayLike,
-    contact_radius_m: ArrayLike,
-    johnson_shear_modulus_pa: ArrayLike,
-) -> FloatArray:
-    """δ = 3μP/(16 G*_J a)·[1 − (1 − Q/μP)^(2/3)] (m), Johnson (1985) Eq. 7.47 (G*_J: Johnson's)."""
-    mup = np.asarray(friction_limit_n, dtype=float)
-    ratio = np.clip(np.asarray(lateral_force_n, dtype=float) / mup, 0.0, 1.0)
-    pref = 3.0 * mup / (16.0 * np.asarray(johnson_shear_modulus_pa) * np.asarray(contact_radius_m))
-    return pref * (1.0 - np.cbrt(1.0 - ratio) ** 2)
-
-
-def cattaneo_mindlin_force(
-    displacement_m: ArrayLike,
-    friction_limit_n: ArrayLike,
-    contact_radius_m: ArrayLike,
-    johnson_shear_modulus_pa: ArrayLike,
-) -> FloatArray:
-    """Q(δ) = μP [1 − (1 − δ/δ*)^(3/2)] for δ <= δ* = 3μP/(16 G*_J a), μP beyond (N)."""
-    mup = np.asarray(friction_limit_n, dtype=float)
-    dstar = 3.0 * mup / (16.0 * np.asarray(johnson_shear_modulus_pa) * np.asarray(contact_radius_m))
-    x = np.clip(np.asarray(displacement_m, dtype=float) / dstar, 0.0, 1.0)
-    return mup * (1.0 - (1.0 - x) ** 1.5)
+# The classical theory lives in :mod:`flatcontact.contact.cattaneo_mindlin` (plain-number
+# functions, Johnson §7.2/§7.4); these names are kept for existing callers.
+cattaneo_mindlin_stick_radius = _cm.stick_radius
+cattaneo_mindlin_displacement = _cm.displacement
+cattaneo_mindlin_force = _cm.force
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,7 @@ to the driver, which alone writes the point store.
 - :class:`ProcessExecutor`: ``concurrent.futures.ProcessPoolExecutor`` with the
   ``spawn`` start method (no fork of a process that holds a LAMMPS instance or MPI),
   one worker per core by default; workers ignore SIGINT so Ctrl-C reaches only the
-  driver.
+  driver, and die with the driver (``kill -9`` of the driver alone leaves no worker).
 - :class:`DaskExecutor`: a ``distributed.Client`` on a running scheduler
   (``--dask-address tcp://host:8786``), a ``LocalCluster``, or a dask-jobqueue
   cluster (SLURM, PBS, ...) described by a dict (see :func:`jobqueue_cluster`).
@@ -19,9 +19,11 @@ to the driver, which alone writes the point store.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import ctypes
 import multiprocessing
 import os
 import signal
+import sys
 from collections.abc import Callable, Iterable
 from typing import Any
 
@@ -63,8 +65,29 @@ class SerialExecutor:
         pass
 
 
-def _ignore_sigint() -> None:
+#: ``prctl`` option that asks the kernel to signal a process when its parent dies (Linux).
+_PR_SET_PDEATHSIG = 1
+
+
+def die_with_parent(parent_pid: int) -> None:
+    """Make this process receive SIGKILL when ``parent_pid`` (its parent) dies.
+
+    Linux ``prctl(PR_SET_PDEATHSIG)``: a worker of a driver killed with ``kill -9`` must not
+    go on computing points nobody will store. If the parent is already gone (it died
+    between the spawn and this call), exit at once. A no-op on other systems.
+    """
+    if not sys.platform.startswith("linux"):  # pragma: no cover - Linux only
+        return
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    if os.getppid() != parent_pid:
+        os._exit(1)
+
+
+def _init_worker(parent_pid: int) -> None:
+    """Worker initializer: Ctrl-C reaches only the driver; die with the driver."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    die_with_parent(parent_pid)
 
 
 class ProcessExecutor(SerialExecutor):
@@ -82,7 +105,8 @@ class ProcessExecutor(SerialExecutor):
         self._pool = cf.ProcessPoolExecutor(
             max_workers=self.workers,
             mp_context=multiprocessing.get_context("spawn"),
-            initializer=_ignore_sigint,
+            initializer=_init_worker,
+            initargs=(os.getpid(),),
         )
 
     def submit(self, fn: Callable, *args: Any) -> cf.Future:
@@ -160,8 +184,13 @@ class DaskExecutor(SerialExecutor):
             ) from None
         except ValueError as exc:
             raise InputError(f"dask-address {address!r}: not a scheduler address ({exc})") from None
+
+    @property
+    def workers(self) -> int:
+        """Worker threads the scheduler has now (asked each time: workers join and leave,
+        e.g. ``dask worker`` processes started after the client, or a batch job queue)."""
         info = self._client.scheduler_info()
-        self.workers = max(1, sum(w.get("nthreads", 1) for w in info.get("workers", {}).values()))
+        return max(1, sum(w.get("nthreads", 1) for w in info.get("workers", {}).values()))
 
     @classmethod
     def local(cls, workers: int = 2) -> DaskExecutor:

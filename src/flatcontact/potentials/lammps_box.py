@@ -165,6 +165,7 @@ def create_box(
     atom_style: str = "atomic",
     molecules: Sequence[int] | None = None,
     positions: np.ndarray | None = None,
+    charges: Sequence[float] | None = None,
 ) -> LammpsBox:
     """Create the box and atoms in the empty LAMMPS instance ``lmp``; return the frame.
 
@@ -174,7 +175,8 @@ def create_box(
         LAMMPS type (1-based) of each atom, in the atoms' order; ``type_elements[t - 1]`` is
         the element of type ``t`` (its mass is set from ASE's table).
     atom_style
-        ``atomic``, or ``full`` for styles that need molecule ids (``molecules``, one per atom).
+        ``atomic``, or ``full`` for styles that need molecule ids (``molecules``, one per atom)
+        or charges (``charges``, e, one per atom).
     positions
         Initial positions (caller's frame); zeros when not given (set before the first run).
     """
@@ -188,4 +190,8 @@ def create_box(
             raise InputError("molecule ids need atom_style full")
         buf = (ctypes.c_int * n)(*[int(m) for m in molecules])
         lmp.scatter_atoms("molecule", 0, 1, buf)
+    if charges is not None:
+        if atom_style != "full":
+            raise InputError("charges need atom_style full")
+        lmp.scatter_atoms("q", 1, 1, (ctypes.c_double * n)(*[float(q) for q in charges]))
     return box

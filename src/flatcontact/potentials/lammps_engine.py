@@ -38,6 +38,8 @@ class LammpsSetup:
         ``atomic``, or ``full`` when ``molecules`` are needed (interlayer potentials).
     molecules
         Molecule id per atom (``atom_style full``), else ``None``.
+    charges
+        Charge per atom (e; ``atom_style full``), else ``None``.
     """
 
     types: tuple[int, ...]
@@ -45,6 +47,7 @@ class LammpsSetup:
     commands: tuple[str, ...]
     atom_style: str = "atomic"
     molecules: tuple[int, ...] | None = None
+    charges: tuple[float, ...] | None = None
 
 
 class LammpsEngine:
@@ -73,6 +76,7 @@ class LammpsEngine:
                 setup.type_elements,
                 atom_style=setup.atom_style,
                 molecules=setup.molecules,
+                charges=setup.charges,
             )
             self.lmp.commands_list(list(setup.commands))
             # pressures only for periodic cells (the virial costs time in every run)

@@ -8,8 +8,11 @@ types, the molecule ids and the ``pair_style``/``pair_coeff`` commands (the typi
   a single instance over all types for ``coupling: same`` or a bulk crystal), its element map
   naming the element on that group's types it has parameters for and ``NULL`` elsewhere;
 - **lj**: ``lj/cut`` with ``pair_modify shift yes`` on the type pairs of different slabs only;
-- **interlayer**: one instance of the interlayer style over all types, ``atom_style full``
-  with molecule id = layer (interlayer styles act between different molecule ids only).
+- **interlayer**: one instance of each interlayer style over all types, ``atom_style full``
+  with molecule id = layer (interlayer styles act between different molecule ids only);
+  a style with ``pair_coeff_pairs`` (e.g. ``coul/shield`` with its shielding per element
+  pair) gets ``pair_coeff I J`` lines per type pair instead, and ``charges`` set the charge
+  of each atom by element.
 A single instance and no coupling is written as a plain ``pair_style`` (no hybrid).
 """
 
@@ -25,8 +28,9 @@ from flatcontact.potentials.lj import LJPair, pair_key
 def layer_ids(atoms, fallback_planes: bool = False) -> np.ndarray:
     """``atoms.arrays["layer"]``; else the slab ids; else (``fallback_planes``) z-planes.
 
-    The plane fallback (bulk crystals of layered materials) groups atoms whose z differ by
-    less than 1 Å along the sorted z coordinates.
+    The plane fallback (bulk crystals of layered materials) starts a new layer after a gap
+    of more than 2 Å along the sorted z (graphite 3.35 Å, MoS₂'s S–S gap ≈ 3 Å, while the
+    Mo–S planes of one MoS₂ layer are 1.6 Å apart).
     """
     if "layer" in atoms.arrays:
         return np.asarray(atoms.arrays["layer"], dtype=int)
@@ -37,7 +41,7 @@ def layer_ids(atoms, fallback_planes: bool = False) -> np.ndarray:
     ids = np.empty(len(atoms), dtype=int)
     current = 1
     for k, i in enumerate(order):
-        if k and z[i] - z[order[k - 1]] > 1.0:
+        if k and z[i] - z[order[k - 1]] > 2.0:
             current += 1
         ids[i] = current
     return ids
@@ -78,10 +82,12 @@ def compile_setup(model, atoms, bulk: bool = False) -> LammpsSetup:
         if interlayer or model.intra_scope == "layer"
         else None
     )
-    if bulk or model.coupling == "same":
+    if model.coupling == "same":
         groups = np.ones(len(atoms), dtype=int)
     elif model.intra_scope == "layer":
-        groups = layers
+        groups = layers  # a layered bulk crystal keeps its layers apart too
+    elif bulk:
+        groups = np.ones(len(atoms), dtype=int)
     else:
         groups = slabs
     group_ids = sorted(set(groups.tolist()))
@@ -114,8 +120,10 @@ def compile_setup(model, atoms, bulk: bool = False) -> LammpsSetup:
             for t, e in enumerate(type_elements)
         )
 
-    instances: list[tuple[str, str, str]] = []  # (pair_style, coeff args, map)
-    single = bulk or model.coupling == "same"
+    # (pair_style, coeff args, map) for "pair_coeff * *" styles; map None for per-pair styles
+    instances: list[tuple[str, str, str | None]] = []
+    pair_lines: dict[int, list[tuple[int, int, str]]] = {}  # instance -> (ti, tj, args)
+    single = model.coupling == "same" or (bulk and model.intra_scope != "layer")
     for style in model.intra_styles:
         if not style.map_elements:
             instances.append((style.pair_style, style.coeff_args(), ""))
@@ -124,9 +132,18 @@ def compile_setup(model, atoms, bulk: bool = False) -> LammpsSetup:
             mapping = element_map(style, g)
             if set(mapping.split()) != {"NULL"}:
                 instances.append((style.pair_style, style.coeff_args(), mapping))
-    if interlayer:
-        style = model.interlayer
-        instances.append((style.pair_style, style.coeff_args(), element_map(style)))
+    for style in model.interlayer_styles if interlayer else ():
+        if style.pair_coeff_pairs is None:
+            instances.append((style.pair_style, style.coeff_args(), element_map(style)))
+            continue
+        lines = []
+        for ti in range(1, ntypes + 1):
+            for tj in range(ti, ntypes + 1):
+                key = "-".join(sorted((type_elements[ti - 1], type_elements[tj - 1])))
+                if key in style.pair_coeff_pairs:
+                    lines.append((ti, tj, style.pair_coeff_pairs[key]))
+        pair_lines[len(instances)] = lines
+        instances.append((style.pair_style, "", None))
     lj_table = None
     if model.coupling == "lj" and not bulk and len(set(slabs.tolist())) > 1:
         sym = np.array(symbols)
@@ -167,7 +184,7 @@ def compile_setup(model, atoms, bulk: bool = False) -> LammpsSetup:
                     commands.append(f"pair_coeff {ti} {tj} 0.0 1.0")
         commands += lj_coeffs("")
         commands.append("pair_modify shift yes")
-    elif len(instances) == 1 and lj_table is None:
+    elif len(instances) == 1 and lj_table is None and instances[0][2] is not None:
         style, args, mapping = instances[0]
         commands.append(f"pair_style {style}")
         commands.append(" ".join(f"pair_coeff * * {args} {mapping}".split()))
@@ -176,12 +193,16 @@ def compile_setup(model, atoms, bulk: bool = False) -> LammpsSetup:
         substyles = [s for s, _, _ in instances] + ([f"lj/cut {cutoff:.17g}"] if lj_table else [])
         commands.append("pair_style hybrid/overlay " + " ".join(substyles))
         seen: dict[str, int] = {}
-        for (_style, args, mapping), name in zip(instances, names, strict=True):
+        covered = set()
+        for k, ((_style, args, mapping), name) in enumerate(zip(instances, names, strict=True)):
             seen[name] = seen.get(name, 0) + 1
             index = f" {seen[name]}" if names.count(name) > 1 else ""
+            if mapping is None:  # per type pair
+                for ti, tj, pair_args in pair_lines[k]:
+                    commands.append(f"pair_coeff {ti} {tj} {name}{index} {pair_args}")
+                    covered.add((ti, tj))
+                continue
             commands.append(" ".join(f"pair_coeff * * {name}{index} {args} {mapping}".split()))
-        covered = set()
-        for _style, _args, mapping in instances:
             on = [t + 1 for t, e in enumerate(mapping.split()) if e != "NULL"] if mapping else []
             covered |= {(ti, tj) for ti in on for tj in on if ti <= tj}
         if lj_table is not None:
@@ -196,10 +217,13 @@ def compile_setup(model, atoms, bulk: bool = False) -> LammpsSetup:
             for tj in range(ti, ntypes + 1)
             if (ti, tj) not in covered
         ]
+    if interlayer:  # 16 Å interlayer cutoffs in small periodic cells: long neighbour lists
+        commands.append("neigh_modify one 20000 page 400000")
     return LammpsSetup(
         types=tuple(types),
         type_elements=tuple(type_elements),
         commands=tuple(commands),
         atom_style="full" if interlayer else "atomic",
         molecules=tuple(int(v) for v in layers) if interlayer else None,
+        charges=tuple(float(model.charges.get(s, 0.0)) for s in symbols) if model.charges else None,
     )

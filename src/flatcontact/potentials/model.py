@@ -227,6 +227,9 @@ class LammpsStyle(BaseModel):
         Append the element map (one element or ``NULL`` per type) to ``pair_coeff * *``
         (true for every many-body style; false e.g. for ``eam`` funcfl files, whose
         ``pair_coeff * * file`` takes no map and which then must be the only instance).
+    pair_coeff_pairs
+        For pairwise styles set per type pair (``coul/shield``): the ``pair_coeff I J``
+        arguments per element pair (``"B-N"``); written for every type pair of those elements.
     """
 
     model_config = ConfigDict(frozen=True, extra="forbid")
@@ -239,6 +242,11 @@ class LammpsStyle(BaseModel):
         None, description="elements it has parameters for (default: read from its files)"
     )
     map_elements: bool = Field(True, description="append the element map to pair_coeff * *")
+    pair_coeff_pairs: dict[str, str] | None = Field(
+        None,
+        description="instead of pair_coeff * *: the pair_coeff arguments per element pair, "
+        "e.g. {B-B: '0.70', B-N: '0.695', N-N: '0.69'} for coul/shield",
+    )
 
     @field_validator("pair_style")
     @classmethod
@@ -264,6 +272,23 @@ class LammpsStyle(BaseModel):
             for symbol in value:
                 _check_element(symbol, "elements")
         return value
+
+    @field_validator("pair_coeff_pairs")
+    @classmethod
+    def _pairs(cls, value: dict[str, str] | None) -> dict[str, str] | None:
+        if value is None:
+            return None
+        out = {}
+        for key, args in value.items():
+            parts = str(key).split("-")
+            if len(parts) != 2:
+                raise ValueError(
+                    f"pair_coeff_pairs key '{key}': expected an element pair like 'B-N'"
+                )
+            for symbol in parts:
+                _check_element(symbol, f"pair_coeff_pairs key '{key}'")
+            out["-".join(sorted(parts))] = " ".join(str(args).split())
+        return dict(sorted(out.items()))
 
     @model_validator(mode="after")
     def _files_exist(self) -> LammpsStyle:
@@ -295,6 +320,8 @@ class LammpsStyle(BaseModel):
         """``elements``, or those of the first file that names any."""
         if self.elements is not None:
             return self.elements
+        if self.pair_coeff_pairs is not None:
+            return tuple(sorted({e for key in self.pair_coeff_pairs for e in key.split("-")}))
         for path in self.files:
             found = file_elements(path)
             if found:
@@ -518,7 +545,10 @@ class InteractionModel(BaseModel):
     coupling
         ``lj``, ``same``, ``interlayer`` or ``none`` (module docstring).
     interlayer
-        The interlayer style for ``coupling: interlayer``.
+        The interlayer style (or styles) for ``coupling: interlayer``.
+    charges
+        Charge per element (e) for the interlayer Coulomb term (``coul/shield``); 0 for
+        elements not given.
     type_per_plane
         One LAMMPS type per atomic plane of each element within a group (``ilp/tmd`` takes
         a TMD atom's normal from neighbours of its own type: the two chalcogen planes of a
@@ -532,7 +562,9 @@ class InteractionModel(BaseModel):
     model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
 
     preset: str | None = Field(
-        None, description="a named model (flatcontact.potentials.presets); the fields override it"
+        None,
+        description=f"a named model ({', '.join(PRESETS)}; docs/potentials.md); "
+        "fields given beside it override the preset's",
     )
     intra: str | tuple[LammpsStyle, ...] = Field(
         "vashishta",
@@ -547,8 +579,14 @@ class InteractionModel(BaseModel):
         description="across the interface: lj (TS C6), same (the intra potential, bonded or "
         "metallic contact), interlayer (KC/ILP between layers), none",
     )
-    interlayer: LammpsStyle | None = Field(
-        None, description="the interlayer LAMMPS style of coupling interlayer"
+    interlayer: LammpsStyle | tuple[LammpsStyle, ...] | None = Field(
+        None,
+        description="the interlayer LAMMPS style(s) of coupling interlayer (KC, ILP, and e.g. "
+        "coul/shield)",
+    )
+    charges: dict[str, float] = Field(
+        default_factory=dict,
+        description="atomic charges per element (e), for coul/shield beside an ILP",
     )
     type_per_plane: bool = Field(
         False,
@@ -631,6 +669,10 @@ class InteractionModel(BaseModel):
             raise ValueError(
                 f"'interlayer' is only used with coupling 'interlayer', not {self.coupling!r}"
             )
+        if self.charges and self.coupling != "interlayer":
+            raise ValueError("charges need coupling 'interlayer' (atom_style full)")
+        for symbol in self.charges:
+            _check_element(symbol, "charges")
         if self.coupling == "same" and not self.intra_styles:
             raise ValueError("coupling 'same' needs LAMMPS intra styles")
         if self.coupling != "lj" and self.lj != LJSpec():
@@ -653,6 +695,15 @@ class InteractionModel(BaseModel):
         if isinstance(self.intra, str):
             return _legacy_styles(self.intra)
         return tuple(self.intra)
+
+    @property
+    def interlayer_styles(self) -> tuple[LammpsStyle, ...]:
+        """The interlayer styles as a tuple (empty without one)."""
+        if self.interlayer is None:
+            return ()
+        if isinstance(self.interlayer, LammpsStyle):
+            return (self.interlayer,)
+        return tuple(self.interlayer)
 
     @property
     def engine(self) -> Literal["lammps", "ase-slab", "ase-interface"]:
@@ -700,7 +751,8 @@ class InteractionModel(BaseModel):
         if self.coupling == "same":
             return prefix + intra + " (same potential across the interface)"
         if self.coupling == "interlayer":
-            return prefix + f"{intra} + {self.interlayer.label} between layers"
+            across = " + ".join(style.label for style in self.interlayer_styles)
+            return prefix + f"{intra} + {across} between layers"
         return prefix + intra + " (no coupling across the interface)"
 
     @property
@@ -742,15 +794,16 @@ class InteractionModel(BaseModel):
             from flatcontact.potentials.lj import ts_elements
 
             out = ts_elements()
-        if self.coupling == "interlayer":
-            out = out & frozenset(self.interlayer.known_elements)
+        for style in self.interlayer_styles:  # per-pair styles (Coulomb) restrict nothing
+            if style.pair_coeff_pairs is None:
+                out = out & frozenset(style.known_elements)
         return out
 
     def input_files(self) -> list[Path]:
         """The files whose content defines the model (potential files), sorted, no repeats."""
         files = [p for s in self.intra_styles for p in s.files]
-        if self.interlayer is not None:
-            files += list(self.interlayer.files)
+        for style in self.interlayer_styles:
+            files += list(style.files)
         return sorted({Path(p) for p in files}, key=lambda p: (p.name, str(p)))
 
     def fingerprint(self) -> dict:

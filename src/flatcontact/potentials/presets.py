@@ -10,8 +10,8 @@ graphene-rebo-kc     REBO (Brenner et al. 2002, ``CH.rebo``) in each layer + Kol
 graphene-rebo-ilp    REBO + graphene ILP (Leven, Maaravi, Azuri, Kronik & Hod 2016; Ouyang et
                      al. 2018, ``BNCH.ILP``)
 hbn-tersoff-ilp      Tersoff for h-BN (Kinaci et al. 2012, ``BNC.tersoff``) + h-BN ILP
-                     (``BNCH.ILP``; ILP's shielded Coulomb term not included)
-graphene-hbn-ilp     REBO on C, Tersoff on B and N, ILP across (``BNCH.ILP``): graphene/h-BN
+                     (``BNCH.ILP``) + its shielded Coulomb term (``coul/shield``, ±0.42 e)
+graphene-hbn-ilp     REBO on C, Tersoff on B and N, ILP + coul/shield across: graphene/h-BN
 mos2-sw-ilp          Stillinger–Weber for MoS₂ (Jiang 2015, ``tmd.sw.mod``, ``sw/mod``) in each
                      layer + TMD ILP (Ouyang et al. 2021, ``MoS2.ILP``)
 cu-eam               Mishin et al. 2001 Cu EAM (``Cu_mishin1.eam.alloy``), same potential
@@ -26,6 +26,14 @@ sio2-snap-lj         flatcontact's bundled SiO₂ SNAP per slab + Tkatchenko–S
 from __future__ import annotations
 
 _REBO = {"pair_style": "rebo", "pair_coeff": ["CH.rebo"], "elements": ["C"]}
+#: h-BN's shielded interlayer Coulomb term (Leven et al. 2016; Maaravi et al. 2017): partial
+#: charges ±0.42 e on B and N and the shielding λ per element pair (1/Å), B–N the geometric
+#: mean, as in the LAMMPS example ``examples/PACKAGES/interlayer/ilp_graphene_hbn``.
+_COUL_SHIELD = {
+    "pair_style": "coul/shield 16.0 1",
+    "pair_coeff_pairs": {"B-B": "0.70", "B-N": "0.69498201415576216335", "N-N": "0.69"},
+}
+_BN_CHARGES = {"B": 0.42, "N": -0.42}
 _TERSOFF_BN = {"pair_style": "tersoff", "pair_coeff": ["BNC.tersoff"], "elements": ["B", "N"]}
 
 #: α-quartz number densities (nm⁻³, experimental cell a = 4.916, c = 5.405 Å) rounded as in
@@ -58,21 +66,29 @@ PRESETS: dict[str, dict] = {
         "intra": [_TERSOFF_BN],
         "intra_scope": "layer",
         "coupling": "interlayer",
-        "interlayer": {
-            "pair_style": "ilp/graphene/hbn 16.0 1",
-            "pair_coeff": ["BNCH.ILP"],
-            "elements": ["B", "N"],
-        },
+        "interlayer": [
+            {
+                "pair_style": "ilp/graphene/hbn 16.0 1",
+                "pair_coeff": ["BNCH.ILP"],
+                "elements": ["B", "N"],
+            },
+            _COUL_SHIELD,
+        ],
+        "charges": _BN_CHARGES,
     },
     "graphene-hbn-ilp": {
         "intra": [_REBO, _TERSOFF_BN],
         "intra_scope": "layer",
         "coupling": "interlayer",
-        "interlayer": {
-            "pair_style": "ilp/graphene/hbn 16.0 1",
-            "pair_coeff": ["BNCH.ILP"],
-            "elements": ["B", "C", "N"],
-        },
+        "interlayer": [
+            {
+                "pair_style": "ilp/graphene/hbn 16.0 1",
+                "pair_coeff": ["BNCH.ILP"],
+                "elements": ["B", "C", "N"],
+            },
+            _COUL_SHIELD,
+        ],
+        "charges": _BN_CHARGES,
     },
     "mos2-sw-ilp": {
         "intra": [{"pair_style": "sw/mod", "pair_coeff": ["tmd.sw.mod"], "elements": ["Mo", "S"]}],

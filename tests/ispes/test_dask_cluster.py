@@ -1,0 +1,148 @@
+"""The distributed route for real: a ``dask scheduler`` and a ``dask worker`` (two worker
+processes) started as separate processes on localhost; one worker is killed with SIGKILL
+in the middle of the scan, and the scan still completes with every point, equal to a
+serial scan of the same grid (the warm-start tree makes the result independent of which
+worker relaxed which point)."""
+
+import json
+import os
+import shutil
+import signal
+import sqlite3
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+
+import numpy as np
+import psutil
+import pytest
+
+from flatcontact.ispes.calculators import CalculatorFactory
+from flatcontact.ispes.executors import DaskExecutor, SerialExecutor
+from flatcontact.ispes.geometry import thickness
+from flatcontact.ispes.grid import GridSpec
+from flatcontact.ispes.relax import RelaxSettings
+from flatcontact.ispes.scan import run_scan
+
+SETTINGS = RelaxSettings(fmax_ev_per_a=1e-4, optimizer="FIRE")
+
+#: the toy calculator, slowed down so that the scan lasts long enough to kill a worker in it
+SLOW_TOY = textwrap.dedent(
+    """
+    import time
+    from flatcontact.ispes.toy import toy_calculator
+
+    def slow_toy(atoms, delay_s=0.004):
+        calc = toy_calculator(atoms)
+        inner = calc.calculate
+
+        def calculate(*args, **kwargs):
+            time.sleep(delay_s)
+            return inner(*args, **kwargs)
+
+        calc.calculate = calculate
+        return calc
+    """
+)
+
+
+def _rows(db):
+    try:
+        with sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=1) as con:
+            return con.execute("select count(*) from systems").fetchone()[0]
+    except sqlite3.OperationalError:
+        return 0
+
+
+def _wait_for(predicate, timeout_s: float, what: str):
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        value = predicate()
+        if value:
+            return value
+        time.sleep(0.1)
+    raise AssertionError(f"timed out waiting for {what}")
+
+
+@pytest.fixture
+def cluster(tmp_path, monkeypatch):
+    """A scheduler and one `dask worker` with two single-threaded worker processes."""
+    dask = shutil.which("dask", path=os.path.dirname(sys.executable)) or shutil.which("dask")
+    if dask is None:
+        pytest.skip("the dask command is not installed")
+    (tmp_path / "slowtoy.py").write_text(SLOW_TOY)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), *sys.path])}
+    env["OMP_NUM_THREADS"] = "1"
+    info = tmp_path / "scheduler.json"
+    procs = []
+    try:
+        procs.append(
+            subprocess.Popen(
+                [dask, "scheduler", "--host", "127.0.0.1", "--port", "0",
+                 "--no-dashboard", "--scheduler-file", str(info)],
+                env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+            )
+        )
+        _wait_for(info.exists, 60, "the scheduler file")
+        address = _wait_for(lambda: json.loads(info.read_text() or "{}").get("address"), 30,
+                            "the scheduler address")
+        procs.append(
+            subprocess.Popen(
+                [dask, "worker", address, "--nworkers", "2", "--nthreads", "1",
+                 "--no-dashboard", "--host", "127.0.0.1"],
+                env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+            )
+        )
+        yield address, procs[1]
+    finally:
+        for proc in reversed(procs):
+            for child in psutil.Process(proc.pid).children(recursive=True):
+                child.kill()
+            proc.kill()
+            proc.wait()
+
+
+def test_scan_on_a_separate_scheduler_survives_a_killed_worker(cluster, tmp_path, toy_reference):
+    address, worker_cmd = cluster
+    factory = CalculatorFactory.from_target("slowtoy:slow_toy")
+    z0 = thickness(toy_reference)
+    grid = GridSpec(3, 3, thickness_angstrom=(z0 - 0.2, z0, z0 + 0.3))
+    total = grid.n_a * grid.n_b * len(grid.thickness_angstrom)
+
+    executor = DaskExecutor(address=address, timeout_s=30)
+    _wait_for(lambda: len(executor._client.scheduler_info()["workers"]) >= 2, 60, "two workers")
+    assert executor.workers == 2
+    out = tmp_path / "dask"
+    result = {}
+
+    def scan():
+        result["scan"] = run_scan(toy_reference, factory, grid, out, SETTINGS, executor=executor)
+
+    driver = threading.Thread(target=scan)
+    driver.start()
+    _wait_for(lambda: _rows(out / "points.db") >= 4, 120, "the first stored points")
+    nanny_children = psutil.Process(worker_cmd.pid).children(recursive=True)
+    # the worker processes are the nannies' children; kill one of them mid-scan
+    victims = [p for p in nanny_children if p.children() == []]
+    assert victims, "no worker process found"
+    before = _rows(out / "points.db")
+    os.kill(victims[0].pid, signal.SIGKILL)
+    driver.join(timeout=300)
+    executor.close()
+    assert not driver.is_alive(), "the scan did not finish after a worker was killed"
+    assert before < total, "the kill did not land in the middle of the scan"
+    scanned = result["scan"].dataset
+    assert bool(scanned["converged"].all()), "points were lost with the killed worker"
+    assert _rows(out / "points.db") == total
+
+    plain = CalculatorFactory.from_target("flatcontact.ispes.toy:toy_calculator")
+    serial = run_scan(
+        toy_reference, plain, grid, tmp_path / "serial", SETTINGS, executor=SerialExecutor()
+    )
+    for name in ("energy", "normal_stress"):
+        np.testing.assert_allclose(
+            scanned[name].values, serial.dataset[name].values, rtol=0, atol=1e-10
+        )
