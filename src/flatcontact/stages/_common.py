@@ -49,13 +49,16 @@ def captured(category: type[Warning]) -> Iterator[list[warnings.WarningMessage]]
 def rename(message: str, names: dict[str, str]) -> str:
     """``message`` with each parameter name of ``names`` replaced by what the user wrote.
 
-    Whole names only (``p_gpa`` is not found inside ``analysis.p_gpa`` or ``p0_gpa``), longest
-    first, each position once.
+    Whole names only (``p_gpa`` is not found inside ``analysis.p_gpa``, ``p0_gpa`` or a file
+    path), longest first, each position once.
     """
     if not names:
         return message
     keys = sorted(names, key=len, reverse=True)
-    pattern = re.compile(r"(?<![\w.\-])(" + "|".join(map(re.escape, keys)) + r")(?![\w\-])")
+    # a name inside a longer name, a dotted path or a file path (…/p_gpa/x.nc) is left alone
+    pattern = re.compile(
+        r"(?<![\w.\-/\\])(" + "|".join(map(re.escape, keys)) + r")(?![\w\-/\\]|\.\w)"
+    )
     return pattern.sub(lambda m: names[m.group(1)], message)
 
 
