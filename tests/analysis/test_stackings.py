@@ -348,7 +348,7 @@ def test_an_unknown_direction_word_is_a_one_line_error(bad):
     ds = syn.SyntheticInterface(a1, a2, syn.three_cosine(a1, a2)).grid(
         4, 4, np.linspace(24.3, 25.6, 8)
     )
-    with pytest.raises(InputError, match="--direction-deg") as err:
+    with pytest.raises(InputError, match="direction_deg") as err:
         analyze_ispes(ds, [1.0], direction_deg=bad)
     assert "\n" not in str(err.value)
 

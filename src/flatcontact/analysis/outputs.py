@@ -11,8 +11,9 @@
   ``p_gpa``, ``shift_a``, ``shift_b``), ``z*`` (Å) and, on dims ``p_gpa``,
   ``start`` (NaN-padded), each near-degenerate start's position, energy above
   the lowest minimum, τ, σ_MSS and shear stiffness, with ``selected_start``;
-- ``laws.json``: ``k_mpa_per_gpa``, ``tau0_mpa``, ``mu_mpa_per_gpa``,
-  ``sigma0_mpa``, their standard errors, ``p_max_gpa`` and the regime ends.
+
+The analyze stage (:mod:`flatcontact.stages.analyze`) writes them; ``laws.json`` is the laws
+stage's (:mod:`flatcontact.stages.laws`).
 """
 
 from __future__ import annotations
@@ -20,8 +21,6 @@ from __future__ import annotations
 import csv
 import io
 import math
-import os
-from pathlib import Path
 
 import numpy as np
 import xarray as xr
@@ -30,7 +29,6 @@ from flatcontact import __version__, units
 from flatcontact.analysis.friction import EV_PER_A4_TO_GPA_PER_NM
 from flatcontact.analysis.noise import BARRIER_NOISE_FACTOR
 from flatcontact.analysis.pipeline import AnalysisResult
-from flatcontact.fileio import atomic_path, write_json_atomic, write_text_atomic
 
 CSV_COLUMNS = (
     "p_gpa",
@@ -183,7 +181,7 @@ def summary_json(result: AnalysisResult) -> dict:
             | {"stackings": stackings_json(pa)}
             for row, pa in zip(per_pressure_rows(result), result.pressures, strict=True)
         ],
-        "laws": result.laws.to_json(),
+        "laws": result.laws.to_json() if result.laws is not None else None,
     }
     sym = [pa.symmetry for pa in result.pressures if pa.symmetry is not None]
     if sym:
@@ -440,17 +438,3 @@ def friction_dataset(result: AnalysisResult) -> xr.Dataset:
 def _attr(v: float) -> float:
     """netCDF attributes cannot be None: NaN stands for 'not estimated'."""
     return float(v)
-
-
-def write_outputs(result: AnalysisResult, out_dir: str | os.PathLike[str]) -> dict[str, Path]:
-    """Write ``friction.csv``, ``friction.nc`` and ``laws.json`` into ``out_dir`` atomically."""
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    paths = {
-        "friction.csv": write_text_atomic(out / "friction.csv", friction_csv_text(result)),
-        "laws.json": write_json_atomic(out / "laws.json", result.laws.to_json()),
-    }
-    with atomic_path(out / "friction.nc") as tmp:
-        friction_dataset(result).to_netcdf(tmp, engine="h5netcdf")
-    paths["friction.nc"] = out / "friction.nc"
-    return paths

@@ -100,7 +100,7 @@ class AnalysisResult:
 
     pressures: tuple[PressureAnalysis, ...]
     constant_pressure: ConstantPressureISPES
-    laws: LoadLaws
+    laws: LoadLaws | None
     direction_deg: float
     form: str
     energy_zero: str
@@ -130,11 +130,11 @@ def check_pressures(p_gpa: list[float] | np.ndarray) -> np.ndarray:
     """Finite, distinct loads in GPa, returned ascending; InputError otherwise."""
     p = np.atleast_1d(np.asarray(p_gpa, dtype=float))
     if p.size == 0:
-        raise InputError("--p-gpa: give at least one target pressure in GPa")
+        raise InputError("p_gpa: give at least one target pressure in GPa")
     if not np.all(np.isfinite(p)):
-        raise InputError(f"--p-gpa: expected finite pressures in GPa, got {p.tolist()}")
+        raise InputError(f"p_gpa: expected finite pressures in GPa, got {p.tolist()}")
     if np.unique(p).size != p.size:
-        raise InputError(f"--p-gpa: pressures must be distinct, got {p.tolist()}")
+        raise InputError(f"p_gpa: pressures must be distinct, got {p.tolist()}")
     return np.sort(p)
 
 
@@ -145,7 +145,7 @@ def analyze_ispes(
     form: str = "internal",
     energy_zero: str = "lowest-p",
     allow_missing: bool = False,
-    threshold_gpa: float = 3.0,
+    threshold_gpa: float | None = 3.0,
     with_mep: bool = False,
     with_symmetry: bool = True,
     max_length_angstrom: float | None = None,
@@ -172,7 +172,14 @@ def analyze_ispes(
     allow_missing
         Interpolate columns with missing thickness points instead of refusing.
     threshold_gpa
-        Upper end of the load range of the linear fits.
+        Upper end of the load range of the linear fits; ``None``: no fit (``laws`` is
+        ``None``; the run's laws stage fits them from ``friction.csv``).
+
+    Raises
+    ------
+    InputError
+        One line naming the parameter (``p_gpa``, ``form``, ``energy_zero``, ...); the CLI and
+        the run translate it to the flag or the settings path.
     with_mep, with_symmetry
         Also compute the string-method MEP / the symmetry report per load.
     max_length_angstrom
@@ -194,25 +201,25 @@ def analyze_ispes(
     auto = isinstance(direction_deg, str)
     if auto and direction_deg != AUTO_DIRECTION:
         raise InputError(
-            f"--direction-deg: expected an angle in degrees or {AUTO_DIRECTION!r}, got {direction_deg!r}"
+            f"direction_deg: expected an angle in degrees or {AUTO_DIRECTION!r}, got {direction_deg!r}"
         )
     if auto and not with_stackings:
         raise InputError(
-            "--direction-deg auto: needs the stackings analysis (the lowest-barrier direction)"
+            "direction_deg auto: needs the stackings analysis (the lowest-barrier direction)"
         )
     if not auto and not np.isfinite(direction_deg):
-        raise InputError(f"--direction-deg: expected a finite angle, got {direction_deg}")
+        raise InputError(f"direction_deg: expected a finite angle, got {direction_deg}")
     if form not in FORMS:
-        raise InputError(f"--energy: expected one of {', '.join(FORMS)}, got {form!r}")
+        raise InputError(f"form: expected one of {', '.join(FORMS)}, got {form!r}")
     if energy_zero not in ENERGY_ZEROS:
         raise InputError(
-            f"--energy-zero: expected one of {', '.join(ENERGY_ZEROS)}, got {energy_zero!r}"
+            f"energy_zero: expected one of {', '.join(ENERGY_ZEROS)}, got {energy_zero!r}"
         )
-    if not threshold_gpa > 0:
-        raise InputError(f"--threshold-gpa: expected a positive pressure, got {threshold_gpa}")
+    if threshold_gpa is not None and not threshold_gpa > 0:
+        raise InputError(f"threshold_gpa: expected a positive pressure, got {threshold_gpa}")
     if load_source not in LOAD_SOURCES:
         raise InputError(
-            f"--load-source: expected one of {', '.join(LOAD_SOURCES)}, got {load_source!r}"
+            f"load_source: expected one of {', '.join(LOAD_SOURCES)}, got {load_source!r}"
         )
     n_lateral = (ds.sizes.get(contract.DIM_A, 0), ds.sizes.get(contract.DIM_B, 0))
     if min(n_lateral) < MIN_LATERAL_POINTS:
@@ -299,8 +306,9 @@ def analyze_ispes(
     clock = time.perf_counter()
     tau = np.array([r.friction.tau_mpa for r in results])
     sigma = np.array([r.friction.sigma_mss_mpa for r in results])
-    laws = fit_load_laws(p, tau, sigma, threshold_gpa)
-    timings["laws"] = time.perf_counter() - clock
+    laws = None if threshold_gpa is None else fit_load_laws(p, tau, sigma, threshold_gpa)
+    if laws is not None:
+        timings["laws"] = time.perf_counter() - clock
     return AnalysisResult(
         pressures=tuple(results),
         constant_pressure=cp,
@@ -329,7 +337,11 @@ def _warn_noise(cp: ConstantPressureISPES, i: int, fr: FrictionResult, source: s
             f"energy noise {eps:.3g} meV/Å² (largest barrier {barrier:.3g}), force noise "
             f"{force:.3g} MPa (τ = {fr.tau_mpa:.4g} MPa) from δp = {nz.delta_p_gpa:.3g} GPa rms "
             f"and |dp/dz| = {nz.slope_gpa_per_angstrom[i]:.3g} GPa/Å"
-            + ("; try --load-source energy" if nz.load_source == "stress" else ""),
+            + (
+                "; try the energy load source (--load-source energy, analysis.load_source: energy)"
+                if nz.load_source == "stress"
+                else ""
+            ),
             LoadNoiseWarning,
             stacklevel=3,
         )
