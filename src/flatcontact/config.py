@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import copy
 import json
+import typing
 from pathlib import Path
 from typing import Any, Literal
 
@@ -52,7 +53,8 @@ from flatcontact.reference import (
     PAPER_THRESHOLD_GPA,
     QUARTZ_HAMAKER_ZJ,
 )
-from flatcontact.structures.build import MIN_LAYERS
+from flatcontact.structures.recipe import FILE_FIELDS as _RECIPE_FILE_FIELDS
+from flatcontact.structures.recipe import QuartzDenseRecipe, StructureRecipe
 
 #: The bundled SNAP the default run uses when it is present.
 BUNDLED_SNAP = "sio2-snap"
@@ -83,69 +85,47 @@ def _show(value: Any) -> str:
         return repr(value)
 
 
-class StructureConfig(_Section):
-    """Which interface to build (stage ``build``)."""
+#: Flat keys of the earlier one-model ``structure`` section that a recipe kind may lack:
+#: dropped when the chosen kind has no such field (``file: null`` of a quartz run, the
+#: preset's ``layers``/``source`` under ``kind: file``). ``face_depth_angstrom`` goes too:
+#: the slab recipe finds the layers from the structure instead of a depth.
+_LEGACY_STRUCTURE_KEYS = (
+    "layers",
+    "source",
+    "file",
+    "gap_angstrom",
+    "fmax_ev_per_angstrom",
+    "normal_axis",
+    "face_depth_angstrom",
+)
 
-    kind: Literal["quartz-dense", "file", "slab", "toy-lj"] = Field(
-        "quartz-dense",
-        description="quartz-dense: the paper's alpha-quartz (0001) dense interface; "
-        "file: an interface.extxyz following the interface contract (path in 'file'); "
-        "slab: any slab structure file (path in 'file'), two copies facing each other, "
-        "faces tagged by depth; "
-        "toy-lj: a tiny two-slab Lennard-Jones model (tests and demos only; "
-        "needs calculator.target flatcontact.ispes.toy:toy_calculator)",
-    )
-    layers: int = Field(
-        6,
-        description=f"O-Si-O layers per slab (quartz-dense; >= {MIN_LAYERS}) "
-        "or atomic layers (toy-lj; >= 3)",
-    )
-    source: Literal["auto", "shipped", "seed"] = Field(
-        "auto",
-        description="quartz-dense starting slab: shipped (CHGNet-relaxed 6-layer slab), "
-        "seed (seeded dense reconstruction relaxed with the potential) or auto "
-        "(shipped if present and layers == 6, else seed)",
-    )
-    file: str | None = Field(
-        None,
-        description="kind=file: path of an interface.extxyz; kind=slab: a slab structure file "
-        "(relative to the config file)",
-    )
-    normal_axis: int | None = Field(
-        None,
-        ge=0,
-        le=2,
-        exclude_if=lambda value: value is None,
-        description="kind=slab: cell axis (0, 1, 2) along the surface normal; null: 2",
-    )
-    face_depth_angstrom: float | None = Field(
-        None,
-        gt=0,
-        exclude_if=lambda value: value is None,
-        description="kind=slab: depth of each tagged face (Å); null: 2 Å",
-    )
-    gap_angstrom: float = Field(
-        3.0, gt=0, description="initial gap between the slabs before the interface relaxation (Å)"
-    )
-    fmax_ev_per_angstrom: float = Field(
-        0.01, gt=0, description="force tolerance of the slab and interface relaxations (eV/Å)"
-    )
 
-    @model_validator(mode="after")
-    def _consistent(self) -> StructureConfig:
-        if self.kind == "file" and not self.file:
-            raise ValueError("kind 'file' needs 'file: path/to/interface.extxyz'")
-        if self.kind == "slab" and not self.file:
-            raise ValueError("kind 'slab' needs 'file: path/to/slab' (any ASE-readable structure)")
-        if self.kind == "quartz-dense" and self.layers < MIN_LAYERS:
-            raise ValueError(
-                f"layers={self.layers}: the dense quartz interface needs >= {MIN_LAYERS} "
-                "(a fixed outer and a sliding inner face layer of 2 units each, and at least "
-                "one inner layer between them)"
-            )
-        if self.kind == "toy-lj" and self.layers < 3:
-            raise ValueError(f"layers={self.layers}: the toy interface needs >= 3")
-        return self
+def _structure_section(value: Any) -> Any:
+    """The ``structure`` mapping as a recipe model (:data:`flatcontact.structures.recipe.StructureRecipe`).
+
+    Earlier flat keys that the chosen kind does not have are dropped; ``normal_axis`` other
+    than 2 is refused (the slab recipe takes the normal along cell vector 3).
+    """
+    from flatcontact.structures.recipe import KINDS, StructureRecipe, parse_recipe
+
+    if not isinstance(value, dict):
+        return value  # a model already, or pydantic's own type error
+    data = dict(value)
+    kind = data.get("kind", "quartz-dense")
+    data["kind"] = kind
+    axis = data.pop("normal_axis", None)
+    if axis not in (None, 2):
+        raise InputError(
+            f"structure.normal_axis={axis}: the slab recipe takes the surface normal along cell "
+            "vector 3; reorder the file's cell (e.g. ase.build.rotate) and drop normal_axis"
+        )
+    if kind in KINDS:
+        models = typing.get_args(typing.get_args(StructureRecipe)[0])
+        fields = {m.model_fields["kind"].default: m.model_fields for m in models}[kind]
+        for key in _LEGACY_STRUCTURE_KEYS:
+            if key in data and key not in fields:
+                data.pop(key)
+    return parse_recipe(data)
 
 
 class CalculatorConfig(_Section):
@@ -200,6 +180,20 @@ class ScanConfig(_Section):
         description="ASE optimiser of each point: " + ", ".join(OPTIMIZERS),
     )
     max_steps: int = Field(2000, ge=1, description="optimiser step cap per point")
+    relax_mode: Literal["full", "normal", "rigid-layers", "rigid"] = Field(
+        "full",
+        # left out of the dumped config while default, so existing run fingerprints are unchanged
+        exclude_if=lambda value: value == "full",
+        description="relaxation of each point: full (free atoms in 3D, the paper's), normal "
+        "(along z only: the generalized-stacking-fault convention), rigid-layers (each free "
+        "layer a rigid body along z), rigid (none)",
+    )
+    bracket_all_stackings: bool = Field(
+        True,
+        exclude_if=lambda value: value is True,
+        description="p_range_gpa: probe the extreme columns so that every stacking spans the "
+        "loads (default); false: only the lowest-energy column decides the thicknesses",
+    )
     order: str = Field(
         "columns",
         description="warm-start tree: columns (walk each column along z), planes, cold",
@@ -254,11 +248,14 @@ class ScanConfig(_Section):
             self.grid[1],
             thickness_angstrom=tuple(self.thickness_angstrom) if self.thickness_angstrom else None,
             p_range_gpa=(r.lo_gpa, r.hi_gpa, r.n) if r else None,
+            bracket_all_stackings=self.bracket_all_stackings,
         )
 
     def relax_settings(self) -> RelaxSettings:
         """The per-point relaxation of these settings."""
-        return RelaxSettings(self.fmax_ev_per_angstrom, self.optimizer, self.max_steps)
+        return RelaxSettings(
+            self.fmax_ev_per_angstrom, self.optimizer, self.max_steps, mode=self.relax_mode
+        )
 
     def executor_options(self) -> dict[str, Any]:
         """How the points are run (:func:`flatcontact.ispes.scan.run_scan`'s ``executor_options``)."""
@@ -277,8 +274,10 @@ class AnalysisConfig(_Section):
         [0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0],
         description="target normal pressures P (GPa) at which the constant-pressure ISPES is analysed",
     )
-    direction_deg: float = Field(
-        90.0, description="pulling direction, degrees from x (90 = y, the paper's)"
+    direction_deg: float | Literal["auto"] = Field(
+        90.0,
+        description="pulling direction, degrees from x (90 = y, the paper's), or auto: the "
+        "lowest-barrier direction of the landscape at the lowest load (stated in the outputs)",
     )
     energy_form: Literal["internal", "enthalpy"] = Field(
         "internal", description="internal: U at z*(P) (the paper's); enthalpy: U + P·A·z*"
@@ -319,9 +318,10 @@ class ElasticConfig(_Section):
     )
     enabled: bool = Field(
         False,
-        description="compute E* and G* (paper's convention) of bulk alpha-quartz with the "
-        "run's interaction model as a single crystal (it must know Si and O); otherwise "
-        "contact.contact_modulus_gpa/shear_modulus_gpa",
+        description="compute E* and G* (paper's convention) of the slabs' bulk crystal (alpha-"
+        "quartz, the fcc metal, the crystal file, the layered bulk of sheets) with the run's "
+        "interaction model; otherwise contact.contact_modulus_gpa/shear_modulus_gpa (required "
+        "for any material but alpha-quartz)",
     )
 
 
@@ -410,8 +410,11 @@ class RunConfig(_Section):
     preset: Literal["quick", "paper"] = Field(
         "quick", description="preset the values below were resolved from"
     )
-    structure: StructureConfig = Field(
-        default_factory=StructureConfig, description="the interface to build (stage build)"
+    structure: StructureRecipe = Field(
+        default_factory=QuartzDenseRecipe,
+        description="the interface to build (stage build): a recipe of "
+        "flatcontact.structures.recipe, by kind: quartz-dense, file, slab, toy-lj, sheets, "
+        "crystal, fcc111 (docs/structures.md)",
     )
     potential: InteractionModel = Field(
         default_factory=InteractionModel,
@@ -438,6 +441,11 @@ class RunConfig(_Section):
     report: ReportConfig = Field(
         default_factory=ReportConfig, description="the HTML report and figures (stage report)"
     )
+
+    @field_validator("structure", mode="before")
+    @classmethod
+    def _structure(cls, value: Any) -> Any:
+        return _structure_section(value)
 
     @model_validator(mode="before")
     @classmethod
@@ -563,8 +571,20 @@ def preset(name: str) -> dict:
 
 
 def merge_config(base: dict, over: dict) -> dict:
+    """``over`` laid over ``base`` (nested mappings merged, everything else replaced).
+
+    Top-level sections that start afresh instead of merging: a ``structure`` of another
+    ``kind`` (none of the old recipe's fields apply) and a ``potential`` that defines a whole
+    model (:func:`_replaces_model`: a preset, a calculator, a coupling, LAMMPS styles).
+    """
     out = copy.deepcopy(base)
     for key, value in over.items():
+        if isinstance(value, dict) and isinstance(out.get(key), dict):
+            old = out[key]
+            if key == "structure" and value.get("kind", old.get("kind")) != old.get("kind"):
+                out[key] = {}
+            elif key == "potential" and "preset" in old and _replaces_model(value):
+                out[key] = {}
         if isinstance(value, dict) and isinstance(out.get(key), dict) and key != "kwargs":
             # an explicit pressure range or thickness list replaces the other
             if key == "scan":
@@ -606,7 +626,12 @@ _MESSAGES = {
 def _one_line(exc: ValidationError, source: str) -> InputError:
     """The first pydantic error as ``<source>: <dotted.path>: expected ..., got <value>``."""
     first = exc.errors()[0]
-    loc = [str(p) for p in first.get("loc", ()) if not str(p).startswith("function-")]
+    # union members (direction_deg: float | 'auto') name their type in the path: drop them
+    loc = [
+        str(p)
+        for p in first.get("loc", ())
+        if not str(p).startswith(("function-", "literal[")) and str(p) not in ("float", "int")
+    ]
     where = ".".join(loc)
     kind = first.get("type", "")
     if kind in _MESSAGES:
@@ -701,19 +726,57 @@ def load_config(path: str | Path | None = None, preset_name: str | None = None) 
     for section, key in _FILE_FIELDS:
         block = data.get(section)
         if isinstance(block, dict) and isinstance(block.get(key), str):
-            target = Path(block[key]).expanduser()
-            if not target.is_absolute():
-                block[key] = str((path.parent / target).resolve())
+            block[key] = _resolved(block[key], path.parent)
+    structure = data.get("structure")
+    if isinstance(structure, dict):
+        _resolverecipe_files(structure, path.parent)
     cfg = build_config(data, preset_name, str(path))
     for section, key in _FILE_FIELDS:
         value = getattr(getattr(cfg, section), key)
         if value is not None and not Path(value).is_file():
             raise InputError(f"{path}: {section}.{key}: file {value} not found")
+    for dotted, value in recipe_files(cfg.structure):
+        if not Path(value).is_file():
+            raise InputError(f"{path}: structure.{dotted}: file {value} not found")
     return cfg
 
 
+def _resolved(value: str, base: Path) -> str:
+    target = Path(value).expanduser()
+    return str(target if target.is_absolute() else (base / target).resolve())
+
+
+def _resolverecipe_files(structure: dict, base: Path) -> None:
+    """Make the recipe's file fields (``file``, ``bulk``, ``sheet``, ``slab2.*``) relative to
+    ``base``, in place; built-in sheet names (graphene, h-BN, MoS2) stay names."""
+    from flatcontact.structures.sheets import BUILTIN_SHEETS
+
+    for dotted in _RECIPE_FILE_FIELDS:
+        *parents, leaf = dotted.split(".")
+        holder: Any = structure
+        for part in parents:
+            holder = holder.get(part) if isinstance(holder, dict) else None
+        if isinstance(holder, dict) and isinstance(holder.get(leaf), str):
+            if holder[leaf] not in BUILTIN_SHEETS:
+                holder[leaf] = _resolved(holder[leaf], base)
+
+
+def recipe_files(recipe: Any) -> list[tuple[str, str]]:
+    """(dotted field, path) of every file the recipe reads (built-in sheets excluded)."""
+    from flatcontact.structures.sheets import BUILTIN_SHEETS
+
+    out = []
+    for dotted in _RECIPE_FILE_FIELDS:
+        obj = recipe
+        for part in dotted.split("."):
+            obj = getattr(obj, part, None)
+        if isinstance(obj, str) and obj not in BUILTIN_SHEETS:
+            out.append((dotted, obj))
+    return out
+
+
 #: Fields naming an input file (relative to the config file); they must exist.
-_FILE_FIELDS = (("structure", "file"), ("contact", "experiment_csv"))
+_FILE_FIELDS = (("contact", "experiment_csv"),)
 
 
 # --------------------------------------------------------------------------- YAML out
@@ -726,7 +789,6 @@ def _descriptions(model: type[BaseModel]) -> dict[str, str]:
 def _section_model(name: str) -> type[BaseModel] | None:
     ann = RunConfig.model_fields[name].annotation
     for cand in (
-        StructureConfig,
         InteractionModel,
         ScanConfig,
         AnalysisConfig,
@@ -764,7 +826,8 @@ def to_yaml(config: RunConfig, comments: bool = True) -> str:
             lines.append(f"{key}: {_yaml_value(value)}")
             continue
         lines.append(f"{key}:")
-        model = _section_model(key)
+        obj = getattr(config, key, None)
+        model = type(obj) if key == "structure" else _section_model(key)
         desc = _descriptions(model) if model is not None else {}
         for sub, subval in value.items():
             if comments and desc.get(sub):

@@ -54,7 +54,7 @@ from pathlib import Path
 from typing import Any
 
 from flatcontact import __version__
-from flatcontact.config import RunConfig, to_yaml
+from flatcontact.config import RunConfig, recipe_files, to_yaml
 from flatcontact.errors import InputError
 from flatcontact.fileio import write_json_atomic, write_text_atomic
 from flatcontact.rundir import RunDirectory, StageResult, code_digest, package_versions
@@ -215,16 +215,27 @@ class Pipeline:
 
     def _check_config(self) -> None:
         """Checks that need the file system or optional modules, before any work."""
+        from flatcontact.stages.contact import check_moduli_source
+
         cfg = self.config
+        elements = _structure_elements(cfg.structure)
         if cfg.structure.kind == "file":
             from flatcontact.structures.interface import read_interface
 
-            read_interface(cfg.structure.file)
+            _calculator.check_atoms(cfg, read_interface(cfg.structure.file))
+        check_moduli_source(cfg, elements)
         if cfg.contact.experiment_csv is not None:
             from flatcontact.contact.experiment import load_stiffness_csv
 
             load_stiffness_csv(cfg.contact.experiment_csv)
-        _calculator.check(cfg)
+        if cfg.elastic.enabled:
+            from flatcontact.stages.elastic import bulk_crystal
+
+            bulk, _ = bulk_crystal(cfg.structure)
+            if bulk is None:
+                _calculator.check(cfg)
+            else:
+                _calculator.check_atoms(cfg, bulk)
 
     def _open_log(self) -> None:
         handler = logging.FileHandler(self.root / "run.log", encoding="utf-8")
@@ -313,9 +324,15 @@ class Pipeline:
         from flatcontact.structures.interface import read_interface
 
         cfg = self.config
-        inputs = {"structure": cfg.section("structure"), "model": self._model_inputs()}
+        structure = cfg.section("structure")
+        if cfg.structure.kind == "quartz-dense":
+            structure.setdefault("file", None)  # the fingerprint of runs made before recipes
+        inputs = {"structure": structure, "model": self._model_inputs()}
         if cfg.structure.kind in ("file", "slab"):
             inputs["file_sha256"] = file_sha256(cfg.structure.file)
+        for dotted, path in recipe_files(cfg.structure):
+            if dotted != "file":
+                inputs[f"{dotted}_sha256"] = file_sha256(path)
 
         def work(folder: Path) -> None:
             for line in run_build(cfg, BuildInputs(), folder).warnings:
@@ -437,6 +454,8 @@ class Pipeline:
             )
             return None
         inputs = {"elastic": cfg.section("elastic"), "model": self._model_inputs()}
+        if cfg.structure.kind != "quartz-dense":  # the bulk crystal follows the recipe
+            inputs["structure"] = cfg.section("structure")
         self._run("elastic", inputs, lambda folder: run_elastic(cfg, ElasticInputs(), folder))
         return self._json("elastic", ELASTIC_JSON)
 
@@ -533,6 +552,23 @@ class Pipeline:
         for name in ("build", "scan", "analyze", "laws", "elastic", "contact"):
             getattr(self, name)()
         return self.report()
+
+
+def _structure_elements(recipe) -> set[str] | None:
+    """The elements of a recipe read from its files (``file``, ``slab``, ``crystal``), cheaply
+    and before any work; ``None`` when only the build knows them."""
+    from ase.io import read
+
+    path = {"file": "file", "slab": "file", "crystal": "bulk"}.get(recipe.kind)
+    if path is None:
+        return None
+    try:
+        return set(read(getattr(recipe, path)).get_chemical_symbols())
+    except Exception as exc:  # any reader error, named with the field
+        raise InputError(
+            f"structure.{path}: {getattr(recipe, path)} is not a structure file ASE can read "
+            f"({type(exc).__name__})"
+        ) from None
 
 
 def run(config: RunConfig, root: str | Path, console: Any = None) -> Path:

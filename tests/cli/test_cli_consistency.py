@@ -127,19 +127,19 @@ def test_min_layers_leaves_one_inner_layer_between_fixed_and_sliding_faces():
 def test_build_and_config_refuse_the_same_layer_counts(tmp_path, monkeypatch, capsys):
     from pydantic import ValidationError
 
-    from flatcontact.config import StructureConfig
     from flatcontact.structures.build import MIN_LAYERS, check_layers
+    from flatcontact.structures.recipe import QuartzDenseRecipe
 
     monkeypatch.chdir(tmp_path)
     for layers in (MIN_LAYERS - 1, 1, 0, -3):
         line = _one_error_line(*_run(["build", "--layers", str(layers)], capsys)[::2])
         assert line.startswith(f"error: --layers={layers}: expected an integer >= {MIN_LAYERS}")
         with pytest.raises(ValidationError, match=f"needs >= {MIN_LAYERS}"):
-            StructureConfig(layers=layers)
+            QuartzDenseRecipe(layers=layers)
     line = _one_error_line(*_run(["build", "--layers", "4", "--regenerate-dense"], capsys)[::2])
     assert "--layers=4" in line
     assert list(tmp_path.iterdir()) == []
-    assert check_layers(MIN_LAYERS) == StructureConfig(layers=MIN_LAYERS).layers == MIN_LAYERS
+    assert check_layers(MIN_LAYERS) == QuartzDenseRecipe(layers=MIN_LAYERS).layers == MIN_LAYERS
 
 
 def test_build_writes_the_run_build_stage_names(tmp_path, capsys):

@@ -72,11 +72,13 @@ def analyze_command(
         ),
     ] = None,
     direction_deg: Annotated[
-        float,
+        str,
         typer.Option(
-            "--direction-deg", help="Pulling direction, degrees from x (90 = y, the paper's)."
+            "--direction-deg",
+            help="Pulling direction, degrees from x (90 = y, the paper's), or 'auto': the "
+            "lowest-barrier direction of the lowest load's landscape (stated in the outputs).",
         ),
-    ] = 90.0,
+    ] = "90",
     energy: Annotated[
         str,
         typer.Option("--energy", help="'internal' (paper: U at z*(P)) or 'enthalpy' (U + P·A·z*)."),
@@ -136,7 +138,7 @@ def analyze_command(
     if out is not None:
         check_out_dir(out)
     section = {
-        "direction_deg": direction_deg,
+        "direction_deg": _direction(direction_deg),
         "energy_form": energy,
         "load_source": load_source,
         "energy_zero": energy_zero,
@@ -170,7 +172,8 @@ def analyze_command(
     from rich.table import Table
 
     table = Table(
-        title=f"{path.name}: {energy} energy, {load_source} load, pulling at {direction_deg:g}°"
+        title=f"{path.name}: {energy} energy, {load_source} load, pulling at "
+        + _direction_title(result)
     )
     for col in (
         "P (GPa)",
@@ -215,3 +218,25 @@ def analyze_command(
 
 def _fmt(v: float | None) -> str:
     return "n/a" if v is None else f"{v:.4g}"
+
+
+def _direction(text: str) -> float | str:
+    """``--direction-deg`` as an angle in degrees or ``'auto'`` (one line naming the flag)."""
+    if text.strip().lower() == "auto":
+        return "auto"
+    try:
+        return float(text)
+    except ValueError:
+        raise InputError(
+            f"--direction-deg: expected an angle in degrees or 'auto', got {text!r}"
+        ) from None
+
+
+def _direction_title(result) -> str:
+    """The direction the analysis pulled along (auto's choice included)."""
+    path = result.pressures[0].path if result.pressures else None
+    angle = getattr(path, "direction_deg", None)
+    rule = getattr(result, "direction_rule", "given")
+    if angle is None:
+        return "the requested direction"
+    return f"{angle:g}°" + ("" if rule == "given" else f" ({rule})")

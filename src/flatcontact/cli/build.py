@@ -104,7 +104,15 @@ def build(
         2, "--normal-axis", help="With --structure: cell axis (0, 1, 2) along the surface normal."
     ),
     face_depth_angstrom: float = typer.Option(
-        2.0, "--face-depth-angstrom", help="With --structure: depth of each tagged face (Å)."
+        2.0,
+        "--face-depth-angstrom",
+        help="Ignored (kept for old scripts): the layers are found from the structure.",
+    ),
+    config: Path | None = typer.Option(
+        None,
+        "--config",
+        help="A run configuration (YAML): its structure recipe and potential, the same as "
+        "'flatcontact run CONFIG' builds (--structure, --potential override them).",
     ),
     svg: bool = typer.Option(True, "--svg/--no-svg", help="Also write fig1_interface.svg."),
     regenerate_dense: bool = typer.Option(
@@ -136,9 +144,16 @@ def build(
             f"wrote {builder.SHIPPED_DENSE_SLAB} (CHGNet energy {provenance['energy_ev']:.4f} eV)"
         )
         return
-    spec = _potential_spec(potential, lj_cutoff_angstrom)
     if structure is not None and not structure.is_file():
         raise InputError(f"--structure {structure}: file not found")
+    if config is not None:
+        cfg = _config_settings(config, structure, potential, gap_angstrom, svg)
+        check_out_dir(out)
+        with flag_errors(_FLAG_OF):
+            result = run_build(cfg, BuildInputs(), out)
+        _print(result, out)
+        return
+    spec = _potential_spec(potential, lj_cutoff_angstrom)
     check_out_dir(out)
     section = {
         "kind": "quartz-dense",
@@ -148,12 +163,15 @@ def build(
         "fmax_ev_per_angstrom": fmax_ev_per_angstrom,
     }
     if structure is not None:
-        section.update(
-            kind="slab",
-            file=str(structure),
-            normal_axis=normal_axis,
-            face_depth_angstrom=face_depth_angstrom,
-        )
+        # the slab recipe finds the layers from the structure (a monolayer works); a normal
+        # other than cell vector 3 is refused naming --normal-axis
+        section = {
+            "kind": "slab",
+            "file": str(structure),
+            "normal_axis": normal_axis,
+            "gap_angstrom": gap_angstrom,
+            "fmax_ev_per_angstrom": fmax_ev_per_angstrom,
+        }
     data = {
         "structure": section,
         "potential": spec.model_dump(mode="json"),
@@ -162,6 +180,27 @@ def build(
     with flag_errors(_FLAG_OF):
         cfg = build_config(data, source=FLAGS_SOURCE)
         result = run_build(cfg, BuildInputs(), out)
+    _print(result, out)
+
+
+def _config_settings(config: Path, structure: Path | None, potential: str | None, gap, svg):
+    """The run settings of ``--config`` with ``--structure`` (a slab file: the ``slab``
+    recipe, layers found from the structure, so a 2D monolayer works) and ``--potential``
+    (a preset name or an intra-slab model) laid over."""
+    from flatcontact.cli.settings import resolve_config
+
+    flags: dict = {"report": {"svg": svg}}
+    if structure is not None:
+        flags["structure"] = {"kind": "slab", "file": str(structure), "gap_angstrom": gap}
+    if potential is not None:
+        from flatcontact.potentials.presets import PRESETS
+
+        name = potential.strip()
+        flags["potential"] = {"preset": name} if name in PRESETS else {"intra": name}
+    return resolve_config(config, None, flags, _FLAG_OF)
+
+
+def _print(result, out: Path) -> None:
     for line in result.warnings:
         print_warning(line)
     figures = [f for f in result.files if f.name.startswith("fig1_")]

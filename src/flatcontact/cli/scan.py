@@ -31,6 +31,8 @@ _FLAG_OF = {
     "scan.fmax_ev_per_angstrom": "--fmax-ev-per-angstrom",
     "scan.optimizer": "--optimizer",
     "scan.max_steps": "--max-steps",
+    "scan.relax_mode": "--relax-mode",
+    "potential.calculator.kwargs": "--calculator-kwarg",
     "scan.order": "--order",
     "scan.executor": "--executor",
     "scan.workers": "--workers",
@@ -105,6 +107,22 @@ def scan_command(
         typer.Option(
             "--calculator",
             help="calculator.target: an ASE calculator 'module:callable' instead of --potential.",
+        ),
+    ] = None,
+    calculator_kwarg: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--calculator-kwarg",
+            help="calculator.kwargs: key=value (value read as YAML), repeatable, e.g. "
+            "--calculator-kwarg model=medium --calculator-kwarg device=cpu.",
+        ),
+    ] = None,
+    relax_mode: Annotated[
+        str | None,
+        typer.Option(
+            "--relax-mode",
+            help="scan.relax_mode: full (default) | normal (generalized-stacking-fault "
+            "convention) | rigid-layers | rigid.",
         ),
     ] = None,
     grid: Annotated[
@@ -194,6 +212,7 @@ def scan_command(
         "fmax_ev_per_angstrom": fmax_ev_per_angstrom,
         "optimizer": optimizer,
         "max_steps": max_steps,
+        "relax_mode": relax_mode,
         "order": order,
         "executor": executor,
         "workers": workers,
@@ -203,8 +222,12 @@ def scan_command(
     if potential is not None:
         # an intra-slab model in place of the configured model's (its LJ kept), not a calculator
         flags["potential"] = {**_potential_section(potential), "calculator": None}
+    if calculator_kwarg and calculator is None:
+        raise InputError("--calculator-kwarg: give --calculator module:callable with it")
     if calculator is not None:
-        flags["calculator"] = {"target": calculator, "kwargs": {}}
+        from flatcontact.potentials.loader import parse_kwargs
+
+        flags["calculator"] = {"target": calculator, "kwargs": parse_kwargs(calculator_kwarg)}
     cfg = resolve_config(config, preset, flags)
     out_dir = check_out_dir(out or "ispes")
     where = Path(interface or DEFAULT_INTERFACE)

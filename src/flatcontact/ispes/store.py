@@ -60,7 +60,7 @@ def _acquire_driver_lock(path: Path):
 
 def interface_hash(atoms: Atoms) -> str:
     """SHA-256 of what defines an interface: species, positions, cell, pbc, slab/surface tags,
-    and the held atoms when they differ from the default (surfaces 1 and 4).
+    the held atoms when they differ from the default (surfaces 1 and 4) and the layer ids.
 
     Positions and cell are rounded to 1e-6 Å so that a file round trip gives the same hash.
     """
@@ -75,6 +75,9 @@ def interface_hash(atoms: Atoms) -> str:
     if not np.array_equal(held, np.isin(atoms.arrays["surface"], (1, 4))):
         h.update(b"held")  # held atoms other than the default surfaces 1 and 4
         h.update(held.astype(np.int8).tobytes())
+    if "layer" in atoms.arrays:  # molecule IDs of interlayer potentials, rigid-layer bodies
+        h.update(b"layer")
+        h.update(np.asarray(atoms.arrays["layer"], dtype=np.int64).tobytes())
     return h.hexdigest()
 
 

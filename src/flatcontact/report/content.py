@@ -25,6 +25,7 @@ from flatcontact.reference import (
     QUARTZ_LATTICE_EXPERIMENT_ANGSTROM,
 )
 from flatcontact.stages import _calculator
+from flatcontact.stages.contact import is_paper_material
 
 A_EXP = QUARTZ_LATTICE_EXPERIMENT_ANGSTROM["a"]
 
@@ -75,6 +76,99 @@ def compare_with_paper(laws: dict) -> list[tuple[str, str, str, str, str]]:
             )
         rows.append((label, _pm(value, err), f"{ref:g}", rel, reading))
     return rows
+
+
+def _interface(folder: Path):
+    from ase.io import read
+
+    return read(folder / "interface.extxyz")
+
+
+def interface_material(folder: Path) -> str:
+    """The material of the run's interface (``info['material']`` of ``interface.extxyz``;
+    its formula when the file names none)."""
+    atoms = _interface(folder)
+    return str(atoms.info.get("material") or atoms.get_chemical_formula(mode="hill"))
+
+
+def interface_elements(folder: Path) -> set[str]:
+    """The elements of the run's interface."""
+    return set(_interface(folder).get_chemical_symbols())
+
+
+def _direction_text(cfg, table) -> str:
+    """The pulling direction as run: the given angle, or auto's lowest-barrier direction."""
+    if cfg.analysis.direction_deg != "auto":
+        return f"{cfg.analysis.direction_deg:g}° from x"
+    if "direction_deg" in table:
+        angles = ", ".join(f"{v:g}°" for v in sorted(set(np.round(table["direction_deg"], 3))))
+        return f"auto: the lowest-barrier direction at the lowest load, {angles} from x"
+    return "auto: the lowest-barrier direction at the lowest load"
+
+
+def _stacking_rows(table) -> list[tuple[str, ...]]:
+    """(P, name=energy ...) rows of the named stackings (friction.csv), meV/Å² above the lowest."""
+    if "stacking_energies_mev_per_a2" not in table:
+        return []
+    rows = []
+    for r in table.itertuples():
+        text = str(r.stacking_energies_mev_per_a2)
+        if text in ("", "nan"):
+            continue
+        pairs = [item.split("=") for item in text.split(";") if "=" in item]
+        low = min(float(v) for _, v in pairs)
+        named = ", ".join(f"{k} {float(v) - low:.4g}" for k, v in pairs)
+        rows.append((f"{r.p_gpa:g}", named, fmt(getattr(r, "lowest_barrier_mev_per_a2", None))))
+    return rows
+
+
+def _own_results_section(
+    cfg, material: str, model: str, laws: dict, scan: dict, contact: dict, table
+):
+    """The laws, W, stackings and contact results of a material other than the paper's: no
+    comparison with the paper's α-quartz numbers, which are not about this material."""
+    from flatcontact.report.html import Section, Table
+
+    rows = [
+        ("k (MPa/GPa)", _pm(laws.get("k_mpa_per_gpa"), laws.get("k_stderr_mpa_per_gpa"))),
+        ("τ0 (MPa)", _pm(laws.get("tau0_mpa"), laws.get("tau0_stderr_mpa"))),
+        ("μ (MPa/GPa)", _pm(laws.get("mu_mpa_per_gpa"), laws.get("mu_stderr_mpa_per_gpa"))),
+        ("σ0 (MPa)", _pm(laws.get("sigma0_mpa"), laws.get("sigma0_stderr_mpa"))),
+        (
+            "work of separation W (J/m²)",
+            fmt((scan.get("adhesion") or {}).get("work_of_separation_j_per_m2")),
+        ),
+    ]
+    for r in contact["results"]:
+        rows.append(
+            (
+                f"effective shear strength Q_peak/πa² at p0 = {r['p0_gpa']:g} GPa (MPa)",
+                fmt(r["effective_shear_strength_mpa"]),
+            )
+        )
+    moduli = contact.get("provenance", {}).get("moduli", "config")
+    params = contact.get("parameters", {})
+    tables = [Table(("quantity", "this run"), rows)]
+    stackings = _stacking_rows(table)
+    if stackings:
+        tables.append(
+            Table(
+                ("P (GPa)", "named stackings (meV/Å² above the lowest)", "barrier (meV/Å²)"),
+                stackings,
+                "High-symmetry stackings of the lattice and the minimum-energy-path barrier",
+            )
+        )
+    return Section(
+        f"Results for {material}",
+        paragraphs=[
+            f"Material: {material}; interaction model: {model}. The paper's numbers are for "
+            "α-quartz (0001) and are not compared here. Load laws τ = k·P + τ0 and "
+            f"σ = μ·P + σ0 fitted on P ≤ {cfg.analysis.threshold_gpa:g} GPa.",
+            f"Contact moduli E* = {fmt(params.get('contact_modulus_gpa'))} GPa, G* = "
+            f"{fmt(params.get('shear_modulus_gpa'))} GPa ({moduli}).",
+        ],
+        tables=tables,
+    )
 
 
 def _setup_differences(cfg) -> list[str]:
@@ -245,6 +339,8 @@ def build_sections(
     contact = json.loads((f_ct / "summary.json").read_text())
     table = pd.read_csv(f_an / "friction.csv")
     model = _calculator.label(cfg)
+    material = interface_material(f_build)
+    paper_system = is_paper_material(cfg, interface_elements(f_build))
     sections = []
 
     # ---- summary
@@ -252,10 +348,11 @@ def build_sections(
         Section(
             "Summary",
             paragraphs=[
-                f"Interaction model: {model}. Structure: {cfg.structure.kind}"
+                f"Material: {material}. Interaction model: {model}. Structure: "
+                f"{cfg.structure.kind}"
                 + (
                     f", {cfg.structure.layers} layers per slab"
-                    if cfg.structure.kind != "file"
+                    if getattr(cfg.structure, "layers", None) is not None
                     else ""
                 )
                 + f". Preset: {cfg.preset}. ISPES grid {cfg.scan.grid[0]}×{cfg.scan.grid[1]} lateral × "
@@ -276,43 +373,46 @@ def build_sections(
         )
     )
 
-    # ---- comparison with the paper
-    rows = compare_with_paper(laws)
-    w = (scan.get("adhesion") or {}).get("work_of_separation_j_per_m2")
-    rows.append(
-        (
-            "work of separation W (J/m²)",
-            fmt(w),
-            "not reported",
-            "",
-            "from the probe column: [U(separated) − U(z_eq)]/A",
-        )
-    )
-    res = contact["results"]
-    ref = contact["results_with_paper_laws"]
-    for r_run, r_pap in zip(res, ref, strict=True):
+    # ---- comparison with the paper (its SiO2 numbers only for its system)
+    if not paper_system:
+        sections.append(_own_results_section(cfg, material, model, laws, scan, contact, table))
+    if paper_system:
+        rows = compare_with_paper(laws)
+        w = (scan.get("adhesion") or {}).get("work_of_separation_j_per_m2")
         rows.append(
             (
-                f"effective shear strength Q_peak/πa² at p0 = {r_run['p0_gpa']:g} GPa (MPa)",
-                fmt(r_run["effective_shear_strength_mpa"]),
-                fmt(r_pap["effective_shear_strength_mpa"]),
-                f"{r_run['effective_shear_strength_mpa'] - r_pap['effective_shear_strength_mpa']:+.3g}",
-                "paper column: the same contact model with the paper's k, τ0, μ, σ0",
+                "work of separation W (J/m²)",
+                fmt(w),
+                "not reported",
+                "",
+                "from the probe column: [U(separated) − U(z_eq)]/A",
             )
         )
-    sections.append(
-        Section(
-            "This run next to the paper",
-            paragraphs=[
-                f"Paper (Dong, Uluca, Cross, Sanvito): τ = k·P + τ0 with k = {PAPER['k_mpa_per_gpa']:g} "
-                f"MPa/GPa, τ0 = {PAPER['tau0_mpa']:g} MPa; σ = μ·P + σ0 with μ = "
-                f"{PAPER['mu_mpa_per_gpa']:g} MPa/GPa, σ0 = {PAPER['sigma0_mpa']:g} MPa (SNAP + "
-                f"TS-vdW LJ, P < {PAPER_THRESHOLD_GPA:g} GPa).",
-            ],
-            notes=["Why the numbers can differ: " + " ".join(_setup_differences(cfg))],
-            tables=[Table(("quantity", "this run", "paper", "difference", "reading"), rows)],
+        res = contact["results"]
+        ref = contact["results_with_paper_laws"]
+        for r_run, r_pap in zip(res, ref, strict=True):
+            rows.append(
+                (
+                    f"effective shear strength Q_peak/πa² at p0 = {r_run['p0_gpa']:g} GPa (MPa)",
+                    fmt(r_run["effective_shear_strength_mpa"]),
+                    fmt(r_pap["effective_shear_strength_mpa"]),
+                    f"{r_run['effective_shear_strength_mpa'] - r_pap['effective_shear_strength_mpa']:+.3g}",
+                    "paper column: the same contact model with the paper's k, τ0, μ, σ0",
+                )
+            )
+        sections.append(
+            Section(
+                "This run next to the paper",
+                paragraphs=[
+                    f"Paper (Dong, Uluca, Cross, Sanvito): τ = k·P + τ0 with k = {PAPER['k_mpa_per_gpa']:g} "
+                    f"MPa/GPa, τ0 = {PAPER['tau0_mpa']:g} MPa; σ = μ·P + σ0 with μ = "
+                    f"{PAPER['mu_mpa_per_gpa']:g} MPa/GPa, σ0 = {PAPER['sigma0_mpa']:g} MPa (SNAP + "
+                    f"TS-vdW LJ, P < {PAPER_THRESHOLD_GPA:g} GPa).",
+                ],
+                notes=["Why the numbers can differ: " + " ".join(_setup_differences(cfg))],
+                tables=[Table(("quantity", "this run", "paper", "difference", "reading"), rows)],
+            )
         )
-    )
 
     # ---- interface
     rel = build.get("interface_relaxation", {})
@@ -325,7 +425,8 @@ def build_sections(
                 f"{build.get('n_atoms', '?')} atoms; reference thickness z = {fmt(build.get('thickness_angstrom'))} Å"
                 + (
                     f"; interface relaxation {'converged' if rel.get('converged') else 'NOT converged'}"
-                    f" in {rel.get('steps', '?')} steps to {cfg.structure.fmax_ev_per_angstrom:g} eV/Å"
+                    f" in {rel.get('steps', '?')} steps to "
+                    f"{getattr(cfg.structure, 'fmax_ev_per_angstrom', float('nan')):g} eV/Å"
                     if rel
                     else ""
                 )
@@ -407,7 +508,7 @@ def build_sections(
         Section(
             "3. Constant-pressure ISPES, sliding path, τ and σ",
             paragraphs=[
-                f"Pulling direction {cfg.analysis.direction_deg:g}° from x; energy form "
+                f"Pulling direction {_direction_text(cfg, table)}; energy form "
                 f"'{cfg.analysis.energy_form}' (the paper's is 'internal'). τ is the paper's "
                 "shear strength (largest force before leaving the initial minimum); τ_period is "
                 "the largest force over a whole period, the pull needed for sustained sliding "
@@ -469,6 +570,7 @@ def build_sections(
         ("overshoot", "overshoot (Q_peak > Q_sat)"),
         ("knee_stress_amplitude_mpa", "stiffness knee, amplitude stress (MPa)"),
     ]
+    res = contact["results"]
     keys = [k for k in keys if k[0] in res[0]]
     ct_rows = [(label, *(fmt(r[k]) for r in res)) for k, label in keys]
     contact_figs = [

@@ -11,7 +11,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from flatcontact.errors import InputError
 from flatcontact.fileio import write_json_atomic
 from flatcontact.stages import _calculator
 from flatcontact.stages._common import save
@@ -19,8 +18,16 @@ from flatcontact.stages._common import save
 INTERFACE = "interface.extxyz"
 BUILD_JSON = "build.json"
 FIGURE_STEM = "fig1_interface"
-#: Depth of each tagged face of a ``structure.kind: slab`` interface (Å) when not given.
-SLAB_FACE_DEPTH_ANGSTROM = 2.0
+#: Recipes whose interface is relaxed once with the run's model (cut surfaces reconstruct).
+RELAXED_KINDS = ("slab", "crystal")
+#: Recipes kept at their ideal geometry: a relaxation at the reference stacking would imprint
+#: that stacking on the held (rigid) layers, e.g. the 0.0025 Å buckling of AB graphene, and
+#: AB and BA would stop being equivalent (measured: 0.08 meV/Å² apart with REBO + KC).
+IDEAL_KINDS = ("sheets", "fcc111")
+IDEAL_GEOMETRY = (
+    "ideal: sheets at their built-in (or file) geometry, fcc planes of the perfect crystal; "
+    "not relaxed at the reference stacking, so symmetry-equivalent stackings stay equivalent"
+)
 
 
 @dataclass(frozen=True)
@@ -58,64 +65,47 @@ def unconverged_warnings(report: dict, fmax_ev_per_angstrom: float) -> list[str]
     return out
 
 
-def _read_slab(path: str):
-    from ase.io import read
+def _relax_calculator(settings):
+    """A callable(atoms) -> the model's calculator that first checks the model knows ``atoms``
+    (one line naming element and model), so a bad pair fails before the relaxation."""
+    factory = _calculator.factory(settings)
 
-    if not Path(path).is_file():
-        raise InputError(f"structure.file {path}: file not found")
-    try:
-        return read(path)
-    except Exception as exc:
-        raise InputError(f"structure.file {path}: cannot read it ({type(exc).__name__})") from None
+    def calculator(atoms):
+        _calculator.check_atoms(settings, atoms)
+        return factory(atoms)
+
+    return calculator
 
 
 def run_build(settings, inputs: BuildInputs, folder: Path | None, progress=None) -> BuildResult:
-    """Build the interface of ``settings.structure`` with the run's interaction model.
+    """Build the interface of the recipe ``settings.structure`` with the run's interaction model.
 
-    ``structure.kind``: ``quartz-dense`` (the paper's α-quartz (0001) dense interface),
-    ``slab`` (any slab file, its faces tagged by depth), ``file`` (a finished interface) or
-    ``toy-lj``. Errors name the settings path (``structure.file``).
+    Every kind goes through :func:`flatcontact.structures.construct.build_interface`:
+    ``quartz-dense`` (the paper's α-quartz (0001) dense interface, relaxed by its builder),
+    ``file`` (a finished interface), ``toy-lj``, and ``slab``, ``sheets``, ``crystal``,
+    ``fcc111`` (relaxed once with the run's model, no atom held, after the model's element
+    check). Errors name the settings path (``structure.bulk``, ``structure.miller``, ...).
     """
-    from flatcontact.structures.interface import read_interface, thickness, write_interface
+    from flatcontact.structures.construct import build_interface
+    from flatcontact.structures.interface import write_interface
+    from flatcontact.structures.recipe import QuartzDenseRecipe, ToyRecipe
 
     s = settings.structure
-    if s.kind == "quartz-dense":
-        from flatcontact.structures.build import build_quartz_interface
-
-        atoms, report = build_quartz_interface(
-            _calculator.model(settings),
-            s.layers,
-            source=s.source,
-            gap_angstrom=s.gap_angstrom,
-            fmax_ev_per_angstrom=s.fmax_ev_per_angstrom,
-        )
-    elif s.kind == "slab":
-        from flatcontact.structures.build import interface_from_slab
-
-        atoms, report = interface_from_slab(
-            _read_slab(s.file),
-            _calculator.model(settings),
-            normal_axis=2 if s.normal_axis is None else s.normal_axis,
-            face_depth_angstrom=(
-                SLAB_FACE_DEPTH_ANGSTROM if s.face_depth_angstrom is None else s.face_depth_angstrom
-            ),
-            gap_angstrom=s.gap_angstrom,
-            fmax_ev_per_angstrom=s.fmax_ev_per_angstrom,
-            source=str(s.file),
-        )
-    elif s.kind == "toy-lj":
-        from flatcontact.ispes.toy import toy_interface
-
-        atoms = toy_interface(s.layers, **_calculator.toy_kwargs(settings))
-        report = {
-            "source": "flatcontact.ispes.toy",
-            "n_atoms": len(atoms),
-            "thickness_angstrom": thickness(atoms),
-        }
+    if isinstance(s, ToyRecipe) and not s.params:
+        # the toy's geometry follows its calculator's LJ (calculator.kwargs), as before recipes
+        s = s.model_copy(update={"params": _calculator.toy_kwargs(settings)})
+    if isinstance(s, QuartzDenseRecipe):
+        atoms, report = build_interface(s, potential=_calculator.model(settings))
+    elif s.kind in RELAXED_KINDS:
+        atoms, report = build_interface(s, relax_calculator=_relax_calculator(settings))
     else:
-        atoms = read_interface(s.file)
-        report = {"source": s.file, "n_atoms": len(atoms), "thickness_angstrom": thickness(atoms)}
-    result = BuildResult(atoms, report, unconverged_warnings(report, s.fmax_ev_per_angstrom))
+        atoms, report = build_interface(s)
+        if s.kind in IDEAL_KINDS:
+            report["interface_relaxation"] = None
+            report["reference_geometry"] = IDEAL_GEOMETRY
+    _calculator.check_atoms(settings, atoms)
+    fmax = getattr(s, "fmax_ev_per_angstrom", 0.0)
+    result = BuildResult(atoms, report, unconverged_warnings(report, fmax))
     if folder is not None:
         from flatcontact.plots.structures import figure_interface
 

@@ -110,6 +110,48 @@ def contact_parameters(settings, inputs: ContactInputs):
     return params, provenance
 
 
+#: The elements of the paper's material (α-quartz): the only one the default moduli are for.
+PAPER_ELEMENTS = frozenset({"Si", "O"})
+
+
+def moduli_given(settings) -> bool:
+    """Whether the run sets E* and G* itself: the elastic stage, or both contact moduli given."""
+    given = settings.contact.model_fields_set
+    return settings.elastic.enabled or {"contact_modulus_gpa", "shear_modulus_gpa"} <= given
+
+
+def is_paper_material(settings, elements=None) -> bool:
+    """Whether the run's slabs are the paper's α-quartz, the material of the default E*, G*.
+
+    ``quartz-dense`` always; ``toy-lj`` (a demonstration model, no material) takes the
+    defaults too; another recipe only when its atoms (``elements``, known after reading the
+    structure) are Si and O alone.
+    """
+    kind = settings.structure.kind
+    if kind in ("quartz-dense", "toy-lj"):
+        return True
+    return elements is not None and set(elements) <= PAPER_ELEMENTS
+
+
+def check_moduli_source(settings, elements=None) -> None:
+    """Refuse, before any work, a material other than α-quartz that would take the quartz E*, G*.
+
+    The contact defaults (E* = 52.5 GPa, G* = 29 GPa) are the paper's α-quartz values; for
+    another material the run needs ``elastic.enabled: true`` (the moduli of its bulk crystal
+    with its own potential) or both ``contact.contact_modulus_gpa`` and
+    ``contact.shear_modulus_gpa``.
+    """
+    if moduli_given(settings) or is_paper_material(settings, elements):
+        return
+    what = f"structure.kind={settings.structure.kind}"
+    if elements is not None:
+        what += f" ({'-'.join(sorted(elements))})"
+    raise InputError(
+        f"contact.contact_modulus_gpa/shear_modulus_gpa: {what} is not the paper's alpha-quartz, "
+        "whose E* and G* are the defaults; give both moduli (GPa) or set elastic.enabled: true"
+    )
+
+
 def check_contact(settings, params) -> None:
     """Everything the contact stage refuses, before any work (one line naming the setting)."""
     c = settings.contact

@@ -1,8 +1,24 @@
-"""Stage 5 (optional), elastic: E* and G* of bulk α-quartz with the run's potential.
+"""Stage 5 (optional), elastic: E* and G* of the slab material's bulk crystal with the run's model.
 
 File: ``elastic.json`` (:meth:`ElasticResult.to_json`: lattice, Cij, Hill moduli and the contact
 moduli the contact stage takes, ``contact_modulus_gpa`` = E* and ``shear_modulus_gpa`` = G*
-in the paper's convention, 4 × Johnson's G*_J).
+in the paper's convention, 4 × Johnson's G*_J, plus ``crystal``: which bulk crystal was
+computed and why it stands for the slabs).
+
+The bulk crystal of each recipe (:func:`bulk_crystal`):
+
+``quartz-dense``  α-quartz (:func:`flatcontact.elastic.quartz_contact_moduli`, the paper's);
+``fcc111``        the fcc crystal of ``element`` (``a_angstrom`` or ASE's reference, relaxed);
+``crystal``       the bulk file the slabs are cut from;
+``sheets``        the bulk layered crystal: two sheets in the recipe's stacking (AB: Bernal
+                  graphite; AA′: h-BN, 2H-MoS2) at the interlayer distance, periodic along z.
+                  Convention (stated in ``elastic.json``): the Hill average of the relaxed-ion
+                  Cij, i.e. the layered crystal as an isotropic polycrystal. A single-asperity
+                  contact of a layered material is strongly anisotropic (C33, C44 << C11), so
+                  this E*, G* is an order of magnitude, not a property of that contact.
+
+A hetero-interface (``slab2``), ``file``, ``slab`` and ``toy-lj`` have no single bulk crystal:
+the stage refuses them in one line naming ``elastic.enabled`` (give the contact moduli).
 """
 
 from __future__ import annotations
@@ -10,10 +26,17 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from flatcontact.errors import InputError
 from flatcontact.fileio import write_json_atomic
 from flatcontact.stages import _calculator
 
 ELASTIC_JSON = "elastic.json"
+
+#: The convention of the layered crystals' moduli (elastic.json ``crystal.convention``).
+LAYERED_CONVENTION = (
+    "Hill average of the relaxed-ion Cij of the bulk layered crystal (isotropic polycrystal); "
+    "a contact of a layered material is strongly anisotropic, so E* and G* are an order of magnitude"
+)
 
 
 @dataclass(frozen=True)
@@ -23,7 +46,7 @@ class ElasticInputs:
 
 @dataclass
 class ElasticResult:
-    """:func:`flatcontact.elastic.quartz_contact_moduli`'s document."""
+    """:func:`flatcontact.elastic.crystal_contact_moduli`'s document (+ ``crystal``)."""
 
     doc: dict
     files: list[Path] = field(default_factory=list)
@@ -45,16 +68,85 @@ class ElasticResult:
         }
 
 
+def bulk_crystal(recipe):
+    """The bulk crystal standing for the slabs of ``recipe`` and a record of it.
+
+    Returns ``(atoms, record)``; ``atoms`` is ``None`` for ``quartz-dense`` (α-quartz, the
+    paper's path). Raises a one-line InputError naming ``elastic.enabled`` for recipes with
+    no single bulk crystal.
+    """
+    kind = recipe.kind
+    if getattr(recipe, "slab2", None) is not None:
+        raise InputError(
+            "elastic.enabled: structure.slab2 makes a hetero-interface of two materials; the "
+            "elastic stage computes one crystal: give contact.contact_modulus_gpa and "
+            "contact.shear_modulus_gpa instead"
+        )
+    if kind == "quartz-dense":
+        return None, {"crystal": "alpha-quartz"}
+    if kind == "fcc111":
+        from ase.build import bulk
+
+        atoms = bulk(recipe.element, "fcc", a=recipe.a_angstrom)
+        return atoms, {"crystal": f"fcc {recipe.element}"}
+    if kind == "crystal":
+        from flatcontact.structures.crystal import read_bulk
+
+        return read_bulk(recipe.bulk, "structure.bulk"), {
+            "crystal": f"bulk file {Path(recipe.bulk).name}"
+        }
+    if kind == "sheets":
+        return _layered_bulk(recipe)
+    raise InputError(
+        f"elastic.enabled: structure.kind={kind} names no bulk crystal; give "
+        "contact.contact_modulus_gpa and contact.shear_modulus_gpa instead"
+    )
+
+
+def _layered_bulk(recipe):
+    from ase.io import read
+
+    from flatcontact.structures.sheets import BUILTIN_SHEETS, builtin_sheet, stack_sheets
+
+    if recipe.sheet in BUILTIN_SHEETS:
+        sheet = builtin_sheet(recipe.sheet)
+        d = recipe.interlayer_angstrom or BUILTIN_SHEETS[recipe.sheet].interlayer_angstrom
+    else:
+        sheet = read(recipe.sheet)
+        d = recipe.interlayer_angstrom
+    stacking = recipe.stacking if len(recipe.stacking.replace("'", "")) >= 2 else "AB"
+    atoms = stack_sheets(sheet, 2, stacking, d, "structure.stacking")
+    cell = atoms.cell.array.copy()
+    cell[2] = [0.0, 0.0, 2 * d]
+    atoms.set_cell(cell)
+    atoms.positions[:, 2] -= atoms.positions[:, 2].min()
+    atoms.pbc = True
+    atoms.wrap()
+    record = {
+        "crystal": f"bulk {recipe.sheet}, two sheets stacked {stacking} at {d:g} Å",
+        "convention": LAYERED_CONVENTION,
+    }
+    return atoms, record
+
+
 def run_elastic(
     settings, inputs: ElasticInputs, folder: Path | None, progress=None
 ) -> ElasticResult:
-    """Cij of relaxed α-quartz by finite strains (``elastic.strain``) and its contact moduli,
-    with the run's model as a single crystal (:meth:`InteractionModel.bulk_calculator`)."""
-    from flatcontact.elastic import quartz_contact_moduli
+    """Cij of the relaxed bulk crystal of the slabs (:func:`bulk_crystal`) by finite strains
+    (``elastic.strain``) and its contact moduli, with the run's model as a single crystal
+    (:meth:`InteractionModel.bulk_calculator`)."""
+    from flatcontact.elastic import crystal_contact_moduli, quartz_contact_moduli
 
-    _calculator.check_elastic(settings)
-    doc = quartz_contact_moduli(_calculator.model(settings), strain=settings.elastic.strain)
-    result = ElasticResult(doc)
+    atoms, record = bulk_crystal(settings.structure)
+    model = _calculator.model(settings)
+    if atoms is None:
+        _calculator.check_elastic(settings)
+        doc = quartz_contact_moduli(model, strain=settings.elastic.strain)
+    else:
+        _calculator.check_atoms(settings, atoms)
+        doc = crystal_contact_moduli(atoms, model, strain=settings.elastic.strain)
+        doc["potential"] = model.label
+    result = ElasticResult({**doc, "crystal": record})
     if folder is not None:
         folder.mkdir(parents=True, exist_ok=True)
         result.files.append(write_json_atomic(folder / ELASTIC_JSON, result.to_json()))

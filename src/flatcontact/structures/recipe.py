@@ -65,7 +65,10 @@ class _PairOptions(_Model):
         description="commensurate twist (m, n) of a hexagonal lattice: slab 2 rotated by "
         "acos((m²+4mn+n²)/(2(m²+mn+n²))), (1, 2) → 21.787°",
     )
-    match: MatchSettings = Field(default_factory=MatchSettings)
+    match: MatchSettings = Field(
+        default_factory=MatchSettings,
+        description="bounds of the coincidence-lattice search and of the atom count",
+    )
     fmax_ev_per_angstrom: float = Field(
         0.01,
         gt=0,
@@ -89,7 +92,7 @@ class SheetSlab(_Model):
 class SheetsRecipe(_PairOptions):
     """2D monolayers stacked into two slabs."""
 
-    kind: Literal["sheets"] = "sheets"
+    kind: Literal["sheets"] = Field("sheets", description="recipe kind")
     sheet: str = Field(description="built-in graphene | h-BN | MoS2, or a monolayer file")
     layers: int = Field(1, ge=1, description="sheets per slab")
     stacking: str = Field(
@@ -122,7 +125,7 @@ class CrystalSlab(_Model):
 class CrystalRecipe(_PairOptions):
     """Slabs cut from a bulk crystal."""
 
-    kind: Literal["crystal"] = "crystal"
+    kind: Literal["crystal"] = Field("crystal", description="recipe kind")
     bulk: str = Field(description="bulk crystal file, any format ASE reads (CIF, POSCAR, extxyz)")
     miller: tuple[int, int, int] = Field(description="Miller index in the file's cell")
     layers: int = Field(6, ge=1, description="bulk repeats (layers) per slab")
@@ -137,15 +140,17 @@ class CrystalRecipe(_PairOptions):
 
 
 class Fcc111Slab(_Model):
-    element: str
-    a_angstrom: float | None = Field(None, gt=0)
-    layers: int = Field(6, ge=1)
+    element: str = Field(description="fcc element of slab 2")
+    a_angstrom: float | None = Field(
+        None, gt=0, description="lattice constant (default: ASE's reference)"
+    )
+    layers: int = Field(6, ge=1, description="close-packed planes of slab 2")
 
 
 class Fcc111Recipe(_PairOptions):
     """fcc(111) metal slabs (ase.build.fcc111), one close-packed plane per layer."""
 
-    kind: Literal["fcc111"] = "fcc111"
+    kind: Literal["fcc111"] = Field("fcc111", description="recipe kind")
     element: str = Field(description="Cu, Ni, Al, ... (fcc)")
     a_angstrom: float | None = Field(
         None, gt=0, description="lattice constant (default: ASE's reference)"
@@ -162,11 +167,19 @@ class Fcc111Recipe(_PairOptions):
 class QuartzDenseRecipe(_Model):
     """The paper's α-quartz (0001) dense interface (flatcontact.structures.build)."""
 
-    kind: Literal["quartz-dense"] = "quartz-dense"
+    kind: Literal["quartz-dense"] = Field("quartz-dense", description="recipe kind")
     layers: int = Field(6, description="O-Si-O layers per slab (>= 5)")
-    source: Literal["auto", "shipped", "seed"] = "auto"
-    gap_angstrom: float = Field(3.0, gt=0)
-    fmax_ev_per_angstrom: float = Field(0.01, gt=0)
+    source: Literal["auto", "shipped", "seed"] = Field(
+        "auto",
+        description="starting slab: shipped (CHGNet-relaxed 6-layer slab), seed (seeded dense "
+        "reconstruction relaxed with the potential) or auto (shipped if present and layers == 6)",
+    )
+    gap_angstrom: float = Field(
+        3.0, gt=0, description="initial gap between the slabs before the interface relaxation (Å)"
+    )
+    fmax_ev_per_angstrom: float = Field(
+        0.01, gt=0, description="force tolerance of the slab and interface relaxations (eV/Å)"
+    )
 
     @model_validator(mode="after")
     def _layers(self) -> QuartzDenseRecipe:
@@ -182,14 +195,14 @@ class QuartzDenseRecipe(_Model):
 class FileRecipe(_Model):
     """A prepared interface.extxyz following the contract."""
 
-    kind: Literal["file"] = "file"
+    kind: Literal["file"] = Field("file", description="recipe kind")
     file: str = Field(description="path of an interface.extxyz")
 
 
 class SlabFileRecipe(_Model):
     """A prepared slab file: two copies facing each other, layers found from the structure."""
 
-    kind: Literal["slab"] = "slab"
+    kind: Literal["slab"] = Field("slab", description="recipe kind")
     file: str = Field(
         description="slab file (any format ASE reads), periodic along cell vectors 1, 2"
     )
@@ -208,8 +221,8 @@ class SlabFileRecipe(_Model):
 class ToyRecipe(_Model):
     """The toy two-slab Lennard-Jones interface (flatcontact.ispes.toy)."""
 
-    kind: Literal["toy-lj"] = "toy-lj"
-    layers: int = Field(3, ge=3)
+    kind: Literal["toy-lj"] = Field("toy-lj", description="recipe kind")
+    layers: int = Field(3, ge=3, description="atomic layers per slab (>= 3)")
     params: dict[str, float] = Field(
         default_factory=dict, description="ToyPairCalculator parameters"
     )
