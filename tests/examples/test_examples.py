@@ -1,0 +1,362 @@
+"""The example configurations (``examples/*.yaml``) against independent numbers.
+
+Fast: every example loads as ``flatcontact config --check`` reads it and its model knows every
+element of its interface; the graphene (REBO + KC) example's ISPES at one thickness equals, point
+by point, a plain LAMMPS input written here (``tests/potentials/plain_lammps.py``: atoms by
+``create_atoms``, molecule ids by ``set atom``, the pair commands verbatim) on the rigid geometry
+built here from the interface file (slab 2 translated by the shift, its layer put at the
+thickness); bad inputs are refused in one line naming the field before any work.
+
+Slow (end to end, ``flatcontact run examples/NAME.yaml``): the 2D examples' named stacking
+energies at P = 0 equal the plain-LAMMPS constant-load values (each stacking's rigid E(z)
+minimised over z with scipy), symmetry-equivalent stackings are equal to round-off, and the
+Cu(111) zero-load ISPES has the intrinsic stacking-fault energy of Mishin et al. (2001).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from flatcontact.config import load_config
+from flatcontact.errors import InputError
+from flatcontact.potentials.lammps_runtime import lammps_potential_file
+
+sys.path.insert(0, str(Path(__file__).parents[1] / "potentials"))
+from plain_lammps import lammps_energy
+
+EXAMPLES = Path(__file__).parents[2] / "examples"
+ALL = sorted(EXAMPLES.glob("*.yaml"))
+MEV = 1000.0
+
+
+def f(name: str) -> str:
+    return str(lammps_potential_file(name))
+
+
+# plain LAMMPS pair commands per example (types: one per element and layer, see _types)
+KC = [
+    "pair_style hybrid/overlay rebo kolmogorov/crespi/full 16.0 1",
+    f"pair_coeff * * rebo {f('CH.rebo')} C C",
+    f"pair_coeff * * kolmogorov/crespi/full {f('CH_taper.KC')} C C",
+]
+ILP = [
+    "pair_style hybrid/overlay rebo ilp/graphene/hbn 16.0 1",
+    f"pair_coeff * * rebo {f('CH.rebo')} C C",
+    f"pair_coeff * * ilp/graphene/hbn {f('BNCH.ILP')} C C",
+]
+HBN = [  # LAMMPS example in.bilayer-hBN: Tersoff + ILP, shielded Coulomb across the layers
+    "pair_style hybrid/overlay tersoff ilp/graphene/hbn 16.0 1 coul/shield 16.0 1",
+    f"pair_coeff * * tersoff {f('BNC.tersoff')} B N B N",
+    f"pair_coeff * * ilp/graphene/hbn {f('BNCH.ILP')} B N B N",
+    "pair_coeff 1 3 coul/shield 0.70",
+    "pair_coeff 1 4 coul/shield 0.69498201415576216335",
+    "pair_coeff 2 3 coul/shield 0.69498201415576216335",
+    "pair_coeff 2 4 coul/shield 0.69",
+    "set type 1 charge 0.42",
+    "set type 3 charge 0.42",
+    "set type 2 charge -0.42",
+    "set type 4 charge -0.42",
+]
+PLAIN = {
+    "graphene-bilayer-kc": (KC, ("C",)),
+    "graphene-bilayer-ilp": (ILP, ("C",)),
+    "hbn-bilayer-ilp": (HBN, ("B", "N")),
+}
+
+
+def _types(atoms, order) -> list[int]:
+    """LAMMPS type per atom: element index within ``order``, one set of types per layer."""
+    layer = atoms.arrays["layer"]
+    return [
+        (int(k) - 1) * len(order) + order.index(s) + 1
+        for k, s in zip(layer, atoms.get_chemical_symbols(), strict=True)
+    ]
+
+
+def rigid_geometry(reference, shift, thickness):
+    """The reference bilayer with slab 2 translated by ``shift`` (fractions of a1, a2) and its
+    layer's mean height put ``thickness`` above slab 1's (the interface contract's z)."""
+    atoms = reference.copy()
+    top = atoms.arrays["slab"] == 2
+    cell = atoms.cell.array
+    atoms.positions[top, :2] += np.asarray(shift) @ cell[:2, :2]
+    z = atoms.positions[:, 2]
+    atoms.positions[top, 2] += thickness - (z[top].mean() - z[~top].mean())
+    return atoms
+
+
+def plain_energy_per_area(reference, shift, thickness, name) -> float:
+    commands, order = PLAIN[name]
+    atoms = rigid_geometry(reference, shift, thickness)
+    e = lammps_energy(atoms, _types(atoms, order), commands, list(atoms.arrays["layer"]))
+    return e / abs(np.linalg.det(reference.cell.array[:2, :2]))
+
+
+def _aa_shift(reference) -> np.ndarray:
+    """The shift (fractions of a1, a2) that puts every slab-2 atom over a slab-1 atom of its
+    element: the eclipsed (AA) registry, found from the geometry alone."""
+    cell = reference.cell.array[:2, :2]
+    top = reference.arrays["slab"] == 2
+    sym = np.array(reference.get_chemical_symbols())
+    p1, p2 = reference.positions[~top, :2], reference.positions[top, :2]
+    for j in range(len(p1)):
+        d = np.linalg.solve(cell.T, p1[j] - p2[0])
+        moved = (np.linalg.solve(cell.T, p2.T).T + d) % 1.0
+        target = np.linalg.solve(cell.T, p1.T).T % 1.0
+        ok = all(
+            any(
+                sym[~top][m] == sym[top][i]
+                and np.allclose((moved[i] - target[m] + 0.5) % 1.0 - 0.5, 0, atol=1e-6)
+                for m in range(len(p1))
+            )
+            for i in range(len(p2))
+        )
+        if ok:
+            return d % 1.0
+    raise AssertionError("no eclipsed registry")
+
+
+def _fractional(reference, vector_xy) -> np.ndarray:
+    return np.linalg.solve(reference.cell.array[:2, :2].T, vector_xy) % 1.0
+
+
+def _sp_shift(reference) -> np.ndarray:
+    """The saddle (SP) registry: half the shortest step from AB to BA, the AA vector turned
+    by 60° (AB, BA, AA form a triangular lattice of spacing a/√3 in translation space)."""
+    aa = _aa_shift(reference)
+    v = ((aa + 0.5) % 1.0 - 0.5) @ reference.cell.array[:2, :2]
+    c, s = np.cos(np.pi / 3), np.sin(np.pi / 3)
+    return _fractional(reference, 0.5 * np.array([c * v[0] - s * v[1], s * v[0] + c * v[1]]))
+
+
+# --------------------------------------------------------------------------- fast
+@pytest.mark.parametrize("path", ALL, ids=[p.stem for p in ALL])
+def test_every_example_loads_and_its_model_knows_its_elements(path):
+    """``config --check`` semantics: valid, moduli source accepted, elements known."""
+    from flatcontact.stages.contact import check_moduli_source
+    from flatcontact.structures.construct import build_interface
+
+    cfg = load_config(path)
+    assert cfg.structure.kind in ("quartz-dense", "sheets", "fcc111")
+    if cfg.structure.kind == "quartz-dense":
+        assert {"Si", "O"} <= set(cfg.potential.elements or {"Si", "O"})
+        check_moduli_source(cfg)
+        return
+    atoms, _ = build_interface(cfg.structure)  # ideal geometry: no relaxation, no calculator
+    cfg.potential.check_atoms(atoms)
+    check_moduli_source(cfg, set(atoms.get_chemical_symbols()))
+    assert atoms.info["material"]
+
+
+def test_expected_examples_are_present():
+    names = {p.stem for p in ALL}
+    assert names >= {
+        "graphene-bilayer-kc",
+        "graphene-bilayer-ilp",
+        "hbn-bilayer-ilp",
+        "mos2-bilayer-ilp",
+        "cu111-eam",
+        "quartz-paper",
+        "graphene-hbn-ilp",
+    }
+
+
+def test_quartz_example_is_the_default_run():
+    assert load_config(EXAMPLES / "quartz-paper.yaml").to_dict() == load_config().to_dict()
+
+
+def test_graphene_kc_ispes_equals_plain_lammps_point_by_point(tmp_path):
+    """The scan stage's energies (6×6 grid, two thicknesses, rigid sheets) are the plain
+    LAMMPS energies of the geometry built here, to round-off; AB = BA exactly."""
+    from flatcontact.ispes.contract import open_ispes
+    from flatcontact.stages.build import BuildInputs, run_build
+    from flatcontact.stages.scan import ScanInputs, run_scan_stage
+
+    cfg = load_config(EXAMPLES / "graphene-bilayer-kc.yaml")
+    scan = cfg.scan.model_copy(
+        update={"p_range_gpa": None, "thickness_angstrom": [3.3, 3.5], "executor": "serial"}
+    )
+    cfg = cfg.model_copy(update={"scan": scan})
+    run_build(cfg, BuildInputs(), tmp_path / "build")
+    run_scan_stage(cfg, ScanInputs(tmp_path / "build" / "interface.extxyz"), tmp_path / "scan")
+    from flatcontact.structures.interface import read_interface
+
+    reference = read_interface(tmp_path / "build" / "interface.extxyz")
+    ds = open_ispes(tmp_path / "scan" / "ispes.nc")
+    area = float(ds.attrs["area"])
+    e = ds["energy"].values / area
+    for iz, z in enumerate(ds.thickness.values):
+        plain = np.array(
+            [
+                [
+                    plain_energy_per_area(reference, (sa, sb), z, "graphene-bilayer-kc")
+                    for sb in ds.shift_b.values
+                ]
+                for sa in ds.shift_a.values
+            ]
+        )
+        # absolute energies: same geometry, same potential -> round-off
+        np.testing.assert_allclose(e[:, :, iz], plain, atol=1e-9, rtol=0)
+    aa = np.rint(_aa_shift(reference) * 6).astype(int) % 6
+    ba = (-aa) % 6  # the AA step reversed lands on BA (equivalent to AB by symmetry)
+    for iz in range(e.shape[2]):
+        assert e[ba[0], ba[1], iz] == pytest.approx(e[0, 0, iz], abs=1e-12)
+        assert e[aa[0], aa[1], iz] - e[0, 0, iz] > 1e-4  # AA is repulsive (eV/Å²)
+
+
+def _one_line(exc) -> str:
+    text = str(exc.value)
+    assert "\n" not in text and "Traceback" not in text
+    return text
+
+
+def test_element_the_potential_lacks_is_refused_before_any_work(tmp_path):
+    from flatcontact.pipeline import Pipeline
+
+    path = tmp_path / "c.yaml"
+    path.write_text(
+        "structure: {kind: sheets, sheet: h-BN}\npotential: {preset: graphene-rebo-kc}\n"
+        "contact: {contact_modulus_gpa: 50, shear_modulus_gpa: 30}\n"
+    )
+    cfg = load_config(path)
+    with pytest.raises(InputError) as exc:
+        Pipeline(cfg, tmp_path / "run").build()
+    text = _one_line(exc)
+    assert "B" in text and "graphene-rebo-kc" in text
+    assert not (tmp_path / "run" / "02-scan").exists()
+
+
+def test_miller_index_giving_no_slab_names_the_field(tmp_path):
+    from ase.build import bulk
+
+    from flatcontact.stages.build import BuildInputs, run_build
+
+    bulk("Cu", "fcc", a=3.615).write(tmp_path / "cu.cif")
+    path = tmp_path / "c.yaml"
+    path.write_text(
+        "structure: {kind: crystal, bulk: cu.cif, miller: [0, 0, 0]}\n"
+        "potential: {preset: cu-eam}\nelastic: {enabled: true}\n"
+    )
+    with pytest.raises(InputError) as exc:
+        run_build(load_config(path), BuildInputs(), None)
+    assert "structure.miller" in _one_line(exc)
+
+
+def test_hetero_pair_without_a_match_under_the_strain_bound_names_the_field(tmp_path):
+    from flatcontact.stages.build import BuildInputs, run_build
+
+    path = tmp_path / "c.yaml"
+    path.write_text(
+        "structure: {kind: sheets, sheet: graphene, slab2: {sheet: h-BN}, "
+        "match: {max_strain_percent: 0.5, max_atoms: 20}}\n"
+        "potential: {preset: graphene-hbn-ilp}\n"
+        "contact: {contact_modulus_gpa: 50, shear_modulus_gpa: 30}\n"
+    )
+    with pytest.raises(InputError) as exc:
+        run_build(load_config(path), BuildInputs(), None)
+    text = _one_line(exc)
+    assert "structure.slab2" in text and "max_strain" in text and "0.5%" in text
+
+
+def test_too_many_atoms_names_the_field(tmp_path):
+    from flatcontact.stages.build import BuildInputs, run_build
+
+    path = tmp_path / "c.yaml"
+    path.write_text(
+        "structure: {kind: sheets, sheet: graphene, twist: [1, 2], match: {max_atoms: 10}}\n"
+        "potential: {preset: graphene-rebo-kc}\n"
+        "contact: {contact_modulus_gpa: 50, shear_modulus_gpa: 30}\n"
+    )
+    with pytest.raises(InputError) as exc:
+        run_build(load_config(path), BuildInputs(), None)
+    assert "max_atoms" in _one_line(exc)
+
+
+def test_non_quartz_material_without_moduli_is_refused_before_any_work(tmp_path):
+    from flatcontact.pipeline import Pipeline
+
+    path = tmp_path / "c.yaml"
+    path.write_text("structure: {kind: fcc111, element: Cu}\npotential: {preset: cu-eam}\n")
+    cfg = load_config(path)
+    with pytest.raises(InputError) as exc:
+        Pipeline(cfg, tmp_path / "run")
+    text = _one_line(exc)
+    assert "contact.contact_modulus_gpa" in text and "elastic.enabled" in text
+    assert not (tmp_path / "run" / "01-build").exists()
+    # either source of moduli is accepted
+    for extra in (
+        "elastic: {enabled: true}\n",
+        "contact: {contact_modulus_gpa: 120, shear_modulus_gpa: 80}\n",
+    ):
+        path.write_text(
+            path.read_text().split("\n", 2)[0] + "\n" + "potential: {preset: cu-eam}\n" + extra
+        )
+        from flatcontact.stages.contact import check_moduli_source
+
+        check_moduli_source(load_config(path))
+
+
+# --------------------------------------------------------------------------- slow
+def _run(name: str, out: Path) -> Path:
+    from flatcontact.pipeline import run
+
+    return run(load_config(EXAMPLES / f"{name}.yaml"), out)
+
+
+def _stackings(csv: Path) -> dict[float, dict[str, float]]:
+    import pandas as pd
+
+    table = pd.read_csv(csv)
+    out = {}
+    for p, text in zip(table.p_gpa, table.stacking_energies_mev_per_a2, strict=True):
+        out[float(p)] = {k: float(v) for k, v in (item.split("=") for item in text.split(";"))}
+    return out
+
+
+def _constant_load_zero(reference, shift, name, bracket) -> float:
+    """Min over z of the plain-LAMMPS rigid E(z) (meV/Å²): the stacking's energy at P = 0."""
+    from scipy.optimize import minimize_scalar
+
+    res = minimize_scalar(
+        lambda z: plain_energy_per_area(reference, shift, z, name),
+        bounds=bracket,
+        method="bounded",
+        options={"xatol": 1e-5},
+    )
+    return res.fun * MEV
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["graphene-bilayer-kc", "graphene-bilayer-ilp"])
+def test_graphene_run_stacking_energies_match_plain_lammps_at_zero_load(tmp_path, name):
+    from flatcontact.structures.interface import read_interface
+
+    root = _run(name, tmp_path / name)
+    named = _stackings(root / "03-analyze" / "friction.csv")[0.0]
+    reference = read_interface(root / "01-build" / "interface.extxyz")
+    assert named["AB"] == pytest.approx(named["BA"], abs=1e-9)  # symmetry-equivalent
+    bracket = (3.0, 4.0)
+    ab = _constant_load_zero(reference, (0, 0), name, bracket)
+    aa = _constant_load_zero(reference, _aa_shift(reference), name, bracket)
+    sp = _constant_load_zero(reference, _sp_shift(reference), name, bracket)
+    # the run interpolates E(z) over its thicknesses (measured: 2e-6 relative for KC)
+    assert named["AA"] - named["AB"] == pytest.approx(aa - ab, rel=1e-3)
+    assert named["SP"] - named["AB"] == pytest.approx(sp - ab, rel=1e-3)
+
+
+@pytest.mark.slow
+def test_cu111_gamma_surface_has_mishins_stacking_fault_energy(tmp_path):
+    """Zero-load ISPES of Cu(111)/Cu(111) with the same EAM across: the minimum at the
+    (1/3, 2/3)-type shift is the intrinsic stacking fault; Mishin et al. (2001) report
+    γ_isf = 44.4 mJ/m² for this potential."""
+    root = _run("cu111-eam", tmp_path / "cu")
+    named = _stackings(root / "03-analyze" / "friction.csv")[0.0]
+    energies = sorted(named.values())
+    assert energies[0] == pytest.approx(0.0, abs=1e-9)
+    # the second-lowest stationary stacking is the fault (the fcc perfect crystal is 0)
+    isf_mj_m2 = energies[1] * 16.021766  # meV/Å² -> mJ/m²
+    assert isf_mj_m2 == pytest.approx(44.4, rel=0.1)
