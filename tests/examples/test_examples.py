@@ -360,3 +360,28 @@ def test_cu111_gamma_surface_has_mishins_stacking_fault_energy(tmp_path):
     # the second-lowest stationary stacking is the fault (the fcc perfect crystal is 0)
     isf_mj_m2 = energies[1] * 16.021766  # meV/Å² -> mJ/m²
     assert isf_mj_m2 == pytest.approx(44.4, rel=0.1)
+
+
+def test_build_cli_takes_a_monolayer_slab_file_and_a_config(tmp_path):
+    """`build --structure graphene_1L --potential graphene-rebo-kc`: the slab recipe finds the
+    single layer, tags it as both faces (2 / 3) and holds it; `build --config` builds a
+    recipe."""
+    from ase.build import graphene
+    from typer.testing import CliRunner
+
+    from flatcontact.cli.app import app
+    from flatcontact.structures.interface import read_interface
+
+    graphene(a=2.46, vacuum=5.0).write(tmp_path / "g.extxyz")
+    runner = CliRunner()
+    args = ["build", "--structure", str(tmp_path / "g.extxyz"), "--potential", "graphene-rebo-kc"]
+    result = runner.invoke(app, [*args, "--no-svg", "--out", str(tmp_path / "b")])
+    assert result.exit_code == 0, result.output
+    atoms = read_interface(tmp_path / "b" / "interface.extxyz")
+    assert list(atoms.arrays["surface"]) == [2, 2, 3, 3]
+    assert atoms.arrays["held"].all() and list(atoms.arrays["layer"]) == [1, 1, 2, 2]
+    config = EXAMPLES / "cu111-eam.yaml"
+    result = runner.invoke(app, ["build", "--config", str(config), "--out", str(tmp_path / "c")])
+    assert result.exit_code == 0, result.output
+    cu = read_interface(tmp_path / "c" / "interface.extxyz")
+    assert cu.info["material"].startswith("Cu") and len(cu) == 8

@@ -48,12 +48,15 @@ def _potential_spec(potential: str | None, lj_cutoff_angstrom: float | None):
     """
     from flatcontact.config import default_potential
     from flatcontact.potentials import PotentialSpec
+    from flatcontact.potentials.presets import PRESETS
 
     section = default_potential()
-    if potential is not None:
+    if potential is not None and potential.strip() in PRESETS:
+        section = {"preset": potential.strip()}  # a whole model, not the quartz LJ's intra
+    elif potential is not None:
         section["intra"] = potential
     if lj_cutoff_angstrom is not None:
-        section["lj"]["cutoff_angstrom"] = _positive_finite(
+        section.setdefault("lj", {})["cutoff_angstrom"] = _positive_finite(
             lj_cutoff_angstrom, "--lj-cutoff-angstrom", "Å"
         )
     try:
