@@ -304,7 +304,9 @@ def test_non_quartz_material_without_moduli_is_refused_before_any_work(tmp_path)
 def _run(name: str, out: Path) -> Path:
     from flatcontact.pipeline import run
 
-    return run(load_config(EXAMPLES / f"{name}.yaml"), out)
+    report = run(load_config(EXAMPLES / f"{name}.yaml"), out)
+    assert report.name == "report.html" and report.is_file()
+    return report.parent
 
 
 def _stackings(csv: Path) -> dict[float, dict[str, float]]:
