@@ -13,7 +13,7 @@ chosen from a pressure range). A store whose settings differ from the current on
 refused with a line naming the first difference.
 
 Crash safety: only the driver process writes; every point is one SQLite transaction
-(ASE commits each ``write``), so a kill at any moment leaves every committed point
+(committed right after its ``write`` on the store's one connection), so a kill at any moment leaves every committed point
 intact and loses at most the points in flight. ASE's own lock file is disabled: after a
 ``kill -9`` inside a write it would stay behind and block every later run forever.
 Instead the driver holds an advisory ``flock`` on ``points.db.driver`` for as long as
@@ -174,9 +174,19 @@ class PointStore:
         self._done: dict[Index, dict] = {}
         for row in self._db.select():
             self._done[(row.i_a, row.i_b, row.i_z)] = self._record(row)
+        # one connection for the store's lifetime, one commit per point: ASE otherwise opens
+        # a connection and commits (an fsync each) several times inside every write
+        self._db.__enter__()
+
+    def _commit(self) -> None:
+        if self._db.connection is not None:
+            self._db.connection.commit()
 
     def close(self) -> None:
-        """Release the driver lock (the database itself needs no closing)."""
+        """Commit, close the database connection and release the driver lock."""
+        db = getattr(self, "_db", None)
+        if db is not None and db.connection is not None:
+            db.__exit__(None, None, None)
         if self._driver_lock is not None:
             self._driver_lock.close()
             self._driver_lock = None
@@ -211,6 +221,7 @@ class PointStore:
         meta = dict(self._meta)
         meta["resolved"] = json.loads(json.dumps(resolved))
         self._db.metadata = meta
+        self._commit()
         self._meta = meta
 
     # -- points ---------------------------------------------------------------------
@@ -261,8 +272,8 @@ class PointStore:
             "start": ",".join(str(i) for i in result.start_index) if result.start_index else "",
         }
         row_id = self._db.write(atoms, key_value_pairs=kvp)
-        rec = self._record(self._db.get(id=row_id))
-        self._done[index] = rec
+        self._commit()  # the point is stored (one transaction) before it counts as done
+        self._done[index] = self._record(self._db.get(id=row_id))
 
     # -- assembly -------------------------------------------------------------------
     def assemble(self) -> xr.Dataset:
