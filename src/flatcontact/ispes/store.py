@@ -28,16 +28,18 @@ import hashlib
 import json
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import xarray as xr
 from ase import Atoms
 from ase.calculators.singlepoint import SinglePointCalculator
 
 from flatcontact.errors import InputError
 from flatcontact.ispes import contract
 from flatcontact.ispes.relax import Index, PointResult
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 FORMAT = "flatcontact.points/1"
 
