@@ -91,9 +91,9 @@ def run_script(script: Path) -> dict:
     log = script.with_suffix(".log")
     lmp = new_lammps(["-log", str(log)])
     try:
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         lmp.file(str(script))
-        wall = time.perf_counter() - t0
+        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     finally:
         lmp.close()
     text = log.read_text()
@@ -104,4 +104,4 @@ def run_script(script: Path) -> dict:
         int(m.group(1))
         for m in re.finditer(r"Iterations, force evaluations\s*=\s*\d+\s+(\d+)", text)
     ]
-    return {"wall": wall, "energies": energies, "force_evaluations": int(sum(evals))}
+    return {"wall": wall, "cpu": cpu, "energies": energies, "force_evaluations": int(sum(evals))}
