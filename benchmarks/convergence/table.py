@@ -60,20 +60,21 @@ def write_tables(results: Path, rel_tol: float = 0.05, noise_multiple: float = 1
         f"or {noise_multiple:g}× the combined force-noise scale)\n"
     )
     md.append(
-        "| variant | setting | change | max |Δτ|/τ (at P) | max |Δσ|/σ (at P) | max |ΔG|/G | "
+        "| variant | vs | setting | change | max |Δτ|/τ (at P) | max |Δσ|/σ (at P) | max |ΔG|/G | "
         "loads outside bound (τ; σ) | W (J/m²) | wall time scan (s) |"
     )
-    md.append("|---|---|---|---|---|---|---|---|---|---|")
+    md.append("|---|---|---|---|---|---|---|---|---|---|---|")
     for name, doc in docs.items():
         scan_s = (doc.get("wall_time_s_this_call") or {}).get("scan")
         if name == REFERENCE:
             md.append(
-                f"| {name} | reference | {doc['description']} | – | – | – | – | "
+                f"| {name} | – | reference | {doc['description']} | – | – | – | – | "
                 f"{doc['work_of_separation_j_per_m2']:.4f} | {_fmt(scan_s, 3)} |"
             )
             continue
+        base = docs.get(doc.get("compare_with", REFERENCE), ref)
         ch = per_load_changes(
-            ref["loads"], doc["loads"], rel_tol=rel_tol, noise_multiple=noise_multiple
+            base["loads"], doc["loads"], rel_tol=rel_tol, noise_multiple=noise_multiple
         )
         ch.insert(0, "variant", name)
         long_rows.append(ch)
@@ -83,6 +84,7 @@ def write_tables(results: Path, rel_tol: float = 0.05, noise_multiple: float = 1
         summary_rows.append(
             {
                 "variant": name,
+                "compared_with": base["name"],
                 "setting": doc["setting"],
                 "description": doc["description"],
                 **{f"{q}_{k}": v for q, d in s.items() for k, v in d.items()},
@@ -91,7 +93,7 @@ def write_tables(results: Path, rel_tol: float = 0.05, noise_multiple: float = 1
             }
         )
         md.append(
-            f"| {name} | {doc['setting']} | {doc['description']} | "
+            f"| {name} | {base['name']} | {doc['setting']} | {doc['description']} | "
             f"{tau.get('max_abs_rel_change', float('nan')):.1%} ({tau.get('at_p_gpa', float('nan')):g}) | "
             f"{sig.get('max_abs_rel_change', float('nan')):.1%} ({sig.get('at_p_gpa', float('nan')):g}) | "
             f"{g.get('max_abs_rel_change', float('nan')):.1%} | "
@@ -108,13 +110,14 @@ def write_tables(results: Path, rel_tol: float = 0.05, noise_multiple: float = 1
     md.append("|---|---|---|---|---|---|---|---|---|")
     for name, doc in docs.items():
         lw = doc["laws"]
-        z = law_changes(ref["laws"], lw).set_index("coefficient")["z"]
+        base = docs.get(doc.get("compare_with", REFERENCE), ref)
+        z = law_changes(base["laws"], lw).set_index("coefficient")["z"]
         md.append(
             f"| {name} | {lw['k_mpa_per_gpa']:.2f} ± {lw['k_stderr_mpa_per_gpa']:.2f} | "
             f"{lw['tau0_mpa']:.1f} ± {lw['tau0_stderr_mpa']:.1f} | "
             f"{lw['mu_mpa_per_gpa']:.2f} ± {lw['mu_stderr_mpa_per_gpa']:.2f} | "
             f"{lw['sigma0_mpa']:.2f} ± {lw['sigma0_stderr_mpa']:.2f} | "
-            + " | ".join(_fmt(z[k], 2) if name != REFERENCE else "–" for k in z.index)
+            + " | ".join(_fmt(z[k], 2) if base is not doc else "–" for k in z.index)
             + " |"
         )
     md.append("")
