@@ -29,6 +29,8 @@ FORM = os.environ.get("FLATCONTACT_STUDY_FORM", "internal")
 RESULTS = HERE / "results" if FORM == "internal" else HERE / "results" / FORM
 RUNS = Path(os.environ.get("FLATCONTACT_CONVERGENCE_RUNS", "/tmp/flatcontact-convergence"))
 
+#: The study's reference LJ cutoff (the paper preset's before this study set it to 18 Å).
+STUDY_LJ_CUTOFF_ANGSTROM = 10.0
 #: name -> (setting varied, what, config overrides laid over the paper preset, the run it is
 #: compared with). Variants on an 8x8 grid (``*_g8``) measure a setting's effect at the
 #: coarser grid, to fit the CPU budget of a shared 2-core machine.
@@ -64,6 +66,24 @@ VARIANTS: dict[str, tuple[str, str, dict, str]] = {
         "cross-interface LJ cutoff 14 Å (8x8 grid; compared with grid8)",
         {"scan": {"grid": [8, 8]}, "potential": {"lj": {"cutoff_angstrom": 14.0}}},
         "grid8",
+    ),
+    "cutoff18_g8": (
+        "LJ cutoff",
+        "cross-interface LJ cutoff 18 Å (8x8 grid; compared with cutoff14_g8)",
+        {"scan": {"grid": [8, 8]}, "potential": {"lj": {"cutoff_angstrom": 18.0}}},
+        "cutoff14_g8",
+    ),
+    "fmax0025_g8": (
+        "force tolerance",
+        "fmax 0.0025 eV/Å (half; 8x8 grid; compared with grid8)",
+        {"scan": {"grid": [8, 8], "fmax_ev_per_angstrom": 0.0025}},
+        "grid8",
+    ),
+    "paper": (
+        "preset",
+        "the new paper preset (12x12, 20 thicknesses, fmax 0.005, LJ 18 Å)",
+        {"potential": {"lj": {"cutoff_angstrom": 18.0}}},
+        "ref",
     ),
     "layers9_g8": (
         "slab layers",
@@ -118,7 +138,11 @@ def config_for(name: str, form: str | None = None):
     from flatcontact.config import build_config, merge_config
 
     overrides = merge_config(
-        {"scan": {"workers": 1, "executor": "serial"}, "analysis": {"energy_form": form or FORM}},
+        {
+            "scan": {"workers": 1, "executor": "serial"},
+            "analysis": {"energy_form": form or FORM},
+            "potential": {"lj": {"cutoff_angstrom": STUDY_LJ_CUTOFF_ANGSTROM}},
+        },
         VARIANTS[name][2],
     )
     return build_config(overrides, "paper", f"variant {name}")
