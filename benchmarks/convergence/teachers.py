@@ -20,7 +20,7 @@ import json
 import os
 import sys
 
-from benchmarks.convergence.study import RESULTS, RUNS
+from benchmarks.convergence.study import RESULTS, RUNS, config_for
 
 MODELS = ["snap", "chgnet-r2scan", "sevennet-0", "sevennet-mf-0-r2scan", "sevennet-mf-0-pbe"]
 ISPES_GRID = (4, 4)
@@ -50,19 +50,20 @@ def elastic(names: list[str]) -> None:
 
 
 def ispes(names: list[str]) -> None:
-    from flatcontact.config import build_config
     from flatcontact.potentials import PotentialSpec
     from flatcontact.structures.interface import read_interface
     from flatcontact.training.ispes_check import compare_ispes, teacher_spec
 
     interface = read_interface(RUNS / "ref" / "01-build" / "interface.extxyz")
-    snap = build_config({}, "paper").potential
+    # the study's reference model (LJ cut at 10 Å, as the teachers' default_potential() LJ)
+    snap = config_for("ref").potential
+    lj = snap.lj.model_dump()
     models = {}
     for name in names:
         models[name] = (
             PotentialSpec.model_validate(snap.model_dump())
             if name == "snap"
-            else teacher_spec(name)
+            else teacher_spec(name, lj)
         )
     RESULTS.mkdir(parents=True, exist_ok=True)
     for form in ("internal", "enthalpy"):  # the second reuses the scans (resumable stores)
