@@ -45,20 +45,17 @@ from flatcontact.ispes.order import PREFERENCES
 from flatcontact.ispes.relax import OPTIMIZERS, RelaxSettings
 from flatcontact.potentials.files import BUNDLED_DIR
 from flatcontact.potentials.model import InteractionModel
+from flatcontact.reference import (
+    DEFAULT_P0_GPA,
+    PAPER,
+    PAPER_EXPERIMENT_P0_GPA,
+    PAPER_THRESHOLD_GPA,
+    QUARTZ_HAMAKER_ZJ,
+)
 from flatcontact.structures.build import MIN_LAYERS
 
 #: The bundled SNAP the default run uses when it is present.
 BUNDLED_SNAP = "sio2-snap"
-#: The paper's load laws and contact parameters (Dong et al.), for comparison tables.
-PAPER_VALUES = {
-    "k_mpa_per_gpa": 4.52,
-    "tau0_mpa": 26.7,
-    "mu_mpa_per_gpa": 0.21,
-    "sigma0_mpa": 11.1,
-    "radius_um": 5.0,
-    "contact_modulus_gpa": 52.5,
-    "shear_modulus_gpa": 29.0,
-}
 
 
 class _Section(BaseModel):
@@ -89,10 +86,12 @@ def _show(value: Any) -> str:
 class StructureConfig(_Section):
     """Which interface to build (stage ``build``)."""
 
-    kind: Literal["quartz-dense", "file", "toy-lj"] = Field(
+    kind: Literal["quartz-dense", "file", "slab", "toy-lj"] = Field(
         "quartz-dense",
         description="quartz-dense: the paper's alpha-quartz (0001) dense interface; "
         "file: an interface.extxyz following the interface contract (path in 'file'); "
+        "slab: any slab structure file (path in 'file'), two copies facing each other, "
+        "faces tagged by depth; "
         "toy-lj: a tiny two-slab Lennard-Jones model (tests and demos only; "
         "needs calculator.target flatcontact.ispes.toy:toy_calculator)",
     )
@@ -108,7 +107,22 @@ class StructureConfig(_Section):
         "(shipped if present and layers == 6, else seed)",
     )
     file: str | None = Field(
-        None, description="kind=file: path of an interface.extxyz (relative to the config file)"
+        None,
+        description="kind=file: path of an interface.extxyz; kind=slab: a slab structure file "
+        "(relative to the config file)",
+    )
+    normal_axis: int | None = Field(
+        None,
+        ge=0,
+        le=2,
+        exclude_if=lambda value: value is None,
+        description="kind=slab: cell axis (0, 1, 2) along the surface normal; null: 2",
+    )
+    face_depth_angstrom: float | None = Field(
+        None,
+        gt=0,
+        exclude_if=lambda value: value is None,
+        description="kind=slab: depth of each tagged face (Å); null: 2 Å",
     )
     gap_angstrom: float = Field(
         3.0, gt=0, description="initial gap between the slabs before the interface relaxation (Å)"
@@ -121,6 +135,8 @@ class StructureConfig(_Section):
     def _consistent(self) -> StructureConfig:
         if self.kind == "file" and not self.file:
             raise ValueError("kind 'file' needs 'file: path/to/interface.extxyz'")
+        if self.kind == "slab" and not self.file:
+            raise ValueError("kind 'slab' needs 'file: path/to/slab' (any ASE-readable structure)")
         if self.kind == "quartz-dense" and self.layers < MIN_LAYERS:
             raise ValueError(
                 f"layers={self.layers}: the dense quartz interface needs >= {MIN_LAYERS} "
@@ -278,7 +294,9 @@ class AnalysisConfig(_Section):
         description="energy zero of the maps: global minimum at the lowest P, each, none",
     )
     threshold_gpa: float = Field(
-        3.0, gt=0, description="fit the linear load laws on P <= this (GPa; the paper's 3 GPa)"
+        PAPER_THRESHOLD_GPA,
+        gt=0,
+        description="fit the linear load laws on P <= this (GPa; the paper's 3 GPa)",
     )
     allow_missing: bool = Field(
         False, description="interpolate columns with unconverged/missing points instead of refusing"
@@ -302,22 +320,23 @@ class ElasticConfig(_Section):
     enabled: bool = Field(
         False,
         description="compute E* and G* (paper's convention) of bulk alpha-quartz with the "
-        "potential (vashishta or snap); otherwise contact.contact_modulus_gpa/shear_modulus_gpa",
+        "run's interaction model as a single crystal (it must know Si and O); otherwise "
+        "contact.contact_modulus_gpa/shear_modulus_gpa",
     )
 
 
 class ContactConfig(_Section):
     """The modified Mindlin contact (stage ``contact``)."""
 
-    p0_gpa: list[float] = Field(
-        [0.5, 1.0, 1.77, 2.0, 3.0], description="peak Hertz pressures p0 (GPa)"
-    )
-    radius_um: float = Field(5.0, gt=0, description="tip radius R (µm)")
+    p0_gpa: list[float] = Field(list(DEFAULT_P0_GPA), description="peak Hertz pressures p0 (GPa)")
+    radius_um: float = Field(PAPER["radius_um"], gt=0, description="tip radius R (µm)")
     contact_modulus_gpa: float = Field(
-        52.5, gt=0, description="Hertz contact modulus E* (GPa; the paper's DFT value)"
+        PAPER["contact_modulus_gpa"],
+        gt=0,
+        description="Hertz contact modulus E* (GPa; the paper's DFT value)",
     )
     shear_modulus_gpa: float = Field(
-        29.0,
+        PAPER["shear_modulus_gpa"],
         gt=0,
         description="effective shear modulus G* (GPa) in the paper's q0 = G*·u/(π a) (= 4 × Johnson's G*_J)",
     )
@@ -339,6 +358,14 @@ class ContactConfig(_Section):
         description="work of adhesion w (J/m²) for DMT/JKR radii; null: the work of separation "
         "measured by the scan",
     )
+    maugis_lambda: float | None = Field(
+        None,
+        gt=0,
+        # left out of the dumped config while unset, so existing run fingerprints are unchanged
+        exclude_if=lambda value: value is None,
+        description="Maugis parameter λ: adds the Maugis–Dugdale radius and pull-off force "
+        "(needs a work of adhesion > 0); null: none",
+    )
     knee_fraction: float = Field(
         0.5, gt=0, lt=1, description="knee: stiffness falls to this fraction of its initial value"
     )
@@ -347,7 +374,9 @@ class ContactConfig(_Section):
         description="measured stiffness CSV ('mean shear stress [MPa],lateral stiffness [N/m]') "
         "for the Fig. 6 overlay (relative to the config file)",
     )
-    experiment_p0_gpa: float = Field(1.77, gt=0, description="p0 of the measured data (GPa)")
+    experiment_p0_gpa: float = Field(
+        PAPER_EXPERIMENT_P0_GPA, gt=0, description="p0 of the measured data (GPa)"
+    )
     experiment_stress_measure: Literal["amplitude", "rms"] = Field(
         "amplitude", description="stress of the data: amplitude Q_max/πa² or rms ⟨Q⟩/πa²"
     )
@@ -457,11 +486,6 @@ class RunConfig(_Section):
 # --------------------------------------------------------------------------- presets
 
 
-#: Non-retarded Hamaker constant of α-quartz across vacuum from Lifshitz theory with
-#: measured dielectric spectra (zJ), Bergström, Adv. Colloid Interface Sci. 70, 125 (1997).
-QUARTZ_HAMAKER_ZJ = 88.0
-
-
 def default_potential() -> dict:
     """The default interaction model: the bundled SiO₂ SNAP if present, else Vashishta 1990.
 
@@ -522,10 +546,15 @@ def preset(name: str) -> dict:
             "report": {"title": "flatcontact run (quick preset)"},
         }
     if name == "paper":
+        # Measured in docs/convergence.md: one refinement of the 12x12 grid or the 20
+        # thicknesses moves every per-load τ and σ_MSS by < 3 % (enthalpy form); the LJ tail
+        # beyond 10 Å adds 16 % to W, beyond 18 Å 2.8 %, so the cutoff is 18 Å here.
+        potential = default_potential()
+        potential["lj"] = {**potential["lj"], "cutoff_angstrom": 18.0}
         return {
             "preset": "paper",
             "structure": {"kind": "quartz-dense", "layers": 6, "source": _dense_slab_source()},
-            "potential": default_potential(),
+            "potential": potential,
             "scan": {
                 "grid": [12, 12],
                 "p_range_gpa": {"lo_gpa": -0.3, "hi_gpa": 5.5, "n": 20},

@@ -109,3 +109,34 @@ def test_bad_input_is_one_line_exit_2(grid_file, capsys, args, message):
 def test_missing_file_is_one_line(tmp_path, capsys):
     code, _, err = _run(["analyze", str(tmp_path / "nope.nc"), "--p-gpa", "1"], capsys)
     assert code == 2 and "no such ISPES file" in err
+
+
+def test_a_core_error_names_the_flag_for_the_cli_and_the_settings_path_for_the_run(
+    grid_file, tmp_path, capsys
+):
+    """The core names its parameter (allow_missing); the analyze stage renames it to the
+    settings path a YAML user wrote (analysis.allow_missing), the CLI to the flag it offers."""
+    from flatcontact.config import build_config
+    from flatcontact.errors import InputError
+    from flatcontact.ispes.contract import open_ispes
+    from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
+
+    holed = open_ispes(grid_file).load()
+    holed["energy"][2, 1, 5] = np.nan
+    holed["converged"][2, 1, 5] = False
+    path = tmp_path / "holed.nc"
+    write_ispes(holed, path)
+    code, _, err = _run(["analyze", str(path), "--p-gpa", "0.5,1"], capsys)
+    assert code == 2 and len(err.strip().splitlines()) == 1
+    assert "1 grid points are missing" in err and "(--allow-missing)" in err
+    settings = build_config({"analysis": {"p_gpa": [0.5, 1.0]}})
+    with pytest.raises(InputError, match=r"missing.*\(analysis\.allow_missing\)$"):
+        run_analyze(settings, AnalyzeInputs(path), None)
+    # allowed: the hole is interpolated and both doors give the same τ
+    code, out, _ = _run(
+        ["analyze", str(path), "--p-gpa", "0.5,1", "--allow-missing", "--json"], capsys
+    )
+    assert code == 0
+    allowed = build_config({"analysis": {"p_gpa": [0.5, 1.0], "allow_missing": True}})
+    tau = run_analyze(allowed, AnalyzeInputs(path), None).analysis.column("tau_mpa")
+    np.testing.assert_array_equal([r["tau_mpa"] for r in json.loads(out)["pressures"]], tau)

@@ -125,16 +125,17 @@ def test_noise_moves_the_numbers_in_proportion_to_its_size():
 
 
 def test_bad_arguments_fail_before_any_work():
+    """Each error names the parameter (the CLI and the run translate it to their flag or path)."""
     ds = _cobblestone().grid(4, 4, Z)
-    with pytest.raises(InputError, match="--p-gpa: give at least one"):
+    with pytest.raises(InputError, match=r"^p_gpa: give at least one"):
         analyze_ispes(ds, [])
     with pytest.raises(InputError, match="distinct"):
         analyze_ispes(ds, [1.0, 1.0])
-    with pytest.raises(InputError, match="--energy: expected one of internal, enthalpy"):
+    with pytest.raises(InputError, match=r"^form: expected one of internal, enthalpy"):
         analyze_ispes(ds, [1.0], form="gibbs")
-    with pytest.raises(InputError, match="--energy-zero"):
+    with pytest.raises(InputError, match=r"^energy_zero: expected one of"):
         analyze_ispes(ds, [1.0], energy_zero="min")
-    with pytest.raises(InputError, match="--direction-deg"):
+    with pytest.raises(InputError, match=r"^direction_deg: expected a finite angle"):
         analyze_ispes(ds, [1.0], direction_deg=float("nan"))
     with pytest.raises(InputError, match="outside the data"):
         analyze_ispes(ds, [1.0, 80.0])

@@ -9,6 +9,7 @@ foreign stores, records and run directories are refused with one line.
 
 from __future__ import annotations
 
+import html
 import json
 import os
 import signal
@@ -213,6 +214,10 @@ def test_a_change_reruns_exactly_the_dependent_stages(tiny_run, tmp_path, change
         ("contact/mindlin.py", {"contact", "report"}),
         ("analysis/friction.py", {"analyze", "laws", "contact", "report"}),
         ("ispes/relax.py", {"scan", "analyze", "laws", "contact", "report"}),
+        # the report's wording and the contact figures are in no upstream stage's digest
+        ("report/content.py", {"report"}),
+        ("plots/contact.py", {"contact", "report"}),
+        ("analysis/laws.py", {"analyze", "laws", "contact", "report"}),
     ],
 )
 def test_a_code_edit_reruns_exactly_the_stages_it_can_change(
@@ -241,6 +246,46 @@ def test_a_code_edit_reruns_exactly_the_stages_it_can_change(
     assert {n for n, a in actions.items() if a != "skipped"} == rerun
 
 
+def test_each_stage_digest_covers_its_stage_module_and_nothing_of_the_report():
+    """Fingerprints hold the code a stage runs: its own stage module always, the report's
+    content module only in the report's digest."""
+    from flatcontact.pipeline import STAGE_CODE
+
+    for name, parts in STAGE_CODE.items():
+        module = "stages/scan.py" if name == "scan" else f"stages/{name}.py"
+        assert module in parts, name
+        assert ("report" in parts) == (name == "report"), name
+        assert "pipeline.py" not in parts and "." not in parts
+
+
+def test_a_changed_threshold_leaves_no_stale_fit_warning(tiny_run, tmp_path):
+    """analyze fits no law: a threshold that leaves two loads warns in laws.json and the report;
+    back at the default threshold neither analyze.json, laws.json nor the report keeps it."""
+    import shutil
+
+    src, _, _ = tiny_run
+    root = tmp_path / "copy"
+    shutil.copytree(src, root)
+    stale = "at P <= 0.6 GPa"
+    with Pipeline(build_config(_merge(TINY, {"analysis": {"threshold_gpa": 0.6}})), root) as pipe:
+        pipe.run()
+        assert {n for n, a in _actions(pipe).items() if a != "skipped"} == {
+            "laws",
+            "contact",
+            "report",
+        }
+    laws = json.loads((root / "04-laws" / "laws.json").read_text())
+    assert any(stale in w for w in laws["warnings"])  # two loads: no standard errors
+    assert html.escape(stale) in (root / "report.html").read_text()
+    with Pipeline(build_config(TINY), root) as pipe:
+        pipe.run()
+    analyze = json.loads((root / "03-analyze" / "analyze.json").read_text())
+    assert not any("LinearFitWarning" in w or "0.6" in w for w in analyze["warnings"])
+    laws = json.loads((root / "04-laws" / "laws.json").read_text())
+    assert not any(stale in w for w in laws["warnings"])
+    assert html.escape(stale) not in (root / "report.html").read_text()
+
+
 def test_a_retrained_potential_file_reruns_from_the_build(tmp_path):
     """Coefficient files enter the fingerprint by content, not by name."""
     from flatcontact.potentials.spec import BUNDLED_DIR
@@ -255,7 +300,7 @@ def test_a_retrained_potential_file_reruns_from_the_build(tmp_path):
         coeff = tmp_path / "my.snapcoeff"
         coeff.write_text(coeff.read_text() + "\n")
         after = pipe._model_inputs()
-    assert before["potential"] == after["potential"]
+    assert before["model"] == after["model"]
     assert before["files_sha256"]["my.snapparam"] == after["files_sha256"]["my.snapparam"]
     assert before["files_sha256"]["my.snapcoeff"] != after["files_sha256"]["my.snapcoeff"]
 
@@ -361,7 +406,7 @@ def test_kill_9_mid_scan_then_rerun_loses_nothing(tiny_run, tmp_path):
         actions = _actions(pipe)
     assert actions["build"] == "skipped" and actions["scan"] == "resumed"
     scan = json.loads((root / "02-scan" / "scan.json").read_text())
-    assert scan["points_computed_last_attempt"] == total - len(stored)  # nothing recomputed
+    assert scan["points_computed"] == total - len(stored)  # nothing recomputed
     after = _points(db)
     assert {k: after[k] for k in stored} == stored  # nothing finished was lost or changed
     ref = open_ispes(src / "02-scan" / "ispes.nc")
@@ -468,3 +513,100 @@ def test_elastic_stage_feeds_the_contact_model_and_the_report(tiny_run, tmp_path
     assert np.all(np.linalg.eigvalsh(0.5 * (tensor + tensor.T)) > 0)
     html = (root / "report.html").read_text()
     assert "α-quartz with the potential" in html and "C11 (GPa)" in html
+
+
+# ---- one door per stage: `flatcontact <stage>` writes what `flatcontact run` writes ------------
+
+
+def _cli(argv: list[str]) -> None:
+    from flatcontact.cli import main
+
+    with pytest.raises(SystemExit) as info:
+        main(argv)
+    assert info.value.code == 0
+
+
+def _same_json(a: Path, b: Path, ignore: tuple[str, ...] = ()) -> None:
+    da, db = json.loads(a.read_text()), json.loads(b.read_text())
+    for key in ignore:
+        da.pop(key, None), db.pop(key, None)
+    assert da == db, a.name
+
+
+def _same_netcdf(a: Path, b: Path) -> None:
+    with xr.open_dataset(a, engine="h5netcdf") as da, xr.open_dataset(b, engine="h5netcdf") as db:
+        xr.testing.assert_identical(da.load(), db.load())
+
+
+def _figures(folder: Path) -> set[str]:
+    return {p.name for p in folder.iterdir() if p.suffix in (".png", ".svg")}
+
+
+def test_each_stage_through_the_cli_writes_the_files_of_the_run(tiny_run, tmp_path):
+    """build, scan, analyze (+ laws) and contact through their commands with the run's settings
+    write the run's files, with the same names and contents (wall times excepted)."""
+    import shutil
+
+    from flatcontact.structures.interface import read_interface
+
+    src, _, _ = tiny_run
+    config = tmp_path / "tiny.yaml"
+    config.write_text(json.dumps(TINY))  # JSON is YAML
+
+    # build: the run's structure and potential as flags
+    out = tmp_path / "build"
+    _cli(["build", "--layers", "5", "--source", "seed", "--potential", "vashishta",
+          "--no-svg", "--out", str(out)])  # fmt: skip
+    assert sorted(p.name for p in out.iterdir()) == sorted(
+        p.name for p in (src / "01-build").iterdir() if p.name != "stage.json"
+    )
+    _same_json(out / "build.json", src / "01-build" / "build.json")
+    ours, run = (
+        read_interface(out / "interface.extxyz"),
+        read_interface(src / "01-build" / "interface.extxyz"),
+    )
+    np.testing.assert_allclose(ours.positions, run.positions, rtol=0, atol=1e-8)
+    assert ours.info["recipe"] == run.info["recipe"]
+
+    # scan: the run's config file; the run's store is taken over (the store refuses any other
+    # settings), so nothing is recomputed and the files must match
+    out = tmp_path / "scan"
+    out.mkdir()
+    shutil.copyfile(src / "02-scan" / "points.db", out / "points.db")
+    interface = src / "01-build" / "interface.extxyz"
+    _cli(["scan", str(config), "--interface", str(interface), "--out", str(out), "--json"])
+    assert _figures(out) == _figures(src / "02-scan") == {"fig_scan_columns.png"}
+    _same_netcdf(out / "ispes.nc", src / "02-scan" / "ispes.nc")
+    _same_json(
+        out / "scan.json",
+        src / "02-scan" / "scan.json",
+        ignore=("points_computed", "median_force_calls_per_point"),
+    )
+
+    # analyze + laws: the run's analysis section as flags, into one folder
+    out = tmp_path / "analyze"
+    p_gpa = ",".join(f"{p:g}" for p in TINY["analysis"]["p_gpa"])
+    ispes = src / "02-scan" / "ispes.nc"
+    _cli(["analyze", str(ispes), "--p-gpa", p_gpa, "--no-svg", "--out", str(out)])
+    assert (out / "friction.csv").read_text() == (src / "03-analyze" / "friction.csv").read_text()
+    _same_netcdf(out / "friction.nc", src / "03-analyze" / "friction.nc")
+    _same_json(out / "analyze.json", src / "03-analyze" / "analyze.json", ignore=("timings_s",))
+    _same_json(out / "laws.json", src / "04-laws" / "laws.json")
+    assert _figures(out) == _figures(src / "03-analyze") | _figures(src / "04-laws")
+
+    # contact: the fitted laws and the scan's work of separation given as flags
+    out = tmp_path / "contact"
+    laws = json.loads((src / "04-laws" / "laws.json").read_text())
+    w = json.loads((src / "02-scan" / "scan.json").read_text())["adhesion"]
+    flags = [f"--{k.replace('_', '-')}={laws[k]!r}" for k in
+             ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa")]  # fmt: skip
+    p0 = ",".join(f"{p:g}" for p in TINY["contact"]["p0_gpa"])
+    _cli(["contact", "--p0-gpa", p0, *flags, "--no-svg", "--out", str(out),
+          f"--work-of-adhesion-j-m2={w['work_of_separation_j_per_m2']!r}"])  # fmt: skip
+    _same_netcdf(out / "contact.nc", src / "06-contact" / "contact.nc")
+    ours = json.loads((out / "summary.json").read_text())
+    run = json.loads((src / "06-contact" / "summary.json").read_text())
+    assert run.pop("provenance")["tau0_mpa"] == "fitted laws"
+    assert ours.pop("provenance")["tau0_mpa"] == "config"
+    assert ours == run
+    assert _figures(out) == _figures(src / "06-contact")

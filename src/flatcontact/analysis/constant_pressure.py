@@ -287,7 +287,7 @@ def _missing_message(ds: xr.Dataset, bad: np.ndarray, source: str) -> str:
     more = f" and {len(where) - 3} more" if len(where) > 3 else ""
     return (
         f"{source}: {len(where)} grid points are missing (NaN energy or normal_stress): "
-        f"{shown}{more}; finish the scan or allow missing points (--allow-missing)"
+        f"{shown}{more}; finish the scan or allow missing points (allow_missing)"
     )
 
 

@@ -11,8 +11,9 @@
   ``p_gpa``, ``shift_a``, ``shift_b``), ``z*`` (Å) and, on dims ``p_gpa``,
   ``start`` (NaN-padded), each near-degenerate start's position, energy above
   the lowest minimum, τ, σ_MSS and shear stiffness, with ``selected_start``;
-- ``laws.json``: ``k_mpa_per_gpa``, ``tau0_mpa``, ``mu_mpa_per_gpa``,
-  ``sigma0_mpa``, their standard errors, ``p_max_gpa`` and the regime ends.
+
+The analyze stage (:mod:`flatcontact.stages.analyze`) writes them; ``laws.json`` is the laws
+stage's (:mod:`flatcontact.stages.laws`).
 """
 
 from __future__ import annotations
@@ -20,8 +21,6 @@ from __future__ import annotations
 import csv
 import io
 import math
-import os
-from pathlib import Path
 
 import numpy as np
 import xarray as xr
@@ -30,8 +29,6 @@ from flatcontact import __version__, units
 from flatcontact.analysis.friction import EV_PER_A4_TO_GPA_PER_NM
 from flatcontact.analysis.noise import BARRIER_NOISE_FACTOR
 from flatcontact.analysis.pipeline import AnalysisResult
-from flatcontact.analysis.starts import TAU_START_RULE
-from flatcontact.fileio import atomic_path, write_json_atomic, write_text_atomic
 
 CSV_COLUMNS = (
     "p_gpa",
@@ -50,6 +47,12 @@ CSV_COLUMNS = (
     "force_noise_mpa",
     "n_degenerate_minima",
     "tau_by_start_mpa",
+    "direction_deg",
+    "start_stacking",
+    "lowest_barrier_mev_per_a2",
+    "lowest_barrier_direction_deg",
+    "barrier_along_direction_mev_per_a2",
+    "stacking_energies_mev_per_a2",
 )
 #: Separator of the per-start values in one ``friction.csv`` cell.
 LIST_SEPARATOR = ";"
@@ -60,6 +63,8 @@ def _clean(v: object) -> object:
         return [_clean(x) for x in v]
     if isinstance(v, float | np.floating):
         return None if not math.isfinite(float(v)) else float(v)
+    if isinstance(v, dict):
+        return {k: _clean(x) for k, x in v.items()}
     return v
 
 
@@ -89,15 +94,65 @@ def per_pressure_rows(result: AnalysisResult) -> list[dict]:
                 "force_noise_mpa": float(nz.force_noise_mpa[i]),
                 "n_degenerate_minima": max(1, len(pa.starts)),
                 "tau_by_start_mpa": [o.tau_mpa for o in pa.starts] or [fr.tau_mpa],
+                "direction_deg": float(path.direction_deg),
+                **_stacking_columns(pa),
             }
         )
     return [{k: _clean(v) for k, v in row.items()} for row in rows]
+
+
+def _stacking_columns(pa) -> dict:
+    """Per-load stacking outputs (:mod:`.stackings`); NaN/empty without the stackings analysis."""
+    mev = units.EV_PER_A2_TO_MEV_PER_A2
+    st = pa.stackings
+    if st is None:
+        return {
+            "start_stacking": "",
+            "lowest_barrier_mev_per_a2": float("nan"),
+            "lowest_barrier_direction_deg": float("nan"),
+            "barrier_along_direction_mev_per_a2": float("nan"),
+            "stacking_energies_mev_per_a2": {},
+        }
+    return {
+        "start_stacking": start_stacking_name(pa),
+        "lowest_barrier_mev_per_a2": st.barrier * mev,
+        "lowest_barrier_direction_deg": st.barrier_direction_deg,
+        "barrier_along_direction_mev_per_a2": pa.barrier_along_direction_ev_per_a2 * mev,
+        "stacking_energies_mev_per_a2": {k: v * mev for k, v in st.energies().items()},
+    }
+
+
+def start_stacking_name(pa) -> str:
+    """Name of the stationary point the reported path starts from ('' if not matched)."""
+    st = pa.stackings
+    if st is None:
+        return ""
+    surf = pa.surface
+    scale = float(np.min(np.linalg.norm(surf.lattice, axis=0)))
+    for p in st.points:
+        ds = surf.fractional(p.xy_angstrom - pa.minimum_xy_angstrom)
+        ds -= np.round(ds)
+        if p.kind == "minimum" and np.linalg.norm(surf.cartesian(ds)) < 1e-4 * scale:
+            return p.name
+    return ""
+
+
+def stackings_json(pa) -> dict:
+    """``{name: {kind, energy_mev_per_a2, x_angstrom, y_angstrom, multiplicity}}`` of one load."""
+    if pa.stackings is None:
+        return {}
+    out = pa.stackings.to_json(units.EV_PER_A2_TO_MEV_PER_A2)
+    for v in out.values():
+        v["energy_mev_per_a2"] = _clean(v.pop("energy"))
+    return out
 
 
 def summary_json(result: AnalysisResult) -> dict:
     """What ``flatcontact analyze --json`` prints."""
     out = {
         "direction_deg": result.direction_deg,
+        "direction_rule": result.direction_rule,
+        "tau_start_rule": result.tau_start_rule,
         "energy_form": result.form,
         "load_source": result.load_source,
         "noise": result.noise.to_json(),
@@ -117,11 +172,16 @@ def summary_json(result: AnalysisResult) -> dict:
                     "force_noise_mpa",
                     "n_degenerate_minima",
                     "tau_by_start_mpa",
+                    "start_stacking",
+                    "lowest_barrier_mev_per_a2",
+                    "lowest_barrier_direction_deg",
+                    "barrier_along_direction_mev_per_a2",
                 )
             }
-            for row in per_pressure_rows(result)
+            | {"stackings": stackings_json(pa)}
+            for row, pa in zip(per_pressure_rows(result), result.pressures, strict=True)
         ],
-        "laws": result.laws.to_json(),
+        "laws": result.laws.to_json() if result.laws is not None else None,
     }
     sym = [pa.symmetry for pa in result.pressures if pa.symmetry is not None]
     if sym:
@@ -137,6 +197,10 @@ def _cell(v: object) -> object:
         return ""
     if isinstance(v, list):
         return LIST_SEPARATOR.join("" if x is None else repr(float(x)) for x in v)
+    if isinstance(v, dict):
+        return LIST_SEPARATOR.join(
+            f"{k}={'' if x is None else repr(float(x))}" for k, x in v.items()
+        )
     return v
 
 
@@ -177,6 +241,29 @@ def friction_dataset(result: AnalysisResult) -> xr.Dataset:
         for i, pa in enumerate(result.pressures):
             for j, o in enumerate(pa.starts):
                 out[i, j] = get(o, pa)
+        return out
+
+    names = list(
+        dict.fromkeys(
+            name for pa in result.pressures if pa.stackings for name in pa.stackings.energies()
+        )
+    )
+    kinds = {}
+    for pa in result.pressures:
+        if pa.stackings:
+            kinds.update({k: v for k, v in pa.stackings.kinds().items() if k not in kinds})
+
+    def by_stacking(get) -> np.ndarray:
+        out = np.full((p.size, len(names)), np.nan)
+        for i, pa in enumerate(result.pressures):
+            if pa.stackings is None:
+                continue
+            first = {}
+            for pt in pa.stackings.points:
+                first.setdefault(pt.name, pt)
+            for j, name in enumerate(names):
+                if name in first:
+                    out[i, j] = get(first[name])
         return out
 
     ds = xr.Dataset(
@@ -274,6 +361,46 @@ def friction_dataset(result: AnalysisResult) -> xr.Dataset:
                 by_start(lambda o, pa: o.above_lowest_mev_per_a2),
                 {"units": "meV/angstrom^2"},
             ),
+            "lowest_barrier_mev_per_a2": (
+                "p_gpa",
+                col("lowest_barrier_mev_per_a2"),
+                {
+                    "units": "meV/angstrom^2",
+                    "long_name": "lowest minimum-energy-path barrier from the global minimum "
+                    "to an equivalent one",
+                },
+            ),
+            "lowest_barrier_direction_deg": (
+                "p_gpa",
+                col("lowest_barrier_direction_deg"),
+                {"units": "degree", "long_name": "shortest translation over that barrier"},
+            ),
+            "barrier_along_direction_mev_per_a2": (
+                "p_gpa",
+                col("barrier_along_direction_mev_per_a2"),
+                {
+                    "units": "meV/angstrom^2",
+                    "long_name": "lowest MEP barrier to the start's image one lattice period "
+                    "along the pulling direction",
+                },
+            ),
+            "start_stacking": ("p_gpa", np.array([r["start_stacking"] for r in rows], dtype=str)),
+            "stacking_energy_mev_per_a2": (
+                ("p_gpa", "stacking"),
+                by_stacking(lambda pt: pt.energy * mev),
+                {"units": "meV/angstrom^2", "long_name": "energy of each named stationary point"},
+            ),
+            "stacking_x": (
+                ("p_gpa", "stacking"),
+                by_stacking(lambda pt: pt.xy_angstrom[0]),
+                {"units": "angstrom"},
+            ),
+            "stacking_y": (
+                ("p_gpa", "stacking"),
+                by_stacking(lambda pt: pt.xy_angstrom[1]),
+                {"units": "angstrom"},
+            ),
+            "stacking_kind": ("stacking", np.array([kinds[n] for n in names], dtype=str)),
             "energy_map": (("p_gpa", "shift_a", "shift_b"), maps, {"units": "meV/angstrom^2"}),
             "thickness_at_p": (
                 ("p_gpa", "shift_a", "shift_b"),
@@ -285,6 +412,7 @@ def friction_dataset(result: AnalysisResult) -> xr.Dataset:
             "p_gpa": ("p_gpa", p, {"units": "GPa"}),
             "shift_a": cp.shift_a,
             "shift_b": cp.shift_b,
+            "stacking": ("stacking", np.array(names, dtype=str)),
         },
         attrs={
             "a1": cp.a1,
@@ -298,7 +426,8 @@ def friction_dataset(result: AnalysisResult) -> xr.Dataset:
             "stress_energy_mismatch_rms_gpa": _attr(result.noise.stress_energy_mismatch_rms_gpa),
             "lateral_grid_spacing_angstrom": result.noise.grid_spacing_angstrom,
             "barrier_noise_factor": BARRIER_NOISE_FACTOR,
-            "tau_start_rule": TAU_START_RULE,
+            "tau_start_rule": result.tau_start_rule,
+            "direction_rule": result.direction_rule,
             "force_sign": "path_force = de/dt, the resisting lateral stress (positive while climbing)",
             "flatcontact_version": __version__,
         },
@@ -309,17 +438,3 @@ def friction_dataset(result: AnalysisResult) -> xr.Dataset:
 def _attr(v: float) -> float:
     """netCDF attributes cannot be None: NaN stands for 'not estimated'."""
     return float(v)
-
-
-def write_outputs(result: AnalysisResult, out_dir: str | os.PathLike[str]) -> dict[str, Path]:
-    """Write ``friction.csv``, ``friction.nc`` and ``laws.json`` into ``out_dir`` atomically."""
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    paths = {
-        "friction.csv": write_text_atomic(out / "friction.csv", friction_csv_text(result)),
-        "laws.json": write_json_atomic(out / "laws.json", result.laws.to_json()),
-    }
-    with atomic_path(out / "friction.nc") as tmp:
-        friction_dataset(result).to_netcdf(tmp, engine="h5netcdf")
-    paths["friction.nc"] = out / "friction.nc"
-    return paths

@@ -46,7 +46,9 @@ from flatcontact.analysis.path import (
     minimum_energy_path,
 )
 from flatcontact.analysis.periodic import PeriodicSurface, lattice_vectors, rectangular_supercell
+from flatcontact.analysis.stackings import Stackings, analyze_stackings, lattice_vector_along
 from flatcontact.analysis.starts import (
+    TAU_START_RULE,
     StartOutcome,
     degeneracy_tolerance_ev_per_a2,
     paths_from_near_degenerate_minima,
@@ -81,6 +83,15 @@ class PressureAnalysis:
     starts: tuple[StartOutcome, ...] = ()
     selected_start: int = 0
     degeneracy_tolerance_ev_per_a2: float = float("nan")
+    stackings: Stackings | None = None
+
+    @property
+    def barrier_along_direction_ev_per_a2(self) -> float:
+        """Lowest MEP barrier (eV/Å²) to the start's image one lattice period along the pull."""
+        if self.stackings is None:
+            return float("nan")
+        v = lattice_vector_along(self.surface.a1, self.surface.a2, self.path.direction_deg)
+        return float("nan") if v is None else self.stackings.barrier_for(v)
 
 
 @dataclass(frozen=True)
@@ -89,7 +100,7 @@ class AnalysisResult:
 
     pressures: tuple[PressureAnalysis, ...]
     constant_pressure: ConstantPressureISPES
-    laws: LoadLaws
+    laws: LoadLaws | None
     direction_deg: float
     form: str
     energy_zero: str
@@ -97,6 +108,8 @@ class AnalysisResult:
     supercell: tuple[np.ndarray, np.ndarray] | None
     timings_s: dict[str, float] = field(default_factory=dict)
     load_source: str = DEFAULT_LOAD_SOURCE
+    direction_rule: str = "given"
+    tau_start_rule: str = TAU_START_RULE
 
     @property
     def noise(self):
@@ -117,27 +130,28 @@ def check_pressures(p_gpa: list[float] | np.ndarray) -> np.ndarray:
     """Finite, distinct loads in GPa, returned ascending; InputError otherwise."""
     p = np.atleast_1d(np.asarray(p_gpa, dtype=float))
     if p.size == 0:
-        raise InputError("--p-gpa: give at least one target pressure in GPa")
+        raise InputError("p_gpa: give at least one target pressure in GPa")
     if not np.all(np.isfinite(p)):
-        raise InputError(f"--p-gpa: expected finite pressures in GPa, got {p.tolist()}")
+        raise InputError(f"p_gpa: expected finite pressures in GPa, got {p.tolist()}")
     if np.unique(p).size != p.size:
-        raise InputError(f"--p-gpa: pressures must be distinct, got {p.tolist()}")
+        raise InputError(f"p_gpa: pressures must be distinct, got {p.tolist()}")
     return np.sort(p)
 
 
 def analyze_ispes(
     ds: xr.Dataset,
     p_gpa: list[float] | np.ndarray,
-    direction_deg: float = 90.0,
+    direction_deg: float | str = 90.0,
     form: str = "internal",
     energy_zero: str = "lowest-p",
     allow_missing: bool = False,
-    threshold_gpa: float = 3.0,
+    threshold_gpa: float | None = 3.0,
     with_mep: bool = False,
     with_symmetry: bool = True,
     max_length_angstrom: float | None = None,
     source: str = "ISPES grid",
     load_source: str = DEFAULT_LOAD_SOURCE,
+    with_stackings: bool = True,
 ) -> AnalysisResult:
     """Analyse an ISPES grid at the loads ``p_gpa`` (see module docstring).
 
@@ -148,7 +162,9 @@ def analyze_ispes(
     p_gpa
         Target loads (GPa, positive when pressed).
     direction_deg
-        Pulling direction in degrees from x (90 = y, the paper's).
+        Pulling direction in degrees from x (90 = y, the paper's, the default), or
+        ``"auto"``: the lowest-barrier direction of the landscape at the lowest load
+        (:data:`AUTO_DIRECTION_RULE`; needs the stackings).
     form
         ``"internal"`` (paper) or ``"enthalpy"``.
     energy_zero
@@ -156,7 +172,14 @@ def analyze_ispes(
     allow_missing
         Interpolate columns with missing thickness points instead of refusing.
     threshold_gpa
-        Upper end of the load range of the linear fits.
+        Upper end of the load range of the linear fits; ``None``: no fit (``laws`` is
+        ``None``; the run's laws stage fits them from ``friction.csv``).
+
+    Raises
+    ------
+    InputError
+        One line naming the parameter (``p_gpa``, ``form``, ``energy_zero``, ...); the CLI and
+        the run translate it to the flag or the settings path.
     with_mep, with_symmetry
         Also compute the string-method MEP / the symmetry report per load.
     max_length_angstrom
@@ -169,21 +192,34 @@ def analyze_ispes(
         ``BARRIER_NOISE_FACTOR`` × the energy-noise estimate of the chosen source
         and form do not count (:mod:`.noise`); a :class:`LoadNoiseWarning` says
         when that noise is a sizeable fraction of τ or of the largest barrier.
+    with_stackings
+        Find, classify and name the stationary points of each load's landscape and the
+        minimum-energy-path barrier (:mod:`.stackings`); their symmetry classes make
+        equivalent minima starts (:mod:`.starts`).
     """
     p = check_pressures(p_gpa)
-    if not np.isfinite(direction_deg):
-        raise InputError(f"--direction-deg: expected a finite angle, got {direction_deg}")
+    auto = isinstance(direction_deg, str)
+    if auto and direction_deg != AUTO_DIRECTION:
+        raise InputError(
+            f"direction_deg: expected an angle in degrees or {AUTO_DIRECTION!r}, got {direction_deg!r}"
+        )
+    if auto and not with_stackings:
+        raise InputError(
+            "direction_deg auto: needs the stackings analysis (the lowest-barrier direction)"
+        )
+    if not auto and not np.isfinite(direction_deg):
+        raise InputError(f"direction_deg: expected a finite angle, got {direction_deg}")
     if form not in FORMS:
-        raise InputError(f"--energy: expected one of {', '.join(FORMS)}, got {form!r}")
+        raise InputError(f"form: expected one of {', '.join(FORMS)}, got {form!r}")
     if energy_zero not in ENERGY_ZEROS:
         raise InputError(
-            f"--energy-zero: expected one of {', '.join(ENERGY_ZEROS)}, got {energy_zero!r}"
+            f"energy_zero: expected one of {', '.join(ENERGY_ZEROS)}, got {energy_zero!r}"
         )
-    if not threshold_gpa > 0:
-        raise InputError(f"--threshold-gpa: expected a positive pressure, got {threshold_gpa}")
+    if threshold_gpa is not None and not threshold_gpa > 0:
+        raise InputError(f"threshold_gpa: expected a positive pressure, got {threshold_gpa}")
     if load_source not in LOAD_SOURCES:
         raise InputError(
-            f"--load-source: expected one of {', '.join(LOAD_SOURCES)}, got {load_source!r}"
+            f"load_source: expected one of {', '.join(LOAD_SOURCES)}, got {load_source!r}"
         )
     n_lateral = (ds.sizes.get(contract.DIM_A, 0), ds.sizes.get(contract.DIM_B, 0))
     if min(n_lateral) < MIN_LATERAL_POINTS:
@@ -196,6 +232,7 @@ def analyze_ispes(
     timings = {"constant_pressure": 0.0, "interpolation": 0.0, "path": 0.0, "friction": 0.0}
     timings.update({"mep": 0.0} if with_mep else {})
     timings.update({"symmetry": 0.0} if with_symmetry else {})
+    timings.update({"stackings": 0.0} if with_stackings else {})
     clock = time.perf_counter()
     cp = constant_pressure(
         ds, p, form=form, allow_missing=allow_missing, source=source, load_source=load_source
@@ -219,7 +256,17 @@ def analyze_ispes(
     surfaces = [PeriodicSurface(s.values - r, a1, a2) for s, r in zip(surfaces, refs, strict=True)]
     timings["interpolation"] = time.perf_counter() - clock
 
+    stackings: list[Stackings | None] = [None] * p.size
+    if with_stackings:
+        clock = time.perf_counter()
+        stackings = [analyze_stackings(surf) for surf in surfaces]
+        timings["stackings"] = time.perf_counter() - clock
+    direction_rule = "given"
+    if auto:
+        direction_deg, direction_rule = _lowest_barrier_direction(stackings[0], a1, float(p[0]))
+
     results = []
+    previous_xy = None
     for i, pk in enumerate(p):
         surf = surfaces[i]
         tol = degeneracy_tolerance_ev_per_a2(float(floor[i]))
@@ -230,8 +277,11 @@ def analyze_ispes(
             min_barrier_ev_per_a2=float(floor[i]),
             max_length_angstrom=max_length_angstrom,
             timings_s=timings,
+            stackings=stackings[i],
+            previous_xy=previous_xy,
         )
         r0, path, fr = starts[k].xy_angstrom, starts[k].path, starts[k].friction
+        previous_xy = r0
         warn_if_tau_depends_on_start(starts, k, float(pk), tol, source)
         mep = None
         if with_mep:
@@ -248,14 +298,17 @@ def analyze_ispes(
             clock = time.perf_counter()
             sym = symmetry_report(surf)
             timings["symmetry"] += time.perf_counter() - clock
-        results.append(PressureAnalysis(float(pk), surf, r0, path, fr, mep, sym, starts, k, tol))
+        results.append(
+            PressureAnalysis(float(pk), surf, r0, path, fr, mep, sym, starts, k, tol, stackings[i])
+        )
         _warn_noise(cp, i, fr, source)
 
     clock = time.perf_counter()
     tau = np.array([r.friction.tau_mpa for r in results])
     sigma = np.array([r.friction.sigma_mss_mpa for r in results])
-    laws = fit_load_laws(p, tau, sigma, threshold_gpa)
-    timings["laws"] = time.perf_counter() - clock
+    laws = None if threshold_gpa is None else fit_load_laws(p, tau, sigma, threshold_gpa)
+    if laws is not None:
+        timings["laws"] = time.perf_counter() - clock
     return AnalysisResult(
         pressures=tuple(results),
         constant_pressure=cp,
@@ -267,6 +320,7 @@ def analyze_ispes(
         supercell=rectangular_supercell(a1, a2),
         timings_s=timings,
         load_source=load_source,
+        direction_rule=direction_rule,
     )
 
 
@@ -283,10 +337,39 @@ def _warn_noise(cp: ConstantPressureISPES, i: int, fr: FrictionResult, source: s
             f"energy noise {eps:.3g} meV/Å² (largest barrier {barrier:.3g}), force noise "
             f"{force:.3g} MPa (τ = {fr.tau_mpa:.4g} MPa) from δp = {nz.delta_p_gpa:.3g} GPa rms "
             f"and |dp/dz| = {nz.slope_gpa_per_angstrom[i]:.3g} GPa/Å"
-            + ("; try --load-source energy" if nz.load_source == "stress" else ""),
+            + (
+                "; try the energy load source (--load-source energy, analysis.load_source: energy)"
+                if nz.load_source == "stress"
+                else ""
+            ),
             LoadNoiseWarning,
             stacklevel=3,
         )
+
+
+#: ``direction_deg`` value that asks for the lowest-barrier direction.
+AUTO_DIRECTION = "auto"
+#: How the ``"auto"`` direction is chosen, as stored with the outputs.
+AUTO_DIRECTION_RULE = (
+    "lowest-barrier: the shortest lattice translation the slider reaches from the global "
+    "minimum over the lowest minimum-energy-path barrier, at the lowest load (P = {p:g} GPa); "
+    "equal lengths: the smallest angle from x in [0, 360)"
+)
+
+
+def _lowest_barrier_direction(
+    stackings: Stackings | None, a1: np.ndarray, p_gpa: float
+) -> tuple[float, str]:
+    """``(direction_deg, rule)`` for ``direction_deg="auto"``.
+
+    Falls back on the direction of ``a1`` (stated in the rule) when no saddle
+    connects the global minimum to an equivalent one (a landscape without barrier).
+    """
+    rule = AUTO_DIRECTION_RULE.format(p=p_gpa)
+    if stackings is not None and np.isfinite(stackings.barrier_direction_deg):
+        return float(stackings.barrier_direction_deg), rule
+    angle = float(np.degrees(np.arctan2(a1[1], a1[0])) % 360.0)
+    return angle, rule + "; no barrier found: along a1"
 
 
 def _shortest_forward_vector(a1: np.ndarray, a2: np.ndarray, direction_deg: float) -> np.ndarray:

@@ -11,7 +11,7 @@ resolve, while τ from each of them differs (pulling along ``+d`` from one
 hollow is pulling along ``-d`` from the other): τ flipped between 60.5 and
 180.4 MPa with the thickness grid on such a landscape.
 
-Rule (deterministic, independent of round-off):
+Rule (deterministic, independent of round-off, the same at every load):
 
 1. all inequivalent local minima in the cell are found on the exact periodic
    interpolant (:meth:`.PeriodicSurface.local_minima`);
@@ -19,17 +19,32 @@ Rule (deterministic, independent of round-off):
    ``DEGENERACY_FLOOR_MEV_PER_A2)`` of the lowest are *near-degenerate*
    (``ε(P)`` the energy noise of the load, :mod:`.noise`; the same ``2 ε``
    below which a dip is not a minimum in σ_MSS). The data cannot tell which
-   of them is the ground state;
+   of them is the ground state. With the landscape's symmetry classes
+   (:mod:`.stackings`), every minimum **symmetry-equivalent** to a
+   near-degenerate one (mapped onto it by an operation the landscape keeps
+   within 2 %, and within 2 % of the landscape's range in energy) is a start
+   too, whatever its energy difference: a splitting of equivalent stackings
+   (AB/BA made unequal by pinning or round-off) then cannot add or remove a
+   start from one load to the next;
 3. the path and τ, σ_MSS and the shear stiffness are computed from each
-   near-degenerate start (``tau_by_start_mpa`` etc. in the outputs), the
-   starts ordered by their fractional position ``(s_a, s_b)`` in the cell;
-4. the reported τ is the **largest τ over the near-degenerate starts**: the
-   pull that sets the slider sliding out of its rest position whichever of
-   the indistinguishable minima it sits in. Equal τ (within ``1e-9``
-   relative) go to the lower minimum, then to the first in that order. The reported path, barriers,
-   σ_MSS and shear stiffness are those of that start. With a single
-   near-degenerate minimum (a clearly deeper global minimum) nothing changes:
-   the path starts from the global minimum as in the paper;
+   start (``tau_by_start_mpa`` etc. in the outputs), the starts ordered by
+   their fractional position ``(s_a, s_b)`` in the cell;
+4. the reported τ is the **largest τ over the starts**: the pull that sets
+   the slider sliding out of its rest position whichever of the
+   indistinguishable minima it sits in. Equal τ (within ``1e-9`` relative,
+   or ``TAU_SPREAD_RTOL`` between symmetry-equivalent starts) go to the
+   start nearest the previous load's reported one (modulo the lattice), so
+   the representative is followed continuously through the loads; at the
+   first load, or at equal distance, to the lower minimum, then to the first
+   in cell order. The reported path, barriers, σ_MSS and shear stiffness are
+   those of that start. With a single start nothing changes: the path starts
+   from the global minimum as in the paper. Minima equivalent by an operation
+   that keeps the pulling direction (``R d = d``, e.g. a lattice translation
+   or a mirror along d; or AB/BA of a six-fold landscape pulled along a
+   lattice vector, via inversion and the mirror normal to d) give the same τ
+   by construction; equivalent by one that does not (AB/BA of a hexagonal
+   landscape pulled along y), τ from one is τ from the other along ``R⁻¹ d``,
+   and the largest is reported;
 5. a :class:`DegenerateMinimaWarning` gives every start's energy and τ when
    the τ differ by more than ``TAU_SPREAD_RTOL`` of the largest.
 
@@ -54,6 +69,7 @@ from flatcontact.analysis.diagnostics import DegenerateMinimaWarning
 from flatcontact.analysis.friction import FrictionResult, friction_along_path
 from flatcontact.analysis.path import SlidingPath, zero_perpendicular_force_path
 from flatcontact.analysis.periodic import PeriodicSurface
+from flatcontact.analysis.stackings import SYMMETRY_TOLERANCE, Stackings
 
 #: Smallest degeneracy tolerance (meV/Å²), used where the energy noise is unknown or smaller.
 DEGENERACY_FLOOR_MEV_PER_A2 = 1.0e-4
@@ -62,8 +78,9 @@ TAU_SPREAD_RTOL = 1.0e-3
 #: The rule, as stored with the outputs.
 TAU_START_RULE = (
     "tau from the global minimum; if other inequivalent minima lie within the degeneracy "
-    "tolerance max(2 eps, floor) of it, the largest tau over those starts (equal tau: the lower "
-    "minimum)"
+    "tolerance max(2 eps, floor) of it, or minima are symmetry-equivalent to it (landscape "
+    "symmetry within 2%), the largest tau over those starts (equal tau: the start nearest the "
+    "previous load's, then the lower minimum)"
 )
 #: τ within this relative difference count as equal when choosing the start.
 TAU_TIE_RTOL = 1.0e-9
@@ -113,13 +130,35 @@ def _cell_order(surface: PeriodicSurface, xy: np.ndarray) -> tuple[float, float]
     return float(s[0]), float(s[1])
 
 
-def choose_start(taus: np.ndarray, energies: np.ndarray) -> int:
-    """Index of the reported start: largest τ; equal τ → lower energy → first (see module doc)."""
+def choose_start(
+    taus: np.ndarray,
+    energies: np.ndarray,
+    distances: np.ndarray | None = None,
+    classes: np.ndarray | None = None,
+) -> int:
+    """Index of the reported start: largest τ; equal τ → nearest the previous start → lower energy.
+
+    τ within ``TAU_TIE_RTOL`` of the largest are equal; with ``classes`` (symmetry
+    class per start, :mod:`.stackings`) so are the starts of the largest τ's class
+    within ``TAU_SPREAD_RTOL`` (equivalent minima, whose τ differ only by round-off
+    or a symmetry breaking below the symmetry tolerance). ``distances`` (Å, to the
+    previous load's reported start modulo the lattice) makes the choice among equal
+    τ continuous in the load; without it, or at equal distance (1e-6 Å), the lower
+    minimum, then the first.
+    """
     taus = np.asarray(taus, float)
     energies = np.asarray(energies, float)
     top = float(np.max(taus))
-    tied = np.flatnonzero(taus >= top - TAU_TIE_RTOL * max(abs(top), 1e-300))
-    return int(tied[np.argmin(energies[tied])])
+    tied = taus >= top - TAU_TIE_RTOL * max(abs(top), 1e-300)
+    if classes is not None:
+        classes = np.asarray(classes)
+        best = classes[int(np.argmax(taus))]
+        tied |= (classes == best) & (taus >= top - TAU_SPREAD_RTOL * max(abs(top), 1e-300))
+    idx = np.flatnonzero(tied)
+    if distances is not None:
+        d = np.round(np.asarray(distances, float)[idx], 6)
+        idx = idx[d == d.min()]
+    return int(idx[np.argmin(energies[idx])])
 
 
 def paths_from_near_degenerate_minima(
@@ -129,6 +168,8 @@ def paths_from_near_degenerate_minima(
     min_barrier_ev_per_a2: float = 0.0,
     max_length_angstrom: float | None = None,
     timings_s: dict[str, float] | None = None,
+    stackings: Stackings | None = None,
+    previous_xy: np.ndarray | None = None,
 ) -> tuple[tuple[StartOutcome, ...], int]:
     """Path and friction from every near-degenerate minimum, and the index of the reported one.
 
@@ -150,12 +191,23 @@ def paths_from_near_degenerate_minima(
     timings_s
         If given, seconds spent are added to its ``"path"`` (minima search and
         tracking) and ``"friction"`` entries.
+    stackings
+        The landscape's stationary points and symmetry classes (:mod:`.stackings`): the
+        minima symmetry-equivalent to a near-degenerate one are starts too, whatever
+        their energy difference (module rule, step 2).
+    previous_xy
+        The previous load's reported start (Å): among equal τ the nearest one is
+        reported (:func:`choose_start`).
     """
     clock = time.perf_counter()
     minima = near_degenerate_minima(surface.local_minima(), tolerance_ev_per_a2)
     if not minima:  # no isolated minimum found: fall back on the refined lowest sample
         minima = [surface.global_minimum()]
-    minima.sort(key=lambda m: _cell_order(surface, m[0]))
+    classes = [-1] * len(minima)
+    if stackings is not None:
+        minima, classes = _with_equivalent_minima(surface, minima, stackings)
+    order = sorted(range(len(minima)), key=lambda i: _cell_order(surface, minima[i][0]))
+    minima, classes = [minima[i] for i in order], [classes[i] for i in order]
     lowest = min(m[1] for m in minima)
     outcomes, caught_by_start = [], []
     spent = {"path": 0.0, "friction": 0.0}
@@ -172,9 +224,16 @@ def paths_from_near_degenerate_minima(
             clock = time.perf_counter()
         caught_by_start.append(caught)
         outcomes.append(StartOutcome(np.asarray(xy, float), float(value), value - lowest, path, fr))
+    distances = None
+    if previous_xy is not None:
+        distances = np.array(
+            [_lattice_distance(surface, o.xy_angstrom, previous_xy) for o in outcomes]
+        )
     k = choose_start(
         np.array([o.friction.tau_ev_per_a3 for o in outcomes]),
         np.array([o.energy_ev_per_a2 for o in outcomes]),
+        distances,
+        np.array(classes) if stackings is not None else None,
     )
     for w in caught_by_start[k]:
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
@@ -182,6 +241,45 @@ def paths_from_near_degenerate_minima(
         for key, value in spent.items():
             timings_s[key] = timings_s.get(key, 0.0) + value
     return tuple(outcomes), k
+
+
+def _lattice_distance(surface: PeriodicSurface, xy: np.ndarray, other: np.ndarray) -> float:
+    """Distance (Å) between two points modulo the lattice (minimum image)."""
+    ds = surface.fractional(np.asarray(xy, float) - np.asarray(other, float))
+    ds -= np.round(ds)
+    return float(np.linalg.norm(surface.cartesian(ds)))
+
+
+def _with_equivalent_minima(
+    surface: PeriodicSurface, minima: list[tuple[np.ndarray, float]], stackings: Stackings
+) -> tuple[list[tuple[np.ndarray, float]], list[int]]:
+    """The near-degenerate minima plus every minimum symmetry-equivalent to one of them.
+
+    Returns the minima and their symmetry class (-1: not matched to a stationary point).
+    """
+    scale = float(np.min(np.linalg.norm(surface.lattice, axis=0)))
+    tol = 1e-4 * scale
+    pts = [p for p in stackings.points if p.kind == "minimum"]
+
+    def match(xy: np.ndarray) -> int:
+        for p in pts:
+            if _lattice_distance(surface, xy, p.xy_angstrom) < tol:
+                return p.symmetry_class
+        return -1
+
+    classes = [match(xy) for xy, _ in minima]
+    out = list(minima)
+    spread = float(np.ptp(surface.values))
+    reach = max(m[1] for m in minima) + SYMMETRY_TOLERANCE * spread
+    for p in pts:
+        if (
+            p.symmetry_class in classes
+            and p.energy <= reach
+            and all(_lattice_distance(surface, p.xy_angstrom, xy) >= tol for xy, _ in out)
+        ):
+            out.append((np.asarray(p.xy_angstrom, float), float(surface(p.xy_angstrom))))
+            classes.append(p.symmetry_class)
+    return out, classes
 
 
 def warn_if_tau_depends_on_start(
@@ -208,8 +306,9 @@ def warn_if_tau_depends_on_start(
             f"{o.friction.sigma_mss_mpa:.4g} MPa)"
         )
     warnings.warn(
-        f"{source} at P = {p_gpa:g} GPa: {len(outcomes)} inequivalent minima lie within "
-        f"{tolerance_ev_per_a2 * mev:.2g} meV/Å² of each other, so the slider's τ depends on "
+        f"{source} at P = {p_gpa:g} GPa: {len(outcomes)} minima lie within "
+        f"{tolerance_ev_per_a2 * mev:.2g} meV/Å² of each other or are symmetry-equivalent, "
+        "so the slider's τ depends on "
         f"which one it sits in: " + "; ".join(parts) + f". Reported τ = "
         f"{outcomes[selected].tau_mpa:.4g} MPa, the largest (the pull that starts sliding from "
         "either)",

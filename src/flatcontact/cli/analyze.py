@@ -1,8 +1,10 @@
 """``flatcontact analyze``: ISPES grid → τ, σ_MSS, shear stiffness per load and the load laws.
 
-Thin: parses flags, calls :func:`flatcontact.analysis.pipeline.analyze_ispes`,
-prints a table or JSON and, with ``--out``, writes ``friction.csv``,
-``friction.nc``, ``laws.json`` and the figures (Fig. 2 per load, Fig. 3).
+Thin: maps the flags to run settings (``analysis``, ``report.svg``), runs the analyze and the
+laws stages (:mod:`flatcontact.stages.analyze`, :mod:`flatcontact.stages.laws`, the ones
+``flatcontact run`` runs), prints a table or JSON and, with ``--out``, the stages write their
+files there: ``friction.csv``, ``friction.nc``, ``analyze.json``, Fig. 2 per load,
+``laws.json`` and Fig. 3.
 
 ``--p-gpa`` takes several values after one flag (``--p-gpa 0.5 1 2``), repeated
 flags or comma-separated lists; negative (tensile) loads are accepted.
@@ -11,14 +13,26 @@ flags or comma-separated lists; negative (tensile) loads are accepted.
 from __future__ import annotations
 
 import json
-import warnings
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
-from flatcontact.cli.app import app, check_out_dir, console, err_console, split_list
+from flatcontact.cli.app import app, check_out_dir, console, print_warning, split_list
 from flatcontact.errors import InputError
+
+#: Settings paths and core parameters -> the flag that sets them, to name it in errors.
+_FLAG_OF = {
+    "analysis.p_gpa": "--p-gpa",
+    "analysis.direction_deg": "--direction-deg",
+    "analysis.energy_form": "--energy",
+    "analysis.load_source": "--load-source",
+    "analysis.energy_zero": "--energy-zero",
+    "analysis.threshold_gpa": "--threshold-gpa",
+    "analysis.allow_missing": "--allow-missing",
+    "analysis.with_mep": "--mep",
+    "p_gpa": "--p-gpa",
+}
 
 
 def _split_arguments(items: list[str], p_values: list[str] | None) -> tuple[Path, list[float]]:
@@ -103,10 +117,13 @@ def analyze_command(
     as_json: Annotated[bool, typer.Option("--json", help="Print the results as JSON.")] = False,
 ) -> None:
     """Constant-pressure ISPES, sliding path, τ, σ_MSS, shear stiffness and load laws."""
-    from flatcontact.analysis.diagnostics import AnalysisWarning
-    from flatcontact.analysis.outputs import per_pressure_rows, summary_json, write_outputs
-    from flatcontact.analysis.pipeline import ENERGY_ZEROS, FORMS, LOAD_SOURCES, analyze_ispes
-    from flatcontact.ispes.contract import open_ispes
+    from flatcontact.analysis.constant_pressure import FORMS, LOAD_SOURCES
+    from flatcontact.analysis.outputs import per_pressure_rows, summary_json
+    from flatcontact.analysis.pipeline import ENERGY_ZEROS
+    from flatcontact.cli.settings import FLAGS_SOURCE, flag_errors
+    from flatcontact.config import build_config
+    from flatcontact.stages.analyze import FRICTION_CSV, AnalyzeInputs, run_analyze
+    from flatcontact.stages.laws import LawsInputs, run_laws
 
     for flag, value, allowed in (
         ("--energy", energy, FORMS),
@@ -118,37 +135,37 @@ def analyze_command(
     path, pressures = _split_arguments(items, p_gpa)
     if out is not None:
         check_out_dir(out)
-    ds = open_ispes(path)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", AnalysisWarning)
-        result = analyze_ispes(
-            ds,
-            pressures,
-            direction_deg=direction_deg,
-            form=energy,
-            load_source=load_source,
-            energy_zero=energy_zero,
-            allow_missing=allow_missing,
-            threshold_gpa=threshold_gpa,
-            with_mep=mep,
-            source=str(path),
+    section = {
+        "direction_deg": direction_deg,
+        "energy_form": energy,
+        "load_source": load_source,
+        "energy_zero": energy_zero,
+        "threshold_gpa": threshold_gpa,
+        "allow_missing": allow_missing,
+        "with_mep": mep,
+    }
+    with flag_errors(_FLAG_OF):
+        cfg = build_config({"analysis": section, "report": {"svg": svg}}, source=FLAGS_SOURCE)
+        # one load is enough here (the run's config asks for two, to fit the laws)
+        cfg = cfg.model_copy(
+            update={"analysis": cfg.analysis.model_copy(update={"p_gpa": pressures})}
         )
-    for w in caught:
-        if issubclass(w.category, AnalysisWarning):
-            err_console.print(
-                f"warning: {w.category.__name__}: {w.message}", highlight=False, soft_wrap=True
-            )
-        else:
-            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
-    written = []
-    if out is not None:
-        from flatcontact.plots.analysis import write_figures
-
-        written = list(write_outputs(result, out).values())
-        written += write_figures(result, out, svg=svg)
+        analyzed = run_analyze(cfg, AnalyzeInputs(path), out)
+        laws_inputs = (
+            LawsInputs.read(out / FRICTION_CSV)
+            if out is not None
+            else LawsInputs.from_analysis(analyzed.analysis)
+        )
+        fitted = run_laws(cfg, laws_inputs, out)
+    result = analyzed.analysis
+    for line in analyzed.warnings:
+        print_warning(line)
+    for w in fitted.caught:
+        print_warning(f"{w.category.__name__}: {w.message}")
+    written = analyzed.files + fitted.files
 
     if as_json:
-        typer.echo(json.dumps(summary_json(result), indent=2))
+        typer.echo(json.dumps({**summary_json(result), "laws": fitted.laws.to_json()}, indent=2))
         return
     from rich.table import Table
 
@@ -176,7 +193,7 @@ def analyze_command(
             _fmt(row["force_noise_mpa"]),
         )
     console.print(table)
-    laws = result.laws.to_json()
+    laws = fitted.laws.to_json()
     if laws["k_mpa_per_gpa"] is not None:
         console.print(
             f"τ = ({_fmt(laws['k_mpa_per_gpa'])} ± {_fmt(laws['k_stderr_mpa_per_gpa'])}) MPa/GPa · P "

@@ -1,7 +1,9 @@
 """``flatcontact build``: the relaxed, verified two-slab interface.
 
-Writes the same files, under the same names, as the build stage of ``flatcontact run``
-(``01-build/``): ``interface.extxyz``, ``build.json`` and ``fig1_interface.png`` (+ ``.svg``).
+Thin: maps the flags to run settings (``structure``, ``potential``, ``report.svg``) and runs
+the build stage (:func:`flatcontact.stages.build.run_build`), the one ``flatcontact run``
+runs, so it writes the same files under the same names as ``01-build/``:
+``interface.extxyz``, ``build.json`` and ``fig1_interface.png`` (+ ``.svg``).
 """
 
 from __future__ import annotations
@@ -12,10 +14,19 @@ import typer
 
 from flatcontact.cli.app import app, check_out_dir, console, print_warning
 from flatcontact.errors import InputError
+from flatcontact.stages.build import BUILD_JSON as BUILD_REPORT
 
-#: File names shared with the build stage of ``flatcontact run`` (``01-build/``).
-BUILD_REPORT = "build.json"
-BUILD_FIGURE_STEM = "fig1_interface"
+#: Settings path -> the flag that sets it, to name the flag in errors.
+_FLAG_OF = {
+    "structure.file": "--structure",
+    "structure.layers": "--layers",
+    "structure.source": "--source",
+    "structure.gap_angstrom": "--gap-angstrom",
+    "structure.fmax_ev_per_angstrom": "--fmax-ev-per-angstrom",
+    "structure.normal_axis": "--normal-axis",
+    "structure.face_depth_angstrom": "--face-depth-angstrom",
+    "potential": "--potential",
+}
 
 
 def _positive_finite(value: float, flag: str, unit: str) -> float:
@@ -52,21 +63,6 @@ def _potential_spec(potential: str | None, lj_cutoff_angstrom: float | None):
         if text.startswith("potential lj.cutoff_angstrom"):
             raise InputError(f"--lj-cutoff-angstrom: {text.split(': ', 1)[-1]}") from None
         raise InputError(f"--potential: {text.removeprefix('potential intra: ')}") from None
-
-
-def _warn_unconverged(report: dict, fmax_ev_per_angstrom: float) -> None:
-    """One warning line per relaxation of ``report`` that stopped before reaching fmax."""
-    for key in ("slab_relaxation", "interface_relaxation"):
-        outcome = report.get(key)
-        if isinstance(outcome, dict) and not outcome.get("converged", True):
-            what = key.replace("_", " ")
-            steps = outcome.get("steps", "?")
-            fmax = outcome.get("max_force_ev_per_angstrom")
-            got = f" (max force {fmax:.3g} eV/Å)" if isinstance(fmax, float) else ""
-            print_warning(
-                f"the {what} did not converge to {fmax_ev_per_angstrom:g} eV/Å in {steps} "
-                f"steps{got}; the interface is written but is not a relaxed reference"
-            )
 
 
 @app.command("build")
@@ -121,13 +117,10 @@ def build(
 
     The same files as the build stage of 'flatcontact run' (its 01-build/ folder).
     """
-    import json
-
-    from flatcontact.fileio import write_json_atomic
-    from flatcontact.pipeline import figure_interface
-    from flatcontact.plots import save_figure
+    from flatcontact.cli.settings import FLAGS_SOURCE, flag_errors
+    from flatcontact.config import build_config
+    from flatcontact.stages.build import BuildInputs, run_build
     from flatcontact.structures import build as builder
-    from flatcontact.structures.interface import write_interface
 
     if structure is None:
         builder.check_layers(layers, "--layers")
@@ -144,45 +137,37 @@ def build(
         )
         return
     spec = _potential_spec(potential, lj_cutoff_angstrom)
+    if structure is not None and not structure.is_file():
+        raise InputError(f"--structure {structure}: file not found")
     check_out_dir(out)
+    section = {
+        "kind": "quartz-dense",
+        "layers": layers,
+        "source": source,
+        "gap_angstrom": gap_angstrom,
+        "fmax_ev_per_angstrom": fmax_ev_per_angstrom,
+    }
     if structure is not None:
-        from ase.io import read
-
-        if not structure.is_file():
-            raise InputError(f"--structure {structure}: file not found")
-        try:
-            slab = read(structure)
-        except Exception as exc:
-            raise InputError(
-                f"--structure {structure}: cannot read it ({type(exc).__name__})"
-            ) from None
-        interface, report = builder.interface_from_slab(
-            slab,
-            spec,
+        section.update(
+            kind="slab",
+            file=str(structure),
             normal_axis=normal_axis,
             face_depth_angstrom=face_depth_angstrom,
-            gap_angstrom=gap_angstrom,
-            fmax_ev_per_angstrom=fmax_ev_per_angstrom,
-            source=str(structure),
         )
-    else:
-        interface, report = builder.build_quartz_interface(
-            spec,
-            layers,
-            source=source,
-            gap_angstrom=gap_angstrom,
-            fmax_ev_per_angstrom=fmax_ev_per_angstrom,
-        )
-    _warn_unconverged(report, fmax_ev_per_angstrom)
-    out.mkdir(parents=True, exist_ok=True)
-    write_interface(interface, out / "interface.extxyz")
-    write_json_atomic(out / BUILD_REPORT, json.loads(json.dumps(report, default=float)))
-    figures = save_figure(
-        figure_interface(interface), out / BUILD_FIGURE_STEM, ("png", "svg") if svg else ("png",)
-    )
+    data = {
+        "structure": section,
+        "potential": spec.model_dump(mode="json"),
+        "report": {"svg": svg},
+    }
+    with flag_errors(_FLAG_OF):
+        cfg = build_config(data, source=FLAGS_SOURCE)
+        result = run_build(cfg, BuildInputs(), out)
+    for line in result.warnings:
+        print_warning(line)
+    figures = [f for f in result.files if f.name.startswith("fig1_")]
     console.print(
-        f"wrote {out / 'interface.extxyz'} ({len(interface)} atoms, thickness "
-        f"{report['thickness_angstrom']:.3f} Å), {out / BUILD_REPORT}, "
+        f"wrote {out / 'interface.extxyz'} ({len(result.atoms)} atoms, thickness "
+        f"{result.report['thickness_angstrom']:.3f} Å), {out / BUILD_REPORT}, "
         + ", ".join(str(f) for f in figures),
         highlight=False,
         soft_wrap=True,

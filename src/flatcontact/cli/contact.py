@@ -1,8 +1,10 @@
 """``flatcontact contact``: the continuum contact model (Hertz, adhesion, modified Mindlin).
 
-Thin: parses flags named by quantity and unit, calls :mod:`flatcontact.contact`,
-prints a rich table or JSON and, with ``--out``, writes figures, ``summary.json``
-and ``contact.nc`` atomically.
+Thin: maps the flags (named by quantity and unit) to the run settings' ``contact`` section
+(k, τ0, μ, σ0 default to the paper's, :mod:`flatcontact.reference`) and ``report.svg``, runs
+the contact stage (:func:`flatcontact.stages.contact.run_contact`, the one ``flatcontact run``
+runs) and prints a rich table or JSON; with ``--out`` the stage writes its figures,
+``summary.json`` and ``contact.nc`` there.
 """
 
 from __future__ import annotations
@@ -14,13 +16,33 @@ from typing import Annotated
 import typer
 
 from flatcontact.cli.app import app, check_out_dir, console, parse_floats
-from flatcontact.errors import InputError, require
+from flatcontact.reference import DEFAULT_P0_GPA, PAPER, PAPER_EXPERIMENT_P0_GPA
 
 _DEFAULT_HELP = "(default: the paper's value)"
+#: Settings paths -> the flag that sets them, to name it in errors.
+_FLAG_OF = {
+    f"contact.{name}": "--" + name.replace("_", "-")
+    for name in (
+        "p0_gpa",
+        "radius_um",
+        "contact_modulus_gpa",
+        "shear_modulus_gpa",
+        "k_mpa_per_gpa",
+        "tau0_mpa",
+        "mu_mpa_per_gpa",
+        "sigma0_mpa",
+        "work_of_adhesion_j_m2",
+        "maugis_lambda",
+        "knee_fraction",
+        "experiment_p0_gpa",
+        "experiment_stress_measure",
+        "collapse_fraction",
+    )
+} | {"contact.experiment_csv": "--experiment", "report.svg": "--svg"}
 
 
 def _parse_p0(values: list[str] | None) -> list[float]:
-    from flatcontact.contact.parameters import DEFAULT_P0_GPA, check_p0_gpa
+    from flatcontact.contact.parameters import check_p0_gpa
 
     if not values:
         return list(DEFAULT_P0_GPA)
@@ -34,25 +56,28 @@ def contact_command(
         list[str] | None,
         typer.Option(
             "--p0-gpa",
-            help="Peak Hertz pressure(s) p0 in GPa; repeat or comma-separate. Default 0.5,1,1.77,2,3.",
+            help="Peak Hertz pressure(s) p0 in GPa; repeat or comma-separate. Default "
+            + ",".join(f"{p:g}" for p in DEFAULT_P0_GPA)
+            + ".",
         ),
     ] = None,
     radius_um: Annotated[
         float, typer.Option("--radius-um", help=f"Tip radius R (µm) {_DEFAULT_HELP}.")
-    ] = 5.0,
+    ] = PAPER["radius_um"],
     contact_modulus_gpa: Annotated[
         float,
         typer.Option(
             "--contact-modulus-gpa", help=f"Hertz contact modulus E* (GPa) {_DEFAULT_HELP}."
         ),
-    ] = 52.5,
+    ] = PAPER["contact_modulus_gpa"],
     shear_modulus_gpa: Annotated[
         float,
         typer.Option(
             "--shear-modulus-gpa",
-            help="Effective shear modulus G* (GPa) in the paper's convention q0 = G*·u/(πa) (= 4× Johnson's G*_J); default 29.",
+            help="Effective shear modulus G* (GPa) in the paper's convention q0 = G*·u/(πa) "
+            f"(= 4× Johnson's G*_J); default {PAPER['shear_modulus_gpa']:g}.",
         ),
-    ] = 29.0,
+    ] = PAPER["shear_modulus_gpa"],
     johnson: Annotated[
         bool,
         typer.Option(
@@ -64,22 +89,30 @@ def contact_command(
         float,
         typer.Option(
             "--k-mpa-per-gpa",
-            help="k in τ = k·p + τ0 (MPa/GPa; may be < 0, then p0 < τ0/|k|); default 4.52.",
+            help="k in τ = k·p + τ0 (MPa/GPa; may be < 0, then p0 < τ0/|k|); default "
+            f"{PAPER['k_mpa_per_gpa']:g}.",
         ),
-    ] = 4.52,
+    ] = PAPER["k_mpa_per_gpa"],
     tau0_mpa: Annotated[
-        float, typer.Option("--tau0-mpa", help="τ0 in τ = k·p + τ0 (MPa); default 26.7.")
-    ] = 26.7,
+        float,
+        typer.Option(
+            "--tau0-mpa", help=f"τ0 in τ = k·p + τ0 (MPa); default {PAPER['tau0_mpa']:g}."
+        ),
+    ] = PAPER["tau0_mpa"],
     mu_mpa_per_gpa: Annotated[
         float,
         typer.Option(
             "--mu-mpa-per-gpa",
-            help="μ in σ = μ·p + σ0 (MPa/GPa; may be < 0, then p0 <= σ0/|μ|); default 0.21.",
+            help="μ in σ = μ·p + σ0 (MPa/GPa; may be < 0, then p0 <= σ0/|μ|); default "
+            f"{PAPER['mu_mpa_per_gpa']:g}.",
         ),
-    ] = 0.21,
+    ] = PAPER["mu_mpa_per_gpa"],
     sigma0_mpa: Annotated[
-        float, typer.Option("--sigma0-mpa", help="σ0 in σ = μ·p + σ0 (MPa); default 11.1.")
-    ] = 11.1,
+        float,
+        typer.Option(
+            "--sigma0-mpa", help=f"σ0 in σ = μ·p + σ0 (MPa); default {PAPER['sigma0_mpa']:g}."
+        ),
+    ] = PAPER["sigma0_mpa"],
     work_of_adhesion_j_m2: Annotated[
         float | None,
         typer.Option(
@@ -109,9 +142,10 @@ def contact_command(
     experiment_p0_gpa: Annotated[
         float,
         typer.Option(
-            "--experiment-p0-gpa", help="p0 (GPa) of the measured data; default 1.77 (the paper's)."
+            "--experiment-p0-gpa",
+            help=f"p0 (GPa) of the measured data; default {PAPER_EXPERIMENT_P0_GPA:g} (the paper's).",
         ),
-    ] = 1.77,
+    ] = PAPER_EXPERIMENT_P0_GPA,
     experiment_stress_measure: Annotated[
         str,
         typer.Option(
@@ -130,123 +164,45 @@ def contact_command(
         Path | None,
         typer.Option("--out", help="Directory for figures, summary.json and contact.nc."),
     ] = None,
+    svg: Annotated[bool, typer.Option("--svg/--no-svg", help="Also write SVG figures.")] = True,
     as_json: Annotated[
         bool, typer.Option("--json", help="Print the per-p0 results as JSON.")
     ] = False,
 ) -> None:
     """Hertz + adhesion + modified Mindlin: Q(u), peak and gross-sliding forces, oscillatory stiffness."""
-    from flatcontact.contact import experiment as exp
+    from flatcontact.cli.settings import flag_errors, settings_from_flags
     from flatcontact.contact.mindlin import paper_shear_modulus_from_johnson
-    from flatcontact.contact.parameters import ContactParameters, check_positive
-    from flatcontact.contact.summary import analyse
+    from flatcontact.stages.contact import ContactInputs, run_contact
 
-    # ---- validate everything before any work --------------------------------------
     p0_list = _parse_p0(p0_gpa)
     g = float(paper_shear_modulus_from_johnson(shear_modulus_gpa)) if johnson else shear_modulus_gpa
-    try:
-        params = ContactParameters(
-            radius_um=radius_um,
-            contact_modulus_gpa=contact_modulus_gpa,
-            shear_modulus_gpa=g,
-            k_mpa_per_gpa=k_mpa_per_gpa,
-            tau0_mpa=tau0_mpa,
-            mu_mpa_per_gpa=mu_mpa_per_gpa,
-            sigma0_mpa=sigma0_mpa,
-            work_of_adhesion_j_m2=0.0 if work_of_adhesion_j_m2 is None else work_of_adhesion_j_m2,
-        )
-        # τ > 0 and σ >= 0 on the whole contact (limits p0 when k or μ < 0)
-        params.check_p0_gpa(p0_list, "--p0-gpa")
-        if experiment is not None:
-            params.check_p0_gpa(experiment_p0_gpa, "--experiment-p0-gpa")
-    except InputError as e:
-        msg = str(e)
-        for field in ContactParameters.__dataclass_fields__:
-            msg = msg.replace(field, "--" + field.replace("_", "-"))
-        raise InputError(msg) from None
-    if work_of_adhesion_j_m2 is not None:
-        check_positive("--work-of-adhesion-j-m2", work_of_adhesion_j_m2)
-    if maugis_lambda is not None:
-        check_positive("--maugis-lambda", maugis_lambda)
-        require(work_of_adhesion_j_m2 is not None, "--maugis-lambda needs --work-of-adhesion-j-m2")
-    require(0.0 < knee_fraction < 1.0, f"--knee-fraction must be in (0, 1), got {knee_fraction!r}")
-    require(
-        0.0 < collapse_fraction < 1.0,
-        f"--collapse-fraction must be in (0, 1), got {collapse_fraction!r}",
-    )
-    require(
-        experiment_stress_measure in ("amplitude", "rms"),
-        f"--experiment-stress-measure must be 'amplitude' or 'rms', got {experiment_stress_measure!r}",
-    )
-    check_positive("--experiment-p0-gpa", experiment_p0_gpa)
-    measured = exp.load_stiffness_csv(experiment) if experiment is not None else None
+    contact = {
+        "p0_gpa": p0_list,
+        "radius_um": radius_um,
+        "contact_modulus_gpa": contact_modulus_gpa,
+        "shear_modulus_gpa": g,
+        "k_mpa_per_gpa": k_mpa_per_gpa,
+        "tau0_mpa": tau0_mpa,
+        "mu_mpa_per_gpa": mu_mpa_per_gpa,
+        "sigma0_mpa": sigma0_mpa,
+        "work_of_adhesion_j_m2": work_of_adhesion_j_m2,
+        "maugis_lambda": maugis_lambda,
+        "knee_fraction": knee_fraction,
+        "experiment_csv": str(experiment) if experiment is not None else None,
+        "experiment_p0_gpa": experiment_p0_gpa,
+        "experiment_stress_measure": experiment_stress_measure,
+        "collapse_fraction": collapse_fraction,
+    }
+    cfg = settings_from_flags({"contact": contact, "report": {"svg": svg}}, _FLAG_OF)
     if out is not None:
         check_out_dir(out)
-
-    # ---- compute ---------------------------------------------------------------------
-    analysis = analyse(p0_list, params, maugis_lambda=maugis_lambda, knee_fraction=knee_fraction)
-    records = analysis.records()
-    exp_summary = None
-    fitted = None
-    if measured is not None:
-        comparison = exp.compare_with_measurement(
-            measured,
-            experiment_p0_gpa,
-            params,
-            fraction=collapse_fraction,
-            measure=experiment_stress_measure,
-        )
-        fitted = comparison.fitted_params
-        exp_summary = comparison.to_json()
-
-    # ---- write -----------------------------------------------------------------------
-    doc = {
-        "parameters": params.as_dict(),
-        "conventions": {
-            "shear_modulus": "paper: q0 = G* u/(pi a); Johnson's G*_J = G*/4",
-            "effective_shear_strength_mpa": "amplitude Q_peak/(pi a^2)",
-            "effective_shear_strength_rms_mpa": "Q_peak/(sqrt(2) pi a^2)",
-            "knee": f"stress where d<Q>/d<u> = {knee_fraction:g} x initial stiffness",
-        },
-        "results": records,
-    }
-    if exp_summary is not None:
-        doc["experiment"] = exp_summary
-    if out is not None:
-        _write_outputs(out, doc, analysis, measured, fitted, exp_summary)
-
+    with flag_errors(_FLAG_OF):
+        result = run_contact(cfg, ContactInputs(), out)
+    doc = result.to_json()
     if as_json:
         typer.echo(json.dumps(doc, indent=2))
         return
-    _print_table(records, exp_summary, out)
-
-
-def _write_outputs(out, doc, analysis, measured, fitted, exp_summary) -> None:
-    from flatcontact.fileio import write_json_atomic
-    from flatcontact.plots import save_figure
-    from flatcontact.plots.contact import fig4_traction, fig5_force_and_stiffness, fig6_overlay
-
-    out.mkdir(parents=True, exist_ok=True)
-    p0_fig4 = 1.0 if 1.0 in analysis.p0_gpa else analysis.p0_gpa[0]
-    figs = {
-        "fig4_traction": fig4_traction(analysis.params, p0_fig4, 0.2),
-        "fig5_force_stiffness": fig5_force_and_stiffness(analysis, "amplitude"),
-        "fig5_force_stiffness_rms": fig5_force_and_stiffness(analysis, "rms"),
-    }
-    if measured is not None:
-        figs["fig6_experiment"] = fig6_overlay(
-            measured,
-            exp_summary["p0_gpa"],
-            {
-                f"τ0 = {analysis.params.tau0_mpa:g} MPa": analysis.params,
-                f"fitted τ0 = {fitted.tau0_mpa:.3g} MPa": fitted,
-            },
-            measure=exp_summary["stress_measure"],
-            measured_collapse_mpa=exp_summary["measured_collapse_stress_mpa"],
-        )
-    for name, fig in figs.items():
-        save_figure(fig, out / name)
-    analysis.write_netcdf(out / "contact.nc")
-    write_json_atomic(out / "summary.json", doc)
+    _print_table(doc["results"], doc.get("experiment"), out)
 
 
 def _print_table(records, exp_summary, out) -> None:

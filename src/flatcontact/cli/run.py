@@ -1,7 +1,8 @@
 """``flatcontact run`` (the whole study in a run directory) and ``flatcontact config``.
 
 Thin: loads and validates the configuration (:mod:`flatcontact.config`), runs
-:class:`flatcontact.pipeline.Pipeline` with rich progress and prints where the report is.
+:class:`flatcontact.pipeline.Pipeline` with rich progress (:mod:`flatcontact.cli.progress`)
+and prints where the report is.
 Ctrl-C stops cleanly; the same command resumes.
 """
 
@@ -32,15 +33,17 @@ def run_command(
 
     Rerunning skips stages whose inputs did not change and resumes an interrupted scan.
     """
+    from flatcontact.cli.progress import ScanBar
     from flatcontact.config import load_config
     from flatcontact.pipeline import Pipeline
+    from flatcontact.stages import _calculator
 
     cfg = load_config(config, preset)
     check_out_dir(out)
-    with Pipeline(cfg, out, console=console) as pipe:
-        model = cfg.calculator.target if cfg.calculator is not None else cfg.potential.label
+    with Pipeline(cfg, out, console=console, scan_progress=ScanBar(console)) as pipe:
         console.print(
-            f"flatcontact run: preset {cfg.preset}, {cfg.structure.kind}, {model} -> {out}",
+            f"flatcontact run: preset {cfg.preset}, {cfg.structure.kind}, "
+            f"{_calculator.label(cfg)} -> {out}",
             highlight=False,
         )
         try:

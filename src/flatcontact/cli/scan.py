@@ -2,8 +2,10 @@
 
 Thin: reads the run configuration (:func:`flatcontact.config.load_config`, the file
 ``flatcontact run`` reads; its ``potential``/``calculator`` and ``scan`` sections), lays the
-flags over it, validates everything, runs :func:`flatcontact.ispes.scan.run_scan` and prints
-a summary.
+flags over it, runs the scan stage (:func:`flatcontact.stages.scan.run_scan_stage`, the one
+``flatcontact run`` runs: ``points.db``, ``ispes.nc``, ``scan.json`` and
+``fig_scan_columns.png``, + ``.svg`` with ``report.svg``) with a progress bar and prints its
+summary and warnings.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ _FLAG_OF = {
     "potential": "--potential",
     "potential.intra": "--potential",
     "calculator": "--calculator",
+    "potential.calculator": "--calculator",
     "scan.grid": "--grid",
     "scan.thickness_angstrom": "--thickness",
     "scan.p_range_gpa": "--p-range-gpa",
@@ -33,7 +36,6 @@ _FLAG_OF = {
     "scan.workers": "--workers",
     "scan.dask_address": "--dask-address",
 }
-_FLAGS_SOURCE = "command-line flags"
 #: Where ``flatcontact build`` writes the interface by default (``--out build``).
 DEFAULT_INTERFACE = "build/interface.extxyz"
 
@@ -59,39 +61,11 @@ def _potential_section(potential: str) -> dict[str, Any]:
     return {"intra": potential}  # any spelling: PotentialSpec normalizes it
 
 
-def _flag_error(exc: InputError) -> InputError:
-    """A validation error of the flags, with the flag named instead of the config path."""
-    text = str(exc).removeprefix(f"{_FLAGS_SOURCE}: ")
-    where, sep, msg = text.partition(": ")
-    field, sep2, rest = msg.partition(": ")  # a section validator naming its field first
-    if sep2 and f"{where}.{field}" in _FLAG_OF:
-        where, msg = f"{where}.{field}", rest
-    for key in sorted(_FLAG_OF, key=len, reverse=True):
-        if sep and where == key:
-            return InputError(f"{_FLAG_OF[key]}: {msg}")
-        if sep and where.startswith(key + "."):
-            return InputError(f"{_FLAG_OF[key]} ({where}): {msg}")
-    return InputError(f"{_FLAGS_SOURCE}: {text}")
-
-
 def resolve_config(config: Path | None, preset: str | None, flags: dict[str, Any]):
-    """The :class:`~flatcontact.config.RunConfig` of ``CONFIG`` (or the preset) with ``flags`` laid over.
+    """The run configuration of ``CONFIG`` with the scan flags laid over (errors name the flag)."""
+    from flatcontact.cli.settings import resolve_config as resolve
 
-    ``flags`` holds the non-``None`` flag values as a nested mapping of config sections
-    (``{"scan": {"grid": [4, 4]}, "potential": {"intra": "vashishta"}}``). Errors in the file
-    name the file and ``scan.<field>``; errors in a flag name the flag.
-    """
-    from flatcontact.config import build_config, load_config, merge_config
-
-    cfg = load_config(config, preset)
-    flags = {k: v for k, v in flags.items() if v != {}}
-    if not flags:
-        return cfg
-    merged = merge_config(cfg.to_dict(), flags)
-    try:
-        return build_config(merged, source=_FLAGS_SOURCE)
-    except InputError as exc:
-        raise _flag_error(exc) from None
+    return resolve(config, preset, flags, _FLAG_OF)
 
 
 @app.command("scan")
@@ -202,8 +176,10 @@ def scan_command(
     the same command continues an interrupted scan; a store made with other settings is
     refused.
     """
-    from flatcontact.ispes.scan import ScanInterrupted, run_scan
-    from flatcontact.structures.interface import read_interface
+    from flatcontact.cli.app import print_warning
+    from flatcontact.cli.progress import ScanBar
+    from flatcontact.ispes.scan import ScanInterrupted
+    from flatcontact.stages.scan import ScanInputs, run_scan_stage
 
     if thickness and p_range_gpa is not None:
         raise InputError("give either --thickness or --p-range-gpa, not both")
@@ -225,39 +201,18 @@ def scan_command(
     }
     flags: dict[str, Any] = {"scan": {k: v for k, v in scan_flags.items() if v is not None}}
     if potential is not None:
-        flags["potential"] = _potential_section(potential)
-        flags["calculator"] = None
+        # an intra-slab model in place of the configured model's (its LJ kept), not a calculator
+        flags["potential"] = {**_potential_section(potential), "calculator": None}
     if calculator is not None:
         flags["calculator"] = {"target": calculator, "kwargs": {}}
     cfg = resolve_config(config, preset, flags)
     out_dir = check_out_dir(out or "ispes")
-    s = cfg.scan
-    spec = s.grid_spec()
-    relax = s.relax_settings()
-    reference = read_interface(interface or DEFAULT_INTERFACE)
-    _warn_other_potential(reference, cfg, interface or DEFAULT_INTERFACE)
-    if cfg.calculator is not None:
-        from flatcontact.ispes.calculators import CalculatorFactory
-
-        factory = CalculatorFactory.from_target(cfg.calculator.target, **cfg.calculator.kwargs)
-    else:
-        from flatcontact.ispes.calculators import PotentialFactory
-        from flatcontact.potentials import check_elements
-
-        check_elements(cfg.potential, reference)
-        factory = PotentialFactory.from_spec(cfg.potential)
+    where = Path(interface or DEFAULT_INTERFACE)
     try:
-        result = run_scan(
-            reference,
-            factory,
-            spec,
-            out_dir,
-            relax,
-            order=s.order,
-            executor_options=s.executor_options(),
-            progress=not as_json,
-            console=console,
-        )
+        with ScanBar(console) as bar:
+            result = run_scan_stage(
+                cfg, ScanInputs(where), out_dir, progress=None if as_json else bar
+            )
     except ScanInterrupted as stop:
         r = stop.result
         err_console.print(
@@ -266,93 +221,19 @@ def scan_command(
             highlight=False,
         )
         raise typer.Exit(130) from None
-    _warn_no_repulsive_branch(result)
+    for line in result.warnings:
+        print_warning(line)
     _summary(result, as_json)
 
 
-def _warn_no_repulsive_branch(result) -> None:
-    """One warning line when no scanned thickness is under compression (p > 0 nowhere).
-
-    Such a grid holds only the separated (tensile) branch; the constant-pressure analysis at
-    P >= 0 needs thicknesses where the slabs push back (p = normal_stress > 0, compressive).
-    """
-    import numpy as np
-
-    from flatcontact.cli.app import print_warning
-
-    p = np.asarray(result.dataset.normal_stress.values, dtype=float)
-    if p.size and not np.any(p[np.isfinite(p)] > 0):
-        z = [float(v) for v in result.dataset.thickness.values]
-        print_warning(
-            f"no scanned thickness reached p > 0 (max {np.nanmax(p):.3g} GPa at z = "
-            f"{min(z):g}..{max(z):g} Å): the interface is separated everywhere and "
-            "'flatcontact analyze' has no repulsive branch; scan smaller thicknesses"
-        )
-
-
-def built_with_other_model(reference, cfg) -> str | None:
-    """The model an interface's recipe names when it is not the one of ``cfg``, else ``None``.
-
-    The recipe (``info["recipe"]``, written by :mod:`flatcontact.structures.build`) holds the
-    whole ``PotentialSpec`` (``potential_spec``; older files only its label ``potential``, of
-    which the intra-slab part is compared). A recipe naming no potential gives ``None``.
-    """
-    from flatcontact.potentials.spec import PotentialSpec, normalize_potential_name
-
-    try:
-        recipe = json.loads(reference.info.get("recipe", "{}") or "{}")
-    except (TypeError, ValueError):
-        return None
-    if not isinstance(recipe, dict):
-        return None
-    if isinstance(recipe.get("potential_spec"), dict):
-        try:
-            built = PotentialSpec(**recipe["potential_spec"])
-        except (InputError, TypeError):
-            return str(recipe["potential_spec"].get("intra", "an unknown model"))
-        same = cfg.calculator is None and built == cfg.potential
-        return None if same else built.label
-    label = recipe.get("potential")
-    if not isinstance(label, str) or not label:
-        return None
-    intra = label.split("+LJ(")[0]
-    try:
-        intra = normalize_potential_name(intra)
-    except InputError:
-        pass
-    same = cfg.calculator is None and intra == cfg.potential.intra
-    return None if same else label
-
-
-def _warn_other_potential(reference, cfg, where: str) -> None:
-    """One warning line when the interface was relaxed with another model than the scan's."""
-    from flatcontact.cli.app import print_warning
-
-    built_with = built_with_other_model(reference, cfg)
-    if built_with is not None:
-        model = cfg.calculator.target if cfg.calculator is not None else cfg.potential.label
-        print_warning(
-            f"{where} was built with {built_with}, this scan uses {model}: its reference "
-            "stacking and thickness are not the relaxed ones of the scan's model"
-        )
-
-
 def _summary(result, as_json: bool) -> None:
-    import numpy as np
-
-    calls = result.force_calls_computed
+    """Print the stage's ``scan.json`` (plus the paths and wall time) as JSON or a table."""
+    scan = result.scan
     summary = {
-        "ispes": str(result.ispes_path),
-        "points_db": str(result.store_path),
-        "points_total": result.points_total,
-        "points_done": result.points_done,
-        "points_computed": result.points_computed,
-        "converged": int(result.dataset.converged.sum()),
-        "median_force_calls": float(np.median(calls)) if calls else None,
-        "seconds": round(result.seconds, 3),
-        "thickness_angstrom": [float(z) for z in result.dataset.thickness.values],
-        "adhesion": result.adhesion,
-        "notes": result.notes,
+        "ispes": str(scan.ispes_path),
+        "points_db": str(scan.store_path),
+        "seconds": round(scan.seconds, 3),
+        **result.to_json(),
     }
     if as_json:
         print(json.dumps(summary, indent=2))
@@ -366,6 +247,6 @@ def _summary(result, as_json: bool) -> None:
                 table.add_row(k, f"{v:.6g}" if isinstance(v, float) else str(v))
         elif key == "thickness_angstrom":
             table.add_row(key, ", ".join(f"{z:.4f}" for z in value))
-        elif key != "adhesion":
+        elif key not in ("adhesion", "warnings"):
             table.add_row(key, str(value))
     console.print(table)

@@ -26,22 +26,7 @@ from numpy.typing import ArrayLike
 
 from flatcontact import units
 from flatcontact.errors import require
-
-#: The paper's parameters (Dong, Uluca, Cross, Sanvito): tip radius, DFT moduli of
-#: α-quartz and the ISPES load laws τ = k·p + τ0, σ = μ·p + σ0.
-PAPER_DEFAULTS: dict[str, float] = {
-    "radius_um": 5.0,
-    "contact_modulus_gpa": 52.5,
-    "shear_modulus_gpa": 29.0,
-    "k_mpa_per_gpa": 4.52,
-    "tau0_mpa": 26.7,
-    "mu_mpa_per_gpa": 0.21,
-    "sigma0_mpa": 11.1,
-}
-
-#: p0 values (GPa) used when none are given: the paper's Fig. 4 (1 GPa) and
-#: experiment (1.77 GPa) loads, bracketed by a light and two heavier loads.
-DEFAULT_P0_GPA: tuple[float, ...] = (0.5, 1.0, 1.77, 2.0, 3.0)
+from flatcontact.reference import PAPER as PAPER_DEFAULTS
 
 
 def _finite(name: str, value: Any) -> float:

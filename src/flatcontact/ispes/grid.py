@@ -32,14 +32,19 @@ class GridSpec:
     """Which points to compute.
 
     Exactly one of ``thickness_angstrom`` (explicit z list, Å) and ``p_range_gpa``
-    (``(lo, hi, n)``: n thicknesses whose loads at the probe stacking are evenly
-    spaced from lo to hi GPa) is given.
+    (``(lo, hi, n)``: n thicknesses whose loads at the lowest-energy stacking are
+    evenly spaced from lo to hi GPa) is given. With ``bracket_all_stackings`` (default)
+    the extreme stackings are probed too and thicknesses are added until every one of
+    them brackets the loads (:func:`probe_thicknesses`); ``False`` probes the
+    lowest-energy stacking only (the rule before; it enters the store fingerprint only
+    when ``False``).
     """
 
     n_a: int
     n_b: int
     thickness_angstrom: tuple[float, ...] | None = None
     p_range_gpa: tuple[float, float, int] | None = None
+    bracket_all_stackings: bool = True
 
     def __post_init__(self) -> None:
         for name in ("n_a", "n_b"):
@@ -86,6 +91,8 @@ class GridSpec:
             d["thickness_angstrom"] = list(self.thickness_angstrom)
         else:
             d["p_range_gpa"] = list(self.p_range_gpa)
+            if not self.bracket_all_stackings:
+                d["bracket_all_stackings"] = False
         return d
 
 
@@ -135,26 +142,98 @@ class ColumnProbe:
         )
 
 
-def lowest_energy_stacking(reference: Atoms, calc, grid: GridSpec) -> tuple[float, float]:
-    """The lateral shift with the lowest rigid (unrelaxed) energy at the reference thickness.
+@dataclasses.dataclass(frozen=True)
+class RigidStackings:
+    """Rigid (unrelaxed) energy (eV) and normal load (GPa, > 0 pressed) of every lateral
+    grid shift at the reference thickness, shape ``(n_a, n_b)``; NaN where the slabs overlap."""
 
-    One single-point evaluation per lateral grid point; shifts that overlap are skipped.
+    energy_ev: np.ndarray
+    normal_stress_gpa: np.ndarray
+
+
+def rigid_stackings(reference: Atoms, calc, grid: GridSpec) -> RigidStackings:
+    """One single-point evaluation per lateral grid shift at the reference thickness.
+
+    The load is the net z-force on slab 2 per area
+    (:func:`flatcontact.ispes.relax.normal_stress_gpa`, the scan's own definition).
     """
+    from flatcontact.ispes.relax import normal_stress_gpa
+
     z_ref = thickness(reference)
-    best, best_e = (0.0, 0.0), np.inf
     sa, sb = grid.shifts()
-    for a in sa:
-        for b in sb:
+    energy = np.full(grid.shape_lateral, np.nan)
+    load = np.full(grid.shape_lateral, np.nan)
+    for i, a in enumerate(sa):
+        for j, b in enumerate(sb):
             try:
                 atoms = place_slab2(reference, float(a), float(b), z_ref)
             except InputError:
                 continue
             atoms.calc = calc
-            e = atoms.get_potential_energy()
+            energy[i, j] = atoms.get_potential_energy()
+            load[i, j] = normal_stress_gpa(atoms, atoms.get_forces(apply_constraint=False))
             atoms.calc = None
-            if e < best_e - 1e-12:
-                best, best_e = (float(a), float(b)), e
-    return best
+    return RigidStackings(energy, load)
+
+
+def _first_extreme(values: np.ndarray, grid: GridSpec, highest: bool) -> tuple[float, float]:
+    """Shift of the smallest (largest) finite value; ties (1e-12) go to the first in grid order."""
+    v = np.asarray(values, dtype=float)
+    if not np.any(np.isfinite(v)):
+        raise InputError(
+            "probe column: the slabs overlap at every lateral shift of the reference thickness"
+        )
+    flat = v.ravel()
+    if highest:
+        k = int(np.flatnonzero(flat >= np.nanmax(flat) - 1e-12)[0])
+    else:
+        k = int(np.flatnonzero(flat <= np.nanmin(flat) + 1e-12)[0])
+    sa, sb = grid.shifts()
+    i, j = np.unravel_index(k, v.shape)
+    return float(sa[i]), float(sb[j])
+
+
+def extreme_stackings(
+    energies: np.ndarray, grid: GridSpec
+) -> tuple[tuple[float, float], tuple[float, float]]:
+    """The lateral shifts of the lowest and of the highest rigid energy (NaN = overlap, skipped).
+
+    Ties go to the first shift in (shift_a, shift_b) order within 1e-12 eV. Returns
+    ``(lowest, highest)``; they coincide for a landscape without corrugation.
+    """
+    return _first_extreme(energies, grid, False), _first_extreme(energies, grid, True)
+
+
+def probed_stackings(
+    rigid: RigidStackings, grid: GridSpec
+) -> list[tuple[str, tuple[float, float]]]:
+    """The columns a pressure-range grid probes, as ``(role, shift)``, duplicates removed.
+
+    ``"lowest energy"`` first (the paper's probe, which also gives the adhesion), then
+    ``"highest energy"``, ``"most repulsive"`` and ``"least repulsive"`` (the largest and
+    the smallest rigid load at the reference thickness): the columns whose loads at a
+    given z are the extremes of the grid, so thicknesses that bracket the requested
+    loads at them bracket them at the other stackings too.
+    """
+    wanted = [
+        ("lowest energy", _first_extreme(rigid.energy_ev, grid, False)),
+        ("highest energy", _first_extreme(rigid.energy_ev, grid, True)),
+        ("most repulsive", _first_extreme(rigid.normal_stress_gpa, grid, True)),
+        ("least repulsive", _first_extreme(rigid.normal_stress_gpa, grid, False)),
+    ]
+    out: list[tuple[str, tuple[float, float]]] = []
+    for role, shift in wanted:
+        if all(shift != s for _, s in out):
+            out.append((role, shift))
+    return out
+
+
+def lowest_energy_stacking(reference: Atoms, calc, grid: GridSpec) -> tuple[float, float]:
+    """The lateral shift with the lowest rigid (unrelaxed) energy at the reference thickness.
+
+    One single-point evaluation per lateral grid point; shifts that overlap are skipped.
+    """
+    return extreme_stackings(rigid_stackings(reference, calc, grid).energy_ev, grid)[0]
 
 
 #: default z offsets (Å, relative to the reference thickness) for probing tension and separation
@@ -171,6 +250,7 @@ def probe_column(
     dz_down_angstrom: float = 0.1,
     max_down_steps: int = 80,
     separated_gpa: float = 1e-4,
+    stop_at_gpa: float | None = None,
 ) -> ColumnProbe:
     """Relax a column at ``shift`` from compression up to separation.
 
@@ -229,6 +309,8 @@ def probe_column(
         start, start_z = pos, z
         past_min = p > p_min
         p_min = min(p_min, p)
+        if stop_at_gpa is not None and (p <= stop_at_gpa or past_min):
+            break
         if past_min and p_min < 0 and abs(p) < separated_gpa:
             break
     zs = np.array(sorted(records))
@@ -325,3 +407,121 @@ def thicknesses_for_pressures(
     targets = np.linspace(lo_gpa, hi_gpa, n)
     zs = np.interp(targets, pb[::-1], zb[::-1])
     return np.sort(zs), notes
+
+
+def _repulsive_branch(probe: ColumnProbe) -> tuple[np.ndarray, np.ndarray]:
+    """``(z, p)`` from the most compressed sample up to the tensile maximum (p decreasing)."""
+    z, p = probe.thickness_angstrom, probe.normal_stress_gpa
+    i_min = int(np.argmin(p))
+    zb, pb = z[: i_min + 1], p[: i_min + 1]
+    if np.any(np.diff(pb) >= 0):
+        raise InputError(
+            f"probe column at shift {probe.shift}: p(z) is not monotonic between compression "
+            "and the tensile maximum; give explicit thicknesses"
+        )
+    return zb, pb
+
+
+#: A probed column whose load at the end thickness misses its target by less than this
+#: fraction of the requested load range (HI - LO) counts as bracketed (no extra thickness).
+BRACKET_RTOL = 0.01
+
+
+def thicknesses_spanning_columns(
+    probes: Sequence[ColumnProbe], lo_gpa: float, hi_gpa: float, n: int
+) -> tuple[np.ndarray, list[str]]:
+    """Thicknesses whose loads span [lo, hi] GPa at every probed stacking.
+
+    The first probe (the lowest-energy stacking) sets ``n`` thicknesses exactly as
+    :func:`thicknesses_for_pressures` (loads evenly spaced from lo to hi there). Every
+    other probed column ``c`` (e.g. the most repulsive stacking, whose load at a given
+    z is larger) must also be bracketed on its repulsive branch: its load at the
+    largest thickness must be at most ``lo_c = max(lo, its maximum tension)`` and at
+    the smallest thickness at least ``hi``. Where it is not, thicknesses are appended
+    beyond the largest (or prepended below the smallest) with the mean spacing of the
+    first probe's thicknesses, the last one exactly at the z where ``p_c = lo_c``
+    (or ``hi``), each by linear inversion of the probe's ``p_c(z)``. ``lo`` here is
+    the first column's (raised to its maximum tension if below). A miss smaller than
+    ``BRACKET_RTOL`` × (HI − LO) is not extended (e.g. two columns whose tensile
+    maxima differ by a few MPa). When the first column already brackets every other
+    one, the result is that of :func:`thicknesses_for_pressures` unchanged. Notes
+    name every extension.
+    """
+    if not probes:
+        raise InputError("probe column: no probed column to choose thicknesses from")
+    z, notes = thicknesses_for_pressures(probes[0], lo_gpa, hi_gpa, n)
+    lo_gpa = max(lo_gpa, float(_repulsive_branch(probes[0])[1][-1]))
+    slack = BRACKET_RTOL * (hi_gpa - lo_gpa)
+    dz = float(np.ptp(z)) / max(n - 1, 1)
+    for probe in probes[1:]:
+        zb, pb = _repulsive_branch(probe)
+        if hi_gpa > pb[0]:
+            raise InputError(
+                f"p-range-gpa: HI={hi_gpa} GPa above the most compressed probe load {pb[0]:.3g} GPa "
+                f"at shift {probe.shift}"
+            )
+        lo_c = max(lo_gpa, float(pb[-1]))
+        z_lo_c = float(np.interp(lo_c, pb[::-1], zb[::-1]))  # thickness where p_c = lo_c
+        z_hi_c = float(np.interp(hi_gpa, pb[::-1], zb[::-1]))  # thickness where p_c = hi
+        top, bottom = float(z.max()), float(z.min())
+        if z_lo_c > top + 1e-9 and float(np.interp(top, zb, pb)) > lo_c + slack:
+            m = max(1, int(np.ceil((z_lo_c - top) / dz - 1e-9))) if dz > 0 else 1
+            extra = np.linspace(top, z_lo_c, m + 1)[1:]
+            z = np.concatenate([z, extra])
+            notes.append(
+                f"p-range-gpa: the stacking at shift ({probe.shift[0]:.4g}, {probe.shift[1]:.4g}) "
+                f"is still at {float(np.interp(top, zb, pb)):.3g} GPa at z = {top:.4g} Å; added "
+                f"{m} thickness(es) up to {z_lo_c:.4g} Å where its load is {lo_c:.4g} GPa"
+            )
+        if z_hi_c < bottom - 1e-9 and float(np.interp(bottom, zb, pb)) < hi_gpa - slack:
+            m = max(1, int(np.ceil((bottom - z_hi_c) / dz - 1e-9))) if dz > 0 else 1
+            extra = np.linspace(bottom, z_hi_c, m + 1)[1:]
+            z = np.concatenate([z, extra])
+            notes.append(
+                f"p-range-gpa: the stacking at shift ({probe.shift[0]:.4g}, {probe.shift[1]:.4g}) "
+                f"is only at {float(np.interp(bottom, zb, pb)):.3g} GPa at z = {bottom:.4g} Å; added "
+                f"{m} thickness(es) down to {z_hi_c:.4g} Å where its load is {hi_gpa:.4g} GPa"
+            )
+    return np.sort(z), notes
+
+
+def probe_thicknesses(
+    relax: Callable[[float, float, float, np.ndarray | None, float | None], tuple],
+    reference: Atoms,
+    rigid: RigidStackings,
+    grid: GridSpec,
+) -> tuple[dict, list[str]]:
+    """Probe the extreme columns and choose the thicknesses of a pressure-range grid.
+
+    The columns of :func:`probed_stackings` are probed along z (:func:`probe_column`;
+    all but the first stop stretching once their load is at most LO or past their
+    tensile maximum); the thicknesses bracket the requested loads at every one of them
+    (:func:`thicknesses_spanning_columns`). The adhesion is that of the lowest-energy
+    column (the paper's z-scan).
+
+    Returns
+    -------
+    resolved, notes
+        ``resolved`` holds ``thickness_angstrom``, ``probe`` (the lowest-energy
+        column, as before), ``probes`` (every probed column with its ``role``),
+        ``adhesion`` and ``notes``.
+    """
+    lo, hi, n = grid.p_range_gpa
+    columns = probed_stackings(rigid, grid)
+    if not grid.bracket_all_stackings:
+        columns = columns[:1]
+    probes = [
+        probe_column(relax, reference, shift, hi, stop_at_gpa=None if k == 0 else lo)
+        for k, (_, shift) in enumerate(columns)
+    ]
+    adh = adhesion(probes[0])
+    z, notes = thicknesses_spanning_columns(probes, lo, hi, n)
+    return {
+        "thickness_angstrom": z.tolist(),
+        "probe": probes[0].as_dict(),
+        "probes": [
+            {"role": role, **p.as_dict()} for (role, _), p in zip(columns, probes, strict=True)
+        ],
+        "adhesion": adh.as_dict(),
+        "notes": notes,
+    }, notes

@@ -15,6 +15,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -81,55 +82,14 @@ def _probe(
     reference: Atoms, factory: Any, grid: grid_mod.GridSpec, relax: RelaxSettings
 ) -> tuple[dict, list[str]]:
     calc = worker_calculator(factory, reference)
-    shift = grid_mod.lowest_energy_stacking(reference, calc, grid)
 
     def relax_one(a, b, z, start, start_z):
         task = PointTask((0, 0, 0), a, b, z, start, (a, b) if start is not None else None, start_z)
         r = relax_point(reference, calc, task, relax)
         return r.energy_ev, r.normal_stress_gpa, r.force_calls, r.positions
 
-    lo, hi, n = grid.p_range_gpa
-    probe = grid_mod.probe_column(relax_one, reference, shift, hi)
-    adh = grid_mod.adhesion(probe)
-    z, notes = grid_mod.thicknesses_for_pressures(probe, lo, hi, n)
-    return {
-        "thickness_angstrom": z.tolist(),
-        "probe": probe.as_dict(),
-        "adhesion": adh.as_dict(),
-        "notes": notes,
-    }, notes
-
-
-def _progress(console, total: int, done: int):
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        ProgressColumn,
-        TextColumn,
-        TimeElapsedColumn,
-        TimeRemainingColumn,
-    )
-    from rich.text import Text
-
-    class Rate(ProgressColumn):
-        def render(self, task):
-            speed = task.finished_speed or task.speed
-            return Text("-- pt/s" if speed is None else f"{speed:.2f} pt/s")
-
-    prog = Progress(
-        TextColumn("ISPES"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        Rate(),
-        TimeElapsedColumn(),
-        TextColumn("ETA"),
-        TimeRemainingColumn(),
-        console=console,
-        transient=False,
-    )
-    task = prog.add_task("scan", total=total, completed=done)
-    return prog, task
+    rigid = grid_mod.rigid_stackings(reference, calc, grid)
+    return grid_mod.probe_thicknesses(relax_one, reference, rigid, grid)
 
 
 def run_scan(
@@ -141,8 +101,7 @@ def run_scan(
     order: str = "columns",
     executor: Any = None,
     executor_options: dict | None = None,
-    progress: bool = False,
-    console: Any = None,
+    progress: Callable[[int, int], None] | None = None,
     max_new_points: int | None = None,
 ) -> ScanResult:
     """Compute the ISPES grid of ``reference`` with ``factory``'s calculator into ``out_dir``.
@@ -166,6 +125,10 @@ def run_scan(
     executor
         An executor object (:mod:`flatcontact.ispes.executors`); if None, one is built
         from ``executor_options`` (``make_executor`` keywords) after validation.
+    progress
+        Called as ``progress(done, total)`` (points in the store, points of the grid) once
+        the grid is known and after every stored point, like an observer attached to an ASE
+        dynamics; the CLI draws its progress bar from it.
     max_new_points
         Stop after computing this many new points (benchmarks); the store stays resumable.
 
@@ -228,10 +191,8 @@ def run_scan(
                 rank = {idx: k for k, idx in enumerate(parent)}
                 todo = [idx for idx in parent if idx not in store]
                 total = len(parent)
-                prog = None
-                if progress:
-                    prog, ptask = _progress(console, total, len(store))
-                    prog.start()
+                if progress is not None:
+                    progress(len(store), total)
                 in_flight: dict[Any, tuple] = {}
                 cap = 2 * max(1, getattr(executor, "workers", 1))
                 pending = set(todo)
@@ -295,13 +256,10 @@ def run_scan(
                             result = executor.result(handle)
                             store.write(result)
                             computed_calls.append(result.force_calls)
-                            if prog is not None:
-                                prog.update(ptask, completed=len(store))
+                            if progress is not None:
+                                progress(len(store), total)
                 except KeyboardInterrupt:
                     interrupted = True
-                finally:
-                    if prog is not None:
-                        prog.stop()
             finally:
                 if own_executor:
                     executor.close(cancel=True)

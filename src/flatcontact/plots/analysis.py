@@ -10,9 +10,6 @@ Fig. 3: τ and σ against P with their linear fits over the fitted range.
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
-
 import matplotlib
 
 matplotlib.use("Agg")
@@ -20,14 +17,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from flatcontact import units
+from flatcontact.analysis.laws import LoadLaws
 from flatcontact.analysis.pipeline import AnalysisResult, PressureAnalysis
-from flatcontact.plots import save_figure
 
 MEV = units.EV_PER_A2_TO_MEV_PER_A2
-
-
-def _formats(svg: bool) -> tuple[str, ...]:
-    return ("png", "svg") if svg else ("png",)
 
 
 def figure_pressure(pa: PressureAnalysis, result: AnalysisResult) -> plt.Figure:
@@ -106,16 +99,15 @@ def figure_pressure(pa: PressureAnalysis, result: AnalysisResult) -> plt.Figure:
     return fig
 
 
-def figure_laws(result: AnalysisResult) -> plt.Figure:
-    """Fig. 3: τ and σ vs P with the linear fits."""
+def figure_laws(p_gpa, tau_mpa, sigma_mss_mpa, laws: LoadLaws) -> plt.Figure:
+    """Fig. 3: τ and σ vs P (one value per load, GPa and MPa) with the linear fits ``laws``."""
     fig, ax = plt.subplots(figsize=(5.5, 4.2))
-    p = result.p_gpa
-    for name, law, style, label in (
-        ("tau_mpa", result.laws.tau, "o", "τ"),
-        ("sigma_mss_mpa", result.laws.sigma, "s", "σ"),
+    p = np.asarray(p_gpa, dtype=float)
+    for y, law, style, label in (
+        (tau_mpa, laws.tau, "o", "τ"),
+        (sigma_mss_mpa, laws.sigma, "s", "σ"),
     ):
-        y = result.column(name)
-        line = ax.plot(p, y, style, label=label)[0]
+        line = ax.plot(p, np.asarray(y, dtype=float), style, label=label)[0]
         if law is not None:
             pf = np.linspace(min(0.0, p.min()), law.p_max_gpa, 50)
             ax.plot(
@@ -130,21 +122,7 @@ def figure_laws(result: AnalysisResult) -> plt.Figure:
                 ax.plot(pe, law(pe), ":", color=line.get_color())
     ax.set_xlabel("P (GPa)")
     ax.set_ylabel("stress (MPa)")
-    ax.set_title(f"load laws (fit P ≤ {result.laws.threshold_gpa:g} GPa)")
+    ax.set_title(f"load laws (fit P ≤ {laws.threshold_gpa:g} GPa)")
     ax.legend(fontsize=8)
     fig.tight_layout()
     return fig
-
-
-def write_figures(
-    result: AnalysisResult, out_dir: str | os.PathLike[str], svg: bool = True
-) -> list[Path]:
-    """Fig. 2 per load (``fig2_p<P>gpa``) and Fig. 3 (``fig3_laws``), PNG (+SVG)."""
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    written = []
-    for pa in result.pressures:
-        stem = out / f"fig2_p{pa.p_gpa:g}gpa"
-        written += save_figure(figure_pressure(pa, result), stem, _formats(svg))
-    written += save_figure(figure_laws(result), out / "fig3_laws", _formats(svg))
-    return written

@@ -1,0 +1,61 @@
+"""One home for the paper's values and the literature constants flatcontact compares with.
+
+Everything here is a published number, not a setting: the run configuration's defaults
+(:class:`flatcontact.config.ContactConfig`), the ``flatcontact contact`` flag defaults,
+:class:`flatcontact.contact.parameters.ContactParameters` and the report's comparison
+table all read it from here, so a corrected value changes every place at once.
+
+Sources
+-------
+- The paper: Dong, Uluca, Cross and Sanvito, *Single-Contact Problem in Atomically Flat
+  Interfaces: a Simulation Approach* (α-quartz (0001) dense interface, SNAP + TS-vdW LJ).
+  Its load laws τ = k·P + τ0 and σ = μ·P + σ0 (fitted on P < 3 GPa), the tip radius and
+  the DFT contact moduli of the contact model (G* in the paper's convention
+  q0 = G*·u/(πa), i.e. 4 × Johnson's G*_J).
+- Hamaker constant of α-quartz across vacuum from Lifshitz theory with measured dielectric
+  spectra: Bergström, Adv. Colloid Interface Sci. 70, 125 (1997).
+- Elastic constants of α-quartz at room temperature, adiabatic, experiment (McSkimin,
+  Andreatch and Thurston, J. Appl. Phys. 36, 1624 (1965); Heyliger, Ledbetter and Kim,
+  J. Acoust. Soc. Am. 114, 644 (2003)): the set :mod:`flatcontact.training.validate`
+  checks potentials against.
+- Lattice constants of α-quartz, experiment (Levien, Prewitt and Weidner, Am. Mineral. 65,
+  920 (1980)).
+"""
+
+from __future__ import annotations
+
+from types import MappingProxyType
+
+#: The paper's parameters: tip radius R (µm), DFT moduli E* and G* (GPa, G* in the paper's
+#: convention), and the load laws k (MPa/GPa), τ0 (MPa), μ (MPa/GPa), σ0 (MPa).
+PAPER = MappingProxyType(
+    {
+        "radius_um": 5.0,
+        "contact_modulus_gpa": 52.5,
+        "shear_modulus_gpa": 29.0,
+        "k_mpa_per_gpa": 4.52,
+        "tau0_mpa": 26.7,
+        "mu_mpa_per_gpa": 0.21,
+        "sigma0_mpa": 11.1,
+    }
+)
+#: The four load-law coefficients of :data:`PAPER`.
+PAPER_LAW_KEYS = ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa")
+#: The load range of the paper's linear fits (GPa).
+PAPER_THRESHOLD_GPA = 3.0
+#: p0 of the paper's measured stiffness (its Fig. 6, GPa).
+PAPER_EXPERIMENT_P0_GPA = 1.77
+#: Peak Hertz pressures used when none are given (GPa): the paper's Fig. 4 (1 GPa) and
+#: experiment (1.77 GPa) loads, bracketed by a light and two heavier loads.
+DEFAULT_P0_GPA: tuple[float, ...] = (0.5, 1.0, 1.77, 2.0, 3.0)
+
+#: Non-retarded Hamaker constant of α-quartz across vacuum, Lifshitz theory (zJ; Bergström 1997).
+QUARTZ_HAMAKER_ZJ = 88.0
+
+#: Elastic constants of α-quartz, experiment (GPa, Voigt notation); C14 in the IEEE-1949 axes
+#: of right-handed quartz (negative).
+QUARTZ_CIJ_EXPERIMENT_GPA = MappingProxyType(
+    {"C11": 86.6, "C12": 6.7, "C13": 12.6, "C14": -17.8, "C33": 106.1, "C44": 57.8, "C66": 39.9}
+)
+#: Lattice constants of α-quartz, experiment (Å).
+QUARTZ_LATTICE_EXPERIMENT_ANGSTROM = MappingProxyType({"a": 4.916, "c": 5.405})

@@ -1,0 +1,27 @@
+"""The stages of a study, one module each, and the only code that writes a stage's files.
+
+Every stage is a function ``run_<stage>(settings, inputs, folder, progress=None)``:
+
+- ``settings`` is the validated run configuration (:class:`flatcontact.config.RunConfig`);
+  the stage reads only its own sections (and ``report.svg`` for its figures);
+- ``inputs`` is a small frozen dataclass naming what the stage reads from upstream (files,
+  or values such as the fitted laws), so the stage never looks into a run directory;
+- ``folder`` receives the stage's files (``None``: compute and write nothing);
+- ``progress`` is an optional callback (the scan calls ``progress(done, total)``).
+
+It returns a typed result whose ``to_json()`` defines the keys of the stage's JSON file
+once. ``flatcontact <stage>`` (:mod:`flatcontact.cli`) and ``flatcontact run``
+(:mod:`flatcontact.pipeline`) both call these functions, so they write the same files.
+
+=========  =====================================  ==========================================
+stage      function                               files
+=========  =====================================  ==========================================
+build      :func:`.build.run_build`               interface.extxyz, build.json, fig1_interface
+scan       :func:`.scan.run_scan_stage`           points.db, ispes.nc, scan.json, fig_scan_columns
+analyze    :func:`.analyze.run_analyze`           friction.csv, friction.nc, analyze.json, fig2_p*
+laws       :func:`.laws.run_laws`                 laws.json, fig3_laws
+elastic    :func:`.elastic.run_elastic`           elastic.json
+contact    :func:`.contact.run_contact`           contact.nc, summary.json, fig4, fig5, (fig6)
+report     :func:`.report.run_report`             report.html
+=========  =====================================  ==========================================
+"""

@@ -1,0 +1,86 @@
+"""The run's interaction model as the stages see it: the one place they touch
+:class:`flatcontact.potentials.InteractionModel` (``settings.potential``).
+
+Everything goes through the model's API (``label``, ``fingerprint()``, ``check_atoms``,
+``calculator_factory()``, ``bulk_calculator``); nothing here branches on the kind of model
+except the report's reading of it (:func:`intra`, :func:`lj`).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from flatcontact.errors import InputError
+
+#: The elements the elastic stage's crystal (α-quartz) needs.
+QUARTZ_ELEMENTS = frozenset({"Si", "O"})
+
+
+def model(settings) -> Any:
+    """The run's :class:`~flatcontact.potentials.InteractionModel`."""
+    return settings.potential
+
+
+def label(settings) -> str:
+    """Human-readable name of the run's interaction model."""
+    return settings.potential.label
+
+
+def fingerprint(settings) -> dict:
+    """The model's part of a stage fingerprint: content-based (files by name and SHA-256)."""
+    return settings.potential.fingerprint()
+
+
+def factory(settings) -> Any:
+    """The picklable calculator factory of the scan workers (``factory(atoms)``)."""
+    return settings.potential.calculator_factory()
+
+
+def check_atoms(settings, atoms) -> None:
+    """One-line InputError when the model cannot compute ``atoms`` (element, LJ table)."""
+    settings.potential.check_atoms(atoms)
+
+
+def toy_kwargs(settings) -> dict:
+    """Keyword arguments of the toy interface: the toy calculator's (they set its LJ)."""
+    calc = settings.potential.calculator
+    return dict(calc.kwargs) if calc is not None else {}
+
+
+def check_elastic(settings) -> None:
+    """The elastic stage computes α-quartz: the model must know Si and O (when it says)."""
+    known = settings.potential.elements
+    if known is not None and not QUARTZ_ELEMENTS <= known:
+        raise InputError(
+            f"elastic.enabled: the model {settings.potential.label} has no parameters for "
+            f"{sorted(QUARTZ_ELEMENTS - known)}; the elastic stage computes alpha-quartz"
+        )
+
+
+def same_model(settings, built: Any) -> bool:
+    """Whether an interface's recorded model is the run's."""
+    return built == settings.potential
+
+
+def same_intra(settings, intra: str) -> bool:
+    """Whether an interface's recorded intra-slab name (older recipes) is the run's."""
+    m = settings.potential
+    return m.calculator is None and m.intra == intra
+
+
+def lj(settings) -> Any:
+    """The cross-interface LJ of the model, or ``None`` when it has none."""
+    m = settings.potential
+    return m.lj if m.coupling == "lj" and m.engine != "ase-interface" else None
+
+
+def intra(settings) -> str | None:
+    """The legacy intra-slab name (``vashishta``, ``snap:...``) of a LAMMPS model, else ``None``."""
+    m = settings.potential
+    return m.intra if m.engine == "lammps" and isinstance(m.intra, str) else None
+
+
+def check(settings) -> None:
+    """Checks of the model that need the file system or imports, before any work."""
+    if settings.elastic.enabled:
+        check_elastic(settings)

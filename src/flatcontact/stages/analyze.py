@@ -1,0 +1,123 @@
+"""Stage 3, analyze: constant-pressure ISPES, sliding path, τ, σ_MSS and G_int per load.
+
+Files: ``friction.csv``, ``friction.nc`` (:mod:`flatcontact.analysis.outputs`),
+``analyze.json`` (:meth:`AnalyzeResult.to_json`) and ``fig2_p<P>gpa.png`` (+ ``.svg``) per
+load. The load laws are not fitted here: they are the laws stage's (:mod:`.laws`), so a
+change of ``analysis.threshold_gpa`` reruns only that stage and leaves no stale warning of
+the old threshold in ``analyze.json``.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from flatcontact.fileio import atomic_path, write_json_atomic, write_text_atomic
+from flatcontact.stages._common import captured, renamed_errors, save
+
+FRICTION_CSV = "friction.csv"
+FRICTION_NC = "friction.nc"
+ANALYZE_JSON = "analyze.json"
+
+#: Parameters of :func:`flatcontact.analysis.pipeline.analyze_ispes` -> the settings path.
+SETTINGS_NAMES = {
+    "p_gpa": "analysis.p_gpa",
+    "direction_deg": "analysis.direction_deg",
+    "form": "analysis.energy_form",
+    "energy_zero": "analysis.energy_zero",
+    "load_source": "analysis.load_source",
+    "allow_missing": "analysis.allow_missing",
+}
+
+log = logging.getLogger("flatcontact.run")
+
+
+@dataclass(frozen=True)
+class AnalyzeInputs:
+    """The ISPES grid to analyse (``ispes.nc``)."""
+
+    ispes: Path
+
+
+@dataclass
+class AnalyzeResult:
+    """The analysis (:class:`flatcontact.analysis.pipeline.AnalysisResult`, ``laws`` None)
+    and the analysis warnings raised while computing it (``"Category: message"``)."""
+
+    analysis: Any
+    warnings: list[str] = field(default_factory=list)
+    files: list[Path] = field(default_factory=list)
+
+    def to_json(self) -> dict:
+        """``analyze.json``: warnings, timings, Fig. 2 names, symmetry, energy zero, load noise."""
+        result = self.analysis
+        return {
+            "warnings": list(self.warnings),
+            "timings_s": result.timings_s,
+            "fig2": [f"fig2_p{pa.p_gpa:g}gpa" for pa in result.pressures],
+            "symmetry": {
+                f"{pa.p_gpa:g}": pa.symmetry.to_json()
+                for pa in result.pressures
+                if pa.symmetry is not None
+            },
+            "energy_reference_ev_per_a2": result.energy_reference_ev_per_a2,
+            "load_source": result.load_source,
+            "noise": result.noise.to_json(),
+        }
+
+
+def run_analyze(
+    settings, inputs: AnalyzeInputs, folder: Path | None, progress=None
+) -> AnalyzeResult:
+    """Analyse ``inputs.ispes`` at ``settings.analysis.p_gpa`` (see the module docstring).
+
+    Raises
+    ------
+    InputError
+        One line; a bad value names its settings path (``analysis.energy_form``), which the
+        CLI translates to its flag.
+    """
+    from flatcontact.analysis.diagnostics import AnalysisWarning
+    from flatcontact.analysis.pipeline import analyze_ispes
+    from flatcontact.ispes.contract import open_ispes
+
+    s = settings.analysis
+    with renamed_errors(SETTINGS_NAMES):
+        ds = open_ispes(inputs.ispes)
+        with captured(AnalysisWarning) as caught:
+            analysis = analyze_ispes(
+                ds,
+                s.p_gpa,
+                direction_deg=s.direction_deg,
+                form=s.energy_form,
+                load_source=s.load_source,
+                energy_zero=s.energy_zero,
+                allow_missing=s.allow_missing,
+                threshold_gpa=None,
+                with_mep=s.with_mep,
+                source=str(inputs.ispes),
+            )
+    notes = [f"{w.category.__name__}: {w.message}" for w in caught]
+    for note in notes:
+        log.warning("analyze: %s", note)
+    result = AnalyzeResult(analysis, notes)
+    if folder is not None:
+        _write(result, folder, settings.report.svg)
+    return result
+
+
+def _write(result: AnalyzeResult, folder: Path, svg: bool) -> None:
+    from flatcontact.analysis.outputs import friction_csv_text, friction_dataset
+    from flatcontact.plots.analysis import figure_pressure
+
+    folder.mkdir(parents=True, exist_ok=True)
+    analysis = result.analysis
+    result.files.append(write_text_atomic(folder / FRICTION_CSV, friction_csv_text(analysis)))
+    with atomic_path(folder / FRICTION_NC) as tmp:
+        friction_dataset(analysis).to_netcdf(tmp, engine="h5netcdf")
+    result.files.append(folder / FRICTION_NC)
+    for pa in analysis.pressures:
+        result.files += save(figure_pressure(pa, analysis), folder, f"fig2_p{pa.p_gpa:g}gpa", svg)
+    result.files.append(write_json_atomic(folder / ANALYZE_JSON, result.to_json()))

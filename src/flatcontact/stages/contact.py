@@ -1,0 +1,228 @@
+"""Stage 6, contact: the modified Mindlin contact at every ``contact.p0_gpa``.
+
+Files: ``contact.nc`` (Q(u) and stiffness curves, per-p0 scalars), ``summary.json``
+(:meth:`ContactResult.to_json`: parameters and where each comes from, conventions, the
+per-p0 results, the same with the paper's laws, and the measured-data comparison) and the
+figures ``fig4_traction``, ``fig5_force_stiffness`` (amplitude), ``fig5_force_stiffness_rms``
+and, with ``contact.experiment_csv``, ``fig6_experiment`` (PNG, + SVG with ``report.svg``).
+
+Fig. 4 is drawn at 60 % of the displacement at the peak force
+(:data:`flatcontact.plots.contact.FIG4_FRACTION_OF_PEAK`) at p0 = 1 GPa (or the first p0),
+so both the stick and the slip zone show whatever the laws.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from flatcontact.errors import InputError
+from flatcontact.fileio import write_json_atomic
+from flatcontact.reference import PAPER, PAPER_LAW_KEYS
+from flatcontact.stages._common import renamed_errors, save
+
+SUMMARY_JSON = "summary.json"
+CONTACT_NC = "contact.nc"
+#: ContactParameters fields -> the settings path that sets them.
+SETTINGS_NAMES = {
+    name: f"contact.{name}"
+    for name in (
+        "radius_um",
+        "contact_modulus_gpa",
+        "shear_modulus_gpa",
+        "work_of_adhesion_j_m2",
+        *PAPER_LAW_KEYS,
+    )
+}
+
+
+@dataclass(frozen=True)
+class ContactInputs:
+    """What the contact model takes from upstream stages (all optional).
+
+    ``laws``: ``laws.json`` of the laws stage (k, τ0, μ, σ0 where ``contact`` gives none);
+    ``work_of_separation_j_per_m2``: the scan's (w where ``contact.work_of_adhesion_j_m2``
+    is null; ``from_scan`` says a scan was read); ``moduli``: ``elastic.json`` of the elastic
+    stage (E*, G* replacing ``contact.contact_modulus_gpa``/``shear_modulus_gpa``).
+    """
+
+    laws: dict | None = None
+    work_of_separation_j_per_m2: float | None = None
+    from_scan: bool = False
+    moduli: dict | None = None
+
+
+def contact_parameters(settings, inputs: ContactInputs):
+    """The :class:`~flatcontact.contact.parameters.ContactParameters` and their provenance.
+
+    k, τ0, μ, σ0 come from ``contact`` where given, else from the fitted laws; w is
+    ``contact.work_of_adhesion_j_m2`` or the scan's work of separation; E*, G* come from the
+    elastic stage when it ran. Errors name the settings path (``contact.tau0_mpa``).
+    """
+    from flatcontact.contact.parameters import ContactParameters
+
+    c = settings.contact
+    laws = inputs.laws or {}
+    provenance: dict[str, str] = {}
+    values = {}
+    for key in PAPER_LAW_KEYS:
+        given = getattr(c, key)
+        if given is not None:
+            values[key], provenance[key] = given, "config"
+            continue
+        fitted = laws.get(key)
+        if fitted is None:
+            why = "; ".join(laws.get("warnings", [])) or "too few loads"
+            if inputs.laws is None:
+                why = "no fitted laws were given"
+            raise InputError(
+                f"contact.{key}: the load law could not be fitted ({why}); give contact.{key}"
+            )
+        # negative slopes pass through: the model takes k < 0, μ < 0 wherever τ > 0
+        # and σ >= 0 on the contact, and refuses the p0 where they are not
+        values[key], provenance[key] = fitted, "fitted laws"
+    w = c.work_of_adhesion_j_m2
+    provenance["work_of_adhesion_j_m2"] = "config"
+    if w is None:
+        w = inputs.work_of_separation_j_per_m2
+        provenance["work_of_adhesion_j_m2"] = "scan work of separation"
+        if w is None or not w > 0:
+            why = "none (no probe column)" if inputs.from_scan else "none"
+            w, provenance["work_of_adhesion_j_m2"] = 0.0, why
+    e_star, g_star = c.contact_modulus_gpa, c.shear_modulus_gpa
+    provenance["moduli"] = "config"
+    if inputs.moduli is not None:
+        e_star, g_star = inputs.moduli["contact_modulus_gpa"], inputs.moduli["shear_modulus_gpa"]
+        provenance["moduli"] = "elastic stage"
+    try:
+        with renamed_errors(SETTINGS_NAMES):
+            params = ContactParameters(
+                radius_um=c.radius_um,
+                contact_modulus_gpa=e_star,
+                shear_modulus_gpa=g_star,
+                work_of_adhesion_j_m2=float(w),
+                **values,
+            )
+    except InputError as exc:  # e.g. a fitted τ0 < 0, or k < 0 with τ0 = 0
+        sources = ", ".join(f"contact.{k} from {provenance[k]}" for k in values)
+        raise InputError(f"{exc} ({sources})") from None
+    return params, provenance
+
+
+def check_contact(settings, params) -> None:
+    """Everything the contact stage refuses, before any work (one line naming the setting)."""
+    c = settings.contact
+    # with k < 0 or μ < 0 the model is defined only where τ > 0 and σ >= 0 on the whole
+    # contact (p0 < τ0/|k|, p0 <= σ0/|μ|)
+    params.check_p0_gpa(c.p0_gpa, "contact.p0_gpa")
+    if c.experiment_csv:
+        params.check_p0_gpa(c.experiment_p0_gpa, "contact.experiment_p0_gpa")
+    if c.maugis_lambda is not None and not params.work_of_adhesion_j_m2 > 0:
+        raise InputError(
+            "contact.maugis_lambda: the Maugis–Dugdale radius needs a work of adhesion > 0 "
+            "(contact.work_of_adhesion_j_m2, or the scan's work of separation)"
+        )
+
+
+@dataclass
+class ContactResult:
+    """The contact analysis, its parameters and provenance, and the paper-laws comparison."""
+
+    analysis: Any  # flatcontact.contact.summary.ContactAnalysis
+    params: Any
+    provenance: dict
+    knee_fraction: float
+    paper: Any = None  # the same analysis with the paper's k, τ0, μ, σ0 (None: identical)
+    experiment: dict | None = None
+    files: list[Path] = field(default_factory=list)
+
+    def to_json(self) -> dict:
+        """``summary.json``."""
+        doc = {
+            "parameters": self.params.as_dict(),
+            "provenance": self.provenance,
+            "conventions": {
+                "shear_modulus": "paper: q0 = G* u/(pi a); Johnson's G*_J = G*/4",
+                "effective_shear_strength_mpa": "amplitude Q_peak/(pi a^2)",
+                "effective_shear_strength_rms_mpa": "Q_peak/(sqrt(2) pi a^2)",
+                "knee": f"stress where d<Q>/d<u> = {self.knee_fraction:g} x initial stiffness",
+            },
+            "results": self.analysis.records(),
+            "results_with_paper_laws": (self.paper or self.analysis).records(),
+        }
+        if self.experiment is not None:
+            doc["experiment"] = self.experiment
+        return doc
+
+
+def run_contact(
+    settings, inputs: ContactInputs, folder: Path | None, progress=None
+) -> ContactResult:
+    """The modified Mindlin contact of ``settings.contact`` with the upstream ``inputs``."""
+    from flatcontact.contact import experiment as exp
+    from flatcontact.contact.summary import analyse
+
+    c = settings.contact
+    params, provenance = contact_parameters(settings, inputs)
+    check_contact(settings, params)
+    measured = exp.load_stiffness_csv(c.experiment_csv) if c.experiment_csv else None
+    analysis = analyse(
+        c.p0_gpa,
+        params,
+        maugis_lambda=c.maugis_lambda,
+        knee_fraction=c.knee_fraction,
+        p0_name="contact.p0_gpa",
+    )
+    paper_laws = {key: PAPER[key] for key in PAPER_LAW_KEYS}
+    paper = None
+    if any(getattr(params, k) != v for k, v in paper_laws.items()):
+        paper = analyse(
+            c.p0_gpa,
+            params.replace(**paper_laws),
+            maugis_lambda=c.maugis_lambda,
+            knee_fraction=c.knee_fraction,
+        )
+    result = ContactResult(analysis, params, provenance, c.knee_fraction, paper)
+    comparison = None
+    if measured is not None:
+        comparison = exp.compare_with_measurement(
+            measured,
+            c.experiment_p0_gpa,
+            params,
+            fraction=c.collapse_fraction,
+            measure=c.experiment_stress_measure,
+        )
+        result.experiment = comparison.to_json()
+    if folder is not None:
+        _write(result, settings, folder, measured, comparison)
+    return result
+
+
+def _write(result: ContactResult, settings, folder: Path, measured, comparison) -> None:
+    from flatcontact.plots.contact import fig4_traction, fig5_force_and_stiffness, fig6_overlay
+
+    c, analysis, params = settings.contact, result.analysis, result.params
+    folder.mkdir(parents=True, exist_ok=True)
+    p0_fig4 = 1.0 if 1.0 in analysis.p0_gpa else analysis.p0_gpa[0]
+    figs = {
+        "fig4_traction": fig4_traction(params, p0_fig4),
+        "fig5_force_stiffness": fig5_force_and_stiffness(analysis, "amplitude"),
+        "fig5_force_stiffness_rms": fig5_force_and_stiffness(analysis, "rms"),
+    }
+    if comparison is not None:
+        figs["fig6_experiment"] = fig6_overlay(
+            measured,
+            c.experiment_p0_gpa,
+            {
+                f"τ0 = {params.tau0_mpa:.3g} MPa (run)": params,
+                f"fitted τ0 = {comparison.fitted_tau0_mpa:.3g} MPa": comparison.fitted_params,
+            },
+            measure=c.experiment_stress_measure,
+            measured_collapse_mpa=result.experiment["measured_collapse_stress_mpa"],
+        )
+    for name, fig in figs.items():
+        result.files += save(fig, folder, name, settings.report.svg)
+    analysis.write_netcdf(folder / CONTACT_NC)
+    result.files.append(folder / CONTACT_NC)
+    result.files.append(write_json_atomic(folder / SUMMARY_JSON, result.to_json()))

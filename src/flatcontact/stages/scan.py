@@ -1,0 +1,169 @@
+"""Stage 2, scan: the ISPES grid of the interface (resumable, parallel).
+
+Files: ``points.db`` (the resumable point store), ``ispes.nc`` (the ISPES contract),
+``scan.json`` (:meth:`ScanStageResult.to_json`) and ``fig_scan_columns.png`` (+ ``.svg``).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from flatcontact.errors import InputError
+from flatcontact.fileio import write_json_atomic
+from flatcontact.stages import _calculator
+from flatcontact.stages._common import save
+
+SCAN_JSON = "scan.json"
+FIGURE_STEM = "fig_scan_columns"
+
+log = logging.getLogger("flatcontact.run")
+
+
+@dataclass(frozen=True)
+class ScanInputs:
+    """The interface to scan (``interface.extxyz`` of the build stage or ``flatcontact build``)."""
+
+    interface: Path
+
+
+@dataclass
+class ScanStageResult:
+    """What the scan stage did: the scan driver's result and the stage's warnings."""
+
+    scan: Any  # flatcontact.ispes.scan.ScanResult
+    warnings: list[str] = field(default_factory=list)
+    files: list[Path] = field(default_factory=list)
+
+    @property
+    def dataset(self):
+        """The ``ispes.nc`` content (xarray Dataset)."""
+        return self.scan.dataset
+
+    def to_json(self) -> dict:
+        """``scan.json``: counts, force calls, thicknesses, adhesion, notes and warnings."""
+        r, ds = self.scan, self.scan.dataset
+        calls = r.force_calls_computed
+        return {
+            "points_total": r.points_total,
+            "points_done": r.points_done,
+            "points_computed": r.points_computed,
+            "converged": int(ds["converged"].sum()),
+            "force_calls_total": int(np.nansum(ds["force_calls"].values)),
+            "median_force_calls_per_point": float(np.median(calls)) if calls else None,
+            "thickness_angstrom": [float(z) for z in ds["thickness"].values],
+            "area_angstrom2": float(ds.attrs["area"]),
+            "potential": str(ds.attrs.get("potential", "")),
+            "adhesion": r.adhesion,
+            "notes": list(r.notes),
+            "warnings": list(self.warnings),
+        }
+
+
+def built_with_other_model(reference, settings) -> str | None:
+    """The model an interface's recipe names when it is not the run's, else ``None``.
+
+    The recipe (``info["recipe"]``, written by :mod:`flatcontact.structures.build`) holds the
+    whole ``PotentialSpec`` (``potential_spec``; older files only its label ``potential``, of
+    which the intra-slab part is compared). A recipe naming no potential gives ``None``.
+    """
+    from flatcontact.potentials.spec import PotentialSpec, normalize_potential_name
+
+    try:
+        recipe = json.loads(reference.info.get("recipe", "{}") or "{}")
+    except (TypeError, ValueError):
+        return None
+    if not isinstance(recipe, dict):
+        return None
+    if isinstance(recipe.get("potential_spec"), dict):
+        try:
+            built = PotentialSpec(**recipe["potential_spec"])
+        except (InputError, TypeError):
+            return str(recipe["potential_spec"].get("intra", "an unknown model"))
+        return None if _calculator.same_model(settings, built) else built.label
+    label = recipe.get("potential")
+    if not isinstance(label, str) or not label:
+        return None
+    intra = label.split("+LJ(")[0]
+    try:
+        intra = normalize_potential_name(intra)
+    except InputError:
+        pass
+    return None if _calculator.same_intra(settings, intra) else label
+
+
+def _no_repulsive_branch(ds) -> str | None:
+    """A warning when no scanned thickness is under compression (p > 0 nowhere).
+
+    Such a grid holds only the separated (tensile) branch; the constant-pressure analysis at
+    P >= 0 needs thicknesses where the slabs push back (p = normal_stress > 0, compressive).
+    """
+    p = np.asarray(ds.normal_stress.values, dtype=float)
+    if p.size and not np.any(p[np.isfinite(p)] > 0):
+        z = [float(v) for v in ds.thickness.values]
+        return (
+            f"no scanned thickness reached p > 0 (max {np.nanmax(p):.3g} GPa at z = "
+            f"{min(z):g}..{max(z):g} Å): the interface is separated everywhere and "
+            "'flatcontact analyze' has no repulsive branch; scan smaller thicknesses"
+        )
+    return None
+
+
+def run_scan_stage(
+    settings,
+    inputs: ScanInputs,
+    folder: Path,
+    progress: Callable[[int, int], None] | None = None,
+) -> ScanStageResult:
+    """Scan ``inputs.interface`` with the run's model on ``settings.scan``'s grid into ``folder``.
+
+    Checks before any relaxation: the interface contract, the model's elements, the grid and
+    the store's settings (:func:`flatcontact.ispes.scan.run_scan`). A different model than the
+    one the interface was relaxed with is a warning (its reference stacking and thickness are
+    not the scan model's), in ``scan.json`` and on the console. Ctrl-C raises
+    :class:`flatcontact.ispes.scan.ScanInterrupted` after the store is consistent.
+    """
+    from flatcontact.ispes.scan import run_scan
+    from flatcontact.plots.scan import figure_scan_columns
+    from flatcontact.structures.interface import read_interface
+
+    s = settings.scan
+    reference = read_interface(inputs.interface)
+    _calculator.check_atoms(settings, reference)
+    factory = _calculator.factory(settings)
+    warnings = []
+    built_with = built_with_other_model(reference, settings)
+    if built_with is not None:
+        warnings.append(
+            f"{inputs.interface} was built with {built_with}, this scan uses "
+            f"{_calculator.label(settings)}: its reference stacking and thickness are not the "
+            "relaxed ones of the scan's model"
+        )
+        log.warning("scan: %s", warnings[-1])
+    scan = run_scan(
+        reference,
+        factory,
+        s.grid_spec(),
+        folder,
+        s.relax_settings(),
+        order=s.order,
+        executor_options=s.executor_options(),
+        progress=progress,
+    )
+    separated = _no_repulsive_branch(scan.dataset)
+    if separated is not None:
+        warnings.append(separated)
+    for note in scan.notes:
+        log.warning("scan: %s", note)
+    result = ScanStageResult(scan, warnings, [scan.store_path, scan.ispes_path])
+    result.files.append(write_json_atomic(folder / SCAN_JSON, result.to_json()))
+    result.files += save(
+        figure_scan_columns(scan.dataset, scan.adhesion), folder, FIGURE_STEM, settings.report.svg
+    )
+    return result
