@@ -39,6 +39,7 @@ from pydantic import (
     model_validator,
 )
 
+from flatcontact.contact.cycle import DEFAULT_AMPLITUDE_FRACTIONS as CYCLE_AMPLITUDE_FRACTIONS
 from flatcontact.errors import InputError
 from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.order import PREFERENCES
@@ -383,6 +384,76 @@ class ContactConfig(_Section):
     collapse_fraction: float = Field(
         0.2, gt=0, lt=1, description="collapse: stiffness first below this fraction of the plateau"
     )
+    # issue 13: the oscillation cycle and the multi-load fit. Each field is left out of the
+    # dumped config at its default, so the fingerprints of existing runs are unchanged.
+    cycle: bool = Field(
+        False,
+        exclude_if=lambda value: value is False,
+        description="steady load-controlled cycle per p0: loops, dissipated energy per cycle, "
+        "lock-in stiffness Q_amp/u'_1 and quadrature u''_1 (summary.json 'cycle', contact.nc)",
+    )
+    model: Literal["modified", "classical"] = Field(
+        "modified",
+        exclude_if=lambda value: value == "modified",
+        description="model of the cycle: modified (the paper's Mindlin model) or classical "
+        "(Cattaneo-Mindlin, friction coefficient mu = k, Johnson's G*_J = G*/4)",
+    )
+    cycle_amplitude_fractions: list[float] = Field(
+        list(CYCLE_AMPLITUDE_FRACTIONS),
+        exclude_if=lambda value: list(value) == list(CYCLE_AMPLITUDE_FRACTIONS),
+        description="force amplitudes of the cycle as fractions of the gross-sliding force, "
+        "each in (0, 1)",
+    )
+    cycle_amplitudes_un: list[float] | None = Field(
+        None,
+        exclude_if=lambda value: value is None,
+        description="force amplitudes of the cycle in uN (each below gross sliding at every "
+        "p0); null: cycle_amplitude_fractions",
+    )
+    fit_csv: list[str] = Field(
+        [],
+        exclude_if=lambda value: not value,
+        description="measured stiffness CSVs to fit at several loads at once (one per load, "
+        "or with a load column 'p0 [GPa]'/'normal load [uN]'; relative to the config file)",
+    )
+    fit_p0_gpa: list[float] | None = Field(
+        None,
+        exclude_if=lambda value: value is None,
+        description="p0 (GPa) of each fit_csv file without a load column, one per file",
+    )
+    fit_free: list[str] = Field(
+        ["tau0_mpa"],
+        exclude_if=lambda value: list(value) == ["tau0_mpa"],
+        description="parameters the fit frees (tau0_mpa, k_mpa_per_gpa, mu_mpa_per_gpa, "
+        "sigma0_mpa, shear_modulus_gpa); the rest are held at their values",
+    )
+    fit_fixed: list[str] = Field(
+        [],
+        exclude_if=lambda value: not value,
+        description="parameters the fit must hold (checked against fit_free)",
+    )
+    fit_stiffness: Literal["lockin", "paper"] = Field(
+        "lockin",
+        exclude_if=lambda value: value == "lockin",
+        description="model stiffness the fit compares with the data: lockin (Q_amp/u'_1, "
+        "what a lock-in amplifier reads) or paper (d<Q>/d<u>)",
+    )
+
+    @field_validator("cycle_amplitude_fractions")
+    @classmethod
+    def _fractions(cls, value: list[float]) -> list[float]:
+        if not value or any(not 0.0 < v < 1.0 for v in value):
+            raise ValueError(
+                f"expected fractions of the gross-sliding force in (0, 1), got {_show(value)}"
+            )
+        return [float(v) for v in value]
+
+    @field_validator("cycle_amplitudes_un")
+    @classmethod
+    def _amplitudes(cls, value: list[float] | None) -> list[float] | None:
+        if value is not None and (not value or any(not v > 0 for v in value)):
+            raise ValueError(f"expected positive force amplitudes in uN, got {_show(value)}")
+        return value
 
     @field_validator("p0_gpa")
     @classmethod
@@ -704,16 +775,34 @@ def load_config(path: str | Path | None = None, preset_name: str | None = None) 
             target = Path(block[key]).expanduser()
             if not target.is_absolute():
                 block[key] = str((path.parent / target).resolve())
+    _resolve_file_lists(data, path)
     cfg = build_config(data, preset_name, str(path))
     for section, key in _FILE_FIELDS:
         value = getattr(getattr(cfg, section), key)
         if value is not None and not Path(value).is_file():
             raise InputError(f"{path}: {section}.{key}: file {value} not found")
+    for section, key in _FILE_LIST_FIELDS:
+        for value in getattr(getattr(cfg, section), key):
+            if not Path(value).is_file():
+                raise InputError(f"{path}: {section}.{key}: file {value} not found")
     return cfg
+
+
+def _resolve_file_lists(data: dict, path: Path) -> None:
+    """Relative entries of the list-of-files fields, against the config file's directory."""
+    for section, key in _FILE_LIST_FIELDS:
+        block = data.get(section)
+        if isinstance(block, dict) and isinstance(block.get(key), list):
+            block[key] = [
+                str((path.parent / Path(v).expanduser()).resolve()) if isinstance(v, str) else v
+                for v in block[key]
+            ]
 
 
 #: Fields naming an input file (relative to the config file); they must exist.
 _FILE_FIELDS = (("structure", "file"), ("contact", "experiment_csv"))
+#: Fields naming a list of input files (each relative to the config file).
+_FILE_LIST_FIELDS = (("contact", "fit_csv"),)
 
 
 # --------------------------------------------------------------------------- YAML out

@@ -130,6 +130,7 @@ STAGE_CODE: dict[str, tuple[str, ...]] = {
         "contact",
         "plots/__init__.py",
         "plots/contact.py",
+        "plots/cycle.py",
         "reference.py",
         *_SHARED,
     ),
@@ -224,6 +225,10 @@ class Pipeline:
             from flatcontact.contact.experiment import load_stiffness_csv
 
             load_stiffness_csv(cfg.contact.experiment_csv)
+        if cfg.contact.fit_csv:
+            from flatcontact.stages.contact import check_fit_settings
+
+            check_fit_settings(cfg)
         _calculator.check(cfg)
 
     def _open_log(self) -> None:
@@ -494,6 +499,8 @@ class Pipeline:
         }
         if cfg.contact.experiment_csv:
             inputs["experiment_sha256"] = file_sha256(cfg.contact.experiment_csv)
+        if cfg.contact.fit_csv:
+            inputs["fit_sha256"] = [file_sha256(f) for f in cfg.contact.fit_csv]
 
         result = self._run("contact", inputs, lambda f: run_contact(cfg, stage_inputs, f))
         with xr.open_dataset(result.folder / CONTACT_NC, engine="h5netcdf") as ds:
