@@ -463,6 +463,80 @@ class ContactConfig(_Section):
         return [float(v) for v in value]
 
 
+_LAW_KEYS = ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa")
+#: Measured for the bundled sio2-snap + Hamaker-calibrated LJ on the α-quartz (0001) dense
+#: interface (docs/convergence.md, docs/teachers.md): per form, the largest change of each law
+#: coefficient under one refinement (grid 8→12, thicknesses 20→30, fmax 0.005→0.0025, LJ
+#: cutoff 14→18 Å) and half the SNAP–CHGNet r2SCAN spread (4×4 grid, an upper bound).
+MEASURED_LAW_UNCERTAINTY = {
+    "convergence_internal": {
+        "k_mpa_per_gpa": 6.48,
+        "tau0_mpa": 3.60,
+        "mu_mpa_per_gpa": 0.594,
+        "sigma0_mpa": 0.384,
+    },
+    "convergence_enthalpy": {
+        "k_mpa_per_gpa": 0.714,
+        "tau0_mpa": 1.56,
+        "mu_mpa_per_gpa": 0.052,
+        "sigma0_mpa": 0.147,
+    },
+    "model_spread_internal": {
+        "k_mpa_per_gpa": 0.064,
+        "tau0_mpa": 1.28,
+        "mu_mpa_per_gpa": 0.276,
+        "sigma0_mpa": 0.666,
+    },
+    "model_spread_enthalpy": {
+        "k_mpa_per_gpa": 2.52,
+        "tau0_mpa": 7.40,
+        "mu_mpa_per_gpa": 0.338,
+        "sigma0_mpa": 0.425,
+    },
+    "source": "measured for the bundled sio2-snap + Hamaker LJ, alpha-quartz (0001) dense, "
+    "paper-preset settings (docs/convergence.md, docs/teachers.md); a lower bound for coarser "
+    "grids, not a measurement for another model or surface",
+}
+
+
+class UncertaintyConfig(_Section):
+    """Uncertainty of the load laws beyond the fit (stage ``laws``; propagated by ``contact``).
+
+    Per coefficient c the half-width is coverage·sqrt(se_fit² + δ_conv² + δ_model²)
+    (:func:`flatcontact.analysis.uncertainty.law_half_widths`), per energy form.
+    """
+
+    convergence_internal: dict[str, float] = Field(
+        {}, description="δ_conv per law coefficient, internal form (change under one refinement)"
+    )
+    convergence_enthalpy: dict[str, float] = Field(
+        {}, description="δ_conv per law coefficient, enthalpy form"
+    )
+    model_spread_internal: dict[str, float] = Field(
+        {}, description="δ_model per law coefficient, internal form (half the spread over models)"
+    )
+    model_spread_enthalpy: dict[str, float] = Field(
+        {}, description="δ_model per law coefficient, enthalpy form"
+    )
+    coverage: float = Field(1.0, gt=0, description="multiple of the combined standard error")
+    source: str = Field("", description="where the δ_conv and δ_model numbers come from")
+
+    @field_validator(
+        "convergence_internal",
+        "convergence_enthalpy",
+        "model_spread_internal",
+        "model_spread_enthalpy",
+    )
+    @classmethod
+    def _coefficients(cls, value: dict[str, float]) -> dict[str, float]:
+        for key, v in value.items():
+            if key not in _LAW_KEYS:
+                raise ValueError(f"{key!r}: expected law coefficients among {', '.join(_LAW_KEYS)}")
+            if not (v == v and 0.0 <= float(v) < float("inf")):
+                raise ValueError(f"{key} = {_show(v)}: expected a finite value >= 0")
+        return {k: float(v) for k, v in value.items()}
+
+
 class ReportConfig(_Section):
     """The HTML report (stage ``report``)."""
 
@@ -502,6 +576,12 @@ class RunConfig(_Section):
     )
     elastic: ElasticConfig = Field(
         default_factory=ElasticConfig, description="optional self-consistent E*, G* (stage elastic)"
+    )
+    uncertainty: UncertaintyConfig = Field(
+        default_factory=UncertaintyConfig,
+        # left out of the dump while empty, so the fingerprints of existing runs are unchanged
+        exclude_if=lambda value: value == UncertaintyConfig(),
+        description="uncertainty of the laws beyond the fit (convergence, model spread)",
     )
     contact: ContactConfig = Field(
         default_factory=ContactConfig, description="modified Mindlin contact (stage contact)"
@@ -633,6 +713,7 @@ def preset(name: str) -> dict:
             },
             "analysis": {"p_gpa": [0.0, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 4.5]},
             "contact": {"p0_gpa": [0.5, 1.0, 1.5, 1.77, 2.0, 2.5, 3.0]},
+            "uncertainty": copy.deepcopy(MEASURED_LAW_UNCERTAINTY),
             "report": {"title": "flatcontact run (paper preset)", "fig2_p_gpa": [0.5, 1.0, 3.0]},
         }
     raise InputError(f"preset: expected quick or paper, got {name!r}")

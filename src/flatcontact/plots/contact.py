@@ -100,7 +100,10 @@ def fig4_traction(
 
 
 def fig5_force_and_stiffness(
-    analysis: ContactAnalysis, measure: str = "amplitude", lockin: Sequence[Any] | None = None
+    analysis: ContactAnalysis,
+    measure: str = "amplitude",
+    lockin: Sequence[Any] | None = None,
+    bands: Sequence[ContactAnalysis] | None = None,
 ) -> Figure:
     """Fig. 5: (a) Q(u) for each p0; (b) oscillatory stiffness vs mean shear stress (``measure``).
 
@@ -109,6 +112,9 @@ def fig5_force_and_stiffness(
     stiffness k′ = Q_amp/u′₁ (dash-dot, what a lock-in amplifier measures) next to the
     paper's d⟨Q⟩/d⟨u⟩ (solid), against the same stress measure (amplitude Q_amp/πa², rms
     Q_amp/(√2 πa²)), falling to 0 at gross sliding.
+
+    ``bands``: the analyses at the lower and upper corner of the load laws' uncertainty box
+    (same p0); Q(u) and the stiffness curve of each p0 are shaded between them.
     """
     fig = Figure(figsize=(11, 4.2), layout="constrained")
     ax, bx = fig.subplots(1, 2)
@@ -126,6 +132,28 @@ def fig5_force_and_stiffness(
             color=line.get_color(),
         )
         cv = analysis.curves[i]
+        if bands is not None:
+            lo, hi = (b.curves[i] for b in bands)
+            x_hi = hi.stress_pa(measure) / units.MPA_TO_PA
+            k_lo = np.interp(
+                x_hi, lo.stress_pa(measure) / units.MPA_TO_PA, lo.stiffness_n_per_m, right=0.0
+            )
+            bx.fill_between(
+                x_hi, k_lo, hi.stiffness_n_per_m, color=line.get_color(), alpha=0.15, lw=0
+            )
+            ax.fill_between(
+                bands[1].displacement_m[i] / units.NM_TO_M,
+                np.interp(
+                    bands[1].displacement_m[i],
+                    bands[0].displacement_m[i],
+                    bands[0].response.lateral_force_n[i],
+                )
+                * units.N_TO_UN,
+                bands[1].response.lateral_force_n[i] * units.N_TO_UN,
+                color=line.get_color(),
+                alpha=0.15,
+                lw=0,
+            )
         bx.plot(
             cv.stress_pa(measure) / units.MPA_TO_PA,
             cv.stiffness_n_per_m,
@@ -158,8 +186,11 @@ def fig5_force_and_stiffness(
     label = r"$Q_{max}/\pi a^2$" if measure == "amplitude" else r"$\langle Q\rangle/\pi a^2$"
     bx.set_xlabel(f"mean shear stress, {measure} {label} (MPa)")
     bx.set_ylabel(r"lateral stiffness $d\langle Q\rangle/d\langle u\rangle$ (N/m)")
+    if bands is not None:
+        ax.set_title("(a) Q(u); dots: peak; shaded: the laws' uncertainty box", fontsize=10)
     bx.set_title(
         "(b) oscillatory stiffness d⟨Q⟩/d⟨u⟩; x: knee"
+        + ("; shaded: laws' uncertainty" if bands is not None else "")
         + ("\ndash-dot: lock-in Q_amp/u'₁, what a lock-in amplifier measures" if lockin else ""),
         fontsize=10 if lockin else None,
     )

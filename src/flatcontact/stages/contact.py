@@ -27,6 +27,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from flatcontact.errors import InputError
 from flatcontact.fileio import atomic_path, write_json_atomic
 from flatcontact.reference import PAPER, PAPER_LAW_KEYS
@@ -164,6 +166,72 @@ def fit_curves(settings, params) -> list:
         raise InputError(f"contact.fit_csv: {text}") from None
 
 
+def law_half_widths_used(inputs: ContactInputs, provenance: dict) -> dict[str, float]:
+    """Half-widths of the law coefficients the contact model takes from the fitted laws
+    (``laws.json`` ``half_widths`` of its configured energy form); 0 for a coefficient set
+    in ``contact`` (a given number has no fit, convergence or model error here)."""
+    laws = inputs.laws or {}
+    form = laws.get("energy_form")
+    hw = (laws.get(form) or {}).get("half_widths", {}) if form else {}
+    return {
+        key: float(hw.get(key) or 0.0) if provenance.get(key) == "fitted laws" else 0.0
+        for key in PAPER_LAW_KEYS
+    }
+
+
+def contact_intervals(settings, params, half_widths: dict[str, float]) -> dict:
+    """Intervals of the effective shear strength Q_peak/πa², the collapse stress (stiffness
+    at ``contact.collapse_fraction``·k0) and the knee (``knee_fraction``·k0), amplitude stress,
+    at every p0, over the box of the law coefficients ± ``half_widths``
+    (:func:`flatcontact.analysis.uncertainty.propagate_box`; τ0 and σ0 clipped at 0).
+
+    Returns ``{"half_widths", "method", "results": [{"p0_gpa", <quantity>: {"low", "value",
+    "high"}}]}``, or with ``"unavailable"`` (the reason) when a corner of the box leaves the
+    model's domain (e.g. τ(centre) <= 0 for k < 0).
+    """
+    from flatcontact import units
+    from flatcontact.analysis.uncertainty import propagate_box
+    from flatcontact.contact import experiment, mindlin, oscillation
+
+    c = settings.contact
+    p0s = [float(p) for p in c.p0_gpa]
+    names = ("effective_shear_strength_mpa", "collapse_stress_mpa", "knee_stress_amplitude_mpa")
+
+    def outputs(x: dict[str, float]) -> dict[str, float]:
+        prm = params.replace(**x)
+        out = {}
+        for i, p0 in enumerate(p0s):
+            pa = p0 * units.GPA_TO_PA
+            area = np.pi * float(mindlin.contact_radius(pa, prm)) ** 2
+            peak = float(mindlin.peak_force(pa, prm).force_n)
+            knee = oscillation.amplitude_at_stiffness_fraction(pa, prm, c.knee_fraction)
+            collapse = experiment.model_collapse_stress(pa, prm, fraction=c.collapse_fraction)
+            out[(i, names[0])] = peak / area / units.MPA_TO_PA
+            out[(i, names[1])] = collapse / units.MPA_TO_PA
+            out[(i, names[2])] = knee / area / units.MPA_TO_PA
+        return out
+
+    doc: dict = {
+        "half_widths": dict(half_widths),
+        "method": "box of the law coefficients +- half-width (laws.json), every corner "
+        "evaluated; tau0, sigma0 clipped at 0; amplitude stresses",
+    }
+    central = {k: float(getattr(params, k)) for k in PAPER_LAW_KEYS}
+    try:
+        box = propagate_box(outputs, central, half_widths, nonnegative=("tau0_mpa", "sigma0_mpa"))
+    except InputError as exc:
+        doc["unavailable"] = str(exc)
+        return doc
+    doc["results"] = [
+        {
+            "p0_gpa": p0,
+            **{n: dict(zip(("low", "value", "high"), box[(i, n)], strict=True)) for n in names},
+        }
+        for i, p0 in enumerate(p0s)
+    ]
+    return doc
+
+
 def check_fit_settings(settings) -> None:
     """``contact.fit_*`` checked at the start of a run, before the laws exist (names freed and
     fixed, files readable, load columns): the loads of a normal-load column are converted with
@@ -212,6 +280,8 @@ class ContactResult:
     cycles: tuple = ()  # flatcontact.contact.cycle.SteadyCycle per p0 (contact.cycle)
     fit: Any = None  # flatcontact.contact.fit.ModelComparison (contact.fit_csv)
     fit_files: list[dict] = field(default_factory=list)
+    intervals: dict | None = None  # contact_intervals: the laws' uncertainty carried through
+    bands: tuple | None = None  # analyses at the lower and upper corner of the law box
     files: list[Path] = field(default_factory=list)
 
     def cycle_rows(self) -> list[dict]:
@@ -243,6 +313,8 @@ class ContactResult:
         }
         if self.experiment is not None:
             doc["experiment"] = self.experiment
+        if self.intervals is not None:
+            doc["intervals"] = self.intervals
         if self.cycles:
             doc["conventions"]["cycle"] = (
                 "Q(t) = Q_amp sin(theta); first harmonic u'_1 sin(theta) - u''_1 cos(theta); "
@@ -291,6 +363,10 @@ def run_contact(
             knee_fraction=c.knee_fraction,
         )
     result = ContactResult(analysis, params, provenance, c.knee_fraction, paper)
+    half_widths = law_half_widths_used(inputs, provenance)
+    result.intervals = contact_intervals(settings, params, half_widths)
+    if any(h > 0 for h in half_widths.values()) and "unavailable" not in result.intervals:
+        result.bands = _band_analyses(settings, params, half_widths)
     comparison = None
     if measured is not None:
         comparison = exp.compare_with_measurement(
@@ -328,6 +404,31 @@ def run_contact(
     return result
 
 
+def _band_analyses(settings, params, half_widths: dict[str, float]) -> tuple | None:
+    """The contact analysis at the lower and the upper corner of the law box (every
+    coefficient − and + its half-width; τ0, σ0 clipped at 0): the edges of the Fig. 5 band.
+    The Mindlin outputs grow with each of k, τ0, μ, σ0, so these corners bound them.
+    None if a corner leaves the model's domain."""
+    from flatcontact.contact.summary import analyse
+
+    out = []
+    for sign in (-1.0, 1.0):
+        corner = {k: getattr(params, k) + sign * h for k, h in half_widths.items()}
+        for k in ("tau0_mpa", "sigma0_mpa"):
+            corner[k] = max(corner[k], 0.0)
+        try:
+            out.append(
+                analyse(
+                    settings.contact.p0_gpa,
+                    params.replace(**corner),
+                    knee_fraction=settings.contact.knee_fraction,
+                )
+            )
+        except InputError:
+            return None
+    return tuple(out)
+
+
 def _write(result: ContactResult, settings, folder: Path, measured, comparison) -> None:
     from flatcontact.plots.contact import fig4_traction, fig5_force_and_stiffness, fig6_overlay
 
@@ -342,8 +443,10 @@ def _write(result: ContactResult, settings, folder: Path, measured, comparison) 
         lockin = [lockin_curve(p * GPA_TO_PA, params, c.model) for p in analysis.p0_gpa]
     figs = {
         "fig4_traction": fig4_traction(params, p0_fig4),
-        "fig5_force_stiffness": fig5_force_and_stiffness(analysis, "amplitude", lockin),
-        "fig5_force_stiffness_rms": fig5_force_and_stiffness(analysis, "rms", lockin),
+        "fig5_force_stiffness": fig5_force_and_stiffness(
+            analysis, "amplitude", lockin, result.bands
+        ),
+        "fig5_force_stiffness_rms": fig5_force_and_stiffness(analysis, "rms", lockin, result.bands),
     }
     if comparison is not None:
         figs["fig6_experiment"] = fig6_overlay(
