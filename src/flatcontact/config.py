@@ -924,9 +924,31 @@ def _yaml_value(value: Any) -> str:
     )
 
 
+def _with_defaults_shown(config: RunConfig) -> dict:
+    """``config.to_dict()`` with the fields a section leaves out of its dump at their default
+    (``exclude_if``, to keep fingerprints) put back, so the YAML shows every setting."""
+    data = config.to_dict()
+    out: dict = {}
+    for name in type(config).model_fields:
+        section = getattr(config, name)
+        if not isinstance(section, _Section):
+            if name in data:
+                out[name] = data[name]
+            continue
+        dumped = data.get(name, {})
+        out[name] = {
+            field: dumped[field]
+            if field in dumped
+            else json.loads(json.dumps(getattr(section, field), default=str))
+            for field in type(section).model_fields
+        }
+    return out
+
+
 def to_yaml(config: RunConfig, comments: bool = True) -> str:
     """The configuration as YAML, with each field's description as a comment above it."""
-    data = config.to_dict()
+    # the commented YAML documents every setting; the bare one is exactly to_dict()
+    data = _with_defaults_shown(config) if comments else config.to_dict()
     lines = [
         "# flatcontact run configuration (units in the names: GPa, MPa, Å, eV, µm, J/m²)",
         "# values not given in a file come from the preset",
