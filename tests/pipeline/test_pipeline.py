@@ -608,6 +608,15 @@ def test_each_stage_through_the_cli_writes_the_files_of_the_run(tiny_run, tmp_pa
     run = json.loads((src / "06-contact" / "summary.json").read_text())
     assert run.pop("provenance")["tau0_mpa"] == "fitted laws"
     assert ours.pop("provenance")["tau0_mpa"] == "config"
+    # the fitted laws carry their intervals into the contact outputs; numbers given as flags
+    # have none: same central values, zero width from the CLI
+    ours_iv, run_iv = ours.pop("intervals"), run.pop("intervals")
+    assert not any(ours_iv["half_widths"].values()) and all(run_iv["half_widths"].values())
+    for a, b in zip(ours_iv["results"], run_iv["results"], strict=True):
+        for key, value in a.items():
+            if isinstance(value, dict):
+                assert value["low"] == value["value"] == value["high"] == b[key]["value"]
+                assert b[key]["low"] < b[key]["value"] < b[key]["high"]
     assert ours == run
     assert _figures(out) == _figures(src / "06-contact")
 
