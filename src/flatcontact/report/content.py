@@ -454,8 +454,8 @@ def build_sections(
                     f_laws / "fig3_laws.png",
                     "Fig. 3: τ and σ against P with the linear fits"
                     + (
-                        " and their bands over the coefficient intervals (fit, convergence, "
-                        "model spread)."
+                        " and their bands over the coefficient intervals of the table "
+                        "(every corner of the box of slope and intercept)."
                         if any(
                             (laws.get(laws.get("energy_form", ""), {}) or {})
                             .get("half_widths", {})
