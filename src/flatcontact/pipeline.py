@@ -57,7 +57,15 @@ from flatcontact import __version__
 from flatcontact.config import RunConfig, to_yaml
 from flatcontact.errors import InputError
 from flatcontact.fileio import write_json_atomic, write_text_atomic
-from flatcontact.rundir import RunDirectory, StageResult, code_digest, package_versions
+from flatcontact.rundir import (
+    RunDirectory,
+    RunLock,
+    StageResult,
+    code_digest,
+    package_versions,
+    portable,
+    writable,
+)
 from flatcontact.stages import _calculator
 from flatcontact.stages._common import file_sha256
 
@@ -181,9 +189,15 @@ class Pipeline:
         self.scan_progress = scan_progress
         self._check_root()
         self._check_config()
-        self.rundir = RunDirectory(self.root)
         self.results: dict[str, StageResult] = {}
         self._handler: logging.Handler | None = None
+        self._lock: RunLock | None = None
+        # a finished run on a read-only mount is read, never written (run_stage says so)
+        read_only = writable(self.root) if (self.root / RUN_MARKER).is_file() else None
+        self.rundir = RunDirectory(self.root, read_only=read_only)
+        if read_only is not None:
+            return
+        self._lock = RunLock(self.root).acquire()  # one writer per run directory
         self._open_log()
         write_json_atomic(
             self.root / RUN_MARKER, {"format": RUN_FORMAT, "flatcontact_version": __version__}
@@ -203,8 +217,8 @@ class Pipeline:
                     f"{root}: not a flatcontact run directory (no {RUN_MARKER}); choose another --out"
                 )
             try:
-                data = json.loads(marker.read_text())
-            except (OSError, json.JSONDecodeError):
+                data = json.loads(marker.read_bytes().decode("utf-8"))
+            except (OSError, UnicodeDecodeError, json.JSONDecodeError):
                 raise InputError(
                     f"{marker}: corrupt run marker; remove it only if {root} is a flatcontact run"
                 ) from None
@@ -215,16 +229,9 @@ class Pipeline:
 
     def _check_config(self) -> None:
         """Checks that need the file system or optional modules, before any work."""
-        cfg = self.config
-        if cfg.structure.kind == "file":
-            from flatcontact.structures.interface import read_interface
+        from flatcontact.config import check_inputs
 
-            read_interface(cfg.structure.file)
-        if cfg.contact.experiment_csv is not None:
-            from flatcontact.contact.experiment import load_stiffness_csv
-
-            load_stiffness_csv(cfg.contact.experiment_csv)
-        _calculator.check(cfg)
+        check_inputs(self.config)
 
     def _open_log(self) -> None:
         handler = logging.FileHandler(self.root / "run.log", encoding="utf-8")
@@ -242,11 +249,14 @@ class Pipeline:
         )
 
     def close(self) -> None:
-        """Detach the run log."""
+        """Detach the run log and give up the run directory's lock."""
         if self._handler is not None:
             logging.getLogger("flatcontact").removeHandler(self._handler)
             self._handler.close()
             self._handler = None
+        if self._lock is not None:
+            self._lock.release()
+            self._lock = None
 
     def __enter__(self) -> Pipeline:
         return self
@@ -313,7 +323,9 @@ class Pipeline:
         from flatcontact.structures.interface import read_interface
 
         cfg = self.config
-        inputs = {"structure": cfg.section("structure"), "model": self._model_inputs()}
+        # the file by name and content (file_sha256), not by where it is
+        structure = portable(cfg.section("structure"), "file")
+        inputs = {"structure": structure, "model": self._model_inputs()}
         if cfg.structure.kind in ("file", "slab"):
             inputs["file_sha256"] = file_sha256(cfg.structure.file)
 
@@ -487,7 +499,7 @@ class Pipeline:
         # before the stage folder is touched: a refused p0 keeps the previous results
         check_contact(cfg, contact_parameters(cfg, stage_inputs)[0])
         inputs = {
-            "contact": cfg.section("contact"),
+            "contact": portable(cfg.section("contact"), "experiment_csv"),
             "laws": laws.fingerprint,
             "scan": scan.fingerprint,
             "elastic": elastic.fingerprint if elastic else None,
@@ -523,6 +535,8 @@ class Pipeline:
 
         result = self._run("report", inputs, work)
         target = self.root / REPORT_HTML
+        if self.rundir.read_only is not None:  # a finished run on a read-only mount
+            return target if target.is_file() else result.folder / REPORT_HTML
         tmp = target.with_name(".report.html.tmp")
         shutil.copyfile(result.folder / REPORT_HTML, tmp)
         tmp.replace(target)
