@@ -150,9 +150,14 @@ class StructureConfig(_Section):
             )
         if self.kind == "toy-lj" and self.layers < 3:
             raise ValueError(f"layers={self.layers}: the toy interface needs >= 3")
-        if self.layers > limits.bound("layers"):
-            raise ValueError("layers: " + limits.message("layers", self.layers, "layers per slab"))
         return self
+
+    @field_validator("layers")
+    @classmethod
+    def _layers_bound(cls, value: int) -> int:
+        if value > limits.bound("layers"):
+            raise ValueError(limits.message("layers", value, "layers per slab"))
+        return value
 
 
 class CalculatorConfig(_Section):
@@ -362,7 +367,9 @@ class ContactConfig(_Section):
     """The modified Mindlin contact (stage ``contact``)."""
 
     p0_gpa: list[float] = Field(list(DEFAULT_P0_GPA), description="peak Hertz pressures p0 (GPa)")
-    radius_um: float = Field(PAPER["radius_um"], gt=0, description="tip radius R (µm)")
+    radius_um: float = Field(
+        PAPER["radius_um"], gt=0, le=1e4, description="tip radius R (µm; at most 1 cm)"
+    )
     contact_modulus_gpa: float = Field(
         PAPER["contact_modulus_gpa"],
         gt=0,

@@ -91,8 +91,9 @@ def check(name: str, value: float, field: str, what: str = "") -> None:
     limit = bound(name)
     if value > limit:
         counted = f" ({what})" if what else ""
+        shown = str(int(value)) if float(value).is_integer() else f"{value:g}"
         raise InputError(
-            f"{field}: {value:g}{counted} exceeds the bound {limit}; if you really mean it, "
+            f"{field}: {shown}{counted} exceeds the bound {limit}; if you really mean it, "
             f"set {env_name(name)}={int(value) if value == int(value) else value} "
             "(see docs/run.md, 'Limits and errors')"
         )

@@ -36,6 +36,7 @@ is one line.
 
 from __future__ import annotations
 
+import contextlib
 import datetime as _dt
 import errno
 import fcntl
@@ -59,7 +60,7 @@ from flatcontact.fileio import write_json_atomic
 RECORD_NAME = "stage.json"
 LOCK_NAME = ".flatcontact.lock"
 #: Files of a stage folder that are not outputs (records, locks, SQLite side files).
-_NOT_OUTPUTS = (RECORD_NAME, ".driver", "-journal", "-wal", "-shm", ".part", ".tmp")
+_NOT_OUTPUTS = (RECORD_NAME, ".flatcontact.lock", ".driver", "-journal", "-wal", "-shm", ".part", ".tmp")
 #: errno values meaning "this place cannot be written" (not "the disk is full").
 READ_ONLY_ERRNOS = (errno.EROFS, errno.EACCES, errno.EPERM)
 STATE_RUNNING = "running"
@@ -218,11 +219,24 @@ class RunLock:
         self._handle = handle
         return self
 
-    def release(self) -> None:
-        """Give the lock up (idempotent)."""
-        if self._handle is not None:
-            self._handle.close()
-            self._handle = None
+    def release(self, tidy: bool | str = False) -> None:
+        """Give the lock up (idempotent).
+
+        With ``tidy``, a directory that holds nothing but the lock file is left as it was
+        found: the lock file is removed (and the directory too when ``tidy`` is the
+        directory this writer created), so a command that failed before writing leaves
+        nothing behind.
+        """
+        if self._handle is None:
+            return
+        root = self.path.parent
+        if tidy and [p.name for p in root.iterdir()] == [LOCK_NAME]:
+            self.path.unlink(missing_ok=True)
+            if tidy == "created":
+                with contextlib.suppress(OSError):
+                    root.rmdir()
+        self._handle.close()
+        self._handle = None
 
     def __enter__(self) -> RunLock:
         return self.acquire()
