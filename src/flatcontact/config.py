@@ -658,6 +658,9 @@ def _one_line(exc: ValidationError, source: str) -> InputError:
             msg += f", got {_show(first.get('input'))}"
     else:
         msg = str(first.get("msg", "invalid")).removeprefix("Value error, ")
+        field, sep, rest = msg.partition(": ")
+        if sep and field.isidentifier() and field.islower() and where:
+            where, msg = f"{where}.{field}", rest  # a model check naming its field
         if where == "potential" and msg.startswith("potential "):  # PotentialSpec's InputError
             return InputError(f"{source}: potential.{msg.removeprefix('potential ')}")
     return InputError(f"{source}: {where}: {msg}" if where else f"{source}: {msg}")

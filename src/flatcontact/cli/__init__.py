@@ -19,6 +19,7 @@ from __future__ import annotations
 import errno
 import logging
 import sys
+import warnings
 from typing import Annotated
 
 import typer
@@ -81,10 +82,20 @@ def disk_full_line(exc: OSError) -> str:
     )
 
 
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Python warnings (numpy, ASE, ...) as one ``warning:`` line, without source lines."""
+    from flatcontact.cli.app import print_warning
+
+    print_warning(" ".join(f"{category.__name__}: {message}".split()))
+
+
 def main(argv: list[str] | None = None) -> None:
     """Entry point of the ``flatcontact`` console script."""
     # a full disk under the run log must not print logging's own traceback on stderr
     logging.raiseExceptions = False
+    warnings.showwarning = _one_line_warning
+    # ASE's note on reading its own extxyz files (info it cannot hash): noise, not news
+    warnings.filterwarnings("ignore", message="Skipping unhashable information")
     try:
         rv = app(args=argv, standalone_mode=False, prog_name="flatcontact")
     except InputError as exc:
