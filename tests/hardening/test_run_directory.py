@@ -269,3 +269,32 @@ def test_out_of_disk_in_a_stage_is_one_line_and_the_rerun_resumes(
     assert json.loads((run / folder / "stage.json").read_text())["state"] == "done"
     assert (run / "report.html").is_file()
     assert all(a == "unchanged, skipped" for a in _actions(out)[:2])
+
+
+def test_out_of_disk_in_the_scan_store_is_one_line_and_the_rerun_resumes(
+    copy, finished, monkeypatch, capsys
+):
+    """SQLite says "database or disk is full" (not ENOSPC) when the point store cannot grow."""
+    import sqlite3
+
+    from flatcontact.ispes.store import PointStore
+
+    config, run = copy
+    (run / "02-scan" / "ispes.nc").unlink()
+    (run / "02-scan" / "points.db").unlink()  # the scan recomputes its points
+    calls = {"n": 0}
+    real_write = PointStore.write
+
+    def full_after_ten(self, result):
+        calls["n"] += 1
+        if calls["n"] > 10:
+            raise sqlite3.OperationalError("database or disk is full")
+        return real_write(self, result)
+
+    monkeypatch.setattr(PointStore, "write", full_after_ten)
+    code, _, err = run_cli(["run", config, "--out", run], capsys)
+    refused(code, err, "no space left", "database or disk is full", "rerun the same command")
+    monkeypatch.setattr(PointStore, "write", real_write)
+    code, _, err = run_cli(["run", config, "--out", run], capsys)
+    assert code == 0, err
+    _same_content(run / "02-scan" / "ispes.nc", finished[1] / "02-scan" / "ispes.nc")

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import errno
 import logging
+import sqlite3
 import sys
 import warnings
 from typing import Annotated
@@ -105,6 +106,11 @@ def main(argv: list[str] | None = None) -> None:
         if exc.errno not in _DISK_FULL:
             raise
         print_error(disk_full_line(exc))
+        sys.exit(2)
+    except sqlite3.OperationalError as exc:  # the scan's point store on a full disk
+        if "full" not in str(exc):
+            raise
+        print_error(disk_full_line(OSError(errno.ENOSPC, str(exc))))
         sys.exit(2)
     except typer.TyperException as exc:  # typer's (vendored click's) usage errors
         code = getattr(exc, "exit_code", 2)
