@@ -195,7 +195,9 @@ class Pipeline:
         # a finished run on a read-only mount is read, never written (run_stage says so)
         read_only = writable(self.root) if (self.root / RUN_MARKER).is_file() else None
         self.rundir = RunDirectory(self.root, read_only=read_only)
-        if read_only is not None:
+        if read_only is not None:  # no run.log: the progress lines are the record
+            self._handler = logging.NullHandler()
+            logging.getLogger("flatcontact").addHandler(self._handler)
             return
         self._lock = RunLock(self.root).acquire()  # one writer per run directory
         self._open_log()

@@ -347,7 +347,7 @@ class RunDirectory:
                 log.info("stage %s: inputs unchanged, skipped", name)
                 return StageResult(name, folder, digest, "skipped", 0.0)
         if self.read_only is not None:
-            why = "its outputs " + ", ".join(damaged) + " are damaged" if damaged else "not done"
+            why = f"{', '.join(damaged)} missing or changed" if damaged else "not done"
             raise InputError(
                 f"{self.root}: cannot write here ({self.read_only.strerror}) and stage {name} "
                 f"must run ({why}); copy the run directory somewhere writable and rerun there"

@@ -298,3 +298,47 @@ def test_out_of_disk_in_the_scan_store_is_one_line_and_the_rerun_resumes(
     code, _, err = run_cli(["run", config, "--out", run], capsys)
     assert code == 0, err
     _same_content(run / "02-scan" / "ispes.nc", finished[1] / "02-scan" / "ispes.nc")
+
+
+def _bind_read_only(src, dst) -> bool:
+    """Bind-mount ``src`` read-only on ``dst``; False where that needs privileges we lack."""
+    import subprocess
+
+    dst.mkdir()
+    ok = (
+        subprocess.run(["mount", "--bind", str(src), str(dst)], capture_output=True).returncode == 0
+    )
+    if (
+        ok
+        and subprocess.run(
+            ["mount", "-o", "remount,ro,bind", str(dst)], capture_output=True
+        ).returncode
+        != 0
+    ):
+        subprocess.run(["umount", str(dst)], capture_output=True)
+        ok = False
+    return ok
+
+
+def test_a_finished_run_on_a_real_read_only_mount(copy, tmp_path, capsys):
+    """The same on a real read-only bind mount (needs mount privileges; skipped without)."""
+    import subprocess
+
+    config, run = copy
+    mounted = tmp_path / "ro"
+    if not _bind_read_only(run, mounted):
+        pytest.skip("no privilege to bind-mount read-only here")
+    again = tmp_path / "ro2"
+    try:
+        code, out, err = run_cli(["run", config, "--out", mounted], capsys)
+        assert code == 0, err
+        assert err == ""
+        assert "report.html" in out
+        subprocess.run(["umount", str(mounted)], check=True)
+        (run / "06-contact" / "summary.json").unlink()
+        assert _bind_read_only(run, again)
+        code, _, err = run_cli(["run", config, "--out", again], capsys)
+        refused(code, err, "Read-only file system", "contact", "summary.json", "copy")
+    finally:
+        for m in (mounted, again):
+            subprocess.run(["umount", str(m)], capture_output=True)
