@@ -177,6 +177,16 @@ def damaged_outputs(folder: Path, recorded: Mapping[str, str]) -> list[str]:
     return bad
 
 
+def _inside(name: Any) -> bool:
+    """Whether a recorded output name stays inside its stage folder (no absolute path, no ..)."""
+    return (
+        isinstance(name, str)
+        and bool(name)
+        and not Path(name).is_absolute()
+        and ".." not in Path(name).parts
+    )
+
+
 class RunLock:
     """One writer per directory: an exclusive advisory ``flock`` on ``<root>/.flatcontact.lock``.
 
@@ -315,7 +325,13 @@ class RunDirectory:
             raise InputError(
                 f"{path}: corrupt stage record; remove the folder to recompute it"
             ) from None
-        if not isinstance(record, dict) or not {"stage", "fingerprint", "state"} <= record.keys():
+        outputs = record.get("outputs", {}) if isinstance(record, dict) else None
+        if (
+            not isinstance(record, dict)
+            or not {"stage", "fingerprint", "state"} <= record.keys()
+            or not isinstance(outputs, dict)
+            or not all(_inside(k) and isinstance(v, str) for k, v in outputs.items())
+        ):
             raise InputError(
                 f"{path}: not a flatcontact stage record; remove the folder to recompute it"
             )

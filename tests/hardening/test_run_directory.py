@@ -342,3 +342,22 @@ def test_a_finished_run_on_a_real_read_only_mount(copy, tmp_path, capsys):
     finally:
         for m in (mounted, again):
             subprocess.run(["umount", str(m)], capture_output=True)
+
+
+@pytest.mark.parametrize(
+    "outputs",
+    [["laws.json"], {"laws.json": 3}, {"../../outside.txt": "0" * 64}, {"/etc/hostname": "0" * 64}],
+)
+def test_a_tampered_output_list_is_a_corrupt_record_and_removes_nothing(
+    copy, tmp_path, capsys, outputs
+):
+    config, run = copy
+    bait = tmp_path / "outside.txt"
+    bait.write_text("keep me")
+    record_path = run / "04-laws" / "stage.json"
+    record = json.loads(record_path.read_text())
+    record["outputs"] = outputs
+    record_path.write_text(json.dumps(record))
+    code, _, err = run_cli(["run", config, "--out", run], capsys)
+    refused(code, err, "04-laws", "stage.json", "remove the folder")
+    assert bait.read_text() == "keep me"
