@@ -145,3 +145,22 @@ def test_bad_flag_is_one_line_before_work(case, tmp_path, monkeypatch, capsys):
     assert_refused_cleanly(argv, capsys, work, names, out)
     assert not out.exists()
     assert not list(tmp_path.glob("evil*")) and not Path("/tmp/evil.snapcoeff").exists()
+
+
+@pytest.mark.parametrize(
+    "kwargs, field",
+    [
+        ({"name": "../../evil"}, "name"),
+        ({"name": "sub/evil"}, "name"),
+        ({"scale": -1.0}, "scale"),
+        ({"active_rounds": -1}, "active_rounds"),
+    ],
+)
+def test_train_snap_library_refuses_before_reading(tmp_path, kwargs, field):
+    """The library door checks the same arguments as the CLI, before reading any data."""
+    from flatcontact.errors import InputError
+    from flatcontact.training.train import train_snap
+
+    with pytest.raises(InputError, match=field):
+        train_snap(tmp_path / "out", data=tmp_path / "never-read.extxyz", **kwargs)
+    assert not (tmp_path / "out").exists() and not list(tmp_path.parent.glob("evil*"))
