@@ -30,7 +30,11 @@ Measured
    extra cost (an upper estimate as long as 2 workers are not slower than 1). It assumes
    a 2J = 8 model needs as many force calls per point as the 2J = 6 one.
 
-Run: ``python -m benchmarks scan`` (4–5 minutes on 2 shared cores).
+0. First, issue 14's scale figures (:mod:`benchmarks.scale_report`): the ratio against a
+   native LAMMPS input script, force calls per point, per-call overhead, fixed costs, parallel
+   efficiency (measured and modelled) and one point of 1,000-5,000-atom cells.
+
+Run: ``python -m benchmarks scan`` (10 minutes or more on 2 shared cores).
 """
 
 from __future__ import annotations
@@ -308,6 +312,9 @@ def full_grid(tmp: Path) -> dict:
 
 
 def main() -> None:
+    from benchmarks import scale_report
+
+    scale_report.main()  # issue 14: native ratio, per-call overhead, fixed costs, parallel, large
     print(
         f"{os.cpu_count()} cores (shared), load average {os.getloadavg()[0]:.2f}; "
         f"relax {OPTIMIZER} fmax {FMAX} eV/Å",

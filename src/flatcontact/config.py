@@ -40,6 +40,7 @@ from pydantic import (
 )
 
 from flatcontact import limits
+from flatcontact.contact.cycle import DEFAULT_AMPLITUDE_FRACTIONS as CYCLE_AMPLITUDE_FRACTIONS
 from flatcontact.errors import InputError
 from flatcontact.fileio import read_text_file
 from flatcontact.ispes.grid import GridSpec
@@ -423,6 +424,76 @@ class ContactConfig(_Section):
     collapse_fraction: float = Field(
         0.2, gt=0, lt=1, description="collapse: stiffness first below this fraction of the plateau"
     )
+    # issue 13: the oscillation cycle and the multi-load fit. Each field is left out of the
+    # dumped config at its default, so the fingerprints of existing runs are unchanged.
+    cycle: bool = Field(
+        False,
+        exclude_if=lambda value: value is False,
+        description="steady load-controlled cycle per p0: loops, dissipated energy per cycle, "
+        "lock-in stiffness Q_amp/u'_1 and quadrature u''_1 (summary.json 'cycle', contact.nc)",
+    )
+    model: Literal["modified", "classical"] = Field(
+        "modified",
+        exclude_if=lambda value: value == "modified",
+        description="model of the cycle: modified (the paper's Mindlin model) or classical "
+        "(Cattaneo-Mindlin, friction coefficient mu = k, Johnson's G*_J = G*/4)",
+    )
+    cycle_amplitude_fractions: list[float] = Field(
+        list(CYCLE_AMPLITUDE_FRACTIONS),
+        exclude_if=lambda value: list(value) == list(CYCLE_AMPLITUDE_FRACTIONS),
+        description="force amplitudes of the cycle as fractions of the gross-sliding force, "
+        "each in (0, 1)",
+    )
+    cycle_amplitudes_un: list[float] | None = Field(
+        None,
+        exclude_if=lambda value: value is None,
+        description="force amplitudes of the cycle in uN (each below gross sliding at every "
+        "p0); null: cycle_amplitude_fractions",
+    )
+    fit_csv: list[str] = Field(
+        [],
+        exclude_if=lambda value: not value,
+        description="measured stiffness CSVs to fit at several loads at once (one per load, "
+        "or with a load column 'p0 [GPa]'/'normal load [uN]'; relative to the config file)",
+    )
+    fit_p0_gpa: list[float] | None = Field(
+        None,
+        exclude_if=lambda value: value is None,
+        description="p0 (GPa) of each fit_csv file without a load column, one per file",
+    )
+    fit_free: list[str] = Field(
+        ["tau0_mpa"],
+        exclude_if=lambda value: list(value) == ["tau0_mpa"],
+        description="parameters the fit frees (tau0_mpa, k_mpa_per_gpa, mu_mpa_per_gpa, "
+        "sigma0_mpa, shear_modulus_gpa); the rest are held at their values",
+    )
+    fit_fixed: list[str] = Field(
+        [],
+        exclude_if=lambda value: not value,
+        description="parameters the fit must hold (checked against fit_free)",
+    )
+    fit_stiffness: Literal["lockin", "paper"] = Field(
+        "lockin",
+        exclude_if=lambda value: value == "lockin",
+        description="model stiffness the fit compares with the data: lockin (Q_amp/u'_1, "
+        "what a lock-in amplifier reads) or paper (d<Q>/d<u>)",
+    )
+
+    @field_validator("cycle_amplitude_fractions")
+    @classmethod
+    def _fractions(cls, value: list[float]) -> list[float]:
+        if not value or any(not 0.0 < v < 1.0 for v in value):
+            raise ValueError(
+                f"expected fractions of the gross-sliding force in (0, 1), got {_show(value)}"
+            )
+        return [float(v) for v in value]
+
+    @field_validator("cycle_amplitudes_un")
+    @classmethod
+    def _amplitudes(cls, value: list[float] | None) -> list[float] | None:
+        if value is not None and (not value or any(not v > 0 for v in value)):
+            raise ValueError(f"expected positive force amplitudes in uN, got {_show(value)}")
+        return value
 
     @field_validator("p0_gpa")
     @classmethod
@@ -430,6 +501,80 @@ class ContactConfig(_Section):
         if not value or any(not v > 0 for v in value):
             raise ValueError(f"expected positive peak pressures in GPa, got {_show(value)}")
         return [float(v) for v in value]
+
+
+_LAW_KEYS = ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa")
+#: Measured for the bundled sio2-snap + Hamaker-calibrated LJ on the α-quartz (0001) dense
+#: interface (docs/convergence.md, docs/teachers.md): per form, the largest change of each law
+#: coefficient under one refinement (grid 8→12, thicknesses 20→30, fmax 0.005→0.0025, LJ
+#: cutoff 14→18 Å) and half the SNAP–CHGNet r2SCAN spread (4×4 grid, an upper bound).
+MEASURED_LAW_UNCERTAINTY = {
+    "convergence_internal": {
+        "k_mpa_per_gpa": 6.48,
+        "tau0_mpa": 3.60,
+        "mu_mpa_per_gpa": 0.594,
+        "sigma0_mpa": 0.384,
+    },
+    "convergence_enthalpy": {
+        "k_mpa_per_gpa": 0.714,
+        "tau0_mpa": 1.56,
+        "mu_mpa_per_gpa": 0.052,
+        "sigma0_mpa": 0.147,
+    },
+    "model_spread_internal": {
+        "k_mpa_per_gpa": 0.064,
+        "tau0_mpa": 1.28,
+        "mu_mpa_per_gpa": 0.276,
+        "sigma0_mpa": 0.666,
+    },
+    "model_spread_enthalpy": {
+        "k_mpa_per_gpa": 2.52,
+        "tau0_mpa": 7.40,
+        "mu_mpa_per_gpa": 0.338,
+        "sigma0_mpa": 0.425,
+    },
+    "source": "measured for the bundled sio2-snap + Hamaker LJ, alpha-quartz (0001) dense, "
+    "paper-preset settings (docs/convergence.md, docs/teachers.md); a lower bound for coarser "
+    "grids, not a measurement for another model or surface",
+}
+
+
+class UncertaintyConfig(_Section):
+    """Uncertainty of the load laws beyond the fit (stage ``laws``; propagated by ``contact``).
+
+    Per coefficient c the half-width is coverage·sqrt(se_fit² + δ_conv² + δ_model²)
+    (:func:`flatcontact.analysis.uncertainty.law_half_widths`), per energy form.
+    """
+
+    convergence_internal: dict[str, float] = Field(
+        {}, description="δ_conv per law coefficient, internal form (change under one refinement)"
+    )
+    convergence_enthalpy: dict[str, float] = Field(
+        {}, description="δ_conv per law coefficient, enthalpy form"
+    )
+    model_spread_internal: dict[str, float] = Field(
+        {}, description="δ_model per law coefficient, internal form (half the spread over models)"
+    )
+    model_spread_enthalpy: dict[str, float] = Field(
+        {}, description="δ_model per law coefficient, enthalpy form"
+    )
+    coverage: float = Field(1.0, gt=0, description="multiple of the combined standard error")
+    source: str = Field("", description="where the δ_conv and δ_model numbers come from")
+
+    @field_validator(
+        "convergence_internal",
+        "convergence_enthalpy",
+        "model_spread_internal",
+        "model_spread_enthalpy",
+    )
+    @classmethod
+    def _coefficients(cls, value: dict[str, float]) -> dict[str, float]:
+        for key, v in value.items():
+            if key not in _LAW_KEYS:
+                raise ValueError(f"{key!r}: expected law coefficients among {', '.join(_LAW_KEYS)}")
+            if not (v == v and 0.0 <= float(v) < float("inf")):
+                raise ValueError(f"{key} = {_show(v)}: expected a finite value >= 0")
+        return {k: float(v) for k, v in value.items()}
 
 
 class ReportConfig(_Section):
@@ -471,6 +616,12 @@ class RunConfig(_Section):
     )
     elastic: ElasticConfig = Field(
         default_factory=ElasticConfig, description="optional self-consistent E*, G* (stage elastic)"
+    )
+    uncertainty: UncertaintyConfig = Field(
+        default_factory=UncertaintyConfig,
+        # left out of the dump while empty, so the fingerprints of existing runs are unchanged
+        exclude_if=lambda value: value == UncertaintyConfig(),
+        description="uncertainty of the laws beyond the fit (convergence, model spread)",
     )
     contact: ContactConfig = Field(
         default_factory=ContactConfig, description="modified Mindlin contact (stage contact)"
@@ -586,10 +737,15 @@ def preset(name: str) -> dict:
             "report": {"title": "flatcontact run (quick preset)"},
         }
     if name == "paper":
+        # Measured in docs/convergence.md: one refinement of the 12x12 grid or the 20
+        # thicknesses moves every per-load τ and σ_MSS by < 3 % (enthalpy form); the LJ tail
+        # beyond 10 Å adds 16 % to W, beyond 18 Å 2.8 %, so the cutoff is 18 Å here.
+        potential = default_potential()
+        potential["lj"] = {**potential["lj"], "cutoff_angstrom": 18.0}
         return {
             "preset": "paper",
             "structure": {"kind": "quartz-dense", "layers": 6, "source": _dense_slab_source()},
-            "potential": default_potential(),
+            "potential": potential,
             "scan": {
                 "grid": [12, 12],
                 "p_range_gpa": {"lo_gpa": -0.3, "hi_gpa": 5.5, "n": 20},
@@ -597,6 +753,7 @@ def preset(name: str) -> dict:
             },
             "analysis": {"p_gpa": [0.0, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 4.5]},
             "contact": {"p0_gpa": [0.5, 1.0, 1.5, 1.77, 2.0, 2.5, 3.0]},
+            "uncertainty": copy.deepcopy(MEASURED_LAW_UNCERTAINTY),
             "report": {"title": "flatcontact run (paper preset)", "fig2_p_gpa": [0.5, 1.0, 3.0]},
         }
     raise InputError(f"preset: expected quick or paper, got {name!r}")
@@ -820,6 +977,7 @@ def load_config(path: str | Path | None = None, preset_name: str | None = None) 
             target = Path(block[key]).expanduser()
             if not target.is_absolute():
                 block[key] = str((path.parent / target).resolve())
+    _resolve_file_lists(data, path)
     try:
         cfg = build_config(data, preset_name, str(path))
     except RecursionError:
@@ -833,6 +991,10 @@ def load_config(path: str | Path | None = None, preset_name: str | None = None) 
             raise InputError(f"{path}: {section}.{key}: file {value} not found")
         if not target.is_file():
             raise InputError(f"{path}: {section}.{key}: {value} is not a regular file")
+    for section, key in _FILE_LIST_FIELDS:
+        for value in getattr(getattr(cfg, section), key):
+            if not Path(value).is_file():
+                raise InputError(f"{path}: {section}.{key}: file {value} not found")
     return cfg
 
 
@@ -861,6 +1023,10 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
             load_stiffness_csv(cfg.contact.experiment_csv)
         except InputError as exc:
             raise InputError(f"{source}: contact.experiment_csv: {exc}") from None
+    if cfg.contact.fit_csv:
+        from flatcontact.stages.contact import check_fit_settings
+
+        check_fit_settings(cfg)
     calc = cfg.potential.calculator
     if calc is not None:
         try:
@@ -924,8 +1090,21 @@ def _check_structure_file(cfg: RunConfig, source: str) -> None:
         raise InputError(f"{field}: {limits.message('atoms', n, f'atoms in {file.name}')}")
 
 
+def _resolve_file_lists(data: dict, path: Path) -> None:
+    """Relative entries of the list-of-files fields, against the config file's directory."""
+    for section, key in _FILE_LIST_FIELDS:
+        block = data.get(section)
+        if isinstance(block, dict) and isinstance(block.get(key), list):
+            block[key] = [
+                str((path.parent / Path(v).expanduser()).resolve()) if isinstance(v, str) else v
+                for v in block[key]
+            ]
+
+
 #: Fields naming an input file (relative to the config file); they must exist.
 _FILE_FIELDS = (("structure", "file"), ("contact", "experiment_csv"))
+#: Fields naming a list of input files (each relative to the config file).
+_FILE_LIST_FIELDS = (("contact", "fit_csv"),)
 
 
 # --------------------------------------------------------------------------- YAML out
@@ -961,9 +1140,31 @@ def _yaml_value(value: Any) -> str:
     )
 
 
+def _with_defaults_shown(config: RunConfig) -> dict:
+    """``config.to_dict()`` with the fields a section leaves out of its dump at their default
+    (``exclude_if``, to keep fingerprints) put back, so the YAML shows every setting."""
+    data = config.to_dict()
+    out: dict = {}
+    for name in type(config).model_fields:
+        section = getattr(config, name)
+        if not isinstance(section, _Section):
+            if name in data:
+                out[name] = data[name]
+            continue
+        dumped = data.get(name, {})
+        out[name] = {
+            field: dumped[field]
+            if field in dumped
+            else json.loads(json.dumps(getattr(section, field), default=str))
+            for field in type(section).model_fields
+        }
+    return out
+
+
 def to_yaml(config: RunConfig, comments: bool = True) -> str:
     """The configuration as YAML, with each field's description as a comment above it."""
-    data = config.to_dict()
+    # the commented YAML documents every setting; the bare one is exactly to_dict()
+    data = _with_defaults_shown(config) if comments else config.to_dict()
     lines = [
         "# flatcontact run configuration (units in the names: GPa, MPa, Å, eV, µm, J/m²)",
         "# values not given in a file come from the preset",

@@ -119,8 +119,9 @@ STAGE_CODE: dict[str, tuple[str, ...]] = {
     ),
     "laws": (
         "stages/laws.py",
-        "analysis/laws.py",
-        "analysis/diagnostics.py",
+        "stages/analyze.py",  # its settings names; the other energy form is analysed here
+        "analysis",
+        "ispes/contract.py",
         "plots/__init__.py",
         "plots/analysis.py",
         *_SHARED,
@@ -138,6 +139,7 @@ STAGE_CODE: dict[str, tuple[str, ...]] = {
         "contact",
         "plots/__init__.py",
         "plots/contact.py",
+        "plots/cycle.py",
         "reference.py",
         *_SHARED,
     ),
@@ -420,15 +422,21 @@ class Pipeline:
             ``laws.json`` (``k_mpa_per_gpa``, ``tau0_mpa``, ``mu_mpa_per_gpa``, ``sigma0_mpa``,
             standard errors, fitted range, end of the linear regime, warnings).
         """
+        from flatcontact.ispes.scan import ISPES_NC
         from flatcontact.stages.analyze import FRICTION_CSV
         from flatcontact.stages.laws import LAWS_JSON, LawsInputs, run_laws
 
         cfg = self.config
         analyze = self._upstream("analyze")
+        scan = self._upstream("scan")
         inputs = {"threshold_gpa": cfg.analysis.threshold_gpa, "analyze": analyze.fingerprint}
+        # the other energy form comes from the scan's ISPES (analyze's fingerprint covers it
+        # and the analysis settings); the laws' intervals from the uncertainty section
+        inputs["uncertainty"] = cfg.section("uncertainty")
 
         def work(folder: Path) -> None:
-            run_laws(cfg, LawsInputs.read(analyze.folder / FRICTION_CSV), folder)
+            ispes = scan.folder / ISPES_NC
+            run_laws(cfg, LawsInputs.read(analyze.folder / FRICTION_CSV, ispes), folder)
 
         self._run("laws", inputs, work)
         return self._json("laws", LAWS_JSON)
@@ -501,13 +509,15 @@ class Pipeline:
         # before the stage folder is touched: a refused p0 keeps the previous results
         check_contact(cfg, contact_parameters(cfg, stage_inputs)[0])
         inputs = {
-            "contact": portable(cfg.section("contact"), "experiment_csv"),
+            "contact": portable(cfg.section("contact"), "experiment_csv", "fit_csv"),
             "laws": laws.fingerprint,
             "scan": scan.fingerprint,
             "elastic": elastic.fingerprint if elastic else None,
         }
         if cfg.contact.experiment_csv:
             inputs["experiment_sha256"] = file_sha256(cfg.contact.experiment_csv)
+        if cfg.contact.fit_csv:
+            inputs["fit_sha256"] = [file_sha256(f) for f in cfg.contact.fit_csv]
 
         result = self._run("contact", inputs, lambda f: run_contact(cfg, stage_inputs, f))
         with xr.open_dataset(result.folder / CONTACT_NC, engine="h5netcdf") as ds:

@@ -143,6 +143,8 @@ def portable(section: Mapping[str, Any] | None, *path_keys: str) -> dict[str, An
     for key in path_keys:
         if isinstance(out.get(key), str):
             out[key] = Path(out[key]).name
+        elif isinstance(out.get(key), list):
+            out[key] = [Path(v).name if isinstance(v, str) else v for v in out[key]]
     return out
 
 

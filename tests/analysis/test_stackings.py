@@ -302,14 +302,20 @@ def test_outputs_carry_the_stackings_barriers_and_rules(tmp_path):
 
     import xarray as xr
 
-    from flatcontact.analysis.outputs import CSV_COLUMNS, summary_json, write_outputs
+    from flatcontact.analysis.outputs import (
+        CSV_COLUMNS,
+        friction_csv_text,
+        friction_dataset,
+        summary_json,
+    )
 
     v = 1e-4
     a1, a2 = syn.hexagonal_cell(2.46)
     model = syn.SyntheticInterface(a1, a2, syn.three_cosine(a1, a2), corrugation_ev_per_a2=v)
     ds = model.grid(9, 9, np.linspace(24.3, 25.6, 12))
     res = analyze_ispes(ds, [0.5, 1.0], direction_deg="auto", energy_zero="each")
-    write_outputs(res, tmp_path)
+    (tmp_path / "friction.csv").write_text(friction_csv_text(res))
+    friction_dataset(res).to_netcdf(tmp_path / "friction.nc", engine="h5netcdf")
     mev = 1e3
     with open(tmp_path / "friction.csv") as fh:
         rows = list(csv.DictReader(fh))

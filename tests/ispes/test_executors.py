@@ -41,3 +41,53 @@ def test_workers_die_when_the_driver_is_killed():
     finally:
         if proc.poll() is None:
             proc.kill()
+
+
+SCAN_DRIVER = textwrap.dedent(
+    """
+    import os, sys
+    from flatcontact.ispes.calculators import CalculatorFactory
+    from flatcontact.ispes.grid import GridSpec
+    from flatcontact.ispes.scan import run_scan
+    from flatcontact.ispes.toy import toy_interface
+    from flatcontact.structures.interface import thickness
+
+    ref = toy_interface(layers=3)
+    factory = CalculatorFactory.from_target("flatcontact.ispes.toy:toy_calculator")
+    z = thickness(ref)
+    r = run_scan(ref, factory, GridSpec(2, 2, thickness_angstrom=(z, z + 0.3)), sys.argv[1],
+                 executor_options={"kind": "processes", "workers": 2})
+    print("points", r.points_done, flush=True)
+    """
+)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="process groups: POSIX")
+def test_a_two_worker_scan_leaves_no_process_behind(tmp_path):
+    """The scan runs in its own session; once it has exited, nothing of that session is left
+    (its workers, and the workers started early while it probes, all ended with it)."""
+    proc = subprocess.Popen(
+        [sys.executable, "-c", SCAN_DRIVER, str(tmp_path / "scan")],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=dict(os.environ),
+        start_new_session=True,
+    )
+    out, err = proc.communicate(timeout=300)
+    assert proc.returncode == 0, err
+    assert out.split() == ["points", "8"]
+    sid = proc.pid  # the session id of a process started as its session's leader
+
+    def left():
+        out = []
+        for p in psutil.process_iter(["pid"]):
+            try:
+                if os.getsid(p.pid) == sid:
+                    out.append(p)
+            except (ProcessLookupError, PermissionError):
+                pass
+        return out
+
+    _gone, alive = psutil.wait_procs(left(), timeout=10)
+    assert not alive, f"processes left in the scan's session: {[p.pid for p in alive]}"

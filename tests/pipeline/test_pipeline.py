@@ -608,5 +608,79 @@ def test_each_stage_through_the_cli_writes_the_files_of_the_run(tiny_run, tmp_pa
     run = json.loads((src / "06-contact" / "summary.json").read_text())
     assert run.pop("provenance")["tau0_mpa"] == "fitted laws"
     assert ours.pop("provenance")["tau0_mpa"] == "config"
+    # the fitted laws carry their intervals into the contact outputs; numbers given as flags
+    # have none: same central values, zero width from the CLI
+    ours_iv, run_iv = ours.pop("intervals"), run.pop("intervals")
+    assert not any(ours_iv["half_widths"].values()) and all(run_iv["half_widths"].values())
+    for a, b in zip(ours_iv["results"], run_iv["results"], strict=True):
+        for key, value in a.items():
+            if isinstance(value, dict):
+                assert value["low"] == value["value"] == value["high"] == b[key]["value"]
+                assert b[key]["low"] < b[key]["value"] < b[key]["high"]
     assert ours == run
     assert _figures(out) == _figures(src / "06-contact")
+
+
+def test_cycle_and_fit_in_a_run_match_the_cli_and_the_fit_file_content_reruns_contact(
+    tiny_run, tmp_path, capsys
+):
+    """contact.cycle/model/fit_* in the run config: only contact and report rerun; the run's
+    cycle rows and fit equal ``flatcontact contact`` with the run's parameters as flags;
+    new content in the same fit file (its sha256 is in the fingerprint) reruns contact."""
+    import shutil
+
+    from flatcontact.cli import main
+    from flatcontact.contact import fit
+    from flatcontact.contact.cycle import CycleModel
+    from flatcontact.contact.parameters import ContactParameters
+
+    src, _, _ = tiny_run
+    root = tmp_path / "copy"
+    shutil.copytree(src, root)
+    fitted = json.loads((root / "06-contact" / "summary.json").read_text())["parameters"]
+    truth = ContactParameters(**fitted).replace(tau0_mpa=1.3 * fitted["tau0_mpa"])
+
+    def write_data(path, prm):
+        lines = ["mean shear stress [MPa],lateral stiffness [N/m],p0 [GPa]"]
+        for p0 in (1.0, 2.0):
+            mdl = CycleModel("modified", p0 * 1e9, prm)
+            stress = np.linspace(0.05, 1.1, 10) * mdl.gross / (np.pi * mdl.a**2)
+            k = fit.model_stiffness(fit.LoadCurve(p0, stress, np.zeros(10), "t"), prm)
+            lines += [f"{s / 1e6:.10g},{v:.10g},{p0}" for s, v in zip(stress, k, strict=True)]
+        path.write_text("\n".join(lines) + "\n")
+
+    csv = tmp_path / "curves.csv"
+    write_data(csv, truth)
+    change = {"cycle": True, "cycle_amplitude_fractions": [0.4, 0.8], "fit_csv": [str(csv)]}
+    cfg = build_config(_merge(TINY, {"contact": change}))
+    with Pipeline(cfg, root) as pipe:
+        pipe.run()
+        actions = _actions(pipe)
+    assert {n for n, a in actions.items() if a != "skipped"} == {"contact", "report"}
+    summary = json.loads((root / "06-contact" / "summary.json").read_text())
+    assert len(summary["cycle"]) == 2 * len(TINY["contact"]["p0_gpa"])
+    assert summary["fit"]["modified"]["fitted"]["tau0_mpa"] == pytest.approx(
+        truth.tau0_mpa, rel=1e-3
+    )
+    assert (root / "06-contact" / "fit.json").is_file()
+    assert "Multi-load fit of curves.csv" in (root / "07-report" / "report.html").read_text()
+
+    flags = [f"--{k.replace('_', '-')}={v!r}" for k, v in fitted.items()]
+    argv = ["contact", "--p0-gpa", ",".join(map(str, TINY["contact"]["p0_gpa"])), *flags]
+    argv += ["--cycle", "--cycle-amplitude-fractions", "0.4,0.8", "--fit", str(csv), "--json"]
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code in (0, None)
+    cli = json.loads(capsys.readouterr().out)
+    assert cli["cycle"] == summary["cycle"]
+    assert cli["fit"] == summary["fit"]
+
+    write_data(csv, truth.replace(tau0_mpa=1.6 * fitted["tau0_mpa"]))  # same name, new content
+    with Pipeline(cfg, root) as pipe:
+        pipe.run()
+        actions = _actions(pipe)
+    assert {n for n, a in actions.items() if a != "skipped"} == {"contact", "report"}
+    again = json.loads((root / "06-contact" / "summary.json").read_text())
+    assert again["fit"]["modified"]["fitted"]["tau0_mpa"] == pytest.approx(
+        1.6 * fitted["tau0_mpa"], rel=1e-3
+    )

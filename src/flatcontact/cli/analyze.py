@@ -152,7 +152,7 @@ def analyze_command(
         )
         analyzed = run_analyze(cfg, AnalyzeInputs(path), out)
         laws_inputs = (
-            LawsInputs.read(out / FRICTION_CSV)
+            LawsInputs.read(out / FRICTION_CSV, path)  # + the other energy form, as the run
             if out is not None
             else LawsInputs.from_analysis(analyzed.analysis)
         )

@@ -15,7 +15,7 @@ from typing import Annotated
 
 import typer
 
-from flatcontact.cli.app import app, check_out_dir, console, parse_floats
+from flatcontact.cli.app import app, check_out_dir, console, parse_floats, split_list
 from flatcontact.reference import DEFAULT_P0_GPA, PAPER, PAPER_EXPERIMENT_P0_GPA
 
 _DEFAULT_HELP = "(default: the paper's value)"
@@ -38,7 +38,19 @@ _FLAG_OF = {
         "experiment_stress_measure",
         "collapse_fraction",
     )
-} | {"contact.experiment_csv": "--experiment", "report.svg": "--svg"}
+} | {
+    "contact.experiment_csv": "--experiment",
+    "report.svg": "--svg",
+    "contact.cycle": "--cycle",
+    "contact.model": "--model",
+    "contact.cycle_amplitude_fractions": "--cycle-amplitude-fractions",
+    "contact.cycle_amplitudes_un": "--cycle-amplitude-un",
+    "contact.fit_csv": "--fit",
+    "contact.fit_p0_gpa": "--fit-p0-gpa",
+    "contact.fit_free": "--fit-free",
+    "contact.fit_fixed": "--fit-fixed",
+    "contact.fit_stiffness": "--fit-stiffness",
+}
 
 
 def _parse_p0(values: list[str] | None) -> list[float]:
@@ -160,6 +172,73 @@ def contact_command(
             help="Collapse = stiffness first below this fraction of its low-stress value.",
         ),
     ] = 0.2,
+    cycle: Annotated[
+        bool,
+        typer.Option(
+            "--cycle",
+            help="Steady oscillation cycle per p0: loops, dissipated energy per cycle, lock-in "
+            "stiffness Q_amp/u'_1 and quadrature u''_1 (JSON 'cycle' rows, contact.nc loops, "
+            "lock-in curve in Fig. 5b/6).",
+        ),
+    ] = False,
+    model: Annotated[
+        str,
+        typer.Option(
+            "--model",
+            help="Model of the cycle: 'modified' (the paper's Mindlin model) or 'classical' "
+            "(Cattaneo–Mindlin, friction coefficient μ = k·1e-3, Johnson's G*_J = G*/4 with G* "
+            "in the paper's convention).",
+        ),
+    ] = "modified",
+    cycle_amplitude_fractions: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--cycle-amplitude-fractions",
+            help="Force amplitudes of the cycle as fractions of gross sliding, each in (0, 1); "
+            "default 0.2,0.4,0.6,0.8,0.9,0.95.",
+        ),
+    ] = None,
+    cycle_amplitude_un: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--cycle-amplitude-un",
+            help="Force amplitudes of the cycle in µN (below gross sliding at every p0); "
+            "replaces --cycle-amplitude-fractions.",
+        ),
+    ] = None,
+    fit_files: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--fit",
+            help="Measured stiffness CSV(s) to fit at several loads at once (repeat or "
+            "comma-separate; one file per load with --fit-p0-gpa, or files with a load column "
+            "'p0 [GPa]'/'normal load [uN]'): fit.json and fig6_fit with --out.",
+        ),
+    ] = None,
+    fit_p0_gpa: Annotated[
+        list[str] | None,
+        typer.Option("--fit-p0-gpa", help="p0 (GPa) of each --fit file without a load column."),
+    ] = None,
+    fit_free: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--fit-free",
+            help="Parameters the fit frees (tau0_mpa, k_mpa_per_gpa, mu_mpa_per_gpa, "
+            "sigma0_mpa, shear_modulus_gpa); default tau0_mpa.",
+        ),
+    ] = None,
+    fit_fixed: Annotated[
+        list[str] | None,
+        typer.Option("--fit-fixed", help="Parameters the fit must hold at their values."),
+    ] = None,
+    fit_stiffness: Annotated[
+        str,
+        typer.Option(
+            "--fit-stiffness",
+            help="Model stiffness compared with the data: 'lockin' (Q_amp/u'_1) or 'paper' "
+            "(d<Q>/d<u>).",
+        ),
+    ] = "lockin",
     out: Annotated[
         Path | None,
         typer.Option("--out", help="Directory for figures, summary.json and contact.nc."),
@@ -192,7 +271,26 @@ def contact_command(
         "experiment_p0_gpa": experiment_p0_gpa,
         "experiment_stress_measure": experiment_stress_measure,
         "collapse_fraction": collapse_fraction,
+        "cycle": cycle,
+        "model": model,
+        "fit_stiffness": fit_stiffness,
     }
+    if cycle_amplitude_fractions:
+        contact["cycle_amplitude_fractions"] = parse_floats(
+            cycle_amplitude_fractions, "--cycle-amplitude-fractions"
+        )
+    if cycle_amplitude_un:
+        contact["cycle_amplitudes_un"] = parse_floats(
+            cycle_amplitude_un, "--cycle-amplitude-un", "µN"
+        )
+    if fit_files:
+        contact["fit_csv"] = split_list(fit_files, "--fit", whitespace=False)
+    if fit_p0_gpa:
+        contact["fit_p0_gpa"] = parse_floats(fit_p0_gpa, "--fit-p0-gpa", "GPa")
+    if fit_free:
+        contact["fit_free"] = split_list(fit_free, "--fit-free")
+    if fit_fixed:
+        contact["fit_fixed"] = split_list(fit_fixed, "--fit-fixed")
     cfg = settings_from_flags({"contact": contact, "report": {"svg": svg}}, _FLAG_OF)
     if out is not None:
         check_out_dir(out)
@@ -203,6 +301,47 @@ def contact_command(
         typer.echo(json.dumps(doc, indent=2))
         return
     _print_table(doc["results"], doc.get("experiment"), out)
+    if "cycle" in doc:
+        _print_cycle(doc["cycle"])
+    if "fit" in doc:
+        _print_fit(doc["fit"])
+
+
+def _print_cycle(rows) -> None:
+    from rich.table import Table
+
+    table = Table(title=f"steady cycle ({rows[0]['model']} model); lock-in k' = Q_amp/u'_1")
+    cols = [
+        ("p0_gpa", "p0 (GPa)", "{:g}"),
+        ("lateral_force_amplitude_un", "Q_amp (µN)", "{:.4g}"),
+        ("amplitude_fraction_of_gross_sliding", "Q_amp/Q_gross", "{:.3g}"),
+        ("dissipated_energy_per_cycle_fj", "W per cycle (fJ)", "{:.4g}"),
+        ("lockin_stiffness_n_per_m", "lock-in k' (N/m)", "{:.0f}"),
+        ("lockin_quadrature_nm", "u''_1 (nm)", "{:.4g}"),
+        ("loss_tangent", "tan δ", "{:.3g}"),
+        ("paper_stiffness_n_per_m", "d<Q>/d<u> (N/m)", "{:.0f}"),
+    ]
+    for _, label, _ in cols:
+        table.add_column(label, justify="right")
+    for row in rows:
+        table.add_row(*(fmt.format(row[key]) for key, _, fmt in cols))
+    console.print(table)
+
+
+def _print_fit(doc) -> None:
+    for name in ("modified", "classical"):
+        res = doc[name]
+        vals = ", ".join(
+            f"{k} = {res['fitted'][k]:.4g} ± {res['standard_errors'][k]:.2g}" for k in res["free"]
+        )
+        console.print(
+            f"fit ({name}, {res['stiffness']} stiffness, {res['n_points']} points at "
+            f"{len(res['loads_gpa'])} loads): {vals}; AICc {res['aicc']:.1f}"
+        )
+    console.print(
+        f"preferred model: {doc['preferred_model']} (ΔAICc classical − modified = "
+        f"{doc['delta_aicc_classical_minus_modified']:.1f})"
+    )
 
 
 def _print_table(records, exp_summary, out) -> None:

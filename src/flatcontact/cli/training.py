@@ -136,8 +136,62 @@ def validate_potential_cmd(
     json_out: bool = typer.Option(False, "--json", help="Print the report as JSON."),
     surface: bool = typer.Option(True, "--surface/--no-surface", help="Dense-surface checks."),
     out: Path = typer.Option(None, "--out", help="Also write the report to this JSON file."),
+    ispes: bool = typer.Option(
+        False,
+        "--ispes",
+        help="Instead: scan the same interface with --reference (first) and POTENTIAL and "
+        "compare τ, σ_MSS, G_int and W per load (models: vashishta, tersoff, a SNAP, or an "
+        "offline teacher chgnet-r2scan, sevennet-0, sevennet-mf-0-r2scan, sevennet-mf-0-pbe).",
+    ),
+    ispes_model: list[str] = typer.Option(
+        None, "--ispes-model", help="With --ispes: a further model to compare (repeat)."
+    ),
+    interface: Path = typer.Option(
+        None,
+        "--interface",
+        help="With --ispes: interface.extxyz to scan (default: the dense α-quartz (0001) "
+        "interface built and relaxed with POTENTIAL, --layers per slab).",
+    ),
+    layers: int = typer.Option(
+        6, "--layers", help="With --ispes: layers per slab of the built interface."
+    ),
+    grid: tuple[int, int] = typer.Option(
+        (4, 4), "--grid", help="With --ispes: lateral grid NA NB."
+    ),
+    p_range_gpa: tuple[float, float, int] = typer.Option(
+        (-0.3, 5.5, 8),
+        "--p-range-gpa",
+        help="With --ispes: thicknesses spanning loads LO HI (GPa) in N steps, per model.",
+    ),
+    p_gpa: list[str] = typer.Option(
+        None, "--p-gpa", help="With --ispes: loads analysed (GPa); default 0,0.5,…,3."
+    ),
+    fmax: float = typer.Option(
+        0.005, "--fmax-ev-per-angstrom", help="With --ispes: force tolerance per point (eV/Å)."
+    ),
+    energy: str = typer.Option(
+        "internal",
+        "--energy",
+        help="With --ispes: energy form, internal (the paper's) or enthalpy.",
+    ),
+    lj_cutoff_angstrom: float = typer.Option(
+        None,
+        "--lj-cutoff-angstrom",
+        help="With --ispes: cutoff of the cross-interface LJ shared by all models (default the "
+        "run's default model's).",
+    ),
+    ispes_dir: Path = typer.Option(
+        Path("flatcontact-ispes-check"),
+        "--ispes-dir",
+        help="With --ispes: folder of the resumable scans, one per model.",
+    ),
 ) -> None:
-    """Held-out RMSEs, alpha-quartz lattice, Cij, EOS, dense surface; vs reference and experiment."""
+    """Held-out RMSEs, alpha-quartz lattice, Cij, EOS, dense surface; vs reference and experiment.
+
+    With ``--ispes``: the potential's error on the quantities of interest (τ, σ_MSS, G_int,
+    W per load) against a reference model on the same interface
+    (:func:`flatcontact.training.ispes_check.compare_ispes`).
+    """
     from flatcontact.errors import InputError
     from flatcontact.fileio import write_json_atomic
     from flatcontact.training.dataset import read_dataset
@@ -148,6 +202,28 @@ def validate_potential_cmd(
         if out.is_dir():
             raise InputError(f"--out {str(out)!r}: is a directory, expected a JSON file path")
         check_out_dir(out.parent)
+    if ispes:
+        report = _ispes_check(
+            potential,
+            reference,
+            ispes_model or [],
+            interface=interface,
+            layers=layers,
+            grid=grid,
+            p_range_gpa=p_range_gpa,
+            p_gpa=p_gpa,
+            fmax=fmax,
+            energy=energy,
+            lj_cutoff_angstrom=lj_cutoff_angstrom,
+            ispes_dir=ispes_dir,
+        )
+        if out is not None:
+            write_json_atomic(out, report)
+        if json_out:
+            print(json.dumps(report, indent=2))
+            return
+        _print_ispes_check(report)
+        return
     calc = bulk_calculator(_bulk_potential(potential, "POTENTIAL"))
     ref_calc, frames, ref_label = None, None, None
     if heldout is not None:
@@ -172,6 +248,162 @@ def validate_potential_cmd(
         print(json.dumps(report, indent=2))
         return
     _print_validation(report)
+
+
+def _ispes_model(name: str, flag: str, lj: dict):
+    """The interaction model of ``name`` for the ISPES comparison: an offline teacher
+    (``chgnet`` = ``chgnet-r2scan``) or any intra-slab potential name, with the shared LJ."""
+    from flatcontact.errors import InputError
+    from flatcontact.potentials import PotentialSpec
+    from flatcontact.training.ispes_check import TEACHERS, teacher_spec
+
+    name = name.strip()
+    if name == "chgnet":
+        name = "chgnet-r2scan"
+    if name in TEACHERS:
+        return name, teacher_spec(name, lj)
+    try:
+        return name, PotentialSpec(intra=name, lj=lj)
+    except InputError as exc:
+        raise InputError(f"{flag} {name!r}: {exc}") from None
+
+
+def _ispes_check(
+    potential: str,
+    reference: str | None,
+    extra: list[str],
+    *,
+    interface,
+    layers,
+    grid,
+    p_range_gpa,
+    p_gpa,
+    fmax,
+    energy,
+    lj_cutoff_angstrom,
+    ispes_dir,
+) -> dict:
+    """``validate-potential --ispes``: checks every argument, then compare_ispes."""
+    import numpy as np
+
+    from flatcontact.cli.app import parse_floats
+    from flatcontact.config import default_potential
+    from flatcontact.errors import InputError, require
+    from flatcontact.training.ispes_check import compare_ispes
+
+    require(reference is not None, "--ispes: give the reference model with --reference NAME")
+    require(
+        Path(reference).suffix not in (".extxyz", ".xyz"),
+        f"--reference {reference!r}: with --ispes the reference is a model, not frames",
+    )
+    require(
+        energy in ("internal", "enthalpy"),
+        f"--energy: expected internal or enthalpy, got {energy!r}",
+    )
+    require(
+        grid[0] >= 2 and grid[1] >= 2, f"--grid: expected at least 2 x 2, got {grid[0]} {grid[1]}"
+    )
+    lo, hi, n = p_range_gpa
+    require(
+        np.isfinite(lo) and np.isfinite(hi) and lo < hi and n >= 3,
+        f"--p-range-gpa: expected LO < HI and N >= 3, got {lo:g} {hi:g} {n}",
+    )
+    require(np.isfinite(fmax) and fmax > 0, f"--fmax-ev-per-angstrom: expected > 0, got {fmax:g}")
+    loads = parse_floats(p_gpa, "--p-gpa", "GPa") if p_gpa else [0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0]
+    require(len(loads) >= 2, "--p-gpa: expected at least two loads")
+    lj = dict(default_potential()["lj"])
+    if lj_cutoff_angstrom is not None:
+        require(
+            np.isfinite(lj_cutoff_angstrom) and lj_cutoff_angstrom > 0,
+            f"--lj-cutoff-angstrom: expected > 0, got {lj_cutoff_angstrom:g}",
+        )
+        lj["cutoff_angstrom"] = float(lj_cutoff_angstrom)
+    named = [(reference, "--reference"), (potential, "POTENTIAL")]
+    named += [(m, "--ispes-model") for m in extra]
+    pairs = [_ispes_model(name, flag, lj) for name, flag in named]
+    labels = [label for label, _ in pairs]
+    models = dict(pairs)
+    require(len(models) == len(named), "--ispes: the models to compare must be distinct")
+    if interface is not None:
+        from flatcontact.structures.interface import read_interface
+
+        require(interface.is_file(), f"--interface {str(interface)!r}: file not found")
+        atoms = read_interface(interface)
+        source = str(interface)
+    else:
+        from flatcontact.structures.build import MIN_LAYERS, build_quartz_interface
+
+        if layers < MIN_LAYERS:
+            raise InputError(f"--layers: expected >= {MIN_LAYERS}, got {layers}")
+        _say(f"building the dense alpha-quartz (0001) interface with {potential} ({layers} layers)")
+        atoms, _ = build_quartz_interface(models[labels[1]], layers)
+        source = f"dense alpha-quartz (0001), {layers} layers per slab, relaxed with {potential}"
+    check_out_dir(ispes_dir)
+    per_model: dict = {}
+    table = compare_ispes(
+        models,
+        atoms,
+        ispes_dir,
+        grid=(int(grid[0]), int(grid[1])),
+        p_range_gpa=(float(lo), float(hi), int(n)),
+        p_gpa=loads,
+        fmax_ev_per_angstrom=fmax,
+        form=energy,
+        results=per_model,
+    )
+    return {
+        "reference": labels[0],
+        "interface": source,
+        "settings": {
+            "grid": list(grid),
+            "p_range_gpa": [lo, hi, n],
+            "p_gpa": loads,
+            "fmax_ev_per_angstrom": fmax,
+            "energy_form": energy,
+            "lj": lj,
+        },
+        "models": {
+            label: {k: v for k, v in res.items() if k != "rows"} for label, res in per_model.items()
+        },
+        "table": json.loads(table.to_json(orient="records")),
+    }
+
+
+def _print_ispes_check(report: dict) -> None:
+    from rich.table import Table
+
+    ref = report["reference"]
+    t = Table(title=f"ISPES per load vs {ref} ({report['settings']['energy_form']} form)")
+    for col in ("model", "P (GPa)", "τ (MPa)", "Δτ/τ", "σ_MSS (MPa)", "Δσ/σ", "W (J/m²)"):
+        t.add_column(col, justify="right")
+    for r in report["table"]:
+
+        def pct(v):
+            return "–" if v is None else f"{100 * v:+.0f} %"
+
+        t.add_row(
+            r["model"],
+            f"{r['p_gpa']:g}",
+            f"{r['tau_mpa']:.3g}" if r["tau_mpa"] is not None else "n/a",
+            pct(r.get("rel_tau_mpa")),
+            f"{r['sigma_mss_mpa']:.3g}" if r["sigma_mss_mpa"] is not None else "n/a",
+            pct(r.get("rel_sigma_mss_mpa")),
+            f"{r['work_of_separation_j_per_m2']:.4g}",
+        )
+    console.print(t)
+    for label, res in report["models"].items():
+        laws = res["laws"]
+
+        def num(key, laws=laws):
+            v = laws.get(key)
+            return "n/a" if v is None else f"{v:.3g}"
+
+        console.print(
+            f"{label}: k = {num('k_mpa_per_gpa')} MPa/GPa, τ0 = {num('tau0_mpa')} MPa, "
+            f"μ = {num('mu_mpa_per_gpa')} MPa/GPa, σ0 = {num('sigma0_mpa')} MPa "
+            f"({res['force_calls']} force calls, {res['seconds']:.0f} s)",
+            highlight=False,
+        )
 
 
 def _print_validation(report: dict) -> None:

@@ -25,13 +25,16 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from flatcontact import __version__
 from flatcontact.errors import InputError
 from flatcontact.fileio import atomic_path
+
+if TYPE_CHECKING:  # xarray is imported where a dataset is made: scan workers never need it
+    import xarray as xr
 
 DIM_A = "shift_a"
 DIM_B = "shift_b"
@@ -82,6 +85,8 @@ def empty_grid(
     **attrs: object,
 ) -> xr.Dataset:
     """A contract-conforming grid with every point missing (NaN, not converged)."""
+    import xarray as xr
+
     z = np.asarray(thickness_angstrom, dtype=float)
     if z.ndim != 1 or z.size < 1:
         raise InputError("thickness: expected a non-empty list of values in Å")
@@ -191,6 +196,8 @@ def _to_contract_units(ds: xr.Dataset, source: str) -> xr.Dataset:
 
 def open_ispes(path: str | os.PathLike[str]) -> xr.Dataset:
     """Read and validate an ``ispes.nc`` file into memory."""
+    import xarray as xr
+
     path = Path(path)
     if not path.is_file():
         raise InputError(f"{path}: no such ISPES file")

@@ -112,8 +112,26 @@ class ProcessExecutor(SerialExecutor):
     def submit(self, fn: Callable, *args: Any) -> cf.Future:
         return self._pool.submit(fn, *args)
 
+    def prestart(self, factory: Any, reference: Any) -> None:
+        """Start every worker now and build its calculator, without waiting.
+
+        The driver calls this before its own serial work (the probe column, the overlap
+        check): the workers' start (spawn, imports, LAMMPS setup: seconds) then overlaps it
+        instead of delaying the first grid points. One task per worker; a worker that gets
+        two builds once (the calculator is cached per worker).
+        """
+        for _ in range(self.workers):
+            self._pool.submit(warm_worker, factory, reference)
+
     def close(self, cancel: bool = False) -> None:
         self._pool.shutdown(wait=not cancel, cancel_futures=cancel)
+
+
+def warm_worker(factory: Any, reference: Any) -> None:
+    """Build this worker's calculator for ``factory`` (cached for its later points)."""
+    from flatcontact.ispes.relax import worker_calculator
+
+    worker_calculator(factory, reference)
 
 
 def jobqueue_cluster(spec: dict) -> Any:

@@ -156,6 +156,11 @@ def run_scan(
             own_executor = executor is None
             if own_executor:
                 executor = make_executor(**(executor_options or {}))
+            known = store.resolved
+            if hasattr(executor, "prestart") and (
+                known is None or len(store) < grid.n_a * grid.n_b * len(known["thickness_angstrom"])
+            ):
+                executor.prestart(factory, reference)  # worker start overlaps the probe
             notes: list[str] = []
             interrupted = False
             computed_calls: list[int] = []

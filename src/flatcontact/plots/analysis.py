@@ -99,13 +99,37 @@ def figure_pressure(pa: PressureAnalysis, result: AnalysisResult) -> plt.Figure:
     return fig
 
 
-def figure_laws(p_gpa, tau_mpa, sigma_mss_mpa, laws: LoadLaws) -> plt.Figure:
-    """Fig. 3: τ and σ vs P (one value per load, GPa and MPa) with the linear fits ``laws``."""
+def law_band(
+    p_gpa, slope: float, intercept: float, slope_half_width: float, intercept_half_width: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper edge of the law c(P) = slope·P + intercept over the box of its
+    coefficients (each ± its half-width), at every P: the extremes are at the box corners
+    (:func:`flatcontact.analysis.uncertainty.propagate_box`, exact for a linear law)."""
+    from flatcontact.analysis.uncertainty import propagate_box
+
+    p = np.asarray(p_gpa, dtype=float)
+    box = propagate_box(
+        lambda x: {i: x["s"] * pi + x["c"] for i, pi in enumerate(p)},
+        {"s": slope, "c": intercept},
+        {"s": slope_half_width, "c": intercept_half_width},
+    )
+    return np.array([box[i][0] for i in range(p.size)]), np.array(
+        [box[i][2] for i in range(p.size)]
+    )
+
+
+def figure_laws(
+    p_gpa, tau_mpa, sigma_mss_mpa, laws: LoadLaws, half_widths: dict | None = None
+) -> plt.Figure:
+    """Fig. 3: τ and σ vs P (one value per load, GPa and MPa) with the linear fits ``laws``;
+    with ``half_widths`` (coefficient -> half-width, ``laws.json``) the band of each law over
+    its coefficient box (fit, convergence and model spread)."""
     fig, ax = plt.subplots(figsize=(5.5, 4.2))
     p = np.asarray(p_gpa, dtype=float)
-    for y, law, style, label in (
-        (tau_mpa, laws.tau, "o", "τ"),
-        (sigma_mss_mpa, laws.sigma, "s", "σ"),
+    hw = half_widths or {}
+    for y, law, style, label, keys in (
+        (tau_mpa, laws.tau, "o", "τ", ("k_mpa_per_gpa", "tau0_mpa")),
+        (sigma_mss_mpa, laws.sigma, "s", "σ", ("mu_mpa_per_gpa", "sigma0_mpa")),
     ):
         line = ax.plot(p, np.asarray(y, dtype=float), style, label=label)[0]
         if law is not None:
@@ -117,6 +141,18 @@ def figure_laws(p_gpa, tau_mpa, sigma_mss_mpa, laws: LoadLaws) -> plt.Figure:
                 color=line.get_color(),
                 label=f"{label} = {law.slope:.3g}·P + {law.intercept:.3g}",
             )
+            hs, hc = (float(hw.get(k) or 0.0) for k in keys)
+            if hs > 0 or hc > 0:
+                lo, hi = law_band(pf, law.slope, law.intercept, hs, hc)
+                ax.fill_between(
+                    pf,
+                    lo,
+                    hi,
+                    color=line.get_color(),
+                    alpha=0.18,
+                    lw=0,
+                    label=f"{label} band (±{hs:.2g}·P ± {hc:.2g})",
+                )
             if p.max() > law.p_max_gpa:
                 pe = np.linspace(law.p_max_gpa, p.max(), 20)
                 ax.plot(pe, law(pe), ":", color=line.get_color())

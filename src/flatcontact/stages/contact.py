@@ -6,6 +6,16 @@ per-p0 results, the same with the paper's laws, and the measured-data comparison
 figures ``fig4_traction``, ``fig5_force_stiffness`` (amplitude), ``fig5_force_stiffness_rms``
 and, with ``contact.experiment_csv``, ``fig6_experiment`` (PNG, + SVG with ``report.svg``).
 
+With ``contact.cycle`` (issue 13) the steady load-controlled cycle of ``contact.model`` at the
+force amplitudes ``contact.cycle_amplitude_fractions`` (or ``cycle_amplitudes_un``) of every p0:
+``summary.json`` gains ``cycle`` (one row per p0 and amplitude: W per cycle, lock-in k′ =
+Q_amp/u′₁, quadrature u″₁, ...), ``contact.nc`` the loops (``cycle_*`` variables), Fig. 5b and
+the Fig. 6 overlay the lock-in curve next to the paper's d⟨Q⟩/d⟨u⟩, plus ``fig5c_cycle_loops``
+and ``fig6_lockin`` (lock-in vs the paper's construction, loss tangent). With
+``contact.fit_csv`` the multi-load least-squares fit of the measured curves (modified and
+classical model on the same data, :func:`flatcontact.contact.fit.fit_and_compare`) goes to
+``fit.json`` (also ``summary.json`` ``fit``) and ``fig6_fit``.
+
 Fig. 4 is drawn at 60 % of the displacement at the peak force
 (:data:`flatcontact.plots.contact.FIG4_FRACTION_OF_PEAK`) at p0 = 1 GPa (or the first p0),
 so both the stick and the slip zone show whatever the laws.
@@ -17,13 +27,16 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from flatcontact.errors import InputError
-from flatcontact.fileio import write_json_atomic
+from flatcontact.fileio import atomic_path, write_json_atomic
 from flatcontact.reference import PAPER, PAPER_LAW_KEYS
-from flatcontact.stages._common import renamed_errors, save
+from flatcontact.stages._common import file_sha256, rename, renamed_errors, save
 
 SUMMARY_JSON = "summary.json"
 CONTACT_NC = "contact.nc"
+FIT_JSON = "fit.json"
 #: ContactParameters fields -> the settings path that sets them.
 SETTINGS_NAMES = {
     name: f"contact.{name}"
@@ -34,6 +47,15 @@ SETTINGS_NAMES = {
         "work_of_adhesion_j_m2",
         *PAPER_LAW_KEYS,
     )
+}
+
+
+#: Cycle library parameter names -> the settings path that sets them.
+CYCLE_NAMES = {
+    "lateral_force_amplitude_un": "contact.cycle_amplitudes_un",
+    "amplitude_fraction": "contact.cycle_amplitude_fractions",
+    "p0_gpa": "contact.p0_gpa",
+    **{k: v for k, v in SETTINGS_NAMES.items() if k != "radius_um"},
 }
 
 
@@ -110,9 +132,129 @@ def contact_parameters(settings, inputs: ContactInputs):
     return params, provenance
 
 
+def check_cycle(settings, params) -> None:
+    """The cycle request of ``contact`` (model, amplitudes below gross sliding at every p0,
+    σ <= τ on the contact): one line naming the setting, before any work."""
+    from flatcontact.contact import cycle
+
+    c = settings.contact
+    with renamed_errors(CYCLE_NAMES):
+        cycle.validate_cycle_request(
+            c.p0_gpa,
+            params,
+            c.model,
+            amplitudes_un=c.cycle_amplitudes_un,
+            amplitude_fractions=None if c.cycle_amplitudes_un else c.cycle_amplitude_fractions,
+        )
+
+
+def fit_curves(settings, params) -> list:
+    """The measured curves of ``contact.fit_csv`` (validated with the parameter names, before
+    any work): :func:`flatcontact.contact.fit.load_fit_data`, ``check_free_fixed``."""
+    from flatcontact.contact import fit
+
+    c = settings.contact
+    try:
+        fit.check_free_fixed(c.fit_free, c.fit_fixed, "modified")
+    except InputError as exc:
+        where = "contact.fit_fixed" if "fixed" in str(exc) else "contact.fit_free"
+        raise InputError(f"{where}: {exc} (contact.fit_free = {list(c.fit_free)})") from None
+    try:
+        return fit.load_fit_data(c.fit_csv, params, c.fit_p0_gpa)
+    except InputError as exc:
+        text = rename(str(exc), {"fit_p0_gpa": "contact.fit_p0_gpa"})
+        raise InputError(f"contact.fit_csv: {text}") from None
+
+
+def law_half_widths_used(inputs: ContactInputs, provenance: dict) -> dict[str, float]:
+    """Half-widths of the law coefficients the contact model takes from the fitted laws
+    (``laws.json`` ``half_widths`` of its configured energy form); 0 for a coefficient set
+    in ``contact`` (a given number has no fit, convergence or model error here)."""
+    laws = inputs.laws or {}
+    form = laws.get("energy_form")
+    hw = (laws.get(form) or {}).get("half_widths", {}) if form else {}
+    return {
+        key: float(hw.get(key) or 0.0) if provenance.get(key) == "fitted laws" else 0.0
+        for key in PAPER_LAW_KEYS
+    }
+
+
+def contact_intervals(settings, params, half_widths: dict[str, float]) -> dict:
+    """Intervals of the effective shear strength Q_peak/πa², the collapse stress (stiffness
+    at ``contact.collapse_fraction``·k0) and the knee (``knee_fraction``·k0), amplitude stress,
+    at every p0, over the box of the law coefficients ± ``half_widths``
+    (:func:`flatcontact.analysis.uncertainty.propagate_box`; τ0 and σ0 clipped at 0).
+
+    Returns ``{"half_widths", "method", "results": [{"p0_gpa", <quantity>: {"low", "value",
+    "high"}}]}``, or with ``"unavailable"`` (the reason) when a corner of the box leaves the
+    model's domain (e.g. τ(centre) <= 0 for k < 0).
+    """
+    from flatcontact import units
+    from flatcontact.analysis.uncertainty import propagate_box
+    from flatcontact.contact import experiment, mindlin, oscillation
+
+    c = settings.contact
+    p0s = [float(p) for p in c.p0_gpa]
+    names = ("effective_shear_strength_mpa", "collapse_stress_mpa", "knee_stress_amplitude_mpa")
+
+    def outputs(x: dict[str, float]) -> dict[str, float]:
+        prm = params.replace(**x)
+        out = {}
+        for i, p0 in enumerate(p0s):
+            pa = p0 * units.GPA_TO_PA
+            area = np.pi * float(mindlin.contact_radius(pa, prm)) ** 2
+            peak = float(mindlin.peak_force(pa, prm).force_n)
+            knee = oscillation.amplitude_at_stiffness_fraction(pa, prm, c.knee_fraction)
+            collapse = experiment.model_collapse_stress(pa, prm, fraction=c.collapse_fraction)
+            out[(i, names[0])] = peak / area / units.MPA_TO_PA
+            out[(i, names[1])] = collapse / units.MPA_TO_PA
+            out[(i, names[2])] = knee / area / units.MPA_TO_PA
+        return out
+
+    doc: dict = {
+        "half_widths": dict(half_widths),
+        "method": "box of the law coefficients +- half-width (laws.json), every corner "
+        "evaluated; tau0, sigma0 clipped at 0; amplitude stresses",
+    }
+    central = {k: float(getattr(params, k)) for k in PAPER_LAW_KEYS}
+    try:
+        box = propagate_box(outputs, central, half_widths, nonnegative=("tau0_mpa", "sigma0_mpa"))
+    except InputError as exc:
+        doc["unavailable"] = str(exc)
+        return doc
+    doc["results"] = [
+        {
+            "p0_gpa": p0,
+            **{n: dict(zip(("low", "value", "high"), box[(i, n)], strict=True)) for n in names},
+        }
+        for i, p0 in enumerate(p0s)
+    ]
+    return doc
+
+
+def check_fit_settings(settings) -> None:
+    """``contact.fit_*`` checked at the start of a run, before the laws exist (names freed and
+    fixed, files readable, load columns): the loads of a normal-load column are converted with
+    the configured R and E* here; the stage converts them again with the run's moduli."""
+    from flatcontact.contact.parameters import ContactParameters
+
+    c = settings.contact
+    if c.fit_csv:
+        start = ContactParameters(
+            radius_um=c.radius_um,
+            contact_modulus_gpa=c.contact_modulus_gpa,
+            shear_modulus_gpa=c.shear_modulus_gpa,
+        )
+        fit_curves(settings, start)
+
+
 def check_contact(settings, params) -> None:
     """Everything the contact stage refuses, before any work (one line naming the setting)."""
     c = settings.contact
+    if c.cycle:
+        check_cycle(settings, params)
+    if c.fit_csv:
+        fit_curves(settings, params)
     # with k < 0 or μ < 0 the model is defined only where τ > 0 and σ >= 0 on the whole
     # contact (p0 < τ0/|k|, p0 <= σ0/|μ|)
     params.check_p0_gpa(c.p0_gpa, "contact.p0_gpa")
@@ -135,7 +277,25 @@ class ContactResult:
     knee_fraction: float
     paper: Any = None  # the same analysis with the paper's k, τ0, μ, σ0 (None: identical)
     experiment: dict | None = None
+    cycles: tuple = ()  # flatcontact.contact.cycle.SteadyCycle per p0 (contact.cycle)
+    fit: Any = None  # flatcontact.contact.fit.ModelComparison (contact.fit_csv)
+    fit_files: list[dict] = field(default_factory=list)
+    intervals: dict | None = None  # contact_intervals: the laws' uncertainty carried through
+    bands: tuple | None = None  # analyses at the lower and upper corner of the law box
     files: list[Path] = field(default_factory=list)
+
+    def cycle_rows(self) -> list[dict]:
+        """One row per p0 and force amplitude (:func:`flatcontact.contact.cycle.cycle_records`)."""
+        from flatcontact.contact.cycle import cycle_records
+
+        return cycle_records(self.cycles) if self.cycles else []
+
+    def fit_json(self) -> dict | None:
+        """``fit.json``: both models' fitted parameters with standard errors and correlations,
+        information criteria, and the fitted files with their sha256."""
+        if self.fit is None:
+            return None
+        return {"files": self.fit_files, **self.fit.to_json()}
 
     def to_json(self) -> dict:
         """``summary.json``."""
@@ -153,6 +313,24 @@ class ContactResult:
         }
         if self.experiment is not None:
             doc["experiment"] = self.experiment
+        if self.intervals is not None:
+            doc["intervals"] = self.intervals
+        if self.cycles:
+            doc["conventions"]["cycle"] = (
+                "Q(t) = Q_amp sin(theta); first harmonic u'_1 sin(theta) - u''_1 cos(theta); "
+                "lockin_stiffness_n_per_m = Q_amp/u'_1 (what a lock-in amplifier reads); "
+                "dissipated energy per cycle W = pi Q_amp u''_1; paper_stiffness_n_per_m = the "
+                "paper's d<Q>/d<u>; "
+                + (
+                    "classical = Cattaneo-Mindlin with friction coefficient mu = k "
+                    "(k_mpa_per_gpa x 1e-3), Johnson's G*_J = G*/4 (paper's G* = 4 G*_J)"
+                    if self.cycles[0].model == "classical"
+                    else "modified Mindlin, paper's G*: q0 = G* u/(pi a)"
+                )
+            )
+            doc["cycle"] = self.cycle_rows()
+        if self.fit is not None:
+            doc["fit"] = self.fit_json()
         return doc
 
 
@@ -167,6 +345,7 @@ def run_contact(
     params, provenance = contact_parameters(settings, inputs)
     check_contact(settings, params)
     measured = exp.load_stiffness_csv(c.experiment_csv) if c.experiment_csv else None
+    curves = fit_curves(settings, params) if c.fit_csv else None
     analysis = analyse(
         c.p0_gpa,
         params,
@@ -184,6 +363,10 @@ def run_contact(
             knee_fraction=c.knee_fraction,
         )
     result = ContactResult(analysis, params, provenance, c.knee_fraction, paper)
+    half_widths = law_half_widths_used(inputs, provenance)
+    result.intervals = contact_intervals(settings, params, half_widths)
+    if any(h > 0 for h in half_widths.values()) and "unavailable" not in result.intervals:
+        result.bands = _band_analyses(settings, params, half_widths)
     comparison = None
     if measured is not None:
         comparison = exp.compare_with_measurement(
@@ -194,9 +377,56 @@ def run_contact(
             measure=c.experiment_stress_measure,
         )
         result.experiment = comparison.to_json()
+    if c.cycle:
+        from flatcontact.contact import cycle
+
+        result.cycles = cycle.cycles(
+            c.p0_gpa,
+            params,
+            c.model,
+            amplitudes_un=c.cycle_amplitudes_un,
+            amplitude_fractions=None if c.cycle_amplitudes_un else c.cycle_amplitude_fractions,
+        )
+    if curves is not None:
+        from flatcontact.contact import fit
+
+        result.fit = fit.fit_and_compare(
+            curves,
+            params,
+            c.fit_free,
+            c.fit_fixed,
+            stiffness=c.fit_stiffness,
+            measure=c.experiment_stress_measure,
+        )
+        result.fit_files = [{"name": Path(f).name, "sha256": file_sha256(f)} for f in c.fit_csv]
     if folder is not None:
         _write(result, settings, folder, measured, comparison)
     return result
+
+
+def _band_analyses(settings, params, half_widths: dict[str, float]) -> tuple | None:
+    """The contact analysis at the lower and the upper corner of the law box (every
+    coefficient − and + its half-width; τ0, σ0 clipped at 0): the edges of the Fig. 5 band.
+    The Mindlin outputs grow with each of k, τ0, μ, σ0, so these corners bound them.
+    None if a corner leaves the model's domain."""
+    from flatcontact.contact.summary import analyse
+
+    out = []
+    for sign in (-1.0, 1.0):
+        corner = {k: getattr(params, k) + sign * h for k, h in half_widths.items()}
+        for k in ("tau0_mpa", "sigma0_mpa"):
+            corner[k] = max(corner[k], 0.0)
+        try:
+            out.append(
+                analyse(
+                    settings.contact.p0_gpa,
+                    params.replace(**corner),
+                    knee_fraction=settings.contact.knee_fraction,
+                )
+            )
+        except InputError:
+            return None
+    return tuple(out)
 
 
 def _write(result: ContactResult, settings, folder: Path, measured, comparison) -> None:
@@ -205,10 +435,18 @@ def _write(result: ContactResult, settings, folder: Path, measured, comparison) 
     c, analysis, params = settings.contact, result.analysis, result.params
     folder.mkdir(parents=True, exist_ok=True)
     p0_fig4 = 1.0 if 1.0 in analysis.p0_gpa else analysis.p0_gpa[0]
+    lockin = None
+    if result.cycles:
+        from flatcontact.contact.cycle import lockin_curve
+        from flatcontact.units import GPA_TO_PA
+
+        lockin = [lockin_curve(p * GPA_TO_PA, params, c.model) for p in analysis.p0_gpa]
     figs = {
         "fig4_traction": fig4_traction(params, p0_fig4),
-        "fig5_force_stiffness": fig5_force_and_stiffness(analysis, "amplitude"),
-        "fig5_force_stiffness_rms": fig5_force_and_stiffness(analysis, "rms"),
+        "fig5_force_stiffness": fig5_force_and_stiffness(
+            analysis, "amplitude", lockin, result.bands
+        ),
+        "fig5_force_stiffness_rms": fig5_force_and_stiffness(analysis, "rms", lockin, result.bands),
     }
     if comparison is not None:
         figs["fig6_experiment"] = fig6_overlay(
@@ -220,9 +458,31 @@ def _write(result: ContactResult, settings, folder: Path, measured, comparison) 
             },
             measure=c.experiment_stress_measure,
             measured_collapse_mpa=result.experiment["measured_collapse_stress_mpa"],
+            lockin_model=c.model if result.cycles else None,
         )
+    if result.cycles:
+        from flatcontact.plots.cycle import fig_lockin_overlay, fig_loops
+
+        shown = sorted({p0_fig4, max(analysis.p0_gpa)})
+        figs["fig5c_cycle_loops"] = fig_loops(
+            params, shown, c.cycle_amplitude_fractions, model=c.model
+        )
+        figs["fig6_lockin"] = fig_lockin_overlay(params, analysis.p0_gpa, model=c.model)
+    if result.fit is not None:
+        from flatcontact.plots.cycle import fig_fit
+
+        figs["fig6_fit"] = fig_fit(result.fit)
+        result.files.append(write_json_atomic(folder / FIT_JSON, result.fit_json()))
     for name, fig in figs.items():
         result.files += save(fig, folder, name, settings.report.svg)
-    analysis.write_netcdf(folder / CONTACT_NC)
+    ds = analysis.to_dataset()
+    if result.cycles:
+        from flatcontact.contact.cycle import cycle_dataset
+
+        cyc = cycle_dataset(result.cycles, params)
+        ds = ds.merge(cyc)
+        ds.attrs.update(cyc.attrs)
+    with atomic_path(folder / CONTACT_NC) as tmp:
+        ds.to_netcdf(tmp, engine="h5netcdf")
     result.files.append(folder / CONTACT_NC)
     result.files.append(write_json_atomic(folder / SUMMARY_JSON, result.to_json()))

@@ -1,5 +1,10 @@
 """Stage 4, laws: τ = k·P + τ0 and σ = μ·P + σ0 fitted on P ≤ ``analysis.threshold_gpa``.
 
+Both energy forms side by side (issue 12): the configured ``analysis.energy_form`` from the
+analyze stage's table, the other from the same ISPES (when the inputs carry it); each with
+intervals c ± h_c, h_c = coverage·√(se_fit² + δ_conv² + δ_model²) from the fit and the
+``uncertainty`` section (:mod:`flatcontact.analysis.uncertainty`).
+
 The one place the load laws are fitted (:func:`flatcontact.analysis.laws.fit_load_laws`),
 from the analyze stage's ``friction.csv``. Files: ``laws.json``
 (:meth:`LawsResult.to_json`: the coefficients, standard errors, fitted range, regime ends
@@ -20,24 +25,31 @@ from flatcontact.stages._common import captured, save
 LAWS_JSON = "laws.json"
 FIGURE_STEM = "fig3_laws"
 _COLUMNS = ("p_gpa", "tau_mpa", "sigma_mss_mpa")
+FORMS = ("internal", "enthalpy")
 
 
 @dataclass(frozen=True)
 class LawsInputs:
     """τ and σ_MSS (MPa) per load P (GPa): the analyze stage's ``friction.csv``
-    (:meth:`read`) or an analysis in memory (:meth:`from_analysis`)."""
+    (:meth:`read`) or an analysis in memory (:meth:`from_analysis`).
+
+    ``ispes``: the scan's ``ispes.nc``; when given, the laws of the other energy form are
+    computed from it too (:func:`flatcontact.analysis.energy_forms.laws_both_forms`, same
+    analysis settings), so ``laws.json`` has both forms side by side.
+    """
 
     p_gpa: tuple[float, ...]
     tau_mpa: tuple[float, ...]
     sigma_mss_mpa: tuple[float, ...]
+    ispes: Path | None = None
 
     @classmethod
-    def read(cls, friction_csv: Path) -> LawsInputs:
-        """The columns of ``friction.csv``."""
+    def read(cls, friction_csv: Path, ispes: Path | None = None) -> LawsInputs:
+        """The columns of ``friction.csv`` (and the ISPES for the other energy form)."""
         import pandas as pd
 
         table = pd.read_csv(friction_csv)
-        return cls(*(tuple(table[c].to_numpy(float)) for c in _COLUMNS))
+        return cls(*(tuple(table[c].to_numpy(float)) for c in _COLUMNS), ispes=ispes)
 
     @classmethod
     def from_analysis(cls, analysis) -> LawsInputs:
@@ -60,15 +72,77 @@ class LawsResult:
     sigma_mss_mpa: np.ndarray
     caught: list = field(default_factory=list)  # the fit's warnings.WarningMessage objects
     files: list[Path] = field(default_factory=list)
+    form: str = "internal"  # the energy form of ``laws`` (analysis.energy_form)
+    other: dict | None = None  # the other form: {"loads", "laws", "warnings"} (laws_both_forms)
+    uncertainty: dict = field(default_factory=dict)  # settings.uncertainty as a dict
 
     @property
     def warnings(self) -> list[str]:
         """The fit's warnings (messages), as ``laws.json`` stores them."""
         return [str(w.message) for w in self.caught]
 
+    def form_laws(self) -> dict[str, dict]:
+        """Form -> its ``laws.json`` coefficients (the configured form first)."""
+        out = {self.form: self.laws.to_json()}
+        if self.other is not None:
+            out[other_form(self.form)] = self.other["laws"]
+        return out
+
+    def half_widths(self, form: str) -> dict[str, float]:
+        """Half-width of each coefficient of ``form``: fit, convergence and model spread in
+        quadrature, times the coverage (:func:`flatcontact.analysis.uncertainty.law_half_widths`)."""
+        from flatcontact.analysis.uncertainty import law_half_widths
+
+        u = self.uncertainty
+        return law_half_widths(
+            self.form_laws()[form],
+            convergence=u.get(f"convergence_{form}", {}),
+            model=u.get(f"model_spread_{form}", {}),
+            coverage=u.get("coverage", 1.0),
+        )
+
     def to_json(self) -> dict:
-        """``laws.json``: :meth:`LoadLaws.to_json` and ``warnings``."""
-        return {**self.laws.to_json(), "warnings": self.warnings}
+        """``laws.json``: :meth:`LoadLaws.to_json` of the configured form and ``warnings`` at
+        the top level (the contact stage reads these), ``energy_form``, ``intervals`` (the
+        configured form's coefficients ± half-width), and one block per computed form
+        (``internal``, ``enthalpy``: coefficients, standard errors, ``half_widths``,
+        ``intervals``, per-load ``loads``, ``warnings``), with ``uncertainty`` stating the
+        inputs (fit standard errors, ``convergence_<form>``, ``model_spread_<form>``,
+        ``coverage``, ``source``)."""
+        from flatcontact.analysis.uncertainty import law_intervals
+
+        doc = {**self.laws.to_json(), "warnings": self.warnings, "energy_form": self.form}
+        loads = {
+            self.form: [
+                {"p_gpa": float(p), "tau_mpa": float(t), "sigma_mss_mpa": float(s)}
+                for p, t, s in zip(self.p_gpa, self.tau_mpa, self.sigma_mss_mpa, strict=True)
+            ]
+        }
+        warns = {self.form: self.warnings}
+        if self.other is not None:
+            loads[other_form(self.form)] = self.other["loads"]
+            warns[other_form(self.form)] = self.other["warnings"]
+        for form, laws in self.form_laws().items():
+            hw = self.half_widths(form)
+            doc[form] = {
+                **laws,
+                "half_widths": hw,
+                "intervals": law_intervals(laws, hw),
+                "loads": loads[form],
+                "warnings": warns[form],
+            }
+        doc["intervals"] = doc[self.form]["intervals"]
+        doc["uncertainty"] = {
+            "combination": "half-width = coverage * sqrt(fit stderr^2 + convergence^2 + "
+            "model_spread^2) per coefficient",
+            **self.uncertainty,
+        }
+        return doc
+
+
+def other_form(form: str) -> str:
+    """The energy form that is not ``form``."""
+    return FORMS[1 - FORMS.index(form)]
 
 
 def run_laws(settings, inputs: LawsInputs, folder: Path | None, progress=None) -> LawsResult:
@@ -81,13 +155,47 @@ def run_laws(settings, inputs: LawsInputs, folder: Path | None, progress=None) -
     )
     with captured(AnalysisWarning) as caught:
         laws = fit_load_laws(p, tau, sigma, settings.analysis.threshold_gpa)
-    result = LawsResult(laws, p, tau, sigma, list(caught))
+    unc = getattr(settings, "uncertainty", None)
+    result = LawsResult(
+        laws,
+        p,
+        tau,
+        sigma,
+        list(caught),
+        form=settings.analysis.energy_form,
+        uncertainty=unc.model_dump() if unc is not None else {},
+    )
+    if inputs.ispes is not None:
+        result.other = _other_form(settings, inputs.ispes)
     if folder is not None:
         from flatcontact.plots.analysis import figure_laws
 
         folder.mkdir(parents=True, exist_ok=True)
         result.files.append(write_json_atomic(folder / LAWS_JSON, result.to_json()))
-        result.files += save(
-            figure_laws(p, tau, sigma, laws), folder, FIGURE_STEM, settings.report.svg
-        )
+        fig = figure_laws(p, tau, sigma, laws, half_widths=result.half_widths(result.form))
+        result.files += save(fig, folder, FIGURE_STEM, settings.report.svg)
     return result
+
+
+def _other_form(settings, ispes: Path) -> dict:
+    """Per-load values and laws of the energy form the analyze stage did not use, from the same
+    ISPES with the same analysis settings."""
+    from flatcontact.analysis.energy_forms import laws_both_forms
+    from flatcontact.ispes.contract import open_ispes
+    from flatcontact.stages._common import renamed_errors
+    from flatcontact.stages.analyze import SETTINGS_NAMES
+
+    s = settings.analysis
+    form = other_form(s.energy_form)
+    with renamed_errors(SETTINGS_NAMES):
+        both = laws_both_forms(
+            open_ispes(ispes),
+            s.p_gpa,
+            direction_deg=s.direction_deg,
+            threshold_gpa=s.threshold_gpa,
+            load_source=s.load_source,
+            energy_zero=s.energy_zero,
+            allow_missing=s.allow_missing,
+            forms=(form,),
+        )
+    return both["forms"][form]

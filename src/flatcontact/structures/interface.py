@@ -36,7 +36,6 @@ from pathlib import Path
 import numpy as np
 from ase import Atoms
 from ase.io import read, write
-from ase.neighborlist import neighbor_list
 
 from flatcontact.errors import InputError, require
 from flatcontact.fileio import atomic_path
@@ -179,11 +178,46 @@ def interslab_min_distance(atoms: Atoms, cutoff_angstrom: float = 4.0) -> float:
     """Closest distance (Å) between an atom of slab 1 and one of slab 2 (lateral PBC).
 
     Returns ``inf`` if no pair is closer than ``cutoff_angstrom``.
+
+    Only cross pairs are searched (a k-d tree over slab 1's atoms within ``cutoff_angstrom``
+    in z of slab 2 and their periodic images, queried with the facing atoms of slab 2): the
+    scan runs this for every grid point, and a neighbour list of all pairs cost more than a
+    force call on small cells.
     """
+    from scipy.spatial import cKDTree
+
     slab = _array(atoms, "slab")
-    i, j, d = neighbor_list("ijd", atoms, cutoff_angstrom)
-    cross = slab[i] != slab[j]
-    return float(d[cross].min()) if np.any(cross) else float("inf")
+    pos = atoms.positions
+    p1, p2 = pos[slab == 1], pos[slab != 1]
+    if not len(p1) or not len(p2):
+        return float("inf")
+    p1 = p1[p1[:, 2] >= p2[:, 2].min() - cutoff_angstrom]
+    if not len(p1):
+        return float("inf")
+    p2 = p2[p2[:, 2] <= p1[:, 2].max() + cutoff_angstrom]
+    if not len(p2):
+        return float("inf")
+    cell = atoms.cell.array
+    pbc = np.asarray(atoms.pbc, dtype=bool)
+    # wrap both into the cell along periodic directions; images of slab 1 covering the cutoff
+    frac1, frac2 = np.linalg.solve(cell.T, p1.T).T, np.linalg.solve(cell.T, p2.T).T
+    frac1[:, pbc] -= np.floor(frac1[:, pbc])
+    frac2[:, pbc] -= np.floor(frac2[:, pbc])
+    p1, p2 = frac1 @ cell, frac2 @ cell
+    volume = abs(np.linalg.det(cell))
+    reach = []
+    for k in range(3):
+        if not pbc[k]:
+            reach.append((0,))
+            continue
+        height = volume / np.linalg.norm(np.cross(cell[(k + 1) % 3], cell[(k + 2) % 3]))
+        n = int(np.ceil(cutoff_angstrom / height)) + 1
+        reach.append(tuple(range(-n, n + 1)))
+    shifts = np.array([[i, j, k] for i in reach[0] for j in reach[1] for k in reach[2]]) @ cell
+    images = (p1[None, :, :] + shifts[:, None, :]).reshape(-1, 3)
+    d, _ = cKDTree(images).query(p2, k=1, distance_upper_bound=cutoff_angstrom)
+    closest = float(d.min())
+    return closest if closest < cutoff_angstrom else float("inf")
 
 
 # --------------------------------------------------------------------------- construction

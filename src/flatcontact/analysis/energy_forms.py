@@ -1,0 +1,120 @@
+"""Both constant-pressure energy forms from one ISPES: per-load friction and load laws side by side.
+
+The paper (its constant-pressure ISPES, Ũ(x, y)|_P = U(x, y, z*(x, y; P))) analyses the
+*internal* energy at the gap z* that carries the load P. The lateral force at constant
+load is the gradient of the *enthalpy* h = U/A + P·z* instead: by the envelope theorem
+∇h|_P = ∇U|_z (z* makes h stationary in z), while ∇Ũ|_P = ∇U|_z − P·∇z* leaves out the
+work P·A·Δz done against the load when the gap changes along the path
+(:mod:`flatcontact.analysis.constant_pressure`). The two give the same τ and σ_MSS at
+P = 0 and differ by the load-dependent gap corrugation above it; their slopes k and μ
+can differ by an order of magnitude.
+
+:func:`laws_both_forms` runs :func:`flatcontact.analysis.pipeline.analyze_ispes` on the same
+grid with both forms (everything else equal) and returns per form the per-load table and
+the fitted laws, plus a side-by-side table for the report.
+"""
+
+from __future__ import annotations
+
+import io
+import warnings
+from collections.abc import Sequence
+
+import pandas as pd
+
+from flatcontact.errors import require
+
+FORMS = ("internal", "enthalpy")
+#: Per-load columns kept for each form.
+COLUMNS = (
+    "tau_mpa",
+    "sigma_mss_mpa",
+    "shear_stiffness_gpa_per_nm",
+    "tau_limited_by",
+    "force_noise_mpa",
+)
+
+
+def laws_both_forms(
+    ds,
+    p_gpa: Sequence[float],
+    *,
+    direction_deg: float = 90.0,
+    threshold_gpa: float = 3.0,
+    load_source: str = "energy",
+    energy_zero: str = "lowest-p",
+    allow_missing: bool = False,
+    forms: Sequence[str] = FORMS,
+) -> dict:
+    """Per-load τ, σ_MSS, G_int and the load laws of one ISPES in each energy form.
+
+    Parameters
+    ----------
+    ds
+        An ISPES grid (``ispes.nc`` contract, :func:`flatcontact.ispes.contract.open_ispes`).
+    p_gpa, direction_deg, threshold_gpa, load_source, energy_zero, allow_missing
+        As :func:`flatcontact.analysis.pipeline.analyze_ispes` (same for both forms).
+    forms
+        Which forms (default both, internal first).
+
+    Returns
+    -------
+    dict
+        ``{"forms": {form: {"loads": [per-load dict], "laws": laws.json dict,
+        "warnings": [str]}}, "table": [per-load dict with <column>_<form> keys],
+        "laws_table": [one dict per law coefficient with one value and stderr per form]}``.
+    """
+    from flatcontact.analysis.diagnostics import AnalysisWarning
+    from flatcontact.analysis.outputs import friction_csv_text
+    from flatcontact.analysis.pipeline import analyze_ispes
+
+    require(len(forms) >= 1, "forms: expected at least one of internal, enthalpy")
+    for form in forms:
+        require(form in FORMS, f"forms: {form!r}: expected internal or enthalpy")
+    out: dict = {"forms": {}}
+    tables = {}
+    for form in forms:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", AnalysisWarning)
+            result = analyze_ispes(
+                ds,
+                list(p_gpa),
+                direction_deg=direction_deg,
+                form=form,
+                load_source=load_source,
+                energy_zero=energy_zero,
+                allow_missing=allow_missing,
+                threshold_gpa=threshold_gpa,
+                with_symmetry=False,
+            )
+        table = pd.read_csv(io.StringIO(friction_csv_text(result)))
+        table = table[["p_gpa", *[c for c in COLUMNS if c in table.columns]]]
+        tables[form] = table
+        out["forms"][form] = {
+            "loads": table.to_dict(orient="records"),
+            "laws": result.laws.to_json(),
+            "warnings": [
+                f"{w.category.__name__}: {w.message}"
+                for w in caught
+                if issubclass(w.category, AnalysisWarning)
+            ],
+        }
+    side = None
+    for form, table in tables.items():
+        renamed = table.rename(columns={c: f"{c}_{form}" for c in table.columns if c != "p_gpa"})
+        side = renamed if side is None else side.merge(renamed, on="p_gpa")
+    out["table"] = side.to_dict(orient="records")
+    out["laws_table"] = [
+        {
+            "coefficient": key,
+            **{f"{form}": out["forms"][form]["laws"][key] for form in forms},
+            **{f"{form}_stderr": out["forms"][form]["laws"][err] for form in forms},
+        }
+        for key, err in (
+            ("k_mpa_per_gpa", "k_stderr_mpa_per_gpa"),
+            ("tau0_mpa", "tau0_stderr_mpa"),
+            ("mu_mpa_per_gpa", "mu_stderr_mpa_per_gpa"),
+            ("sigma0_mpa", "sigma0_stderr_mpa"),
+        )
+    ]
+    return out

@@ -1,0 +1,165 @@
+"""Uncertainty of the load laws and its propagation to the contact outputs (pure functions).
+
+Three independent sources set the uncertainty of each law coefficient
+c ∈ {k, τ0, μ, σ0} (τ = k·P + τ0, σ = μ·P + σ0, the paper's linear laws):
+
+* the fit: its standard error ``se_fit`` (``laws.json``);
+* the numerical convergence: the change ``δ_conv`` of the coefficient under one more
+  refinement of the scan settings (``docs/convergence.md``);
+* the potential: the spread ``δ_model`` of the coefficient over models that the
+  surrogate stands for (teachers/committee, :func:`model_spread`).
+
+They are combined in quadrature, ``h_c = m·sqrt(se_fit² + δ_conv² + δ_model²)``
+(:func:`law_half_widths`, ``m`` the coverage multiple; m = 2 ≈ 95 % for Gaussian errors).
+
+:func:`propagate_box` carries the box ``c ± h_c`` through any output function
+(effective shear strength Q_peak/πa², collapse stress, knee amplitude, ...): it evaluates
+the function at the central point and at every corner of the box and returns per output
+``(low, central, high)`` = (min, central, max). This is exact for outputs monotone in each
+coefficient (the Mindlin outputs are monotone in τ0, k, σ0, μ separately) and a lower
+bound of the true range otherwise. Coefficients the contact model requires to be ≥ 0 can
+be clipped at 0 (``nonnegative``), as the run does for fitted negatives within two
+standard errors (docs/run.md).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Callable, Mapping, Sequence
+
+import numpy as np
+
+from flatcontact.errors import InputError, require
+
+#: Law coefficients and their standard-error keys in ``laws.json``.
+LAW_COEFFICIENTS: dict[str, str] = {
+    "k_mpa_per_gpa": "k_stderr_mpa_per_gpa",
+    "tau0_mpa": "tau0_stderr_mpa",
+    "mu_mpa_per_gpa": "mu_stderr_mpa_per_gpa",
+    "sigma0_mpa": "sigma0_stderr_mpa",
+}
+#: Largest number of varied inputs of :func:`propagate_box` (2**n corner evaluations).
+MAX_BOX_INPUTS = 8
+
+
+def _num(value, what: str) -> float:
+    if value is None:
+        return 0.0
+    v = float(value)
+    require(math.isfinite(v) and v >= 0, f"{what}: expected a finite value >= 0, got {value!r}")
+    return v
+
+
+def model_spread(per_model_laws: Mapping[str, Mapping]) -> dict[str, float]:
+    """Half the range of each law coefficient over models (e.g. SNAP and its teachers).
+
+    Parameters
+    ----------
+    per_model_laws
+        Model label -> ``laws.json`` document (at least two models).
+
+    Returns
+    -------
+    dict
+        Coefficient -> (max − min)/2 over the models where it was fitted (0 with fewer
+        than two fitted values).
+    """
+    require(len(per_model_laws) >= 2, "per_model_laws: expected laws of at least two models")
+    out = {}
+    for key in LAW_COEFFICIENTS:
+        vals = [float(d[key]) for d in per_model_laws.values() if d.get(key) is not None]
+        out[key] = (max(vals) - min(vals)) / 2 if len(vals) >= 2 else 0.0
+    return out
+
+
+def law_half_widths(
+    laws: Mapping,
+    *,
+    convergence: Mapping[str, float] | None = None,
+    model: Mapping[str, float] | None = None,
+    coverage: float = 1.0,
+) -> dict[str, float]:
+    """Half-width of each law coefficient from the fit, the convergence and the model spread.
+
+    ``h_c = coverage · sqrt(se_fit² + δ_conv² + δ_model²)`` (module docstring). Missing
+    entries count as 0. Returns coefficient -> half-width in the coefficient's unit.
+    """
+    require(coverage >= 0 and math.isfinite(coverage), f"coverage={coverage}: expected >= 0")
+    convergence = convergence or {}
+    model = model or {}
+    out = {}
+    for key, err in LAW_COEFFICIENTS.items():
+        parts = (
+            _num(laws.get(err), f"laws.{err}"),
+            abs(float(convergence.get(key) or 0.0)),
+            _num(model.get(key), f"model.{key}"),
+        )
+        out[key] = coverage * float(np.sqrt(sum(p * p for p in parts)))
+    return out
+
+
+def law_intervals(laws: Mapping, half_widths: Mapping[str, float]) -> dict[str, dict]:
+    """``{coefficient: {"value", "low", "high", "half_width"}}`` for ``laws.json``."""
+    out = {}
+    for key in LAW_COEFFICIENTS:
+        if laws.get(key) is None:
+            continue
+        v, h = float(laws[key]), float(half_widths.get(key, 0.0))
+        out[key] = {"value": v, "low": v - h, "high": v + h, "half_width": h}
+    return out
+
+
+def propagate_box(
+    fn: Callable[[dict[str, float]], Mapping[str, float]],
+    central: Mapping[str, float],
+    half_widths: Mapping[str, float],
+    *,
+    nonnegative: Sequence[str] = (),
+) -> dict[str, tuple[float, float, float]]:
+    """Interval of every output of ``fn`` over the box ``central ± half_widths``.
+
+    Parameters
+    ----------
+    fn
+        ``fn(inputs) -> {output: value}``; ``inputs`` has the keys of ``central``.
+    central
+        The central inputs (e.g. the fitted k, τ0, μ, σ0 and any fixed parameter).
+    half_widths
+        Input -> half-width (≥ 0); inputs not listed, or with 0, are not varied.
+    nonnegative
+        Inputs clipped at 0 at the box corners (the central value is used as given).
+
+    Returns
+    -------
+    dict
+        Output -> ``(low, central, high)``: min and max over the central point and the
+        box corners. Zero half-widths give ``low == central == high``.
+    """
+    for key, h in half_widths.items():
+        require(
+            key in central,
+            f"half_widths: {key!r} is not an input (expected one of {sorted(central)})",
+        )
+        _num(h, f"half_widths.{key}")
+    varied = [k for k, h in half_widths.items() if float(h) > 0]
+    if len(varied) > MAX_BOX_INPUTS:
+        raise InputError(
+            f"half_widths: {len(varied)} varied inputs, expected at most {MAX_BOX_INPUTS} "
+            f"(2**n corner evaluations)"
+        )
+    base = {k: float(v) for k, v in central.items()}
+    mid = {k: float(v) for k, v in fn(dict(base)).items()}
+    low, high = dict(mid), dict(mid)
+    for signs in itertools.product((-1.0, 1.0), repeat=len(varied)):
+        point = dict(base)
+        for key, s in zip(varied, signs, strict=True):
+            point[key] = base[key] + s * float(half_widths[key])
+            if key in nonnegative:
+                point[key] = max(point[key], 0.0)
+        values = fn(point)
+        for name, v in values.items():
+            v = float(v)
+            low[name] = min(low[name], v)
+            high[name] = max(high[name], v)
+    return {name: (low[name], mid[name], high[name]) for name in mid}

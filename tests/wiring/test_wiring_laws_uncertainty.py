@@ -1,0 +1,285 @@
+"""Issue 12 wiring: both energy forms in the laws stage, the laws' uncertainty carried to the
+contact outputs, and ``validate-potential --ispes``.
+
+The cobblestone landscape (tests/convergence/test_energy_forms.py) has exact laws in each
+form: internal k = 0, enthalpy k = 4π|δ|/a (δ the gap modulation), the same τ0.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cli"))
+from cli_helpers import one_error_line, run_cli
+
+from flatcontact import units
+from flatcontact.analysis import synthetic as syn
+from flatcontact.config import MEASURED_LAW_UNCERTAINTY, build_config
+from flatcontact.contact import mindlin
+from flatcontact.stages.analyze import FRICTION_CSV, AnalyzeInputs, run_analyze
+from flatcontact.stages.contact import ContactInputs, run_contact
+from flatcontact.stages.laws import LAWS_JSON, LawsInputs, run_laws
+
+A = 4.916
+A1, A2 = syn.hexagonal_cell(A)
+P_GPA = [0.0, 0.5, 1.0, 2.0]
+V, DELTA = -2e-4, -0.02
+LAW_KEYS = ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa")
+STDERR = {
+    "k_mpa_per_gpa": "k_stderr_mpa_per_gpa",
+    "tau0_mpa": "tau0_stderr_mpa",
+    "mu_mpa_per_gpa": "mu_stderr_mpa_per_gpa",
+    "sigma0_mpa": "sigma0_stderr_mpa",
+}
+UNC = {
+    "convergence_internal": {"tau0_mpa": 3.0, "k_mpa_per_gpa": 1.0},
+    "model_spread_internal": {"tau0_mpa": 4.0},
+    "convergence_enthalpy": {"k_mpa_per_gpa": 2.0},
+    "coverage": 2.0,
+    "source": "test numbers",
+}
+pytestmark = pytest.mark.filterwarnings("ignore::flatcontact.analysis.diagnostics.AnalysisWarning")
+
+
+@pytest.fixture(scope="module")
+def stages(tmp_path_factory):
+    """analyze -> laws (both forms) on the cobblestone ISPES, as the run chains them."""
+    root = tmp_path_factory.mktemp("forms")
+    z = np.linspace(24.3, 26.4, 36)
+    grid = syn.SyntheticInterface(
+        A1, A2, syn.three_cosine(A1, A2), corrugation_ev_per_a2=V, gap_modulation_angstrom=DELTA
+    ).grid(9, 9, z)
+    ispes = root / "ispes.nc"
+    grid.to_netcdf(ispes, engine="h5netcdf")
+    cfg = build_config(
+        {
+            "analysis": {"p_gpa": P_GPA, "direction_deg": 0.0},
+            "uncertainty": UNC,
+            "report": {"svg": False},
+        }
+    )
+    run_analyze(cfg, AnalyzeInputs(ispes), root / "analyze")
+    inputs = LawsInputs.read(root / "analyze" / FRICTION_CSV, ispes)
+    run_laws(cfg, inputs, root / "laws")
+    laws = json.loads((root / "laws" / LAWS_JSON).read_text())
+    return cfg, laws, root
+
+
+def test_laws_json_has_both_forms_with_their_exact_slopes(stages):
+    _, laws, root = stages
+    tau0 = 4 * np.pi * -V / A * units.EV_PER_A3_TO_MPA
+    k_enthalpy = 4 * np.pi * -DELTA / A * 1e3  # MPa/GPa
+    tol = 5e-3 * tau0
+    assert laws["energy_form"] == "internal"
+    assert laws["internal"]["k_mpa_per_gpa"] == pytest.approx(0.0, abs=tol)
+    assert laws["enthalpy"]["k_mpa_per_gpa"] == pytest.approx(k_enthalpy, abs=tol)
+    assert laws["internal"]["tau0_mpa"] == pytest.approx(laws["enthalpy"]["tau0_mpa"], rel=5e-3)
+    # the top level (what the contact stage reads) is the configured form's block
+    for key in LAW_KEYS:
+        assert laws[key] == laws["internal"][key]
+    assert laws["intervals"] == laws["internal"]["intervals"]
+    # per-load values of both forms, at the analysed loads
+    for form in ("internal", "enthalpy"):
+        assert [r["p_gpa"] for r in laws[form]["loads"]] == P_GPA
+    assert (root / "laws" / "fig3_laws.png").is_file()
+
+
+def test_half_widths_combine_fit_convergence_and_model_spread(stages):
+    _, laws, _ = stages
+    for form in ("internal", "enthalpy"):
+        block = laws[form]
+        for key in LAW_KEYS:
+            se = block[STDERR[key]] or 0.0
+            conv = UNC.get(f"convergence_{form}", {}).get(key, 0.0)
+            model = UNC.get(f"model_spread_{form}", {}).get(key, 0.0)
+            want = UNC["coverage"] * math.sqrt(se**2 + conv**2 + model**2)
+            assert block["half_widths"][key] == pytest.approx(want, rel=1e-12)
+            iv = block["intervals"][key]
+            # the interval contains the central value, symmetric by the half-width
+            assert iv["low"] <= iv["value"] == block[key] <= iv["high"]
+            assert iv["high"] - iv["value"] == pytest.approx(want, rel=1e-12)
+    assert laws["uncertainty"]["source"] == "test numbers"
+
+
+def test_contact_intervals_contain_the_central_values_and_match_the_tau0_edges(stages):
+    _, laws, _ = stages
+    # the contact model takes the fitted τ0 (and its interval); k, μ, σ0 from the settings
+    doc = laws | {"tau0_mpa": 26.7}
+    doc["internal"] = laws["internal"] | {"tau0_mpa": 26.7}
+    contact_cfg = build_config(
+        {
+            "contact": {
+                "p0_gpa": [1.0, 2.0],
+                "k_mpa_per_gpa": 4.52,
+                "mu_mpa_per_gpa": 0.21,
+                "sigma0_mpa": 11.1,
+            },
+            "report": {"svg": False},
+        }
+    )
+    res = run_contact(contact_cfg, ContactInputs(laws=doc), None)
+    iv = res.to_json()["intervals"]
+    h = laws["internal"]["half_widths"]["tau0_mpa"]
+    assert iv["half_widths"] == {
+        "k_mpa_per_gpa": 0.0,
+        "tau0_mpa": h,
+        "mu_mpa_per_gpa": 0.0,
+        "sigma0_mpa": 0.0,
+    }
+    for r in iv["results"]:
+        for key in (
+            "effective_shear_strength_mpa",
+            "collapse_stress_mpa",
+            "knee_stress_amplitude_mpa",
+        ):
+            assert r[key]["low"] < r[key]["value"] < r[key]["high"]
+        # Q_peak/πa² grows with τ0: its edges are the values at τ0 ∓ h, computed here directly
+        p0 = r["p0_gpa"] * units.GPA_TO_PA
+        for edge, sign in (("low", -1), ("high", 1)):
+            prm = res.params.replace(tau0_mpa=max(26.7 + sign * h, 0.0))
+            a = float(mindlin.contact_radius(p0, prm))
+            want = float(mindlin.peak_force(p0, prm).force_n) / (np.pi * a**2) / 1e6
+            assert r["effective_shear_strength_mpa"][edge] == pytest.approx(want, rel=1e-9)
+    central = {r["p0_gpa"]: r for r in res.to_json()["results"]}
+    for r in iv["results"]:
+        assert r["effective_shear_strength_mpa"]["value"] == pytest.approx(
+            central[r["p0_gpa"]]["effective_shear_strength_mpa"], rel=1e-12
+        )
+
+
+def test_zero_input_error_gives_zero_width(capsys):
+    # the CLI gives every law coefficient as a number: no fit, convergence or model error
+    code, out, err = run_cli(["contact", "--p0-gpa", "1,1.77", "--json"], capsys)
+    assert code in (0, None), err
+    iv = json.loads(out)["intervals"]
+    assert not any(iv["half_widths"].values())
+    for r in iv["results"]:
+        for q in r.values():
+            if isinstance(q, dict):
+                assert q["low"] == q["value"] == q["high"]
+
+
+def test_paper_preset_carries_the_measured_uncertainty():
+    cfg = build_config({}, "paper")
+    assert cfg.uncertainty.convergence_internal == MEASURED_LAW_UNCERTAINTY["convergence_internal"]
+    # docs/teachers.md: internal τ0 ± 7.4 MPa from fit s.e. 6.29, convergence and model spread
+    h = math.sqrt(
+        6.289**2
+        + cfg.uncertainty.convergence_internal["tau0_mpa"] ** 2
+        + cfg.uncertainty.model_spread_internal["tau0_mpa"] ** 2
+    )
+    assert h == pytest.approx(7.4, abs=0.05)
+    assert build_config({}).uncertainty.convergence_internal == {}
+
+
+def test_bad_uncertainty_fields_name_the_field():
+    from flatcontact.errors import InputError
+
+    with pytest.raises(InputError, match=r"uncertainty\.convergence_internal"):
+        build_config({"uncertainty": {"convergence_internal": {"kappa": 1.0}}})
+    with pytest.raises(InputError, match=r"uncertainty\.model_spread_enthalpy"):
+        build_config({"uncertainty": {"model_spread_enthalpy": {"tau0_mpa": -1.0}}})
+
+
+# ------------------------------------------------------------------ validate-potential --ispes
+
+ISPES_ARGS = [
+    "--grid",
+    "3",
+    "3",
+    "--p-range-gpa",
+    "-0.5",
+    "2.5",
+    "6",
+    "--p-gpa",
+    "0,0.5,1",
+    "--fmax-ev-per-angstrom",
+    "0.01",
+    "--lj-cutoff-angstrom",
+    "8",
+]
+
+
+@pytest.mark.filterwarnings("ignore")
+def test_validate_potential_ispes_compares_two_classical_models(tmp_path, capsys):
+    out = tmp_path / "report.json"
+    code, stdout, err = run_cli(
+        [
+            "validate-potential",
+            "tersoff",
+            "--ispes",
+            "--reference",
+            "vashishta",
+            *ISPES_ARGS,
+            "--ispes-dir",
+            str(tmp_path / "scans"),
+            "--out",
+            str(out),
+            "--json",
+        ],
+        capsys,
+    )
+    assert code in (0, None), err
+    report = json.loads(stdout)
+    assert json.loads(out.read_text()) == report
+    assert report["reference"] == "vashishta"
+    rows = report["table"]
+    ref = {r["p_gpa"]: r for r in rows if r["model"] == "vashishta"}
+    other = [r for r in rows if r["model"] == "tersoff"]
+    assert sorted(ref) == [0.0, 0.5, 1.0] and len(other) == 3
+    for r in ref.values():
+        assert r["d_tau_mpa"] == 0 and r["d_sigma_mss_mpa"] == 0
+    for r in other:
+        base = ref[r["p_gpa"]]
+        assert r["d_tau_mpa"] == pytest.approx(r["tau_mpa"] - base["tau_mpa"], rel=1e-9)
+        assert r["rel_sigma_mss_mpa"] == pytest.approx(
+            (r["sigma_mss_mpa"] - base["sigma_mss_mpa"]) / abs(base["sigma_mss_mpa"]), rel=1e-9
+        )
+        assert 0 < r["work_of_separation_j_per_m2"] < 1
+    for label in ("vashishta", "tersoff"):
+        assert report["models"][label]["force_calls"] > 0
+        assert set(report["models"][label]["laws"]) >= set(LAW_KEYS)
+    # the scans are resumable: a second call recomputes nothing
+    code, stdout2, _ = run_cli(
+        [
+            "validate-potential",
+            "tersoff",
+            "--ispes",
+            "--reference",
+            "vashishta",
+            *ISPES_ARGS,
+            "--ispes-dir",
+            str(tmp_path / "scans"),
+            "--json",
+        ],
+        capsys,
+    )
+    assert json.loads(stdout2)["table"] == report["table"]
+
+
+@pytest.mark.parametrize(
+    "extra,needle",
+    [
+        ([], "--reference"),
+        (["--reference", "vashishta", "--energy", "gibbs"], "--energy"),
+        (["--reference", "vashishta", "--grid", "1", "3"], "--grid"),
+        (["--reference", "nonsense-model"], "--reference"),
+        (["--reference", "vashishta", "--p-range-gpa", "2", "1", "5"], "--p-range-gpa"),
+        (["--reference", "tersoff"], "distinct"),
+    ],
+)
+def test_validate_potential_ispes_bad_input_is_one_line_before_work(
+    extra, needle, tmp_path, capsys
+):
+    scans = tmp_path / "scans"
+    code, _, err = run_cli(
+        ["validate-potential", "tersoff", "--ispes", *extra, "--ispes-dir", str(scans)], capsys
+    )
+    assert needle in one_error_line(code, err)
+    assert not scans.exists()
