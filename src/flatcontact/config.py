@@ -40,8 +40,10 @@ from pydantic import (
     model_validator,
 )
 
+from flatcontact import limits
 from flatcontact.contact.cycle import DEFAULT_AMPLITUDE_FRACTIONS as CYCLE_AMPLITUDE_FRACTIONS
 from flatcontact.errors import InputError
+from flatcontact.fileio import read_text_file
 from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.order import PREFERENCES
 from flatcontact.ispes.relax import OPTIMIZERS, RelaxSettings
@@ -74,6 +76,9 @@ def _positive_pair(value: Any, what: str) -> tuple[int, int]:
     )
     if not ok:
         raise ValueError(f"expected two positive integers, got {_show(value)}")
+    for v in value:
+        if v > limits.bound("grid_axis"):
+            raise ValueError(limits.message("grid_axis", v, f"points along one axis of {_show(value)}"))
     return (int(value[0]), int(value[1]))
 
 
@@ -126,6 +131,9 @@ def _structure_section(value: Any) -> Any:
         for key in _LEGACY_STRUCTURE_KEYS:
             if key in data and key not in fields:
                 data.pop(key)
+    layers = data.get("layers")
+    if isinstance(layers, int | float) and not isinstance(layers, bool):
+        limits.check("layers", layers, "structure.layers", "layers per slab")
     return parse_recipe(data)
 
 
@@ -156,6 +164,8 @@ class PressureRange(_Section):
     def _order(self) -> PressureRange:
         if not self.lo_gpa < self.hi_gpa:
             raise ValueError(f"expected lo_gpa < hi_gpa, got {self.lo_gpa} and {self.hi_gpa}")
+        if self.n > limits.bound("thicknesses"):
+            raise ValueError("n: " + limits.message("thicknesses", self.n, "thicknesses"))
         return self
 
 
@@ -239,6 +249,28 @@ class ScanConfig(_Section):
             z = self.thickness_angstrom
             if not z or any(not v > 0 for v in z):
                 raise ValueError(f"thickness_angstrom: expected positive values in Å, got {z}")
+            if len(set(z)) != len(z):
+                repeated = sorted({v for v in z if z.count(v) > 1})
+                raise ValueError(
+                    f"thickness_angstrom: expected distinct values in Å, {_show(repeated)} repeated"
+                )
+        n_z = len(self.thickness_angstrom) if self.thickness_angstrom else self.p_range_gpa.n
+        if n_z > limits.bound("thicknesses"):
+            raise ValueError(
+                "thickness_angstrom: " + limits.message("thicknesses", n_z, "thicknesses")
+            )
+        points = self.grid[0] * self.grid[1] * n_z
+        if points > limits.bound("scan_points"):
+            raise ValueError(
+                "grid: "
+                + limits.message(
+                    "scan_points", points, f"{self.grid[0]}x{self.grid[1]} points x {n_z} thicknesses"
+                )
+            )
+        if self.workers is not None and self.workers > limits.bound("workers"):
+            raise ValueError(
+                "workers: " + limits.message("workers", self.workers, "worker processes")
+            )
         return self
 
     def grid_spec(self) -> GridSpec:
@@ -308,6 +340,8 @@ class AnalysisConfig(_Section):
     def _pressures(cls, value: list[float]) -> list[float]:
         if len(value) < 2 or len(set(value)) != len(value):
             raise ValueError(f"expected at least two distinct pressures in GPa, got {_show(value)}")
+        if len(value) > limits.bound("loads"):
+            raise ValueError(limits.message("loads", len(value), "pressures"))
         return sorted(float(v) for v in value)
 
 
@@ -330,7 +364,9 @@ class ContactConfig(_Section):
     """The modified Mindlin contact (stage ``contact``)."""
 
     p0_gpa: list[float] = Field(list(DEFAULT_P0_GPA), description="peak Hertz pressures p0 (GPa)")
-    radius_um: float = Field(PAPER["radius_um"], gt=0, description="tip radius R (µm)")
+    radius_um: float = Field(
+        PAPER["radius_um"], gt=0, le=1e4, description="tip radius R (µm; at most 1 cm)"
+    )
     contact_modulus_gpa: float = Field(
         PAPER["contact_modulus_gpa"],
         gt=0,
@@ -800,6 +836,9 @@ def _one_line(exc: ValidationError, source: str) -> InputError:
             msg += f", got {_show(first.get('input'))}"
     else:
         msg = str(first.get("msg", "invalid")).removeprefix("Value error, ")
+        field, sep, rest = msg.partition(": ")
+        if sep and field.isidentifier() and field.islower() and where:
+            where, msg = f"{where}.{field}", rest  # a model check naming its field
         if where == "potential" and msg.startswith("potential "):  # PotentialSpec's InputError
             return InputError(f"{source}: potential.{msg.removeprefix('potential ')}")
     return InputError(f"{source}: {where}: {msg}" if where else f"{source}: {msg}")
@@ -858,24 +897,97 @@ def _replaces_model(section: Any) -> bool:
     )
 
 
+#: Largest configuration file read (bytes): a run configuration is a few kB.
+MAX_CONFIG_BYTES = 1_000_000
+#: Deepest nesting of a configuration (sections are 3 levels deep; kwargs a few more).
+MAX_CONFIG_DEPTH = 32
+
+
+class _StrictLoader(yaml.SafeLoader):
+    """``yaml.SafeLoader`` that refuses a key given twice in one mapping.
+
+    Plain YAML keeps the last value, so a second ``scan:`` silently replaced the first.
+    """
+
+    def construct_mapping(self, node, deep=False):
+        seen: dict[Any, int] = {}
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=deep)
+            try:
+                hash(key)
+            except TypeError:
+                continue  # SafeLoader refuses it itself, with its own message
+            if key in seen:
+                raise _DuplicateKey(key, key_node.start_mark.line + 1, seen[key])
+            seen[key] = key_node.start_mark.line + 1
+        return super().construct_mapping(node, deep=deep)
+
+
+_StrictLoader.add_constructor(
+    yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _StrictLoader.construct_mapping
+)
+
+
+class _DuplicateKey(Exception):
+    def __init__(self, key: Any, line: int, first: int):
+        super().__init__(key, line, first)
+        self.key, self.line, self.first = key, line, first
+
+
+def _depth(value: Any, limit: int, level: int = 0) -> int:
+    """Nesting depth of ``value`` (lists and mappings), stopping once past ``limit``."""
+    if level > limit:
+        return level
+    if isinstance(value, dict):
+        items = list(value.values())
+    elif isinstance(value, list):
+        items = value
+    else:
+        return level
+    return max([_depth(v, limit, level + 1) for v in items], default=level + 1)
+
+
+def parse_yaml(text: str, source: str) -> Any:
+    """YAML ``text`` as data; duplicate keys, bad syntax and deep nesting are one-line errors."""
+    try:
+        data = yaml.load(text, Loader=_StrictLoader)
+    except _DuplicateKey as dup:
+        raise InputError(
+            f"{source}: key {_show(dup.key)} given twice (lines {dup.first} and {dup.line}); "
+            "expected each key once"
+        ) from None
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" (line {mark.line + 1})" if mark is not None else ""
+        problem = getattr(exc, "problem", None)
+        raise InputError(
+            f"{source}: not valid YAML{where}" + (f": {problem}" if problem else "")
+        ) from None
+    except RecursionError:
+        raise InputError(
+            f"{source}: nested deeper than {MAX_CONFIG_DEPTH} levels; expected a mapping of sections"
+        ) from None
+    if _depth(data, MAX_CONFIG_DEPTH) > MAX_CONFIG_DEPTH:
+        raise InputError(
+            f"{source}: nested deeper than {MAX_CONFIG_DEPTH} levels; expected a mapping of sections"
+        )
+    return data
+
+
 def load_config(path: str | Path | None = None, preset_name: str | None = None) -> RunConfig:
     """Read and validate a run configuration (YAML); ``None`` gives the preset alone.
 
     Relative paths inside the file (``structure.file``, ``contact.experiment_csv``) are
     resolved against the file's directory. Every problem is one :class:`InputError` line
-    naming the file and the field path.
+    naming the file and the field path: a file that is missing, a directory, unreadable,
+    larger than :data:`MAX_CONFIG_BYTES`, not UTF-8, not YAML, nested deeper than
+    :data:`MAX_CONFIG_DEPTH` or with a key given twice; a field out of range or above a size
+    bound (:mod:`flatcontact.limits`); a file field naming no readable file.
     """
     if path is None:
         return build_config({}, preset_name, "default config")
     path = Path(path)
-    if not path.is_file():
-        raise InputError(f"{path}: no such config file")
-    try:
-        data = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" (line {mark.line + 1})" if mark is not None else ""
-        raise InputError(f"{path}: not valid YAML{where}") from None
+    data = parse_yaml(read_text_file(path, "config file", MAX_CONFIG_BYTES), str(path))
     if data is None:
         data = {}
     if not isinstance(data, dict):
@@ -888,11 +1000,19 @@ def load_config(path: str | Path | None = None, preset_name: str | None = None) 
     if isinstance(structure, dict):
         _resolve_recipe_files(structure, path.parent)
     _resolve_file_lists(data, path)
-    cfg = build_config(data, preset_name, str(path))
+    try:
+        cfg = build_config(data, preset_name, str(path))
+    except RecursionError:
+        raise InputError(f"{path}: nested too deeply; expected a mapping of sections") from None
     for section, key in _FILE_FIELDS:
         value = getattr(getattr(cfg, section), key)
-        if value is not None and not Path(value).is_file():
+        if value is None:
+            continue
+        target = Path(value)
+        if not target.exists():
             raise InputError(f"{path}: {section}.{key}: file {value} not found")
+        if not target.is_file():
+            raise InputError(f"{path}: {section}.{key}: {value} is not a regular file")
     for dotted, value in recipe_files(cfg.structure):
         if not Path(value).is_file():
             raise InputError(f"{path}: structure.{dotted}: file {value} not found")
@@ -935,6 +1055,113 @@ def recipe_files(recipe: Any) -> list[tuple[str, str]]:
         if isinstance(obj, str) and obj not in BUILTIN_SHEETS:
             out.append((dotted, obj))
     return out
+
+
+def check_inputs(cfg: RunConfig, source: str = "config") -> None:
+    """Every check of ``cfg`` that needs its files or imports, before any stage runs.
+
+    ``flatcontact config --check`` and :class:`flatcontact.pipeline.Pipeline` both call it,
+    so the check refuses what a run would refuse before its first stage: an interface file
+    that does not follow the contract (or has more atoms than the ``atoms`` bound), a
+    measured stiffness CSV that does not parse, a calculator that does not import, a model
+    that cannot compute the elastic stage's crystal.
+
+    Raises
+    ------
+    InputError
+        One line naming ``source``'s field and the file.
+    """
+    from flatcontact.stages import _calculator
+
+    if cfg.structure.kind in ("file", "slab") and getattr(cfg.structure, "file", None) is not None:
+        _check_structure_file(cfg, source)
+    if cfg.contact.experiment_csv is not None:
+        from flatcontact.contact.experiment import load_stiffness_csv
+
+        try:
+            load_stiffness_csv(cfg.contact.experiment_csv)
+        except InputError as exc:
+            raise InputError(f"{source}: contact.experiment_csv: {exc}") from None
+    if cfg.contact.fit_csv:
+        from flatcontact.stages.contact import check_fit_settings
+
+        check_fit_settings(cfg)
+    calc = cfg.potential.calculator
+    if calc is not None:
+        try:
+            cfg.potential.calculator_factory()
+            _import_target(calc.target)
+        except InputError as exc:
+            raise InputError(f"{source}: potential.calculator.target: {exc}") from None
+    from flatcontact.stages.build import structure_elements
+    from flatcontact.stages.contact import check_moduli_source
+
+    if cfg.structure.kind == "file":
+        from flatcontact.structures.interface import read_interface
+
+        _calculator.check_atoms(cfg, read_interface(cfg.structure.file))
+    check_moduli_source(cfg, structure_elements(cfg.structure))
+    if cfg.elastic.enabled:
+        from flatcontact.stages.elastic import bulk_crystal
+
+        bulk, _ = bulk_crystal(cfg.structure)
+        if bulk is None:
+            _calculator.check(cfg)
+        else:
+            _calculator.check_atoms(cfg, bulk)
+
+
+def _import_target(target: str) -> None:
+    """Import ``'module:callable'`` (InputError when the module or the attribute is missing)."""
+    import importlib
+
+    module, _, name = target.partition(":")
+    try:
+        obj = importlib.import_module(module)
+    except Exception as exc:  # any import failure of user code is the user's to fix
+        raise InputError(
+            f"{target!r}: cannot import module {module!r} ({type(exc).__name__})"
+        ) from None
+    for part in name.split("."):
+        if not hasattr(obj, part):
+            raise InputError(f"{target!r}: module {module!r} has no {name!r}")
+        obj = getattr(obj, part)
+    if not callable(obj):
+        raise InputError(f"{target!r}: {name!r} is not callable")
+
+
+def _check_structure_file(cfg: RunConfig, source: str) -> None:
+    """structure.file: readable, within the ``atoms`` bound, and (kind file) an interface."""
+    from flatcontact.structures.interface import read_interface
+
+    file = Path(cfg.structure.file)
+    field = f"{source}: structure.file"
+    try:
+        with file.open("rb") as handle:
+            handle.read(1)
+    except OSError as exc:
+        raise InputError(f"{field}: {file}: cannot read ({exc.strerror})") from None
+    if cfg.structure.kind == "file":
+        try:
+            atoms = read_interface(file)
+        except InputError as exc:
+            raise InputError(f"{field}: {exc}") from None
+        except Exception as exc:  # ASE readers raise anything on garbage
+            raise InputError(
+                f"{field}: {file}: not a readable interface.extxyz ({type(exc).__name__})"
+            ) from None
+        n = len(atoms)
+    else:
+        import ase.io
+
+        try:
+            n = len(ase.io.read(file))
+        except Exception as exc:  # ASE readers raise anything on garbage
+            raise InputError(
+                f"{field}: {file}: not a structure file ASE can read ({type(exc).__name__})"
+            ) from None
+    if n > limits.bound("atoms"):
+        raise InputError(f"{field}: {limits.message('atoms', n, f'atoms in {file.name}')}")
 
 
 def _resolve_file_lists(data: dict, path: Path) -> None:

@@ -1,4 +1,4 @@
-"""Small file helpers shared by every stage: atomic writes.
+"""Small file helpers shared by every stage: atomic writes, checked reads of user files.
 
 A file a stage produces either appears whole or not at all: write to a
 temporary sibling, then ``os.replace`` it into place.
@@ -13,6 +13,8 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
+
+from flatcontact.errors import InputError
 
 
 def _umask() -> int:
@@ -53,3 +55,43 @@ def write_text_atomic(path: str | os.PathLike[str], text: str) -> Path:
 def write_json_atomic(path: str | os.PathLike[str], data: Any) -> Path:
     """Write ``data`` as indented JSON to ``path`` atomically."""
     return write_text_atomic(path, json.dumps(data, indent=2, sort_keys=False) + "\n")
+
+
+def read_text_file(path: str | Path, what: str, max_bytes: int) -> str:
+    """The text of a small user file, every failure one :class:`InputError` line naming it.
+
+    Parameters
+    ----------
+    path
+        The file.
+    what
+        What the file is, for the messages (``"config file"``, ``"measured stiffness CSV"``).
+    max_bytes
+        Largest size read; a bigger file is refused (it is not a file of this kind).
+
+    Raises
+    ------
+    InputError
+        Missing, a directory, unreadable (permissions, ``/proc/self/mem``), larger than
+        ``max_bytes`` or not UTF-8 text.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise InputError(f"{path}: no such {what}")
+    if path.is_dir():
+        raise InputError(f"{path}: is a directory, expected a {what}")
+    try:
+        with path.open("rb") as handle:
+            raw = handle.read(max_bytes + 1)
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise InputError(f"{path}: cannot read the {what} ({reason})") from None
+    if len(raw) > max_bytes:
+        raise InputError(f"{path}: larger than {max_bytes} bytes, expected a {what}")
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError(
+            f"{path}: not UTF-8 text (byte 0x{raw[exc.start]:02x} at offset {exc.start}); "
+            f"expected a {what} saved as UTF-8"
+        ) from None

@@ -57,7 +57,15 @@ from flatcontact import __version__
 from flatcontact.config import RunConfig, recipe_files, to_yaml
 from flatcontact.errors import InputError
 from flatcontact.fileio import write_json_atomic, write_text_atomic
-from flatcontact.rundir import RunDirectory, StageResult, code_digest, package_versions
+from flatcontact.rundir import (
+    RunDirectory,
+    RunLock,
+    StageResult,
+    code_digest,
+    package_versions,
+    portable,
+    writable,
+)
 from flatcontact.stages import _calculator
 from flatcontact.stages._common import file_sha256
 
@@ -183,9 +191,17 @@ class Pipeline:
         self.scan_progress = scan_progress
         self._check_root()
         self._check_config()
-        self.rundir = RunDirectory(self.root)
         self.results: dict[str, StageResult] = {}
         self._handler: logging.Handler | None = None
+        self._lock: RunLock | None = None
+        # a finished run on a read-only mount is read, never written (run_stage says so)
+        read_only = writable(self.root) if (self.root / RUN_MARKER).is_file() else None
+        self.rundir = RunDirectory(self.root, read_only=read_only)
+        if read_only is not None:  # no run.log: the progress lines are the record
+            self._handler = logging.NullHandler()
+            logging.getLogger("flatcontact").addHandler(self._handler)
+            return
+        self._lock = RunLock(self.root).acquire()  # one writer per run directory
         self._open_log()
         write_json_atomic(
             self.root / RUN_MARKER, {"format": RUN_FORMAT, "flatcontact_version": __version__}
@@ -205,8 +221,8 @@ class Pipeline:
                     f"{root}: not a flatcontact run directory (no {RUN_MARKER}); choose another --out"
                 )
             try:
-                data = json.loads(marker.read_text())
-            except (OSError, json.JSONDecodeError):
+                data = json.loads(marker.read_bytes().decode("utf-8"))
+            except (OSError, UnicodeDecodeError, json.JSONDecodeError):
                 raise InputError(
                     f"{marker}: corrupt run marker; remove it only if {root} is a flatcontact run"
                 ) from None
@@ -217,31 +233,9 @@ class Pipeline:
 
     def _check_config(self) -> None:
         """Checks that need the file system or optional modules, before any work."""
-        from flatcontact.stages.contact import check_moduli_source
+        from flatcontact.config import check_inputs
 
-        cfg = self.config
-        elements = _structure_elements(cfg.structure)
-        if cfg.structure.kind == "file":
-            from flatcontact.structures.interface import read_interface
-
-            _calculator.check_atoms(cfg, read_interface(cfg.structure.file))
-        check_moduli_source(cfg, elements)
-        if cfg.contact.experiment_csv is not None:
-            from flatcontact.contact.experiment import load_stiffness_csv
-
-            load_stiffness_csv(cfg.contact.experiment_csv)
-        if cfg.contact.fit_csv:
-            from flatcontact.stages.contact import check_fit_settings
-
-            check_fit_settings(cfg)
-        if cfg.elastic.enabled:
-            from flatcontact.stages.elastic import bulk_crystal
-
-            bulk, _ = bulk_crystal(cfg.structure)
-            if bulk is None:
-                _calculator.check(cfg)
-            else:
-                _calculator.check_atoms(cfg, bulk)
+        check_inputs(self.config)
 
     def _open_log(self) -> None:
         handler = logging.FileHandler(self.root / "run.log", encoding="utf-8")
@@ -259,11 +253,14 @@ class Pipeline:
         )
 
     def close(self) -> None:
-        """Detach the run log."""
+        """Detach the run log and give up the run directory's lock."""
         if self._handler is not None:
             logging.getLogger("flatcontact").removeHandler(self._handler)
             self._handler.close()
             self._handler = None
+        if self._lock is not None:
+            self._lock.release()
+            self._lock = None
 
     def __enter__(self) -> Pipeline:
         return self
@@ -330,7 +327,8 @@ class Pipeline:
         from flatcontact.structures.interface import read_interface
 
         cfg = self.config
-        structure = cfg.section("structure")
+        # the file by name and content (file_sha256), not by where it is
+        structure = portable(cfg.section("structure"), "file")
         if cfg.structure.kind == "quartz-dense":
             structure.setdefault("file", None)  # the fingerprint of runs made before recipes
         inputs = {"structure": structure, "model": self._model_inputs()}
@@ -518,7 +516,7 @@ class Pipeline:
         # before the stage folder is touched: a refused p0 keeps the previous results
         check_contact(cfg, contact_parameters(cfg, stage_inputs)[0])
         inputs = {
-            "contact": cfg.section("contact"),
+            "contact": portable(cfg.section("contact"), "experiment_csv", "fit_csv"),
             "laws": laws.fingerprint,
             "scan": scan.fingerprint,
             "elastic": elastic.fingerprint if elastic else None,
@@ -556,6 +554,8 @@ class Pipeline:
 
         result = self._run("report", inputs, work)
         target = self.root / REPORT_HTML
+        if self.rundir.read_only is not None:  # a finished run on a read-only mount
+            return target if target.is_file() else result.folder / REPORT_HTML
         tmp = target.with_name(".report.html.tmp")
         shutil.copyfile(result.folder / REPORT_HTML, tmp)
         tmp.replace(target)
@@ -566,23 +566,6 @@ class Pipeline:
         for name in ("build", "scan", "analyze", "laws", "elastic", "contact"):
             getattr(self, name)()
         return self.report()
-
-
-def _structure_elements(recipe) -> set[str] | None:
-    """The elements of a recipe read from its files (``file``, ``slab``, ``crystal``), cheaply
-    and before any work; ``None`` when only the build knows them."""
-    from ase.io import read
-
-    path = {"file": "file", "slab": "file", "crystal": "bulk"}.get(recipe.kind)
-    if path is None:
-        return None
-    try:
-        return set(read(getattr(recipe, path)).get_chemical_symbols())
-    except Exception as exc:  # any reader error, named with the field
-        raise InputError(
-            f"structure.{path}: {getattr(recipe, path)} is not a structure file ASE can read "
-            f"({type(exc).__name__})"
-        ) from None
 
 
 def run(config: RunConfig, root: str | Path, console: Any = None) -> Path:

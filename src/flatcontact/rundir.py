@@ -18,16 +18,33 @@ edit can change) plus the fingerprints of the stages it reads from. Hence
   (the ISPES point store, for instance);
 - a stage whose fingerprint changed is rerun from an empty folder (the old
   folder is moved aside to ``<name>.previous``), and so is every stage that
-  depends on it, because their fingerprints contain this one.
+  depends on it, because their fingerprints contain this one;
+- a stage recorded ``done`` whose output files are missing or changed (the record keeps
+  the SHA-256 of each, ``"outputs"``) is resumed: the damaged files are removed and the
+  stage's code recomputes them from what is left (a scan from its point store).
+
+Fingerprints hold content, never absolute paths (input files enter by name and SHA-256),
+so a run directory or its configuration folder can be moved without rerunning anything.
+
+One writer per run directory: :class:`RunLock` holds an advisory ``flock`` on
+``.flatcontact.lock`` (with the writer's pid in it) for as long as the run lives; a second
+writer is refused in one line, and the kernel drops the lock when the first dies, however
+it dies, so the next run takes over. A run directory that cannot be written (a read-only
+mount) is opened read-only: finished stages are reported, a stage that would need to run
+is one line.
 """
 
 from __future__ import annotations
 
+import contextlib
 import datetime as _dt
+import errno
+import fcntl
 import functools
 import hashlib
 import json
 import logging
+import os
 import platform
 import shutil
 import time
@@ -41,6 +58,11 @@ from flatcontact.errors import InputError
 from flatcontact.fileio import write_json_atomic
 
 RECORD_NAME = "stage.json"
+LOCK_NAME = ".flatcontact.lock"
+#: Files of a stage folder that are not outputs (records, locks, SQLite side files).
+_NOT_OUTPUTS = (RECORD_NAME, ".flatcontact.lock", ".driver", "-journal", "-wal", "-shm", ".part", ".tmp")
+#: errno values meaning "this place cannot be written" (not "the disk is full").
+READ_ONLY_ERRNOS = (errno.EROFS, errno.EACCES, errno.EPERM)
 STATE_RUNNING = "running"
 STATE_DONE = "done"
 
@@ -109,6 +131,151 @@ def _now() -> str:
     return _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
 
 
+def portable(section: Mapping[str, Any] | None, *path_keys: str) -> dict[str, Any] | None:
+    """``section`` with the file paths under ``path_keys`` reduced to their file names.
+
+    For fingerprints: a file enters by its content (SHA-256, added by the caller) and its
+    name, never by where it is, so moving a configuration folder reruns nothing.
+    """
+    if section is None:
+        return None
+    out = dict(section)
+    for key in path_keys:
+        if isinstance(out.get(key), str):
+            out[key] = Path(out[key]).name
+        elif isinstance(out.get(key), list):
+            out[key] = [Path(v).name if isinstance(v, str) else v for v in out[key]]
+    return out
+
+
+def file_digest(path: Path) -> str:
+    """SHA-256 of a file's bytes (read in 1 MiB blocks)."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as handle:
+        for block in iter(lambda: handle.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def output_digests(folder: Path) -> dict[str, str]:
+    """SHA-256 of every output file below ``folder`` (relative POSIX path -> digest)."""
+    out = {}
+    for path in sorted(folder.rglob("*")):
+        if path.is_file() and not path.name.endswith(_NOT_OUTPUTS):
+            out[path.relative_to(folder).as_posix()] = file_digest(path)
+    return out
+
+
+def damaged_outputs(folder: Path, recorded: Mapping[str, str]) -> list[str]:
+    """The recorded outputs of ``folder`` that are missing or whose bytes changed."""
+    bad = []
+    for name, digest in recorded.items():
+        path = folder / name
+        try:
+            if not path.is_file() or file_digest(path) != digest:
+                bad.append(name)
+        except OSError:
+            bad.append(name)
+    return bad
+
+
+def _inside(name: Any) -> bool:
+    """Whether a recorded output name stays inside its stage folder (no absolute path, no ..)."""
+    return (
+        isinstance(name, str)
+        and bool(name)
+        and not Path(name).is_absolute()
+        and ".." not in Path(name).parts
+    )
+
+
+class RunLock:
+    """One writer per directory: an exclusive advisory ``flock`` on ``<root>/.flatcontact.lock``.
+
+    The file holds the writer's pid (for the refusal message). The lock belongs to the open
+    file, so it ends with :meth:`release` or with the process, however it ends (``kill -9``
+    included): a later writer takes over without anyone removing a stale file.
+
+    Parameters
+    ----------
+    root
+        The directory (a run directory or a scan's ``--out``); must exist.
+    flag
+        How the user named it, for the message (``--out``).
+    """
+
+    def __init__(self, root: str | Path, flag: str = "--out"):
+        self.path = Path(root) / LOCK_NAME
+        self.flag = flag
+        self._handle = None
+
+    def acquire(self) -> RunLock:
+        """Take the lock or raise a one-line :class:`InputError` naming the live writer."""
+        handle = open(self.path, "a+")
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            handle.seek(0)
+            pid = handle.read().strip() or "?"
+            handle.close()
+            root = self.path.parent
+            raise InputError(
+                f"{self.flag} {str(root)!r}: another flatcontact process (pid {pid}) is writing "
+                "this directory; wait for it to finish (or stop it), or choose another "
+                f"{self.flag}"
+            ) from None
+        handle.seek(0)
+        handle.truncate()
+        handle.write(f"{os.getpid()}\n")
+        handle.flush()
+        self._handle = handle
+        return self
+
+    def release(self, tidy: bool | str = False) -> None:
+        """Give the lock up (idempotent).
+
+        With ``tidy``, a directory that holds nothing but the lock file is left as it was
+        found: the lock file is removed (and the directory too when ``tidy`` is the
+        directory this writer created), so a command that failed before writing leaves
+        nothing behind.
+        """
+        if self._handle is None:
+            return
+        root = self.path.parent
+        if tidy and [p.name for p in root.iterdir()] == [LOCK_NAME]:
+            self.path.unlink(missing_ok=True)
+            if tidy == "created":
+                with contextlib.suppress(OSError):
+                    root.rmdir()
+        self._handle.close()
+        self._handle = None
+
+    def __enter__(self) -> RunLock:
+        return self.acquire()
+
+    def __exit__(self, *exc) -> None:
+        self.release()
+
+
+def writable(root: Path) -> OSError | None:
+    """``None`` if a file can be created in ``root``, else the error saying why not.
+
+    Tries for real (permission bits say nothing for root or a read-only mount). A full disk
+    (ENOSPC) counts as writable: it is reported where a write fails.
+    """
+    import tempfile
+
+    try:
+        fd, name = tempfile.mkstemp(prefix=".flatcontact-probe.", dir=root)
+    except OSError as exc:
+        if exc.errno in READ_ONLY_ERRNOS:
+            return exc
+        return None
+    os.close(fd)
+    os.unlink(name)
+    return None
+
+
 @dataclass(frozen=True)
 class StageResult:
     """What :meth:`RunDirectory.run_stage` did: ``"skipped"``, ``"resumed"`` or ``"ran"``."""
@@ -129,11 +296,14 @@ class RunDirectory:
         The run directory; created if missing.
     """
 
-    def __init__(self, root: str | Path):
+    def __init__(self, root: str | Path, read_only: OSError | None = None):
         self.root = Path(root)
         if self.root.exists() and not self.root.is_dir():
             raise InputError(f"{self.root}: exists and is not a directory")
-        self.root.mkdir(parents=True, exist_ok=True)
+        #: why the directory cannot be written (then only finished stages can be read)
+        self.read_only = read_only
+        if read_only is None:
+            self.root.mkdir(parents=True, exist_ok=True)
 
     def folder(self, index: int, name: str) -> Path:
         """The folder of stage ``name`` (``NN-name``)."""
@@ -152,12 +322,18 @@ class RunDirectory:
         if not path.exists():
             return None
         try:
-            record = json.loads(path.read_text())
-        except (OSError, json.JSONDecodeError):
+            record = json.loads(path.read_bytes().decode("utf-8"))
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError):
             raise InputError(
                 f"{path}: corrupt stage record; remove the folder to recompute it"
             ) from None
-        if not isinstance(record, dict) or not {"stage", "fingerprint", "state"} <= record.keys():
+        outputs = record.get("outputs", {}) if isinstance(record, dict) else None
+        if (
+            not isinstance(record, dict)
+            or not {"stage", "fingerprint", "state"} <= record.keys()
+            or not isinstance(outputs, dict)
+            or not all(_inside(k) and isinstance(v, str) for k, v in outputs.items())
+        ):
             raise InputError(
                 f"{path}: not a flatcontact stage record; remove the folder to recompute it"
             )
@@ -182,10 +358,28 @@ class RunDirectory:
             raise InputError(
                 f"{folder / RECORD_NAME}: belongs to stage '{record.get('stage')}', not '{name}'"
             )
+        damaged: list[str] = []
         if record is not None and record["fingerprint"] == digest and record["state"] == STATE_DONE:
-            log.info("stage %s: inputs unchanged, skipped", name)
-            return StageResult(name, folder, digest, "skipped", 0.0)
-        if record is not None and record["fingerprint"] == digest:
+            damaged = damaged_outputs(folder, record.get("outputs") or {})
+            if not damaged:
+                log.info("stage %s: inputs unchanged, skipped", name)
+                return StageResult(name, folder, digest, "skipped", 0.0)
+        if self.read_only is not None:
+            why = f"{', '.join(damaged)} missing or changed" if damaged else "not done"
+            raise InputError(
+                f"{self.root}: cannot write here ({self.read_only.strerror}) and stage {name} "
+                f"must run ({why}); copy the run directory somewhere writable and rerun there"
+            )
+        if damaged:
+            log.warning(
+                "stage %s: outputs missing or changed since it finished (%s); recomputing them",
+                name,
+                ", ".join(damaged),
+            )
+            for rel in damaged:
+                (folder / rel).unlink(missing_ok=True)
+            action = "resumed"
+        elif record is not None and record["fingerprint"] == digest:
             action = "resumed"
         else:
             action = "ran"
@@ -209,7 +403,13 @@ class RunDirectory:
         seconds = time.perf_counter() - start
         write_json_atomic(
             folder / RECORD_NAME,
-            {**base, "state": STATE_DONE, "finished": _now(), "seconds": round(seconds, 3)},
+            {
+                **base,
+                "state": STATE_DONE,
+                "finished": _now(),
+                "seconds": round(seconds, 3),
+                "outputs": output_digests(folder),
+            },
         )
         log.info("stage %s: done in %.1f s", name, seconds)
         return StageResult(name, folder, digest, action, seconds)

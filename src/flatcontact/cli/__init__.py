@@ -5,6 +5,8 @@ on stderr with exit status 2 (the status click uses for usage errors), never a t
 or a boxed multi-line message:
 
 - :class:`~flatcontact.errors.InputError` raised by a command (bad values, files, configs);
+- a full disk (``ENOSPC``, ``EDQUOT``) in any stage: one line saying to free space and
+  rerun (the rerun resumes: stage records and scan points are written atomically);
 - click's own usage errors (``--layers abc``, a missing argument, an unknown option),
   printed as click's one-line message followed by where to find help.
 
@@ -14,7 +16,11 @@ standalone mode).
 
 from __future__ import annotations
 
+import errno
+import logging
+import sqlite3
 import sys
+import warnings
 from typing import Annotated
 
 import typer
@@ -64,12 +70,47 @@ def usage_error_line(exc: Exception) -> str:
     return message
 
 
+#: errno values of a full disk or an exhausted quota.
+_DISK_FULL = (errno.ENOSPC, errno.EDQUOT)
+
+
+def disk_full_line(exc: OSError) -> str:
+    """One line for a write that failed because the disk (or the quota) is full."""
+    where = f" writing {exc.filename}" if exc.filename else ""
+    return (
+        f"no space left on the device{where} ({exc.strerror or 'disk full'}); free some space "
+        "and rerun the same command: finished stages and scan points are kept"
+    )
+
+
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Python warnings (numpy, ASE, ...) as one ``warning:`` line, without source lines."""
+    from flatcontact.cli.app import print_warning
+
+    print_warning(" ".join(f"{category.__name__}: {message}".split()))
+
+
 def main(argv: list[str] | None = None) -> None:
     """Entry point of the ``flatcontact`` console script."""
+    # a full disk under the run log must not print logging's own traceback on stderr
+    logging.raiseExceptions = False
+    warnings.showwarning = _one_line_warning
+    # ASE's note on reading its own extxyz files (info it cannot hash): noise, not news
+    warnings.filterwarnings("ignore", message="Skipping unhashable information")
     try:
         rv = app(args=argv, standalone_mode=False, prog_name="flatcontact")
     except InputError as exc:
         print_error(exc)
+        sys.exit(2)
+    except OSError as exc:
+        if exc.errno not in _DISK_FULL:
+            raise
+        print_error(disk_full_line(exc))
+        sys.exit(2)
+    except sqlite3.OperationalError as exc:  # the scan's point store on a full disk
+        if "full" not in str(exc):
+            raise
+        print_error(disk_full_line(OSError(errno.ENOSPC, str(exc))))
         sys.exit(2)
     except typer.TyperException as exc:  # typer's (vendored click's) usage errors
         code = getattr(exc, "exit_code", 2)

@@ -39,7 +39,8 @@ def run_command(
     from flatcontact.stages import _calculator
 
     cfg = load_config(config, preset)
-    check_out_dir(out)
+    if not (out / "run.json").is_file():  # an existing run may be read-only: Pipeline decides
+        check_out_dir(out)
     with Pipeline(cfg, out, console=console, scan_progress=ScanBar(console)) as pipe:
         console.print(
             f"flatcontact run: preset {cfg.preset}, {cfg.structure.kind}, "
@@ -72,10 +73,12 @@ def config_command(
     ] = True,
 ) -> None:
     """Print the default run configuration (with every field described) or check a file."""
-    from flatcontact.config import load_config, to_yaml
+    from flatcontact.config import check_inputs, load_config, to_yaml
     from flatcontact.errors import InputError
 
     if not show_default and check is None:
         raise InputError("config: give --show-default [--preset quick|paper] or --check FILE")
     cfg = load_config(check, preset)
+    if check is not None:  # what `run` refuses before its first stage, refused here too
+        check_inputs(cfg, str(check))
     typer.echo(to_yaml(cfg, comments=comments), nl=False)

@@ -197,6 +197,7 @@ def scan_command(
     from flatcontact.cli.app import print_warning
     from flatcontact.cli.progress import ScanBar
     from flatcontact.ispes.scan import ScanInterrupted
+    from flatcontact.rundir import RunLock
     from flatcontact.stages.scan import ScanInputs, run_scan_stage
 
     if thickness and p_range_gpa is not None:
@@ -231,6 +232,9 @@ def scan_command(
     cfg = resolve_config(config, preset, flags)
     out_dir = check_out_dir(out or "ispes")
     where = Path(interface or DEFAULT_INTERFACE)
+    created = not out_dir.exists()
+    out_dir.mkdir(parents=True, exist_ok=True)
+    lock = RunLock(out_dir).acquire()  # one writer per --out (a run or another scan)
     try:
         with ScanBar(console) as bar:
             result = run_scan_stage(
@@ -244,6 +248,8 @@ def scan_command(
             highlight=False,
         )
         raise typer.Exit(130) from None
+    finally:
+        lock.release(tidy="created" if created else True)
     for line in result.warnings:
         print_warning(line)
     _summary(result, as_json)

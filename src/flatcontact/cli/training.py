@@ -36,6 +36,26 @@ def _bulk_potential(potential: str, flag: str) -> str:
     )
 
 
+def check_base_name(name: str, flag: str = "--name") -> str:
+    """A base file name written inside ``--out``: no path components, no leading dot.
+
+    Raises
+    ------
+    InputError
+        One line naming ``flag`` and the value (``../../evil``, ``a/b``, ``.hidden``, empty).
+    """
+    import re
+
+    from flatcontact.errors import InputError
+
+    if not re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.+-]{0,99}", name or ""):
+        raise InputError(
+            f"{flag} {name!r}: expected a plain file name (letters, digits, _ . + -, no '/' "
+            "or '..', at most 100 characters); the files are written inside --out"
+        )
+    return name
+
+
 def _say(msg: str) -> None:
     err_console.print(msg, style="dim")
 
@@ -59,8 +79,16 @@ def train_snap_cmd(
     ),
 ) -> None:
     """Fit a SNAP (LAMMPS .snapcoeff/.snapparam) to a dataset or a generated recipe."""
+    from flatcontact.errors import InputError
     from flatcontact.training.train import train_snap
 
+    check_base_name(name)
+    if not (scale > 0 and scale <= 100):
+        raise InputError(
+            f"--scale {scale:g}: expected a size factor of the recipe's random groups in (0, 100]"
+        )
+    if not 0 <= active_rounds <= 50:
+        raise InputError(f"--active-rounds {active_rounds}: expected an integer from 0 to 50")
     check_out_dir(out)
     command = "flatcontact " + " ".join(shlex.quote(a) for a in sys.argv[1:])
     report = train_snap(
@@ -438,7 +466,12 @@ def elastic_cmd(
 ) -> None:
     """alpha-quartz Cij (relaxed ions), Voigt-Reuss-Hill K, G, E, nu and contact moduli E*, G*."""
     from flatcontact.elastic import quartz_contact_moduli
+    from flatcontact.errors import InputError
 
+    if not 0 < strain < 0.05:  # the run's elastic.strain bounds
+        raise InputError(
+            f"--strain {strain:g}: expected a finite strain amplitude in (0, 0.05), e.g. 0.005"
+        )
     res = quartz_contact_moduli(_bulk_potential(potential, "--potential"), strain=strain)
     if json_out:
         print(json.dumps(res, indent=2))

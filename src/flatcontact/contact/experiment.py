@@ -138,10 +138,13 @@ def load_stiffness_csv(path: str | Path) -> MeasuredStiffness:
         one, two columns of the same kind, a non-numeric or NaN/inf cell, a
         negative stress, fewer than 4 rows.
     """
+    from flatcontact.fileio import read_text_file
+
     p = Path(path)
-    require(p.is_file(), f"experiment file {str(p)!r} does not exist")
+    require(p.exists(), f"experiment file {str(p)!r} does not exist")
+    text = read_text_file(p, "measured stiffness CSV", 50_000_000)
     lines = [
-        ln for ln in p.read_text().splitlines() if ln.strip() and not ln.lstrip().startswith("#")
+        ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")
     ]
     require(len(lines) > 0, f"{p.name}: empty file, expected a header and data rows")
     header = [c.strip() for c in lines[0].split(",")]

@@ -114,3 +114,22 @@ def run_build(settings, inputs: BuildInputs, folder: Path | None, progress=None)
         result.files.append(write_json_atomic(folder / BUILD_JSON, result.to_json()))
         result.files += save(figure_interface(atoms), folder, FIGURE_STEM, settings.report.svg)
     return result
+
+
+def structure_elements(recipe) -> set[str] | None:
+    """The elements of a recipe read from its files (``file``, ``slab``, ``crystal``), cheaply
+    and before any work; ``None`` when only the build knows them."""
+    from ase.io import read
+
+    from flatcontact.errors import InputError
+
+    path = {"file": "file", "slab": "file", "crystal": "bulk"}.get(recipe.kind)
+    if path is None:
+        return None
+    try:
+        return set(read(getattr(recipe, path)).get_chemical_symbols())
+    except Exception as exc:  # any reader error, named with the field
+        raise InputError(
+            f"structure.{path}: {getattr(recipe, path)} is not a structure file ASE can read "
+            f"({type(exc).__name__})"
+        ) from None

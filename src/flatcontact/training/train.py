@@ -202,6 +202,12 @@ def train_snap(
     say = progress or (lambda msg: None)
     if (data is None) == (recipe is None):
         raise InputError("give exactly one of --data FILE.extxyz or --recipe NAME")
+    if not name or Path(name).name != name or name in (".", "..") or name.startswith("."):
+        raise InputError(f"name {name!r}: expected a plain file name written inside {out}")
+    if not scale > 0:
+        raise InputError(f"scale {scale!r}: expected a positive size factor")
+    if active_rounds < 0:
+        raise InputError(f"active_rounds {active_rounds!r}: expected >= 0")
     out = Path(out)
     t_start = time.perf_counter()
     teacher = None
