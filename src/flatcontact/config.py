@@ -1014,8 +1014,10 @@ def load_config(path: str | Path | None = None, preset_name: str | None = None) 
         if not target.is_file():
             raise InputError(f"{path}: {section}.{key}: {value} is not a regular file")
     for dotted, value in recipe_files(cfg.structure):
-        if not Path(value).is_file():
+        if not Path(value).exists():
             raise InputError(f"{path}: structure.{dotted}: file {value} not found")
+        if not Path(value).is_file():
+            raise InputError(f"{path}: structure.{dotted}: {value} is not a regular file")
     for section, key in _FILE_LIST_FIELDS:
         for value in getattr(getattr(cfg, section), key):
             if not Path(value).is_file():
