@@ -1091,8 +1091,10 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
     calc = cfg.potential.calculator
     if calc is not None:
         try:
+            from flatcontact.potentials.loader import load_callable
+
             cfg.potential.calculator_factory()
-            _import_target(calc.target)
+            load_callable(calc.target)
         except InputError as exc:
             raise InputError(f"{source}: potential.calculator.target: {exc}") from None
     from flatcontact.stages.build import structure_elements
@@ -1111,25 +1113,6 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
             _calculator.check(cfg)
         else:
             _calculator.check_atoms(cfg, bulk)
-
-
-def _import_target(target: str) -> None:
-    """Import ``'module:callable'`` (InputError when the module or the attribute is missing)."""
-    import importlib
-
-    module, _, name = target.partition(":")
-    try:
-        obj = importlib.import_module(module)
-    except Exception as exc:  # any import failure of user code is the user's to fix
-        raise InputError(
-            f"{target!r}: cannot import module {module!r} ({type(exc).__name__})"
-        ) from None
-    for part in name.split("."):
-        if not hasattr(obj, part):
-            raise InputError(f"{target!r}: module {module!r} has no {name!r}")
-        obj = getattr(obj, part)
-    if not callable(obj):
-        raise InputError(f"{target!r}: {name!r} is not callable")
 
 
 def _check_structure_file(cfg: RunConfig, source: str) -> None:

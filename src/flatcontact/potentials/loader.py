@@ -28,8 +28,10 @@ def load_callable(target: str, what: str = "calculator") -> Any:
         )
     try:
         obj = importlib.import_module(module_name)
-    except ImportError as exc:
-        raise InputError(f"{what} '{target}': cannot import module {module_name} ({exc})") from None
+    except Exception as exc:  # any failure while importing user code is the user's to fix
+        raise InputError(
+            f"{what} '{target}': cannot import module {module_name} ({type(exc).__name__}: {exc})"
+        ) from None
     for part in attr.split("."):
         if not hasattr(obj, part):
             raise InputError(f"{what} '{target}': {module_name} has no '{attr}'")
