@@ -89,7 +89,7 @@ def main() -> None:
         f"ridge: SVD of {rows} x {ncol} in {t1 - t0:.2f} s; 4 ridge solves in {(t2 - t1) * 1e3:.1f} ms"
     )
 
-    from flatcontact.training.label import chgnet_available
+    from flatcontact.potentials.chgnet import chgnet_available
 
     if chgnet_available():
         from flatcontact.training.label import teacher_calculator

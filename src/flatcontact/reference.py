@@ -14,12 +14,14 @@ Sources
   q0 = G*·u/(πa), i.e. 4 × Johnson's G*_J).
 - Hamaker constant of α-quartz across vacuum from Lifshitz theory with measured dielectric
   spectra: Bergström, Adv. Colloid Interface Sci. 70, 125 (1997).
-- Elastic constants of α-quartz at room temperature, adiabatic, experiment (McSkimin,
-  Andreatch and Thurston, J. Appl. Phys. 36, 1624 (1965); Heyliger, Ledbetter and Kim,
-  J. Acoust. Soc. Am. 114, 644 (2003)): the set :mod:`flatcontact.training.validate`
-  checks potentials against.
-- Lattice constants of α-quartz, experiment (Levien, Prewitt and Weidner, Am. Mineral. 65,
-  920 (1980)).
+- Elastic constants of α-quartz at 25 °C and zero pressure, adiabatic, ultrasonic
+  pulse superposition, experiment: McSkimin, Andreatch and Thurston, J. Appl. Phys. 36,
+  1624 (1965), their adjusted set (c11 8.680, c12 0.704, c13 1.191, c14 −1.804, c33 10.575,
+  c44 5.820, c66 3.988 × 10¹¹ dyn/cm²). The one set every comparison of a potential with
+  experiment reads (:mod:`flatcontact.training.validate`,
+  :mod:`flatcontact.training.ispes_check`, ``flatcontact validate-potential``).
+- Lattice constants and density of α-quartz, experiment (Levien, Prewitt and Weidner,
+  Am. Mineral. 65, 920 (1980)).
 """
 
 from __future__ import annotations
@@ -52,10 +54,21 @@ DEFAULT_P0_GPA: tuple[float, ...] = (0.5, 1.0, 1.77, 2.0, 3.0)
 #: Non-retarded Hamaker constant of α-quartz across vacuum, Lifshitz theory (zJ; Bergström 1997).
 QUARTZ_HAMAKER_ZJ = 88.0
 
-#: Elastic constants of α-quartz, experiment (GPa, Voigt notation); C14 in the IEEE-1949 axes
-#: of right-handed quartz (negative).
+#: Elastic constants of α-quartz, experiment (GPa, Voigt notation, 25 °C; McSkimin et al.
+#: 1965); C14 in the IEEE-1949 axes of right-handed quartz (negative). Its sign depends on
+#: the handedness and on which a-axis is +x: compare |C14| with a model's.
 QUARTZ_CIJ_EXPERIMENT_GPA = MappingProxyType(
-    {"C11": 86.6, "C12": 6.7, "C13": 12.6, "C14": -17.8, "C33": 106.1, "C44": 57.8, "C66": 39.9}
+    {
+        "C11": 86.80,
+        "C12": 7.04,
+        "C13": 11.91,
+        "C14": -18.04,
+        "C33": 105.75,
+        "C44": 58.20,
+        "C66": 39.88,
+    }
 )
 #: Lattice constants of α-quartz, experiment (Å).
 QUARTZ_LATTICE_EXPERIMENT_ANGSTROM = MappingProxyType({"a": 4.916, "c": 5.405})
+#: Density of α-quartz, experiment (g/cm³).
+QUARTZ_DENSITY_EXPERIMENT_G_CM3 = 2.648

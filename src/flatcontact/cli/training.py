@@ -14,13 +14,15 @@ from flatcontact.cli.app import app, check_out_dir, console, err_console
 
 def _bulk_potential(potential: str, flag: str) -> str:
     """``potential`` in any spelling of :func:`~flatcontact.potentials.spec.normalize_potential_name`
-    as the name or ``.snapcoeff`` path that the bulk calculators take (``chgnet`` passes through).
+    as the name or ``.snapcoeff`` path that the bulk calculators take (offline teachers of
+    :mod:`flatcontact.training.teachers` pass through).
     """
     from flatcontact.errors import InputError
     from flatcontact.potentials.spec import normalize_potential_name, resolve_intra
+    from flatcontact.training.teachers import is_teacher
 
-    if potential.strip() == "chgnet":
-        return "chgnet"
+    if is_teacher(potential):
+        return potential.strip()
     try:
         resolved = resolve_intra(potential)
     except InputError as exc:
@@ -32,7 +34,8 @@ def _bulk_potential(potential: str, flag: str) -> str:
         bundled = normalize_potential_name(potential) == f"snap:{name}"
         return name if bundled else resolved.files[0]
     raise InputError(
-        f"{flag} {potential!r}: expected a LAMMPS model (vashishta, tersoff, a SNAP) or chgnet"
+        f"{flag} {potential!r}: expected a LAMMPS model (vashishta, tersoff, a SNAP) or an "
+        "offline teacher (chgnet-r2scan, sevennet-0, sevennet-mf-0-r2scan, sevennet-mf-0-pbe)"
     )
 
 
@@ -64,7 +67,12 @@ def _say(msg: str) -> None:
 def train_snap_cmd(
     data: Path = typer.Option(None, "--data", help="Labelled extxyz (energies, forces, stresses)."),
     recipe: str = typer.Option(None, "--recipe", help="Training-set recipe to generate (sio2)."),
-    label: str = typer.Option("chgnet", "--label", help="Teacher for --recipe labels (chgnet)."),
+    label: str = typer.Option(
+        "chgnet",
+        "--label",
+        help="Offline teacher for --recipe labels: chgnet (= chgnet-r2scan), sevennet-0, "
+        "sevennet-mf-0-r2scan, sevennet-mf-0-pbe.",
+    ),
     out: Path = typer.Option(Path("snap-training"), "--out", help="Output directory."),
     name: str = typer.Option("snap", "--name", help="Base name of the .snapcoeff/.snapparam."),
     seed: int = typer.Option(0, "--seed", help="Seed of the recipe and the data split."),
@@ -80,9 +88,12 @@ def train_snap_cmd(
 ) -> None:
     """Fit a SNAP (LAMMPS .snapcoeff/.snapparam) to a dataset or a generated recipe."""
     from flatcontact.errors import InputError
+    from flatcontact.training.teachers import get_teacher
     from flatcontact.training.train import train_snap
 
     check_base_name(name)
+    if recipe is not None:
+        get_teacher(label, "--label")
     if not (scale > 0 and scale <= 100):
         raise InputError(
             f"--scale {scale:g}: expected a size factor of the recipe's random groups in (0, 100]"
@@ -126,7 +137,8 @@ def validate_potential_cmd(
     reference: str = typer.Option(
         None,
         "--reference",
-        help="Reference model (chgnet) or a labelled extxyz of held-out frames.",
+        help="Reference model (an offline teacher: chgnet, sevennet-0, sevennet-mf-0-r2scan, "
+        "sevennet-mf-0-pbe; or a LAMMPS model) or a labelled extxyz of held-out frames.",
     ),
     heldout: Path = typer.Option(
         None,
@@ -255,12 +267,12 @@ def _ispes_model(name: str, flag: str, lj: dict):
     (``chgnet`` = ``chgnet-r2scan``) or any intra-slab potential name, with the shared LJ."""
     from flatcontact.errors import InputError
     from flatcontact.potentials import PotentialSpec
-    from flatcontact.training.ispes_check import TEACHERS, teacher_spec
+    from flatcontact.training.ispes_check import teacher_spec
+    from flatcontact.training.teachers import get_teacher, is_teacher
 
     name = name.strip()
-    if name == "chgnet":
-        name = "chgnet-r2scan"
-    if name in TEACHERS:
+    if is_teacher(name):
+        name = get_teacher(name).name
         return name, teacher_spec(name, lj)
     try:
         return name, PotentialSpec(intra=name, lj=lj)
@@ -409,8 +421,9 @@ def _print_ispes_check(report: dict) -> None:
 def _print_validation(report: dict) -> None:
     from rich.table import Table
 
-    from flatcontact.training.validate import (
+    from flatcontact.reference import (
         QUARTZ_CIJ_EXPERIMENT_GPA,
+        QUARTZ_DENSITY_EXPERIMENT_G_CM3,
         QUARTZ_LATTICE_EXPERIMENT_ANGSTROM,
     )
 
@@ -421,7 +434,11 @@ def _print_validation(report: dict) -> None:
         t.add_column(c)
     t.add_column("experiment")
     for key, unit in (("a_angstrom", "Å"), ("c_angstrom", "Å"), ("density_g_cm3", "g/cm³")):
-        exp = QUARTZ_LATTICE_EXPERIMENT_ANGSTROM.get(key[0]) if key != "density_g_cm3" else 2.648
+        exp = (
+            QUARTZ_LATTICE_EXPERIMENT_ANGSTROM.get(key[0])
+            if key != "density_g_cm3"
+            else QUARTZ_DENSITY_EXPERIMENT_G_CM3
+        )
         t.add_row(
             f"{key.split('_')[0]} ({unit})",
             *[f"{report[c]['lattice'][key]:.4f}" for c in cols],

@@ -5,7 +5,7 @@ Two measurements for any SiO₂ model that has an ASE calculator (issue 12):
 * :func:`quartz_elastic_vs_experiment`: zero-stress α-quartz lattice and relaxed-ion
   Cij (:func:`flatcontact.training.validate.quartz_lattice`,
   :func:`~flatcontact.training.validate.quartz_elastic`: central finite strains ±0.5 %,
-  ions relaxed) against experiment (:data:`QUARTZ_CIJ_EXPERIMENT_GPA`);
+  ions relaxed) against experiment (:mod:`flatcontact.reference`, |C14|);
 * :func:`compare_ispes`: the ISPES of ONE interface (the same reference geometry and
   lateral cell) scanned with each model on the same lateral grid and load range, then
   analysed identically (constant-pressure ISPES, zero-perpendicular-force path, τ and
@@ -16,9 +16,10 @@ Two measurements for any SiO₂ model that has an ASE calculator (issue 12):
 A model is a :class:`~flatcontact.potentials.PotentialSpec` (intra-slab model + the same
 cross-interface LJ: this isolates the intra-slab potential, which is what a surrogate
 replaces), a factory with ``fingerprint`` (:mod:`flatcontact.ispes.calculators`), or
-anything with ``calculator_factory()``. Offline teachers are named in :data:`TEACHERS`
-(CHGNet r2SCAN, SevenNet-0, SevenNet-MF-0 with its r2SCAN and PBE heads; weights ship in
-the wheels, nothing is downloaded); they need ``torch`` (CPU) plus ``chgnet``/``sevenn``.
+anything with ``calculator_factory()``. Offline teachers come from their one registry,
+:mod:`flatcontact.training.teachers` (CHGNet r2SCAN, SevenNet-0, SevenNet-MF-0 with its
+r2SCAN and PBE heads; weights ship in the wheels, nothing is downloaded); they need
+``torch`` (CPU) plus ``chgnet``/``sevenn``.
 """
 
 from __future__ import annotations
@@ -34,83 +35,14 @@ import pandas as pd
 from ase import Atoms
 
 from flatcontact.errors import InputError, require
+from flatcontact.reference import QUARTZ_CIJ_EXPERIMENT_GPA, QUARTZ_LATTICE_EXPERIMENT_ANGSTROM
+from flatcontact.training.teachers import TEACHERS, get_teacher, teacher_calculator  # noqa: F401
 
-#: α-quartz elastic constants at room temperature (GPa), the experimental set of issue 12
-#: (McSkimin et al. 1965; Heyliger et al. 2003); |C14| only (its sign depends on the axes).
-QUARTZ_CIJ_EXPERIMENT_GPA = {
-    "C11": 86.8,
-    "C33": 105.8,
-    "C44": 58.2,
-    "C66": 39.9,
-    "C12": 7.0,
-    "C13": 11.9,
-    "C14": 18.0,
-}
-#: Lattice of α-quartz at room temperature (Å; Levien, Prewitt & Weidner 1980).
-QUARTZ_LATTICE_EXPERIMENT_ANGSTROM = {"a": 4.916, "c": 5.405}
+#: Experimental α-quartz Cij (GPa) as compared here: :data:`flatcontact.reference.QUARTZ_CIJ_EXPERIMENT_GPA`
+#: with |C14| (a model's C14 sign depends on its axes).
+QUARTZ_CIJ_ABS_EXPERIMENT_GPA = {k: abs(v) for k, v in QUARTZ_CIJ_EXPERIMENT_GPA.items()}
 #: Per-load quantities compared between models.
 ISPES_QUANTITIES = ("tau_mpa", "sigma_mss_mpa", "shear_stiffness_gpa_per_nm")
-
-
-def _torch_threads() -> None:
-    try:
-        import torch
-
-        torch.set_num_threads(1)
-    except ImportError:  # pragma: no cover - only without torch, then nothing to set
-        pass
-
-
-def sevennet_0():
-    """SevenNet-0 (PBE, MPtrj; 11Jul2024 checkpoint shipped in the ``sevenn`` wheel), CPU."""
-    return _sevennet("7net-0", None)
-
-
-def sevennet_mf0_r2scan():
-    """SevenNet-MF-0, r2SCAN head (multi-fidelity checkpoint shipped in the wheel), CPU."""
-    return _sevennet("7net-mf-0", "R2SCAN")
-
-
-def sevennet_mf0_pbe():
-    """SevenNet-MF-0, PBE head, CPU."""
-    return _sevennet("7net-mf-0", "PBE")
-
-
-def _sevennet(model: str, modal: str | None):
-    try:
-        from sevenn.calculator import SevenNetCalculator
-    except ImportError as exc:
-        raise InputError(
-            f"SevenNet is not installed ({exc}); install torch==2.13.0 (CPU) and then 'sevenn'"
-        ) from None
-    _torch_threads()
-    kwargs = {"modal": modal} if modal else {}
-    return SevenNetCalculator(model, device="cpu", **kwargs)
-
-
-def chgnet_r2scan():
-    """CHGNet 0.4 r2SCAN weights (:func:`flatcontact.potentials.factories.chgnet_r2scan`), 1 thread."""
-    from flatcontact.potentials.factories import chgnet_r2scan as make
-
-    _torch_threads()
-    return make()
-
-
-#: Offline teachers: name -> ``module:factory`` (no-argument ASE calculator factories).
-TEACHERS: dict[str, str] = {
-    "chgnet-r2scan": "flatcontact.training.ispes_check:chgnet_r2scan",
-    "sevennet-0": "flatcontact.training.ispes_check:sevennet_0",
-    "sevennet-mf-0-r2scan": "flatcontact.training.ispes_check:sevennet_mf0_r2scan",
-    "sevennet-mf-0-pbe": "flatcontact.training.ispes_check:sevennet_mf0_pbe",
-}
-
-
-def teacher_calculator(name: str):
-    """A fresh ASE calculator of the offline teacher ``name`` (:data:`TEACHERS`)."""
-    from flatcontact.potentials.calculator import load_factory
-
-    require(name in TEACHERS, f"teacher {name!r}: expected one of {', '.join(TEACHERS)}")
-    return load_factory(TEACHERS[name])()
 
 
 def teacher_spec(name: str, lj: Mapping | None = None):
@@ -118,9 +50,9 @@ def teacher_spec(name: str, lj: Mapping | None = None):
     from flatcontact.config import default_potential
     from flatcontact.potentials import PotentialSpec
 
-    require(name in TEACHERS, f"teacher {name!r}: expected one of {', '.join(TEACHERS)}")
+    teacher = get_teacher(name)
     lj = dict(lj if lj is not None else default_potential()["lj"])
-    return PotentialSpec(intra=f"ase:{TEACHERS[name]}", lj=lj)
+    return PotentialSpec(intra=f"ase:{teacher.factory}", lj=lj)
 
 
 # --------------------------------------------------------------------------- elasticity
@@ -152,7 +84,7 @@ def quartz_elastic_vs_experiment(calc, label: str, strain: float = 0.005) -> dic
     elastic = quartz_elastic(relaxed, calc, strain=strain)
     cij = {k: float(v) for k, v in elastic["cij_gpa"].items()}
     cij["C14"] = abs(cij["C14"])
-    rel = {k: cij[k] / QUARTZ_CIJ_EXPERIMENT_GPA[k] - 1 for k in QUARTZ_CIJ_EXPERIMENT_GPA}
+    rel = {k: cij[k] / v - 1 for k, v in QUARTZ_CIJ_ABS_EXPERIMENT_GPA.items()}
     rel["a"] = lattice["a_angstrom"] / QUARTZ_LATTICE_EXPERIMENT_ANGSTROM["a"] - 1
     rel["c"] = lattice["c_angstrom"] / QUARTZ_LATTICE_EXPERIMENT_ANGSTROM["c"] - 1
     return {
@@ -175,7 +107,7 @@ def elastic_table(reports: Sequence[Mapping]) -> pd.DataFrame:
             "model": "experiment",
             "a_angstrom": QUARTZ_LATTICE_EXPERIMENT_ANGSTROM["a"],
             "c_angstrom": QUARTZ_LATTICE_EXPERIMENT_ANGSTROM["c"],
-            **QUARTZ_CIJ_EXPERIMENT_GPA,
+            **QUARTZ_CIJ_ABS_EXPERIMENT_GPA,
             "e_star_gpa": np.nan,
             "max_rel_error_c11_c33_c44": 0.0,
         }

@@ -10,7 +10,8 @@ so training, validation and the elastic stage use the same model as the scan):
 * ``vashishta`` (Vashishta et al. 1990, LAMMPS ``SiO.1990.vashishta``) or ``tersoff``
   (Munetoh et al. 2007, LAMMPS ``SiO.tersoff``);
 * a preset name (``cu-eam``, ``graphene-rebo-kc``, ...; the intra model of the preset);
-* ``chgnet`` (the r2SCAN CHGNet teacher; optional extra).
+* an offline teacher of :mod:`flatcontact.training.teachers` (``chgnet`` = ``chgnet-r2scan``,
+  ``sevennet-0``, ``sevennet-mf-0-r2scan``, ``sevennet-mf-0-pbe``; optional extras).
 """
 
 from __future__ import annotations
@@ -19,9 +20,9 @@ from pathlib import Path
 
 from flatcontact.errors import InputError
 from flatcontact.potentials.files import BUNDLED_DIR, bundled_snap_names
+from flatcontact.training.teachers import ALIASES, TEACHERS, is_teacher, teacher_calculator
 
 CLASSICAL = ("vashishta", "tersoff")
-TEACHERS = ("chgnet",)
 
 
 def bundled_dir() -> Path:
@@ -38,7 +39,7 @@ def snapcoeff_path(name_or_path: str) -> Path | None:
     """The ``.snapcoeff`` a name or path refers to, or None for a non-SNAP name."""
     from flatcontact.potentials.model import normalize_potential_name, resolve_intra
 
-    if name_or_path in CLASSICAL or name_or_path in TEACHERS:
+    if name_or_path in CLASSICAL or is_teacher(name_or_path):
         return None
     try:
         resolved = resolve_intra(normalize_potential_name(name_or_path))
@@ -47,7 +48,7 @@ def snapcoeff_path(name_or_path: str) -> Path | None:
     if resolved is None or resolved.style != "snap":
         raise InputError(
             f"potential '{name_or_path}': not a bundled SNAP ({bundled_names()}), "
-            f"not one of {list(CLASSICAL + TEACHERS)}, and not a .snapcoeff file or directory"
+            f"not one of {[*CLASSICAL, *TEACHERS, *ALIASES]}, and not a .snapcoeff file or directory"
         )
     return Path(resolved.files[0])
 
@@ -56,10 +57,8 @@ def bulk_calculator(name_or_path: str, atoms=None):
     """A single-body ASE calculator for ``name_or_path`` (see the module docstring)."""
     from flatcontact.potentials import InteractionModel
 
-    if name_or_path == "chgnet":
-        from flatcontact.potentials.chgnet import chgnet_calculator
-
-        return chgnet_calculator("r2scan")
+    if is_teacher(name_or_path):
+        return teacher_calculator(name_or_path)
     if name_or_path not in CLASSICAL:
         coeff = None
         try:

