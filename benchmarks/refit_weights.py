@@ -29,21 +29,18 @@ import numpy as np
 
 from flatcontact.fileio import write_json_atomic
 from flatcontact.training.dataset import read_dataset, write_dataset
-from flatcontact.training.fit import default_settings, fit_snap
+from flatcontact.training.fit import default_settings, fit_snap, split_indices
 from flatcontact.training.snapfiles import SnapHyper, write_snap_files
-from flatcontact.training.train import DEFAULT_GROUP_WEIGHTS, ELEMENTS, parity_plot
+from flatcontact.training.train import ELEMENTS, parity_plot
 
 
 def parse_weights(items: list[str]) -> dict[str, float]:
-    """``["group=w", ...]`` -> {group: w}; groups must be known, weights positive."""
+    """``["group=w", ...]`` -> {group: w}; weights positive (new groups come with ``--add``)."""
     out = {}
     for item in items:
         group, sep, value = item.partition("=")
-        if not sep or group not in DEFAULT_GROUP_WEIGHTS:
-            raise SystemExit(
-                f"error: --weight {item!r}: expected GROUP=W with GROUP one of "
-                f"{', '.join(DEFAULT_GROUP_WEIGHTS)}"
-            )
+        if not sep or not group:
+            raise SystemExit(f"error: --weight {item!r}: expected GROUP=W")
         w = float(value)
         if not w > 0:
             raise SystemExit(f"error: --weight {item!r}: expected a positive weight")
@@ -52,16 +49,39 @@ def parse_weights(items: list[str]) -> dict[str, float]:
 
 
 def refit(
-    train_dir: Path, out: Path, name: str, overrides: dict[str, float], command: str = ""
+    train_dir: Path,
+    out: Path,
+    name: str,
+    overrides: dict[str, float],
+    command: str = "",
+    add: list[Path] = (),
+    seed: int = 2026,
+    rcutfac: float | None = None,
 ) -> dict:
-    """Refit ``train_dir``'s data and split with group weights ``overrides``; write ``out``."""
+    """Refit ``train_dir``'s data and split with group weights ``overrides``; write ``out``.
+
+    ``add``: further labelled extxyz files; their frames are split (stratified by
+    ``config_type``, ``seed``) and appended to each part of the original split.
+    ``rcutfac``: replace the chosen descriptor's cutoff scale (Å), everything else kept.
+    """
     t0 = time.perf_counter()
     report0 = json.loads((train_dir / "fit_report.json").read_text())
     prov0 = json.loads((train_dir / "provenance.json").read_text())
     frames = read_dataset(train_dir / "dataset.extxyz", ELEMENTS)
-    split = {k: np.array(v, dtype=int) for k, v in report0["split_indices"].items()}
+    split = {k: list(v) for k, v in report0["split_indices"].items()}
     assert sum(len(v) for v in split.values()) == len(frames), "dataset and split disagree"
+    added = {}
+    for path in add:
+        extra = read_dataset(path, ELEMENTS)
+        part = split_indices([a.info.get("config_type", "default") for a in extra], seed)
+        for k, idx in part.items():
+            split[k] += [len(frames) + int(i) for i in idx]
+        frames += extra
+        added[str(path)] = len(extra)
+    split = {k: np.array(sorted(v), dtype=int) for k, v in split.items()}
     hyper = SnapHyper(**report0["hyper"])
+    if rcutfac is not None:
+        hyper = SnapHyper(**{**report0["hyper"], "rcutfac": rcutfac})
     weights = {**report0["settings"]["group_weights"], **overrides}
     result = fit_snap(
         frames, ELEMENTS, [hyper], default_settings(weights), split=split, progress=print
@@ -90,11 +110,13 @@ def refit(
     write_json_atomic(out / "fit_report.json", report)
     provenance = {
         **prov0,
+        "hyper": report["hyper"],
         "settings": report["settings"],
         "files": [coeff.name, param.name],
         "refit": {
             "from": f"{prov0.get('command')} (its dataset.extxyz and fit_report.json split)",
             "group_weight_overrides": overrides,
+            "added_frames": added,
             "descriptor_fixed": report["hyper"],
             "command": command,
             "refit_s": fit_s,
@@ -110,10 +132,22 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("out", type=Path)
     ap.add_argument("--name", required=True)
     ap.add_argument("--weight", action="append", default=[], help="GROUP=W (repeat)")
+    ap.add_argument(
+        "--add", action="append", default=[], type=Path, help="extra labelled extxyz (repeat)"
+    )
     argv = sys.argv[1:] if argv is None else argv
+    ap.add_argument("--rcutfac", type=float, default=None, help="descriptor cutoff scale (Å)")
     args = ap.parse_args(argv)
     command = "python -m benchmarks.refit_weights " + shlex.join(argv)
-    report = refit(args.train_dir, args.out, args.name, parse_weights(args.weight), command)
+    report = refit(
+        args.train_dir,
+        args.out,
+        args.name,
+        parse_weights(args.weight),
+        command,
+        args.add,
+        rcutfac=args.rcutfac,
+    )
     for split in ("train", "validation", "test"):
         e = report["errors"][split]
         print(

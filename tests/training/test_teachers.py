@@ -74,4 +74,6 @@ def test_every_consumer_resolves_teachers_through_the_registry():
     for name, t in reg.TEACHERS.items():
         assert ispes_check.teacher_spec(name).intra == f"ase:{t.factory}"
         assert snapcoeff_path(name) is None  # a teacher, not a SNAP file
-    assert ispes_check.teacher_spec("chgnet").intra == f"ase:{reg.TEACHERS['chgnet-r2scan'].factory}"
+    assert (
+        ispes_check.teacher_spec("chgnet").intra == f"ase:{reg.TEACHERS['chgnet-r2scan'].factory}"
+    )

@@ -20,6 +20,9 @@ ni-eam               Foiles, Baskes & Daw 1986 Ni EAM (``Ni_u3.eam``), same pote
 al-eam               Zhou et al. 2001 Al EAM (``Al_zhou.eam.alloy``), same potential across
 sio2-snap-lj         flatcontact's bundled SiO₂ SNAP per slab + Tkatchenko–Scheffler LJ across,
                      C6 scaled to α-quartz's Lifshitz Hamaker constant 88 zJ (today's default)
+sio2-snap-mf0-lj     the same LJ across, inside each slab the SNAP trained on SevenNet-MF-0
+                     r2SCAN labels (``sio2-snap-mf0``: α-quartz C11, C33, C44 within 15 % of
+                     experiment; docs/teachers.md)
 ===================  ===========================================================================
 """
 
@@ -39,6 +42,13 @@ _TERSOFF_BN = {"pair_style": "tersoff", "pair_coeff": ["BNC.tersoff"], "elements
 #: α-quartz number densities (nm⁻³, experimental cell a = 4.916, c = 5.405 Å) rounded as in
 #: the default run configuration.
 _QUARTZ_DENSITIES = {"O": 53.04, "Si": 26.52}
+#: The cross-interface LJ of the SiO₂ presets: TS C6 scaled to the Lifshitz Hamaker constant.
+_QUARTZ_LJ = {
+    "c6_source": "ts",
+    "hamaker_zj": 88.0,
+    "number_density_per_nm3": _QUARTZ_DENSITIES,
+    "cutoff_angstrom": 10.0,
+}
 
 #: name -> InteractionModel data (without ``preset``).
 PRESETS: dict[str, dict] = {
@@ -116,11 +126,11 @@ PRESETS: dict[str, dict] = {
     "sio2-snap-lj": {
         "intra": "snap:sio2-snap",
         "coupling": "lj",
-        "lj": {
-            "c6_source": "ts",
-            "hamaker_zj": 88.0,
-            "number_density_per_nm3": _QUARTZ_DENSITIES,
-            "cutoff_angstrom": 10.0,
-        },
+        "lj": _QUARTZ_LJ,
+    },
+    "sio2-snap-mf0-lj": {
+        "intra": "snap:sio2-snap-mf0",
+        "coupling": "lj",
+        "lj": _QUARTZ_LJ,
     },
 }
