@@ -31,7 +31,7 @@ def main() -> None:
         verify_dense_slab,
     )
     from flatcontact.structures.interface import write_interface
-    from flatcontact.training.ispes_check import chgnet_r2scan
+    from flatcontact.training.teachers import chgnet_r2scan
 
     spec = build_config({}, "paper").potential
     teacher = chgnet_r2scan()
