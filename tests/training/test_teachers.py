@@ -77,3 +77,10 @@ def test_every_consumer_resolves_teachers_through_the_registry():
     assert (
         ispes_check.teacher_spec("chgnet").intra == f"ase:{reg.TEACHERS['chgnet-r2scan'].factory}"
     )
+
+
+def test_validate_potential_reference_lists_the_teachers_when_unknown(capsys):
+    code, _, err = run_cli(["validate-potential", "sio2-snap", "--reference", "mace"], capsys)
+    line = one_error_line(code, err)
+    assert line.startswith("error: --reference") and "'mace'" in line
+    assert all(name in line for name in EXPECTED)

@@ -26,7 +26,9 @@ def _bulk_potential(potential: str, flag: str) -> str:
     try:
         resolved = resolve_intra(potential)
     except InputError as exc:
-        raise InputError(f"{flag}: {exc}") from None
+        from flatcontact.training.teachers import TEACHERS
+
+        raise InputError(f"{flag}: {exc}; or an offline teacher ({', '.join(TEACHERS)})") from None
     if resolved.style in ("vashishta", "tersoff"):
         return resolved.style
     if resolved.style == "snap":
