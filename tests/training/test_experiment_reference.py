@@ -75,3 +75,23 @@ def test_experimental_density_follows_from_the_lattice():
     mass_g *= _amu * 1e3
     rho = mass_g / (np.sqrt(3) / 2 * a**2 * c * 1e-24)
     assert rho == pytest.approx(reference.QUARTZ_DENSITY_EXPERIMENT_G_CM3, rel=1e-3)
+
+
+@pytest.mark.parametrize("name", ["sio2-snap", "sio2-snap-mf0"])
+def test_bundled_reports_compare_with_the_one_experimental_set(name):
+    """The stored vs_experiment blocks are what flatcontact.reference gives (|C14| compared)."""
+    import json
+
+    from flatcontact.training.potentials import bundled_dir
+    from flatcontact.training.validate import experiment_moduli, vs_experiment
+
+    report = json.loads((bundled_dir() / name / "validation.json").read_text())
+    stored, now = report["vs_experiment"], vs_experiment(report["potential"])
+    for k, v in now["cij_rel"].items():
+        assert stored["cij_rel"][k] == pytest.approx(v, abs=1e-12), k
+    assert stored["a_rel"] == pytest.approx(now["a_rel"], abs=1e-12)
+    assert report["experiment_moduli_gpa"]["e_star"] == pytest.approx(experiment_moduli()["e_star"])
+    c11 = report["potential"]["elastic"]["cij_gpa"]["C11"]
+    assert now["cij_rel"]["C11"] == pytest.approx(
+        c11 / reference.QUARTZ_CIJ_EXPERIMENT_GPA["C11"] - 1
+    )
