@@ -102,6 +102,7 @@ class ProcessExecutor(SerialExecutor):
                 f"workers: expected a positive number of worker processes, got {workers}"
             )
         self.workers = int(workers)
+        one_blas_thread_in_workers()
         self._pool = cf.ProcessPoolExecutor(
             max_workers=self.workers,
             mp_context=multiprocessing.get_context("spawn"),
@@ -125,6 +126,13 @@ class ProcessExecutor(SerialExecutor):
 
     def close(self, cancel: bool = False) -> None:
         self._pool.shutdown(wait=not cancel, cancel_futures=cancel)
+
+
+def one_blas_thread_in_workers() -> None:
+    """Worker processes started from now on use one OpenBLAS thread (unless the user set
+    ``OPENBLAS_NUM_THREADS``): one worker per core, and BLAS threads inside a worker only
+    contend with the others. The current process's BLAS, already loaded, is unchanged."""
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 
 def warm_worker(factory: Any, reference: Any) -> None:
@@ -215,6 +223,7 @@ class DaskExecutor(SerialExecutor):
         """A ``LocalCluster`` of ``workers`` single-threaded worker processes (owned and closed)."""
         from distributed import LocalCluster
 
+        one_blas_thread_in_workers()
         cluster = LocalCluster(
             n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None
         )

@@ -111,9 +111,12 @@ class TwoLoopMemory:
         k = self.size
         if k == 0:
             return self.h0 * g
-        slots = self._slots()
-        s, y, rho = self.s[slots], self.y[slots], self.rho[slots]
-        a_mat = self.sy[np.ix_(slots, slots)]  # a_mat[i, j] = s_i · y_j, oldest first
+        if self.count <= self.memory:  # not wrapped yet: slots 0 … k-1 in order, views
+            s, y, rho, a_mat = self.s[:k], self.y[:k], self.rho[:k], self.sy[:k, :k]
+        else:
+            slots = self._slots()
+            s, y, rho = self.s[slots], self.y[slots], self.rho[slots]
+            a_mat = self.sy[np.ix_(slots, slots)]  # a_mat[i, j] = s_i · y_j, oldest first
         eye = np.eye(k)
         # first loop: (I + diag(rho) U) a = rho * (S g), U_ij = s_i·y_j for j > i
         upper = eye + rho[:, None] * np.triu(a_mat, 1)
