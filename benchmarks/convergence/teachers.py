@@ -4,6 +4,7 @@ Needs torch (CPU) + chgnet + sevenn, e.g. in a separate venv (docs/teachers.md):
 
     python -m benchmarks.convergence.teachers elastic [NAME ...]   # results/elastic_<name>.json
     python -m benchmarks.convergence.teachers ispes [NAME ...]     # results/ispes_compare_{internal,enthalpy}.{json,csv}
+    python -m benchmarks.convergence.teachers ispes snap sevennet-mf-0-r2scan --reuse chgnet-r2scan
 
 Elastic: :func:`flatcontact.training.ispes_check.quartz_elastic_vs_experiment` per model.
 ISPES: :func:`flatcontact.training.ispes_check.compare_ispes` on the interface built by the
@@ -26,6 +27,10 @@ MODELS = ["snap", "chgnet-r2scan", "sevennet-0", "sevennet-mf-0-r2scan", "sevenn
 ISPES_GRID = (4, 4)
 ISPES_P_RANGE = (-0.3, 5.5, 8)
 ISPES_LOADS = (0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0)
+#: Resumable scan stores, one per model. "teachers-v2": the stores of the first comparison
+#: (``RUNS/teachers``) carry the store fingerprint of before the potential-model refactor
+#: and are refused by the current code; their results stay usable through ``--reuse``.
+ISPES_RUNS = RUNS / "teachers-v2"
 
 
 def bulk(name: str):
@@ -49,17 +54,36 @@ def elastic(names: list[str]) -> None:
         )
 
 
-def ispes(names: list[str]) -> None:
+def ispes(names: list[str], reuse: list[str] = ()) -> None:
+    """Scan ``names`` (resumable stores in :data:`ISPES_RUNS`) and write the comparison.
+
+    ``reuse``: models whose per-model results are taken from the results JSON already
+    written (``results/ispes_compare_<form>.json``) instead of being scanned, in the order
+    of ``names``; e.g. CHGNet, whose store predates the current store fingerprint.
+    """
     from flatcontact.potentials import PotentialSpec
     from flatcontact.structures.interface import read_interface
-    from flatcontact.training.ispes_check import compare_ispes, teacher_spec
+    from flatcontact.training.ispes_check import compare_ispes, comparison_table, teacher_spec
 
     interface = read_interface(RUNS / "ref" / "01-build" / "interface.extxyz")
+    # Layer ids only steer the rigid-layers relax mode; these scans relax fully (same atoms,
+    # cell and tags as the stores of the first comparison).
+    interface.arrays.pop("layer", None)
     # the study's reference model (LJ cut at 10 Å, as the teachers' default_potential() LJ)
     snap = config_for("ref").potential
     lj = snap.lj.model_dump()
+    stored = {}
+    for form in ("internal", "enthalpy"):
+        path = RESULTS / f"ispes_compare_{form}.json"
+        old = json.loads(path.read_text()) if path.exists() else {}
+        missing = [name for name in reuse if name not in old]
+        if missing:
+            sys.exit(f"error: {path} has no results for {missing}; scan them instead")
+        stored[form] = {name: old[name] for name in reuse}
     models = {}
     for name in names:
+        if name in reuse:
+            continue
         models[name] = (
             PotentialSpec.model_validate(snap.model_dump())
             if name == "snap"
@@ -67,17 +91,22 @@ def ispes(names: list[str]) -> None:
         )
     RESULTS.mkdir(parents=True, exist_ok=True)
     for form in ("internal", "enthalpy"):  # the second reuses the scans (resumable stores)
-        per_model: dict = {}
-        table = compare_ispes(
+        scanned: dict = {}
+        compare_ispes(
             models,
             interface,
-            RUNS / "teachers",
+            ISPES_RUNS,
             grid=ISPES_GRID,
             p_range_gpa=ISPES_P_RANGE,
             p_gpa=ISPES_LOADS,
             form=form,
-            results=per_model,
+            results=scanned,
         )
+        per_model = {
+            name: (stored[form][name] | {"reused": True}) if name in reuse else scanned[name]
+            for name in names
+        }
+        table = comparison_table(per_model)
         table.to_csv(RESULTS / f"ispes_compare_{form}.csv", index=False)
         (RESULTS / f"ispes_compare_{form}.json").write_text(
             json.dumps(per_model, indent=1, default=float) + "\n"
@@ -88,12 +117,25 @@ def ispes(names: list[str]) -> None:
 def main(argv: list[str]) -> None:
     os.environ.setdefault("OMP_NUM_THREADS", "1")
     if not argv or argv[0] not in ("elastic", "ispes"):
-        sys.exit("usage: python -m benchmarks.convergence.teachers elastic|ispes [NAME ...]")
-    names = argv[1:] or MODELS
+        sys.exit(
+            "usage: python -m benchmarks.convergence.teachers elastic|ispes [NAME ...] "
+            "[--reuse NAME ...]"
+        )
+    args = argv[1:]
+    reuse: list[str] = []
+    if "--reuse" in args:
+        k = args.index("--reuse")
+        args, reuse = args[:k], args[k + 1 :]
+    names = args + [name for name in reuse if name not in args] if args or reuse else MODELS
     unknown = sorted(set(names) - set(MODELS))
     if unknown:
         sys.exit(f"error: unknown model(s) {unknown}; expected some of {MODELS}")
-    {"elastic": elastic, "ispes": ispes}[argv[0]](names)
+    if argv[0] == "elastic":
+        if reuse:
+            sys.exit("error: --reuse applies to 'ispes' only")
+        elastic(names)
+    else:
+        ispes(names, reuse)
 
 
 if __name__ == "__main__":

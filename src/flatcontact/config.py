@@ -514,11 +514,11 @@ MEASURED_LAW_UNCERTAINTY = {
     "convergence_enthalpy": {
         "k_mpa_per_gpa": 0.714,
         "tau0_mpa": 1.56,
-        "mu_mpa_per_gpa": 0.052,
+        "mu_mpa_per_gpa": 0.0523,
         "sigma0_mpa": 0.147,
     },
     "model_spread_internal": {
-        "k_mpa_per_gpa": 0.064,
+        "k_mpa_per_gpa": 0.0636,
         "tau0_mpa": 1.28,
         "mu_mpa_per_gpa": 0.276,
         "sigma0_mpa": 0.666,
