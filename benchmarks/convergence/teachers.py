@@ -5,6 +5,7 @@ Needs torch (CPU) + chgnet + sevenn, e.g. in a separate venv (docs/teachers.md):
     python -m benchmarks.convergence.teachers elastic [NAME ...]   # results/elastic_<name>.json
     python -m benchmarks.convergence.teachers ispes [NAME ...]     # results/ispes_compare_{internal,enthalpy}.{json,csv}
     python -m benchmarks.convergence.teachers ispes snap sevennet-mf-0-r2scan --reuse chgnet-r2scan
+    python -m benchmarks.convergence.teachers table                # the docs/teachers.md tables
 
 Elastic: :func:`flatcontact.training.ispes_check.quartz_elastic_vs_experiment` per model.
 ISPES: :func:`flatcontact.training.ispes_check.compare_ispes` on the interface built by the
@@ -114,12 +115,91 @@ def ispes(names: list[str], reuse: list[str] = ()) -> None:
         print(form, table.to_string(), flush=True)
 
 
+def _first_scan(form: str) -> dict | None:
+    path = RESULTS / f"ispes_snap_first_scan_{form}.json"
+    return json.loads(path.read_text()) if path.exists() else None
+
+
+def markdown_tables() -> str:
+    """docs/teachers.md tables from ``results/ispes_compare_<form>.json``: per load τ and
+    σ_MSS of every model with its difference from the SNAP (first model), the SNAP's
+    rescan difference |Δ| (``results/ispes_snap_first_scan_<form>.json``: the same model and
+    settings scanned with another warm-start history, the resolution noise), and per model
+    the laws and W."""
+    out = []
+    for form in ("internal", "enthalpy"):
+        per_model = json.loads((RESULTS / f"ispes_compare_{form}.json").read_text())
+        labels = list(per_model)
+        ref = labels[0]
+        rows = {m: {round(r["p_gpa"], 6): r for r in per_model[m]["rows"]} for m in labels}
+        first = _first_scan(form)
+        noise = {round(r["p_gpa"], 6): r for r in first["rows"]} if first else {}
+        out.append(f"**{form} form** (Δ = model − {ref}; noise = |{ref} − its first scan|)\n")
+        head = ["P (GPa)"] + [f"τ {m}" for m in labels] + [f"σ {m}" for m in labels]
+        head += [f"Δτ/τ, Δσ/σ {m}" for m in labels[1:]]
+        if noise:
+            head += ["noise τ, σ"]
+        out.append("| " + " | ".join(head) + " |")
+        out.append("|" + "---|" * len(head))
+
+        def tau(r):
+            if r is None or r.get("tau_mpa") is None:
+                return "n/a"
+            lim = {"barrier top": "barr", "jump": "jump"}.get(r.get("tau_limited_by"), "?")
+            return f"{r['tau_mpa']:.1f} ({lim})"
+
+        for p in sorted(rows[ref]):
+            cells = [f"{p:g}"] + [tau(rows[m].get(p)) for m in labels]
+            cells += [
+                f"{rows[m][p]['sigma_mss_mpa']:.2f}" if p in rows[m] else "n/a" for m in labels
+            ]
+            base = rows[ref][p]
+            for m in labels[1:]:
+                r = rows[m].get(p)
+                if r is None:
+                    cells.append("n/a")
+                    continue
+                dt = (r["tau_mpa"] - base["tau_mpa"]) / abs(base["tau_mpa"])
+                ds = (r["sigma_mss_mpa"] - base["sigma_mss_mpa"]) / abs(base["sigma_mss_mpa"])
+                cells.append(f"{100 * dt:+.0f}%, {100 * ds:+.0f}%")
+            if noise:
+                n = noise.get(p)
+                cells.append(
+                    "n/a"
+                    if n is None
+                    else f"{100 * abs(base['tau_mpa'] - n['tau_mpa']) / abs(n['tau_mpa']):.0f}%, "
+                    f"{100 * abs(base['sigma_mss_mpa'] - n['sigma_mss_mpa']) / abs(n['sigma_mss_mpa']):.0f}%"
+                )
+            out.append("| " + " | ".join(cells) + " |")
+        out.append("")
+        for m in labels:
+            lw, res = per_model[m]["laws"], per_model[m]
+
+            def c(key, err, digits, lw=lw):
+                if lw.get(key) is None:
+                    return "n/a"
+                return f"{lw[key]:.{digits}f} ± {lw[err]:.{digits}f}"
+
+            out.append(
+                f"- {m}: k = {c('k_mpa_per_gpa', 'k_stderr_mpa_per_gpa', 1)} MPa/GPa, "
+                f"τ0 = {c('tau0_mpa', 'tau0_stderr_mpa', 1)} MPa, "
+                f"μ = {c('mu_mpa_per_gpa', 'mu_stderr_mpa_per_gpa', 2)} MPa/GPa, "
+                f"σ0 = {c('sigma0_mpa', 'sigma0_stderr_mpa', 2)} MPa; "
+                f"W = {res['work_of_separation_j_per_m2']:.4f} J/m²; {res['force_calls']} force calls"
+            )
+        out.append("")
+    return "\n".join(out)
+
+
 def main(argv: list[str]) -> None:
     os.environ.setdefault("OMP_NUM_THREADS", "1")
+    if argv[:1] == ["table"]:
+        print(markdown_tables())
+        return
     if not argv or argv[0] not in ("elastic", "ispes"):
         sys.exit(
             "usage: python -m benchmarks.convergence.teachers elastic|ispes [NAME ...] "
-            "[--reuse NAME ...]"
+            "[--reuse NAME ...] | table"
         )
     args = argv[1:]
     reuse: list[str] = []
