@@ -119,6 +119,14 @@ def test_bad_models_are_refused_before_any_scan(interface, tmp_path):
         teacher_spec("mace")
 
 
+def test_teacher_calculator_refuses_an_unknown_teacher_in_one_line():
+    from flatcontact.training.ispes_check import TEACHERS, teacher_calculator
+
+    with pytest.raises(InputError, match=r"teacher 'mace': expected one of chgnet-r2scan"):
+        teacher_calculator("mace")
+    assert all(target.count(":") == 1 for target in TEACHERS.values())
+
+
 def test_elastic_table_errors_are_relative_to_experiment():
     report = {
         "label": "half",
