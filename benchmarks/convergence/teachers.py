@@ -10,10 +10,12 @@ Needs torch (CPU) + chgnet + sevenn, e.g. in a separate venv (docs/teachers.md):
 Elastic: :func:`flatcontact.training.ispes_check.quartz_elastic_vs_experiment` per model.
 ISPES: :func:`flatcontact.training.ispes_check.compare_ispes` on the interface built by the
 reference run of the convergence study (the paper preset's build, bundled SNAP), 4×4
-lateral grid, 8 thicknesses spanning −0.3…5.5 GPa at the probe stacking, fmax
-0.005 eV/Å, loads 0…3 GPa; each teacher inside each slab + the same calibrated LJ across.
-The SNAP row is first (the reference of the table): d_<q> = model − SNAP. Both energy
-forms are analysed from the same scans.
+lateral grid, 8 thicknesses spanning −0.3…5.5 GPa at the probe stacking (the current scan
+adds 2 tensile ones), fmax 0.005 eV/Å, loads 0…3 GPa; each teacher inside each slab + the
+same calibrated LJ across. The SNAP row is first (the reference of the table): d_<q> =
+model − SNAP. Both energy forms are analysed from the same scans. ``table`` needs no torch.
+The model spread of the laws over every model written here enters the paper preset through
+:mod:`benchmarks.convergence.uncertainty`.
 """
 
 from __future__ import annotations
