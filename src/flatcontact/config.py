@@ -503,7 +503,9 @@ _LAW_KEYS = ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa")
 #: Measured for the bundled sio2-snap + Hamaker-calibrated LJ on the α-quartz (0001) dense
 #: interface (docs/convergence.md, docs/teachers.md): per form, the largest change of each law
 #: coefficient under one refinement (grid 8→12, thicknesses 20→30, fmax 0.005→0.0025, LJ
-#: cutoff 14→18 Å) and half the SNAP–CHGNet r2SCAN spread (4×4 grid, an upper bound).
+#: cutoff 14→18 Å) and half the max − min range over the SNAP, CHGNet r2SCAN and SevenNet-MF-0
+#: r2SCAN (4×4 grid, an upper bound). Regenerated from benchmarks/convergence/results by
+#: ``python -m benchmarks.convergence.uncertainty`` (tests/convergence/test_measured_uncertainty.py).
 MEASURED_LAW_UNCERTAINTY = {
     "convergence_internal": {
         "k_mpa_per_gpa": 6.48,
@@ -514,20 +516,20 @@ MEASURED_LAW_UNCERTAINTY = {
     "convergence_enthalpy": {
         "k_mpa_per_gpa": 0.714,
         "tau0_mpa": 1.56,
-        "mu_mpa_per_gpa": 0.052,
+        "mu_mpa_per_gpa": 0.0523,
         "sigma0_mpa": 0.147,
     },
     "model_spread_internal": {
-        "k_mpa_per_gpa": 0.064,
-        "tau0_mpa": 1.28,
-        "mu_mpa_per_gpa": 0.276,
-        "sigma0_mpa": 0.666,
+        "k_mpa_per_gpa": 1.71,
+        "tau0_mpa": 1.27,
+        "mu_mpa_per_gpa": 0.894,
+        "sigma0_mpa": 0.545,
     },
     "model_spread_enthalpy": {
-        "k_mpa_per_gpa": 2.52,
-        "tau0_mpa": 7.40,
-        "mu_mpa_per_gpa": 0.338,
-        "sigma0_mpa": 0.425,
+        "k_mpa_per_gpa": 3.64,
+        "tau0_mpa": 7.23,
+        "mu_mpa_per_gpa": 0.322,
+        "sigma0_mpa": 0.389,
     },
     "source": "measured for the bundled sio2-snap + Hamaker LJ, alpha-quartz (0001) dense, "
     "paper-preset settings (docs/convergence.md, docs/teachers.md); a lower bound for coarser "

@@ -107,10 +107,10 @@ TEACHERS: dict[str, str] = {
 
 def teacher_calculator(name: str):
     """A fresh ASE calculator of the offline teacher ``name`` (:data:`TEACHERS`)."""
-    from flatcontact.potentials.calculator import load_factory
+    from flatcontact.potentials.loader import load_callable
 
     require(name in TEACHERS, f"teacher {name!r}: expected one of {', '.join(TEACHERS)}")
-    return load_factory(TEACHERS[name])()
+    return load_callable(TEACHERS[name], "teacher")()
 
 
 def teacher_spec(name: str, lj: Mapping | None = None):
