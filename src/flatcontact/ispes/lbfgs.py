@@ -103,30 +103,38 @@ class TwoLoopMemory:
         self.y[slot] = y
         self.rho[slot] = 1.0 / np.dot(y, s)
         self.count += 1
-        self.sy[slot, :] = self.y @ s
-        self.sy[:, slot] = self.s @ y
+        k = self.size  # the filled slots are 0 … k-1 (all of them once wrapped)
+        self.sy[slot, :k] = self.y[:k] @ s
+        self.sy[:k, slot] = self.s[:k] @ y
 
     def inverse_hessian_times(self, g: np.ndarray) -> np.ndarray:
-        """H·g of the L-BFGS two-loop recursion (module docstring)."""
+        """H·g of the L-BFGS two-loop recursion (module docstring).
+
+        The long vectors are used in place (slot order, ``S[:k] @ g`` and the like); only the
+        k-vectors and the k×k matrix are put in chronological order, so a wrapped memory on a
+        large cell copies nothing of size n.
+        """
         k = self.size
         if k == 0:
             return self.h0 * g
-        if self.count <= self.memory:  # not wrapped yet: slots 0 … k-1 in order, views
-            s, y, rho, a_mat = self.s[:k], self.y[:k], self.rho[:k], self.sy[:k, :k]
-        else:
-            slots = self._slots()
-            s, y, rho = self.s[slots], self.y[slots], self.rho[slots]
-            a_mat = self.sy[np.ix_(slots, slots)]  # a_mat[i, j] = s_i · y_j, oldest first
+        s, y = self.s[:k], self.y[:k]
+        order = self._slots()  # chronological position -> slot
+        rho = self.rho[order]
+        a_mat = self.sy[np.ix_(order, order)]  # a_mat[i, j] = s_i · y_j, oldest first
         eye = np.eye(k)
         # first loop: (I + diag(rho) U) a = rho * (S g), U_ij = s_i·y_j for j > i
         upper = eye + rho[:, None] * np.triu(a_mat, 1)
-        a = unit_upper_solve(upper, rho * (s @ g))
-        z0 = (g - a @ y) * self.h0
+        a = unit_upper_solve(upper, rho * (s @ g)[order])
+        a_slots = np.empty(k)
+        a_slots[order] = a
+        z0 = (g - a_slots @ y) * self.h0
         # second loop: (I + diag(rho) L) c = a - rho * (Y z0), L_ij = y_i·s_j = a_mat[j, i], j < i;
         # in reversed order (index k-1-i) that lower system is upper triangular
         lower = eye + rho[:, None] * np.tril(a_mat.T, -1)
-        c = unit_upper_solve(lower[::-1, ::-1], (a - rho * (y @ z0))[::-1])[::-1]
-        return z0 + c @ s
+        c = unit_upper_solve(lower[::-1, ::-1], (a - rho * (y @ z0)[order])[::-1])[::-1]
+        c_slots = np.empty(k)
+        c_slots[order] = c
+        return z0 + c_slots @ s
 
 
 def unit_upper_solve(m: np.ndarray, b: np.ndarray) -> np.ndarray:
