@@ -31,6 +31,16 @@ RUNS = Path(os.environ.get("FLATCONTACT_CONVERGENCE_RUNS", "/tmp/flatcontact-con
 
 #: The study's reference LJ cutoff (the paper preset's before this study set it to 18 Å).
 STUDY_LJ_CUTOFF_ANGSTROM = 10.0
+#: Thickness ranges of the thick-slab variants: the paper preset's load spacing at the probe
+#: stacking ((5.5 + 0.3)/19 GPa) and lower bound, ending before the slabs overlap. The scan
+#: places slab 2 rigidly, so the whole elastic compression of the free layers first lands
+#: in the gap; with the 1.0 Å overlap guard of ``place_slab2`` a 9-layer slab reaches about
+#: 5.4 GPa, a 12-layer one about 5 GPa (the 6-layer one > 5.5 GPa).
+_P_STEP_GPA = (5.5 + 0.3) / 19
+THICK_SLAB_P_RANGE = {
+    9: {"lo_gpa": -0.3, "hi_gpa": round(-0.3 + 18 * _P_STEP_GPA, 6), "n": 19},
+    12: {"lo_gpa": -0.3, "hi_gpa": round(-0.3 + 17 * _P_STEP_GPA, 6), "n": 18},
+}
 #: name -> (setting varied, what, config overrides laid over the paper preset, the run it is
 #: compared with). Variants on an 8x8 grid (``*_g8``) measure a setting's effect at the
 #: coarser grid, to fit the CPU budget of a shared 2-core machine.
@@ -85,15 +95,34 @@ VARIANTS: dict[str, tuple[str, str, dict, str]] = {
         {"potential": {"lj": {"cutoff_angstrom": 18.0}}},
         "ref",
     ),
+    "layers6_g8": (
+        "slab layers",
+        "6 O-Si-O layers per slab (the shipped slab): grid8 scanned again with the code of the "
+        "slab-thickness steps, their baseline (compared with grid8: code drift)",
+        {"scan": {"grid": [8, 8]}, "structure": {"layers": 6}},
+        "grid8",
+    ),
     "layers9_g8": (
         "slab layers",
-        "9 O-Si-O layers per slab (CHGNet-seeded dense slab, SNAP-relaxed; 8x8 grid; "
-        "compared with grid8)",
+        "9 O-Si-O layers per slab (shipped dense slab + 1 bulk c-repeat of the SNAP's own "
+        "alpha-quartz, SNAP-relaxed; 8x8 grid, thicknesses up to 5.2 GPa; compared with "
+        "layers6_g8)",
         {
-            "scan": {"grid": [8, 8]},
-            "structure": {"kind": "file", "file": str(HERE / "interface_9L.extxyz")},
+            "scan": {"grid": [8, 8], "p_range_gpa": THICK_SLAB_P_RANGE[9]},
+            "structure": {"layers": 9},
         },
-        "grid8",
+        "layers6_g8",
+    ),
+    "layers12_g8": (
+        "slab layers",
+        "12 O-Si-O layers per slab (shipped dense slab + 2 bulk c-repeats; 8x8 grid, "
+        "thicknesses up to 4.9 GPa, loads up to 4 GPa; compared with layers9_g8)",
+        {
+            "scan": {"grid": [8, 8], "p_range_gpa": THICK_SLAB_P_RANGE[12]},
+            "structure": {"layers": 12},
+            "analysis": {"p_gpa": [0.0, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0]},
+        },
+        "layers9_g8",
     ),
 }
 #: Analysis-only variants: a subset of another run's grid (no new scan): name -> (setting,
