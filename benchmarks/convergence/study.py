@@ -39,7 +39,7 @@ STUDY_LJ_CUTOFF_ANGSTROM = 10.0
 _P_STEP_GPA = (5.5 + 0.3) / 19
 THICK_SLAB_P_RANGE = {
     9: {"lo_gpa": -0.3, "hi_gpa": round(-0.3 + 18 * _P_STEP_GPA, 6), "n": 19},
-    12: {"lo_gpa": -0.3, "hi_gpa": round(-0.3 + 17 * _P_STEP_GPA, 6), "n": 18},
+    12: {"lo_gpa": -0.3, "hi_gpa": round(-0.3 + 15 * _P_STEP_GPA, 6), "n": 16},
 }
 #: name -> (setting varied, what, config overrides laid over the paper preset, the run it is
 #: compared with). Variants on an 8x8 grid (``*_g8``) measure a setting's effect at the
@@ -116,11 +116,11 @@ VARIANTS: dict[str, tuple[str, str, dict, str]] = {
     "layers12_g8": (
         "slab layers",
         "12 O-Si-O layers per slab (shipped dense slab + 2 bulk c-repeats; 8x8 grid, "
-        "thicknesses up to 4.9 GPa, loads up to 4 GPa; compared with layers9_g8)",
+        "thicknesses up to 4.3 GPa, loads up to 3.5 GPa; compared with layers9_g8)",
         {
             "scan": {"grid": [8, 8], "p_range_gpa": THICK_SLAB_P_RANGE[12]},
             "structure": {"layers": 12},
-            "analysis": {"p_gpa": [0.0, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0]},
+            "analysis": {"p_gpa": [0.0, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5]},
         },
         "layers9_g8",
     ),

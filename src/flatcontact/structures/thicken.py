@@ -13,7 +13,8 @@ A slab of ``6 + 3·m`` O–Si–O layers is made from a dense 6-layer slab by
    ``MIN_CUT_GAP_ANGSTROM`` nearest the mid-height between the face-Si planes), lifting
    everything above the cut by ``m·c`` and filling the opening with the ``9·m`` registered
    bulk atoms between the cut and ``cut + m·c``. (With the bundled SNAP the relaxed 9-layer
-   slab's energy changes by at most 2.2 meV, 0.08 meV/atom, over the six possible cuts.)
+   slab's energy changes by at most 2.2 meV, 0.08 meV/atom, over the seven gaps between the
+   face-Si planes.)
 
 A c-repeat (three O–Si–O units; the 3₂ screw axis rotates consecutive units by 120°) is the
 smallest insertion that is a pure translation, so both faces keep their exact geometry and
