@@ -57,7 +57,9 @@ def table(form: str) -> str:
                     mark = "" if row["within"] else " ✗"
                     steps.append(f"{row['rel_change']:+.1%}{mark}")
             out.append(f"| {p:g} | {label} | " + " | ".join(vals + steps) + " |")
-    w = [docs[n]["work_of_separation_j_per_m2"] for n in ("layers6_g8", "layers9_g8", "layers12_g8")]
+    w = [
+        docs[n]["work_of_separation_j_per_m2"] for n in ("layers6_g8", "layers9_g8", "layers12_g8")
+    ]
     out.append(
         f"| – | W (J/m²) | {w[0]:.4f} | {w[1]:.4f} | {w[2]:.4f} | {w[1] / w[0] - 1:+.1%} | "
         f"{w[2] / w[1] - 1:+.1%} |"
