@@ -29,6 +29,7 @@ import numpy as np
 from ase import Atoms
 from ase.filters import UnitCellFilter
 from ase.optimize import BFGS
+from ase.units import GPa
 
 from flatcontact.errors import InputError, require
 from flatcontact.structures.bulk import QUARTZ_C_ANGSTROM, alpha_quartz
@@ -68,8 +69,6 @@ def lateral_bulk(bulk_calc_for, cell2d: np.ndarray, c_angstrom: float = QUARTZ_C
     bulk.calc = bulk_calc_for(bulk)
     opt = BFGS(UnitCellFilter(bulk, mask=[0, 0, 1, 0, 0, 0]), logfile=None)
     converged = bool(opt.run(fmax=BULK_FMAX, steps=1000))
-    from ase.units import GPa
-
     record = {
         "a_angstrom": a,
         "c_angstrom": float(bulk.cell.array[2, 2]),
@@ -97,6 +96,11 @@ def interior_mask(slab: Atoms) -> np.ndarray:
     return (z > lo + PLANE_TOLERANCE_ANGSTROM) & (z < hi - PLANE_TOLERANCE_ANGSTROM)
 
 
+#: Lattice offsets (fractions of a1, a2, c) searched around the rounded image: with the 120°
+#: hexagonal cell the nearest image is not always the rounded one.
+_IMAGES = np.array([(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)])
+
+
 def _residuals(slab: Atoms, index: np.ndarray, bulk: Atoms, shift: np.ndarray) -> np.ndarray:
     """Vector from the nearest same-species atom of the periodic ``bulk + shift`` to each atom."""
     cell = bulk.cell.array
@@ -107,7 +111,7 @@ def _residuals(slab: Atoms, index: np.ndarray, bulk: Atoms, shift: np.ndarray) -
         delta = slab.positions[i] - (bulk.positions[bulk_symbols == symbols[i]] + shift)
         frac = np.linalg.solve(cell.T, delta.T).T
         frac -= np.round(frac)
-        cart = frac @ cell
+        cart = (frac[:, None, :] + _IMAGES[None, :, :]).reshape(-1, 3) @ cell
         out[row] = cart[np.argmin(np.linalg.norm(cart, axis=1))]
     return out
 
