@@ -125,6 +125,24 @@ VARIANTS: dict[str, tuple[str, str, dict, str]] = {
         },
         "layers9_g8",
     ),
+    "paper_layers6": (
+        "slab layers",
+        "the paper preset (12x12, LJ 18 Å, 6 layers) scanned again with the code of the "
+        "slab-thickness steps (compared with paper: code drift)",
+        {"potential": {"lj": {"cutoff_angstrom": 18.0}}, "structure": {"layers": 6}},
+        "paper",
+    ),
+    "paper_layers9": (
+        "slab layers",
+        "the paper preset (12x12, LJ 18 Å) with 9 layers per slab (thicknesses up to 5.19 GPa; "
+        "compared with paper_layers6)",
+        {
+            "potential": {"lj": {"cutoff_angstrom": 18.0}},
+            "structure": {"layers": 9},
+            "scan": {"p_range_gpa": THICK_SLAB_P_RANGE[9]},
+        },
+        "paper_layers6",
+    ),
     "layers6_rigid_g8": (
         "slab layers (diagnostic)",
         "6 layers, rigid slabs (no relaxation at any point: the interface's own corrugation; "

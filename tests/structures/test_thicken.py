@@ -191,3 +191,22 @@ def test_from_nine_layers_on_a_repeat_adds_exactly_the_bulk_energy(snap_builds):
     assert bulk["converged"] and abs(bulk["stress_zz_gpa"]) < 0.01
     assert e[12] - e[9] == pytest.approx(bulk["energy_ev"], abs=5e-3)
     assert len(builds[12][0]) == 72 and builds[12][1]["slab_interior"]["interior_si_planes"] == 8
+
+
+def test_a_thickened_slab_whose_interior_is_not_bulk_like_is_refused(monkeypatch):
+    """The build refuses a thickened slab whose interior unit spacing deviates more than
+    INTERIOR_MAX_SPACING_DEV from c/3 (the check is forced here by a doctored report)."""
+    from flatcontact.potentials import PotentialSpec
+    from flatcontact.structures import build
+
+    real = build.interior_report
+
+    def doctored(slab, bulk):
+        report = real(slab, bulk)
+        report["max_abs_spacing_rel_dev"] = 2 * build.INTERIOR_MAX_SPACING_DEV
+        return report
+
+    monkeypatch.setattr(build, "interior_report", doctored)
+    with pytest.raises(InputError, match="interior is not bulk-like") as err:
+        build.build_quartz_interface(PotentialSpec(**SNAP), 9, source="shipped")
+    assert "\n" not in str(err.value)
