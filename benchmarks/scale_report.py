@@ -280,6 +280,14 @@ def main(argv: list[str] | None = None) -> None:
                 f"max |ΔU| {np.nanmax(np.abs(e_nat - e_tool)):.1e} eV, {load()}",
                 flush=True,
             )
+            in_minimize = native["cpu"] / native["force_evaluations"]
+            print(
+                f"PER CALL against LAMMPS inside its own minimize (the issue's baseline: CPU of "
+                f"the native script per force evaluation, neighbour rebuilds and line search "
+                f"included): {1e3 * per_call:.2f} ms vs {1e3 * in_minimize:.2f} ms, overhead "
+                f"{100 * (per_call - in_minimize) / in_minimize:.0f} %",
+                flush=True,
+            )
         if "parallel" in wanted:
             # -- parallel efficiency, measured and modelled
             wall2 = runs[2][0]
