@@ -92,31 +92,3 @@ def test_a_two_worker_scan_leaves_no_process_behind(tmp_path):
     _gone, alive = psutil.wait_procs(left(), timeout=10)
     assert not alive, f"processes left in the scan's session: {[p.pid for p in alive]}"
 
-
-def test_probe_columns_on_two_workers_equal_the_serial_probe(tmp_path, toy_reference, toy_factory):
-    """The probed columns run on the workers when there are two: the resolved thicknesses,
-    the probes and the grid's energies are those of the serial scan (same relaxations, in
-    other processes: equal to round-off)."""
-    import numpy as np
-
-    from flatcontact.ispes.executors import ProcessExecutor, SerialExecutor
-    from flatcontact.ispes.grid import GridSpec
-    from flatcontact.ispes.relax import RelaxSettings
-    from flatcontact.ispes.scan import run_scan
-
-    grid = GridSpec(3, 3, p_range_gpa=(-0.05, 0.5, 4))
-    relax = RelaxSettings(fmax_ev_per_a=1e-4)
-    serial = run_scan(
-        toy_reference, toy_factory, grid, tmp_path / "s", relax, executor=SerialExecutor()
-    )
-    pool = ProcessExecutor(2)
-    try:
-        parallel = run_scan(toy_reference, toy_factory, grid, tmp_path / "p", relax, executor=pool)
-    finally:
-        pool.close()
-    zs, zp = serial.dataset.thickness.values, parallel.dataset.thickness.values
-    assert len(zs) > 4 and len(zs) == len(zp)
-    np.testing.assert_allclose(zp, zs, rtol=0, atol=1e-9)
-    np.testing.assert_allclose(
-        parallel.dataset.energy.values, serial.dataset.energy.values, rtol=0, atol=1e-8
-    )
