@@ -112,8 +112,20 @@ def start_kind(parent: dict, idx) -> str:
     return "z-extrapolated" if grand is not None and grand[:2] == idx[:2] else "z"
 
 
-def main() -> None:
+SECTIONS = ("native", "parallel", "large")
+
+
+def main(argv: list[str] | None = None) -> None:
+    """All sections, or only the per-call and fixed-cost figures plus those named in ``argv``
+    (``python -m benchmarks.scale_report percall [native] [parallel] [large]``)."""
     import ase.db
+
+    wanted = set(argv) if argv else {"percall", *SECTIONS}
+    unknown = wanted - {"percall", *SECTIONS}
+    if unknown:
+        sys.exit(
+            f"error: unknown section(s) {sorted(unknown)}; available: percall, {', '.join(SECTIONS)}"
+        )
 
     from benchmarks.bench_scan import build
     from benchmarks.large_cells import run as large_point
@@ -150,7 +162,7 @@ def main() -> None:
         tmp = Path(tmp_name)
         # -- 1 worker (serial, in this process) and 2 worker processes, same grid
         runs = {}
-        for workers in (1, 2):
+        for workers in (1, 2) if "parallel" in wanted else (1,):
             executor = make_executor("processes", workers=workers)
             try:
                 t0, c0 = time.perf_counter(), time.process_time()
@@ -245,66 +257,82 @@ def main() -> None:
             f"converged {int(r1.dataset.converged.sum())}/{n_points}",
             flush=True,
         )
-        # -- native script
-        sa, sb = grid.shifts()
-        script = write_inputs(reference, spec, list(sa), list(sb), list(zs), FMAX, tmp / "native")
-        native = run_script(script)
-        e_nat = np.full(e_tool.shape, np.nan)
-        order = np.argsort(zs)
-        rank = np.empty_like(order)
-        rank[order] = np.arange(len(zs))
-        for (ia, ib, iz), e in native["energies"].items():
-            e_nat[ia, ib, rank[iz]] = e
-        print(
-            f"NATIVE LAMMPS script (cg, same max-norm fmax, snake order): {native['wall']:.1f} s "
-            f"(CPU {native['cpu']:.1f} s), {native['force_evaluations'] / n_points:.1f} force "
-            f"evaluations/point; flatcontact serial {wall1:.1f} s (CPU {cpu1:.1f} s), "
-            f"{calls.mean():.1f} calls/point: ratio {wall1 / native['wall']:.2f} wall, "
-            f"{cpu1 / native['cpu']:.2f} CPU, "
-            f"{calls.mean() / (native['force_evaluations'] / n_points):.2f} force calls; "
-            f"max |ΔU| {np.nanmax(np.abs(e_nat - e_tool)):.1e} eV, {load()}",
-            flush=True,
-        )
-        # -- parallel efficiency, measured and modelled
-        wall2 = runs[2][0]
-        print(
-            f"PARALLEL measured ({n_points} points, start included): 1 worker {wall1:.1f} s, "
-            f"2 workers {wall2:.1f} s: speed-up {wall1 / wall2:.2f}, efficiency "
-            f"{wall1 / (2 * wall2):.0%}, {load()}",
-            flush=True,
-        )
-        parent6 = search_tree(
-            (*GRID, len(zs)), (0, 0, int(np.argmin(np.abs(np.asarray(zs) - z_ref)))), "columns"
-        )
-        by_kind: dict[str, list[int]] = {}
-        stored = {(row.i_a, row.i_b, row.i_z): row.force_calls for row in rows}
-        for idx in parent6:
-            by_kind.setdefault(start_kind(parent6, idx), []).append(stored[idx])
-        median = {k: float(np.median(v)) for k, v in by_kind.items()}
-        parent = search_tree(PAPER_SHAPE, (0, 0, PAPER_SHAPE[2] // 2), "columns")
-        cost = {i: median.get(start_kind(parent, i), median["lateral"]) * per_call for i in parent}
-        total = sum(cost.values())
-        line = []
-        for w in (1, 2, 4, 8, 16):
-            span = simulate(parent, cost, w, t_store)
-            line.append(f"{w}: {total / (w * span):.0%}")
-        print(
-            f"PARALLEL model, paper grid {PAPER_SHAPE} ({len(parent)} points, calls/point by "
-            f"start {median}, driver {1e3 * t_store:.1f} ms/point): efficiency " + ", ".join(line),
-            flush=True,
-        )
-    # -- large cells
-    for system, n in (("cu", 8), ("cu", 14), ("quartz", 4)):
-        for threads in (1, 2):
-            d = large_point(system, n, threads)
+        if "native" in wanted:
+            # -- native script
+            sa, sb = grid.shifts()
+            script = write_inputs(
+                reference, spec, list(sa), list(sb), list(zs), FMAX, tmp / "native"
+            )
+            native = run_script(script)
+            e_nat = np.full(e_tool.shape, np.nan)
+            order = np.argsort(zs)
+            rank = np.empty_like(order)
+            rank[order] = np.arange(len(zs))
+            for (ia, ib, iz), e in native["energies"].items():
+                e_nat[ia, ib, rank[iz]] = e
             print(
-                f"LARGE {system} {d['atoms']} atoms, {threads} thread(s): one point "
-                f"{d['seconds_point']:.2f} s (CPU {d['cpu_seconds_point']:.2f} s), {d['force_calls']} "
-                f"force calls, {d['cpu_ms_per_call']:.2f} CPU ms/call (LAMMPS alone {d['ms_per_call_lammps']:.2f}), "
-                f"peak memory {d['peak_rss_mb']:.0f} MB, load {d['load']:.1f}",
+                f"NATIVE LAMMPS script (cg, same max-norm fmax, snake order): {native['wall']:.1f} s "
+                f"(CPU {native['cpu']:.1f} s), {native['force_evaluations'] / n_points:.1f} force "
+                f"evaluations/point; flatcontact serial {wall1:.1f} s (CPU {cpu1:.1f} s), "
+                f"{calls.mean():.1f} calls/point: ratio {wall1 / native['wall']:.2f} wall, "
+                f"{cpu1 / native['cpu']:.2f} CPU, "
+                f"{calls.mean() / (native['force_evaluations'] / n_points):.2f} force calls; "
+                f"max |ΔU| {np.nanmax(np.abs(e_nat - e_tool)):.1e} eV, {load()}",
                 flush=True,
             )
+            in_minimize = native["cpu"] / native["force_evaluations"]
+            print(
+                f"PER CALL against LAMMPS inside its own minimize (the issue's baseline: CPU of "
+                f"the native script per force evaluation, neighbour rebuilds and line search "
+                f"included): {1e3 * per_call:.2f} ms vs {1e3 * in_minimize:.2f} ms, overhead "
+                f"{100 * (per_call - in_minimize) / in_minimize:.0f} %",
+                flush=True,
+            )
+        if "parallel" in wanted:
+            # -- parallel efficiency, measured and modelled
+            wall2 = runs[2][0]
+            print(
+                f"PARALLEL measured ({n_points} points, start included): 1 worker {wall1:.1f} s, "
+                f"2 workers {wall2:.1f} s: speed-up {wall1 / wall2:.2f}, efficiency "
+                f"{wall1 / (2 * wall2):.0%}, {load()}",
+                flush=True,
+            )
+            parent6 = search_tree(
+                (*GRID, len(zs)), (0, 0, int(np.argmin(np.abs(np.asarray(zs) - z_ref)))), "columns"
+            )
+            by_kind: dict[str, list[int]] = {}
+            stored = {(row.i_a, row.i_b, row.i_z): row.force_calls for row in rows}
+            for idx in parent6:
+                by_kind.setdefault(start_kind(parent6, idx), []).append(stored[idx])
+            median = {k: float(np.median(v)) for k, v in by_kind.items()}
+            parent = search_tree(PAPER_SHAPE, (0, 0, PAPER_SHAPE[2] // 2), "columns")
+            cost = {
+                i: median.get(start_kind(parent, i), median["lateral"]) * per_call for i in parent
+            }
+            total = sum(cost.values())
+            line = []
+            for w in (1, 2, 4, 8, 16):
+                span = simulate(parent, cost, w, t_store)
+                line.append(f"{w}: {total / (w * span):.0%}")
+            print(
+                f"PARALLEL model, paper grid {PAPER_SHAPE} ({len(parent)} points, calls/point by "
+                f"start {median}, driver {1e3 * t_store:.1f} ms/point): efficiency "
+                + ", ".join(line),
+                flush=True,
+            )
+    if "large" in wanted:
+        # -- large cells
+        for system, n in (("cu", 8), ("cu", 14), ("quartz", 4)):
+            for threads in (1, 2):
+                d = large_point(system, n, threads)
+                print(
+                    f"LARGE {system} {d['atoms']} atoms, {threads} thread(s): one point "
+                    f"{d['seconds_point']:.2f} s (CPU {d['cpu_seconds_point']:.2f} s), {d['force_calls']} "
+                    f"force calls, {d['cpu_ms_per_call']:.2f} CPU ms/call (LAMMPS alone {d['ms_per_call_lammps']:.2f}), "
+                    f"peak memory {d['peak_rss_mb']:.0f} MB, load {d['load']:.1f}",
+                    flush=True,
+                )
 
 
 if __name__ == "__main__":
-    main()
+    main(sys.argv[1:])

@@ -31,6 +31,17 @@ RUNS = Path(os.environ.get("FLATCONTACT_CONVERGENCE_RUNS", "/tmp/flatcontact-con
 
 #: The study's reference LJ cutoff (the paper preset's before this study set it to 18 Å).
 STUDY_LJ_CUTOFF_ANGSTROM = 10.0
+#: Thickness ranges of the thick-slab variants: the paper preset's load spacing at the probe
+#: stacking ((5.5 + 0.3)/19 GPa) and lower bound, ending before the slabs overlap. The scan
+#: places slab 2 rigidly, so the whole elastic compression of the free layers first lands
+#: in the gap; the 1.0 Å overlap guard of ``place_slab2`` allows 2.0 Å of compression from the
+#: reference, where the stiffest probed stacking (0.5, 0) carries > 5.5 GPa with 6 layers,
+#: between 5.2 and 5.5 GPa with 9 and 3.9 GPa with 12 (measured, LJ 10 Å).
+_P_STEP_GPA = (5.5 + 0.3) / 19
+THICK_SLAB_P_RANGE = {
+    9: {"lo_gpa": -0.3, "hi_gpa": round(-0.3 + 18 * _P_STEP_GPA, 6), "n": 19},
+    12: {"lo_gpa": -0.3, "hi_gpa": round(-0.3 + 11 * _P_STEP_GPA, 6), "n": 12},
+}
 #: name -> (setting varied, what, config overrides laid over the paper preset, the run it is
 #: compared with). Variants on an 8x8 grid (``*_g8``) measure a setting's effect at the
 #: coarser grid, to fit the CPU budget of a shared 2-core machine.
@@ -85,15 +96,89 @@ VARIANTS: dict[str, tuple[str, str, dict, str]] = {
         {"potential": {"lj": {"cutoff_angstrom": 18.0}}},
         "ref",
     ),
+    "layers6_g8": (
+        "slab layers",
+        "6 O-Si-O layers per slab (the shipped slab): grid8 scanned again with the code of the "
+        "slab-thickness steps, their baseline (compared with grid8: code drift)",
+        {"scan": {"grid": [8, 8]}, "structure": {"layers": 6}},
+        "grid8",
+    ),
     "layers9_g8": (
         "slab layers",
-        "9 O-Si-O layers per slab (CHGNet-seeded dense slab, SNAP-relaxed; 8x8 grid; "
-        "compared with grid8)",
+        "9 O-Si-O layers per slab (shipped dense slab + 1 bulk c-repeat of the SNAP's own "
+        "alpha-quartz, SNAP-relaxed; 8x8 grid, thicknesses up to 5.2 GPa; compared with "
+        "layers6_g8)",
         {
-            "scan": {"grid": [8, 8]},
-            "structure": {"kind": "file", "file": str(HERE / "interface_9L.extxyz")},
+            "scan": {"grid": [8, 8], "p_range_gpa": THICK_SLAB_P_RANGE[9]},
+            "structure": {"layers": 9},
         },
-        "grid8",
+        "layers6_g8",
+    ),
+    "layers12_g8": (
+        "slab layers",
+        "12 O-Si-O layers per slab (shipped dense slab + 2 bulk c-repeats; 8x8 grid, "
+        "thicknesses up to 3.06 GPa, loads up to 3 GPa; compared with layers9_g8)",
+        {
+            "scan": {"grid": [8, 8], "p_range_gpa": THICK_SLAB_P_RANGE[12]},
+            "structure": {"layers": 12},
+            "analysis": {"p_gpa": [0.0, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 2.5, 3.0]},
+        },
+        "layers9_g8",
+    ),
+    "paper_layers6": (
+        "slab layers",
+        "the paper preset (12x12, LJ 18 Å, 6 layers) scanned again with the code of the "
+        "slab-thickness steps (compared with paper: code drift)",
+        {"potential": {"lj": {"cutoff_angstrom": 18.0}}, "structure": {"layers": 6}},
+        "paper",
+    ),
+    "paper_layers9": (
+        "slab layers",
+        "the paper preset (12x12, LJ 18 Å) with 9 layers per slab (thicknesses up to 5.19 GPa; "
+        "compared with paper_layers6)",
+        {
+            "potential": {"lj": {"cutoff_angstrom": 18.0}},
+            "structure": {"layers": 9},
+            "scan": {"p_range_gpa": THICK_SLAB_P_RANGE[9]},
+        },
+        "paper_layers6",
+    ),
+    "layers6_rigid_g8": (
+        "slab layers (diagnostic)",
+        "6 layers, rigid slabs (no relaxation at any point: the interface's own corrugation; "
+        "8x8 grid)",
+        {"scan": {"grid": [8, 8], "relax_mode": "rigid"}, "structure": {"layers": 6}},
+        "layers6_g8",
+    ),
+    "layers9_rigid_g8": (
+        "slab layers (diagnostic)",
+        "9 layers, rigid slabs (8x8 grid, thicknesses up to 5.2 GPa; compared with "
+        "layers6_rigid_g8)",
+        {
+            "scan": {
+                "grid": [8, 8],
+                "relax_mode": "rigid",
+                "p_range_gpa": THICK_SLAB_P_RANGE[9],
+            },
+            "structure": {"layers": 9},
+        },
+        "layers6_rigid_g8",
+    ),
+    "layers12_rigid_g8": (
+        "slab layers (diagnostic)",
+        "12 layers, rigid slabs (8x8 grid, thicknesses up to 3.06 GPa, loads up to 2.5 GPa; "
+        "compared with layers9_rigid_g8)",
+        {
+            "scan": {
+                "grid": [8, 8],
+                "relax_mode": "rigid",
+                "p_range_gpa": THICK_SLAB_P_RANGE[12],
+            },
+            "structure": {"layers": 12},
+            "analysis": {"p_gpa": [0.0, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 2.5]},
+            "report": {"fig2_p_gpa": [0.5, 1.0, 2.5]},
+        },
+        "layers9_rigid_g8",
     ),
 }
 #: Analysis-only variants: a subset of another run's grid (no new scan): name -> (setting,

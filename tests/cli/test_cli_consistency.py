@@ -234,3 +234,11 @@ def test_analyze_bad_load_source_is_one_line(grids, tmp_path, capsys, bad):
     line = _one_error_line(*_run(argv, capsys)[::2])
     assert line == f"error: --load-source: expected one of energy, stress, got {bad!r}"
     assert not out.exists()
+
+
+def test_build_layers_the_shipped_slab_cannot_reach_is_one_line(capsys):
+    """`build --layers 7 --source shipped`: one line naming --layers and the reachable counts
+    (the shipped 6-layer slab grows by whole α-quartz c-repeats of 3 layers), before any work."""
+    line = _one_error_line(*_run(["build", "--layers", "7", "--source", "shipped"], capsys)[::2])
+    assert line.startswith("error: --layers=7: the shipped dense slab has 6 O-Si-O layers")
+    assert "expected 6, 9, 12, ..." in line

@@ -80,6 +80,19 @@ def test_the_same_model_twice_gives_the_same_numbers(committee):
         np.testing.assert_allclose(again[f"d_{q}"], 0.0, atol=1e-9)
 
 
+def test_committee_spread_is_half_the_range_and_the_repeated_member_adds_nothing(committee):
+    """The laws' model spread over the whole committee (analysis.uncertainty.committee_spread)."""
+    from flatcontact.analysis.uncertainty import LAW_COEFFICIENTS, committee_spread
+
+    _, results = committee
+    spread = committee_spread(results)
+    assert spread == committee_spread({k: results[k] for k in ("vashishta", "tersoff")})
+    for key in LAW_COEFFICIENTS:
+        a, b = (results[m]["laws"][key] for m in ("vashishta", "tersoff"))
+        assert spread[key] == pytest.approx(abs(a - b) / 2, rel=1e-12)
+    assert max(spread.values()) > 0  # two different silica models: a non-zero spread
+
+
 def test_comparison_table_round_trips_through_json(committee):
     _, results = committee
     back = json.loads(json.dumps(results, default=float))
@@ -104,6 +117,14 @@ def test_bad_models_are_refused_before_any_scan(interface, tmp_path):
     assert not any(tmp_path.iterdir())
     with pytest.raises(InputError, match="teacher"):
         teacher_spec("mace")
+
+
+def test_teacher_calculator_refuses_an_unknown_teacher_in_one_line():
+    from flatcontact.training.ispes_check import TEACHERS, teacher_calculator
+
+    with pytest.raises(InputError, match=r"teacher 'mace': .*expected one of chgnet-r2scan"):
+        teacher_calculator("mace")
+    assert all(t.factory.count(":") == 1 for t in TEACHERS.values())
 
 
 def test_elastic_table_errors_are_relative_to_experiment():

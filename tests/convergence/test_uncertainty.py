@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from flatcontact.analysis.uncertainty import (
+    committee_spread,
     law_half_widths,
     law_intervals,
     model_spread,
@@ -70,6 +71,44 @@ def test_model_spread_is_half_the_range():
     assert spread["k_mpa_per_gpa"] == 0.0 and spread["mu_mpa_per_gpa"] == 0.0
     with pytest.raises(InputError, match="at least two"):
         model_spread({"snap": LAWS})
+
+
+def _tau_at_p0(laws, spread, p0=1.77):
+    hw = law_half_widths(laws, model=spread)
+    return propagate_box(
+        lambda x: {"tau": x["k_mpa_per_gpa"] * p0 + x["tau0_mpa"]}, {k: laws[k] for k in hw}, hw
+    )["tau"]
+
+
+def test_spread_is_over_all_models_and_a_repeated_teacher_does_not_widen_it():
+    teacher_a = {**LAWS, "tau0_mpa": 40.2, "k_mpa_per_gpa": 14.5}
+    teacher_b = {**LAWS, "tau0_mpa": 24.2, "k_mpa_per_gpa": 17.0}
+    two = model_spread({"snap": LAWS, "a": teacher_a})
+    three = model_spread({"snap": LAWS, "a": teacher_a, "b": teacher_b})
+    # half the max - min range over SNAP and every teacher: τ0 in [24.2, 40.2], k in [14.5, 17]
+    assert three["tau0_mpa"] == pytest.approx(8.0) and three["k_mpa_per_gpa"] == pytest.approx(1.25)
+    assert two["tau0_mpa"] == pytest.approx(5.0) and two["k_mpa_per_gpa"] == pytest.approx(1.0)
+    # a teacher repeating another's numbers (or lying inside the range) adds no width
+    again = model_spread({"snap": LAWS, "a": teacher_a, "b": teacher_b, "a-again": dict(teacher_a)})
+    inside = model_spread(
+        {"snap": LAWS, "a": teacher_a, "b": teacher_b, "mid": {**LAWS, "tau0_mpa": 30}}
+    )
+    assert again == three and inside == three
+    assert _tau_at_p0(LAWS, again) == _tau_at_p0(LAWS, three)
+    lo2, mid2, hi2 = _tau_at_p0(LAWS, two)
+    lo3, mid3, hi3 = _tau_at_p0(LAWS, three)
+    assert mid2 == mid3 and lo3 < lo2 <= mid2 <= hi2 < hi3  # a teacher outside does widen
+
+
+def test_committee_spread_reads_the_comparison_results():
+    results = {
+        "snap": {"laws": LAWS, "force_calls": 10},
+        "teacher": {"laws": {**LAWS, "sigma0_mpa": 8.51}, "force_calls": 12},
+    }
+    spread = committee_spread(results)
+    assert spread["sigma0_mpa"] == pytest.approx(0.5) and spread["tau0_mpa"] == 0.0
+    with pytest.raises(InputError, match=r"teacher.*laws"):
+        committee_spread({"snap": results["snap"], "teacher": {"rows": []}})
 
 
 def test_nonnegative_inputs_are_clipped_at_the_corners():

@@ -95,8 +95,13 @@ def test_store_with_other_settings_is_refused(tmp_path, toy_reference, toy_facto
         )
 
 
-def test_executors_give_the_same_grid(tmp_path, toy_reference, toy_factory):
+@pytest.mark.parametrize("thicknesses", ["given", "probed"])
+def test_executors_give_the_same_grid(tmp_path, toy_reference, toy_factory, thicknesses):
+    """Serial, local processes and Dask give the same grid; with a pressure range the probed
+    columns run on the workers of the last two (same thicknesses to round-off)."""
     grid = _grid(toy_reference)
+    if thicknesses == "probed":
+        grid = GridSpec(3, 3, p_range_gpa=(-0.05, 0.5, 4))
     serial = run_scan(
         toy_reference, toy_factory, grid, tmp_path / "s", SETTINGS, executor=SerialExecutor()
     )
@@ -111,6 +116,9 @@ def test_executors_give_the_same_grid(tmp_path, toy_reference, toy_factory):
     finally:
         dask.close()
     for other in (procs, dsk):
+        np.testing.assert_allclose(
+            other.dataset.thickness.values, serial.dataset.thickness.values, rtol=0, atol=1e-12
+        )
         for a, b in zip(_values(serial.dataset), _values(other.dataset), strict=True):
             np.testing.assert_allclose(a, b, rtol=0, atol=1e-12)
 

@@ -53,8 +53,20 @@ def _check_path(model, atoms, bulk_cell=False, seed=0):
             np.testing.assert_allclose(got[1], want[1], rtol=0, atol=1e-9)
             if bulk_cell:
                 np.testing.assert_allclose(got[2], want[2], rtol=0, atol=1e-10)
+            _check_views(engine)
     finally:
         engine.close()
+
+
+def _check_views(engine):
+    """The cached views are LAMMPS's current arrays (same data addresses as the wrapper's)."""
+    rows, x, f = engine._views()
+    assert engine._cached_views is not None  # cached, not rebuilt on every call
+    lmp = engine.lmp
+    assert x.ctypes.data == lmp.numpy.extract_atom("x", nelem=engine.n, dim=3).ctypes.data
+    assert f.ctypes.data == lmp.numpy.extract_atom("f", nelem=engine.n, dim=3).ctypes.data
+    ids = lmp.numpy.extract_atom("id", nelem=engine.n)
+    assert np.array_equal(np.asarray(ids)[rows], np.arange(1, engine.n + 1))
 
 
 @pytest.mark.parametrize("intra", ["vashishta", "tersoff"])

@@ -245,6 +245,10 @@ def test_validate_potential_ispes_compares_two_classical_models(tmp_path, capsys
     for label in ("vashishta", "tersoff"):
         assert report["models"][label]["force_calls"] > 0
         assert set(report["models"][label]["laws"]) >= set(LAW_KEYS)
+    # the model spread a run's uncertainty section takes: half the range of the two laws
+    for key in LAW_KEYS:
+        a, b = (report["models"][m]["laws"][key] for m in ("vashishta", "tersoff"))
+        assert report["model_spread"][key] == pytest.approx(abs(a - b) / 2, rel=1e-12)
     # the scans are resumable: a second call recomputes nothing
     code, stdout2, _ = run_cli(
         [

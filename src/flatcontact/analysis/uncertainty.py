@@ -7,7 +7,8 @@ c ∈ {k, τ0, μ, σ0} (τ = k·P + τ0, σ = μ·P + σ0, the paper's linear l
 * the numerical convergence: the change ``δ_conv`` of the coefficient under one more
   refinement of the scan settings (``docs/convergence.md``);
 * the potential: the spread ``δ_model`` of the coefficient over models that the
-  surrogate stands for (teachers/committee, :func:`model_spread`).
+  surrogate stands for: half the max − min range over the SNAP and every teacher
+  compared (:func:`model_spread`, :func:`committee_spread`).
 
 They are combined in quadrature, ``h_c = m·sqrt(se_fit² + δ_conv² + δ_model²)``
 (:func:`law_half_widths`, ``m`` the coverage multiple; m = 2 ≈ 95 % for Gaussian errors).
@@ -52,12 +53,21 @@ def _num(value, what: str) -> float:
 
 
 def model_spread(per_model_laws: Mapping[str, Mapping]) -> dict[str, float]:
-    """Half the range of each law coefficient over models (e.g. SNAP and its teachers).
+    """Half the range of each law coefficient over ALL models compared (SNAP and every teacher).
+
+    Rule: ``δ_model(c) = (max_m c_m − min_m c_m) / 2`` over every model ``m`` whose law
+    has the coefficient ``c``, i.e. the radius of the smallest interval holding every
+    model's value. It is used, rather than the standard deviation over models, because a
+    committee here has two to four members of which several may agree: the half-range
+    does not change when a model that repeats another's numbers is added (a standard
+    deviation shrinks, although an identical member says nothing new about the potential's
+    error); with two models it equals their (population) standard deviation.
 
     Parameters
     ----------
     per_model_laws
-        Model label -> ``laws.json`` document (at least two models).
+        Model label -> ``laws.json`` document (at least two models); coefficients in the
+        units of ``laws.json`` (MPa, MPa/GPa).
 
     Returns
     -------
@@ -71,6 +81,26 @@ def model_spread(per_model_laws: Mapping[str, Mapping]) -> dict[str, float]:
         vals = [float(d[key]) for d in per_model_laws.values() if d.get(key) is not None]
         out[key] = (max(vals) - min(vals)) / 2 if len(vals) >= 2 else 0.0
     return out
+
+
+def committee_spread(per_model_results: Mapping[str, Mapping]) -> dict[str, float]:
+    """:func:`model_spread` over every model of an ISPES comparison.
+
+    ``per_model_results``: label -> the per-model result of
+    :func:`flatcontact.training.ispes_check.compare_ispes` (its ``results`` dict, also the
+    ``ispes_compare_<form>.json`` of the teacher benchmark), each with a ``laws`` block.
+    The result is the ``uncertainty.model_spread_<form>`` of a run configuration for the
+    energy form the comparison was analysed in.
+    """
+    laws = {}
+    for label, result in per_model_results.items():
+        block = result.get("laws") if isinstance(result, Mapping) else None
+        require(
+            isinstance(block, Mapping),
+            f"per_model_results.{label}: expected a result with a 'laws' block",
+        )
+        laws[label] = block
+    return model_spread(laws)
 
 
 def law_half_widths(

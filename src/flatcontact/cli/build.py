@@ -89,7 +89,10 @@ def build(
         help="Output directory (default ./build, where 'flatcontact scan' looks by default).",
     ),
     source: str = typer.Option(
-        "auto", "--source", help="auto | shipped (CHGNet-relaxed 6-layer slab) | seed"
+        "auto",
+        "--source",
+        help="auto | shipped (CHGNet-relaxed 6-layer slab; 9, 12, ... layers: bulk "
+        "alpha-quartz c-repeats inserted into its interior) | seed",
     ),
     gap_angstrom: float = typer.Option(
         3.0, "--gap-angstrom", help="Initial gap between the slabs (Å)."
@@ -135,6 +138,8 @@ def build(
 
     if structure is None:
         builder.check_layers(layers, "--layers")
+        if source == "shipped":
+            builder.check_shipped_layers(layers, "--layers")
     _positive_finite(fmax_ev_per_angstrom, "--fmax-ev-per-angstrom", "eV/Å")
     _positive_finite(gap_angstrom, "--gap-angstrom", "Å")
     if structure is not None:

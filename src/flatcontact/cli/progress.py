@@ -59,6 +59,9 @@ class ScanBar:
             TimeRemainingColumn(),
             console=self.console,
             transient=False,
+            # twice a second: the driver shares the cores with the scan's workers, and a
+            # redraw at rich's default 10 Hz costs it CPU they would use
+            refresh_per_second=2,
         )
         self._task = self._progress.add_task("scan", total=total, completed=done)
         self._progress.start()

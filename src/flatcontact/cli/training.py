@@ -300,6 +300,7 @@ def _ispes_check(
     """``validate-potential --ispes``: checks every argument, then compare_ispes."""
     import numpy as np
 
+    from flatcontact.analysis.uncertainty import committee_spread
     from flatcontact.cli.app import parse_floats
     from flatcontact.config import default_potential
     from flatcontact.errors import InputError, require
@@ -368,6 +369,9 @@ def _ispes_check(
     return {
         "reference": labels[0],
         "interface": source,
+        # the uncertainty.model_spread_<energy form> of a run: half the max − min range of
+        # each law coefficient over all models compared
+        "model_spread": committee_spread(per_model),
         "settings": {
             "grid": list(grid),
             "p_range_gpa": [lo, hi, n],
@@ -418,6 +422,13 @@ def _print_ispes_check(report: dict) -> None:
             f"({res['force_calls']} force calls, {res['seconds']:.0f} s)",
             highlight=False,
         )
+    spread = report["model_spread"]
+    form = report["settings"]["energy_form"]
+    console.print(
+        f"model spread (half the max - min range over all models; uncertainty.model_spread_{form}): "
+        + ", ".join(f"{k} {v:.3g}" for k, v in spread.items()),
+        highlight=False,
+    )
 
 
 def _print_validation(report: dict) -> None:

@@ -490,6 +490,7 @@ def probe_thicknesses(
     reference: Atoms,
     rigid: RigidStackings,
     grid: GridSpec,
+    probe_columns: Callable[[list[tuple]], list[ColumnProbe]] | None = None,
 ) -> tuple[dict, list[str]]:
     """Probe the extreme columns and choose the thicknesses of a pressure-range grid.
 
@@ -498,6 +499,11 @@ def probe_thicknesses(
     tensile maximum); the thicknesses bracket the requested loads at every one of them
     (:func:`thicknesses_spanning_columns`). The adhesion is that of the lowest-energy
     column (the paper's z-scan).
+
+    The columns are independent chains of relaxations: ``probe_columns(specs)``, given the
+    list of ``(shift, p_hi_gpa, stop_at_gpa)``, returns their :class:`ColumnProbe` in the
+    same order (the scan driver runs them on its workers); by default they run here, one
+    after the other, with ``relax``.
 
     Returns
     -------
@@ -510,10 +516,14 @@ def probe_thicknesses(
     columns = probed_stackings(rigid, grid)
     if not grid.bracket_all_stackings:
         columns = columns[:1]
-    probes = [
-        probe_column(relax, reference, shift, hi, stop_at_gpa=None if k == 0 else lo)
-        for k, (_, shift) in enumerate(columns)
-    ]
+    specs = [(shift, hi, None if k == 0 else lo) for k, (_, shift) in enumerate(columns)]
+    if probe_columns is None:
+        probes = [
+            probe_column(relax, reference, shift, p_hi, stop_at_gpa=stop)
+            for shift, p_hi, stop in specs
+        ]
+    else:
+        probes = list(probe_columns(specs))
     adh = adhesion(probes[0])
     z, notes = thicknesses_spanning_columns(probes, lo, hi, n)
     return {

@@ -67,7 +67,6 @@ from typing import Any, Literal
 
 import numpy as np
 from ase import Atoms
-from ase.constraints import FixAtoms, FixCartesian, FixConstraint
 
 from flatcontact.errors import InputError
 from flatcontact.ispes.calculators import count_force_calls
@@ -78,6 +77,7 @@ from flatcontact.ispes.geometry import (
     place_slab2,
     warm_start_positions,
 )
+from flatcontact.ispes.lbfgs import lbfgs_relax
 from flatcontact.units import EV_PER_A3_TO_GPA
 
 Optimizer = Literal["FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch"]
@@ -237,23 +237,29 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
             atoms.positions = pos
     fixed_positions = atoms.positions[fixed].copy()
     lateral_positions = atoms.positions[:, :2].copy()
-    constraints = [FixAtoms(mask=fixed)]
-    groups = free_layer_groups(atoms, free) if settings.mode == "rigid-layers" else []
-    if settings.mode == "normal" and free.any():
-        constraints.append(FixCartesian(np.flatnonzero(free), mask=(True, True, False)))
-    if groups:
-        constraints.append(RigidLayersAlongZ(groups))
-    atoms.set_constraint(constraints)
     calc = count_force_calls(calc)
     calls0 = calc.force_calls
-    atoms.calc = calc
     steps = 0
-    if relaxing:
-        opt = _optimizer_class(settings.optimizer)(atoms, logfile=None)
-        opt.run(fmax=settings.fmax_ev_per_a, steps=settings.max_steps)
-        steps = int(opt.nsteps)
-    forces = atoms.get_forces(apply_constraint=False)
-    energy = float(atoms.get_potential_energy())
+    groups = free_layer_groups(atoms, free) if settings.mode == "rigid-layers" else []
+    evaluate = point_evaluator(calc, atoms)
+    if relaxing and settings.optimizer == "LBFGS":
+        outcome = lbfgs_relax(
+            evaluate,
+            atoms.positions,
+            constraint_projector(fixed, settings.mode, groups),
+            settings.fmax_ev_per_a,
+            settings.max_steps,
+        )
+        atoms.positions = outcome.positions
+        energy, forces, steps = outcome.energy_ev, outcome.forces, outcome.steps
+    elif relaxing:
+        steps = _relax_with_ase(atoms, calc, fixed, free, groups, settings)
+        forces = atoms.get_forces(apply_constraint=False)
+        energy = float(atoms.get_potential_energy())
+        atoms.calc = None
+        atoms.set_constraint()
+    else:
+        energy, forces = evaluate(atoms.positions)
     if settings.mode == "normal":
         max_force = float(np.abs(forces[free, 2]).max()) if free.any() else 0.0
     elif settings.mode == "rigid-layers":
@@ -282,8 +288,81 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
         positions=atoms.positions.copy(),
         start_index=task.start_index,
     )
-    atoms.calc = None
     return result
+
+
+def constraint_projector(fixed: np.ndarray, mode: str, groups: list[np.ndarray]):
+    """The linear projector P of a relaxation mode, for forces and steps ((n, 3) arrays).
+
+    ``full``: held atoms zero. ``normal``: held atoms zero and every x, y component zero.
+    ``rigid-layers``: every component zero except z on the free layers, where each atom gets
+    its layer's mean (the generalised force on the layer's height per atom). These are the
+    forces ASE's ``FixAtoms``, ``FixCartesian`` and
+    :class:`~flatcontact.ispes.rigid_layers.RigidLayersAlongZ` return, and the
+    steps their ``adjust_positions`` allow.
+    """
+    held = np.asarray(fixed, dtype=bool)
+    if mode == "rigid-layers":
+        members = [np.asarray(g, dtype=int) for g in groups]
+
+        def project(v: np.ndarray) -> np.ndarray:
+            out = np.zeros_like(v)
+            for g in members:
+                out[g, 2] = np.mean(v[g, 2])
+            return out
+
+        return project
+    lateral = mode == "normal"
+
+    def project(v: np.ndarray) -> np.ndarray:
+        out = v.copy()
+        out[held] = 0.0
+        if lateral:
+            out[:, :2] = 0.0
+        return out
+
+    return project
+
+
+def point_evaluator(calc, atoms: Atoms):
+    """``evaluate(positions) -> (energy_ev, forces)`` of ``atoms`` at new positions.
+
+    Calculators of :mod:`flatcontact.potentials` give their engine directly
+    (``calc.position_evaluator``: built once for this structure, one evaluation per call,
+    counted in ``calc.force_calls``); any other ASE calculator is asked through a
+    constraint-free copy of ``atoms`` (``calculate`` once per new structure).
+    """
+    direct = getattr(calc, "position_evaluator", None)
+    if direct is not None:
+        return direct(atoms)
+    work = atoms.copy()
+    work.set_constraint()
+    work.calc = calc
+
+    def evaluate(positions: np.ndarray) -> tuple[float, np.ndarray]:
+        work.positions = positions
+        forces = work.get_forces()
+        return float(work.get_potential_energy()), forces
+
+    return evaluate
+
+
+def _relax_with_ase(atoms, calc, fixed, free, groups, settings: RelaxSettings) -> int:
+    """Relax ``atoms`` in place with an ASE optimiser and constraint objects; the steps."""
+    from ase.constraints import FixAtoms, FixCartesian
+
+    from flatcontact.ispes.rigid_layers import RigidLayersAlongZ
+
+    constraints = [FixAtoms(mask=fixed)]
+    if settings.mode == "normal" and free.any():
+        constraints.append(FixCartesian(np.flatnonzero(free), mask=(True, True, False)))
+    if groups:
+        constraints.append(RigidLayersAlongZ(groups))
+    atoms.set_constraint(constraints)
+    atoms.calc = calc
+    opt = _optimizer_class(settings.optimizer)(atoms, logfile=None)
+    opt.run(fmax=settings.fmax_ev_per_a, steps=settings.max_steps)
+    return int(opt.nsteps)
 
 
 def free_layer_groups(atoms: Atoms, free: np.ndarray) -> list[np.ndarray]:
@@ -296,41 +375,6 @@ def free_layer_groups(atoms: Atoms, free: np.ndarray) -> list[np.ndarray]:
 
         layer = interface_layers(atoms)
     return [np.flatnonzero(free & (layer == k)) for k in np.unique(layer[free])]
-
-
-class RigidLayersAlongZ(FixConstraint):
-    """Each group of atoms (a layer) moves as a rigid body along z only.
-
-    Positions: a proposed step keeps only each group's mean z displacement. Forces: each
-    atom of a group gets the group's mean z-force (the generalised force on its height per
-    atom), x and y zero, so an optimiser's step is the same for every atom of the group and
-    ``fmax`` is |Σ_group F_z| / n_group.
-    """
-
-    def __init__(self, groups: list[np.ndarray]):
-        self.groups = [np.asarray(g, dtype=int) for g in groups]
-
-    def get_removed_dof(self, atoms: Atoms) -> int:
-        return sum(3 * len(g) - 1 for g in self.groups)
-
-    def adjust_positions(self, atoms: Atoms, new: np.ndarray) -> None:
-        old = atoms.positions
-        for g in self.groups:
-            dz = float(np.mean(new[g, 2] - old[g, 2]))
-            new[g] = old[g]
-            new[g, 2] += dz
-
-    def adjust_forces(self, atoms: Atoms, forces: np.ndarray) -> None:
-        for g in self.groups:
-            fz = float(np.mean(forces[g, 2]))
-            forces[g] = 0.0
-            forces[g, 2] = fz
-
-    def todict(self) -> dict:
-        return {
-            "name": "RigidLayersAlongZ",
-            "kwargs": {"groups": [g.tolist() for g in self.groups]},
-        }
 
 
 def extrapolated_start(placed: Atoms, task: PointTask, fixed: np.ndarray) -> np.ndarray:

@@ -12,7 +12,9 @@ because each point's warm start comes from a fixed neighbour
 
 from __future__ import annotations
 
+import collections
 import dataclasses
+import heapq
 import json
 import time
 from collections.abc import Callable
@@ -79,17 +81,56 @@ def scan_settings(
 
 
 def _probe(
-    reference: Atoms, factory: Any, grid: grid_mod.GridSpec, relax: RelaxSettings
+    reference: Atoms,
+    factory: Any,
+    grid: grid_mod.GridSpec,
+    relax: RelaxSettings,
+    executor: Any = None,
 ) -> tuple[dict, list[str]]:
+    """Resolve the thicknesses of a pressure-range grid (:func:`grid_mod.probe_thicknesses`).
+
+    The single points of every stacking run here; the probed columns, independent chains,
+    run on the executor's workers when it has more than one (they are the serial part of a
+    scan: 4 % of the paper preset's serial time, which by Amdahl's law alone capped two
+    workers at 96 %).
+    """
     calc = worker_calculator(factory, reference)
 
     def relax_one(a, b, z, start, start_z):
-        task = PointTask((0, 0, 0), a, b, z, start, (a, b) if start is not None else None, start_z)
-        r = relax_point(reference, calc, task, relax)
-        return r.energy_ev, r.normal_stress_gpa, r.force_calls, r.positions
+        return relax_column_point(reference, calc, relax, a, b, z, start, start_z)
 
     rigid = grid_mod.rigid_stackings(reference, calc, grid)
-    return grid_mod.probe_thicknesses(relax_one, reference, rigid, grid)
+    probe_columns = None
+    if executor is not None and getattr(executor, "workers", 1) > 1:
+        context = ScanContext(reference, factory, relax)
+
+        def probe_columns(specs):
+            handles = [executor.submit(probe_column_task, context, *spec) for spec in specs]
+            return [executor.result(h) for h in handles]
+
+    return grid_mod.probe_thicknesses(relax_one, reference, rigid, grid, probe_columns)
+
+
+def relax_column_point(reference, calc, relax, a, b, z, start, start_z) -> tuple:
+    """One probe point: ``(energy_ev, normal_stress_gpa, force_calls, positions)``."""
+    task = PointTask((0, 0, 0), a, b, z, start, (a, b) if start is not None else None, start_z)
+    r = relax_point(reference, calc, task, relax)
+    return r.energy_ev, r.normal_stress_gpa, r.force_calls, r.positions
+
+
+def probe_column_task(context: ScanContext, shift, p_hi_gpa, stop_at_gpa):
+    """Worker entry point: one probed column (:func:`grid_mod.probe_column`) with this
+    worker's cached calculator."""
+    calc = worker_calculator(context.factory, context.reference)
+
+    def relax_one(a, b, z, start, start_z):
+        return relax_column_point(
+            context.reference, calc, context.settings, a, b, z, start, start_z
+        )
+
+    return grid_mod.probe_column(
+        relax_one, context.reference, shift, p_hi_gpa, stop_at_gpa=stop_at_gpa
+    )
 
 
 def run_scan(
@@ -175,7 +216,7 @@ def run_scan(
                     if grid.thickness_angstrom is not None:
                         resolved["thickness_angstrom"] = list(grid.thickness_angstrom)
                     else:
-                        extra, notes = _probe(reference, factory, grid, relax)
+                        extra, notes = _probe(reference, factory, grid, relax, executor)
                         resolved.update(extra)
                     store.set_resolved(resolved)
                 resolved = store.resolved
@@ -196,13 +237,15 @@ def run_scan(
                 in_flight: dict[Any, tuple] = {}
                 cap = 2 * max(1, getattr(executor, "workers", 1))
                 pending = set(todo)
-
-                def ready(idx):
-                    par = parent[idx]
-                    return par is None or par in store
+                queue = ReadyQueue(parent, rank, store, pending)
+                recent = PositionsCache()
 
                 def converged(idx):
                     return idx is not None and idx in store and store.record(idx)["converged"]
+
+                def positions(idx):
+                    cached = recent.get(idx)
+                    return cached if cached is not None else store.positions(idx)
 
                 def make_task(idx):
                     par = parent[idx]
@@ -214,7 +257,7 @@ def run_scan(
                     previous = {}
                     if converged(grand) and grand[:2] == par[:2] == idx[:2]:
                         previous = {
-                            "previous_positions": store.positions(grand),
+                            "previous_positions": positions(grand),
                             "previous_thickness": float(z[grand[2]]),
                         }
                     return PointTask(
@@ -222,7 +265,7 @@ def run_scan(
                         float(sa[ia]),
                         float(sb[ib]),
                         float(z[iz]),
-                        store.positions(par),
+                        positions(par),
                         (float(sa[pa]), float(sb[pb])),
                         float(z[pz]),
                         par,
@@ -238,12 +281,12 @@ def run_scan(
                             and not in_flight
                         ):
                             break
-                        candidates = sorted((i for i in pending if ready(i)), key=rank.__getitem__)
-                        for idx in candidates:
-                            if len(in_flight) >= cap or (
-                                max_new_points is not None and submitted >= max_new_points
-                            ):
-                                break
+                        while (
+                            queue
+                            and len(in_flight) < cap
+                            and (max_new_points is None or submitted < max_new_points)
+                        ):
+                            idx = queue.pop()
                             handle = executor.submit(run_task, context, make_task(idx))
                             in_flight[handle] = idx
                             pending.discard(idx)
@@ -255,6 +298,8 @@ def run_scan(
                             idx = in_flight.pop(handle)
                             result = executor.result(handle)
                             store.write(result)
+                            recent.put(idx, result.positions)
+                            queue.stored(idx)
                             computed_calls.append(result.force_calls)
                             if progress is not None:
                                 progress(len(store), total)
@@ -288,6 +333,73 @@ def run_scan(
     if interrupted:
         raise ScanInterrupted(result)
     return result
+
+
+class ReadyQueue:
+    """The points whose warm-start parent is stored, in the search tree's visiting order.
+
+    A heap keyed by the point's rank in the tree: each stored point pushes its children,
+    so scheduling costs O(log n) per point (scanning every pending point for readiness
+    after each stored point cost O(n) each, O(n²) per scan: seconds of driver CPU on a
+    paper-size grid, taken from the workers' cores).
+    """
+
+    def __init__(self, parent: dict, rank: dict, store: Any, pending: set):
+        self._rank = rank
+        self._pending = pending
+        self._children: dict = {}
+        for idx, par in parent.items():
+            if par is not None:
+                self._children.setdefault(par, []).append(idx)
+        self._heap = [
+            (rank[idx], idx) for idx in pending if parent[idx] is None or parent[idx] in store
+        ]
+        heapq.heapify(self._heap)
+
+    def __bool__(self) -> bool:
+        return bool(self._heap)
+
+    def pop(self):
+        """The earliest ready point in visiting order."""
+        return heapq.heappop(self._heap)[1]
+
+    def stored(self, idx) -> None:
+        """``idx`` is stored: its pending children become ready."""
+        for child in self._children.get(idx, ()):
+            if child in self._pending:
+                heapq.heappush(self._heap, (self._rank[child], child))
+
+
+class PositionsCache:
+    """Relaxed positions of recently stored points, kept in memory for the warm starts.
+
+    The driver has each result's positions in hand when it stores it; its children and
+    grandchildren start from them moments later. Keeping them (least recently used out,
+    at most ``budget_bytes``) spares a database read per submitted point; a point not in
+    the cache is read from the store (the same float64 array, bit for bit).
+    """
+
+    def __init__(self, budget_bytes: int = 64 * 2**20):
+        self._budget = int(budget_bytes)
+        self._bytes = 0
+        self._items: collections.OrderedDict = collections.OrderedDict()
+
+    def put(self, idx, positions: np.ndarray) -> None:
+        arr = np.asarray(positions, dtype=float)
+        if arr.nbytes > self._budget:
+            return
+        self._items[idx] = arr
+        self._bytes += arr.nbytes
+        while self._bytes > self._budget:
+            _, old = self._items.popitem(last=False)
+            self._bytes -= old.nbytes
+
+    def get(self, idx) -> np.ndarray | None:
+        arr = self._items.get(idx)
+        if arr is not None:
+            self._items.move_to_end(idx)
+            return arr.copy()
+        return None
 
 
 class ScanInterrupted(KeyboardInterrupt):

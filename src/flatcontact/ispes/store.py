@@ -34,6 +34,7 @@ import hashlib
 import json
 import os
 import time
+import types
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -228,7 +229,7 @@ class PointStore:
 
     @staticmethod
     def _record(row) -> dict:
-        start = row.get("start", "")
+        start = getattr(row, "start", "")
         return {
             "id": row.id,
             "energy_ev": float(row.energy),
@@ -305,7 +306,11 @@ class PointStore:
         row_id = self._db.write(atoms, key_value_pairs=kvp)
         if time.monotonic() - self._last_commit >= self.commit_interval_s:
             self._commit()  # everything written so far, in order
-        self._done[index] = self._record(self._db.get(id=row_id))
+        # the record from what was just written (SQLite stores these doubles and integers
+        # exactly), not read back: a select per point was a third of the driver's store cost
+        self._done[index] = self._record(
+            types.SimpleNamespace(id=row_id, energy=float(result.energy_ev), **kvp)
+        )
 
     # -- assembly -------------------------------------------------------------------
     def assemble(self) -> xr.Dataset:

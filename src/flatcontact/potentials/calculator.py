@@ -125,6 +125,42 @@ class InterfaceCalculator(Calculator):
         if want_stress or (self.bulk and len(out) > 2):
             self.results["stress"] = out[2]
 
+    def position_evaluator(self, atoms: Atoms):
+        """``evaluate(positions) -> (energy_ev, forces)`` for ``atoms`` at new positions.
+
+        The engine is checked (and rebuilt if the species, labels, cell or pbc changed) once
+        here; each call is then one evaluation with nothing else around it (no ASE results
+        cache, no change check), counted in ``force_calls``. The positions must belong to
+        ``atoms``'s structure (same atoms, cell, pbc). ASE's cached results are dropped, so
+        a later ``get_forces`` recomputes.
+        """
+        signature = _signature(atoms)
+        if signature != self._signature:
+            self._check(atoms)
+            self.close()
+            self._build(atoms)
+            self._signature = signature
+        self.reset()
+        fast = self._positions_evaluator(atoms)
+
+        def evaluate(positions: np.ndarray) -> tuple[float, np.ndarray]:
+            out = fast(positions)
+            self.force_calls += 1
+            return out[0], out[1]
+
+        return evaluate
+
+    def _positions_evaluator(self, atoms: Atoms):
+        """positions -> engine output, for the structure of ``atoms`` (default: a copy)."""
+        work = atoms.copy()
+        work.set_constraint()
+
+        def fast(positions: np.ndarray):
+            work.positions = positions
+            return self._evaluate(work, False)
+
+        return fast
+
     def close(self) -> None:
         """Release engine resources (LAMMPS instances)."""
 
@@ -139,6 +175,11 @@ class LammpsInterfaceCalculator(InterfaceCalculator):
 
     def _evaluate(self, atoms: Atoms, stress: bool):
         return self.engine.compute(atoms.positions, stress=self.bulk and all(atoms.pbc))
+
+    def _positions_evaluator(self, atoms: Atoms):
+        stress = self.bulk and all(atoms.pbc)
+        compute = self.engine.compute
+        return lambda positions: compute(positions, stress=stress)
 
     def close(self) -> None:
         engine = getattr(self, "engine", None)

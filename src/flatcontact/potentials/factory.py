@@ -32,9 +32,15 @@ class ModelFactory:
     def __call__(self, atoms):
         return self.model.interface_calculator(atoms)
 
-    @property
+    @cached_property
     def fingerprint(self) -> str:
-        """JSON of :meth:`InteractionModel.fingerprint` (content-based, no absolute paths)."""
+        """JSON of :meth:`InteractionModel.fingerprint` (content-based, no absolute paths).
+
+        Computed once per factory (it reads and hashes the model's files) and pickled with
+        it, so a scan worker, which gets a fresh copy with every task, keys its calculator
+        cache by the driver's fingerprint without validating the model again (that cost
+        about 1 ms per grid point).
+        """
         return json.dumps({"potential": self.model.fingerprint()}, sort_keys=True)
 
     @property
@@ -42,7 +48,9 @@ class ModelFactory:
         return self.model.label
 
     def __getstate__(self):
-        return {"model_json": self.model_json}
+        return {"model_json": self.model_json, "fingerprint": self.fingerprint}
 
     def __setstate__(self, state):
         object.__setattr__(self, "model_json", state["model_json"])
+        if "fingerprint" in state:
+            self.__dict__["fingerprint"] = state["fingerprint"]

@@ -29,6 +29,7 @@ Threads: ``threads=N`` (> 1) loads LAMMPS's OPENMP package (``package omp N`` an
 
 from __future__ import annotations
 
+import ctypes
 from dataclasses import dataclass
 
 import numpy as np
@@ -94,6 +95,8 @@ class LammpsEngine:
         extra = ["-pk", "omp", str(self.threads), "-sf", "omp"] if self.threads > 1 else []
         self.lmp = new_lammps(extra)
         self._ready = False  # the first compute runs the full setup (``run 0``)
+        self._extract = None  # lammps_extract_atom with a c_void_p result (see _views)
+        self._cached_views = None
         try:
             self.box = create_box(
                 self.lmp,
@@ -128,12 +131,44 @@ class LammpsEngine:
         One process owns every atom and sorting is off, so this is the identity in
         practice; it is read from the atom ids anyway (LAMMPS may reorder on exchange).
         """
-        ids = self.lmp.numpy.extract_atom("id", nelem=self.n)
+        return self._views()[0]
+
+    def _views(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(rows, x, f): numpy views of LAMMPS's own ``x`` and ``f`` arrays and the rows of the
+        caller's atoms in them, made once and remade only when LAMMPS moved its arrays.
+
+        LAMMPS reallocates its per-atom arrays when the number of local + ghost atoms
+        outgrows them (a neighbour rebuild can do it), and could reorder atoms; so on every
+        call the data addresses of ``id``, ``x`` and ``f`` are read through the C library
+        (three calls of ``lammps_extract_atom``, microseconds) and the ids compared with the
+        cached ones. The numpy wrapper (``lmp.numpy.extract_atom``), which costs tens of
+        microseconds per array, runs only when something changed.
+        """
+        lmp = self.lmp
+        if self._extract is None:
+            self._extract = lmp.lib["lammps_extract_atom"]  # own prototype, not the shared one
+            self._extract.restype = ctypes.c_void_p
+            self._extract.argtypes = [ctypes.c_void_p, ctypes.c_char_p]
+        handle = lmp.lmp
+        addresses = (
+            self._extract(handle, b"id"),
+            _first_row(self._extract(handle, b"x")),
+            _first_row(self._extract(handle, b"f")),
+        )
+        cached = self._cached_views
+        if cached is not None and cached[0] == addresses and np.array_equal(cached[1], cached[2]):
+            return cached[3]
+        ids = lmp.numpy.extract_atom("id", nelem=self.n)
         if ids is None or len(ids) != self.n:  # pragma: no cover - a guard
             raise RuntimeError("LAMMPS does not own every atom in this process")
+        x = lmp.numpy.extract_atom("x", nelem=self.n, dim=3)
+        f = lmp.numpy.extract_atom("f", nelem=self.n, dim=3)
         rows = np.empty(self.n, dtype=np.intp)
         rows[np.asarray(ids, dtype=np.intp) - 1] = np.arange(self.n)
-        return rows
+        views = (rows, x, f)
+        if (ids.ctypes.data, x.ctypes.data, f.ctypes.data) == addresses:
+            self._cached_views = (addresses, ids, np.array(ids), views)
+        return views
 
     def compute(self, positions: np.ndarray, stress: bool = False):
         """Energy (eV) and forces (eV/Å, caller's frame) at ``positions`` (Å).
@@ -143,8 +178,7 @@ class LammpsEngine:
         """
         box = self.box.to_lammps(positions)
         lmp = self.lmp
-        rows = self._atom_rows()
-        x = lmp.numpy.extract_atom("x", nelem=self.n, dim=3)
+        rows, x, _ = self._views()
         x[rows] = box
         if self._ready:  # one force evaluation behind the neighbour check, no setup
             lmp.command("run 1 pre no post no")
@@ -152,9 +186,8 @@ class LammpsEngine:
             lmp.command("run 0 post no")
             self._ready = True
         energy = float(lmp.get_thermo("pe"))
-        rows = self._atom_rows()
-        f = lmp.numpy.extract_atom("f", nelem=self.n, dim=3)[rows]
-        forces = self.box.vectors_to_caller(f)
+        rows, _, f = self._views()
+        forces = self.box.vectors_to_caller(f[rows])
         if not stress:
             return energy, forces
         p = [self.lmp.get_thermo(k) for k in ("pxx", "pyy", "pzz", "pyz", "pxz", "pxy")]
@@ -173,3 +206,10 @@ class LammpsEngine:
             self.close()
         except Exception:
             pass
+
+
+def _first_row(address: int | None) -> int | None:
+    """Data address of a LAMMPS 2D per-atom array from the address of its row pointers."""
+    if not address:
+        return None
+    return ctypes.c_void_p.from_address(address).value

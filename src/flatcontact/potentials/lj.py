@@ -42,8 +42,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from ase import Atoms, units
-from ase.calculators.vdwcorrection import vdWDB_alphaC6
-from ase.neighborlist import neighbor_list
 
 from flatcontact import units as units_conv
 from flatcontact.errors import InputError
@@ -112,6 +110,10 @@ def pair_key(a: str, b: str) -> str:
 
 def ts_free_atom(symbol: str) -> tuple[float, float]:
     """Free-atom (C6 in eV·Å⁶, α in bohr³) of ``symbol`` from the TS/Chu–Dalgarno table."""
+    # imported here: ase.calculators.vdwcorrection pulls scipy.special and ase.neighborlist
+    # (about 0.5 s), which a scan worker on a LAMMPS model never needs
+    from ase.calculators.vdwcorrection import vdWDB_alphaC6
+
     if symbol in vdWDB_alphaC6:
         alpha, c6 = vdWDB_alphaC6[symbol]
     elif symbol in TS_FREE_ATOM:
@@ -248,6 +250,8 @@ def lj_cross_energy_forces(
 
     Periodic images follow ``atoms.pbc``; each cross pair is counted once.
     """
+    from ase.neighborlist import neighbor_list
+
     i, j, d, vec = neighbor_list("ijdD", atoms, cutoff_angstrom)
     cross = groups[i] != groups[j]
     i, j, d, vec = i[cross], j[cross], d[cross], vec[cross]

@@ -96,6 +96,45 @@ def interface_elements(folder: Path) -> set[str]:
     return set(_interface(folder).get_chemical_symbols())
 
 
+def monotonicity_paragraph(table) -> str:
+    """Where τ(P) falls with load by more than its noise, and what limits τ on each side.
+
+    A drop from P_i to P_i+1 counts when τ_i − τ_i+1 > √(ν_i² + ν_i+1²), ν the per-load force
+    noise (``force_noise_mpa``; :func:`flatcontact.analysis.convergence.monotonic_violations`).
+    For each drop the paragraph names the mechanism that sets τ at both loads (the barrier
+    top of the path, a jump, or the path's end), the number of jumps and the start stacking,
+    so a reader can tell a change of mechanism (the model's physics) from scatter.
+    """
+    from flatcontact.analysis.convergence import monotonic_violations
+
+    if "tau_mpa" not in table or len(table) < 2:
+        return ""
+    noise = table["force_noise_mpa"] if "force_noise_mpa" in table else 0.0
+    drops = monotonic_violations(table["p_gpa"], table["tau_mpa"], noise)
+    if not drops:
+        return "τ(P) does not fall with load anywhere by more than its force noise."
+    by_p = {float(r.p_gpa): r for r in table.itertuples()}
+
+    def side(p):
+        r = by_p[p]
+        start = getattr(r, "start_stacking", "")
+        jumps = int(r.n_jumps) if np.isfinite(r.n_jumps) else 0
+        return (
+            f"{fmt(r.tau_mpa)} MPa at {p:g} GPa (limited by the {r.tau_limited_by}, {jumps} "
+            f"jump{'s' if jumps != 1 else ''}{f', start {start}' if isinstance(start, str) and start else ''})"
+        )
+
+    parts = [f"from {side(d['from_p_gpa'])} to {side(d['to_p_gpa'])}" for d in drops]
+    return (
+        "τ(P) is not monotonic: it falls by more than its noise "
+        + "; ".join(parts)
+        + ". Where the limiting mechanism or the number of jumps changes between the two loads, "
+        "the drop is the model's landscape changing shape with load (a different barrier or a "
+        "jump along the path), not scatter; a drop with the same mechanism on both sides is "
+        "tested by refining the lateral grid (docs/convergence.md)."
+    )
+
+
 def _direction_text(cfg, table) -> str:
     """The pulling direction as run: the given angle, or auto's lowest-barrier direction."""
     if cfg.analysis.direction_deg != "auto":
@@ -515,6 +554,7 @@ def build_sections(
                 "(always ≥ σ_MSS). The load laws use τ.",
                 f"Load at each z from {_LOAD_SOURCE_TEXT[analyze.get('load_source', 'stress')]}. "
                 f"Energy zero of the maps and profiles: {_ENERGY_ZERO_TEXT[cfg.analysis.energy_zero]}.",
+                monotonicity_paragraph(table),
             ],
             notes=analyze.get("warnings", []),
             tables=[

@@ -3,7 +3,9 @@
 Pipeline of :func:`build_quartz_interface` (deterministic; no random numbers):
 
 1. Starting slab. Either the shipped verified dense slab (6 layers, relaxed once with
-   CHGNet r2SCAN; provenance in its ``.json``), or, for another layer count or on request,
+   CHGNet r2SCAN; provenance in its ``.json``), for 9, 12, ... layers thickened by whole
+   α-quartz c-repeats of the potential's own bulk inserted into its interior
+   (:mod:`~flatcontact.structures.thicken`), or, for another layer count or on request,
    a seeded reconstruction: the α-quartz 1×1 (0001) slab cut between the two O planes
    (cut 2, the only cleavage plane with two equivalent stoichiometric faces, each with one
    3-fold Si and one 1-fold O per cell), both faces moved to the dense topology with
@@ -11,7 +13,9 @@ Pipeline of :func:`build_quartz_interface` (deterministic; no random numbers):
    vertical-O choice per face, fixed order), each relaxed with the reconstruction model; the lowest-energy verified one wins.
 2. Relaxation of the slab with the chosen potential and verification
    (:func:`~flatcontact.structures.dense.verify_dense_slab`); if the potential does not keep
-   a defect-free dense surface, :class:`InputError` with the failures.
+   a defect-free dense surface, :class:`InputError` with the failures. A thickened slab's
+   interior must also stay bulk-like (:func:`~flatcontact.structures.thicken.interior_report`:
+   every O–Si–O unit spacing within :data:`INTERIOR_MAX_SPACING_DEV` of the bulk's c/3).
 3. Two copies facing each other at ``gap_angstrom``, faces tagged (the dense face layer of
    6 atoms per cell = surfaces 1–4), the whole interface relaxed with the potential + LJ (no
    atoms fixed: slab 2 settles into its equilibrium registry and separation); both slabs
@@ -39,6 +43,12 @@ from flatcontact.structures.dense import (
 from flatcontact.structures.interface import make_interface, thickness
 from flatcontact.structures.layers import chunk_layers
 from flatcontact.structures.slab import quartz_0001_slab
+from flatcontact.structures.thicken import (
+    UNITS_PER_REPEAT,
+    insert_bulk_repeats,
+    interior_report,
+    lateral_bulk,
+)
 
 #: Index (in :func:`~flatcontact.structures.slab.cleavage_heights` order) of the cut between
 #: the two O planes: each face keeps one 3-fold Si and one 1-fold O per 1×1 cell.
@@ -46,6 +56,12 @@ SYMMETRIC_CUT = 2
 #: Directory of shipped structures.
 DATA_DIR = Path(__file__).resolve().parent / "data"
 SHIPPED_DENSE_SLAB = DATA_DIR / "quartz_0001_dense_6L.extxyz"
+#: O–Si–O layers of the shipped slab; thicker slabs insert whole bulk c-repeats (6, 9, 12, ...).
+SHIPPED_LAYERS = 6
+#: Largest relative deviation of an interior O–Si–O unit spacing of a thickened slab from the
+#: bulk's c/3 (same potential, same lateral cell) before the build refuses it (measured with
+#: the bundled SNAP: <= 1.4 % at 9 and 12 layers).
+INTERIOR_MAX_SPACING_DEV = 0.05
 DEFAULT_GAP_ANGSTROM = 3.0
 #: Fewest O–Si–O layers per slab of the dense quartz interface. Each slab has two tagged face
 #: layers of ``DENSE_FACE_LAYERS`` units each: the outer one (surface 1 or 4) is held fixed
@@ -68,6 +84,53 @@ def check_layers(layers: object, name: str = "layers") -> int:
         "and at least one inner layer between them)",
     )
     return layers  # type: ignore[return-value]
+
+
+def shipped_reaches(layers: int) -> bool:
+    """True if the shipped slab, thickened by whole bulk c-repeats, has ``layers`` layers."""
+    return layers >= SHIPPED_LAYERS and (layers - SHIPPED_LAYERS) % UNITS_PER_REPEAT == 0
+
+
+def check_shipped_layers(layers: int, name: str = "layers") -> int:
+    """``layers`` if the shipped slab reaches it (6, 9, 12, ...), else a one-line :class:`InputError`."""
+    require(
+        shipped_reaches(layers),
+        f"{name}={layers}: the shipped dense slab has {SHIPPED_LAYERS} O-Si-O layers and grows "
+        f"by whole alpha-quartz c-repeats of {UNITS_PER_REPEAT} layers: expected "
+        f"{SHIPPED_LAYERS}, {SHIPPED_LAYERS + UNITS_PER_REPEAT}, "
+        f"{SHIPPED_LAYERS + 2 * UNITS_PER_REPEAT}, ... (or source: seed)",
+    )
+    return layers
+
+
+def thicken_shipped_slab(
+    slab: Atoms, layers: int, spec, fmax_ev_per_angstrom: float
+) -> tuple[Atoms, dict, Atoms]:
+    """The shipped slab relaxed with ``spec``, with bulk c-repeats inserted up to ``layers``.
+
+    :mod:`flatcontact.structures.thicken`: α-quartz relaxed with ``spec`` at the slab's lateral
+    cell (c and ions free), registered on the ``spec``-relaxed slab's interior and inserted at
+    mid-height. The caller relaxes and verifies the result. Returns (slab, JSON-ready record, the bulk cell).
+    """
+    from flatcontact.potentials import make_calculator
+
+    repeats = (layers - SHIPPED_LAYERS) // UNITS_PER_REPEAT
+    start = slab.copy()
+    start.calc = None
+    pre = relax(start, make_calculator(spec, start), fmax_ev_per_angstrom=fmax_ev_per_angstrom)
+    start.calc = None
+    bulk, bulk_record = lateral_bulk(spec.bulk_calculator, start.cell.array[:2, :2])
+    thick, insertion = insert_bulk_repeats(start, bulk, repeats)
+    return (
+        thick,
+        {
+            "method": "bulk alpha-quartz c-repeats inserted at mid-height of the relaxed shipped slab",
+            "shipped_slab_relaxation": pre,
+            "bulk": bulk_record,
+            "insertion": insertion,
+        },
+        bulk,
+    )
 
 
 def _version(name: str) -> str | None:
@@ -230,8 +293,10 @@ def build_quartz_interface(
         O–Si–O layers per slab, at least :data:`MIN_LAYERS` (5): two face layers of two
         units each (outer one fixed in a scan, inner one sliding) and at least one inner unit.
     source
-        ``"shipped"`` (the CHGNet-relaxed 6-layer slab), ``"seed"`` (seeded reconstruction
-        relaxed directly with ``spec``) or ``"auto"`` (shipped when ``layers == 6``, else seed).
+        ``"shipped"`` (the CHGNet-relaxed 6-layer slab; 9, 12, ... layers by inserting
+        ``(layers - 6) / 3`` bulk c-repeats relaxed with ``spec``; other counts are refused),
+        ``"seed"`` (seeded reconstruction relaxed directly with ``spec``) or ``"auto"``
+        (shipped when the file is installed and reaches ``layers``, else seed).
     gap_angstrom
         Initial vertical gap between the slabs before the interface relaxation.
     """
@@ -247,13 +312,12 @@ def build_quartz_interface(
         "potential_label": spec.label,
         "layers": layers,
     }
-    use_shipped = source == "shipped" or (source == "auto" and layers == 6)
+    use_shipped = source == "shipped" or (
+        source == "auto" and SHIPPED_DENSE_SLAB.is_file() and shipped_reaches(layers)
+    )
     if use_shipped:
+        check_shipped_layers(layers)
         slab, provenance = load_shipped_dense_slab()
-        require(
-            len(slab) == 3 * layers,
-            f"the shipped dense slab has {len(slab) // 3} layers, not {layers}; use source='seed'",
-        )
         report["start"] = {
             "source": "shipped",
             "file": SHIPPED_DENSE_SLAB.name,
@@ -261,6 +325,10 @@ def build_quartz_interface(
                 k: v for k, v in provenance.items() if k not in ("search", "verification")
             },
         }
+        if layers > SHIPPED_LAYERS:
+            slab, report["start"]["thickening"], bulk = thicken_shipped_slab(
+                slab, layers, spec, fmax_ev_per_angstrom
+            )
     else:
         slab, record = reconstruct_dense_slab(
             layers,
@@ -284,6 +352,15 @@ def build_quartz_interface(
             f"potential {spec.label} does not keep a defect-free dense (0001) surface: "
             + "; ".join(verdict["failures"])
         )
+    if "thickening" in report.get("start", {}):
+        interior = interior_report(slab, bulk)
+        report["slab_interior"] = interior
+        require(
+            interior["max_abs_spacing_rel_dev"] <= INTERIOR_MAX_SPACING_DEV,
+            f"potential {spec.label}: the thickened slab's interior is not bulk-like (an O-Si-O "
+            f"unit spacing deviates {interior['max_abs_spacing_rel_dev']:.1%} from the bulk's "
+            f"c/3, more than {INTERIOR_MAX_SPACING_DEV:.0%})",
+        )
     recipe = {
         "crystal": "alpha-quartz",
         "surface": "(0001) dense 1x1",
@@ -296,6 +373,8 @@ def build_quartz_interface(
         "fmax_ev_per_angstrom": fmax_ev_per_angstrom,
         "flatcontact_version": _version("flatcontact"),
     }
+    if "thickening" in report["start"]:  # absent for the 6-layer slab: its file is unchanged
+        recipe["bulk_repeats_inserted"] = report["start"]["thickening"]["insertion"]["repeats"]
     face = DENSE_FACE_LAYERS * QUARTZ_ATOMS_PER_LAYER
     interface = make_interface(
         slab,

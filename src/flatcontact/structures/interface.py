@@ -35,7 +35,6 @@ from pathlib import Path
 
 import numpy as np
 from ase import Atoms
-from ase.io import read, write
 
 from flatcontact.errors import InputError, require
 from flatcontact.fileio import atomic_path
@@ -428,6 +427,9 @@ def write_interface(atoms: Atoms, path: str | os.PathLike[str]) -> Path:
     if "held" in out.arrays:
         out.arrays["held"] = np.asarray(out.arrays["held"], dtype=bool)
     with atomic_path(path) as tmp:
+        # imported here: ase.io costs 0.3-0.5 s, and scan workers never write a file
+        from ase.io import write
+
         write(tmp, out, format="extxyz")
     return Path(path)
 
@@ -442,6 +444,8 @@ def read_interface(path: str | os.PathLike[str]) -> Atoms:
     path = Path(path)
     require(path.is_file(), f"{path}: interface file not found")
     try:
+        from ase.io import read
+
         atoms = read(path, format="extxyz", index=-1)
     except Exception as exc:  # malformed file: report it as the user's to fix
         raise InputError(

@@ -168,11 +168,15 @@ class QuartzDenseRecipe(_Model):
     """The paper's α-quartz (0001) dense interface (flatcontact.structures.build)."""
 
     kind: Literal["quartz-dense"] = Field("quartz-dense", description="recipe kind")
-    layers: int = Field(6, description="O-Si-O layers per slab (>= 5)")
+    layers: int = Field(
+        6, description="O-Si-O layers per slab (>= 5; with source shipped 6, 9, 12, ...)"
+    )
     source: Literal["auto", "shipped", "seed"] = Field(
         "auto",
-        description="starting slab: shipped (CHGNet-relaxed 6-layer slab), seed (seeded dense "
-        "reconstruction relaxed with the potential) or auto (shipped if present and layers == 6)",
+        description="starting slab: shipped (CHGNet-relaxed 6-layer slab; 9, 12, ... layers by "
+        "inserting whole alpha-quartz c-repeats relaxed with the potential into its interior), "
+        "seed (seeded dense reconstruction relaxed with the potential) or auto (shipped if "
+        "present and it reaches layers, else seed)",
     )
     gap_angstrom: float = Field(
         3.0, gt=0, description="initial gap between the slabs before the interface relaxation (Å)"
@@ -189,6 +193,13 @@ class QuartzDenseRecipe(_Model):
             raise ValueError(
                 f"layers={self.layers}: the dense quartz interface needs >= {MIN_LAYERS}"
             )
+        if self.source == "shipped":
+            from flatcontact.structures.build import check_shipped_layers
+
+            try:
+                check_shipped_layers(self.layers)
+            except InputError as exc:
+                raise ValueError(str(exc)) from None
         return self
 
 
