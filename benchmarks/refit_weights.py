@@ -31,7 +31,7 @@ from flatcontact.fileio import write_json_atomic
 from flatcontact.training.dataset import read_dataset, write_dataset
 from flatcontact.training.fit import default_settings, fit_snap, split_indices
 from flatcontact.training.snapfiles import SnapHyper, write_snap_files
-from flatcontact.training.train import ELEMENTS, parity_plot
+from flatcontact.training.train import ELEMENTS, fit_report, parity_plot
 
 
 def parse_weights(items: list[str]) -> dict[str, float]:
@@ -96,17 +96,7 @@ def refit(
     write_dataset([frames[i] for i in result.split["test"]], out / "test.extxyz")
     parity_plot(result, out / "parity.png")
     fit_s = time.perf_counter() - t0
-    report = {
-        "name": name,
-        "elements": list(ELEMENTS),
-        "hyper": result.coefficients.hyper.as_dict(),
-        "settings": result.settings.as_dict(),
-        "errors": result.errors,
-        "split_sizes": {k: len(v) for k, v in result.split.items()},
-        "split_indices": {k: [int(i) for i in v] for k, v in result.split.items()},
-        "search": list(result.search),
-        "timings_s": {**result.timings, "refit_total_s": fit_s},
-    }
+    report = fit_report(name, result, result.search, {"refit_total_s": fit_s})
     write_json_atomic(out / "fit_report.json", report)
     provenance = {
         **prov0,

@@ -244,18 +244,7 @@ def train_snap(
     coeff, param = write_snap_files(out / name, result.coefficients, header=header)
     write_dataset([frames[i] for i in result.split["test"]], out / "test.extxyz")
     parity_plot(result, out / "parity.png")
-    report = {
-        "name": name,
-        "elements": list(ELEMENTS),
-        "hyper": result.coefficients.hyper.as_dict(),
-        "settings": result.settings.as_dict(),
-        "errors": result.errors,
-        "split_sizes": {k: len(v) for k, v in result.split.items()},
-        "split_indices": {k: [int(i) for i in v] for k, v in result.split.items()},
-        "search": search,
-        "active_learning": rounds,
-        "timings_s": {**result.timings, "fit_total_s": fit_s},
-    }
+    report = fit_report(name, result, search, {"fit_total_s": fit_s}, active_learning=rounds)
     write_json_atomic(out / "fit_report.json", report)
     provenance = {
         **info,
@@ -276,3 +265,21 @@ def train_snap(
     }
     write_json_atomic(out / "provenance.json", provenance)
     return report
+
+
+def fit_report(name: str, result, search, extra_timings_s: dict, **extra) -> dict:
+    """The content of ``fit_report.json``: hyper-parameters, settings, held-out errors, the
+    split (sizes and frame indices), the hyper-parameter search, ``extra`` entries (e.g. the
+    active-learning rounds) and the timings (s), the fit's own plus ``extra_timings_s``."""
+    return {
+        "name": name,
+        "elements": list(ELEMENTS),
+        "hyper": result.coefficients.hyper.as_dict(),
+        "settings": result.settings.as_dict(),
+        "errors": result.errors,
+        "split_sizes": {k: len(v) for k, v in result.split.items()},
+        "split_indices": {k: [int(i) for i in v] for k, v in result.split.items()},
+        "search": list(search),
+        **extra,
+        "timings_s": {**result.timings, **extra_timings_s},
+    }
