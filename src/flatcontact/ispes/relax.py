@@ -77,7 +77,7 @@ from flatcontact.ispes.geometry import (
     place_slab2,
     warm_start_positions,
 )
-from flatcontact.ispes.lbfgs import lbfgs_relax
+from flatcontact.ispes.lbfgs import largest_atomic_norm, lbfgs_relax
 from flatcontact.units import EV_PER_A3_TO_GPA
 
 Optimizer = Literal["FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch"]
@@ -241,12 +241,12 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
     calls0 = calc.force_calls
     steps = 0
     groups = free_layer_groups(atoms, free) if settings.mode == "rigid-layers" else []
-    evaluate = point_evaluator(calc, atoms)
+    project = constraint_projector(fixed, settings.mode, groups)
     if relaxing and settings.optimizer == "LBFGS":
         outcome = lbfgs_relax(
-            evaluate,
+            point_evaluator(calc, atoms),
             atoms.positions,
-            constraint_projector(fixed, settings.mode, groups),
+            project,
             settings.fmax_ev_per_a,
             settings.max_steps,
         )
@@ -259,13 +259,10 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
         atoms.calc = None
         atoms.set_constraint()
     else:
-        energy, forces = evaluate(atoms.positions)
-    if settings.mode == "normal":
-        max_force = float(np.abs(forces[free, 2]).max()) if free.any() else 0.0
-    elif settings.mode == "rigid-layers":
-        max_force = max((abs(float(forces[g, 2].mean())) for g in groups), default=0.0)
-    else:
-        max_force = float(np.linalg.norm(forces[free], axis=1).max()) if free.any() else 0.0
+        energy, forces = point_evaluator(calc, atoms)(atoms.positions)
+    # the force the tolerance applies to, in every mode: the largest atomic norm of P(F)
+    # (full: free atoms; normal: |F_z| of free atoms; rigid-layers: |mean F_z| per layer)
+    max_force = largest_atomic_norm(project(forces))
     if not np.array_equal(atoms.positions[fixed], fixed_positions):  # pragma: no cover - a guard
         raise RuntimeError("held atoms moved during the relaxation")
     if settings.mode in ("normal", "rigid-layers") and not np.array_equal(
