@@ -112,18 +112,23 @@ class InterfaceCalculator(Calculator):
 
     def calculate(self, atoms=None, properties=("energy",), system_changes=all_changes):
         super().calculate(atoms, properties, system_changes)
-        signature = _signature(self.atoms)
-        if signature != self._signature:
-            self._check(self.atoms)
-            self.close()
-            self._build(self.atoms)
-            self._signature = signature
+        self._engine_for(self.atoms)
         want_stress = "stress" in properties
         out = self._evaluate(self.atoms, want_stress)
         self.force_calls += 1
         self.results = {"energy": out[0], "free_energy": out[0], "forces": out[1]}
         if want_stress or (self.bulk and len(out) > 2):
             self.results["stress"] = out[2]
+
+    def _engine_for(self, atoms: Atoms) -> None:
+        """(Re)build the engine when the species, labels, cell or pbc of ``atoms`` are not
+        those it was built for (:func:`_signature`); positions never rebuild it."""
+        signature = _signature(atoms)
+        if signature != self._signature:
+            self._check(atoms)
+            self.close()
+            self._build(atoms)
+            self._signature = signature
 
     def position_evaluator(self, atoms: Atoms):
         """``evaluate(positions) -> (energy_ev, forces)`` for ``atoms`` at new positions.
@@ -134,12 +139,7 @@ class InterfaceCalculator(Calculator):
         ``atoms``'s structure (same atoms, cell, pbc). ASE's cached results are dropped, so
         a later ``get_forces`` recomputes.
         """
-        signature = _signature(atoms)
-        if signature != self._signature:
-            self._check(atoms)
-            self.close()
-            self._build(atoms)
-            self._signature = signature
+        self._engine_for(atoms)
         self.reset()
         fast = self._positions_evaluator(atoms)
 

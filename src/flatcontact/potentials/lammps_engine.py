@@ -125,17 +125,12 @@ class LammpsEngine:
                 raise
             raise InputError(f"LAMMPS could not set up the potential {label}: {exc}") from None
 
-    def _atom_rows(self) -> np.ndarray:
-        """Row of each atom (in the caller's order) in LAMMPS's local arrays.
-
-        One process owns every atom and sorting is off, so this is the identity in
-        practice; it is read from the atom ids anyway (LAMMPS may reorder on exchange).
-        """
-        return self._views()[0]
-
     def _views(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(rows, x, f): numpy views of LAMMPS's own ``x`` and ``f`` arrays and the rows of the
         caller's atoms in them, made once and remade only when LAMMPS moved its arrays.
+
+        One process owns every atom and sorting is off, so the rows are the identity in
+        practice; they are read from the atom ids anyway.
 
         LAMMPS reallocates its per-atom arrays when the number of local + ghost atoms
         outgrows them (a neighbour rebuild can do it), and could reorder atoms; so on every
