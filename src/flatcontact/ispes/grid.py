@@ -465,8 +465,8 @@ def thicknesses_spanning_columns(
         z_hi_c = float(np.interp(hi_gpa, pb[::-1], zb[::-1]))  # thickness where p_c = hi
         top, bottom = float(z.max()), float(z.min())
         if z_lo_c > top + 1e-9 and float(np.interp(top, zb, pb)) > lo_c + slack:
-            m = max(1, int(np.ceil((z_lo_c - top) / dz - 1e-9))) if dz > 0 else 1
-            extra = np.linspace(top, z_lo_c, m + 1)[1:]
+            extra = _thicknesses_beyond(top, z_lo_c, dz)
+            m = extra.size
             z = np.concatenate([z, extra])
             notes.append(
                 f"p-range-gpa: the stacking at shift ({probe.shift[0]:.4g}, {probe.shift[1]:.4g}) "
@@ -474,8 +474,8 @@ def thicknesses_spanning_columns(
                 f"{m} thickness(es) up to {z_lo_c:.4g} Å where its load is {lo_c:.4g} GPa"
             )
         if z_hi_c < bottom - 1e-9 and float(np.interp(bottom, zb, pb)) < hi_gpa - slack:
-            m = max(1, int(np.ceil((bottom - z_hi_c) / dz - 1e-9))) if dz > 0 else 1
-            extra = np.linspace(bottom, z_hi_c, m + 1)[1:]
+            extra = _thicknesses_beyond(bottom, z_hi_c, dz)
+            m = extra.size
             z = np.concatenate([z, extra])
             notes.append(
                 f"p-range-gpa: the stacking at shift ({probe.shift[0]:.4g}, {probe.shift[1]:.4g}) "
@@ -483,6 +483,13 @@ def thicknesses_spanning_columns(
                 f"{m} thickness(es) down to {z_hi_c:.4g} Å where its load is {hi_gpa:.4g} GPa"
             )
     return np.sort(z), notes
+
+
+def _thicknesses_beyond(edge: float, target: float, dz: float) -> np.ndarray:
+    """Thicknesses from just past ``edge`` to ``target`` (Å), evenly spaced at most ``dz``
+    apart (at least one: ``target`` itself; one if ``dz`` is not positive)."""
+    m = max(1, int(np.ceil(abs(target - edge) / dz - 1e-9))) if dz > 0 else 1
+    return np.linspace(edge, target, m + 1)[1:]
 
 
 def probe_thicknesses(

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import collections
 import dataclasses
+import functools
 import heapq
 import json
 import time
@@ -95,10 +96,7 @@ def _probe(
     workers at 96 %).
     """
     calc = worker_calculator(factory, reference)
-
-    def relax_one(a, b, z, start, start_z):
-        return relax_column_point(reference, calc, relax, a, b, z, start, start_z)
-
+    relax_one = functools.partial(relax_column_point, reference, calc, relax)
     rigid = grid_mod.rigid_stackings(reference, calc, grid)
     probe_columns = None
     if executor is not None and getattr(executor, "workers", 1) > 1:
@@ -122,12 +120,7 @@ def probe_column_task(context: ScanContext, shift, p_hi_gpa, stop_at_gpa):
     """Worker entry point: one probed column (:func:`grid_mod.probe_column`) with this
     worker's cached calculator."""
     calc = worker_calculator(context.factory, context.reference)
-
-    def relax_one(a, b, z, start, start_z):
-        return relax_column_point(
-            context.reference, calc, context.settings, a, b, z, start, start_z
-        )
-
+    relax_one = functools.partial(relax_column_point, context.reference, calc, context.settings)
     return grid_mod.probe_column(
         relax_one, context.reference, shift, p_hi_gpa, stop_at_gpa=stop_at_gpa
     )
