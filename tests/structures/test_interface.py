@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 
 from flatcontact.errors import InputError
 from flatcontact.structures.interface import (
+    MAX_SPREAD_STRAIN,
     MIN_INTERSLAB_DISTANCE_ANGSTROM,
     fixed_mask,
     interslab_min_distance,
@@ -86,6 +87,58 @@ def test_place_slab2_refuses_overlap(reference):
         place_slab2(reference, 0.0, 0.0, thickness(reference) - 4.0)
     ok = place_slab2(reference, 0.0, 0.0, thickness(reference))
     assert interslab_min_distance(ok) > MIN_INTERSLAB_DISTANCE_ANGSTROM
+
+
+@pytest.fixture(scope="module")
+def thick_reference():
+    """12 O-Si-O layers per slab: a compliant stack that a rigid placement cannot load far."""
+    slab = quartz_0001_slab(layers=12, cut=2)
+    return make_interface(slab, gap_angstrom=2.5, face_atoms=3, recipe={"test": "raw cut"})
+
+
+def test_place_slab2_spreads_a_compression_the_gap_cannot_take(thick_reference):
+    ref = thick_reference
+    z_ref = thickness(ref)
+    target = z_ref - 3.0  # 6.9 % of the stack; rigidly, an Si faces an O 0.3 Å away at (0.5, 0)
+    with pytest.raises(InputError, match="overlap"):
+        place_slab2(ref, 0.5, 0.0, target, spread_compression=False)
+    rigid = place_slab2(ref, 0.5, 0.0, z_ref)  # the same lateral placement, uncompressed
+    spread = place_slab2(ref, 0.5, 0.0, target)
+    assert thickness(spread) == pytest.approx(target, abs=1e-9)
+    assert interslab_min_distance(spread) >= MIN_INTERSLAB_DISTANCE_ANGSTROM
+    held = fixed_mask(ref)
+    lower = ref.arrays["slab"] == 1
+    # held layers: slab 1's untouched, slab 2's moved rigidly by dz
+    assert np.allclose(spread.positions[held & lower], ref.positions[held & lower])
+    dz = rigid.positions[held & ~lower] - spread.positions[held & ~lower]
+    assert np.allclose(dz, [0.0, 0.0, 3.0], atol=1e-9)
+    # free atoms: lateral as the rigid placement, heights an affine map fixing slab 1's held
+    # layer and scaling every distance above it by z/z_ref (a homogeneous strain)
+    free = ~held
+    assert np.allclose(spread.positions[free, :2], rigid.positions[free, :2], atol=1e-9)
+    h1 = ref.positions[held & lower, 2].mean()
+    h = ref.positions[free, 2]
+    assert np.allclose(spread.positions[free, 2] - h1, (h - h1) * target / z_ref, atol=1e-9)
+    # the stacking order of the atomic planes is kept
+    assert np.array_equal(
+        np.argsort(h, kind="stable"), np.argsort(spread.positions[free, 2], kind="stable")
+    )
+
+
+def test_place_slab2_rigid_whenever_the_rigid_placement_fits(thick_reference):
+    ref = thick_reference
+    for dz in (0.5, 2.0):  # no overlap rigidly at (0, 0): the spread is not used
+        placed = place_slab2(ref, 0.0, 0.0, thickness(ref) - dz)
+        upper = ref.arrays["slab"] == 2
+        assert np.allclose(placed.positions[upper, 2], ref.positions[upper, 2] - dz, atol=1e-9)
+        assert np.allclose(placed.positions[~upper], ref.positions[~upper])
+
+
+def test_place_slab2_refuses_a_spread_beyond_its_strain_bound(thick_reference):
+    ref = thick_reference
+    too_far = thickness(ref) * (1.0 - MAX_SPREAD_STRAIN) - 0.1
+    with pytest.raises(InputError, match="overlap"):
+        place_slab2(ref, 0.5, 0.0, too_far)
 
 
 def test_extxyz_round_trip(reference, tmp_path):

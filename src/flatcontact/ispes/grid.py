@@ -96,17 +96,31 @@ class GridSpec:
         return d
 
 
-def check_thicknesses(reference: Atoms, grid: GridSpec, thicknesses: Sequence[float]) -> None:
+def check_thicknesses(
+    reference: Atoms,
+    grid: GridSpec,
+    thicknesses: Sequence[float],
+    *,
+    spread_compression: bool = True,
+) -> None:
     """Raise InputError if any (shift, z) of the grid makes the slabs overlap.
 
-    ``place_slab2`` performs the overlap check (closest inter-slab distance); this
-    runs it for every lateral shift at every thickness, before any relaxation.
+    ``place_slab2`` performs the overlap check (closest inter-slab distance, with the
+    compression spread over the stack where allowed: ``spread_compression``, false for
+    rigid slabs); this runs it for every lateral shift at every thickness, before any
+    relaxation.
     """
     sa, sb = grid.shifts()
     for z in thicknesses:
         for a in sa:
             for b in sb:
-                place_slab2(reference, float(a), float(b), float(z))
+                place_slab2(
+                    reference,
+                    float(a),
+                    float(b),
+                    float(z),
+                    spread_compression=spread_compression,
+                )
 
 
 @dataclasses.dataclass(frozen=True)

@@ -203,14 +203,21 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
     """Relax one grid point with ``calc`` (reused across calls) and measure it.
 
     The structure is ``place_slab2(reference, task.shift_a, task.shift_b,
-    task.thickness)``; with ``task.start_positions`` the free atoms start from the
+    task.thickness)`` (compression spread over the stack where a rigid placement would
+    overlap, except in ``rigid`` mode); with ``task.start_positions`` the free atoms start from the
     neighbour's relaxed structure translated to this point
     (:func:`~flatcontact.ispes.geometry.warm_start_positions`; in ``normal`` mode only
     their heights are taken from it). Held atoms never move. ``settings.mode`` selects
     full, normal-only or no relaxation (module docstring).
     """
     t0 = time.perf_counter()
-    atoms = place_slab2(reference, task.shift_a, task.shift_b, task.thickness)
+    atoms = place_slab2(
+        reference,
+        task.shift_a,
+        task.shift_b,
+        task.thickness,
+        spread_compression=settings.mode != "rigid",
+    )
     fixed = fixed_mask(atoms)
     free = ~fixed
     relaxing = settings.mode != "rigid" and bool(free.any())

@@ -178,7 +178,9 @@ def run_scan(
         raise InputError(f"order: expected one of {', '.join(PREFERENCES)}, got {order!r}")
     check_interface(reference)
     if grid.thickness_angstrom is not None:
-        grid_mod.check_thicknesses(reference, grid, grid.thickness_angstrom)
+        grid_mod.check_thicknesses(
+            reference, grid, grid.thickness_angstrom, spread_compression=relax.mode != "rigid"
+        )
     out_dir = Path(out_dir)
     store_path = out_dir / POINTS_DB
     fresh_dir, fresh_store = not out_dir.exists(), not store_path.exists()
@@ -216,7 +218,9 @@ def run_scan(
                 notes = list(resolved.get("notes", notes))
                 z = np.asarray(resolved["thickness_angstrom"], dtype=float)
                 if grid.thickness_angstrom is None:
-                    grid_mod.check_thicknesses(reference, grid, z)
+                    grid_mod.check_thicknesses(
+                        reference, grid, z, spread_compression=relax.mode != "rigid"
+                    )
                 shape = (grid.n_a, grid.n_b, z.size)
                 sa, sb = grid.shifts()
                 root = (0, 0, int(np.argmin(np.abs(z - thickness(reference)))))

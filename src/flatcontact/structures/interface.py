@@ -42,6 +42,10 @@ from flatcontact.fileio import atomic_path
 #: Closest allowed distance (Å) between an atom of slab 1 and one of slab 2 in
 #: :func:`place_slab2`; shorter means the slabs overlap (a Si–O bond is 1.6 Å).
 MIN_INTERSLAB_DISTANCE_ANGSTROM = 1.0
+#: Largest compressive strain −dz/z_ref of the stack between the held layers that
+#: :func:`place_slab2` spreads homogeneously when a rigid placement would overlap (10 %: a
+#: stack of quartz slabs carries about 5 GPa at 5 %; beyond, the request is a mistake).
+MAX_SPREAD_STRAIN = 0.10
 #: Vacuum (Å) kept above and below the interface along z in the stored cell.
 DEFAULT_VACUUM_ANGSTROM = 10.0
 
@@ -313,18 +317,40 @@ def place_slab2(
     thickness_angstrom: float,
     *,
     min_distance_angstrom: float = MIN_INTERSLAB_DISTANCE_ANGSTROM,
+    spread_compression: bool = True,
 ) -> Atoms:
-    """A copy of ``reference`` with slab 2 moved rigidly to lateral shift (a, b) and thickness z.
+    """A copy of ``reference`` with slab 2 moved to lateral shift (a, b) and thickness z.
 
     Slab 2 is translated by shift_a·a1 + shift_b·a2 (fractions of the primitive
     in-plane vectors; atoms wrapped back into the cell) and vertically so that
     ``thickness(result) == thickness_angstrom``. Slab 1 is untouched.
 
+    Held atoms (``fixed_mask``) are always placed rigidly: slab 1's stay, slab 2's move by
+    the lateral shift and by dz = z − z(reference). Free atoms are placed rigidly with their
+    slab too, unless that would make the slabs overlap under compression (dz < 0) and
+    ``spread_compression`` is true: then the compression is spread homogeneously over the
+    stack between the held layers (each free atom's height h becomes h₁ + (h − h₁)·z/z_ref,
+    h₁ the mean height of slab 1's held atoms; lateral positions as rigid), the
+    way a compressed elastic stack shares it. A rigid placement puts the whole compression
+    into the interfacial gap, which caps how far a thick (compliant) slab can be loaded;
+    the spread start removes that cap. It is only a starting geometry: a relaxed point
+    depends on it only through the basin it starts in, and every placement that does not
+    overlap rigidly is the rigid one, so scans that ran before are unchanged.
+
+    Parameters
+    ----------
+    min_distance_angstrom
+        Closest allowed inter-slab distance (Å) of the placed structure.
+    spread_compression
+        Allow the homogeneous spread when the rigid placement overlaps (the scan passes
+        false in its ``rigid`` relax mode, where the slabs are never deformed). The spread
+        is refused beyond :data:`MAX_SPREAD_STRAIN` compressive strain.
+
     Raises
     ------
     InputError
-        If the shifts or thickness are not finite, or the slabs would overlap
-        (closest inter-slab distance below ``min_distance_angstrom``).
+        If the shifts or thickness are not finite, or the slabs would overlap (closest
+        inter-slab distance below ``min_distance_angstrom``) with the allowed placement.
     """
     validate_interface(reference, "reference interface")
     for name, value in (
@@ -337,17 +363,34 @@ def place_slab2(
     upper = atoms.arrays["slab"] == 2
     a1, a2 = in_plane_vectors(atoms)
     lateral = shift_a * a1 + shift_b * a2
-    dz = thickness_angstrom - thickness(reference)
+    z_reference = thickness(reference)
+    dz = thickness_angstrom - z_reference
     atoms.positions[upper] += np.array([lateral[0], lateral[1], dz])
     atoms.wrap()
     _set_vertical_cell(atoms, DEFAULT_VACUUM_ANGSTROM, keep_at_least=reference.cell.array[2, 2])
-    closest = interslab_min_distance(atoms, cutoff_angstrom=max(2.0 * min_distance_angstrom, 2.0))
+    closest = _closest_interslab(atoms, min_distance_angstrom)
+    if closest < min_distance_angstrom and spread_compression and dz < 0:
+        strain = -dz / z_reference
+        free = ~fixed_mask(atoms)
+        if strain <= MAX_SPREAD_STRAIN and free.any():
+            held1 = fixed_mask(reference) & ~upper
+            z1 = float(reference.positions[held1, 2].mean())
+            spread = atoms.copy()
+            z = reference.positions[free, 2]
+            spread.positions[free, 2] = z1 + (z - z1) * (thickness_angstrom / z_reference)
+            spread_closest = _closest_interslab(spread, min_distance_angstrom)
+            if spread_closest >= min_distance_angstrom:
+                return spread
     if closest < min_distance_angstrom:
         raise InputError(
             f"thickness {thickness_angstrom:.3f} Å at shift ({shift_a:.4g}, {shift_b:.4g}) makes the slabs "
             f"overlap: closest inter-slab distance {closest:.3f} Å < {min_distance_angstrom} Å"
         )
     return atoms
+
+
+def _closest_interslab(atoms: Atoms, min_distance_angstrom: float) -> float:
+    return interslab_min_distance(atoms, cutoff_angstrom=max(2.0 * min_distance_angstrom, 2.0))
 
 
 # --------------------------------------------------------------------------- I/O and validation
