@@ -137,6 +137,46 @@ VARIANTS: dict[str, tuple[str, str, dict, str]] = {
         },
         "layers12_g8",
     ),
+    "layers9_f25_g8": (
+        "force tolerance (thick slabs)",
+        "9 layers at fmax 0.0025 eV/Å (half; compared with layers9_g8): the relaxation noise "
+        "of a compliant stack",
+        {
+            "scan": {
+                "grid": [8, 8],
+                "p_range_gpa": THICK_SLAB_P_RANGE[9],
+                "fmax_ev_per_angstrom": 0.0025,
+            },
+            "structure": {"layers": 9},
+        },
+        "layers9_g8",
+    ),
+    "layers12_f25_g8": (
+        "slab layers",
+        "12 layers at fmax 0.0025 eV/Å (compared with layers9_f25_g8)",
+        {
+            "scan": {
+                "grid": [8, 8],
+                "p_range_gpa": THICK_SLAB_P_RANGE[9],
+                "fmax_ev_per_angstrom": 0.0025,
+            },
+            "structure": {"layers": 12},
+        },
+        "layers9_f25_g8",
+    ),
+    "layers15_f25_g8": (
+        "slab layers",
+        "15 layers at fmax 0.0025 eV/Å (compared with layers12_f25_g8)",
+        {
+            "scan": {
+                "grid": [8, 8],
+                "p_range_gpa": THICK_SLAB_P_RANGE[9],
+                "fmax_ev_per_angstrom": 0.0025,
+            },
+            "structure": {"layers": 15},
+        },
+        "layers12_f25_g8",
+    ),
     "paper_layers6": (
         "slab layers",
         "the paper preset (12x12, LJ 18 Å, 6 layers) scanned again with the code of the "

@@ -26,7 +26,17 @@ import sys
 
 from benchmarks.convergence.study import RESULTS, RUNS, config_for
 
-MODELS = ["snap", "chgnet-r2scan", "sevennet-0", "sevennet-mf-0-r2scan", "sevennet-mf-0-pbe"]
+#: "snap" is the bundled ``sio2-snap`` (CHGNet r2SCAN labels, the paper preset's), "snap-mf0"
+#: the bundled ``sio2-snap-mf0`` (SevenNet-MF-0 r2SCAN labels, refit to its teacher's Cij).
+SURROGATES = {"snap": "sio2-snap", "snap-mf0": "sio2-snap-mf0"}
+MODELS = [
+    "snap",
+    "snap-mf0",
+    "chgnet-r2scan",
+    "sevennet-0",
+    "sevennet-mf-0-r2scan",
+    "sevennet-mf-0-pbe",
+]
 ISPES_GRID = (4, 4)
 ISPES_P_RANGE = (-0.3, 5.5, 8)
 ISPES_LOADS = (0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0)
@@ -40,7 +50,7 @@ def bulk(name: str):
     from flatcontact.training.ispes_check import teacher_calculator
     from flatcontact.training.potentials import bulk_calculator
 
-    return bulk_calculator("sio2-snap") if name == "snap" else teacher_calculator(name)
+    return bulk_calculator(SURROGATES[name]) if name in SURROGATES else teacher_calculator(name)
 
 
 def elastic(names: list[str]) -> None:
@@ -88,8 +98,8 @@ def ispes(names: list[str], reuse: list[str] = ()) -> None:
         if name in reuse:
             continue
         models[name] = (
-            PotentialSpec.model_validate(snap.model_dump())
-            if name == "snap"
+            PotentialSpec.model_validate(snap.model_dump() | {"intra": f"snap:{SURROGATES[name]}"})
+            if name in SURROGATES
             else teacher_spec(name, lj)
         )
     RESULTS.mkdir(parents=True, exist_ok=True)

@@ -128,7 +128,9 @@ def test_bad_columns_are_refused():
     dented = ds.copy(deep=True)  # a concave kink in U(z): -dU/dz turns, then falls again
     dented["energy"][1, 2, 4] = dented.energy[1, 2, 4] - 0.2
     with pytest.raises(
-        InputError, match=r"-\(1/A\) dU/dz is not monotonic on the repulsive branch.*z = "
+        InputError,
+        match=r"-\(1/A\) dU/dz is not monotonic on the repulsive branch.*z = .*tighten "
+        r"scan.fmax_ev_per_angstrom or use analysis.load_source: stress",
     ):
         constant_pressure(dented, [0.5], load_source="energy")
     with pytest.raises(InputError, match="load source"):

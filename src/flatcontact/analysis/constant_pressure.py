@@ -172,6 +172,15 @@ def _out_of_range(targets, p_lo, p_hi, z, z_end, labels) -> None:
         )
 
 
+#: The remedy named when the energy-derived load is not monotonic: its error is second
+#: order in the relaxation residuals but grows with the number of soft modes (thick,
+#: compliant slabs), so a tighter force tolerance or the first-order stored load fixes it.
+_ENERGY_LOAD_HINT = (
+    "; the energies are not converged enough for their derivative: tighten "
+    "scan.fmax_ev_per_angstrom or use analysis.load_source: stress"
+)
+
+
 def _branch(z, p, labels, what):
     """Index ``m`` of the lowest node of ``p`` per column; InputError unless p falls up to it."""
     n_z = p.shape[1]
@@ -192,6 +201,7 @@ def _branch(z, p, labels, what):
             f"p = {p[j, k] * units.EV_PER_A3_TO_GPA:.4g} GPa at z = {z[k]:.4g} Å, "
             f"{p[j, k + 1] * units.EV_PER_A3_TO_GPA:.4g} GPa at z = {z[k + 1]:.4g} Å "
             "(expected p to decrease with thickness up to the maximum tension)"
+            + (_ENERGY_LOAD_HINT if what.startswith("-(1/A)") else "")
         )
     return m
 
