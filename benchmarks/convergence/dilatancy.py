@@ -1,0 +1,142 @@
+"""Dilatancy of stored ISPES scans: how the thickness at fixed load varies with the registry.
+
+Why two models' enthalpy-form τ differ on the same interface: by the envelope theorem the
+enthalpy corrugation ``h(x, y)|_P = U(z*)/A + P z*`` carries the load term ``P z*(x, y)``,
+so a model whose ``z*`` varies less with the lateral shift has a smaller ``h`` corrugation
+and a smaller τ at the same load. This splits ``z*`` into the interface gap and the slabs.
+
+Usage (no torch; reads the scans, writes nothing else)::
+
+    python -m benchmarks.convergence.dilatancy OUT.json LABEL=DIR [LABEL=DIR ...]
+
+Each ``DIR`` holds a scan's ``ispes.nc`` and ``points.db`` (the relaxed atoms); the first
+model is the reference of the ratios. Per load (0, 0.5, …, 3 GPa): the lateral mean of
+``z*`` (Å), its slope d<z*>/dP (Å/GPa, the normal compliance of interface plus slabs),
+the lateral ranges (max − min over the grid) of ``z*``, of the gap and of the slabs at
+``z*`` (Å), of ``U(z*)/A`` and of ``h`` (mJ/m²), and the correlation of the ``z*`` pattern
+with the reference's. Gap: lowest atom of slab 2 minus highest atom of slab 1 (the first
+and second half of the atoms, the scan's order); slabs: the sum of the two slabs' z
+extents; both interpolated linearly in thickness at ``z*``.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+LOADS_GPA = np.array([0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0])
+#: 1 eV/Å² in mJ/m².
+MJ_PER_M2_PER_EV_PER_A2 = 16021.766
+
+
+def _lateral_range(x: np.ndarray) -> np.ndarray:
+    """max − min over the lateral grid, per load (arrays ``[load, a, b]``)."""
+    return x.max(axis=(1, 2)) - x.min(axis=(1, 2))
+
+
+def gap_and_slabs(folder: Path, shape: tuple[int, int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """Gap and summed slab extents (Å) of every stored point, arrays ``[a, b, thickness]``."""
+    from ase.db import connect
+
+    gap, slabs = np.full(shape, np.nan), np.full(shape, np.nan)
+    for row in connect(folder / "points.db").select():
+        z = row.toatoms().positions[:, 2]
+        half = len(z) // 2
+        lower, upper = z[:half], z[half:]
+        k = (row.i_a, row.i_b, row.i_z)
+        gap[k] = upper.min() - lower.max()
+        slabs[k] = (lower.max() - lower.min()) + (upper.max() - upper.min())
+    return gap, slabs
+
+
+def dilatancy(folder: Path) -> dict:
+    """Per-load dilatancy figures of the scan in ``folder`` (see the module docstring)."""
+    import xarray as xr
+
+    from flatcontact.analysis.constant_pressure import constant_pressure
+
+    ds = xr.open_dataset(folder / "ispes.nc")
+    cp = constant_pressure(ds, LOADS_GPA, form="enthalpy", source=str(folder / "ispes.nc"))
+    z_grid = ds["thickness"].values
+    gap, slabs = gap_and_slabs(folder, ds["energy"].shape)
+    z_star = cp.thickness_angstrom
+    at_z = {"gap": np.empty_like(z_star), "slabs": np.empty_like(z_star)}
+    for name, grid in (("gap", gap), ("slabs", slabs)):
+        for idx in np.ndindex(z_star.shape):
+            at_z[name][idx] = np.interp(z_star[idx], z_grid, grid[idx[1], idx[2]])
+    z_mean = z_star.mean(axis=(1, 2))
+    return {
+        "p_gpa": LOADS_GPA.tolist(),
+        "z_mean_angstrom": z_mean.tolist(),
+        "dz_dp_angstrom_per_gpa": np.gradient(z_mean, LOADS_GPA).tolist(),
+        "z_range_angstrom": _lateral_range(z_star).tolist(),
+        "gap_range_angstrom": _lateral_range(at_z["gap"]).tolist(),
+        "gap_mean_angstrom": at_z["gap"].mean(axis=(1, 2)).tolist(),
+        "slabs_range_angstrom": _lateral_range(at_z["slabs"]).tolist(),
+        "slabs_mean_angstrom": at_z["slabs"].mean(axis=(1, 2)).tolist(),
+        "u_range_mj_per_m2": _lateral_range(
+            cp.internal_ev_per_a2 * MJ_PER_M2_PER_EV_PER_A2
+        ).tolist(),
+        "h_range_mj_per_m2": _lateral_range(cp.energy_ev_per_a2 * MJ_PER_M2_PER_EV_PER_A2).tolist(),
+        "_z_star": z_star,
+    }
+
+
+def pattern_correlation(z: np.ndarray, z_ref: np.ndarray) -> list[float]:
+    """Per load, the correlation over the grid of two ``z*`` patterns (means removed)."""
+    d, d_ref = (
+        z - z.mean(axis=(1, 2), keepdims=True),
+        z_ref - z_ref.mean(axis=(1, 2), keepdims=True),
+    )
+    num = (d * d_ref).sum(axis=(1, 2))
+    return (num / np.sqrt((d**2).sum(axis=(1, 2)) * (d_ref**2).sum(axis=(1, 2)))).tolist()
+
+
+def main(argv: list[str] | None = None) -> None:
+    argv = sys.argv[1:] if argv is None else argv
+    if len(argv) < 2 or any("=" not in a for a in argv[1:]):
+        sys.exit("usage: python -m benchmarks.convergence.dilatancy OUT.json LABEL=DIR [...]")
+    out = Path(argv[0])
+    models = {}
+    for item in argv[1:]:
+        label, folder = item.split("=", 1)
+        models[label] = dilatancy(Path(folder))
+    ref_label = next(iter(models))
+    ref = models[ref_label]
+    for m in models.values():
+        m["z_pattern_correlation_with_reference"] = pattern_correlation(
+            m["_z_star"], ref["_z_star"]
+        )
+        for q in (
+            "z_range_angstrom",
+            "gap_range_angstrom",
+            "h_range_mj_per_m2",
+            "u_range_mj_per_m2",
+        ):
+            m[f"{q}_over_reference"] = (np.array(m[q]) / np.array(ref[q])).tolist()
+    for m in models.values():
+        del m["_z_star"]
+    out.write_text(json.dumps({"reference": ref_label, "models": models}, indent=1) + "\n")
+    for label, m in models.items():
+        print(label)
+        for q in (
+            "z_range_angstrom",
+            "gap_range_angstrom",
+            "slabs_range_angstrom",
+            "h_range_mj_per_m2",
+        ):
+            print(f"  {q:>24}", np.round(m[q], 3))
+        if label != ref_label:
+            print(
+                f"  {'z range / reference':>24}", np.round(m["z_range_angstrom_over_reference"], 3)
+            )
+            print(
+                f"  {'h range / reference':>24}", np.round(m["h_range_mj_per_m2_over_reference"], 3)
+            )
+
+
+if __name__ == "__main__":
+    main()
