@@ -205,3 +205,91 @@ def test_choose_start_does_not_depend_on_the_order_of_the_starts(pairs, rnd):
     # the same start up to the tie: equal energy, τ equal within the tie tolerance
     assert energies[order][j] == energies[k]
     assert abs(taus[order][j] - taus[k]) <= TAU_TIE_RTOL * max(abs(top), 1e-300)
+
+
+def _assert_same_point(
+    surf: PeriodicSurface, xy: np.ndarray, other: np.ndarray, atol: float = 1e-9
+) -> None:
+    """``xy`` and ``other`` (Å) coincide modulo the lattice to ``atol`` (Å)."""
+    ds = surf.fractional(np.asarray(xy) - np.asarray(other))
+    np.testing.assert_allclose(surf.cartesian(ds - np.round(ds)), 0.0, atol=atol)
+
+
+def _clearly_deeper_reference_tau(delta: float) -> float:
+    """τ (eV/Å³) out of the deepest minimum of ``_two_minima(delta)``, dense 1-D along s_a = 0."""
+    u = np.linspace(0.0, 2.0, 2_000_001)
+    f = np.cos(TWO_PI * u) + GAMMA * np.cos(2 * TWO_PI * u) + delta * np.sin(TWO_PI * u)
+    fp = _fprime(u) + delta * TWO_PI * np.cos(TWO_PI * u)
+    i0 = int(np.argmin(f[u < 1]))
+    top = i0 + int(np.argmax((fp[i0 + 1 :] < 0) & (fp[i0:-1] >= 0))) + 1
+    return V / B * float(np.max(fp[i0:top]))
+
+
+@pytest.mark.parametrize("n", [4, 8])
+@pytest.mark.parametrize("offset_ev_per_a2", [0.0, 0.055, 0.3, 1.0])
+def test_a_constant_offset_does_not_lose_the_global_minimum(n, offset_ev_per_a2):
+    """Regression: the trust region stalled on the value's round-off under a large offset.
+
+    At offsets ≥ 0.3 eV/Å² (300× the corrugation V) the deeper minimum was refined only to
+    |∇e| a / ptp(e) ≈ 2e-7, rejected as not stationary, and τ came from the shallower
+    minimum (129 MPa instead of 499 MPa). The minima, the start and τ must not depend on a
+    constant added to the landscape.
+    """
+    delta = 0.05
+    a1, a2 = syn.rectangular_cell(A, B)
+    flat = _surface(_two_minima(delta), a1, a2, n=n)
+    surf = PeriodicSurface(flat.values + offset_ev_per_a2, a1, a2)
+    reference = flat.local_minima()
+    minima = surf.local_minima()
+    assert len(reference) == len(minima) == 2
+    for (x, v), (x0, v0) in zip(minima, reference, strict=True):
+        _assert_same_point(surf, x, x0)
+        assert v - offset_ev_per_a2 == pytest.approx(v0, abs=1e-15)
+    gx, gv = surf.global_minimum()
+    _assert_same_point(surf, minima[0][0], gx, atol=1e-6)  # global_minimum: trust region only
+    assert minima[0][1] <= gv + 1e-15
+    starts, k = paths_from_near_degenerate_minima(surf, 90.0, degeneracy_tolerance_ev_per_a2(0.0))
+    assert len(starts) == 1
+    _assert_same_point(surf, starts[k].xy_angstrom, minima[0][0])
+    tau_ref = _clearly_deeper_reference_tau(delta)
+    assert starts[k].friction.tau_ev_per_a3 == pytest.approx(tau_ref, rel=1e-8)
+
+
+#: The constant-pressure landscape (eV/Å², above its lowest sample) of the bundled-SNAP
+#: teacher-comparison scan (4×4 lateral grid, quartz (0001), enthalpy form) at 0.5 GPa, and
+#: the constant it sat on there (energy zero at the 0 GPa global minimum).
+SNAP_4X4_0P5GPA = [
+    [0.0, 0.0004180172312047148, 0.0004852633001704021, 0.0004221233755465903],
+    [0.0005211914204004131, 0.000418017571185203, 0.0006862494842856393, 0.0007638580601678768],
+    [0.0012890158954981246, 0.0007676704985684069, 0.000488522931803459, 0.000764241494241702],
+    [0.0005211901696107191, 0.0007673609011611404, 0.0006856230769365368, 0.0004221237036574621],
+]
+SNAP_4X4_0P5GPA_OFFSET = 0.0550539703464743
+
+
+def test_snap_4x4_landscape_starts_at_its_global_minimum_whatever_its_offset():
+    """Regression: τ was 13.2 or 1.85 MPa (round-off-dependent) from a metastable minimum.
+
+    The sample at s = (0, 0) is 0.49 meV/Å² below every other minimum of the interpolant; the
+    trust region stalled next to it, so the slider started in the shallow minimum near
+    s = (1/2, 1/2) or near s = (0, 1/2), whose first barriers (0.028, 0.0025 meV/Å²) set τ.
+    """
+    a1, a2 = syn.hexagonal_cell(4.916)
+    values = np.array(SNAP_4X4_0P5GPA)
+    flat = PeriodicSurface(values, a1, a2)
+    surf = PeriodicSurface(values + SNAP_4X4_0P5GPA_OFFSET, a1, a2)
+    assert len(flat.local_minima()) == len(surf.local_minima()) == 3
+    gx, _ = surf.global_minimum()
+    s = surf.fractional(gx)
+    np.testing.assert_allclose(s - np.round(s), 0.0, atol=1e-3)  # next to the lowest sample
+    taus = []
+    for landscape in (flat, surf):
+        starts, k = paths_from_near_degenerate_minima(
+            landscape, 90.0, degeneracy_tolerance_ev_per_a2(0.0)
+        )
+        assert len(starts) == 1
+        _assert_same_point(surf, starts[k].xy_angstrom, gx, atol=1e-6)
+        taus.append(starts[k].tau_mpa)
+        # the first climb out of the global minimum is the hardest one of the period
+        assert starts[k].tau_mpa == pytest.approx(starts[k].friction.tau_period_mpa, rel=1e-9)
+    assert taus[1] == pytest.approx(taus[0], rel=1e-9)

@@ -14,7 +14,8 @@ hollow is pulling along ``-d`` from the other): τ flipped between 60.5 and
 Rule (deterministic, independent of round-off, the same at every load):
 
 1. all inequivalent local minima in the cell are found on the exact periodic
-   interpolant (:meth:`.PeriodicSurface.local_minima`);
+   interpolant (:meth:`.PeriodicSurface.local_minima`; robust to a constant
+   added to the landscape, so the global minimum is always among them);
 2. minima within the **degeneracy tolerance** ``δ = max(2 ε(P),``
    ``DEGENERACY_FLOOR_MEV_PER_A2)`` of the lowest are *near-degenerate*
    (``ε(P)`` the energy noise of the load, :mod:`.noise`; the same ``2 ε``
