@@ -3,6 +3,7 @@
 Usage (from the repository root, one variant at a time, in the background on a shared machine)::
 
     python -m benchmarks.convergence.study run ref grid16 ...   # scans + analysis -> results/<name>.json
+    python -m benchmarks.convergence.study reanalyze ref ...    # stored grids, analysis only
     python -m benchmarks.convergence.study table                # results/convergence.{csv,md}
 
 Every variant is the ``paper`` preset of :func:`flatcontact.config.preset` with ONE change
@@ -388,17 +389,50 @@ def run_derived(name: str) -> dict:
     return doc
 
 
+def reanalyze_variant(name: str) -> dict:
+    """Analyse variant ``name``'s stored grid again and update ``results/<name>.json``.
+
+    For a change of the analysis code only: the pipeline's stage fingerprints include the
+    package's code, so ``run`` would rescan. This reads ``RUNS/<name>/02-scan/ispes.nc`` as
+    it is and replaces the loads, laws and warnings of the results file (scan facts, timings
+    and W are the scan's and stay); ``reanalyzed`` records when.
+    """
+    from flatcontact.ispes.contract import open_ispes
+
+    path = RESULTS / f"{name}.json"
+    if not path.is_file():
+        sys.exit(f"error: {path} does not exist; 'run {name}' first")
+    doc = json.loads(path.read_text())
+    ds = open_ispes(RUNS / name / "02-scan" / "ispes.nc")
+    rows, laws, notes, seconds = analyze_grid(ds, config_for(name).analysis)
+    doc.update(
+        loads=rows,
+        laws=laws,
+        analysis_warnings=notes,
+        reanalyzed={"at": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "analyze_s": seconds},
+    )
+    path.write_text(json.dumps(doc, indent=1, default=float) + "\n")
+    return doc
+
+
 def main(argv: list[str]) -> None:
-    if not argv or argv[0] not in ("run", "table"):
-        sys.exit("usage: python -m benchmarks.convergence.study run NAME ... | table")
-    if argv[0] == "run":
+    if not argv or argv[0] not in ("run", "reanalyze", "table"):
+        sys.exit(
+            "usage: python -m benchmarks.convergence.study run NAME ... | reanalyze NAME ... | table"
+        )
+    if argv[0] in ("run", "reanalyze"):
         unknown = [n for n in argv[1:] if n not in VARIANTS and n not in DERIVED]
         if unknown:
             known = sorted([*VARIANTS, *DERIVED])
             sys.exit(f"error: unknown variant(s) {unknown}; expected some of {known}")
         for name in argv[1:]:
             t0 = time.perf_counter()
-            doc = run_derived(name) if name in DERIVED else run_variant(name)
+            if name in DERIVED:
+                doc = run_derived(name)
+            elif argv[0] == "reanalyze":
+                doc = reanalyze_variant(name)
+            else:
+                doc = run_variant(name)
             print(
                 f"{name}: done in {time.perf_counter() - t0:.0f} s; laws {doc['laws']}", flush=True
             )
