@@ -128,16 +128,6 @@ VARIANTS: dict[str, tuple[str, str, dict, str]] = {
         },
         "layers9_g8",
     ),
-    "layers15_g8": (
-        "slab layers",
-        "15 O-Si-O layers per slab (shipped dense slab + 3 bulk c-repeats; 8x8 grid, "
-        "thicknesses up to 5.2 GPa; compared with layers12_g8)",
-        {
-            "scan": {"grid": [8, 8], "p_range_gpa": THICK_SLAB_P_RANGE[9]},
-            "structure": {"layers": 15},
-        },
-        "layers12_g8",
-    ),
     "layers9_f25_g8": (
         "force tolerance (thick slabs)",
         "9 layers at fmax 0.0025 eV/Å (half; compared with layers9_g8): the relaxation noise "
