@@ -45,6 +45,16 @@ THICK_SLAB_P_RANGE = {
     9: {"lo_gpa": -0.3, "hi_gpa": round(-0.3 + 18 * _P_STEP_GPA, 6), "n": 19},
     "rigid12": {"lo_gpa": -0.3, "hi_gpa": round(-0.3 + 11 * _P_STEP_GPA, 6), "n": 12},
 }
+
+
+def _thick_slab_overrides(layers: int, **scan) -> dict:
+    """Config overrides of a thick-slab step: 8x8, the 9-layer load range, ``layers`` per slab."""
+    return {
+        "scan": {"grid": [8, 8], "p_range_gpa": THICK_SLAB_P_RANGE[9], **scan},
+        "structure": {"layers": layers},
+    }
+
+
 #: name -> (setting varied, what, config overrides laid over the paper preset, the run it is
 #: compared with). Variants on an 8x8 grid (``*_g8``) measure a setting's effect at the
 #: coarser grid, to fit the CPU budget of a shared 2-core machine.
@@ -122,50 +132,26 @@ VARIANTS: dict[str, tuple[str, str, dict, str]] = {
         "12 O-Si-O layers per slab (shipped dense slab + 2 bulk c-repeats; 8x8 grid, "
         "thicknesses up to 5.2 GPa as layers9_g8, compression spread over the stack where the "
         "gap cannot take it; compared with layers9_g8)",
-        {
-            "scan": {"grid": [8, 8], "p_range_gpa": THICK_SLAB_P_RANGE[9]},
-            "structure": {"layers": 12},
-        },
+        _thick_slab_overrides(12),
         "layers9_g8",
     ),
     "layers9_f25_g8": (
         "force tolerance (thick slabs)",
         "9 layers at fmax 0.0025 eV/Å (half; compared with layers9_g8): the relaxation noise "
         "of a compliant stack",
-        {
-            "scan": {
-                "grid": [8, 8],
-                "p_range_gpa": THICK_SLAB_P_RANGE[9],
-                "fmax_ev_per_angstrom": 0.0025,
-            },
-            "structure": {"layers": 9},
-        },
+        _thick_slab_overrides(9, fmax_ev_per_angstrom=0.0025),
         "layers9_g8",
     ),
     "layers12_f25_g8": (
         "slab layers",
         "12 layers at fmax 0.0025 eV/Å (compared with layers9_f25_g8)",
-        {
-            "scan": {
-                "grid": [8, 8],
-                "p_range_gpa": THICK_SLAB_P_RANGE[9],
-                "fmax_ev_per_angstrom": 0.0025,
-            },
-            "structure": {"layers": 12},
-        },
+        _thick_slab_overrides(12, fmax_ev_per_angstrom=0.0025),
         "layers9_f25_g8",
     ),
     "layers15_f25_g8": (
         "slab layers",
         "15 layers at fmax 0.0025 eV/Å (compared with layers12_f25_g8)",
-        {
-            "scan": {
-                "grid": [8, 8],
-                "p_range_gpa": THICK_SLAB_P_RANGE[9],
-                "fmax_ev_per_angstrom": 0.0025,
-            },
-            "structure": {"layers": 15},
-        },
+        _thick_slab_overrides(15, fmax_ev_per_angstrom=0.0025),
         "layers12_f25_g8",
     ),
     "paper_layers6": (
