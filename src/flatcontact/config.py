@@ -78,7 +78,9 @@ def _positive_pair(value: Any, what: str) -> tuple[int, int]:
         raise ValueError(f"expected two positive integers, got {_show(value)}")
     for v in value:
         if v > limits.bound("grid_axis"):
-            raise ValueError(limits.message("grid_axis", v, f"points along one axis of {_show(value)}"))
+            raise ValueError(
+                limits.message("grid_axis", v, f"points along one axis of {_show(value)}")
+            )
     return (int(value[0]), int(value[1]))
 
 
@@ -264,7 +266,9 @@ class ScanConfig(_Section):
             raise ValueError(
                 "grid: "
                 + limits.message(
-                    "scan_points", points, f"{self.grid[0]}x{self.grid[1]} points x {n_z} thicknesses"
+                    "scan_points",
+                    points,
+                    f"{self.grid[0]}x{self.grid[1]} points x {n_z} thicknesses",
                 )
             )
         if self.workers is not None and self.workers > limits.bound("workers"):

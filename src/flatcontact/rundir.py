@@ -60,7 +60,16 @@ from flatcontact.fileio import write_json_atomic
 RECORD_NAME = "stage.json"
 LOCK_NAME = ".flatcontact.lock"
 #: Files of a stage folder that are not outputs (records, locks, SQLite side files).
-_NOT_OUTPUTS = (RECORD_NAME, ".flatcontact.lock", ".driver", "-journal", "-wal", "-shm", ".part", ".tmp")
+_NOT_OUTPUTS = (
+    RECORD_NAME,
+    ".flatcontact.lock",
+    ".driver",
+    "-journal",
+    "-wal",
+    "-shm",
+    ".part",
+    ".tmp",
+)
 #: errno values meaning "this place cannot be written" (not "the disk is full").
 READ_ONLY_ERRNOS = (errno.EROFS, errno.EACCES, errno.EPERM)
 STATE_RUNNING = "running"

@@ -81,19 +81,43 @@ def cluster(tmp_path, monkeypatch):
     try:
         procs.append(
             subprocess.Popen(
-                [dask, "scheduler", "--host", "127.0.0.1", "--port", "0",
-                 "--no-dashboard", "--scheduler-file", str(info)],
-                env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                [
+                    dask,
+                    "scheduler",
+                    "--host",
+                    "127.0.0.1",
+                    "--port",
+                    "0",
+                    "--no-dashboard",
+                    "--scheduler-file",
+                    str(info),
+                ],
+                env=env,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
             )
         )
         _wait_for(info.exists, 60, "the scheduler file")
-        address = _wait_for(lambda: json.loads(info.read_text() or "{}").get("address"), 30,
-                            "the scheduler address")
+        address = _wait_for(
+            lambda: json.loads(info.read_text() or "{}").get("address"), 30, "the scheduler address"
+        )
         procs.append(
             subprocess.Popen(
-                [dask, "worker", address, "--nworkers", "2", "--nthreads", "1",
-                 "--no-dashboard", "--host", "127.0.0.1"],
-                env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                [
+                    dask,
+                    "worker",
+                    address,
+                    "--nworkers",
+                    "2",
+                    "--nthreads",
+                    "1",
+                    "--no-dashboard",
+                    "--host",
+                    "127.0.0.1",
+                ],
+                env=env,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
             )
         )
         yield address, procs[1]

@@ -91,4 +91,3 @@ def test_a_two_worker_scan_leaves_no_process_behind(tmp_path):
 
     _gone, alive = psutil.wait_procs(left(), timeout=10)
     assert not alive, f"processes left in the scan's session: {[p.pid for p in alive]}"
-

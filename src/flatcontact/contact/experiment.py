@@ -143,9 +143,7 @@ def load_stiffness_csv(path: str | Path) -> MeasuredStiffness:
     p = Path(path)
     require(p.exists(), f"experiment file {str(p)!r} does not exist")
     text = read_text_file(p, "measured stiffness CSV", 50_000_000)
-    lines = [
-        ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")
-    ]
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     require(len(lines) > 0, f"{p.name}: empty file, expected a header and data rows")
     header = [c.strip() for c in lines[0].split(",")]
     require(
