@@ -48,13 +48,12 @@ def _potential_spec(potential: str | None, lj_cutoff_angstrom: float | None):
     """
     from flatcontact.config import default_potential
     from flatcontact.potentials import PotentialSpec
-    from flatcontact.potentials.presets import PRESETS
 
     section = default_potential()
-    if potential is not None and potential.strip() in PRESETS:
-        section = {"preset": potential.strip()}  # a whole model, not the quartz LJ's intra
-    elif potential is not None:
-        section["intra"] = potential
+    if potential is not None:
+        flag = _potential_flag_section(potential)
+        # a preset is a whole model, not the quartz LJ's intra-slab part
+        section = flag if "preset" in flag else {**section, **flag}
     if lj_cutoff_angstrom is not None:
         section.setdefault("lj", {})["cutoff_angstrom"] = _positive_finite(
             lj_cutoff_angstrom, "--lj-cutoff-angstrom", "Å"
@@ -201,11 +200,17 @@ def _config_settings(config: Path, structure: Path | None, potential: str | None
     if structure is not None:
         flags["structure"] = {"kind": "slab", "file": str(structure), "gap_angstrom": gap}
     if potential is not None:
-        from flatcontact.potentials.presets import PRESETS
-
-        name = potential.strip()
-        flags["potential"] = {"preset": name} if name in PRESETS else {"intra": name}
+        flags["potential"] = _potential_flag_section(potential)
     return resolve_config(config, None, flags, _FLAG_OF)
+
+
+def _potential_flag_section(potential: str) -> dict:
+    """``--potential`` as a ``potential:`` section: ``{preset: NAME}`` for an interaction
+    preset (:data:`flatcontact.potentials.presets.PRESETS`), else ``{intra: NAME}``."""
+    from flatcontact.potentials.presets import PRESETS
+
+    name = potential.strip()
+    return {"preset": name} if name in PRESETS else {"intra": name}
 
 
 def _print(result, out: Path) -> None:
