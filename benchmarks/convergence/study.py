@@ -172,6 +172,38 @@ VARIANTS: dict[str, tuple[str, str, dict, str]] = {
         },
         "paper_layers6",
     ),
+    "paper_grid16": (
+        "lateral grid",
+        "the paper preset (9 layers, LJ 18 Å) on a 16x16 lateral grid (one step finer; "
+        "compared with paper_layers9; 2 workers, which do not change a number)",
+        {
+            "potential": {"lj": {"cutoff_angstrom": 18.0}},
+            "structure": {"layers": 9},
+            "scan": {
+                "grid": [16, 16],
+                "p_range_gpa": THICK_SLAB_P_RANGE[9],
+                "executor": "processes",
+                "workers": 2,
+            },
+        },
+        "paper_layers9",
+    ),
+    "paper_grid20": (
+        "lateral grid",
+        "the paper preset (9 layers, LJ 18 Å) on a 20x20 lateral grid (compared with "
+        "paper_grid16; 2 workers)",
+        {
+            "potential": {"lj": {"cutoff_angstrom": 18.0}},
+            "structure": {"layers": 9},
+            "scan": {
+                "grid": [20, 20],
+                "p_range_gpa": THICK_SLAB_P_RANGE[9],
+                "executor": "processes",
+                "workers": 2,
+            },
+        },
+        "paper_grid16",
+    ),
     "layers6_rigid_g8": (
         "slab layers (diagnostic)",
         "6 layers, rigid slabs (no relaxation at any point: the interface's own corrugation; "
