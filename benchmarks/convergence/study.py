@@ -55,6 +55,21 @@ def _thick_slab_overrides(layers: int, **scan) -> dict:
     }
 
 
+def _paper_preset_on_grid(n: int) -> dict:
+    """Overrides of the paper preset (9 layers, LJ 18 Å) on an n x n grid; 2 workers, which
+    do not change a number (the executors agree to 1e-12)."""
+    return {
+        "potential": {"lj": {"cutoff_angstrom": 18.0}},
+        "structure": {"layers": 9},
+        "scan": {
+            "grid": [n, n],
+            "p_range_gpa": THICK_SLAB_P_RANGE[9],
+            "executor": "processes",
+            "workers": 2,
+        },
+    }
+
+
 #: name -> (setting varied, what, config overrides laid over the paper preset, the run it is
 #: compared with). Variants on an 8x8 grid (``*_g8``) measure a setting's effect at the
 #: coarser grid, to fit the CPU budget of a shared 2-core machine.
@@ -176,32 +191,14 @@ VARIANTS: dict[str, tuple[str, str, dict, str]] = {
         "lateral grid",
         "the paper preset (9 layers, LJ 18 Å) on a 16x16 lateral grid (one step finer; "
         "compared with paper_layers9; 2 workers, which do not change a number)",
-        {
-            "potential": {"lj": {"cutoff_angstrom": 18.0}},
-            "structure": {"layers": 9},
-            "scan": {
-                "grid": [16, 16],
-                "p_range_gpa": THICK_SLAB_P_RANGE[9],
-                "executor": "processes",
-                "workers": 2,
-            },
-        },
+        _paper_preset_on_grid(16),
         "paper_layers9",
     ),
     "paper_grid20": (
         "lateral grid",
         "the paper preset (9 layers, LJ 18 Å) on a 20x20 lateral grid (compared with "
         "paper_grid16; 2 workers)",
-        {
-            "potential": {"lj": {"cutoff_angstrom": 18.0}},
-            "structure": {"layers": 9},
-            "scan": {
-                "grid": [20, 20],
-                "p_range_gpa": THICK_SLAB_P_RANGE[9],
-                "executor": "processes",
-                "workers": 2,
-            },
-        },
+        _paper_preset_on_grid(20),
         "paper_grid16",
     ),
     "layers6_rigid_g8": (
