@@ -181,8 +181,9 @@ _ENERGY_LOAD_HINT = (
 )
 
 
-def _branch(z, p, labels, what):
-    """Index ``m`` of the lowest node of ``p`` per column; InputError unless p falls up to it."""
+def _branch(z, p, labels, what, remedy=""):
+    """Index ``m`` of the lowest node of ``p`` per column; InputError unless p falls up to it
+    (``remedy`` is appended to the message of a load that is not monotonic)."""
     n_z = p.shape[1]
     m = np.argmin(p, axis=1)
     idx = np.arange(n_z - 1)
@@ -200,13 +201,12 @@ def _branch(z, p, labels, what):
             f"{labels[j]}: {what} is not monotonic on the repulsive branch: "
             f"p = {p[j, k] * units.EV_PER_A3_TO_GPA:.4g} GPa at z = {z[k]:.4g} Å, "
             f"{p[j, k + 1] * units.EV_PER_A3_TO_GPA:.4g} GPa at z = {z[k + 1]:.4g} Å "
-            "(expected p to decrease with thickness up to the maximum tension)"
-            + (_ENERGY_LOAD_HINT if what.startswith("-(1/A)") else "")
+            "(expected p to decrease with thickness up to the maximum tension)" + remedy
         )
     return m
 
 
-def _invert(z, p_nodes, coef_p, spline_e, targets, labels, what):
+def _invert(z, p_nodes, coef_p, spline_e, targets, labels, what, remedy=""):
     """z*(P) on the repulsive branch of a load given at the nodes and as a piecewise cubic.
 
     The branch runs from the first node to the node ``m`` of lowest ``p`` (the
@@ -216,7 +216,7 @@ def _invert(z, p_nodes, coef_p, spline_e, targets, labels, what):
     Returns ``(z*, U(z*)/A, p_lo, p_hi, z_m, dp/dz at z*)``.
     """
     n_col, n_z = p_nodes.shape
-    m = _branch(z, p_nodes, labels, what)
+    m = _branch(z, p_nodes, labels, what, remedy)
     p_lo = p_nodes[np.arange(n_col), m]
     p_hi = p_nodes[:, 0]
     _out_of_range(targets, p_lo, p_hi, z, z[m], labels)
@@ -253,7 +253,7 @@ def _invert_energy(z, spline_e, targets, labels):
     c = spline_e.c  # U/A = c0 x³ + c1 x² + c2 x + c3
     coef = np.stack([np.zeros_like(c[0]), -3 * c[0], -2 * c[1], -c[2]])
     p_nodes = -spline_e(z, 1).T
-    return _invert(z, p_nodes, coef, spline_e, targets, labels, "-(1/A) dU/dz")
+    return _invert(z, p_nodes, coef, spline_e, targets, labels, "-(1/A) dU/dz", _ENERGY_LOAD_HINT)
 
 
 @dataclass(frozen=True)
