@@ -220,8 +220,8 @@ class PeriodicSurface:
         def stationary(sv: SurfaceValues) -> bool:
             return bool(np.linalg.norm(sv.gradient) * scale <= 1e-7 * spread)
 
-        def add(xy: np.ndarray, val: float) -> None:
-            if not np.all(np.linalg.eigvalsh(self.evaluate(xy).hessian) > 0):
+        def add(xy: np.ndarray, val: float, sv: SurfaceValues) -> None:
+            if not np.all(np.linalg.eigvalsh(sv.hessian) > 0):
                 return  # a flat direction or a saddle, not a minimum
             s = self.fractional(xy)
             s = s - np.floor(s)
@@ -235,15 +235,16 @@ class PeriodicSurface:
         stalled = []
         for i, j in cand:
             xy, val = self.local_minimum(self.cartesian(np.array([i / f_a, j / f_b])))
-            if stationary(self.evaluate(xy)):
-                add(xy, val)
+            sv = self.evaluate(xy)
+            if stationary(sv):
+                add(xy, val, sv)
             else:
                 stalled.append(xy)
         for xy in stalled:  # after the directly converged ones: those are kept bit for bit
             xy = self._newton_polish(xy)
             sv = self.evaluate(xy)
             if stationary(sv):
-                add(xy, float(sv.value))
+                add(xy, float(sv.value), sv)
         found.sort(key=lambda m: (m[2], round(float(m[0][0]), 9), round(float(m[0][1]), 9)))
         return [(xy, val) for _, xy, val in found]
 
