@@ -370,16 +370,14 @@ def place_slab2(
     _set_vertical_cell(atoms, DEFAULT_VACUUM_ANGSTROM, keep_at_least=reference.cell.array[2, 2])
     closest = _closest_interslab(atoms, min_distance_angstrom)
     if closest < min_distance_angstrom and spread_compression and dz < 0:
-        strain = -dz / z_reference
-        free = ~fixed_mask(atoms)
-        if strain <= MAX_SPREAD_STRAIN and free.any():
-            held1 = fixed_mask(reference) & ~upper
-            z1 = float(reference.positions[held1, 2].mean())
+        held = fixed_mask(reference)
+        free = ~held
+        if -dz / z_reference <= MAX_SPREAD_STRAIN and free.any():
+            h1 = float(reference.positions[held & ~upper, 2].mean())
+            heights = reference.positions[free, 2]
             spread = atoms.copy()
-            z = reference.positions[free, 2]
-            spread.positions[free, 2] = z1 + (z - z1) * (thickness_angstrom / z_reference)
-            spread_closest = _closest_interslab(spread, min_distance_angstrom)
-            if spread_closest >= min_distance_angstrom:
+            spread.positions[free, 2] = h1 + (heights - h1) * (thickness_angstrom / z_reference)
+            if _closest_interslab(spread, min_distance_angstrom) >= min_distance_angstrom:
                 return spread
     if closest < min_distance_angstrom:
         raise InputError(
