@@ -42,8 +42,6 @@ REFINEMENTS = (
     # preset's own next step alone would understate the grid's share
     ("paper_grid16", "paper_grid20"),
 )
-#: refinements counted in one form only (none since the thick-slab load cap was lifted).
-FORM_REFINEMENTS: dict[str, tuple] = {"enthalpy": (), "internal": ()}
 #: the stored run of the paper preset (9 layers per slab since the slab-thickness study)
 PAPER_RUN = "paper_layers9"
 #: The paper's Hertz peak pressure (GPa) where τ and σ are quoted.
@@ -67,7 +65,7 @@ def convergence_delta(form: str) -> dict[str, float]:
     for key in LAW_COEFFICIENTS:
         out[key] = max(
             abs(float(_study_laws(fine, form)[key]) - float(_study_laws(coarse, form)[key]))
-            for coarse, fine in REFINEMENTS + FORM_REFINEMENTS[form]
+            for coarse, fine in REFINEMENTS
         )
     return out
 
