@@ -397,10 +397,13 @@ def run_derived(name: str) -> dict:
 def reanalyze_variant(name: str) -> dict:
     """Analyse variant ``name``'s stored grid again and update ``results/<name>.json``.
 
-    For a change of the analysis code only: the pipeline's stage fingerprints include the
-    package's code, so ``run`` would rescan. This reads ``RUNS/<name>/02-scan/ispes.nc`` as
-    it is and replaces the loads, laws and warnings of the results file (scan facts, timings
-    and W are the scan's and stay); ``reanalyzed`` records when.
+    For a change that leaves the stored scans as they are: a stage's fingerprint includes
+    its own code (:data:`flatcontact.pipeline.STAGE_CODE`), so ``run`` rescans after any edit
+    of the build or scan code, even one that cannot change a finished point (e.g. the
+    spread compression of ``place_slab2``, which only acts where a rigid placement
+    overlaps). This reads ``RUNS/<name>/02-scan/ispes.nc`` as it is and replaces the loads,
+    laws and warnings of the results file (scan facts, timings and W are the scan's and
+    stay); ``reanalyzed`` records when.
     """
     from flatcontact.ispes.contract import open_ispes
 
