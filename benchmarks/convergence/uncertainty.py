@@ -5,7 +5,7 @@
 Per energy form and law coefficient c ∈ {k, τ0, μ, σ0}:
 
 * ``convergence_<form>``: the largest |Δc| over the refinements :data:`REFINEMENTS` (one
-  step finer in lateral grid, thicknesses, force tolerance, LJ cutoff;
+  step finer in lateral grid, thicknesses, force tolerance, LJ cutoff, slab layers;
   ``results/[enthalpy/]<name>.json`` of :mod:`benchmarks.convergence.study`);
 * ``model_spread_<form>``: half the max − min range of c over every model of the teacher
   comparison (``results/ispes_compare_<form>.json`` of :mod:`benchmarks.convergence.teachers`,
