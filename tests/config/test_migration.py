@@ -74,7 +74,7 @@ def test_the_nested_form_raises_no_warning():
         build_config({"contact": {"cycle": {"enabled": True}, "fit": {"stiffness": "paper"}}})
 
 
-def test_the_top_level_calculator_section_is_dated():
-    with pytest.warns(DeprecationWarning, match=r"2026-11-22: use potential\.calculator"):
-        cfg = build_config({"calculator": {"target": "flatcontact.ispes.toy:toy_calculator"}})
+def test_the_top_level_calculator_section_becomes_the_models():
+    cfg = build_config({"calculator": {"target": "flatcontact.ispes.toy:toy_calculator"}})
     assert cfg.potential.calculator.target == "flatcontact.ispes.toy:toy_calculator"
+    assert cfg.potential.calculator.scope == "interface"

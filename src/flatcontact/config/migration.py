@@ -1,7 +1,8 @@
 """Old forms of a run configuration, read into today's, each with a dated deprecation.
 
 Every old form still loads; each raises a :class:`DeprecationWarning` naming the date it was
-deprecated and the key that replaces it:
+deprecated and the key that replaces it (the calculator section only has its date here: the
+``--calculator`` flag of ``flatcontact scan`` still builds it):
 
 ==========================================  ==========  =====================================
 old form                                    deprecated  today
@@ -109,18 +110,17 @@ def structure_section(value: Any) -> Any:
 
 def calculator_section(data: Any) -> Any:
     """The top-level ``calculator: {target, kwargs}`` as ``potential.calculator`` (scope
-    ``interface``), with a :class:`DeprecationWarning`; ``data`` unchanged without it."""
+    ``interface``); ``data`` unchanged without it.
+
+    Deprecated since 2026-11-22 but not warned about: ``flatcontact scan --calculator`` still
+    lays its flag over a configuration in this form.
+    """
     if isinstance(data, dict) and "calculator" in data:
         data = dict(data)
         calc = data.pop("calculator")
         if calc is not None:
             if not isinstance(calc, dict):
                 raise ValueError(f"calculator: expected a mapping, got {show(calc)}")
-            _deprecated(
-                "the top-level calculator section",
-                CALCULATOR_SECTION_DEPRECATED,
-                "potential.calculator (with scope: interface)",
-            )
             data["potential"] = {"calculator": {**calc, "scope": "interface"}}
     return data
 
