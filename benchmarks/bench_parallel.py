@@ -42,6 +42,7 @@ def main(argv: list[str] | None = None) -> None:
     from flatcontact.ispes.scan import run_scan
     from flatcontact.stages import _calculator
     from flatcontact.stages.build import BuildInputs, run_build
+    from flatcontact.stages.scan import grid_spec, relax_settings
 
     workers = [int(w) for w in argv] if argv else [1, 2]
     if 1 not in workers:
@@ -51,10 +52,10 @@ def main(argv: list[str] | None = None) -> None:
     s = settings.scan
     reference = run_build(settings, BuildInputs(), None).atoms
     factory = _calculator.factory(settings)
-    relax = s.relax_settings()
+    relax = relax_settings(s)
     with tempfile.TemporaryDirectory() as tmp_name:
         tmp = Path(tmp_name)
-        grid = s.grid_spec()
+        grid = grid_spec(s)
         print(
             f"== parallel efficiency, paper preset ({grid.n_a}x{grid.n_b} lateral, thicknesses "
             f"from the probe), {len(reference)} atoms, {cores} cores, load {load():.2f} ==",

@@ -1,6 +1,7 @@
 """The measured law uncertainty of the paper preset, from the stored results (issue 12).
 
-    python -m benchmarks.convergence.uncertainty    # prints MEASURED_LAW_UNCERTAINTY and the table
+    python -m benchmarks.convergence.uncertainty          # prints the numbers and the table
+    python -m benchmarks.convergence.uncertainty --write  # and writes them to DATA_FILE
 
 Per energy form and law coefficient c ∈ {k, τ0, μ, σ0}:
 
@@ -11,8 +12,11 @@ Per energy form and law coefficient c ∈ {k, τ0, μ, σ0}:
   comparison (``results/ispes_compare_<form>.json`` of :mod:`benchmarks.convergence.teachers`,
   :func:`flatcontact.analysis.uncertainty.committee_spread`).
 
-Both are rounded to three significant figures; ``flatcontact.config.MEASURED_LAW_UNCERTAINTY``
-holds these numbers (``tests/convergence/test_measured_uncertainty.py`` checks it). The table is
+Both are rounded to three significant figures and stored, with their provenance (this
+command, the date, the result files read), in the package data file :data:`DATA_FILE`
+(``src/flatcontact/data/measured/law_uncertainty.json``), which the ``paper`` preset reads as
+``flatcontact.config.MEASURED_LAW_UNCERTAINTY``
+(``tests/convergence/test_measured_uncertainty.py`` checks it against the results). The table is
 docs/teachers.md "Carried into the laws": the paper preset's laws (``results/[enthalpy/]paper_layers9.json``)
 ± coverage 1 half-widths and τ, σ at the paper's Hertz peak p0 = 1.77 GPa propagated over
 the law box (:func:`flatcontact.analysis.uncertainty.propagate_box`).
@@ -20,11 +24,22 @@ the law box (:func:`flatcontact.analysis.uncertainty.propagate_box`).
 
 from __future__ import annotations
 
+import argparse
+import datetime
 import json
 import math
 from pathlib import Path
 
+ROOT = Path(__file__).resolve().parents[2]
 RESULTS = Path(__file__).resolve().parent / "results"
+#: The package data file the paper preset reads (flatcontact.config.MEASURED_LAW_UNCERTAINTY).
+DATA_FILE = ROOT / "src" / "flatcontact" / "data" / "measured" / "law_uncertainty.json"
+#: What the numbers are for (the data file's ``source``, carried into a run's settings).
+SOURCE = (
+    "measured for the bundled sio2-snap + Hamaker LJ, alpha-quartz (0001) dense, "
+    "paper-preset settings (docs/convergence.md, docs/teachers.md); a lower bound for coarser "
+    "grids, not a measurement for another model or surface"
+)
 FORMS = ("internal", "enthalpy")
 #: (coarser, finer) result names: one refinement of each scan setting. The slab-thickness
 #: step of the paper preset (9 -> 12 layers) is measured at half the force tolerance, where
@@ -75,8 +90,39 @@ def comparison(form: str) -> dict:
     return json.loads((RESULTS / f"ispes_compare_{form}.json").read_text())
 
 
+def result_files() -> list[str]:
+    """The result files the numbers are computed from (paths relative to the repository)."""
+    names = sorted({name for pair in REFINEMENTS for name in pair})
+    files = [RESULTS / f"{name}.json" for name in names]
+    files += [RESULTS / "enthalpy" / f"{name}.json" for name in names]
+    files += [RESULTS / f"ispes_compare_{form}.json" for form in FORMS]
+    return [str(f.relative_to(ROOT)) for f in files]
+
+
+def document(measured: dict | None = None, date: str | None = None) -> dict:
+    """The data file's content: the numbers, their ``source`` and a ``provenance`` block."""
+    measured = measured or measured_uncertainty()
+    return {
+        **measured,
+        "source": SOURCE,
+        "provenance": {
+            "study": "convergence of the paper preset's load laws under one refinement of "
+            "each scan setting (grid 8->12 at 6 layers, 12->16 and 16->20 at 9 layers, "
+            "thicknesses 20->30, fmax 0.005->0.0025 at 6 and at 9 layers, LJ cutoff 14->18 A, "
+            "slab layers 9->12) and half the max - min range of the laws over the bundled "
+            "SNAPs (sio2-snap, sio2-snap-mf0) and their teachers CHGNet r2SCAN and "
+            "SevenNet-MF-0 r2SCAN (4x4 grid, an upper bound); docs/convergence.md, "
+            "docs/teachers.md",
+            "command": "python -m benchmarks.convergence.uncertainty --write",
+            "date": date or datetime.date.today().isoformat(),
+            "rounding": "three significant figures",
+            "result_files": result_files(),
+        },
+    }
+
+
 def measured_uncertainty() -> dict:
-    """The ``MEASURED_LAW_UNCERTAINTY`` numbers (three significant figures) from the results."""
+    """The measured law uncertainty (three significant figures) from the results."""
     from flatcontact.analysis.uncertainty import committee_spread
 
     out: dict = {}
@@ -129,9 +175,16 @@ def carried_table(measured: dict | None = None) -> str:
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--write", action="store_true", help=f"write {DATA_FILE.name}")
+    args = parser.parse_args()
     measured = measured_uncertainty()
-    for key, value in measured.items():
-        print(f"{key}: {json.dumps(value)}")
+    doc = document(measured)
+    print(json.dumps(doc, indent=2, ensure_ascii=False))
+    if args.write:
+        DATA_FILE.parent.mkdir(parents=True, exist_ok=True)
+        DATA_FILE.write_text(json.dumps(doc, indent=2, ensure_ascii=False) + "\n")
+        print(f"wrote {DATA_FILE.relative_to(ROOT)}")
     for form in FORMS:
         print(f"models in the {form} spread: {', '.join(comparison(form))}")
     print()

@@ -68,6 +68,7 @@ from flatcontact.rundir import (
 )
 from flatcontact.stages import _calculator
 from flatcontact.stages._common import file_sha256
+from flatcontact.stages.preflight import check_inputs
 
 __all__ = ["STAGES", "STAGE_CODE", "Pipeline", "file_sha256", "run"]
 
@@ -147,7 +148,7 @@ STAGE_CODE: dict[str, tuple[str, ...]] = {
         "stages/report.py",
         "report",
         "reference.py",
-        "config.py",
+        "config",
         "stages/_calculator.py",
         "potentials/lj.py",
         "rundir.py",
@@ -233,8 +234,6 @@ class Pipeline:
 
     def _check_config(self) -> None:
         """Checks that need the file system or optional modules, before any work."""
-        from flatcontact.config import check_inputs
-
         check_inputs(self.config)
 
     def _open_log(self) -> None:
@@ -521,10 +520,10 @@ class Pipeline:
             "scan": scan.fingerprint,
             "elastic": elastic.fingerprint if elastic else None,
         }
-        if cfg.contact.experiment_csv:
-            inputs["experiment_sha256"] = file_sha256(cfg.contact.experiment_csv)
-        if cfg.contact.fit_csv:
-            inputs["fit_sha256"] = [file_sha256(f) for f in cfg.contact.fit_csv]
+        if cfg.contact.experiment.csv:
+            inputs["experiment_sha256"] = file_sha256(cfg.contact.experiment.csv)
+        if cfg.contact.fit.csv:
+            inputs["fit_sha256"] = [file_sha256(f) for f in cfg.contact.fit.csv]
 
         result = self._run("contact", inputs, lambda f: run_contact(cfg, stage_inputs, f))
         with xr.open_dataset(result.folder / CONTACT_NC, engine="h5netcdf") as ds:

@@ -37,7 +37,7 @@ def _with_file(field_section: str, name: str, data: bytes, extra: str = ""):
         if field_section == "structure":
             body = f"structure: {{kind: file, file: {name}}}\n{extra}"
         else:
-            body = f"contact: {{experiment_csv: {name}}}\n{extra}"
+            body = f"contact: {{experiment: {{csv: {name}}}}}\n{extra}"
         return _write(d / "c.yaml", body.encode())
 
     return make
@@ -163,7 +163,7 @@ CASES = {
             "m.csv",
             b"mean shear stress [MPa],lateral stiffness [N/m]\na,b\n1,2\n3,4\n5,6\n",
         ),
-        ["contact.experiment_csv", "m.csv", "not numeric"],
+        ["contact.experiment.csv", "m.csv", "not numeric"],
     ),
     "calculator-import": (
         _yaml("calculator: {target: 'nosuchmodule_xyz:make'}\n"),

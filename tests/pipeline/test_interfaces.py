@@ -7,6 +7,7 @@ import pytest
 
 from flatcontact.config import build_config, load_config
 from flatcontact.errors import InputError
+from flatcontact.stages.scan import grid_spec, relax_settings
 
 
 def test_default_structure_section_keeps_the_fingerprint_of_runs_before_recipes(tmp_path):
@@ -82,8 +83,8 @@ def test_relax_mode_and_bracket_reach_the_scan_and_leave_the_default_dump_unchan
     assert "relax_mode" not in default.section("scan")
     assert "bracket_all_stackings" not in default.section("scan")
     cfg = build_config({"scan": {"relax_mode": "normal", "bracket_all_stackings": False}})
-    assert cfg.scan.relax_settings().mode == "normal"
-    assert cfg.scan.grid_spec().bracket_all_stackings is False
+    assert relax_settings(cfg.scan).mode == "normal"
+    assert grid_spec(cfg.scan).bracket_all_stackings is False
     with pytest.raises(InputError, match=r"scan.relax_mode"):
         build_config({"scan": {"relax_mode": "sideways"}})
 

@@ -443,7 +443,7 @@ def test_measured_stiffness_reruns_contact_and_report_and_recovers_tau0(tiny_run
     csv.write_text("mean_shear_stress_mpa,lateral_stiffness_n_per_m\n" + rows + "\n")
 
     with Pipeline(
-        build_config(_merge(TINY, {"contact": {"experiment_csv": str(csv)}})), root
+        build_config(_merge(TINY, {"contact": {"experiment": {"csv": str(csv)}}})), root
     ) as pipe:
         pipe.run()
         actions = _actions(pipe)
@@ -651,7 +651,10 @@ def test_cycle_and_fit_in_a_run_match_the_cli_and_the_fit_file_content_reruns_co
 
     csv = tmp_path / "curves.csv"
     write_data(csv, truth)
-    change = {"cycle": True, "cycle_amplitude_fractions": [0.4, 0.8], "fit_csv": [str(csv)]}
+    change = {
+        "cycle": {"enabled": True, "amplitude_fractions": [0.4, 0.8]},
+        "fit": {"csv": [str(csv)]},
+    }
     cfg = build_config(_merge(TINY, {"contact": change}))
     with Pipeline(cfg, root) as pipe:
         pipe.run()

@@ -124,16 +124,15 @@ def test_cli_and_run_config_give_the_same_cycle_and_fit(tmp_path, capsys):
         "contact:\n"
         "  p0_gpa: [1.0, 2.0]\n"
         + "".join(f"  {k}: {v}\n" for k, v in LAWS.items())
-        + "  cycle: true\n"
-        "  model: modified\n"
-        "  cycle_amplitude_fractions: [0.3, 0.7]\n"
-        "  fit_csv: [data/curves.csv]\n"
-        "  fit_free: [tau0_mpa]\n"
-        "  fit_fixed: [k_mpa_per_gpa]\n"
+        + "  cycle: {enabled: true, model: modified, amplitude_fractions: [0.3, 0.7]}\n"
+        "  fit:\n"
+        "    csv: [data/curves.csv]\n"
+        "    free: [tau0_mpa]\n"
+        "    fixed: [k_mpa_per_gpa]\n"
         "report:\n  svg: false\n"
     )
     cfg = load_config(cfg_path)
-    assert cfg.contact.fit_csv == [str(data.resolve())]
+    assert cfg.contact.fit.csv == [str(data.resolve())]
     run_doc = run_contact(cfg, ContactInputs(), tmp_path / "stage").to_json()
     cli_doc = _cli_json(
         [
@@ -243,9 +242,9 @@ def test_config_file_errors_name_the_field(tmp_path):
     from flatcontact.errors import InputError
 
     bad = tmp_path / "bad.yaml"
-    bad.write_text("contact:\n  fit_csv: [missing.csv]\n")
-    with pytest.raises(InputError, match=r"contact\.fit_csv: file .*missing\.csv not found"):
+    bad.write_text("contact:\n  fit: {csv: [missing.csv]}\n")
+    with pytest.raises(InputError, match=r"contact\.fit\.csv: file .*missing\.csv not found"):
         load_config(bad)
-    bad.write_text("contact:\n  cycle_amplitude_fractions: [0.5, 1.2]\n")
-    with pytest.raises(InputError, match=r"contact\.cycle_amplitude_fractions"):
+    bad.write_text("contact:\n  cycle: {amplitude_fractions: [0.5, 1.2]}\n")
+    with pytest.raises(InputError, match=r"contact\.cycle\.amplitude_fractions"):
         load_config(bad)

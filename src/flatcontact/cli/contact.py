@@ -34,22 +34,22 @@ _FLAG_OF = {
         "work_of_adhesion_j_m2",
         "maugis_lambda",
         "knee_fraction",
-        "experiment_p0_gpa",
-        "experiment_stress_measure",
         "collapse_fraction",
     )
 } | {
-    "contact.experiment_csv": "--experiment",
+    "contact.experiment.csv": "--experiment",
+    "contact.experiment.p0_gpa": "--experiment-p0-gpa",
+    "contact.experiment.stress_measure": "--experiment-stress-measure",
     "report.svg": "--svg",
-    "contact.cycle": "--cycle",
-    "contact.model": "--model",
-    "contact.cycle_amplitude_fractions": "--cycle-amplitude-fractions",
-    "contact.cycle_amplitudes_un": "--cycle-amplitude-un",
-    "contact.fit_csv": "--fit",
-    "contact.fit_p0_gpa": "--fit-p0-gpa",
-    "contact.fit_free": "--fit-free",
-    "contact.fit_fixed": "--fit-fixed",
-    "contact.fit_stiffness": "--fit-stiffness",
+    "contact.cycle.enabled": "--cycle",
+    "contact.cycle.model": "--model",
+    "contact.cycle.amplitude_fractions": "--cycle-amplitude-fractions",
+    "contact.cycle.amplitudes_un": "--cycle-amplitude-un",
+    "contact.fit.csv": "--fit",
+    "contact.fit.p0_gpa": "--fit-p0-gpa",
+    "contact.fit.free": "--fit-free",
+    "contact.fit.fixed": "--fit-fixed",
+    "contact.fit.stiffness": "--fit-stiffness",
 }
 
 
@@ -267,30 +267,31 @@ def contact_command(
         "work_of_adhesion_j_m2": work_of_adhesion_j_m2,
         "maugis_lambda": maugis_lambda,
         "knee_fraction": knee_fraction,
-        "experiment_csv": str(experiment) if experiment is not None else None,
-        "experiment_p0_gpa": experiment_p0_gpa,
-        "experiment_stress_measure": experiment_stress_measure,
         "collapse_fraction": collapse_fraction,
-        "cycle": cycle,
-        "model": model,
-        "fit_stiffness": fit_stiffness,
+        "experiment": {
+            "csv": str(experiment) if experiment is not None else None,
+            "p0_gpa": experiment_p0_gpa,
+            "stress_measure": experiment_stress_measure,
+        },
+        "cycle": {"enabled": cycle, "model": model},
+        "fit": {"stiffness": fit_stiffness},
     }
     if cycle_amplitude_fractions:
-        contact["cycle_amplitude_fractions"] = parse_floats(
+        contact["cycle"]["amplitude_fractions"] = parse_floats(
             cycle_amplitude_fractions, "--cycle-amplitude-fractions"
         )
     if cycle_amplitude_un:
-        contact["cycle_amplitudes_un"] = parse_floats(
+        contact["cycle"]["amplitudes_un"] = parse_floats(
             cycle_amplitude_un, "--cycle-amplitude-un", "µN"
         )
     if fit_files:
-        contact["fit_csv"] = split_list(fit_files, "--fit", whitespace=False)
+        contact["fit"]["csv"] = split_list(fit_files, "--fit", whitespace=False)
     if fit_p0_gpa:
-        contact["fit_p0_gpa"] = parse_floats(fit_p0_gpa, "--fit-p0-gpa", "GPa")
+        contact["fit"]["p0_gpa"] = parse_floats(fit_p0_gpa, "--fit-p0-gpa", "GPa")
     if fit_free:
-        contact["fit_free"] = split_list(fit_free, "--fit-free")
+        contact["fit"]["free"] = split_list(fit_free, "--fit-free")
     if fit_fixed:
-        contact["fit_fixed"] = split_list(fit_fixed, "--fit-fixed")
+        contact["fit"]["fixed"] = split_list(fit_fixed, "--fit-fixed")
     cfg = settings_from_flags({"contact": contact, "report": {"svg": svg}}, _FLAG_OF)
     if out is not None:
         check_out_dir(out)

@@ -73,8 +73,9 @@ def config_command(
     ] = True,
 ) -> None:
     """Print the default run configuration (with every field described) or check a file."""
-    from flatcontact.config import check_inputs, load_config, to_yaml
+    from flatcontact.config import load_config, to_yaml
     from flatcontact.errors import InputError
+    from flatcontact.stages.preflight import check_inputs
 
     if not show_default and check is None:
         raise InputError("config: give --show-default [--preset quick|paper] or --check FILE")

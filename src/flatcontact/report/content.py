@@ -691,8 +691,8 @@ def build_sections(
 
 
 def _cycle_and_fit(contact: dict, folder: Path) -> tuple[list, list, list[str]]:
-    """Tables, figures and notes of the oscillation cycle (``contact.cycle``) and of the
-    multi-load fit (``contact.fit_csv``), from the contact stage's ``summary.json``."""
+    """Tables, figures and notes of the oscillation cycle (``contact.cycle.enabled``) and of the
+    multi-load fit (``contact.fit.csv``), from the contact stage's ``summary.json``."""
     from flatcontact.report.html import Figure, Table
 
     tables, figs, notes = [], [], []

@@ -4,15 +4,15 @@ Files: ``contact.nc`` (Q(u) and stiffness curves, per-p0 scalars), ``summary.jso
 (:meth:`ContactResult.to_json`: parameters and where each comes from, conventions, the
 per-p0 results, the same with the paper's laws, and the measured-data comparison) and the
 figures ``fig4_traction``, ``fig5_force_stiffness`` (amplitude), ``fig5_force_stiffness_rms``
-and, with ``contact.experiment_csv``, ``fig6_experiment`` (PNG, + SVG with ``report.svg``).
+and, with ``contact.experiment.csv``, ``fig6_experiment`` (PNG, + SVG with ``report.svg``).
 
-With ``contact.cycle`` (issue 13) the steady load-controlled cycle of ``contact.model`` at the
-force amplitudes ``contact.cycle_amplitude_fractions`` (or ``cycle_amplitudes_un``) of every p0:
+With ``contact.cycle.enabled`` the steady load-controlled cycle of ``contact.cycle.model`` at the
+force amplitudes ``contact.cycle.amplitude_fractions`` (or ``amplitudes_un``) of every p0:
 ``summary.json`` gains ``cycle`` (one row per p0 and amplitude: W per cycle, lock-in k′ =
 Q_amp/u′₁, quadrature u″₁, ...), ``contact.nc`` the loops (``cycle_*`` variables), Fig. 5b and
 the Fig. 6 overlay the lock-in curve next to the paper's d⟨Q⟩/d⟨u⟩, plus ``fig5c_cycle_loops``
 and ``fig6_lockin`` (lock-in vs the paper's construction, loss tangent). With
-``contact.fit_csv`` the multi-load least-squares fit of the measured curves (modified and
+``contact.fit.csv`` the multi-load least-squares fit of the measured curves (modified and
 classical model on the same data, :func:`flatcontact.contact.fit.fit_and_compare`) goes to
 ``fit.json`` (also ``summary.json`` ``fit``) and ``fig6_fit``.
 
@@ -52,8 +52,8 @@ SETTINGS_NAMES = {
 
 #: Cycle library parameter names -> the settings path that sets them.
 CYCLE_NAMES = {
-    "lateral_force_amplitude_un": "contact.cycle_amplitudes_un",
-    "amplitude_fraction": "contact.cycle_amplitude_fractions",
+    "lateral_force_amplitude_un": "contact.cycle.amplitudes_un",
+    "amplitude_fraction": "contact.cycle.amplitude_fractions",
     "p0_gpa": "contact.p0_gpa",
     **{k: v for k, v in SETTINGS_NAMES.items() if k != "radius_um"},
 }
@@ -184,28 +184,28 @@ def check_cycle(settings, params) -> None:
         cycle.validate_cycle_request(
             c.p0_gpa,
             params,
-            c.model,
-            amplitudes_un=c.cycle_amplitudes_un,
-            amplitude_fractions=None if c.cycle_amplitudes_un else c.cycle_amplitude_fractions,
+            c.cycle.model,
+            amplitudes_un=c.cycle.amplitudes_un,
+            amplitude_fractions=None if c.cycle.amplitudes_un else c.cycle.amplitude_fractions,
         )
 
 
 def fit_curves(settings, params) -> list:
-    """The measured curves of ``contact.fit_csv`` (validated with the parameter names, before
+    """The measured curves of ``contact.fit.csv`` (validated with the parameter names, before
     any work): :func:`flatcontact.contact.fit.load_fit_data`, ``check_free_fixed``."""
     from flatcontact.contact import fit
 
     c = settings.contact
     try:
-        fit.check_free_fixed(c.fit_free, c.fit_fixed, "modified")
+        fit.check_free_fixed(c.fit.free, c.fit.fixed, "modified")
     except InputError as exc:
-        where = "contact.fit_fixed" if "fixed" in str(exc) else "contact.fit_free"
-        raise InputError(f"{where}: {exc} (contact.fit_free = {list(c.fit_free)})") from None
+        where = "contact.fit.fixed" if "fixed" in str(exc) else "contact.fit.free"
+        raise InputError(f"{where}: {exc} (contact.fit.free = {list(c.fit.free)})") from None
     try:
-        return fit.load_fit_data(c.fit_csv, params, c.fit_p0_gpa)
+        return fit.load_fit_data(c.fit.csv, params, c.fit.p0_gpa)
     except InputError as exc:
-        text = rename(str(exc), {"fit_p0_gpa": "contact.fit_p0_gpa"})
-        raise InputError(f"contact.fit_csv: {text}") from None
+        text = rename(str(exc), {"fit_p0_gpa": "contact.fit.p0_gpa"})
+        raise InputError(f"contact.fit.csv: {text}") from None
 
 
 def law_half_widths_used(inputs: ContactInputs, provenance: dict) -> dict[str, float]:
@@ -275,13 +275,13 @@ def contact_intervals(settings, params, half_widths: dict[str, float]) -> dict:
 
 
 def check_fit_settings(settings) -> None:
-    """``contact.fit_*`` checked at the start of a run, before the laws exist (names freed and
+    """``contact.fit`` checked at the start of a run, before the laws exist (names freed and
     fixed, files readable, load columns): the loads of a normal-load column are converted with
     the configured R and E* here; the stage converts them again with the run's moduli."""
     from flatcontact.contact.parameters import ContactParameters
 
     c = settings.contact
-    if c.fit_csv:
+    if c.fit.csv:
         start = ContactParameters(
             radius_um=c.radius_um,
             contact_modulus_gpa=c.contact_modulus_gpa,
@@ -293,15 +293,15 @@ def check_fit_settings(settings) -> None:
 def check_contact(settings, params) -> None:
     """Everything the contact stage refuses, before any work (one line naming the setting)."""
     c = settings.contact
-    if c.cycle:
+    if c.cycle.enabled:
         check_cycle(settings, params)
-    if c.fit_csv:
+    if c.fit.csv:
         fit_curves(settings, params)
     # with k < 0 or μ < 0 the model is defined only where τ > 0 and σ >= 0 on the whole
     # contact (p0 < τ0/|k|, p0 <= σ0/|μ|)
     params.check_p0_gpa(c.p0_gpa, "contact.p0_gpa")
-    if c.experiment_csv:
-        params.check_p0_gpa(c.experiment_p0_gpa, "contact.experiment_p0_gpa")
+    if c.experiment.csv:
+        params.check_p0_gpa(c.experiment.p0_gpa, "contact.experiment.p0_gpa")
     if c.maugis_lambda is not None and not params.work_of_adhesion_j_m2 > 0:
         raise InputError(
             "contact.maugis_lambda: the Maugis–Dugdale radius needs a work of adhesion > 0 "
@@ -320,7 +320,7 @@ class ContactResult:
     paper: Any = None  # the same analysis with the paper's k, τ0, μ, σ0 (None: identical)
     experiment: dict | None = None
     cycles: tuple = ()  # flatcontact.contact.cycle.SteadyCycle per p0 (contact.cycle)
-    fit: Any = None  # flatcontact.contact.fit.ModelComparison (contact.fit_csv)
+    fit: Any = None  # flatcontact.contact.fit.ModelComparison (contact.fit.csv)
     fit_files: list[dict] = field(default_factory=list)
     intervals: dict | None = None  # contact_intervals: the laws' uncertainty carried through
     bands: tuple | None = None  # analyses at the lower and upper corner of the law box
@@ -386,8 +386,8 @@ def run_contact(
     c = settings.contact
     params, provenance = contact_parameters(settings, inputs)
     check_contact(settings, params)
-    measured = exp.load_stiffness_csv(c.experiment_csv) if c.experiment_csv else None
-    curves = fit_curves(settings, params) if c.fit_csv else None
+    measured = exp.load_stiffness_csv(c.experiment.csv) if c.experiment.csv else None
+    curves = fit_curves(settings, params) if c.fit.csv else None
     analysis = analyse(
         c.p0_gpa,
         params,
@@ -413,21 +413,21 @@ def run_contact(
     if measured is not None:
         comparison = exp.compare_with_measurement(
             measured,
-            c.experiment_p0_gpa,
+            c.experiment.p0_gpa,
             params,
             fraction=c.collapse_fraction,
-            measure=c.experiment_stress_measure,
+            measure=c.experiment.stress_measure,
         )
         result.experiment = comparison.to_json()
-    if c.cycle:
+    if c.cycle.enabled:
         from flatcontact.contact import cycle
 
         result.cycles = cycle.cycles(
             c.p0_gpa,
             params,
-            c.model,
-            amplitudes_un=c.cycle_amplitudes_un,
-            amplitude_fractions=None if c.cycle_amplitudes_un else c.cycle_amplitude_fractions,
+            c.cycle.model,
+            amplitudes_un=c.cycle.amplitudes_un,
+            amplitude_fractions=None if c.cycle.amplitudes_un else c.cycle.amplitude_fractions,
         )
     if curves is not None:
         from flatcontact.contact import fit
@@ -435,12 +435,12 @@ def run_contact(
         result.fit = fit.fit_and_compare(
             curves,
             params,
-            c.fit_free,
-            c.fit_fixed,
-            stiffness=c.fit_stiffness,
-            measure=c.experiment_stress_measure,
+            c.fit.free,
+            c.fit.fixed,
+            stiffness=c.fit.stiffness,
+            measure=c.experiment.stress_measure,
         )
-        result.fit_files = [{"name": Path(f).name, "sha256": file_sha256(f)} for f in c.fit_csv]
+        result.fit_files = [{"name": Path(f).name, "sha256": file_sha256(f)} for f in c.fit.csv]
     if folder is not None:
         _write(result, settings, folder, measured, comparison)
     return result
@@ -482,7 +482,7 @@ def _write(result: ContactResult, settings, folder: Path, measured, comparison) 
         from flatcontact.contact.cycle import lockin_curve
         from flatcontact.units import GPA_TO_PA
 
-        lockin = [lockin_curve(p * GPA_TO_PA, params, c.model) for p in analysis.p0_gpa]
+        lockin = [lockin_curve(p * GPA_TO_PA, params, c.cycle.model) for p in analysis.p0_gpa]
     figs = {
         "fig4_traction": fig4_traction(params, p0_fig4),
         "fig5_force_stiffness": fig5_force_and_stiffness(
@@ -493,23 +493,23 @@ def _write(result: ContactResult, settings, folder: Path, measured, comparison) 
     if comparison is not None:
         figs["fig6_experiment"] = fig6_overlay(
             measured,
-            c.experiment_p0_gpa,
+            c.experiment.p0_gpa,
             {
                 f"τ0 = {params.tau0_mpa:.3g} MPa (run)": params,
                 f"fitted τ0 = {comparison.fitted_tau0_mpa:.3g} MPa": comparison.fitted_params,
             },
-            measure=c.experiment_stress_measure,
+            measure=c.experiment.stress_measure,
             measured_collapse_mpa=result.experiment["measured_collapse_stress_mpa"],
-            lockin_model=c.model if result.cycles else None,
+            lockin_model=c.cycle.model if result.cycles else None,
         )
     if result.cycles:
         from flatcontact.plots.cycle import fig_lockin_overlay, fig_loops
 
         shown = sorted({p0_fig4, max(analysis.p0_gpa)})
         figs["fig5c_cycle_loops"] = fig_loops(
-            params, shown, c.cycle_amplitude_fractions, model=c.model
+            params, shown, c.cycle.amplitude_fractions, model=c.cycle.model
         )
-        figs["fig6_lockin"] = fig_lockin_overlay(params, analysis.p0_gpa, model=c.model)
+        figs["fig6_lockin"] = fig_lockin_overlay(params, analysis.p0_gpa, model=c.cycle.model)
     if result.fit is not None:
         from flatcontact.plots.cycle import fig_fit
 

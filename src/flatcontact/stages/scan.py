@@ -17,6 +17,8 @@ import numpy as np
 
 from flatcontact.errors import InputError
 from flatcontact.fileio import write_json_atomic
+from flatcontact.ispes.grid import GridSpec
+from flatcontact.ispes.relax import RelaxSettings
 from flatcontact.stages import _calculator
 from flatcontact.stages._common import save
 
@@ -64,6 +66,25 @@ class ScanStageResult:
             "notes": list(r.notes),
             "warnings": list(self.warnings),
         }
+
+
+def grid_spec(scan) -> GridSpec:
+    """The scan grid of the ``scan`` settings (:class:`flatcontact.ispes.grid.GridSpec`)."""
+    r = scan.p_range_gpa
+    return GridSpec(
+        scan.grid[0],
+        scan.grid[1],
+        thickness_angstrom=tuple(scan.thickness_angstrom) if scan.thickness_angstrom else None,
+        p_range_gpa=(r.lo_gpa, r.hi_gpa, r.n) if r else None,
+        bracket_all_stackings=scan.bracket_all_stackings,
+    )
+
+
+def relax_settings(scan) -> RelaxSettings:
+    """The per-point relaxation of the ``scan`` settings (:class:`flatcontact.ispes.relax.RelaxSettings`)."""
+    return RelaxSettings(
+        scan.fmax_ev_per_angstrom, scan.optimizer, scan.max_steps, mode=scan.relax_mode
+    )
 
 
 def built_with_other_model(reference, settings) -> str | None:
@@ -149,9 +170,9 @@ def run_scan_stage(
     scan = run_scan(
         reference,
         factory,
-        s.grid_spec(),
+        grid_spec(s),
         folder,
-        s.relax_settings(),
+        relax_settings(s),
         order=s.order,
         executor_options=s.executor_options(),
         progress=progress,

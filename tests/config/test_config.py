@@ -101,7 +101,7 @@ def test_file_overlays_preset_and_resolves_paths(tmp_path):
             "'si' is not a chemical element symbol",
         ),
         # input files named by the config exist
-        ("contact: {experiment_csv: nothere.csv}\n", "c.yaml: contact.experiment_csv: file "),
+        ("contact: {experiment: {csv: nothere.csv}}\n", "c.yaml: contact.experiment.csv: file "),
         ("structure: {kind: file, file: no.extxyz}\n", "c.yaml: structure.file: file "),
     ],
 )
@@ -161,7 +161,7 @@ def test_cli_check_refuses_nan_and_missing_files(tmp_path, capsys):
 
     for text, where in (
         ("analysis: {p_gpa: [.nan, 1]}\n", "analysis.p_gpa.0"),
-        ("contact: {experiment_csv: missing.csv}\n", "contact.experiment_csv"),
+        ("contact: {experiment: {csv: missing.csv}}\n", "contact.experiment.csv"),
     ):
         path = tmp_path / "c.yaml"
         path.write_text(text)

@@ -1,0 +1,177 @@
+"""The ``contact`` section: the modified Mindlin contact, with its sub-sections.
+
+At the top: the loads (``p0_gpa``), the tip (``radius_um``), the moduli, the law overrides
+(k, τ0, μ, σ0), the work of adhesion and the stiffness-curve fractions. Below:
+
+- ``cycle``: the steady load-controlled oscillation cycle per p0;
+- ``fit``: the multi-load least-squares fit of measured stiffness curves;
+- ``experiment``: one measured stiffness curve overlaid on Fig. 6.
+
+The flat keys of the earlier one-level section (``fit_csv``, ``cycle_amplitudes_un``, ...)
+are read through :mod:`flatcontact.config.migration`.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import Field, field_validator
+
+from flatcontact.config.messages import show
+from flatcontact.config.section import Section
+from flatcontact.reference import DEFAULT_P0_GPA, PAPER, PAPER_EXPERIMENT_P0_GPA
+
+#: Force amplitudes of the cycle as fractions of the gross-sliding force
+#: (:data:`flatcontact.contact.cycle.DEFAULT_AMPLITUDE_FRACTIONS`; a test keeps them equal).
+CYCLE_AMPLITUDE_FRACTIONS: tuple[float, ...] = (0.2, 0.4, 0.6, 0.8, 0.9, 0.95)
+
+
+class CycleConfig(Section):
+    """The steady load-controlled oscillation cycle per p0 (``contact.cycle``)."""
+
+    enabled: bool = Field(
+        False,
+        description="steady load-controlled cycle per p0: loops, dissipated energy per cycle, "
+        "lock-in stiffness Q_amp/u'_1 and quadrature u''_1 (summary.json 'cycle', contact.nc)",
+    )
+    model: Literal["modified", "classical"] = Field(
+        "modified",
+        description="model of the cycle: modified (the paper's Mindlin model) or classical "
+        "(Cattaneo-Mindlin, friction coefficient mu = k, Johnson's G*_J = G*/4)",
+    )
+    amplitude_fractions: list[float] = Field(
+        list(CYCLE_AMPLITUDE_FRACTIONS),
+        description="force amplitudes of the cycle as fractions of the gross-sliding force, "
+        "each in (0, 1)",
+    )
+    amplitudes_un: list[float] | None = Field(
+        None,
+        description="force amplitudes of the cycle in uN (each below gross sliding at every "
+        "p0); null: amplitude_fractions",
+    )
+
+    @field_validator("amplitude_fractions")
+    @classmethod
+    def _fractions(cls, value: list[float]) -> list[float]:
+        if not value or any(not 0.0 < v < 1.0 for v in value):
+            raise ValueError(
+                f"expected fractions of the gross-sliding force in (0, 1), got {show(value)}"
+            )
+        return [float(v) for v in value]
+
+    @field_validator("amplitudes_un")
+    @classmethod
+    def _amplitudes(cls, value: list[float] | None) -> list[float] | None:
+        if value is not None and (not value or any(not v > 0 for v in value)):
+            raise ValueError(f"expected positive force amplitudes in uN, got {show(value)}")
+        return value
+
+
+class FitConfig(Section):
+    """The multi-load fit of measured stiffness curves (``contact.fit``)."""
+
+    csv: list[str] = Field(
+        [],
+        description="measured stiffness CSVs to fit at several loads at once (one per load, "
+        "or with a load column 'p0 [GPa]'/'normal load [uN]'; relative to the config file)",
+    )
+    p0_gpa: list[float] | None = Field(
+        None, description="p0 (GPa) of each fit.csv file without a load column, one per file"
+    )
+    free: list[str] = Field(
+        ["tau0_mpa"],
+        description="parameters the fit frees (tau0_mpa, k_mpa_per_gpa, mu_mpa_per_gpa, "
+        "sigma0_mpa, shear_modulus_gpa); the rest are held at their values",
+    )
+    fixed: list[str] = Field(
+        [], description="parameters the fit must hold (checked against fit.free)"
+    )
+    stiffness: Literal["lockin", "paper"] = Field(
+        "lockin",
+        description="model stiffness the fit compares with the data: lockin (Q_amp/u'_1, "
+        "what a lock-in amplifier reads) or paper (d<Q>/d<u>)",
+    )
+
+
+class ExperimentConfig(Section):
+    """One measured stiffness curve overlaid on Fig. 6 (``contact.experiment``)."""
+
+    csv: str | None = Field(
+        None,
+        description="measured stiffness CSV ('mean shear stress [MPa],lateral stiffness [N/m]') "
+        "for the Fig. 6 overlay (relative to the config file)",
+    )
+    p0_gpa: float = Field(
+        PAPER_EXPERIMENT_P0_GPA, gt=0, description="p0 of the measured data (GPa)"
+    )
+    stress_measure: Literal["amplitude", "rms"] = Field(
+        "amplitude", description="stress of the data: amplitude Q_max/πa² or rms ⟨Q⟩/πa²"
+    )
+
+
+class ContactConfig(Section):
+    """The modified Mindlin contact (stage ``contact``)."""
+
+    p0_gpa: list[float] = Field(list(DEFAULT_P0_GPA), description="peak Hertz pressures p0 (GPa)")
+    radius_um: float = Field(
+        PAPER["radius_um"], gt=0, le=1e4, description="tip radius R (µm; at most 1 cm)"
+    )
+    contact_modulus_gpa: float = Field(
+        PAPER["contact_modulus_gpa"],
+        gt=0,
+        description="Hertz contact modulus E* (GPa; the paper's DFT value)",
+    )
+    shear_modulus_gpa: float = Field(
+        PAPER["shear_modulus_gpa"],
+        gt=0,
+        description="effective shear modulus G* (GPa) in the paper's q0 = G*·u/(π a) (= 4 × Johnson's G*_J)",
+    )
+    k_mpa_per_gpa: float | None = Field(
+        None,
+        description="override k of τ = k·P + τ0 (MPa/GPa; may be < 0, then p0 < τ0/|k|); "
+        "null: the fitted law",
+    )
+    tau0_mpa: float | None = Field(None, ge=0, description="override τ0 (MPa); null: fitted")
+    mu_mpa_per_gpa: float | None = Field(
+        None,
+        description="override μ of σ = μ·P + σ0 (MPa/GPa; may be < 0, then p0 <= σ0/|μ|); "
+        "null: fitted",
+    )
+    sigma0_mpa: float | None = Field(None, ge=0, description="override σ0 (MPa); null: fitted")
+    work_of_adhesion_j_m2: float | None = Field(
+        None,
+        ge=0,
+        description="work of adhesion w (J/m²) for DMT/JKR radii; null: the work of separation "
+        "measured by the scan",
+    )
+    maugis_lambda: float | None = Field(
+        None,
+        gt=0,
+        description="Maugis parameter λ: adds the Maugis–Dugdale radius and pull-off force "
+        "(needs a work of adhesion > 0); null: none",
+    )
+    knee_fraction: float = Field(
+        0.5, gt=0, lt=1, description="knee: stiffness falls to this fraction of its initial value"
+    )
+    collapse_fraction: float = Field(
+        0.2, gt=0, lt=1, description="collapse: stiffness first below this fraction of the plateau"
+    )
+    cycle: CycleConfig = Field(
+        default_factory=CycleConfig, description="the oscillation cycle per p0 (off by default)"
+    )
+    fit: FitConfig = Field(
+        default_factory=FitConfig,
+        description="the multi-load fit of measured stiffness curves (off without fit.csv)",
+    )
+    experiment: ExperimentConfig = Field(
+        default_factory=ExperimentConfig,
+        description="a measured stiffness curve for the Fig. 6 overlay (off without "
+        "experiment.csv)",
+    )
+
+    @field_validator("p0_gpa")
+    @classmethod
+    def _p0(cls, value: list[float]) -> list[float]:
+        if not value or any(not v > 0 for v in value):
+            raise ValueError(f"expected positive peak pressures in GPa, got {show(value)}")
+        return [float(v) for v in value]

@@ -1,0 +1,19 @@
+"""The ``report`` section: the HTML report and its figures."""
+
+from __future__ import annotations
+
+from pydantic import Field
+
+from flatcontact.config.section import Section
+
+
+class ReportConfig(Section):
+    """The HTML report (stage ``report``)."""
+
+    title: str = Field("flatcontact run", description="report title")
+    fig2_p_gpa: list[float] | None = Field(
+        None,
+        description="pressures (GPa, among analysis.p_gpa) with a Fig. 2 panel; null: lowest, "
+        "middle and highest",
+    )
+    svg: bool = Field(True, description="also write SVG figures next to the PNGs")

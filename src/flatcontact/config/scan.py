@@ -1,0 +1,155 @@
+"""The ``scan`` section: the ISPES grid, the thicknesses, the per-point relaxation, the executor.
+
+The names the section accepts (optimisers, warm-start orders) are data here, the same tuples
+the scan core checks (:mod:`flatcontact.ispes.relax`, :mod:`flatcontact.ispes.order`; a test
+keeps them equal), so the settings import no physics.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+from pydantic import Field, field_validator, model_validator
+
+from flatcontact import limits
+from flatcontact.config.messages import show
+from flatcontact.config.section import Section, positive_pair
+
+#: ASE optimisers a scan point may use (:data:`flatcontact.ispes.relax.OPTIMIZERS`).
+OPTIMIZERS: tuple[str, ...] = ("FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch")
+#: The default optimiser (:class:`flatcontact.ispes.relax.RelaxSettings`' default).
+DEFAULT_OPTIMIZER = "LBFGS"
+#: Warm-start orders of the scan (:data:`flatcontact.ispes.order.PREFERENCES`).
+PREFERENCES: tuple[str, ...] = ("columns", "planes", "cold")
+
+
+class PressureRange(Section):
+    """n loads evenly spaced from lo_gpa to hi_gpa at the probe stacking."""
+
+    lo_gpa: float = Field(description="lowest target load (GPa; negative = tension)")
+    hi_gpa: float = Field(gt=0, description="highest target load (GPa, compressive)")
+    n: int = Field(ge=2, description="number of thicknesses")
+
+    @model_validator(mode="after")
+    def _order(self) -> PressureRange:
+        if not self.lo_gpa < self.hi_gpa:
+            raise ValueError(f"expected lo_gpa < hi_gpa, got {self.lo_gpa} and {self.hi_gpa}")
+        if self.n > limits.bound("thicknesses"):
+            raise ValueError("n: " + limits.message("thicknesses", self.n, "thicknesses"))
+        return self
+
+
+class ScanConfig(Section):
+    """The ISPES grid (stage ``scan``)."""
+
+    grid: tuple[int, int] = Field(
+        (12, 12), description="lateral points along a1 and a2 over the primitive cell"
+    )
+    p_range_gpa: PressureRange | None = Field(
+        None,
+        description="choose the thicknesses z so that the loads at the probe stacking span "
+        "lo_gpa..hi_gpa (n values); exclusive with thickness_angstrom",
+    )
+    thickness_angstrom: list[float] | None = Field(
+        None, description="explicit thicknesses z (Å, surface 1 to surface 4)"
+    )
+    fmax_ev_per_angstrom: float = Field(
+        0.005, gt=0, description="force tolerance on the free atoms at each point (eV/Å)"
+    )
+    optimizer: str = Field(
+        DEFAULT_OPTIMIZER,
+        description="ASE optimiser of each point: " + ", ".join(OPTIMIZERS),
+    )
+    max_steps: int = Field(2000, ge=1, description="optimiser step cap per point")
+    relax_mode: Literal["full", "normal", "rigid-layers", "rigid"] = Field(
+        "full",
+        # left out of the dumped config while default, so existing run fingerprints are unchanged
+        exclude_if=lambda value: value == "full",
+        description="relaxation of each point: full (free atoms in 3D, the paper's), normal "
+        "(along z only: the generalized-stacking-fault convention), rigid-layers (each free "
+        "layer a rigid body along z), rigid (none)",
+    )
+    bracket_all_stackings: bool = Field(
+        True,
+        exclude_if=lambda value: value is True,
+        description="p_range_gpa: probe the extreme columns so that every stacking spans the "
+        "loads (default); false: only the lowest-energy column decides the thicknesses",
+    )
+    order: str = Field(
+        "columns",
+        description="warm-start tree: columns (walk each column along z), planes, cold",
+    )
+    executor: Literal["serial", "processes", "dask"] = Field(
+        "processes", description="serial, local processes, or Dask"
+    )
+    workers: int | None = Field(None, ge=1, description="worker processes (default: one per core)")
+    dask_address: str | None = Field(None, description="address of a running Dask scheduler")
+    jobqueue: dict[str, Any] | None = Field(
+        None,
+        # left out of the dumped config while unset, so existing run fingerprints are unchanged
+        exclude_if=lambda value: value is None,
+        description="a dask-jobqueue cluster instead of local workers: {kind: slurm|pbs|sge|lsf|"
+        "htcondor|oar|moab, jobs: N, ...keyword arguments of the cluster class}",
+    )
+
+    @field_validator("optimizer")
+    @classmethod
+    def _optimizer(cls, value: str) -> str:
+        if value not in OPTIMIZERS:
+            raise ValueError(f"expected one of {', '.join(OPTIMIZERS)}, got {show(value)}")
+        return value
+
+    @field_validator("order")
+    @classmethod
+    def _order(cls, value: str) -> str:
+        if value not in PREFERENCES:
+            raise ValueError(f"expected one of {', '.join(PREFERENCES)}, got {show(value)}")
+        return value
+
+    @field_validator("grid", mode="before")
+    @classmethod
+    def _grid(cls, value: Any) -> tuple[int, int]:
+        return positive_pair(value, "grid")
+
+    @model_validator(mode="after")
+    def _one_of(self) -> ScanConfig:
+        if (self.p_range_gpa is None) == (self.thickness_angstrom is None):
+            raise ValueError("give exactly one of p_range_gpa and thickness_angstrom")
+        if self.thickness_angstrom is not None:
+            z = self.thickness_angstrom
+            if not z or any(not v > 0 for v in z):
+                raise ValueError(f"thickness_angstrom: expected positive values in Å, got {z}")
+            if len(set(z)) != len(z):
+                repeated = sorted({v for v in z if z.count(v) > 1})
+                raise ValueError(
+                    f"thickness_angstrom: expected distinct values in Å, {show(repeated)} repeated"
+                )
+        n_z = len(self.thickness_angstrom) if self.thickness_angstrom else self.p_range_gpa.n
+        if n_z > limits.bound("thicknesses"):
+            raise ValueError(
+                "thickness_angstrom: " + limits.message("thicknesses", n_z, "thicknesses")
+            )
+        points = self.grid[0] * self.grid[1] * n_z
+        if points > limits.bound("scan_points"):
+            raise ValueError(
+                "grid: "
+                + limits.message(
+                    "scan_points",
+                    points,
+                    f"{self.grid[0]}x{self.grid[1]} points x {n_z} thicknesses",
+                )
+            )
+        if self.workers is not None and self.workers > limits.bound("workers"):
+            raise ValueError(
+                "workers: " + limits.message("workers", self.workers, "worker processes")
+            )
+        return self
+
+    def executor_options(self) -> dict[str, Any]:
+        """How the points are run (:func:`flatcontact.ispes.scan.run_scan`'s ``executor_options``)."""
+        return {
+            "kind": self.executor,
+            "workers": self.workers,
+            "dask_address": self.dask_address,
+            "jobqueue": self.jobqueue,
+        }

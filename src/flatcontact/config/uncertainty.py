@@ -1,0 +1,49 @@
+"""The ``uncertainty`` section: the law uncertainty beyond the fit (convergence, model spread)."""
+
+from __future__ import annotations
+
+from pydantic import Field, field_validator
+
+from flatcontact.config.messages import show
+from flatcontact.config.section import Section
+
+#: The law coefficients an uncertainty block may name (τ = k·P + τ0, σ = μ·P + σ0).
+LAW_KEYS = ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa")
+
+
+class UncertaintyConfig(Section):
+    """Uncertainty of the load laws beyond the fit (stage ``laws``; propagated by ``contact``).
+
+    Per coefficient c the half-width is coverage·sqrt(se_fit² + δ_conv² + δ_model²)
+    (:func:`flatcontact.analysis.uncertainty.law_half_widths`), per energy form.
+    """
+
+    convergence_internal: dict[str, float] = Field(
+        {}, description="δ_conv per law coefficient, internal form (change under one refinement)"
+    )
+    convergence_enthalpy: dict[str, float] = Field(
+        {}, description="δ_conv per law coefficient, enthalpy form"
+    )
+    model_spread_internal: dict[str, float] = Field(
+        {}, description="δ_model per law coefficient, internal form (half the spread over models)"
+    )
+    model_spread_enthalpy: dict[str, float] = Field(
+        {}, description="δ_model per law coefficient, enthalpy form"
+    )
+    coverage: float = Field(1.0, gt=0, description="multiple of the combined standard error")
+    source: str = Field("", description="where the δ_conv and δ_model numbers come from")
+
+    @field_validator(
+        "convergence_internal",
+        "convergence_enthalpy",
+        "model_spread_internal",
+        "model_spread_enthalpy",
+    )
+    @classmethod
+    def _coefficients(cls, value: dict[str, float]) -> dict[str, float]:
+        for key, v in value.items():
+            if key not in LAW_KEYS:
+                raise ValueError(f"{key!r}: expected law coefficients among {', '.join(LAW_KEYS)}")
+            if not (v == v and 0.0 <= float(v) < float("inf")):
+                raise ValueError(f"{key} = {show(v)}: expected a finite value >= 0")
+        return {k: float(v) for k, v in value.items()}

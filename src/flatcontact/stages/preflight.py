@@ -1,0 +1,96 @@
+"""Pre-run checks: everything a run would refuse that needs the run's files or the physics cores.
+
+The settings (:mod:`flatcontact.config`) check values alone; :func:`check_inputs` then reads
+what they name (the interface file, the measured CSVs, the calculator's module) and asks the
+stages' own checks (the model's elements, the contact moduli's material, the elastic crystal),
+so ``flatcontact config --check`` and :class:`flatcontact.pipeline.Pipeline` refuse a run
+before its first stage, with one line naming the field and the file.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import ase.io
+
+from flatcontact import limits
+from flatcontact.config import RunConfig
+from flatcontact.contact.experiment import load_stiffness_csv
+from flatcontact.errors import InputError
+from flatcontact.potentials.loader import load_callable
+from flatcontact.stages import _calculator
+from flatcontact.stages.build import structure_elements
+from flatcontact.stages.contact import check_fit_settings, check_moduli_source
+from flatcontact.stages.elastic import bulk_crystal
+from flatcontact.structures.interface import read_interface
+
+
+def check_inputs(cfg: RunConfig, source: str = "config") -> None:
+    """Every check of ``cfg`` that needs its files or imports, before any stage runs.
+
+    ``flatcontact config --check`` and :class:`flatcontact.pipeline.Pipeline` both call it,
+    so the check refuses what a run would refuse before its first stage: an interface file
+    that does not follow the contract (or has more atoms than the ``atoms`` bound), a
+    measured stiffness CSV that does not parse, a calculator that does not import, a model
+    that cannot compute the elastic stage's crystal.
+
+    Raises
+    ------
+    InputError
+        One line naming ``source``'s field and the file.
+    """
+    if cfg.structure.kind in ("file", "slab") and getattr(cfg.structure, "file", None) is not None:
+        _check_structure_file(cfg, source)
+    if cfg.contact.experiment.csv is not None:
+        try:
+            load_stiffness_csv(cfg.contact.experiment.csv)
+        except InputError as exc:
+            raise InputError(f"{source}: contact.experiment.csv: {exc}") from None
+    if cfg.contact.fit.csv:
+        check_fit_settings(cfg)
+    calc = cfg.potential.calculator
+    if calc is not None:
+        try:
+            cfg.potential.calculator_factory()
+            load_callable(calc.target)
+        except InputError as exc:
+            raise InputError(f"{source}: potential.calculator.target: {exc}") from None
+    if cfg.structure.kind == "file":
+        _calculator.check_atoms(cfg, read_interface(cfg.structure.file))
+    check_moduli_source(cfg, structure_elements(cfg.structure))
+    if cfg.elastic.enabled:
+        bulk, _ = bulk_crystal(cfg.structure)
+        if bulk is None:
+            _calculator.check(cfg)
+        else:
+            _calculator.check_atoms(cfg, bulk)
+
+
+def _check_structure_file(cfg: RunConfig, source: str) -> None:
+    """structure.file: readable, within the ``atoms`` bound, and (kind file) an interface."""
+    file = Path(cfg.structure.file)
+    field = f"{source}: structure.file"
+    try:
+        with file.open("rb") as handle:
+            handle.read(1)
+    except OSError as exc:
+        raise InputError(f"{field}: {file}: cannot read ({exc.strerror})") from None
+    if cfg.structure.kind == "file":
+        try:
+            atoms = read_interface(file)
+        except InputError as exc:
+            raise InputError(f"{field}: {exc}") from None
+        except Exception as exc:  # ASE readers raise anything on garbage
+            raise InputError(
+                f"{field}: {file}: not a readable interface.extxyz ({type(exc).__name__})"
+            ) from None
+        n = len(atoms)
+    else:
+        try:
+            n = len(ase.io.read(file))
+        except Exception as exc:  # ASE readers raise anything on garbage
+            raise InputError(
+                f"{field}: {file}: not a structure file ASE can read ({type(exc).__name__})"
+            ) from None
+    if n > limits.bound("atoms"):
+        raise InputError(f"{field}: {limits.message('atoms', n, f'atoms in {file.name}')}")
