@@ -56,7 +56,7 @@ from typing import Any
 from flatcontact import __version__
 from flatcontact.config import RunConfig, recipe_files, to_yaml
 from flatcontact.errors import InputError
-from flatcontact.fileio import write_json_atomic, write_text_atomic
+from flatcontact.fileio import file_sha256, write_json_atomic, write_text_atomic
 from flatcontact.rundir import (
     RunDirectory,
     RunLock,
@@ -67,9 +67,8 @@ from flatcontact.rundir import (
     writable,
 )
 from flatcontact.stages import _calculator
-from flatcontact.stages._common import file_sha256
 
-__all__ = ["STAGES", "STAGE_CODE", "Pipeline", "file_sha256", "run"]
+__all__ = ["STAGES", "STAGE_CODE", "Pipeline", "run"]
 
 log = logging.getLogger("flatcontact.run")
 

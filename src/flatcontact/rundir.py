@@ -55,7 +55,7 @@ from pathlib import Path
 from typing import Any
 
 from flatcontact.errors import InputError
-from flatcontact.fileio import write_json_atomic
+from flatcontact.fileio import file_sha256, write_json_atomic
 
 RECORD_NAME = "stage.json"
 LOCK_NAME = ".flatcontact.lock"
@@ -157,21 +157,12 @@ def portable(section: Mapping[str, Any] | None, *path_keys: str) -> dict[str, An
     return out
 
 
-def file_digest(path: Path) -> str:
-    """SHA-256 of a file's bytes (read in 1 MiB blocks)."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as handle:
-        for block in iter(lambda: handle.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
-
-
 def output_digests(folder: Path) -> dict[str, str]:
     """SHA-256 of every output file below ``folder`` (relative POSIX path -> digest)."""
     out = {}
     for path in sorted(folder.rglob("*")):
         if path.is_file() and not path.name.endswith(_NOT_OUTPUTS):
-            out[path.relative_to(folder).as_posix()] = file_digest(path)
+            out[path.relative_to(folder).as_posix()] = file_sha256(path)
     return out
 
 
@@ -181,7 +172,7 @@ def damaged_outputs(folder: Path, recorded: Mapping[str, str]) -> list[str]:
     for name, digest in recorded.items():
         path = folder / name
         try:
-            if not path.is_file() or file_digest(path) != digest:
+            if not path.is_file() or file_sha256(path) != digest:
                 bad.append(name)
         except OSError:
             bad.append(name)
