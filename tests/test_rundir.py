@@ -80,17 +80,3 @@ def test_corrupt_or_foreign_record_is_refused(tmp_path):
     )
     with pytest.raises(InputError, match="belongs to stage 'build'"):
         run.run_stage(1, "scan", {}, lambda f: None)
-
-
-def test_code_digest_tracks_exactly_the_listed_source():
-    from flatcontact.rundir import code_digest
-
-    whole = code_digest((".",))
-    assert whole == code_digest((".",))  # deterministic
-    assert code_digest(("ispes", "units.py")) == code_digest(("units.py", "ispes"))  # a set
-    assert code_digest(("ispes",)) != code_digest(("analysis",))
-    assert code_digest(("ispes",)) != whole
-    # a part listed twice or inside another part adds nothing
-    assert code_digest(("ispes", "ispes/relax.py")) == code_digest(("ispes",))
-    with pytest.raises(ValueError, match="not part of the flatcontact package"):
-        code_digest(("no_such_module.py",))

@@ -398,7 +398,7 @@ def reanalyze_variant(name: str) -> dict:
     """Analyse variant ``name``'s stored grid again and update ``results/<name>.json``.
 
     For a change that leaves the stored scans as they are: a stage's fingerprint includes
-    its own code (:data:`flatcontact.pipeline.STAGE_CODE`), so ``run`` rescans after any edit
+    its own code (:func:`flatcontact.pipeline.stage_code_digest`), so ``run`` rescans after any edit
     of the build or scan code, even one that cannot change a finished point (e.g. the
     spread compression of ``place_slab2``, which only acts where a rigid placement
     overlaps). This reads ``RUNS/<name>/02-scan/ispes.nc`` as it is and replaces the loads,

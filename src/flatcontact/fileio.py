@@ -1,4 +1,5 @@
-"""Small file helpers shared by every stage: atomic writes, checked reads of user files.
+"""Small file helpers shared by every stage: atomic writes, checked reads of user files,
+the SHA-256 of a file's content.
 
 A file a stage produces either appears whole or not at all: write to a
 temporary sibling, then ``os.replace`` it into place.
@@ -7,6 +8,7 @@ temporary sibling, then ``os.replace`` it into place.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
 import os
 import tempfile
@@ -43,6 +45,19 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     finally:
         if tmp.exists():
             tmp.unlink()
+
+
+def file_sha256(path: str | os.PathLike[str]) -> str:
+    """SHA-256 of a file's bytes, as hex (read in 1 MiB blocks).
+
+    The one file hash of flatcontact: input files enter stage fingerprints by content,
+    stage records keep the digest of each output, recipes record their source files.
+    """
+    digest = hashlib.sha256()
+    with open(path, "rb") as handle:
+        for block in iter(lambda: handle.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
 
 
 def write_text_atomic(path: str | os.PathLike[str], text: str) -> Path:

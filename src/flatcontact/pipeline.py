@@ -3,7 +3,9 @@
 :class:`Pipeline` runs each stage through :meth:`flatcontact.rundir.RunDirectory.run_stage`
 with the stage's inputs = its configuration section + the content of the files it reads
 (potential coefficients, structure and measurement files) + the digest of the source code
-that computes it (:data:`STAGE_CODE`) + the fingerprints of the stages it reads, so that
+that computes it (:func:`stage_code_digest`: the stage module's import closure, figure
+modules left out for build and scan, see :data:`FIGURE_MODULES`) + the fingerprints of the
+stages it reads, so that
 
 - a rerun skips every stage whose inputs are unchanged;
 - an interrupted stage (Ctrl-C, kill -9) is resumed: the scan continues from its point
@@ -54,23 +56,22 @@ from pathlib import Path
 from typing import Any
 
 from flatcontact import __version__
+from flatcontact.codegraph import SOURCE_ROOT, closure_digest, import_closure
 from flatcontact.config import RunConfig, recipe_files, to_yaml
 from flatcontact.errors import InputError
-from flatcontact.fileio import write_json_atomic, write_text_atomic
+from flatcontact.fileio import file_sha256, write_json_atomic, write_text_atomic
 from flatcontact.rundir import (
     RunDirectory,
     RunLock,
     StageResult,
-    code_digest,
     package_versions,
     portable,
     writable,
 )
 from flatcontact.stages import _calculator
-from flatcontact.stages._common import file_sha256
 from flatcontact.stages.preflight import check_inputs
 
-__all__ = ["STAGES", "STAGE_CODE", "Pipeline", "file_sha256", "run"]
+__all__ = ["STAGES", "STAGE_MODULES", "Pipeline", "run", "stage_code", "stage_code_digest"]
 
 log = logging.getLogger("flatcontact.run")
 
@@ -84,77 +85,40 @@ STAGES = {
     "contact": 6,
     "report": 7,
 }
-_SHARED = ("stages/_common.py", "units.py")
-#: The flatcontact source each stage runs (paths in the package, see
-#: :func:`flatcontact.rundir.code_digest`): its stage module and the sub-packages and modules
-#: that stage module calls. Editing one of them reruns the stage and, through the
-#: fingerprints, every stage that reads it; editing the report's wording
-#: (``report/content.py``) reruns only the report. One deliberate exception: the figures of
-#: the expensive stages (``plots/structures.py``, ``plots/scan.py``) are left out of the build
-#: and scan digests, so restyling a figure never reruns a scan (the figure follows with the
-#: next real rerun).
-STAGE_CODE: dict[str, tuple[str, ...]] = {
-    "build": (
-        "stages/build.py",
-        "stages/_calculator.py",
-        "structures",
-        "potentials",
-        "ispes/toy.py",
-        *_SHARED,
-    ),
-    "scan": (
-        "stages/scan.py",
-        "stages/_calculator.py",
-        "ispes",
-        "potentials",
-        "structures",
-        *_SHARED,
-    ),
-    "analyze": (
-        "stages/analyze.py",
-        "analysis",
-        "ispes/contract.py",
-        "plots/__init__.py",
-        "plots/analysis.py",
-        *_SHARED,
-    ),
-    "laws": (
-        "stages/laws.py",
-        "stages/analyze.py",  # its settings names; the other energy form is analysed here
-        "analysis",
-        "ispes/contract.py",
-        "plots/__init__.py",
-        "plots/analysis.py",
-        *_SHARED,
-    ),
-    "elastic": (
-        "stages/elastic.py",
-        "stages/_calculator.py",
-        "elastic.py",
-        "potentials",
-        "structures",
-        *_SHARED,
-    ),
-    "contact": (
-        "stages/contact.py",
-        "contact",
-        "plots/__init__.py",
-        "plots/contact.py",
-        "plots/cycle.py",
-        "reference.py",
-        *_SHARED,
-    ),
-    "report": (
-        "stages/report.py",
-        "report",
-        "reference.py",
-        "config",
-        "stages/_calculator.py",
-        "potentials/lj.py",
-        "rundir.py",
-        *_SHARED,
-    ),
-}
+#: The module of each stage; the flatcontact code a stage runs is that module's import
+#: closure (:func:`flatcontact.codegraph.import_closure`): every flatcontact module it imports,
+#: directly or not, at module or function level, with their parent packages' ``__init__``.
+#: Editing any of them reruns the stage and, through the fingerprints, every stage that reads
+#: it. ``pipeline.py`` itself is in no closure (it orders the stages, it computes nothing).
+STAGE_MODULES: dict[str, str] = {name: f"flatcontact.stages.{name}" for name in STAGES}
+#: The figure modules, left out of the code digest of the expensive stages
+#: (:data:`FIGURES_LEFT_OUT`), so restyling a figure never reruns a build or a scan (the
+#: figure follows with the next real rerun). The cheap stages (analyze, laws, contact, report)
+#: keep their figures in their digest: editing a figure reruns them and redraws it. The
+#: modules the figures import stay in the closure.
+FIGURE_MODULES = "flatcontact.plots"
+FIGURES_LEFT_OUT = ("build", "scan")
+
+
+def stage_code(name: str, root: Path = SOURCE_ROOT) -> frozenset[str]:
+    """The flatcontact modules whose source enters stage ``name``'s code digest.
+
+    Parameters
+    ----------
+    name
+        A stage of :data:`STAGES`.
+    root
+        The source folder holding the ``flatcontact`` package (default: the installed one).
+    """
+    exclude = (FIGURE_MODULES,) if name in FIGURES_LEFT_OUT else ()
+    return import_closure(STAGE_MODULES[name], root, exclude)
+
+
+def stage_code_digest(name: str, root: Path = SOURCE_ROOT) -> str:
+    """SHA-256 of the source of :func:`stage_code` (``code_sha256`` of the stage's inputs)."""
+    return closure_digest(stage_code(name, root), root)
+
+
 RUN_MARKER = "run.json"
 RUN_FORMAT = "flatcontact.run/1"
 #: Scan settings that change how, not what, is computed (kept out of the fingerprint).
@@ -289,7 +253,7 @@ class Pipeline:
 
     def _run(self, name: str, inputs: dict, work: Callable[[Path], Any]) -> StageResult:
         index = STAGES[name]
-        inputs = {**inputs, "code_sha256": code_digest(STAGE_CODE[name])}
+        inputs = {**inputs, "code_sha256": stage_code_digest(name)}
         self._say(f"[bold]{index}. {name}[/]", highlight=False)
         try:
             if self.console is not None and name != "scan":

@@ -9,8 +9,9 @@ Each stage folder carries a ``stage.json`` record::
 
 The fingerprint is the SHA-256 of the canonical JSON of the stage's inputs: its
 own settings, the content of the input files it reads, the digest of the source code
-that computes it (:func:`code_digest`, so editing a development install reruns what the
-edit can change) plus the fingerprints of the stages it reads from. Hence
+that computes it (:func:`flatcontact.pipeline.stage_code_digest`, so editing a development
+install reruns what the edit can change) plus the fingerprints of the stages it reads from.
+Hence
 
 - a stage whose record says ``done`` with the same fingerprint is skipped;
 - a stage interrupted (``running``) with the same fingerprint is resumed: its
@@ -40,7 +41,6 @@ import contextlib
 import datetime as _dt
 import errno
 import fcntl
-import functools
 import hashlib
 import json
 import logging
@@ -55,7 +55,7 @@ from pathlib import Path
 from typing import Any
 
 from flatcontact.errors import InputError
-from flatcontact.fileio import write_json_atomic
+from flatcontact.fileio import file_sha256, write_json_atomic
 
 RECORD_NAME = "stage.json"
 LOCK_NAME = ".flatcontact.lock"
@@ -84,45 +84,6 @@ def fingerprint(inputs: Mapping[str, Any]) -> str:
     """SHA-256 of the canonical JSON form of ``inputs`` (sorted keys, no whitespace)."""
     text = json.dumps(inputs, sort_keys=True, separators=(",", ":"), default=str)
     return hashlib.sha256(text.encode()).hexdigest()
-
-
-@functools.cache
-def code_digest(parts: tuple[str, ...]) -> str:
-    """SHA-256 of the flatcontact source that a stage runs.
-
-    Parameters
-    ----------
-    parts
-        Paths relative to the installed ``flatcontact`` package: a module (``"elastic.py"``),
-        a sub-package (``"ispes"``, every file below it: code and shipped data) or ``"."``
-        for the whole package.
-
-    Returns
-    -------
-    str
-        Hex digest over the sorted (relative path, bytes) of every file, ``__pycache__``
-        and compiled files excluded. It changes when, and only when, one of those files
-        does, whatever the package version says.
-    """
-    import flatcontact
-
-    root = Path(flatcontact.__file__).resolve().parent
-    files: set[Path] = set()
-    for part in parts:
-        path = (root / part).resolve()
-        if not path.exists():
-            raise ValueError(f"code_digest: {part!r} is not part of the flatcontact package")
-        found = [path] if path.is_file() else path.rglob("*")
-        files.update(
-            f
-            for f in found
-            if f.is_file() and "__pycache__" not in f.parts and f.suffix not in (".pyc", ".pyo")
-        )
-    digest = hashlib.sha256()
-    for f in sorted(files):
-        digest.update(f.relative_to(root).as_posix().encode() + b"\0")
-        digest.update(hashlib.sha256(f.read_bytes()).digest())
-    return digest.hexdigest()
 
 
 def package_versions() -> dict[str, str]:
@@ -157,21 +118,12 @@ def portable(section: Mapping[str, Any] | None, *path_keys: str) -> dict[str, An
     return out
 
 
-def file_digest(path: Path) -> str:
-    """SHA-256 of a file's bytes (read in 1 MiB blocks)."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as handle:
-        for block in iter(lambda: handle.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
-
-
 def output_digests(folder: Path) -> dict[str, str]:
     """SHA-256 of every output file below ``folder`` (relative POSIX path -> digest)."""
     out = {}
     for path in sorted(folder.rglob("*")):
         if path.is_file() and not path.name.endswith(_NOT_OUTPUTS):
-            out[path.relative_to(folder).as_posix()] = file_digest(path)
+            out[path.relative_to(folder).as_posix()] = file_sha256(path)
     return out
 
 
@@ -181,7 +133,7 @@ def damaged_outputs(folder: Path, recorded: Mapping[str, str]) -> list[str]:
     for name, digest in recorded.items():
         path = folder / name
         try:
-            if not path.is_file() or file_digest(path) != digest:
+            if not path.is_file() or file_sha256(path) != digest:
                 bad.append(name)
         except OSError:
             bad.append(name)

@@ -5,9 +5,9 @@ import json
 
 import numpy as np
 import pytest
-from cli_helpers import one_error_line, run_cli
 from hypothesis import given
 from hypothesis import strategies as st
+from tests.cli.cli_helpers import one_error_line, run_cli
 
 _run = run_cli
 _one_error_line = one_error_line

@@ -1,7 +1,7 @@
 """The command line's bad-input behaviour: one verbatim ``error:`` line, exit 2, before any work."""
 
 import pytest
-from cli_helpers import one_error_line, run_cli
+from tests.cli.cli_helpers import one_error_line, run_cli
 
 _run = run_cli
 _one_error_line = one_error_line

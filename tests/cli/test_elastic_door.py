@@ -2,7 +2,7 @@
 
 import json
 
-from cli_helpers import one_error_line, run_cli
+from tests.cli.cli_helpers import one_error_line, run_cli
 
 from flatcontact.config import load_config
 from flatcontact.pipeline import Pipeline

@@ -1,9 +1,9 @@
 """The paper preset's measured law uncertainty is what the stored benchmark results give."""
 
-import sys
 from pathlib import Path
 
 import pytest
+from benchmarks.convergence.uncertainty import measured_uncertainty
 
 from flatcontact.config import MEASURED_LAW_UNCERTAINTY
 
@@ -16,11 +16,6 @@ pytestmark = pytest.mark.skipif(
 
 @pytest.fixture(scope="module")
 def measured():
-    sys.path.insert(0, str(ROOT))
-    try:
-        from benchmarks.convergence.uncertainty import measured_uncertainty
-    finally:
-        sys.path.remove(str(ROOT))
     return measured_uncertainty()
 
 

@@ -15,18 +15,15 @@ Cu(111) zero-load ISPES has the intrinsic stacking-fault energy of Mishin et al.
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from tests.potentials.plain_lammps import lammps_energy
 
 from flatcontact.config import load_config
 from flatcontact.errors import InputError
 from flatcontact.potentials.lammps_runtime import lammps_potential_file
-
-sys.path.insert(0, str(Path(__file__).parents[1] / "potentials"))
-from plain_lammps import lammps_energy
 
 EXAMPLES = Path(__file__).parents[2] / "examples"
 ALL = sorted(EXAMPLES.glob("*.yaml"))

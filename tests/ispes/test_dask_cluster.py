@@ -11,7 +11,6 @@ import signal
 import sqlite3
 import subprocess
 import sys
-import textwrap
 import threading
 import time
 
@@ -27,25 +26,6 @@ from flatcontact.ispes.relax import RelaxSettings
 from flatcontact.ispes.scan import run_scan
 
 SETTINGS = RelaxSettings(fmax_ev_per_a=1e-4, optimizer="FIRE")
-
-#: the toy calculator, slowed down so that the scan lasts long enough to kill a worker in it
-SLOW_TOY = textwrap.dedent(
-    """
-    import time
-    from flatcontact.ispes.toy import toy_calculator
-
-    def slow_toy(atoms, delay_s=0.004):
-        calc = toy_calculator(atoms)
-        inner = calc.calculate
-
-        def calculate(*args, **kwargs):
-            time.sleep(delay_s)
-            return inner(*args, **kwargs)
-
-        calc.calculate = calculate
-        return calc
-    """
-)
 
 
 def _rows(db):
@@ -67,14 +47,13 @@ def _wait_for(predicate, timeout_s: float, what: str):
 
 
 @pytest.fixture
-def cluster(tmp_path, monkeypatch):
+def cluster(tmp_path):
     """A scheduler and one `dask worker` with two single-threaded worker processes."""
     dask = shutil.which("dask", path=os.path.dirname(sys.executable)) or shutil.which("dask")
     if dask is None:
         pytest.skip("the dask command is not installed")
-    (tmp_path / "slowtoy.py").write_text(SLOW_TOY)
-    monkeypatch.syspath_prepend(str(tmp_path))
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), *sys.path])}
+    # the workers import the slowed toy (tests.ispes.slow_toy) and flatcontact from this path
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
     env["OMP_NUM_THREADS"] = "1"
     info = tmp_path / "scheduler.json"
     procs = []
@@ -131,7 +110,7 @@ def cluster(tmp_path, monkeypatch):
 
 def test_scan_on_a_separate_scheduler_survives_a_killed_worker(cluster, tmp_path, toy_reference):
     address, worker_cmd = cluster
-    factory = CalculatorFactory.from_target("slowtoy:slow_toy")
+    factory = CalculatorFactory.from_target("tests.ispes.slow_toy:slow_toy")
     z0 = thickness(toy_reference)
     grid = GridSpec(3, 3, thickness_angstrom=(z0 - 0.2, z0, z0 + 0.3))
     total = grid.n_a * grid.n_b * len(grid.thickness_angstrom)

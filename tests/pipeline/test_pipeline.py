@@ -227,19 +227,19 @@ def test_a_code_edit_reruns_exactly_the_stages_it_can_change(
     import shutil
 
     import flatcontact.pipeline as pipeline_module
-    from flatcontact.rundir import code_digest
+    from flatcontact.pipeline import stage_code, stage_code_digest
 
-    def edited_digest(parts):
-        # the digest as if `edited` had new content: changed for every part that contains it
-        touched = any(
-            part == "." or edited == part or edited.startswith(part + "/") for part in parts
-        )
-        return code_digest(parts) + ("+edited" if touched else "")
+    module = "flatcontact." + edited.removesuffix(".py").replace("/", ".")
+
+    def edited_digest(name):
+        # the digest as if `edited` had new content: changed for every stage whose code has it
+        touched = module in stage_code(name)
+        return stage_code_digest(name) + ("+edited" if touched else "")
 
     src, _, _ = tiny_run
     root = tmp_path / "copy"
     shutil.copytree(src, root)
-    monkeypatch.setattr(pipeline_module, "code_digest", edited_digest)
+    monkeypatch.setattr(pipeline_module, "stage_code_digest", edited_digest)
     with Pipeline(build_config(TINY), root) as pipe:
         pipe.run()
         actions = _actions(pipe)
@@ -249,13 +249,13 @@ def test_a_code_edit_reruns_exactly_the_stages_it_can_change(
 def test_each_stage_digest_covers_its_stage_module_and_nothing_of_the_report():
     """Fingerprints hold the code a stage runs: its own stage module always, the report's
     content module only in the report's digest."""
-    from flatcontact.pipeline import STAGE_CODE
+    from flatcontact.pipeline import STAGES, stage_code
 
-    for name, parts in STAGE_CODE.items():
-        module = "stages/scan.py" if name == "scan" else f"stages/{name}.py"
-        assert module in parts, name
-        assert ("report" in parts) == (name == "report"), name
-        assert "pipeline.py" not in parts and "." not in parts
+    for name in STAGES:
+        modules = stage_code(name)
+        assert f"flatcontact.stages.{name}" in modules, name
+        assert ("flatcontact.report.content" in modules) == (name == "report"), name
+        assert "flatcontact.pipeline" not in modules, name
 
 
 def test_a_changed_threshold_leaves_no_stale_fit_warning(tiny_run, tmp_path):

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from ase import Atoms
 from ase.build import mx2
-from plain_lammps import lammps_energy
+from tests.potentials.plain_lammps import lammps_energy
 
 from flatcontact.potentials import InteractionModel
 from flatcontact.potentials.lammps_runtime import lammps_potential_file

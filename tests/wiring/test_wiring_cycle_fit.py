@@ -9,15 +9,12 @@ Mindlin–Deresiewicz energy with μ = k and G*_J = G*/4 (computed here independ
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 import xarray as xr
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cli"))
-from cli_helpers import one_error_line, run_cli
+from tests.cli.cli_helpers import one_error_line, run_cli
 
 from flatcontact.config import load_config
 from flatcontact.contact import fit

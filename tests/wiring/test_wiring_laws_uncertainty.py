@@ -9,14 +9,10 @@ from __future__ import annotations
 
 import json
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "cli"))
-from cli_helpers import one_error_line, run_cli
+from tests.cli.cli_helpers import one_error_line, run_cli
 
 from flatcontact import units
 from flatcontact.analysis import synthetic as syn

@@ -18,7 +18,6 @@ tersoff/sw/vashishta/KC/ILP-style files; REBO/AIREBO files (numbers only) are C 
 from __future__ import annotations
 
 import functools
-import hashlib
 from pathlib import Path
 
 from ase.data import chemical_symbols
@@ -125,8 +124,3 @@ def file_elements(path: Path) -> tuple[str, ...]:
         return _entry_elements(path)
     except (OSError, ValueError, IndexError):
         return ()
-
-
-def file_sha256(path: str | Path) -> str:
-    """SHA-256 of a file's content (hex)."""
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()

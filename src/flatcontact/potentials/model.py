@@ -44,11 +44,11 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from flatcontact.errors import InputError
+from flatcontact.fileio import file_sha256
 from flatcontact.potentials.files import (
     BUNDLED_DIR,
     bundled_snap_names,
     file_elements,
-    file_sha256,
     require_potential_file,
     snap_elements,
 )

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import contextlib
-import hashlib
 import re
 import warnings
 from collections.abc import Iterator
@@ -20,11 +19,6 @@ def save(fig, folder: Path, stem: str, svg: bool) -> list[Path]:
     from flatcontact.plots import save_figure
 
     return save_figure(fig, folder / stem, figure_formats(svg))
-
-
-def file_sha256(path: str | Path) -> str:
-    """SHA-256 of a file's bytes (input files enter fingerprints by content)."""
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
 @contextlib.contextmanager

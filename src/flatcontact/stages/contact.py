@@ -30,9 +30,9 @@ from typing import Any
 import numpy as np
 
 from flatcontact.errors import InputError
-from flatcontact.fileio import atomic_path, write_json_atomic
+from flatcontact.fileio import atomic_path, file_sha256, write_json_atomic
 from flatcontact.reference import PAPER, PAPER_LAW_KEYS
-from flatcontact.stages._common import file_sha256, rename, renamed_errors, save
+from flatcontact.stages._common import rename, renamed_errors, save
 
 SUMMARY_JSON = "summary.json"
 CONTACT_NC = "contact.nc"

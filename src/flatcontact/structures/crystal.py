@@ -20,7 +20,6 @@ tolerance; the window rule above ties terminations and layers to the same repeat
 
 from __future__ import annotations
 
-import hashlib
 from dataclasses import dataclass, field
 from fractions import Fraction
 from math import gcd
@@ -33,6 +32,7 @@ from ase.build import surface as ase_surface
 from ase.data import atomic_numbers, reference_states
 
 from flatcontact.errors import InputError, require
+from flatcontact.fileio import file_sha256
 from flatcontact.structures.cell2d import standard_slab
 from flatcontact.structures.layers import repeat_layers
 
@@ -52,7 +52,7 @@ class OrientedBulk:
 def file_record(path: str | Path) -> dict:
     """Name and sha256 of an input file (for ``info["recipe"]``)."""
     path = Path(path)
-    return {"file": path.name, "sha256": hashlib.sha256(path.read_bytes()).hexdigest()}
+    return {"file": path.name, "sha256": file_sha256(path)}
 
 
 def read_bulk(path: str | Path, field_name: str = "bulk") -> Atoms:

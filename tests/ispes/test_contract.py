@@ -1,20 +1,10 @@
-"""Foundation: unit constants, the ISPES file contract, the CLI error path."""
+"""ispes/contract.py: the ISPES file contract (round trip, refused grids, declared units)."""
 
 import numpy as np
 import pytest
-from typer.testing import CliRunner
 
-from flatcontact import units
-from flatcontact.cli import app
 from flatcontact.errors import InputError
 from flatcontact.ispes import contract
-
-
-def test_unit_constants_against_definitions():
-    # 1 eV/Å^3 = 1.602176634e-19 J / 1e-30 m^3 = 160.2176634 GPa
-    assert units.EV_PER_A3_TO_GPA == pytest.approx(160.2176634, rel=1e-9)
-    assert units.EV_PER_A2_TO_J_PER_M2 == pytest.approx(16.02176634, rel=1e-9)
-    assert units.EV_PER_A3_TO_MPA == pytest.approx(1e3 * units.EV_PER_A3_TO_GPA)
 
 
 def _hex_vectors(a=4.916):
@@ -77,43 +67,3 @@ def test_contract_converts_declared_units_and_refuses_unknown_ones(tmp_path):
     odd["energy"].attrs["units"] = "kJ/mol"
     with pytest.raises(InputError, match="'energy' has units 'kJ/mol'"):
         contract.validate_ispes(odd)
-
-
-def test_cli_version():
-    result = CliRunner().invoke(app, ["version"])
-    assert result.exit_code == 0
-    assert result.stdout.strip()
-
-
-def test_input_error_is_one_line_exit_2(capsys):
-    from flatcontact.cli import main
-    from flatcontact.cli.app import app as the_app
-
-    @the_app.command("_raise-input-error", hidden=True)
-    def _raise() -> None:
-        raise InputError("--radius-um: expected a positive number, got -1")
-
-    with pytest.raises(SystemExit) as exit_info:
-        main(["_raise-input-error"])
-    assert exit_info.value.code == 2
-    err = capsys.readouterr().err
-    assert err.strip() == "error: --radius-um: expected a positive number, got -1"
-    assert "Traceback" not in err
-
-
-def test_atomic_write_leaves_usual_permissions_and_no_partial_file(tmp_path):
-    import os
-    import stat
-
-    from flatcontact.fileio import atomic_path, write_text_atomic
-
-    mask = os.umask(0o022)
-    try:
-        path = write_text_atomic(tmp_path / "out.txt", "x")
-        assert stat.S_IMODE(path.stat().st_mode) == 0o644
-        with pytest.raises(RuntimeError), atomic_path(tmp_path / "never.txt") as tmp:
-            tmp.write_text("half")
-            raise RuntimeError("interrupted")
-    finally:
-        os.umask(mask)
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.txt"]

@@ -1,0 +1,370 @@
+"""The layer contract of docs/architecture.md, checked over the static import graph.
+
+The graph is :func:`flatcontact.codegraph.import_graph`: every ``import`` statement in
+src/flatcontact, function-level imports and ``TYPE_CHECKING`` blocks included (a
+function-level import is an edge like any other: it runs when the function is called).
+Three rules:
+
+1. no import cycle anywhere;
+2. a module imports only from its own layer or below (:data:`LAYERS`, lowest first);
+3. inside the physics cores, a core package imports another core only along
+   :data:`CORE_DEPENDENCIES`.
+
+Imports *from* the top-level package ``flatcontact/__init__.py`` are exempt from all three:
+it is the public API, which reaches every layer lazily; every module may import from it
+(``__version__``). A parent package's ``__init__`` that runs on import is not an edge here
+(re-exporting ``__init__`` files would otherwise all be cycles); the stage fingerprints do
+count it (:func:`flatcontact.codegraph.import_closure`).
+
+:data:`KNOWN_VIOLATIONS` lists what main breaks today, so this passes while the fixes land;
+empty it as they do. Any violation not in it fails with the importing module and line.
+"""
+
+from __future__ import annotations
+
+import collections
+import textwrap
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+from flatcontact.codegraph import SOURCE_ROOT, ImportGraph, import_graph
+
+PACKAGE = "flatcontact"
+
+#: The layers, lowest first: the top-level modules and sub-packages of each.
+LAYERS: tuple[tuple[str, frozenset[str]], ...] = (
+    (
+        "foundation",
+        frozenset(
+            {"config", "reference", "units", "errors", "limits", "fileio", "rundir", "codegraph"}
+        ),
+    ),
+    (
+        "physics cores",
+        frozenset(
+            {"structures", "potentials", "ispes", "analysis", "contact", "elastic", "training"}
+        ),
+    ),
+    ("presentation", frozenset({"plots", "report"})),
+    ("stages", frozenset({"stages"})),
+    ("front doors", frozenset({"cli", "pipeline"})),
+)
+
+#: Which other cores each physics core may import: a core package, or one module of it
+#: (``analysis`` reads the ISPES file contract, nothing else of ``ispes``). The direction:
+#: potentials < structures < ispes < analysis; contact stands alone (plain numbers in);
+#: elastic < training (training validates potentials against the elastic constants).
+CORE_DEPENDENCIES: dict[str, frozenset[str]] = {
+    "potentials": frozenset(),
+    "structures": frozenset({"potentials"}),
+    "ispes": frozenset({"structures", "potentials"}),
+    "analysis": frozenset({"ispes.contract"}),
+    "contact": frozenset(),
+    "elastic": frozenset({"structures", "potentials"}),
+    "training": frozenset({"structures", "potentials", "ispes", "analysis", "elastic"}),
+}
+
+#: Violations on main when this test was written (``"source -> target"`` per import, and
+#: ``"cycle: a, b, ..."`` per strongly connected set). Each is being removed by its own
+#: change: the settings stop importing physics (pre-run checks move beside the stages), the
+#: interaction model stops building its engines, the toy interface and the teacher registry
+#: move down, the report reads the stages' file names from a lower layer. Remove an entry when
+#: its fix lands (``test_known_violations_still_exist`` says which are gone).
+KNOWN_VIOLATIONS: frozenset[str] = frozenset(
+    {
+        "cycle: flatcontact.potentials.calculator, flatcontact.potentials.factory, "
+        "flatcontact.potentials.lammps_setup, flatcontact.potentials.model",
+        "cycle: flatcontact.structures.interface, flatcontact.structures.layers",
+        "flatcontact.structures.construct -> flatcontact.ispes.toy",
+        "flatcontact.elastic -> flatcontact.training.potentials",
+        "flatcontact.report.content -> flatcontact.stages._calculator",
+        "flatcontact.report.content -> flatcontact.stages.contact",
+        # the settings (foundation) read the data classes of the potential and structure
+        # sections from the physics packages that own them
+        "flatcontact.config.load -> flatcontact.structures.recipe",
+        "flatcontact.config.merge -> flatcontact.potentials.presets",
+        "flatcontact.config.migration -> flatcontact.structures.recipe",
+        "flatcontact.config.run -> flatcontact.potentials.model",
+        "flatcontact.config.run -> flatcontact.structures.recipe",
+        "flatcontact.config.yaml_io -> flatcontact.potentials.model",
+    }
+)
+
+
+@dataclass(frozen=True)
+class Violation:
+    """One broken rule: ``key`` identifies it across edits (no line numbers in it)."""
+
+    key: str
+    message: str
+
+
+def _part(module: str, package: str) -> str:
+    """``flatcontact.ispes.scan`` -> ``ispes`` (the top-level module or sub-package)."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 and parts[0] == package else ""
+
+
+def _within(module: str, target: str, package: str) -> bool:
+    """Is ``module`` the core ``target`` (``"ispes"``) or below the module ``"ispes.contract"``."""
+    full = f"{package}.{target}"
+    return module == full or module.startswith(full + ".")
+
+
+def cycles(graph: ImportGraph, package: str = PACKAGE) -> list[list[str]]:
+    """The strongly connected sets of more than one module (explicit imports only)."""
+    adj: dict[str, set[str]] = {m: set() for m in graph.files}
+    for e in graph.edges:
+        if e.source != package:
+            adj[e.source].add(e.target)
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    found = []
+    counter = 0
+    for start in sorted(adj):  # iterative Tarjan
+        if start in index:
+            continue
+        work = [(start, iter(sorted(adj[start])))]
+        index[start] = low[start] = counter
+        counter += 1
+        stack.append(start)
+        on_stack.add(start)
+        while work:
+            node, children = work[-1]
+            for child in children:
+                if child not in index:
+                    index[child] = low[child] = counter
+                    counter += 1
+                    stack.append(child)
+                    on_stack.add(child)
+                    work.append((child, iter(sorted(adj[child]))))
+                    break
+                if child in on_stack:
+                    low[node] = min(low[node], index[child])
+            else:
+                work.pop()
+                if work:
+                    low[work[-1][0]] = min(low[work[-1][0]], low[node])
+                if low[node] == index[node]:
+                    comp = []
+                    while True:
+                        member = stack.pop()
+                        on_stack.discard(member)
+                        comp.append(member)
+                        if member == node:
+                            break
+                    if len(comp) > 1:
+                        found.append(sorted(comp))
+    return sorted(found)
+
+
+def check(
+    graph: ImportGraph,
+    layers=LAYERS,
+    core_dependencies=CORE_DEPENDENCIES,
+    package: str = PACKAGE,
+) -> list[Violation]:
+    """Every violation of the three rules in ``graph`` (see the module docstring)."""
+    layer_of = {part: i for i, (_, parts) in enumerate(layers) for part in parts}
+    names = [name for name, _ in layers]
+    cores = layers[1][1]
+    out = []
+    for comp in cycles(graph, package):
+        lines = [
+            f"{e.source}:{e.line} imports {e.target}"
+            for e in graph.edges
+            if e.source in comp and e.target in comp
+        ]
+        out.append(
+            Violation(
+                "cycle: " + ", ".join(comp),
+                "import cycle between " + ", ".join(comp) + ":\n    " + "\n    ".join(lines),
+            )
+        )
+    unplaced = sorted(
+        {_part(m, package) for m in graph.files if m != package} - set(layer_of), key=str
+    )
+    for part in unplaced:
+        out.append(Violation(f"unplaced: {part}", f"{package}.{part}: in no layer of LAYERS"))
+    for e in graph.edges:
+        if e.source == package or e.target == package:
+            continue
+        src, dst = _part(e.source, package), _part(e.target, package)
+        if src not in layer_of or dst not in layer_of or src == dst:
+            continue
+        key = f"{e.source} -> {e.target}"
+        where = f"{e.source}:{e.line}" + (" (in a function)" if e.function_level else "")
+        if layer_of[dst] > layer_of[src]:
+            out.append(
+                Violation(
+                    key,
+                    f"{where} imports {e.target}: {names[layer_of[src]]} may not import "
+                    f"from {names[layer_of[dst]]} (an upward import)",
+                )
+            )
+        elif src in cores and dst in cores:
+            allowed = core_dependencies.get(src, frozenset())
+            if not any(_within(e.target, a, package) for a in allowed):
+                out.append(
+                    Violation(
+                        key,
+                        f"{where} imports {e.target}: the core {src!r} may import only "
+                        f"{sorted(allowed) or 'no other core'} (CORE_DEPENDENCIES)",
+                    )
+                )
+    return out
+
+
+def new_violations(violations: list[Violation], known=KNOWN_VIOLATIONS) -> list[Violation]:
+    return [v for v in violations if v.key not in known]
+
+
+def test_the_core_table_itself_has_no_cycle_and_names_only_cores():
+    cores = LAYERS[1][1]
+    assert set(CORE_DEPENDENCIES) == set(cores)
+    for core, allowed in CORE_DEPENDENCIES.items():
+        assert {a.split(".")[0] for a in allowed} <= cores - {core}, core
+    # a topological order exists
+    remaining = {c: {a.split(".")[0] for a in allowed} for c, allowed in CORE_DEPENDENCIES.items()}
+    while remaining:
+        free = [c for c, deps in remaining.items() if not deps & set(remaining)]
+        assert free, f"CORE_DEPENDENCIES has a cycle among {sorted(remaining)}"
+        for c in free:
+            del remaining[c]
+
+
+def test_flatcontact_keeps_its_layers_and_has_no_import_cycle():
+    found = new_violations(check(import_graph(SOURCE_ROOT)))
+    assert not found, "new import violations:\n" + "\n".join(v.message for v in found)
+
+
+def test_known_violations_still_exist():
+    """An entry of KNOWN_VIOLATIONS that main no longer breaks is removed from it."""
+    keys = {v.key for v in check(import_graph(SOURCE_ROOT))}
+    gone = sorted(KNOWN_VIOLATIONS - keys)
+    assert not gone, "fixed, remove from KNOWN_VIOLATIONS:\n" + "\n".join(gone)
+
+
+def test_function_level_imports_are_counted():
+    """Informational: function-level imports of flatcontact modules, per module and in all
+    (printed with ``pytest -s``); the house style keeps them for heavy optional dependencies."""
+    graph = import_graph(SOURCE_ROOT)
+    per_module = collections.Counter(e.source for e in graph.edges if e.function_level)
+    total = sum(per_module.values())
+    module_level = sum(1 for e in graph.edges if not e.function_level)
+    print(
+        f"\nfunction-level imports of flatcontact modules: {total} "
+        f"(module level: {module_level}), in {len(per_module)} modules"
+    )
+    for module, count in per_module.most_common():
+        print(f"  {count:4d}  {module}")
+    assert total == sum(e.function_level for e in graph.edges)
+
+
+# ---- the checker on a synthetic package ---------------------------------------------------
+
+
+def _write(root: Path, files: dict[str, str]) -> Path:
+    for rel, text in files.items():
+        path = root / "flatcontact" / rel
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(textwrap.dedent(text))
+    return root
+
+
+@pytest.fixture
+def tiny_package(tmp_path) -> Path:
+    """A package laid out like flatcontact, keeping every rule."""
+    return _write(
+        tmp_path,
+        {
+            "__init__.py": '__version__ = "0"\n',
+            "errors.py": "class InputError(ValueError): ...\n",
+            "units.py": "from flatcontact.errors import InputError\n",
+            "potentials/__init__.py": "",
+            "potentials/model.py": "from flatcontact import __version__\n",
+            "structures/__init__.py": "",
+            "structures/build.py": "from ..potentials import model\n",
+            "ispes/__init__.py": "",
+            "ispes/contract.py": "from flatcontact import units\n",
+            "ispes/scan.py": "from flatcontact.structures.build import x\n",
+            "analysis/__init__.py": "",
+            "analysis/friction.py": "from flatcontact.ispes.contract import read\n",
+            "contact/__init__.py": "",
+            "elastic.py": "",
+            "training/__init__.py": "",
+            "plots/__init__.py": "from flatcontact.analysis import friction\n",
+            "report/__init__.py": "",
+            "stages/__init__.py": "",
+            "stages/scan.py": "from flatcontact.plots import save\nfrom . import _common\n",
+            "stages/_common.py": "",
+            "cli/__init__.py": "def main():\n    from flatcontact.stages.scan import run\n",
+            "pipeline.py": "",
+        },
+    )
+
+
+def _keys(root: Path) -> set[str]:
+    return {v.key for v in check(import_graph(root))}
+
+
+def test_checker_passes_a_package_that_keeps_the_rules(tiny_package):
+    assert _keys(tiny_package) == set()
+
+
+def test_checker_finds_each_new_violation_with_its_module_and_line(tiny_package):
+    _write(
+        tiny_package,
+        {
+            # upward, at function level: a core reaches a stage
+            "ispes/grid.py": "import numpy\n\n\ndef f():\n    from ..stages import scan\n",
+            # a core the table does not allow: contact imports no other core
+            "contact/hertz.py": "from flatcontact.analysis.friction import mu\n",
+            # analysis may read the ISPES contract only
+            "analysis/path.py": "from flatcontact.ispes import scan\n",
+            # a cycle through a function-level import
+            "report/a.py": "from flatcontact.report import b\n",
+            "report/b.py": "def g():\n    import flatcontact.report.a\n",
+            # a module in no layer
+            "newthing.py": "",
+        },
+    )
+    found = {v.key: v.message for v in check(import_graph(tiny_package))}
+    assert set(found) == {
+        "flatcontact.ispes.grid -> flatcontact.stages.scan",
+        "flatcontact.contact.hertz -> flatcontact.analysis.friction",
+        "flatcontact.analysis.path -> flatcontact.ispes.scan",
+        "cycle: flatcontact.report.a, flatcontact.report.b",
+        "unplaced: newthing",
+    }
+    assert found["flatcontact.ispes.grid -> flatcontact.stages.scan"].startswith(
+        "flatcontact.ispes.grid:5 (in a function) imports flatcontact.stages.scan: "
+        "physics cores may not import from stages"
+    )
+    assert (
+        "flatcontact.contact.hertz:1 imports"
+        in (found["flatcontact.contact.hertz -> flatcontact.analysis.friction"])
+    )
+    assert (
+        "flatcontact.report.b:2 imports flatcontact.report.a"
+        in (found["cycle: flatcontact.report.a, flatcontact.report.b"])
+    )
+    # a known violation passes; every other one is still new
+    known = frozenset({"flatcontact.ispes.grid -> flatcontact.stages.scan"})
+    assert len(new_violations(check(import_graph(tiny_package)), known)) == 4
+
+
+def test_checker_exempts_the_public_api_facade(tiny_package):
+    _write(
+        tiny_package,
+        {
+            "__init__.py": '__version__ = "0"\n\n\ndef __getattr__(name):\n'
+            "    from flatcontact.pipeline import Pipeline\n\n    return Pipeline\n",
+            "pipeline.py": "from flatcontact import __version__\n",
+        },
+    )
+    assert _keys(tiny_package) == set()
