@@ -10,7 +10,7 @@ full-stick traction is q0/s with q0 = G*·u/(π a) (paper's G*), i.e. a spring o
 κ(s) = G*/(π a s) per area, in series with a slider that holds until its traction reaches
 its static strength τ(s) = k p0 s + τ0 and then slips carrying the kinetic (MSS) traction
 σ(s) = μ p0 s + σ0. Loading from rest gives the paper's Q(u) (:mod:`.mindlin`). The paper
-is silent about reversal; the rule continued to it (issue 13) is:
+is silent about reversal; the rule continued to it is:
 
 * at a reversal every element re-sticks; its traction then changes by κ·Δu;
 * it slips the other way once the change since the reversal exceeds what holds it:
@@ -93,6 +93,7 @@ from flatcontact import units
 from flatcontact.contact import cattaneo_mindlin as cm
 from flatcontact.contact import mindlin, oscillation
 from flatcontact.contact.parameters import ContactParameters
+from flatcontact.contact.roots import quadratic_roots
 from flatcontact.errors import require
 
 FloatArray = NDArray[np.float64]
@@ -101,9 +102,6 @@ MODELS = ("modified", "classical")
 
 #: Default force amplitudes of ``contact --cycle``, as fractions of the gross-sliding force.
 DEFAULT_AMPLITUDE_FRACTIONS: tuple[float, ...] = (0.2, 0.4, 0.6, 0.8, 0.9, 0.95)
-
-#: J -> fJ
-J_TO_FJ = 1.0e15
 
 
 def check_model(model: str) -> str:
@@ -157,7 +155,7 @@ def check_cycle_domain(
 
 def _roots01(c2, c1, level):
     """The two roots of c2 s² + c1 s = level, as candidates in [0, 1] (0 where absent)."""
-    r1, r2 = mindlin._quadratic_roots(c2, c1, -level)
+    r1, r2 = quadratic_roots(c2, c1, -level)
     out = []
     for r in (r1, r2):
         ok = np.isfinite(r) & (r > 0.0) & (r < 1.0)
@@ -411,7 +409,7 @@ class CycleModel:
 def _classical_paper_stiffness(qa, mup, a, gj):
     """The paper's d⟨Q⟩/d⟨u⟩ for the Cattaneo–Mindlin loading curve (graded quadrature)."""
     qa = np.asarray(qa, dtype=float)[..., None]
-    phi, w = oscillation._graded_nodes()
+    phi, w = oscillation.graded_nodes()
     q = qa * np.cos(phi)  # Q = Q_amp sin θ, θ = π/2 − φ
     u = cm.displacement(q, mup, a, gj)
     x = np.clip(q / mup, 0.0, 1.0)
@@ -525,7 +523,7 @@ def loops(
 
 
 # --------------------------------------------------------------------------------------
-# outputs: JSON rows and the loops as a Dataset
+# the cycles of a list of p0 (JSON rows and the Dataset: :mod:`.cycle_output`)
 
 
 def _amplitudes_for(
@@ -558,7 +556,7 @@ def validate_cycle_request(
     amplitudes_un: ArrayLike | None = None,
     amplitude_fractions: ArrayLike | None = None,
 ) -> list[float]:
-    """Check everything :func:`cycle_records` needs, before any work; returns the p0 list."""
+    """Check everything :func:`cycles` needs, before any work; returns the p0 list."""
     check_model(model)
     p0_list = params.check_p0_gpa(p0_gpa)
     for p in p0_list:
@@ -587,109 +585,6 @@ def cycles(
         qa = _amplitudes_for(mdl.gross, amplitudes_un, amplitude_fractions, p, model)
         out.append(steady_cycle(qa, p0, params, model))
     return tuple(out)
-
-
-def cycle_records(cyc: tuple[SteadyCycle, ...] | list[SteadyCycle]) -> list[dict[str, Any]]:
-    """One JSON-ready row per (p0, amplitude), unit-named keys (``contact --cycle --json``)."""
-    rows = []
-    for c in cyc:
-        area = np.pi * c.contact_radius_m**2
-        for i, qa in enumerate(c.force_amplitude_n):
-            rows.append(
-                {
-                    "p0_gpa": c.p0_pa / units.GPA_TO_PA,
-                    "model": c.model,
-                    "lateral_force_amplitude_un": float(qa * units.N_TO_UN),
-                    "amplitude_fraction_of_gross_sliding": float(qa / c.gross_sliding_force_n),
-                    "stress_amplitude_mpa": float(qa / area / units.MPA_TO_PA),
-                    "stress_rms_mpa": float(qa / (np.sqrt(2.0) * area) / units.MPA_TO_PA),
-                    "displacement_amplitude_nm": float(
-                        c.displacement_amplitude_m[i] / units.NM_TO_M
-                    ),
-                    "dissipated_energy_per_cycle_fj": float(c.dissipated_energy_j[i] * J_TO_FJ),
-                    "lockin_stiffness_n_per_m": float(c.lockin_stiffness_n_per_m[i]),
-                    "lockin_in_phase_nm": float(c.in_phase_displacement_m[i] / units.NM_TO_M),
-                    "lockin_quadrature_nm": float(c.quadrature_displacement_m[i] / units.NM_TO_M),
-                    "loss_tangent": float(c.loss_tangent[i]),
-                    "secant_stiffness_n_per_m": float(c.secant_stiffness_n_per_m[i]),
-                    "paper_stiffness_n_per_m": float(c.paper_stiffness_n_per_m[i]),
-                    "initial_stiffness_n_per_m": float(c.initial_stiffness_n_per_m),
-                    "gross_sliding_force_un": float(c.gross_sliding_force_n * units.N_TO_UN),
-                }
-            )
-    return rows
-
-
-def cycle_dataset(
-    cyc: tuple[SteadyCycle, ...] | list[SteadyCycle],
-    params: ContactParameters,
-    n_points: int = 201,
-):
-    """The loops and per-amplitude cycle results as an xarray Dataset (for ``contact.nc``).
-
-    Dims ``p0`` (GPa, the same coordinate as :meth:`ContactAnalysis.to_dataset`),
-    ``cycle_amplitude`` (index; amplitudes may differ per p0) and ``loop_point``. Variables
-    carry a ``units`` attribute; names are prefixed ``cycle_`` so the Dataset merges with
-    the contact Dataset (``xr.merge([analysis.to_dataset(), cycle_dataset(...)])``).
-    """
-    import xarray as xr
-
-    n_amp = max(c.force_amplitude_n.size for c in cyc)
-    n_loop = 2 * n_points - 1
-    shape2, shape3 = (len(cyc), n_amp), (len(cyc), n_amp, n_loop)
-    lu, lq = np.full(shape3, np.nan), np.full(shape3, np.nan)
-    per = {k: np.full(shape2, np.nan) for k in ("qa", "w", "k", "u1", "u2", "kp", "tan", "ua")}
-    for i, c in enumerate(cyc):
-        n = c.force_amplitude_n.size
-        for j, lp in enumerate(loops(c.force_amplitude_n, c.p0_pa, params, c.model, n_points)):
-            lu[i, j] = lp.displacement_m / units.NM_TO_M
-            lq[i, j] = lp.force_n * units.N_TO_UN
-        per["qa"][i, :n] = c.force_amplitude_n * units.N_TO_UN
-        per["w"][i, :n] = c.dissipated_energy_j * J_TO_FJ
-        per["k"][i, :n] = c.lockin_stiffness_n_per_m
-        per["u1"][i, :n] = c.in_phase_displacement_m / units.NM_TO_M
-        per["u2"][i, :n] = c.quadrature_displacement_m / units.NM_TO_M
-        per["kp"][i, :n] = c.paper_stiffness_n_per_m
-        per["tan"][i, :n] = c.loss_tangent
-        per["ua"][i, :n] = c.displacement_amplitude_m / units.NM_TO_M
-    d2, d3 = ("p0", "cycle_amplitude"), ("p0", "cycle_amplitude", "loop_point")
-    model = cyc[0].model
-    ds = xr.Dataset(
-        {
-            "cycle_loop_displacement": (
-                d3,
-                lu,
-                {"units": "nm", "long_name": "u on the steady loop"},
-            ),
-            "cycle_loop_force": (d3, lq, {"units": "uN", "long_name": "Q on the steady loop"}),
-            "cycle_force_amplitude": (d2, per["qa"], {"units": "uN"}),
-            "cycle_displacement_amplitude": (d2, per["ua"], {"units": "nm"}),
-            "cycle_dissipated_energy": (d2, per["w"], {"units": "fJ", "long_name": "per cycle"}),
-            "cycle_lockin_stiffness": (
-                d2,
-                per["k"],
-                {"units": "N/m", "long_name": "Q_amp/u'_1 (first harmonic, in phase)"},
-            ),
-            "cycle_lockin_in_phase": (d2, per["u1"], {"units": "nm"}),
-            "cycle_lockin_quadrature": (d2, per["u2"], {"units": "nm"}),
-            "cycle_loss_tangent": (d2, per["tan"], {"units": "1"}),
-            "cycle_paper_stiffness": (d2, per["kp"], {"units": "N/m", "long_name": "d<Q>/d<u>"}),
-        },
-        coords={
-            "p0": ("p0", np.asarray([c.p0_pa / units.GPA_TO_PA for c in cyc]), {"units": "GPa"}),
-        },
-    )
-    ds.attrs["cycle_model"] = model
-    ds.attrs["cycle_conventions"] = (
-        "Q(t) = Q_amp sin(theta); u_1 = u'_1 sin(theta) - u''_1 cos(theta); lock-in stiffness "
-        "Q_amp/u'_1; W = pi Q_amp u''_1; "
-        + (
-            "modified Mindlin, q0 = G* u/(pi a), paper's G* = 4 G*_J"
-            if model == "modified"
-            else "Cattaneo-Mindlin/Mindlin-Deresiewicz, mu = k, G*_J = G*/4"
-        )
-    )
-    return ds
 
 
 def lockin_curve(

@@ -41,7 +41,7 @@ def fig_loops(
                 lp.force_n * units.N_TO_UN,
                 lw=1.2,
                 label=f"Q_amp = {lp.force_amplitude_n * units.N_TO_UN:.3g} µN, "
-                f"W = {w * cycle.J_TO_FJ:.3g} fJ",
+                f"W = {w * units.J_TO_FJ:.3g} fJ",
             )
         # the loading branch from rest: the first quarter cycle
         q = np.linspace(0.0, cyc.force_amplitude_n[-1], 200)

@@ -327,8 +327,8 @@ class ContactResult:
     files: list[Path] = field(default_factory=list)
 
     def cycle_rows(self) -> list[dict]:
-        """One row per p0 and force amplitude (:func:`flatcontact.contact.cycle.cycle_records`)."""
-        from flatcontact.contact.cycle import cycle_records
+        """One row per p0 and force amplitude (:func:`flatcontact.contact.cycle_output.cycle_records`)."""
+        from flatcontact.contact.cycle_output import cycle_records
 
         return cycle_records(self.cycles) if self.cycles else []
 
@@ -519,7 +519,7 @@ def _write(result: ContactResult, settings, folder: Path, measured, comparison) 
         result.files += save(fig, folder, name, settings.report.svg)
     ds = analysis.to_dataset()
     if result.cycles:
-        from flatcontact.contact.cycle import cycle_dataset
+        from flatcontact.contact.cycle_output import cycle_dataset
 
         cyc = cycle_dataset(result.cycles, params)
         ds = ds.merge(cyc)
