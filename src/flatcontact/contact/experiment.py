@@ -53,6 +53,7 @@ from flatcontact.contact.oscillation import (
 )
 from flatcontact.contact.parameters import ContactParameters, check_positive
 from flatcontact.errors import InputError, require
+from flatcontact.fileio import read_text_file
 
 FloatArray = NDArray[np.float64]
 
@@ -64,7 +65,7 @@ _SNAKE_STIFF = re.compile(r"^(?P<name>.+?)_(?P<f>kn|mn|un|nn|n)_per_(?P<l>mm|um|
 _SNAKE_PRESS = re.compile(r"^(?P<name>.+?)_(?P<u>kpa|mpa|gpa|pa)$")
 
 
-def _normalise_unit(text: str) -> str:
+def normalise_unit(text: str) -> str:
     return text.strip().replace("µ", "u").replace("μ", "u").replace(" ", "").lower()
 
 
@@ -76,7 +77,7 @@ def parse_unit(unit: str) -> tuple[str, float]:
     InputError
         For a unit that is neither a pressure nor a force per length.
     """
-    u = _normalise_unit(unit)
+    u = normalise_unit(unit)
     if u in _PRESSURE_TO_PA:
         return "stress", _PRESSURE_TO_PA[u]
     if "/" in u:
@@ -138,8 +139,6 @@ def load_stiffness_csv(path: str | Path) -> MeasuredStiffness:
         one, two columns of the same kind, a non-numeric or NaN/inf cell, a
         negative stress, fewer than 4 rows.
     """
-    from flatcontact.fileio import read_text_file
-
     p = Path(path)
     require(p.exists(), f"experiment file {str(p)!r} does not exist")
     text = read_text_file(p, "measured stiffness CSV", 50_000_000)
@@ -252,7 +251,7 @@ def collapse_stress(
     )
 
 
-def _measure_factor(measure: str) -> float:
+def measure_factor(measure: str) -> float:
     require(
         measure in STRESS_MEASURES,
         f"stress measure must be one of {STRESS_MEASURES}, got {measure!r}",
@@ -264,7 +263,7 @@ def model_stiffness_at_stress(
     stress_pa: ArrayLike, p0_pa: float, params: ContactParameters, measure: str = "amplitude"
 ) -> FloatArray:
     """Model lateral stiffness (N/m) at mean shear stresses (Pa) of ``measure``; 0 beyond collapse."""
-    factor = _measure_factor(measure)
+    factor = measure_factor(measure)
     s = np.asarray(stress_pa, dtype=float)
     a = float(mindlin.contact_radius(p0_pa, params))
     qmax = s * np.pi * a**2 / factor
@@ -278,7 +277,7 @@ def model_collapse_stress(
     p0_pa: float, params: ContactParameters, *, fraction: float = 0.2, measure: str = "amplitude"
 ) -> float:
     """The model's stress (Pa, ``measure``) where k falls to ``fraction``·k0 — the data criterion."""
-    factor = _measure_factor(measure)
+    factor = measure_factor(measure)
     a = float(mindlin.contact_radius(p0_pa, params))
     return amplitude_at_stiffness_fraction(p0_pa, params, fraction) * factor / (np.pi * a**2)
 

@@ -86,7 +86,7 @@ def _load_column(header: str) -> tuple[str, float] | None:
     h = header.strip()
     m = re.match(r"^(?P<name>.*?)\s*[\[(](?P<unit>[^\])]+)[\])]\s*$", h)
     if m:
-        name, unit = m.group("name"), experiment._normalise_unit(m.group("unit"))
+        name, unit = m.group("name"), experiment.normalise_unit(m.group("unit"))
     else:
         low = h.lower()
         parts = low.rsplit("_", 1)
@@ -264,7 +264,7 @@ def model_stiffness(
     """Model stiffness (N/m) at the curve's stresses: lock-in k′ or the paper's d⟨Q⟩/d⟨u⟩,
     0 at and beyond gross sliding."""
     require(stiffness in STIFFNESS_KINDS, f"stiffness must be one of {STIFFNESS_KINDS}")
-    factor = experiment._measure_factor(measure)
+    factor = experiment.measure_factor(measure)
     p0 = curve.p0_gpa * units.GPA_TO_PA
     mdl = cycle.CycleModel(model, p0, params)
     qa = curve.stress_pa * np.pi * mdl.a**2 / factor
@@ -361,7 +361,7 @@ def fit_stiffness_curves(
     free = check_free_fixed(free, fixed, model)
     require(len(curves) > 0, "fit: no stiffness curves")
     require(stiffness in STIFFNESS_KINDS, f"stiffness must be one of {STIFFNESS_KINDS}")
-    experiment._measure_factor(measure)
+    experiment.measure_factor(measure)
     for c in curves:
         cycle.check_cycle_domain(c.p0_gpa * units.GPA_TO_PA, params, model)
     y = np.concatenate([c.stiffness_n_per_m for c in curves])
