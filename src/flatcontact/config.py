@@ -1091,7 +1091,7 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
     if cfg.structure.kind in ("file", "slab") and getattr(cfg.structure, "file", None) is not None:
         _check_structure_file(cfg, source)
     if cfg.contact.experiment_csv is not None:
-        from flatcontact.contact.experiment import load_stiffness_csv
+        from flatcontact.contact.measured import load_stiffness_csv
 
         try:
             load_stiffness_csv(cfg.contact.experiment_csv)

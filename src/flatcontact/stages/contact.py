@@ -192,8 +192,8 @@ def check_cycle(settings, params) -> None:
 
 def fit_curves(settings, params) -> list:
     """The measured curves of ``contact.fit_csv`` (validated with the parameter names, before
-    any work): :func:`flatcontact.contact.fit.load_fit_data`, ``check_free_fixed``."""
-    from flatcontact.contact import fit
+    any work): :func:`flatcontact.contact.measured.load_fit_data`, ``check_free_fixed``."""
+    from flatcontact.contact import fit, measured
 
     c = settings.contact
     try:
@@ -202,7 +202,7 @@ def fit_curves(settings, params) -> list:
         where = "contact.fit_fixed" if "fixed" in str(exc) else "contact.fit_free"
         raise InputError(f"{where}: {exc} (contact.fit_free = {list(c.fit_free)})") from None
     try:
-        return fit.load_fit_data(c.fit_csv, params, c.fit_p0_gpa)
+        return measured.load_fit_data(c.fit_csv, params, c.fit_p0_gpa)
     except InputError as exc:
         text = rename(str(exc), {"fit_p0_gpa": "contact.fit_p0_gpa"})
         raise InputError(f"contact.fit_csv: {text}") from None
@@ -381,12 +381,13 @@ def run_contact(
 ) -> ContactResult:
     """The modified Mindlin contact of ``settings.contact`` with the upstream ``inputs``."""
     from flatcontact.contact import experiment as exp
+    from flatcontact.contact.measured import load_stiffness_csv
     from flatcontact.contact.summary import analyse
 
     c = settings.contact
     params, provenance = contact_parameters(settings, inputs)
     check_contact(settings, params)
-    measured = exp.load_stiffness_csv(c.experiment_csv) if c.experiment_csv else None
+    measured = load_stiffness_csv(c.experiment_csv) if c.experiment_csv else None
     curves = fit_curves(settings, params) if c.fit_csv else None
     analysis = analyse(
         c.p0_gpa,
