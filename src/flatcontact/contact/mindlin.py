@@ -344,6 +344,10 @@ def force_slope_s(s: ArrayLike, p0_pa: ArrayLike, params: ContactParameters) -> 
     return br.area2 * br.dy_ds(np.asarray(s, dtype=float))
 
 
+# --------------------------------------------------------------------------------------
+# the peak and the rising-branch inverse (numerics: :mod:`.piecewise_cubic`)
+
+
 @dataclass(frozen=True)
 class PeakForce:
     """The maximum of Q(u) over u (SI; arrays over p0).
@@ -479,6 +483,10 @@ def rising_branch_breaks(p0_pa: ArrayLike, params: ContactParameters) -> RisingB
         displacement_below_m=np.take_along_axis(np.broadcast_to(below, force.shape), order, -1),
         displacement_above_m=np.take_along_axis(np.broadcast_to(above, force.shape), order, -1),
     )
+
+
+# --------------------------------------------------------------------------------------
+# stiffness
 
 
 def initial_lateral_stiffness(p0_pa: ArrayLike, params: ContactParameters) -> FloatArray:
