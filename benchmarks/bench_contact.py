@@ -77,7 +77,7 @@ def main() -> None:
 
     curve, t_curve = _best(lambda: oscillation.stiffness_curve(P0, P), repeat=3)
     nq = curve.q_max_n.size
-    nodes = oscillation._graded_nodes()[0].size
+    nodes = oscillation.graded_nodes()[0].size
     print(
         f"stiffness curve, {nq} amplitudes x {nodes} quadrature nodes (+ knee by brentq): {t_curve * 1e3:.1f} ms"
     )

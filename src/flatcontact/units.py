@@ -43,3 +43,6 @@ ANGSTROM_TO_NM = 0.1
 N_TO_UN = 1.0e6
 UN_TO_N = 1.0e-6
 N_PER_M_TO_N_PER_M = 1.0
+
+#: J -> fJ (energies dissipated per oscillation cycle of a nanocontact)
+J_TO_FJ = 1.0e15

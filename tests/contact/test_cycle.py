@@ -8,7 +8,7 @@ from scipy.integrate import quad
 
 from flatcontact import units
 from flatcontact.contact import cattaneo_mindlin as cm
-from flatcontact.contact import cycle, mindlin
+from flatcontact.contact import cycle, cycle_output, mindlin, modified_cycle
 from flatcontact.contact.cycle_reference import time_stepped_cycle
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.contact.summary import analyse
@@ -107,7 +107,7 @@ def test_loading_branch_of_the_element_rule_is_the_paper_q_of_u(case):
     u = frac * float(mindlin.full_slip_displacement(p0, prm)) * np.array([0.3, 1.0, 1.2])
     a = float(mindlin.contact_radius(p0, prm))
     x = prm.shear_modulus_pa * u / (np.pi * a)
-    got = 2 * np.pi * a**2 * cycle.loading_force_per_area(x, p0, prm)
+    got = 2 * np.pi * a**2 * modified_cycle.loading_force_per_area(x, p0, prm)
     np.testing.assert_allclose(got, _loading(u, p0, prm), rtol=1e-9, atol=1e-15)
 
 
@@ -293,7 +293,7 @@ def test_records_and_dataset_merge_with_contact_nc():
     import xarray as xr
 
     cyc = cycle.cycles([1.0, 1.77], P, amplitude_fractions=[0.5, 0.9])
-    rows = cycle.cycle_records(cyc)
+    rows = cycle_output.cycle_records(cyc)
     assert len(rows) == 4
     for key in (
         "p0_gpa",
@@ -308,7 +308,7 @@ def test_records_and_dataset_merge_with_contact_nc():
         np.pi * r["lateral_force_amplitude_un"] * 1e-6 * r["lockin_quadrature_nm"] * 1e-9 * 1e15,
         rel=1e-5,
     )
-    ds = cycle.cycle_dataset(cyc, P, n_points=21)
+    ds = cycle_output.cycle_dataset(cyc, P, n_points=21)
     assert ds["cycle_loop_force"].shape == (2, 2, 41)
     merged = xr.merge([analyse([1.0, 1.77], P).to_dataset(), ds])
     assert merged.sizes["p0"] == 2

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from flatcontact.contact import fit, mindlin
+from flatcontact.contact.measured import LoadCurve, load_fit_data
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.errors import InputError
 
@@ -19,9 +20,9 @@ def _synthetic(params, noise_fraction, seed, n=25):
         gross = float(mindlin.peak_force(p0 * 1e9, params).force_n)
         a = float(mindlin.contact_radius(p0 * 1e9, params))
         stress = np.linspace(0.05, 1.15, n) * gross / (np.pi * a * a)
-        clean = fit.model_stiffness(fit.LoadCurve(p0, stress, stress * 0, "syn"), params)
+        clean = fit.model_stiffness(LoadCurve(p0, stress, stress * 0, "syn"), params)
         sd = noise_fraction * float(mindlin.initial_lateral_stiffness(p0 * 1e9, params))
-        curves.append(fit.LoadCurve(p0, stress, clean + rng.normal(0.0, sd, n), f"syn{p0}"))
+        curves.append(LoadCurve(p0, stress, clean + rng.normal(0.0, sd, n), f"syn{p0}"))
         sds.append(sd)
     return curves, sds
 
@@ -88,7 +89,7 @@ def test_load_column_csv_p0_and_normal_load(tmp_path):
         "# normal load instead of p0\n" + "\n".join(rows_load) + "\n"
     )
     for name in ("all.csv", "load.csv"):
-        got = fit.load_fit_data([tmp_path / name], TRUE)
+        got = load_fit_data([tmp_path / name], TRUE)
         assert [c.p0_gpa for c in got] == pytest.approx(list(LOADS), rel=1e-9)
         for g, c in zip(got, curves, strict=True):
             np.testing.assert_allclose(g.stress_pa, c.stress_pa, rtol=1e-12)
@@ -106,12 +107,12 @@ def test_one_file_per_load(tmp_path):
         ]
         p.write_text("\n".join(lines) + "\n")
         paths.append(p)
-    got = fit.load_fit_data(paths, TRUE, p0_gpa=LOADS)
+    got = load_fit_data(paths, TRUE, p0_gpa=LOADS)
     assert [c.p0_gpa for c in got] == list(LOADS)
     with pytest.raises(InputError, match=r"^p1.0.csv has no load column .*with 3 files"):
-        fit.load_fit_data(paths, TRUE)
+        load_fit_data(paths, TRUE)
     with pytest.raises(InputError, match=r"^fit_p0_gpa: 2 values for 3 files"):
-        fit.load_fit_data(paths, TRUE, p0_gpa=[1.0, 2.0])
+        load_fit_data(paths, TRUE, p0_gpa=[1.0, 2.0])
 
 
 def test_parameter_names_fixed_and_freed():

@@ -7,7 +7,10 @@ from hypothesis import strategies as st
 from scipy.integrate import quad
 
 from flatcontact import units
+from flatcontact.contact import cattaneo_mindlin as cm
 from flatcontact.contact import mindlin as m
+from flatcontact.contact import moduli
+from flatcontact.contact.classical_limit import classical_limit_of_paper_model
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.contact.quadrature import paper_integrals, stick_zone_by_root_finding
 from flatcontact.errors import InputError
@@ -54,17 +57,17 @@ def test_full_stick_integral():
         lambda r: 2 * np.pi * r * q0 * A / np.sqrt(A + r), 0, A, weight="alg", wvar=(0, -0.5)
     )
     assert val == pytest.approx(2 * P.shear_modulus_pa * A * u, rel=1e-10)
-    gj = float(m.johnson_shear_modulus_from_paper(P.shear_modulus_pa))
+    gj = float(moduli.johnson_shear_modulus_from_paper(P.shear_modulus_pa))
     assert val == pytest.approx(8 * gj * A * u, rel=1e-10)
 
 
 def test_shear_modulus_conversion():
     g, nu = 30e9, 0.2
-    gj = m.johnson_effective_shear_modulus(g, nu, g, nu)
+    gj = moduli.johnson_effective_shear_modulus(g, nu, g, nu)
     assert gj == pytest.approx(g / (2 * (2 - nu)))
-    assert float(m.paper_shear_modulus_from_johnson(gj)) == pytest.approx(4 * gj)
+    assert float(moduli.paper_shear_modulus_from_johnson(gj)) == pytest.approx(4 * gj)
     assert float(
-        m.johnson_shear_modulus_from_paper(m.paper_shear_modulus_from_johnson(gj))
+        moduli.johnson_shear_modulus_from_paper(moduli.paper_shear_modulus_from_johnson(gj))
     ) == pytest.approx(gj)
 
 
@@ -217,20 +220,20 @@ def test_classical_limit_agreements():
     a = float(m.contact_radius(P0, prm))
     load = 2 / 3 * np.pi * a**2 * P0
     mup = prm.mu * load
-    gj = float(m.johnson_shear_modulus_from_paper(prm.shear_modulus_pa))
+    gj = float(moduli.johnson_shear_modulus_from_paper(prm.shear_modulus_pa))
     # full slip: Q = μP in both
     assert float(m.saturated_force(P0, prm)) == pytest.approx(mup, rel=1e-12)
-    assert float(m.cattaneo_mindlin_force(1.0, mup, a, gj)) == pytest.approx(mup)
+    assert float(cm.force(1.0, mup, a, gj)) == pytest.approx(mup)
     # initial stiffness 8 G*_J a in both
     du = 1e-7 * float(m.full_slip_displacement(P0, prm))
     k_paper = float(m.lateral_force(du, P0, prm).lateral_force_n) / du
-    k_cm = float(m.cattaneo_mindlin_force(du, mup, a, gj)) / du
+    k_cm = float(cm.force(du, mup, a, gj)) / du
     assert k_paper == pytest.approx(8 * gj * a, rel=1e-3)
     assert k_cm == pytest.approx(8 * gj * a, rel=1e-3)
     # CM: c/a and δ formulas are consistent with each other (δ <-> Q round trip)
     q = np.linspace(0, 1, 11) * mup
-    d = m.cattaneo_mindlin_displacement(q, mup, a, gj)
-    np.testing.assert_allclose(m.cattaneo_mindlin_force(d, mup, a, gj), q, rtol=1e-10, atol=1e-20)
+    d = cm.displacement(q, mup, a, gj)
+    np.testing.assert_allclose(cm.force(d, mup, a, gj), q, rtol=1e-10, atol=1e-20)
 
 
 def test_classical_limit_exact_relation_of_paper_model():
@@ -239,18 +242,16 @@ def test_classical_limit_exact_relation_of_paper_model():
     prm = _classical()
     a = float(m.contact_radius(P0, prm))
     mup = prm.mu * 2 / 3 * np.pi * a**2 * P0
-    gj = float(m.johnson_shear_modulus_from_paper(prm.shear_modulus_pa))
+    gj = float(moduli.johnson_shear_modulus_from_paper(prm.shear_modulus_pa))
     u = np.linspace(0, 1, 101)[1:-1] * float(m.full_slip_displacement(P0, prm))
     r = m.lateral_force(u, P0, prm)
     s = np.sqrt(1 - (r.stick_radius_m / a) ** 2)
     np.testing.assert_allclose(r.lateral_force_n / mup, 3 * s**2 - 2 * s**3, rtol=1e-10)
     # CM displacement for the Q that gives CM the same c: Q_CM/μP = 1 − (c/a)³
     q_cm = mup * (1 - (r.stick_radius_m / a) ** 3)
-    np.testing.assert_allclose(
-        u / m.cattaneo_mindlin_displacement(q_cm, mup, a, gj), 2.0, rtol=1e-9
-    )
+    np.testing.assert_allclose(u / cm.displacement(q_cm, mup, a, gj), 2.0, rtol=1e-9)
     # the two models differ in between: max |ΔQ|/μP = 2/9 at u = (8/9) δ*_CM (exact)
-    cmp = m.classical_limit_of_paper_model()
+    cmp = classical_limit_of_paper_model()
     assert cmp.max_force_deviation == pytest.approx(2 / 9, abs=1e-9)
     assert cmp.displacement_of_max_deviation == pytest.approx(8 / 9, abs=1e-5)
     assert cmp.max_stick_radius_deviation == pytest.approx(1 - np.sqrt(3) / 2, abs=1e-6)
@@ -258,12 +259,7 @@ def test_classical_limit_exact_relation_of_paper_model():
     # the same deviation from the real functions
     dstar = 3 * mup / (16 * gj * a)
     uu = np.linspace(0, 2, 4001) * dstar
-    dev = (
-        np.abs(
-            m.lateral_force(uu, P0, prm).lateral_force_n - m.cattaneo_mindlin_force(uu, mup, a, gj)
-        )
-        / mup
-    )
+    dev = np.abs(m.lateral_force(uu, P0, prm).lateral_force_n - cm.force(uu, mup, a, gj)) / mup
     assert dev.max() == pytest.approx(2 / 9, abs=1e-6)
 
 

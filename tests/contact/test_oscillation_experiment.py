@@ -8,6 +8,7 @@ from scipy.optimize import brentq
 from flatcontact.contact import experiment as ex
 from flatcontact.contact import mindlin as m
 from flatcontact.contact import oscillation as osc
+from flatcontact.contact.measured import load_stiffness_csv, parse_unit
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.errors import InputError
 
@@ -103,13 +104,13 @@ def test_csv_units_and_column_order(tmp_path):
     f2.write_text(
         "# comment\nlateral_stiffness_un_per_nm,mean_shear_stress_kpa\n1,1000\n0.9,2000\n0.5,3000\n0.01,4000\n"
     )
-    d1, d2 = ex.load_stiffness_csv(f1), ex.load_stiffness_csv(f2)
+    d1, d2 = load_stiffness_csv(f1), load_stiffness_csv(f2)
     np.testing.assert_allclose(d1.stress_pa, [1e6, 2e6, 3e6, 4e6])
     np.testing.assert_allclose(d1.stiffness_n_per_m, d2.stiffness_n_per_m)
     np.testing.assert_allclose(d1.stress_pa, d2.stress_pa)
-    assert ex.parse_unit("µN/nm") == ("stiffness", pytest.approx(1e3))
-    assert ex.parse_unit("mN/m") == ("stiffness", pytest.approx(1e-3))
-    assert ex.parse_unit("GPa") == ("stress", 1e9)
+    assert parse_unit("µN/nm") == ("stiffness", pytest.approx(1e3))
+    assert parse_unit("mN/m") == ("stiffness", pytest.approx(1e-3))
+    assert parse_unit("GPa") == ("stress", 1e9)
 
 
 @pytest.mark.parametrize(
@@ -128,7 +129,7 @@ def test_csv_rejects_bad_files(tmp_path, text, match):
     f = tmp_path / "bad.csv"
     f.write_text(text)
     with pytest.raises(InputError, match=match) as err:
-        ex.load_stiffness_csv(f)
+        load_stiffness_csv(f)
     assert "\n" not in str(err.value)
 
 

@@ -632,6 +632,7 @@ def test_cycle_and_fit_in_a_run_match_the_cli_and_the_fit_file_content_reruns_co
     from flatcontact.cli import main
     from flatcontact.contact import fit
     from flatcontact.contact.cycle import CycleModel
+    from flatcontact.contact.measured import LoadCurve
     from flatcontact.contact.parameters import ContactParameters
 
     src, _, _ = tiny_run
@@ -645,7 +646,7 @@ def test_cycle_and_fit_in_a_run_match_the_cli_and_the_fit_file_content_reruns_co
         for p0 in (1.0, 2.0):
             mdl = CycleModel("modified", p0 * 1e9, prm)
             stress = np.linspace(0.05, 1.1, 10) * mdl.gross / (np.pi * mdl.a**2)
-            k = fit.model_stiffness(fit.LoadCurve(p0, stress, np.zeros(10), "t"), prm)
+            k = fit.model_stiffness(LoadCurve(p0, stress, np.zeros(10), "t"), prm)
             lines += [f"{s / 1e6:.10g},{v:.10g},{p0}" for s, v in zip(stress, k, strict=True)]
         path.write_text("\n".join(lines) + "\n")
 

@@ -19,6 +19,7 @@ from tests.cli.cli_helpers import one_error_line, run_cli
 from flatcontact.config import load_config
 from flatcontact.contact import fit
 from flatcontact.contact.cycle import CycleModel
+from flatcontact.contact.measured import LoadCurve
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.stages.contact import ContactInputs, run_contact
 
@@ -104,7 +105,7 @@ def _synthetic_table(path: Path, truth: ContactParameters, loads=(1.0, 1.77)) ->
         mdl = CycleModel("modified", p0 * 1e9, truth)
         smax = mdl.gross / (np.pi * mdl.a**2)
         stress = np.linspace(0.05, 1.1, 12) * smax
-        k = fit.model_stiffness(fit.LoadCurve(p0, stress, np.zeros(12), "t"), truth)
+        k = fit.model_stiffness(LoadCurve(p0, stress, np.zeros(12), "t"), truth)
         lines += [f"{s / 1e6:.10g},{v:.10g},{p0}" for s, v in zip(stress, k, strict=True)]
     path.write_text("\n".join(lines) + "\n")
 

@@ -250,7 +250,7 @@ def contact_command(
 ) -> None:
     """Hertz + adhesion + modified Mindlin: Q(u), peak and gross-sliding forces, oscillatory stiffness."""
     from flatcontact.cli.settings import flag_errors, settings_from_flags
-    from flatcontact.contact.mindlin import paper_shear_modulus_from_johnson
+    from flatcontact.contact.moduli import paper_shear_modulus_from_johnson
     from flatcontact.stages.contact import ContactInputs, run_contact
 
     p0_list = _parse_p0(p0_gpa)

@@ -9,7 +9,7 @@ Johnson, *Contact Mechanics* (1985), §7.2 and §7.4. A Hertz contact of radius 
 under normal load P, Coulomb friction coefficient μ everywhere (static = kinetic),
 tangential force Q along one axis, relative tangential displacement δ of distant
 points. The shear modulus is **Johnson's** G*_J, 1/G*_J = (2−ν1)/G1 + (2−ν2)/G2; the
-paper's G* (q0 = G*·u/(π a)) is 4 G*_J (:mod:`flatcontact.contact.parameters`).
+paper's G* (q0 = G*·u/(π a)) is 4 G*_J (:mod:`flatcontact.contact.moduli`).
 ``friction_limit_n`` is μP.
 
 - loading from rest (Johnson Eqs. 7.43, 7.47), 0 <= Q <= μP:

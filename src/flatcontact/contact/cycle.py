@@ -5,51 +5,10 @@ the whole cycle — not only the loading quarter the paper uses — for two mode
 
 ``modified`` (the paper's modified Mindlin model, Dong et al.)
 --------------------------------------------------------------
-The paper's local rule, written per surface element at s = √(1 − r²/a²): the element's
-full-stick traction is q0/s with q0 = G*·u/(π a) (paper's G*), i.e. a spring of stiffness
-κ(s) = G*/(π a s) per area, in series with a slider that holds until its traction reaches
-its static strength τ(s) = k p0 s + τ0 and then slips carrying the kinetic (MSS) traction
-σ(s) = μ p0 s + σ0. Loading from rest gives the paper's Q(u) (:mod:`.mindlin`). The paper
-is silent about reversal; the rule continued to it (issue 13) is:
-
-* at a reversal every element re-sticks; its traction then changes by κ·Δu;
-* it slips the other way once the change since the reversal exceeds what holds it:
-  τ + σ if it had slipped (it carried σ), τ + q if it had stuck (it carried q), i.e. once
-  its traction reaches ∓τ; slipping elements carry ∓σ.
-
-With X = G*U/(π a) the drive at the top (U: displacement amplitude) and D = G*Δ/(π a) the
-drive decrement Δ = U − u since the reversal, and g(s) = s τ(s), g₂(s) = s (τ + σ)(s):
-
-* the elements that slipped on loading are S₁ = {s : g(s) <= X} (the slip zone of the
-  loading branch at U; a ring, or ring and centre for k < 0);
-* on unloading the slipped ones re-slip once g₂(s) <= D: S₂(D) = S₁ ∩ {g₂ <= D}; the
-  stuck ones (g > X) never slip during the cycle (their traction stays inside ±τ);
-* the force falls by (dA = 2π a² s ds)
-
-      Q_amp − Q(D) = 2π a² [ D·|[0,1] \\ S₂(D)| + ∫_{S₂(D)} 2 σ(s) s ds ];            (U1)
-
-* if σ <= τ on the contact, S₁ ⊂ {g₂ <= 2X}: at D = 2X (u = −U) every element of S₁ has
-  re-slipped and every traction is the mirror image of the top, Q = −Q_amp. The loop closes
-  after the first quarter cycle (a sudden start and a slow ramp give the same steady cycle),
-  reloading is the mirror image u → −u, Q → −Q of unloading, and Q(D) stays above −Q_amp
-  for D < 2X (it is below 2 Q_load(D/2)). Where (U1) is not monotone in D the load-controlled
-  path jumps (u at fixed Q); it follows the running maximum of Q_amp − Q(D).
-* generalised Masing rule: while S₂ is the full sublevel set {g₂ <= D} (k, k + μ >= 0 and
-  D <= g₂(s₁)), (U1) is the paper's loading branch of a contact with static strength τ + σ
-  and slip traction 2σ, evaluated at the displacement Δ. In the classical limit τ = σ
-  (k = μ, τ0 = σ0) that contact is the original one with both laws doubled, g₂ = 2g, and
-  Q_amp − Q(Δ) = 2 Q_load(Δ/2): **Masing's rule**, the return branch is the loading branch
-  with force and displacement doubled. For σ < τ the return branch is stiffer than Masing's
-  and ends in a straight (elastic) segment once all of S₁ has re-slipped.
-
-Energy per cycle, from each element's own loop (spring + slider: linear from −σ to +τ,
-instantaneous drop τ → σ, sliding at σ, and back):
-
-    W = (2π² a³/G*) ∫_{S₁} [4σ s (X − σ s) + (τ − σ)² s²] ds.                         (W)
-
-The (τ − σ)² term is the energy of the static-to-kinetic drop. As Q_amp → 0 (τ0 > 0):
-S₁ ≈ [0, X/τ0], X ≈ Q_amp/(2π a²), W ≈ (2π²a³/G*)(X/τ0)³(τ0² + 4τ0σ0 − 3σ0²)/3: cubic in
-Q_amp; for τ0 = 0 (then σ0 = 0 here) W ∝ Q_amp^(5/2).
+The paper's local rule per surface element (a spring in series with a slider that holds
+up to τ and slips carrying σ), continued through the reversal; the unloading decrement
+(U1), the energy per cycle (W) and the generalised Masing rule are closed forms in
+:mod:`flatcontact.contact.modified_cycle`. The cycle needs σ <= τ on the contact.
 
 ``classical`` (Cattaneo–Mindlin, Mindlin–Deresiewicz)
 ----------------------------------------------------
@@ -65,8 +24,9 @@ u(θ) is periodic and half-wave symmetric; its first harmonic u₁(θ) = u′₁
     u′₁ = (2/π) ∫_0^{2U} √(1 − (Q/Q_amp)²) dΔ,       u″₁ = −(2/(π Q_amp)) ∫_0^{2U} Q dΔ,
 
 so that ∮Q du = π Q_amp u″₁ (only the first harmonic of u does work against a sine force;
-checked against (W)). A lock-in referenced to the drive reads the in-phase and quadrature
-parts of the displacement at ν: the **lock-in stiffness is k′ = Q_amp/u′₁** at each
+checked against the closed-form energy). A lock-in referenced to the drive reads the
+in-phase and quadrature parts of the displacement at ν: the **lock-in stiffness is
+k′ = Q_amp/u′₁** at each
 amplitude (a secant, first-harmonic stiffness of the whole loop), with loss tangent
 u″₁/u′₁. The paper's k = d⟨Q⟩/d⟨u⟩ (:mod:`.oscillation`) is a different curve: the slope of
 the rms loading quarter-cycle across amplitudes, with no unloading. Both → 2 G*a (modified)
@@ -74,10 +34,8 @@ or 8 G*_J a (classical) as Q_amp → 0; k′ stays finite up to gross sliding (t
 stops existing), while the paper's k falls to 0 there. A measured stiffness-vs-amplitude
 curve from a lock-in is k′ (amplitude stress Q_amp/(π a²)), not d⟨Q⟩/d⟨u⟩.
 
-Numerics: (U1) and (W) are closed forms (polynomials on the intervals cut by the roots of
-the quadratics g = X and g₂ = D; membership decided at each interval's midpoint, which
-covers every sign of k and μ); the Δ integrals use Gauss–Legendre panels in φ,
-Δ = U(1 − cos φ), split where the sets change.
+Numerics: the Δ integrals use Gauss–Legendre panels in φ, Δ = U(1 − cos φ), split where
+the slip sets of the modified model change (:func:`.modified_cycle.unloading_drive_breaks`).
 """
 
 from __future__ import annotations
@@ -91,7 +49,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from flatcontact import units
 from flatcontact.contact import cattaneo_mindlin as cm
-from flatcontact.contact import mindlin, oscillation
+from flatcontact.contact import mindlin, modified_cycle, oscillation
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.errors import require
 
@@ -101,9 +59,6 @@ MODELS = ("modified", "classical")
 
 #: Default force amplitudes of ``contact --cycle``, as fractions of the gross-sliding force.
 DEFAULT_AMPLITUDE_FRACTIONS: tuple[float, ...] = (0.2, 0.4, 0.6, 0.8, 0.9, 0.95)
-
-#: J -> fJ
-J_TO_FJ = 1.0e15
 
 
 def check_model(model: str) -> str:
@@ -149,127 +104,6 @@ def check_cycle_domain(
             f"{params.k_mpa_per_gpa:g}); the cycle needs sigma <= tau on the contact"
         )
         require(False, raise_msg)
-
-
-# --------------------------------------------------------------------------------------
-# closed forms of the modified model
-
-
-def _roots01(c2, c1, level):
-    """The two roots of c2 s² + c1 s = level, as candidates in [0, 1] (0 where absent)."""
-    r1, r2 = mindlin._quadratic_roots(c2, c1, -level)
-    out = []
-    for r in (r1, r2):
-        ok = np.isfinite(r) & (r > 0.0) & (r < 1.0)
-        out.append(np.where(ok, r, 0.0))
-    return out
-
-
-def _poly_integral(coeffs, lo, hi):
-    """∫_lo^hi Σ_j c_j s^j ds, coeffs = (c0, c1, c2, ...) broadcasting."""
-    total = 0.0
-    for j, c in enumerate(coeffs):
-        total = total + c * (hi ** (j + 1) - lo ** (j + 1)) / (j + 1)
-    return total
-
-
-def _pieces(*candidates):
-    """Sorted breakpoints 0, candidates..., 1 along a new last axis; (lo, hi, mid)."""
-    cands = np.broadcast_arrays(*candidates)
-    zero = np.zeros_like(cands[0])
-    b = np.sort(np.stack([zero, *cands, zero + 1.0], axis=-1), axis=-1)
-    lo, hi = b[..., :-1], b[..., 1:]
-    return lo, hi, 0.5 * (lo + hi)
-
-
-def unloading_decrement(
-    drive_decrement_pa: ArrayLike, drive_pa: ArrayLike, p0_pa: ArrayLike, params: ContactParameters
-) -> FloatArray:
-    """(Q_amp − Q)/(2π a²) (Pa) on the unloading branch, Eq. (U1) of the module doc.
-
-    ``drive_pa`` is X = G*U/(π a) at the top, ``drive_decrement_pa`` D = G*Δ/(π a) with
-    Δ = U − u; both broadcast with p0. Closed form for any sign of k, μ.
-    """
-    d = np.asarray(drive_decrement_pa, dtype=float)
-    x = np.asarray(drive_pa, dtype=float)
-    p0 = np.asarray(p0_pa, dtype=float)
-    kp, mp = params.k * p0, params.mu * p0
-    t0, s0 = params.tau0_pa, params.sigma0_pa
-    r1, r2 = _roots01(kp, t0, x)
-    r3, r4 = _roots01(kp + mp, t0 + s0, d)
-    lo, hi, mid = _pieces(r1, r2, r3, r4)
-
-    def ex(z):
-        return np.asarray(z)[..., None]
-
-    member = (ex(kp) * mid**2 + t0 * mid <= ex(x)) & (
-        ex(kp + mp) * mid**2 + (t0 + s0) * mid <= ex(d)
-    )
-    slipped = _poly_integral((0.0, 2.0 * s0, 2.0 * ex(mp)), lo, hi)
-    stuck = ex(d) * (hi - lo)
-    return np.sum(np.where(member, slipped, stuck), axis=-1)
-
-
-def loading_force_per_area(
-    drive_pa: ArrayLike, p0_pa: ArrayLike, params: ContactParameters
-) -> FloatArray:
-    """Q/(2π a²) (Pa) on the loading branch at drive X = q0, from the element rule:
-    ∫ [σ(s) s on S₁, X elsewhere] ds (equal to :func:`mindlin.lateral_force`)."""
-    x = np.asarray(drive_pa, dtype=float)
-    p0 = np.asarray(p0_pa, dtype=float)
-    kp, mp = params.k * p0, params.mu * p0
-    t0, s0 = params.tau0_pa, params.sigma0_pa
-    r1, r2 = _roots01(kp, t0, x)
-    lo, hi, mid = _pieces(r1, r2)
-
-    def ex(z):
-        return np.asarray(z)[..., None]
-
-    member = ex(kp) * mid**2 + t0 * mid <= ex(x)
-    slipped = _poly_integral((0.0, s0, ex(mp)), lo, hi)
-    return np.sum(np.where(member, slipped, ex(x) * (hi - lo)), axis=-1)
-
-
-def modified_dissipated_energy(
-    drive_pa: ArrayLike, p0_pa: ArrayLike, params: ContactParameters
-) -> FloatArray:
-    """Energy dissipated per steady cycle (J), Eq. (W): the sum of every element's own loop."""
-    x = np.asarray(drive_pa, dtype=float)
-    p0 = np.asarray(p0_pa, dtype=float)
-    kp, mp = params.k * p0, params.mu * p0
-    t0, s0 = params.tau0_pa, params.sigma0_pa
-    r1, r2 = _roots01(kp, t0, x)
-    lo, hi, mid = _pieces(r1, r2)
-
-    def ex(z):
-        return np.asarray(z)[..., None]
-
-    member = ex(kp) * mid**2 + t0 * mid <= ex(x)
-    m, n = ex(mp), s0  # σ s = m s² + n s
-    m2, n2 = ex(kp - mp), t0 - s0  # (τ − σ) s = m2 s² + n2 s
-    coeffs = (
-        0.0,
-        4.0 * ex(x) * n,
-        4.0 * ex(x) * m - 4.0 * n * n + n2 * n2,
-        -8.0 * m * n + 2.0 * m2 * n2,
-        -4.0 * m * m + m2 * m2,
-    )
-    integral = np.sum(np.where(member, _poly_integral(coeffs, lo, hi), 0.0), axis=-1)
-    a = mindlin.contact_radius(p0, params)
-    return 2.0 * np.pi**2 * a**3 / params.shear_modulus_pa * integral
-
-
-def _unloading_drive_breaks(x, p0, params: ContactParameters):
-    """D where the set S₂(D) changes structure: g₂ at the boundaries of S₁, at g₂'s vertex, at 1."""
-    kp, mp = params.k * p0, params.mu * p0
-    t0, s0 = params.tau0_pa, params.sigma0_pa
-    r1, r2 = _roots01(kp, t0, x)
-    c2 = np.asarray(kp + mp, dtype=float)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # k + μ -> 0−
-        v = np.where(c2 < 0.0, -(t0 + s0) / (2.0 * np.where(c2 < 0.0, c2, -1.0)), 1.0)
-    v = np.clip(np.where(np.isfinite(v), v, 1.0), 0.0, 1.0)
-    pts = [r1, r2, v, np.ones_like(r1)]
-    return [c2 * s * s + (t0 + s0) * s for s in np.broadcast_arrays(*pts)]
 
 
 # --------------------------------------------------------------------------------------
@@ -386,20 +220,20 @@ class CycleModel:
         """Q_amp − Q on the unloading branch at Δ (shape (n, m)); qa, u_amp (n,)."""
         if self.model == "modified":
             x = self.drive(u_amp)[:, None]
-            e = unloading_decrement(self.drive(delta), x, self.p0, self.params)
+            e = modified_cycle.unloading_decrement(self.drive(delta), x, self.p0, self.params)
             return 2.0 * np.pi * self.a**2 * e
         return 2.0 * cm.force(delta / 2.0, self.mup, self.a, self.gj)
 
     def delta_breaks(self, u_amp):
         if self.model == "modified":
             x = self.drive(u_amp)
-            d = _unloading_drive_breaks(x, self.p0, self.params)
+            d = modified_cycle.unloading_drive_breaks(x, self.p0, self.params)
             return [np.pi * self.a * b / self.params.shear_modulus_pa for b in d]
         return [np.asarray(u_amp)]
 
     def dissipated(self, qa, u_amp):
         if self.model == "modified":
-            return modified_dissipated_energy(self.drive(u_amp), self.p0, self.params)
+            return modified_cycle.dissipated_energy(self.drive(u_amp), self.p0, self.params)
         return cm.dissipated_energy(qa, self.mup, self.a, self.gj)
 
     def paper_stiffness(self, qa):
@@ -411,7 +245,7 @@ class CycleModel:
 def _classical_paper_stiffness(qa, mup, a, gj):
     """The paper's d⟨Q⟩/d⟨u⟩ for the Cattaneo–Mindlin loading curve (graded quadrature)."""
     qa = np.asarray(qa, dtype=float)[..., None]
-    phi, w = oscillation._graded_nodes()
+    phi, w = oscillation.graded_nodes()
     q = qa * np.cos(phi)  # Q = Q_amp sin θ, θ = π/2 − φ
     u = cm.displacement(q, mup, a, gj)
     x = np.clip(q / mup, 0.0, 1.0)
@@ -525,7 +359,7 @@ def loops(
 
 
 # --------------------------------------------------------------------------------------
-# outputs: JSON rows and the loops as a Dataset
+# the cycles of a list of p0 (JSON rows and the Dataset: :mod:`.cycle_output`)
 
 
 def _amplitudes_for(
@@ -558,7 +392,7 @@ def validate_cycle_request(
     amplitudes_un: ArrayLike | None = None,
     amplitude_fractions: ArrayLike | None = None,
 ) -> list[float]:
-    """Check everything :func:`cycle_records` needs, before any work; returns the p0 list."""
+    """Check everything :func:`cycles` needs, before any work; returns the p0 list."""
     check_model(model)
     p0_list = params.check_p0_gpa(p0_gpa)
     for p in p0_list:
@@ -587,109 +421,6 @@ def cycles(
         qa = _amplitudes_for(mdl.gross, amplitudes_un, amplitude_fractions, p, model)
         out.append(steady_cycle(qa, p0, params, model))
     return tuple(out)
-
-
-def cycle_records(cyc: tuple[SteadyCycle, ...] | list[SteadyCycle]) -> list[dict[str, Any]]:
-    """One JSON-ready row per (p0, amplitude), unit-named keys (``contact --cycle --json``)."""
-    rows = []
-    for c in cyc:
-        area = np.pi * c.contact_radius_m**2
-        for i, qa in enumerate(c.force_amplitude_n):
-            rows.append(
-                {
-                    "p0_gpa": c.p0_pa / units.GPA_TO_PA,
-                    "model": c.model,
-                    "lateral_force_amplitude_un": float(qa * units.N_TO_UN),
-                    "amplitude_fraction_of_gross_sliding": float(qa / c.gross_sliding_force_n),
-                    "stress_amplitude_mpa": float(qa / area / units.MPA_TO_PA),
-                    "stress_rms_mpa": float(qa / (np.sqrt(2.0) * area) / units.MPA_TO_PA),
-                    "displacement_amplitude_nm": float(
-                        c.displacement_amplitude_m[i] / units.NM_TO_M
-                    ),
-                    "dissipated_energy_per_cycle_fj": float(c.dissipated_energy_j[i] * J_TO_FJ),
-                    "lockin_stiffness_n_per_m": float(c.lockin_stiffness_n_per_m[i]),
-                    "lockin_in_phase_nm": float(c.in_phase_displacement_m[i] / units.NM_TO_M),
-                    "lockin_quadrature_nm": float(c.quadrature_displacement_m[i] / units.NM_TO_M),
-                    "loss_tangent": float(c.loss_tangent[i]),
-                    "secant_stiffness_n_per_m": float(c.secant_stiffness_n_per_m[i]),
-                    "paper_stiffness_n_per_m": float(c.paper_stiffness_n_per_m[i]),
-                    "initial_stiffness_n_per_m": float(c.initial_stiffness_n_per_m),
-                    "gross_sliding_force_un": float(c.gross_sliding_force_n * units.N_TO_UN),
-                }
-            )
-    return rows
-
-
-def cycle_dataset(
-    cyc: tuple[SteadyCycle, ...] | list[SteadyCycle],
-    params: ContactParameters,
-    n_points: int = 201,
-):
-    """The loops and per-amplitude cycle results as an xarray Dataset (for ``contact.nc``).
-
-    Dims ``p0`` (GPa, the same coordinate as :meth:`ContactAnalysis.to_dataset`),
-    ``cycle_amplitude`` (index; amplitudes may differ per p0) and ``loop_point``. Variables
-    carry a ``units`` attribute; names are prefixed ``cycle_`` so the Dataset merges with
-    the contact Dataset (``xr.merge([analysis.to_dataset(), cycle_dataset(...)])``).
-    """
-    import xarray as xr
-
-    n_amp = max(c.force_amplitude_n.size for c in cyc)
-    n_loop = 2 * n_points - 1
-    shape2, shape3 = (len(cyc), n_amp), (len(cyc), n_amp, n_loop)
-    lu, lq = np.full(shape3, np.nan), np.full(shape3, np.nan)
-    per = {k: np.full(shape2, np.nan) for k in ("qa", "w", "k", "u1", "u2", "kp", "tan", "ua")}
-    for i, c in enumerate(cyc):
-        n = c.force_amplitude_n.size
-        for j, lp in enumerate(loops(c.force_amplitude_n, c.p0_pa, params, c.model, n_points)):
-            lu[i, j] = lp.displacement_m / units.NM_TO_M
-            lq[i, j] = lp.force_n * units.N_TO_UN
-        per["qa"][i, :n] = c.force_amplitude_n * units.N_TO_UN
-        per["w"][i, :n] = c.dissipated_energy_j * J_TO_FJ
-        per["k"][i, :n] = c.lockin_stiffness_n_per_m
-        per["u1"][i, :n] = c.in_phase_displacement_m / units.NM_TO_M
-        per["u2"][i, :n] = c.quadrature_displacement_m / units.NM_TO_M
-        per["kp"][i, :n] = c.paper_stiffness_n_per_m
-        per["tan"][i, :n] = c.loss_tangent
-        per["ua"][i, :n] = c.displacement_amplitude_m / units.NM_TO_M
-    d2, d3 = ("p0", "cycle_amplitude"), ("p0", "cycle_amplitude", "loop_point")
-    model = cyc[0].model
-    ds = xr.Dataset(
-        {
-            "cycle_loop_displacement": (
-                d3,
-                lu,
-                {"units": "nm", "long_name": "u on the steady loop"},
-            ),
-            "cycle_loop_force": (d3, lq, {"units": "uN", "long_name": "Q on the steady loop"}),
-            "cycle_force_amplitude": (d2, per["qa"], {"units": "uN"}),
-            "cycle_displacement_amplitude": (d2, per["ua"], {"units": "nm"}),
-            "cycle_dissipated_energy": (d2, per["w"], {"units": "fJ", "long_name": "per cycle"}),
-            "cycle_lockin_stiffness": (
-                d2,
-                per["k"],
-                {"units": "N/m", "long_name": "Q_amp/u'_1 (first harmonic, in phase)"},
-            ),
-            "cycle_lockin_in_phase": (d2, per["u1"], {"units": "nm"}),
-            "cycle_lockin_quadrature": (d2, per["u2"], {"units": "nm"}),
-            "cycle_loss_tangent": (d2, per["tan"], {"units": "1"}),
-            "cycle_paper_stiffness": (d2, per["kp"], {"units": "N/m", "long_name": "d<Q>/d<u>"}),
-        },
-        coords={
-            "p0": ("p0", np.asarray([c.p0_pa / units.GPA_TO_PA for c in cyc]), {"units": "GPa"}),
-        },
-    )
-    ds.attrs["cycle_model"] = model
-    ds.attrs["cycle_conventions"] = (
-        "Q(t) = Q_amp sin(theta); u_1 = u'_1 sin(theta) - u''_1 cos(theta); lock-in stiffness "
-        "Q_amp/u'_1; W = pi Q_amp u''_1; "
-        + (
-            "modified Mindlin, q0 = G* u/(pi a), paper's G* = 4 G*_J"
-            if model == "modified"
-            else "Cattaneo-Mindlin/Mindlin-Deresiewicz, mu = k, G*_J = G*/4"
-        )
-    )
-    return ds
 
 
 def lockin_curve(

@@ -1,17 +1,7 @@
-"""Measured lateral stiffness vs mean shear stress: loading, collapse detection, inverse τ0.
+"""Measured lateral stiffness vs mean shear stress: collapse detection, inverse τ0.
 
-CSV format
-----------
-Two columns, one a stress and one a lateral stiffness, each with its unit in the
-header, either in brackets or as a snake-case suffix, e.g.::
-
-    mean shear stress [MPa],lateral stiffness [N/m]
-    mean_shear_stress_mpa,lateral_stiffness_n_per_m
-
-Stress units: Pa, kPa, MPa, GPa. Stiffness units: <force>/<length> with force in
-N, mN, µN (uN), nN, kN and length in m, mm, µm (um), nm (e.g. N/m, mN/m, µN/nm).
-Lines starting with ``#`` are comments. Which column is which is decided by its
-unit.
+The measured curve is read by :func:`flatcontact.contact.measured.load_stiffness_csv`
+(the CSV format is described there).
 
 Collapse from data
 ------------------
@@ -35,10 +25,7 @@ below that).
 
 from __future__ import annotations
 
-import math
-import re
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -46,150 +33,16 @@ from scipy.optimize import brentq
 
 from flatcontact import units
 from flatcontact.contact import mindlin
+from flatcontact.contact.measured import MeasuredStiffness
 from flatcontact.contact.oscillation import (
     STRESS_MEASURES,
     amplitude_at_stiffness_fraction,
     lateral_stiffness,
 )
 from flatcontact.contact.parameters import ContactParameters, check_positive
-from flatcontact.errors import InputError, require
+from flatcontact.errors import require
 
 FloatArray = NDArray[np.float64]
-
-_PRESSURE_TO_PA = {"pa": 1.0, "kpa": 1.0e3, "mpa": units.MPA_TO_PA, "gpa": units.GPA_TO_PA}
-_FORCE_TO_N = {"n": 1.0, "kn": 1.0e3, "mn": 1.0e-3, "un": units.UN_TO_N, "nn": 1.0e-9}
-_LENGTH_TO_M = {"m": 1.0, "mm": 1.0e-3, "um": units.UM_TO_M, "nm": units.NM_TO_M}
-_BRACKET = re.compile(r"^(?P<name>.*?)\s*[\[(](?P<unit>[^\])]+)[\])]\s*$")
-_SNAKE_STIFF = re.compile(r"^(?P<name>.+?)_(?P<f>kn|mn|un|nn|n)_per_(?P<l>mm|um|nm|m)$")
-_SNAKE_PRESS = re.compile(r"^(?P<name>.+?)_(?P<u>kpa|mpa|gpa|pa)$")
-
-
-def _normalise_unit(text: str) -> str:
-    return text.strip().replace("µ", "u").replace("μ", "u").replace(" ", "").lower()
-
-
-def parse_unit(unit: str) -> tuple[str, float]:
-    """('stress', factor to Pa) or ('stiffness', factor to N/m) for a unit string.
-
-    Raises
-    ------
-    InputError
-        For a unit that is neither a pressure nor a force per length.
-    """
-    u = _normalise_unit(unit)
-    if u in _PRESSURE_TO_PA:
-        return "stress", _PRESSURE_TO_PA[u]
-    if "/" in u:
-        f, _, ln = u.partition("/")
-        if f in _FORCE_TO_N and ln in _LENGTH_TO_M:
-            return "stiffness", _FORCE_TO_N[f] / _LENGTH_TO_M[ln]
-    raise InputError(
-        f"unknown unit {unit!r}: expected a stress (Pa, kPa, MPa, GPa) or a stiffness "
-        "(force/length, e.g. N/m, mN/m, µN/nm)"
-    )
-
-
-def parse_column(header: str) -> tuple[str, str, float]:
-    """(name, kind, factor) from a header like 'mean shear stress [MPa]' or 'stress_mpa'."""
-    h = header.strip()
-    m = _BRACKET.match(h)
-    if m:
-        kind, factor = parse_unit(m.group("unit"))
-        return m.group("name").strip(), kind, factor
-    low = h.lower()
-    m = _SNAKE_STIFF.match(low)
-    if m:
-        return m.group("name"), "stiffness", _FORCE_TO_N[m.group("f")] / _LENGTH_TO_M[m.group("l")]
-    m = _SNAKE_PRESS.match(low)
-    if m:
-        return m.group("name"), "stress", _PRESSURE_TO_PA[m.group("u")]
-    raise InputError(
-        f"column {header!r} has no unit: write it as 'name [unit]' or 'name_<unit>' "
-        "(e.g. 'mean shear stress [MPa]', 'lateral_stiffness_n_per_m')"
-    )
-
-
-@dataclass(frozen=True)
-class MeasuredStiffness:
-    """Measured stiffness curve in SI, sorted by stress.
-
-    Attributes
-    ----------
-    stress_pa : mean shear stress (Pa), in the measure the experiment used
-    stiffness_n_per_m : lateral stiffness (N/m)
-    source : file name
-    stress_column, stiffness_column : the header cells as read
-    """
-
-    stress_pa: FloatArray
-    stiffness_n_per_m: FloatArray
-    source: str
-    stress_column: str
-    stiffness_column: str
-
-
-def load_stiffness_csv(path: str | Path) -> MeasuredStiffness:
-    """Read a two-column stress/stiffness CSV with units in the header (see module doc).
-
-    Raises
-    ------
-    InputError
-        Missing file, not two columns, a column without a unit or with an unknown
-        one, two columns of the same kind, a non-numeric or NaN/inf cell, a
-        negative stress, fewer than 4 rows.
-    """
-    from flatcontact.fileio import read_text_file
-
-    p = Path(path)
-    require(p.exists(), f"experiment file {str(p)!r} does not exist")
-    text = read_text_file(p, "measured stiffness CSV", 50_000_000)
-    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
-    require(len(lines) > 0, f"{p.name}: empty file, expected a header and data rows")
-    header = [c.strip() for c in lines[0].split(",")]
-    require(
-        len(header) == 2,
-        f"{p.name}: expected 2 columns (mean shear stress, lateral stiffness), got {len(header)}: {header}",
-    )
-    cols = []
-    for h in header:
-        try:
-            cols.append(parse_column(h))
-        except InputError as exc:
-            raise InputError(f"{p.name}: {exc}") from None
-    kinds = [c[1] for c in cols]
-    require(
-        sorted(kinds) == ["stiffness", "stress"],
-        f"{p.name}: need one stress column and one stiffness column, got kinds {kinds} from {header}",
-    )
-    i_stress = kinds.index("stress")
-    rows = []
-    for n, ln in enumerate(lines[1:], start=2):
-        cells = [c.strip() for c in ln.split(",")]
-        require(len(cells) == 2, f"{p.name}: data line {n} has {len(cells)} cells, expected 2")
-        try:
-            vals = [float(c) for c in cells]
-        except ValueError:
-            raise InputError(f"{p.name}: data line {n} is not numeric: {ln.strip()!r}") from None
-        require(
-            all(math.isfinite(v) for v in vals),
-            f"{p.name}: data line {n} has NaN or inf: {ln.strip()!r}",
-        )
-        rows.append(vals)
-    require(len(rows) >= 4, f"{p.name}: need at least 4 data rows, got {len(rows)}")
-    data = np.array(rows)
-    stress = data[:, i_stress] * cols[i_stress][2]
-    stiff = data[:, 1 - i_stress] * cols[1 - i_stress][2]
-    require(
-        bool(np.all(stress >= 0.0)), f"{p.name}: stress must be >= 0 (column {header[i_stress]!r})"
-    )
-    order = np.argsort(stress, kind="stable")
-    return MeasuredStiffness(
-        stress_pa=stress[order],
-        stiffness_n_per_m=stiff[order],
-        source=p.name,
-        stress_column=header[i_stress],
-        stiffness_column=header[1 - i_stress],
-    )
 
 
 @dataclass(frozen=True)
@@ -252,7 +105,7 @@ def collapse_stress(
     )
 
 
-def _measure_factor(measure: str) -> float:
+def measure_factor(measure: str) -> float:
     require(
         measure in STRESS_MEASURES,
         f"stress measure must be one of {STRESS_MEASURES}, got {measure!r}",
@@ -264,7 +117,7 @@ def model_stiffness_at_stress(
     stress_pa: ArrayLike, p0_pa: float, params: ContactParameters, measure: str = "amplitude"
 ) -> FloatArray:
     """Model lateral stiffness (N/m) at mean shear stresses (Pa) of ``measure``; 0 beyond collapse."""
-    factor = _measure_factor(measure)
+    factor = measure_factor(measure)
     s = np.asarray(stress_pa, dtype=float)
     a = float(mindlin.contact_radius(p0_pa, params))
     qmax = s * np.pi * a**2 / factor
@@ -278,7 +131,7 @@ def model_collapse_stress(
     p0_pa: float, params: ContactParameters, *, fraction: float = 0.2, measure: str = "amplitude"
 ) -> float:
     """The model's stress (Pa, ``measure``) where k falls to ``fraction``·k0 — the data criterion."""
-    factor = _measure_factor(measure)
+    factor = measure_factor(measure)
     a = float(mindlin.contact_radius(p0_pa, params))
     return amplitude_at_stiffness_fraction(p0_pa, params, fraction) * factor / (np.pi * a**2)
 

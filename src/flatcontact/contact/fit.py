@@ -2,12 +2,9 @@
 
 Data
 ----
-Stiffness against mean shear stress, either one CSV per load (two columns, the format of
-:mod:`flatcontact.contact.experiment`; the p0 of each file given alongside) or one CSV
-with a third, load column: ``p0 [GPa]`` / ``p0_gpa`` (peak Hertz pressure, any pressure
-unit) or ``normal load [uN]`` / ``normal_load_un`` (converted to p0 with the tip radius and
-E* of the parameters, Hertz: p0 = (6 P E*²/(π³ R²))^(1/3)). A load column is recognised by
-its name (containing ``p0``, ``peak`` or ``load``).
+Stiffness against mean shear stress at several loads, read by
+:func:`flatcontact.contact.measured.load_fit_data` (one two-column CSV per load, or one CSV
+with a load column) (:class:`~flatcontact.contact.measured.LoadCurve`, one per load).
 
 Model
 -----
@@ -39,10 +36,8 @@ data would have against a zero stiffness, times 10.
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -51,6 +46,7 @@ from scipy.optimize import least_squares
 
 from flatcontact import units
 from flatcontact.contact import cycle, experiment, mindlin
+from flatcontact.contact.measured import LoadCurve
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.errors import InputError, require
 
@@ -67,161 +63,6 @@ FIT_PARAMETERS: dict[str, float] = {
 #: The parameters the classical model depends on.
 CLASSICAL_PARAMETERS = ("k_mpa_per_gpa", "shear_modulus_gpa")
 STIFFNESS_KINDS = ("lockin", "paper")
-
-_LOAD_NAME = re.compile(r"p0|peak|load", re.IGNORECASE)
-
-
-@dataclass(frozen=True)
-class LoadCurve:
-    """One measured stiffness curve at one load (SI)."""
-
-    p0_gpa: float
-    stress_pa: FloatArray
-    stiffness_n_per_m: FloatArray
-    source: str
-
-
-def _load_column(header: str) -> tuple[str, float] | None:
-    """('p0', factor to Pa) or ('load', factor to N) for a load column header, else None."""
-    h = header.strip()
-    m = re.match(r"^(?P<name>.*?)\s*[\[(](?P<unit>[^\])]+)[\])]\s*$", h)
-    if m:
-        name, unit = m.group("name"), experiment._normalise_unit(m.group("unit"))
-    else:
-        low = h.lower()
-        parts = low.rsplit("_", 1)
-        if len(parts) != 2:
-            return None
-        name, unit = parts
-    if not _LOAD_NAME.search(name):
-        return None
-    if unit in experiment._PRESSURE_TO_PA:
-        return "p0", experiment._PRESSURE_TO_PA[unit]
-    if unit in experiment._FORCE_TO_N:
-        return "load", experiment._FORCE_TO_N[unit]
-    return None
-
-
-def _p0_from_load_pa(load_n: FloatArray, params: ContactParameters) -> FloatArray:
-    """Hertz peak pressure (Pa) from the normal load (N): p0 = (6 P E*²/(π³ R²))^(1/3)."""
-    e, r = params.contact_modulus_pa, params.radius_m
-    return np.cbrt(6.0 * load_n * e**2 / (np.pi**3 * r**2))
-
-
-def read_table(path: str | Path, params: ContactParameters) -> list[LoadCurve] | None:
-    """Curves of a CSV with a load column, one per distinct load; None if it has none.
-
-    Raises
-    ------
-    InputError
-        Unreadable file, columns without units, non-numeric cells (one line, naming the file).
-    """
-    p = Path(path)
-    require(p.is_file(), f"fit file {str(p)!r} does not exist")
-    lines = [
-        ln for ln in p.read_text().splitlines() if ln.strip() and not ln.lstrip().startswith("#")
-    ]
-    require(len(lines) > 1, f"{p.name}: expected a header and data rows")
-    header = [c.strip() for c in lines[0].split(",")]
-    load_idx = [i for i, h in enumerate(header) if _load_column(h) is not None]
-    if not load_idx:
-        return None
-    require(len(load_idx) == 1, f"{p.name}: more than one load column in {header}")
-    require(
-        len(header) == 3,
-        f"{p.name}: with a load column expected 3 columns (stress, stiffness, load), got {header}",
-    )
-    li = load_idx[0]
-    kind_load, f_load = _load_column(header[li])  # type: ignore[misc]
-    others = [i for i in range(3) if i != li]
-    cols = {}
-    for i in others:
-        try:
-            _, kind, factor = experiment.parse_column(header[i])
-        except InputError as exc:
-            raise InputError(f"{p.name}: {exc}") from None
-        cols[kind] = (i, factor)
-    require(
-        sorted(cols) == ["stiffness", "stress"],
-        f"{p.name}: need one stress and one stiffness column besides the load, got {header}",
-    )
-    rows = []
-    for n, ln in enumerate(lines[1:], start=2):
-        cells = [c.strip() for c in ln.split(",")]
-        require(len(cells) == 3, f"{p.name}: data line {n} has {len(cells)} cells, expected 3")
-        try:
-            vals = [float(c) for c in cells]
-        except ValueError:
-            raise InputError(f"{p.name}: data line {n} is not numeric: {ln.strip()!r}") from None
-        require(all(math.isfinite(v) for v in vals), f"{p.name}: data line {n} has NaN or inf")
-        rows.append(vals)
-    data = np.array(rows)
-    load = data[:, li] * f_load
-    p0_pa = load if kind_load == "p0" else _p0_from_load_pa(load, params)
-    stress = data[:, cols["stress"][0]] * cols["stress"][1]
-    stiff = data[:, cols["stiffness"][0]] * cols["stiffness"][1]
-    require(bool(np.all(p0_pa > 0)), f"{p.name}: loads must be > 0 (column {header[li]!r})")
-    require(bool(np.all(stress >= 0)), f"{p.name}: stress must be >= 0")
-    out = []
-    for p0 in np.unique(np.round(p0_pa / units.GPA_TO_PA, 9)):
-        sel = np.isclose(p0_pa / units.GPA_TO_PA, p0, rtol=1e-9, atol=0)
-        order = np.argsort(stress[sel], kind="stable")
-        require(int(sel.sum()) >= 4, f"{p.name}: need at least 4 rows at p0 = {p0:g} GPa")
-        out.append(
-            LoadCurve(
-                p0_gpa=float(p0),
-                stress_pa=stress[sel][order],
-                stiffness_n_per_m=stiff[sel][order],
-                source=p.name,
-            )
-        )
-    return out
-
-
-def load_fit_data(
-    paths: Sequence[str | Path],
-    params: ContactParameters,
-    p0_gpa: Sequence[float] | None = None,
-) -> list[LoadCurve]:
-    """The curves to fit: from CSVs with a load column, or one two-column CSV per load with
-    its p0 in ``p0_gpa`` (same order as ``paths``).
-
-    Raises
-    ------
-    InputError
-        (one line) no file; ``p0_gpa`` not one per file; a file without a load column when
-        several loads are fitted and no p0 is given for it; a p0 given for a file that has
-        a load column.
-    """
-    paths = [Path(x) for x in paths]
-    require(len(paths) > 0, "fit: give at least one stiffness CSV file")
-    if p0_gpa is not None:
-        p0s = list(p0_gpa)
-        require(
-            len(p0s) == len(paths),
-            f"fit_p0_gpa: {len(p0s)} values for {len(paths)} files; give one p0 per file "
-            "(or none, with a load column 'p0 [GPa]' in the files)",
-        )
-    curves: list[LoadCurve] = []
-    for i, path in enumerate(paths):
-        table = read_table(path, params)
-        if table is not None:
-            require(
-                p0_gpa is None,
-                f"{path.name} has a load column; do not also give fit_p0_gpa for it",
-            )
-            curves.extend(table)
-            continue
-        if p0_gpa is None:
-            raise InputError(
-                f"{path.name} has no load column ('p0 [GPa]' or 'normal load [uN]'): "
-                + (f"with {len(paths)} files (several loads) " if len(paths) > 1 else "")
-                + "give fit_p0_gpa (one p0 per file) or add a load column"
-            )
-        p0 = params.check_p0_gpa(p0s[i], "fit_p0_gpa")[0]
-        m = experiment.load_stiffness_csv(path)
-        curves.append(LoadCurve(p0, m.stress_pa, m.stiffness_n_per_m, m.source))
-    return curves
 
 
 def check_free_fixed(
@@ -264,7 +105,7 @@ def model_stiffness(
     """Model stiffness (N/m) at the curve's stresses: lock-in k′ or the paper's d⟨Q⟩/d⟨u⟩,
     0 at and beyond gross sliding."""
     require(stiffness in STIFFNESS_KINDS, f"stiffness must be one of {STIFFNESS_KINDS}")
-    factor = experiment._measure_factor(measure)
+    factor = experiment.measure_factor(measure)
     p0 = curve.p0_gpa * units.GPA_TO_PA
     mdl = cycle.CycleModel(model, p0, params)
     qa = curve.stress_pa * np.pi * mdl.a**2 / factor
@@ -361,7 +202,7 @@ def fit_stiffness_curves(
     free = check_free_fixed(free, fixed, model)
     require(len(curves) > 0, "fit: no stiffness curves")
     require(stiffness in STIFFNESS_KINDS, f"stiffness must be one of {STIFFNESS_KINDS}")
-    experiment._measure_factor(measure)
+    experiment.measure_factor(measure)
     for c in curves:
         cycle.check_cycle_domain(c.p0_gpa * units.GPA_TO_PA, params, model)
     y = np.concatenate([c.stiffness_n_per_m for c in curves])

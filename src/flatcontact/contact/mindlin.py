@@ -1,4 +1,4 @@
-"""The paper's modified Mindlin model and classical Cattaneo–Mindlin, in SI units.
+"""The paper's modified Mindlin model: tractions, stick zone, Q(u), its peak and inverse, in SI.
 
 Modified Mindlin model (Dong et al., section "Modified Mindlin model")
 ---------------------------------------------------------------------
@@ -7,7 +7,8 @@ s(r) = √(1 − r²/a²)) is displaced laterally by u.
 
 - local shear strength      τ(r) = k·p(r) + τ0
 - slip-zone friction        σ(r) = μ·p(r) + σ0
-- full-stick traction       q(r) = q0 / s(r),  q0 = G*·u/(π a)   (the paper's G*)
+- full-stick traction       q(r) = q0 / s(r),  q0 = G*·u/(π a)   (the paper's G* = 4 G*_J,
+                            :mod:`flatcontact.contact.moduli`)
 - stick zone                q(r) < τ(r) (the paper's "local slip where the applied stress
                             exceeds the local shear strength"); with s = √(1 − r²/a²) this
                             is g(s) = k·p0·s² + τ0·s > q0
@@ -21,6 +22,7 @@ s(r) = √(1 − r²/a²)) is displaced laterally by u.
 Eliminating q0 = k p0 s² + τ0 s gives Q(s)/(2π a²) = A1 s + A2 s² + A3 s³ with
 A1 = τ0, A2 = k p0 − τ0 + σ0/2, A3 = μ p0/3 − k p0 and u(s) = π a (k p0 s² + τ0 s)/G*,
 so the peak (dQ/ds = 0, a quadratic) and the inverse u(Q) (a cubic) are closed forms.
+The initial stiffness is dQ/du|0 = 2 G* a (τ0 > 0).
 
 Negative slopes (k < 0 or μ < 0)
 --------------------------------
@@ -45,23 +47,15 @@ For k < 0, g(s) is concave with its maximum at t* = τ0/(2|k| p0).
 
 So s (outer stick boundary) runs over [0, s_fs], s_fs = min(1, t*); u(s) increases
 on it for either sign of k, and Q(s) is a cubic on [0, s_c], s_c = min(1, 2t* − 1),
-and another on (s_c, s_fs]. The peak and the rising-branch inverse work piece by piece.
+and another on (s_c, s_fs]. The peak and the rising-branch inverse work piece by piece
+(:mod:`flatcontact.contact.piecewise_cubic`).
 
-Inside the stick zone the paper keeps the full-stick traction q0/s (no
-Cattaneo corrective traction). Consequently, in the classical limit
-(k = μ, τ0 = σ0 = 0, G* = 4 G*_J) it gives Q/μP = 3s² − 2s³ and a displacement
-twice Cattaneo–Mindlin's at the same stick radius: it agrees with
-Cattaneo–Mindlin in the initial stiffness 8 G*_J a and at full slip (Q = μP),
-not in between (see :func:`classical_limit_of_paper_model` and docs/contact.md).
-
-Classical Cattaneo–Mindlin (Johnson, *Contact Mechanics*, 1985, §7.2)
---------------------------------------------------------------------
-c/a = (1 − Q/μP)^(1/3), δ = 3μP/(16 G*_J a)·[1 − (1 − Q/μP)^(2/3)] with
-1/G*_J = (2−ν1)/G1 + (2−ν2)/G2 (Johnson's convention; paper's G* = 4 G*_J). The theory,
-with Mindlin–Deresiewicz unloading and the energy per cycle, is
-:mod:`flatcontact.contact.cattaneo_mindlin`; ``cattaneo_mindlin_*`` here are its loading
-functions under their old names. Unloading, reloading and the steady cycle of the
-modified model: :mod:`flatcontact.contact.cycle`.
+Inside the stick zone the paper keeps the full-stick traction q0/s (no Cattaneo
+corrective traction); in the classical limit (k = μ, τ0 = σ0 = 0) it therefore agrees
+with Cattaneo–Mindlin (:mod:`flatcontact.contact.cattaneo_mindlin`) only in the initial
+stiffness and at full slip (:mod:`flatcontact.contact.classical_limit`, docs/contact.md).
+Unloading, reloading and the steady cycle of the modified model:
+:mod:`flatcontact.contact.cycle`.
 """
 
 from __future__ import annotations
@@ -71,30 +65,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from flatcontact.contact import cattaneo_mindlin as _cm
+from flatcontact.contact import piecewise_cubic as pc
 from flatcontact.contact.hertz import hertz_contact_radius
 from flatcontact.contact.parameters import ContactParameters
 
 FloatArray = NDArray[np.float64]
-
-# --------------------------------------------------------------------------------------
-# shear-modulus conventions
-
-
-def johnson_effective_shear_modulus(g1_pa: float, nu1: float, g2_pa: float, nu2: float) -> float:
-    """Johnson's G*_J from the shear moduli and Poisson ratios: 1/G*_J = (2−ν1)/G1 + (2−ν2)/G2."""
-    return 1.0 / ((2.0 - nu1) / g1_pa + (2.0 - nu2) / g2_pa)
-
-
-def paper_shear_modulus_from_johnson(g_johnson: ArrayLike) -> FloatArray:
-    """The paper's G* (q0 = G*·u/(π a)) from Johnson's G*_J (q0 = 4 G*_J u/(π a)): G* = 4 G*_J."""
-    return 4.0 * np.asarray(g_johnson, dtype=float)
-
-
-def johnson_shear_modulus_from_paper(g_paper: ArrayLike) -> FloatArray:
-    """Johnson's G*_J from the paper's G*: G*_J = G*/4."""
-    return np.asarray(g_paper, dtype=float) / 4.0
-
 
 # --------------------------------------------------------------------------------------
 # local laws and tractions
@@ -339,57 +314,11 @@ def annulus_force_coefficients(
     return b0, b1, b3
 
 
-@dataclass(frozen=True)
-class _Branch:
-    """Q(s)/(2π a²) as a piecewise cubic: A on [0, s_c] (disc), B in h = t* − s on (s_c, s_fs]."""
-
-    a: FloatArray
-    area2: FloatArray
-    tstar: FloatArray  # 0 where there is no annulus (k >= 0), never used there
-    s_c: FloatArray
-    s_fs: FloatArray
-    A: tuple[FloatArray, FloatArray, FloatArray]
-    B: tuple[FloatArray, FloatArray, FloatArray]
-
-    def expanded(self) -> _Branch:
-        """The same branch with a trailing axis on every array (to broadcast against (..., n))."""
-
-        def ex(x):
-            return np.asarray(x)[..., None]
-
-        return _Branch(
-            a=ex(self.a),
-            area2=ex(self.area2),
-            tstar=ex(self.tstar),
-            s_c=ex(self.s_c),
-            s_fs=ex(self.s_fs),
-            A=tuple(ex(x) for x in self.A),
-            B=tuple(ex(x) for x in self.B),
-        )
-
-    def y(self, s):
-        """Q/(2π a²) (Pa) at s."""
-        a1, a2, a3 = self.A
-        b0, b1, b3 = self.B
-        h = self.tstar - s
-        with np.errstate(invalid="ignore"):
-            return np.where(s <= self.s_c, ((a3 * s + a2) * s + a1) * s, b0 + (b3 * h * h + b1) * h)
-
-    def dy_ds(self, s):
-        """d(Q/(2π a²))/ds (Pa), the disc piece at s = s_c."""
-        a1, a2, a3 = self.A
-        _, b1, b3 = self.B
-        h = self.tstar - s
-        with np.errstate(invalid="ignore"):
-            return np.where(
-                s <= self.s_c, (3.0 * a3 * s + 2.0 * a2) * s + a1, -(3.0 * b3 * h * h + b1)
-            )
-
-
-def _branch(p0: FloatArray, params: ContactParameters) -> _Branch:
+def _branch(p0: FloatArray, params: ContactParameters) -> pc.Branch:
+    """Q(s)/(2π a²) at each p0 as the piecewise cubic of :mod:`.piecewise_cubic`."""
     a = contact_radius(p0, params)
     ts = _annulus_vertex_s(p0, params)
-    return _Branch(
+    return pc.Branch(
         a=a,
         area2=2.0 * np.pi * a**2,
         tstar=np.where(np.isfinite(ts), ts, 0.0),
@@ -415,40 +344,8 @@ def force_slope_s(s: ArrayLike, p0_pa: ArrayLike, params: ContactParameters) -> 
     return br.area2 * br.dy_ds(np.asarray(s, dtype=float))
 
 
-def _quadratic_roots(qa, qb, qc):
-    """Both roots of qa x² + qb x + qc = 0 (nan where complex), stable, vectorised."""
-    qa, qb, qc = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (qa, qb, qc)))
-    disc = qb**2 - 4.0 * qa * qc
-    sq = np.sqrt(np.where(disc >= 0.0, disc, np.nan))
-    q = -0.5 * (qb + np.copysign(sq, qb))
-    scale = np.maximum(np.abs(qb), np.abs(qc)) + np.abs(qa)
-    linear = np.abs(qa) <= 1e-14 * scale
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        r1 = np.where(linear, -qc / qb, q / qa)
-        r2 = np.where(linear, np.nan, qc / q)
-    return r1, r2
-
-
-def _breakpoints(br: _Branch) -> tuple[FloatArray, FloatArray]:
-    """s (..., 6) splitting [0, s_fs] into pieces where Q(s) is monotone and one cubic:
-    0, the critical points of the disc cubic in (0, s_c), s_c, the critical point of the
-    annulus cubic in (s_c, s_fs), s_fs (missing ones repeat a neighbour); and Q/(2π a²) there."""
-    a1, a2, a3 = br.A
-    _, b1, b3 = br.B
-    r1, r2 = _quadratic_roots(3.0 * a3, 2.0 * a2, a1)
-    with np.errstate(invalid="ignore"):
-        d1 = np.where((r1 > 0.0) & (r1 < br.s_c), r1, br.s_c)
-        d2 = np.where((r2 > 0.0) & (r2 < br.s_c), r2, br.s_c)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        h2 = -b1 / (3.0 * b3)
-        rc = br.tstar - np.sqrt(np.where(h2 > 0.0, h2, np.nan))
-        rc = np.where((rc > br.s_c) & (rc < br.s_fs), rc, br.s_fs)
-    zero = np.zeros_like(br.s_c)
-    b = np.stack(
-        np.broadcast_arrays(zero, np.minimum(d1, d2), np.maximum(d1, d2), br.s_c, rc, br.s_fs),
-        axis=-1,
-    )
-    return b, br.expanded().y(b)
+# --------------------------------------------------------------------------------------
+# the peak and the rising-branch inverse (numerics: :mod:`.piecewise_cubic`)
 
 
 @dataclass(frozen=True)
@@ -481,20 +378,6 @@ class PeakForce:
     first_local_max_s: FloatArray
 
 
-def _peak(br: _Branch, b: FloatArray, yb: FloatArray):
-    """(s_peak, y_peak, overshoot, first_local_max_s) from the breakpoints."""
-    y_fs = yb[..., -1]
-    i = np.argmax(yb[..., :-1], axis=-1)[..., None]
-    y_in = np.take_along_axis(yb, i, axis=-1)[..., 0]
-    overshoot = y_in > y_fs
-    s_peak = np.where(overshoot, np.take_along_axis(b, i, axis=-1)[..., 0], br.s_fs)
-    y_peak = np.where(overshoot, y_in, y_fs)
-    falls = yb[..., 2:] < yb[..., 1:-1]  # Q decreases on the piece after breakpoint j = 1..4
-    j = np.argmax(falls, axis=-1)[..., None] + 1
-    first = np.where(np.any(falls, axis=-1), np.take_along_axis(b, j, axis=-1)[..., 0], br.s_fs)
-    return s_peak, y_peak, overshoot, first
-
-
 def peak_force(p0_pa: ArrayLike, params: ContactParameters) -> PeakForce:
     """Peak of Q(u) (closed form, vectorised over p0).
 
@@ -506,8 +389,8 @@ def peak_force(p0_pa: ArrayLike, params: ContactParameters) -> PeakForce:
     p0 = np.atleast_1d(np.asarray(p0_pa, dtype=float))
     params.check_p0_pa(p0)
     br = _branch(p0, params)
-    b, yb = _breakpoints(br)
-    s_peak, y_peak, overshoot, first = _peak(br, b, yb)
+    b, yb = pc.breakpoints(br)
+    s_peak, y_peak, overshoot, first = pc.peak(br, b, yb)
     t2 = stick_inner_s(s_peak, p0, params)
     sticks = t2 > s_peak
     a = br.a
@@ -526,110 +409,6 @@ def peak_force(p0_pa: ArrayLike, params: ContactParameters) -> PeakForce:
     return PeakForce(**{k: np.reshape(v, shape) for k, v in out.items()})
 
 
-def _cubic_real_roots(c3, c2, c1, c0):
-    """The three roots of c3 x³ + c2 x² + c1 x + c0 (complex Cardano, vectorised).
-
-    Returns an array (..., 3) of complex roots; for |c3| negligible the cubic is
-    solved as a quadratic (the third root is nan).
-    """
-    c3, c2, c1, c0 = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (c3, c2, c1, c0)))
-    scale = np.maximum.reduce([np.abs(c2), np.abs(c1), np.abs(c0)])
-    cubic = np.abs(c3) > 1e-12 * scale
-    a = np.where(cubic, c3, 1.0)
-    b, c, d = c2 / a, c1 / a, c0 / a  # monic
-    d0 = b * b - 3.0 * c
-    d1 = 2.0 * b**3 - 9.0 * b * c + 27.0 * d
-    sq = np.sqrt((d1 * d1 - 4.0 * d0**3).astype(complex))
-    big = np.where(np.abs(d1 + sq) >= np.abs(d1 - sq), d1 + sq, d1 - sq)
-    cc = (big / 2.0) ** (1.0 / 3.0)
-    xi = np.exp(2j * np.pi / 3.0)
-    roots = []
-    for kk in range(3):
-        ck = cc * xi**kk
-        with np.errstate(divide="ignore", invalid="ignore"):
-            r = np.where(np.abs(ck) > 0.0, -(b + ck + d0 / ck) / 3.0, -b / 3.0)
-        roots.append(r)
-    cub = np.stack(roots, axis=-1)
-    # the root of smallest magnitude loses relative accuracy to cancellation; recover it
-    # from Vieta (x1 x2 x3 = −d) and the two larger roots
-    idx = np.argmin(np.abs(cub), axis=-1)[..., None]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        others = np.prod(cub, axis=-1) / np.take_along_axis(cub, idx, axis=-1)[..., 0]
-        small = np.where(
-            np.abs(others) > 0.0, -d / others, np.take_along_axis(cub, idx, axis=-1)[..., 0]
-        )
-    np.put_along_axis(cub, idx, small[..., None], axis=-1)
-    q1, q2 = _quadratic_roots(c2, c1, c0)
-    quad = np.stack([q1, q2, np.full_like(q1, np.nan)], axis=-1).astype(complex)
-    return np.where(cubic[..., None], cub, quad)
-
-
-def _solve_on_piece(y, lo, hi, br: _Branch):
-    """s in [lo, hi] with Q(s)/(2π a²) = y, where [lo, hi] lies in one cubic piece on which
-    Q rises from below y to >= y (unique root): Cardano, Newton polish, bisection safeguard."""
-    a1, a2, a3 = br.A
-    b0, b1, b3 = br.B
-    ring = hi > br.s_c
-    ts = br.tstar
-    # the piece's cubic in its own variable x: x = s (disc, rising) or h = t* − s (ring, falling)
-    c3 = np.where(ring, b3, a3)
-    c2 = np.where(ring, 0.0, a2)
-    c1 = np.where(ring, b1, a1)
-    c0 = np.where(ring, b0 - y, -y)
-    xlo = np.where(ring, ts - hi, lo)
-    xhi = np.where(ring, ts - lo, hi)
-    sign = np.where(ring, -1.0, 1.0)
-    c3, c2, c1, c0, xlo, xhi, sign = np.broadcast_arrays(c3, c2, c1, c0, xlo, xhi, sign)
-    roots = _cubic_real_roots(c3, c2, c1, c0)
-    tol = 1e-6
-    re = roots.real
-    ok = (
-        (np.abs(roots.imag) <= tol * (1.0 + np.abs(re)))
-        & (re >= xlo[..., None] - tol)
-        & (re <= xhi[..., None] + tol)
-    )
-    x = np.min(np.where(ok, re, np.inf), axis=-1)
-    x = np.clip(np.where(np.isfinite(x), x, xhi), xlo, xhi)
-
-    def f(x):
-        return ((c3 * x + c2) * x + c1) * x + c0
-
-    def mag(x):
-        return np.abs(c3 * x**3) + np.abs(c2 * x * x) + np.abs(c1 * x) + np.abs(c0) + np.abs(y)
-
-    scale = np.abs(c3) + np.abs(c2) + np.abs(c1)
-    for _ in range(2):  # Newton x − f/f' = (2 c3 x³ + c2 x² − c0)/f', kept inside the bracket
-        df = (3.0 * c3 * x + 2.0 * c2) * x + c1
-        good = sign * df > 1e-12 * scale
-        newton = ((2.0 * c3 * x + c2) * x * x - c0) / np.where(good, df, 1.0)
-        x = np.clip(np.where(good, newton, x), xlo, xhi)
-    # safeguard: where the closed form is not accurate (near-degenerate cubic, the double
-    # root at a local maximum) finish by bisection on the bracket, where f is monotone
-    bad = np.abs(f(x)) > 1e-12 * np.abs(y) + 1e-14 * mag(x)
-    if np.any(bad):
-        lo_, hi_ = xlo.copy(), xhi.copy()
-        for _ in range(64):
-            mid = 0.5 * (lo_ + hi_)
-            up = sign * f(mid) >= 0.0
-            hi_ = np.where(up, mid, hi_)
-            lo_ = np.where(up, lo_, mid)
-        x = np.where(bad, np.where(sign > 0, hi_, lo_), x)
-    return np.where(ring, ts - x, x)
-
-
-def _first_crossing(y, b, yb, br: _Branch):
-    """Smallest s with Q(s)/(2π a²) = y for 0 <= y <= max Q: the first monotone piece whose
-    end reaches y (every earlier breakpoint lies below y, so Q rises through y there)."""
-    j = np.argmax(yb >= y[..., None], axis=-1)[..., None]
-    j1 = np.maximum(j - 1, 0)
-    shape = np.broadcast_shapes((*y.shape, 1), b.shape)
-    bb = np.broadcast_to(b, shape)
-    lo = np.take_along_axis(bb, j1, axis=-1)[..., 0]
-    hi = np.take_along_axis(bb, j, axis=-1)[..., 0]
-    s = _solve_on_piece(y, lo, hi, br)
-    return np.where(y <= 0.0, 0.0, s)
-
-
 def s_on_rising_branch(
     lateral_force_n: ArrayLike, p0_pa: ArrayLike, params: ContactParameters
 ) -> FloatArray:
@@ -644,10 +423,10 @@ def s_on_rising_branch(
     p0 = np.asarray(p0_pa, dtype=float)
     params.check_p0_pa(p0)
     br = _branch(p0, params)
-    b, yb = _breakpoints(br)
-    _, y_peak, _, _ = _peak(br, b, yb)
+    b, yb = pc.breakpoints(br)
+    _, y_peak, _, _ = pc.peak(br, b, yb)
     y = np.clip(q / br.area2, 0.0, y_peak)
-    return _first_crossing(y, b, yb, br)
+    return pc.first_crossing(y, b, yb, br)
 
 
 def displacement_on_rising_branch(
@@ -678,8 +457,8 @@ def rising_branch_breaks(p0_pa: ArrayLike, params: ContactParameters) -> RisingB
     p0 = np.asarray(p0_pa, dtype=float)
     params.check_p0_pa(p0)
     br = _branch(p0, params)
-    b, yb = _breakpoints(br)
-    s_peak, _, _, _ = _peak(br, b, yb)
+    b, yb = pc.breakpoints(br)
+    s_peak, _, _, _ = pc.peak(br, b, yb)
     inner, y_in = b[..., 1:-1], yb[..., 1:-1]
     earlier = np.maximum.accumulate(yb, axis=-1)[..., :-2]
     record = (y_in > earlier) & (inner < s_peak[..., None])
@@ -693,7 +472,7 @@ def rising_branch_breaks(p0_pa: ArrayLike, params: ContactParameters) -> RisingB
     bb = np.broadcast_to(b[..., None, :], (*i.shape[:-1], 6))
     lo = np.take_along_axis(bb, np.maximum(i - 1, 0), axis=-1)[..., 0]
     hi = np.take_along_axis(bb, i, axis=-1)[..., 0]
-    s_above = np.where(jump, _solve_on_piece(np.where(jump, y_in, 0.0), lo, hi, brx), inner)
+    s_above = np.where(jump, pc.solve_on_piece(np.where(jump, y_in, 0.0), lo, hi, brx), inner)
     pe = p0[..., None]
     force = np.where(record, brx.area2 * y_in, np.inf)
     below = displacement_from_s(inner, pe, params)
@@ -704,6 +483,10 @@ def rising_branch_breaks(p0_pa: ArrayLike, params: ContactParameters) -> RisingB
         displacement_below_m=np.take_along_axis(np.broadcast_to(below, force.shape), order, -1),
         displacement_above_m=np.take_along_axis(np.broadcast_to(above, force.shape), order, -1),
     )
+
+
+# --------------------------------------------------------------------------------------
+# stiffness
 
 
 def initial_lateral_stiffness(p0_pa: ArrayLike, params: ContactParameters) -> FloatArray:
@@ -717,62 +500,3 @@ def initial_lateral_stiffness(p0_pa: ArrayLike, params: ContactParameters) -> Fl
         return 2.0 * g * a * np.ones_like(p0)
     kp0 = params.k * p0  # > 0: ContactParameters refuses τ0 = 0 with k <= 0
     return 2.0 * g * a * (kp0 + params.sigma0_pa / 2.0) / kp0
-
-
-# --------------------------------------------------------------------------------------
-# classical Cattaneo–Mindlin
-
-
-# The classical theory lives in :mod:`flatcontact.contact.cattaneo_mindlin` (plain-number
-# functions, Johnson §7.2/§7.4); these names are kept for existing callers.
-cattaneo_mindlin_stick_radius = _cm.stick_radius
-cattaneo_mindlin_displacement = _cm.displacement
-cattaneo_mindlin_force = _cm.force
-
-
-@dataclass(frozen=True)
-class ClassicalLimitComparison:
-    """The paper's model in the classical limit against Cattaneo–Mindlin.
-
-    Closed forms, x = u/δ* with δ* = 3μP/(16 G*_J a) (CM's full-slip displacement):
-    paper Q/μP = 3(x/2) − 2(x/2)^(3/2) for x <= 2 (then 1); CM Q/μP = 1 − (1 − x)^(3/2)
-    for x <= 1 (then 1).
-
-    Attributes
-    ----------
-    max_force_deviation : max over u of |Q_paper − Q_CM|/μP
-    displacement_of_max_deviation : x at that maximum
-    max_stick_radius_deviation : max over Q of |c_paper − c_CM|/a at equal Q
-    displacement_ratio_at_equal_stick_radius : u_paper/δ_CM at equal c (exactly 2)
-    """
-
-    max_force_deviation: float
-    displacement_of_max_deviation: float
-    max_stick_radius_deviation: float
-    displacement_ratio_at_equal_stick_radius: float
-
-
-def classical_limit_of_paper_model(n: int = 200_001) -> ClassicalLimitComparison:
-    """Quantify how far the paper's model is from Cattaneo–Mindlin in the classical limit
-    (k = μ, τ0 = σ0 = 0, G* = 4 G*_J), on a grid of ``n`` points (dimensionless)."""
-    x = np.linspace(0.0, 2.0, n)
-    s = np.sqrt(np.clip(x / 2.0, 0.0, 1.0))
-    q_paper = 3.0 * s**2 - 2.0 * s**3
-    q_cm = 1.0 - (1.0 - np.clip(x, 0.0, 1.0)) ** 1.5
-    dev = np.abs(q_paper - q_cm)
-    i = int(np.argmax(dev))
-    ss = np.linspace(0.0, 1.0, n)
-    qr = 3.0 * ss**2 - 2.0 * ss**3
-    c_paper = np.sqrt(1.0 - ss**2)
-    c_cm = np.cbrt(1.0 - qr)
-    # at equal c: paper u/δ* = 2 s², CM δ/δ* = 1 − (c/a)² = s²
-    c_over_a = np.linspace(0.01, 0.99, 99)
-    u_paper = 2.0 * (1.0 - c_over_a**2)  # u/δ* = 2 s²
-    d_cm = 1.0 - np.cbrt(1.0 - (1.0 - c_over_a**3)) ** 2  # δ/δ* at Q/μP = 1 − (c/a)³
-    ratio = float(np.max(u_paper / d_cm))
-    return ClassicalLimitComparison(
-        max_force_deviation=float(dev[i]),
-        displacement_of_max_deviation=float(x[i]),
-        max_stick_radius_deviation=float(np.max(np.abs(c_paper - c_cm))),
-        displacement_ratio_at_equal_stick_radius=ratio,
-    )

@@ -49,7 +49,7 @@ STRESS_MEASURES = ("amplitude", "rms")
 
 
 @lru_cache(maxsize=8)
-def _graded_nodes(levels: int = 40, order: int = 6) -> tuple[FloatArray, FloatArray]:
+def graded_nodes(levels: int = 40, order: int = 6) -> tuple[FloatArray, FloatArray]:
     """Nodes φ = π/2 − θ in (0, π/2) and weights, panels [0, h·2^-levels], ..., [h/2, h]."""
     x, w = np.polynomial.legendre.leggauss(order)
     edges = np.concatenate([[0.0], (np.pi / 2) * 2.0 ** -np.arange(levels, -1, -1)])
@@ -97,7 +97,7 @@ def mean_displacement(
         [np.zeros_like(qm), theta[..., :n_split], np.full_like(qm, half)], axis=-1
     )
     lo, hi = edges[..., :-1, None], edges[..., 1:, None]  # (..., parts, 1)
-    phi, w = _graded_nodes()  # distance below each part's upper end, scaled to its length
+    phi, w = graded_nodes()  # distance below each part's upper end, scaled to its length
     span = (hi - lo) / half
     psi = (half - hi) + phi * span  # π/2 − θ at the nodes (accurate near θ = π/2)
     weights = (w * span).reshape(*qmax.shape, -1)

@@ -4,14 +4,9 @@ Values are stored in the units a person reads (``radius_um``, ``p0_gpa``,
 ``k_mpa_per_gpa`` ...) and validated on construction; the ``*_si`` properties
 give the SI values (m, Pa, dimensionless) the physics functions take.
 
-Shear-modulus convention
-------------------------
-``shear_modulus_gpa`` is the paper's G* (Dong et al., Eq. for q0):
-``q0 = G*·u/(π a)``, so a fully stuck contact has lateral stiffness
-``∫q dA / u = 2 G* a``. Johnson (*Contact Mechanics*, 1985, §7.2) writes the
-same traction as ``q0 = 4 G*_J u/(π a)`` with ``1/G*_J = (2−ν1)/G1 + (2−ν2)/G2``
-(stiffness ``8 G*_J a``); hence ``G*_paper = 4 G*_J``. Use
-:func:`flatcontact.contact.mindlin.paper_shear_modulus_from_johnson` to convert.
+Moduli: ``contact_modulus_gpa`` is the Hertz E*, ``shear_modulus_gpa`` the paper's G*
+(``q0 = G*·u/(π a)``, = 4 G*_J of Johnson); the conventions and the conversions are
+:mod:`flatcontact.contact.moduli`.
 """
 
 from __future__ import annotations

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import xarray as xr
 
 from flatcontact import __version__, units
 from flatcontact.contact import adhesion, mindlin
@@ -128,8 +129,6 @@ class ContactAnalysis:
 
     def to_dataset(self):
         """The Q(u) and stiffness curves as an xarray Dataset (units in attributes)."""
-        import xarray as xr
-
         n_amp = max(c.q_max_n.size for c in self.curves)
 
         def pad(arrs):

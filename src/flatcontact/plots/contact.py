@@ -14,7 +14,8 @@ from matplotlib.figure import Figure
 
 from flatcontact import units
 from flatcontact.contact import fit, mindlin
-from flatcontact.contact.experiment import MeasuredStiffness, model_stiffness_at_stress
+from flatcontact.contact.experiment import model_stiffness_at_stress
+from flatcontact.contact.measured import LoadCurve, MeasuredStiffness
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.contact.summary import ContactAnalysis
 
@@ -238,7 +239,7 @@ def fig6_overlay(
         line = ax.plot(grid / units.MPA_TO_PA, k, "--", label=f"model d⟨Q⟩/d⟨u⟩, {name}")[0]
         bx.plot(grid / units.MPA_TO_PA, k / k[0], "--", label=f"model d⟨Q⟩/d⟨u⟩, {name}")
         if lockin_model is not None:
-            curve = fit.LoadCurve(p0_gpa, grid, np.zeros_like(grid), name)
+            curve = LoadCurve(p0_gpa, grid, np.zeros_like(grid), name)
             k2 = fit.model_stiffness(curve, prm, model=lockin_model, measure=measure)
             kw = {"color": line.get_color(), "lw": 1.2}
             ax.plot(grid / units.MPA_TO_PA, k2, "-", label=f"lock-in Q_amp/u'₁, {name}", **kw)

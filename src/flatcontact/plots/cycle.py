@@ -15,6 +15,7 @@ from matplotlib.figure import Figure
 
 from flatcontact import units
 from flatcontact.contact import cycle, fit
+from flatcontact.contact.measured import LoadCurve
 from flatcontact.contact.parameters import ContactParameters
 
 _MPA = units.MPA_TO_PA
@@ -41,7 +42,7 @@ def fig_loops(
                 lp.force_n * units.N_TO_UN,
                 lw=1.2,
                 label=f"Q_amp = {lp.force_amplitude_n * units.N_TO_UN:.3g} µN, "
-                f"W = {w * cycle.J_TO_FJ:.3g} fJ",
+                f"W = {w * units.J_TO_FJ:.3g} fJ",
             )
         # the loading branch from rest: the first quarter cycle
         q = np.linspace(0.0, cyc.force_amplitude_n[-1], 200)
@@ -106,7 +107,7 @@ def fig_fit(comparison: fit.ModelComparison) -> Figure:
             label=f"{c.source}, p0 = {c.p0_gpa:g} GPa",
         )
         hi = max(float(c.stress_pa.max()), 1e-9) * 1.05
-        dense = fit.LoadCurve(c.p0_gpa, np.linspace(0.0, hi, 300), np.zeros(300), c.source)
+        dense = LoadCurve(c.p0_gpa, np.linspace(0.0, hi, 300), np.zeros(300), c.source)
         for res, ls in ((mod, "-"), (cla, ":")):
             k = fit.model_stiffness(
                 dense, res.params, model=res.model, stiffness=res.stiffness, measure=res.measure

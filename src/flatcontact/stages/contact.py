@@ -192,8 +192,8 @@ def check_cycle(settings, params) -> None:
 
 def fit_curves(settings, params) -> list:
     """The measured curves of ``contact.fit.csv`` (validated with the parameter names, before
-    any work): :func:`flatcontact.contact.fit.load_fit_data`, ``check_free_fixed``."""
-    from flatcontact.contact import fit
+    any work): :func:`flatcontact.contact.measured.load_fit_data`, ``check_free_fixed``."""
+    from flatcontact.contact import fit, measured
 
     c = settings.contact
     try:
@@ -202,7 +202,7 @@ def fit_curves(settings, params) -> list:
         where = "contact.fit.fixed" if "fixed" in str(exc) else "contact.fit.free"
         raise InputError(f"{where}: {exc} (contact.fit.free = {list(c.fit.free)})") from None
     try:
-        return fit.load_fit_data(c.fit.csv, params, c.fit.p0_gpa)
+        return measured.load_fit_data(c.fit.csv, params, c.fit.p0_gpa)
     except InputError as exc:
         text = rename(str(exc), {"fit_p0_gpa": "contact.fit.p0_gpa"})
         raise InputError(f"contact.fit.csv: {text}") from None
@@ -327,8 +327,8 @@ class ContactResult:
     files: list[Path] = field(default_factory=list)
 
     def cycle_rows(self) -> list[dict]:
-        """One row per p0 and force amplitude (:func:`flatcontact.contact.cycle.cycle_records`)."""
-        from flatcontact.contact.cycle import cycle_records
+        """One row per p0 and force amplitude (:func:`flatcontact.contact.cycle_output.cycle_records`)."""
+        from flatcontact.contact.cycle_output import cycle_records
 
         return cycle_records(self.cycles) if self.cycles else []
 
@@ -381,12 +381,13 @@ def run_contact(
 ) -> ContactResult:
     """The modified Mindlin contact of ``settings.contact`` with the upstream ``inputs``."""
     from flatcontact.contact import experiment as exp
+    from flatcontact.contact.measured import load_stiffness_csv
     from flatcontact.contact.summary import analyse
 
     c = settings.contact
     params, provenance = contact_parameters(settings, inputs)
     check_contact(settings, params)
-    measured = exp.load_stiffness_csv(c.experiment.csv) if c.experiment.csv else None
+    measured = load_stiffness_csv(c.experiment.csv) if c.experiment.csv else None
     curves = fit_curves(settings, params) if c.fit.csv else None
     analysis = analyse(
         c.p0_gpa,
@@ -519,7 +520,7 @@ def _write(result: ContactResult, settings, folder: Path, measured, comparison) 
         result.files += save(fig, folder, name, settings.report.svg)
     ds = analysis.to_dataset()
     if result.cycles:
-        from flatcontact.contact.cycle import cycle_dataset
+        from flatcontact.contact.cycle_output import cycle_dataset
 
         cyc = cycle_dataset(result.cycles, params)
         ds = ds.merge(cyc)

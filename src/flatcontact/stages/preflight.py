@@ -15,7 +15,7 @@ import ase.io
 
 from flatcontact import limits
 from flatcontact.config import RunConfig
-from flatcontact.contact.experiment import load_stiffness_csv
+from flatcontact.contact.measured import load_stiffness_csv
 from flatcontact.errors import InputError
 from flatcontact.potentials.loader import load_callable
 from flatcontact.stages import _calculator
