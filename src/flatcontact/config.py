@@ -1104,9 +1104,10 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
     calc = cfg.potential.calculator
     if calc is not None:
         try:
+            from flatcontact.potentials.engines import calculator_factory
             from flatcontact.potentials.loader import load_callable
 
-            cfg.potential.calculator_factory()
+            calculator_factory(cfg.potential)
             load_callable(calc.target)
         except InputError as exc:
             raise InputError(f"{source}: potential.calculator.target: {exc}") from None
