@@ -68,7 +68,7 @@ def n_snap_coefficients(twojmax: int, quadratic: bool) -> int:
 
 
 def bundled_snap_files() -> tuple[Path, Path]:
-    from flatcontact.potentials.spec import BUNDLED_DIR
+    from flatcontact.potentials.files import BUNDLED_DIR
 
     coeff = BUNDLED_DIR / SNAP_BUNDLED / f"{SNAP_BUNDLED}.snapcoeff"
     return coeff, coeff.with_suffix(".snapparam")

@@ -53,7 +53,7 @@ def main() -> None:
             )
             _time_force_calls(f"2J={twoj} random SNAP", snap_calculator(coeff, param), slab)
     try:
-        from flatcontact.training.potentials import bulk_calculator
+        from flatcontact.potentials.engines import bulk_calculator
 
         _time_force_calls("bundled sio2-snap", bulk_calculator("sio2-snap"), slab)
     except Exception as exc:  # not bundled yet

@@ -16,10 +16,10 @@ import time
 import numpy as np
 
 from flatcontact.elastic import relax_cell
+from flatcontact.potentials.teachers import teacher_calculator
 from flatcontact.structures.bulk import alpha_quartz
 from flatcontact.training.dataset import write_dataset
 from flatcontact.training.label import label_frames
-from flatcontact.training.teachers import teacher_calculator
 
 
 def main(argv: list[str] | None = None) -> None:

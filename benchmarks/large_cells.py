@@ -64,9 +64,10 @@ def one_point(system: str, n: int, threads: int) -> dict:
     calc = LammpsInterfaceCalculator(model, ref)
     if threads > 1:  # rebuild the engine with OpenMP threads
         from flatcontact.potentials.lammps_engine import LammpsEngine
+        from flatcontact.potentials.lammps_setup import compile_setup
 
         calc.engine.close()
-        setup = model.lammps_setup(ref)
+        setup = compile_setup(model, ref)
         calc.engine = LammpsEngine(setup, ref.cell.array, ref.pbc, threads=threads)
     t_build = time.perf_counter() - t0
     task = PointTask((0, 0, 0), *shift, thickness(ref))

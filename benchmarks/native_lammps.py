@@ -28,10 +28,11 @@ def write_inputs(reference, model, shifts_a, shifts_b, thicknesses, fmax, folder
     """
     from flatcontact.ispes.geometry import fixed_mask, in_plane_vectors, thickness
     from flatcontact.potentials.lammps_engine import LammpsEngine
+    from flatcontact.potentials.lammps_setup import compile_setup
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    setup = model.lammps_setup(reference)
+    setup = compile_setup(model, reference)
     engine = LammpsEngine(setup, reference.cell.array, reference.pbc, label=model.label)
     try:
         engine.compute(reference.positions)

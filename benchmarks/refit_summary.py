@@ -18,9 +18,9 @@ import sys
 from pathlib import Path
 
 from flatcontact.elastic import elastic_tensor, quartz_contact_moduli, trigonal_constants
+from flatcontact.potentials.engines import bulk_calculator
 from flatcontact.reference import QUARTZ_CIJ_EXPERIMENT_GPA, QUARTZ_LATTICE_EXPERIMENT_ANGSTROM
 from flatcontact.training.dataset import read_dataset
-from flatcontact.training.potentials import bulk_calculator
 from flatcontact.training.validate import dataset_errors, quartz_lattice
 
 

@@ -47,8 +47,8 @@ ISPES_RUNS = RUNS / "teachers-v2"
 
 
 def bulk(name: str):
+    from flatcontact.potentials.engines import bulk_calculator
     from flatcontact.training.ispes_check import teacher_calculator
-    from flatcontact.training.potentials import bulk_calculator
 
     return bulk_calculator(SURROGATES[name]) if name in SURROGATES else teacher_calculator(name)
 

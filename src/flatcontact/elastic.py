@@ -36,6 +36,8 @@ from ase.filters import FrechetCellFilter
 from ase.optimize import BFGS
 
 from flatcontact.errors import require
+from flatcontact.potentials.engines import bulk_calculator
+from flatcontact.potentials.model import InteractionModel
 from flatcontact.units import EV_PER_A3_TO_GPA
 
 _VOIGT_PAIRS = ((0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1))
@@ -183,12 +185,8 @@ def isotropic_moduli(c: np.ndarray) -> IsotropicModuli:
 
 def _calculator(model, atoms: Atoms):
     """A bulk calculator from a model (InteractionModel, its name) or an ASE calculator."""
-    if isinstance(model, str):
-        from flatcontact.training.potentials import bulk_calculator
-
+    if isinstance(model, str | InteractionModel):
         return bulk_calculator(model, atoms)
-    if hasattr(model, "bulk_calculator"):
-        return model.bulk_calculator(atoms)
     return model  # already an ASE calculator
 
 
@@ -207,9 +205,9 @@ _CONVENTIONS = (
 def crystal_contact_moduli(atoms: Atoms, model, strain: float = 0.005) -> dict:
     """Self-consistent contact moduli of any bulk crystal for any interaction model.
 
-    ``model`` is an :class:`~flatcontact.potentials.InteractionModel` (its
-    ``bulk_calculator``), a potential name (:func:`flatcontact.training.potentials.bulk_calculator`)
-    or an ASE calculator. Relaxes cell and ions, computes the relaxed-ion C_ij by
+    ``model`` is an :class:`~flatcontact.potentials.InteractionModel` or a potential's name
+    (their bulk calculator: :func:`flatcontact.potentials.engines.bulk_calculator`), or an
+    ASE calculator. Relaxes cell and ions, computes the relaxed-ion C_ij by
     ±``strain`` central differences and returns a JSON-ready dict: ``cellpar`` (a, b, c in Å,
     angles in degrees), ``tensor_gpa`` and ``moduli_gpa`` (Hill K, G, E, nu; E*, G*_Johnson,
     G*_paper = 4 G*_Johnson for two identical isotropic bodies; see the module docstring).

@@ -122,7 +122,7 @@ def test_relax_refuses_non_positive_fmax():
 def snap_copy(tmp_path):
     import shutil
 
-    from flatcontact.potentials.spec import BUNDLED_DIR
+    from flatcontact.potentials.files import BUNDLED_DIR
 
     src = BUNDLED_DIR / "sio2-snap"
     if not (src / "sio2-snap.snapcoeff").is_file():

@@ -142,8 +142,8 @@ def test_elastic_table_errors_are_relative_to_experiment():
 
 def test_bundled_snap_elastic_constants_match_the_measured_values():
     """The bundled SNAP's α-quartz C11 is 54 GPa (NOTES.md, `flatcontact elastic`): 38 % soft."""
+    from flatcontact.potentials.engines import bulk_calculator
     from flatcontact.training.ispes_check import quartz_elastic_vs_experiment
-    from flatcontact.training.potentials import bulk_calculator
 
     doc = quartz_elastic_vs_experiment(bulk_calculator("sio2-snap"), "snap")
     assert doc["cij_gpa"]["C11"] == pytest.approx(54.0, abs=1.0)

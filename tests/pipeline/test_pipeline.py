@@ -288,7 +288,7 @@ def test_a_changed_threshold_leaves_no_stale_fit_warning(tiny_run, tmp_path):
 
 def test_a_retrained_potential_file_reruns_from_the_build(tmp_path):
     """Coefficient files enter the fingerprint by content, not by name."""
-    from flatcontact.potentials.spec import BUNDLED_DIR
+    from flatcontact.potentials.files import BUNDLED_DIR
 
     bundled = BUNDLED_DIR / "sio2-snap"
     for suffix in (".snapcoeff", ".snapparam"):

@@ -57,7 +57,7 @@ def test_the_copy_has_the_installed_digests(source_copy):
 
 def test_the_closures_hold_the_modules_the_hand_lists_missed():
     assert "flatcontact.analysis.uncertainty" in stage_code("contact")
-    assert "flatcontact.training.potentials" in stage_code("elastic")
+    assert "flatcontact.potentials.teachers" in stage_code("elastic")
     assert "flatcontact.ispes.contract" in stage_code("analyze")
     assert "flatcontact.stages.analyze" in stage_code("laws")
     # the parent packages' __init__ run on import

@@ -14,6 +14,7 @@ from ase.build import bulk
 from flatcontact.potentials import InteractionModel, PotentialSpec, make_calculator
 from flatcontact.potentials.calculator import LammpsInterfaceCalculator
 from flatcontact.potentials.lammps_engine import LammpsEngine
+from flatcontact.potentials.lammps_setup import compile_setup
 
 
 def _path(atoms, seed):
@@ -42,7 +43,7 @@ def _fresh(setup, cell, pbc, positions, stress):
 
 
 def _check_path(model, atoms, bulk_cell=False, seed=0):
-    setup = model.lammps_setup(atoms, bulk=bulk_cell)
+    setup = compile_setup(model, atoms, bulk=bulk_cell)
     engine = LammpsEngine(setup, atoms.cell.array, atoms.pbc)
     try:
         engine.compute(atoms.positions, stress=bulk_cell)

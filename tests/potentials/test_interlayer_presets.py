@@ -14,7 +14,8 @@ from ase import Atoms
 from ase.build import mx2
 from tests.potentials.plain_lammps import lammps_energy
 
-from flatcontact.potentials import InteractionModel
+from flatcontact.potentials import InteractionModel, make_calculator
+from flatcontact.potentials.engines import bulk_calculator
 from flatcontact.potentials.lammps_runtime import lammps_potential_file
 
 SHIFTS = {"AA": (0.0, 0.0), "AB": (1 / 3, 1 / 3), "BA": (2 / 3, 2 / 3), "SP": (0.5, 0.5)}
@@ -53,7 +54,7 @@ def mos2_bilayer(d, shift):
 
 def tool_energy(model, atoms):
     a = atoms.copy()
-    a.calc = model.interface_calculator(a)
+    a.calc = make_calculator(model, a)
     return a.get_potential_energy()
 
 
@@ -193,7 +194,7 @@ def test_forces_are_minus_the_energy_gradient(preset):
     """Rattled bilayers: the engine's forces equal central differences of its energy."""
     atoms = CASES[preset][0](SHIFTS["SP"]).repeat((2, 2, 1))
     atoms.rattle(0.05, seed=11)
-    atoms.calc = InteractionModel(preset=preset).interface_calculator(atoms)
+    atoms.calc = make_calculator(InteractionModel(preset=preset), atoms)
     forces = atoms.get_forces()
     h = 1e-5
     for index in (0, len(atoms) - 1):
@@ -220,7 +221,7 @@ def test_bulk_graphite_binds_about_twice_the_bilayer():
         return Atoms("C4", scaled_positions=frac, cell=cell, pbc=True)
 
     def bulk_energy(atoms):
-        atoms.calc = model.bulk_calculator(atoms)
+        atoms.calc = bulk_calculator(model, atoms)
         return atoms.get_potential_energy() / len(atoms)
 
     bulk_binding = bulk_energy(graphite(2 * d)) - bulk_energy(graphite(40.0))

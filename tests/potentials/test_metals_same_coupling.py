@@ -13,7 +13,8 @@ from ase.build import bulk, fcc111
 from ase.constraints import FixCartesian
 from ase.optimize import BFGS
 
-from flatcontact.potentials import InteractionModel
+from flatcontact.potentials import InteractionModel, make_calculator
+from flatcontact.potentials.engines import bulk_calculator
 
 EV_PER_A2_TO_MJ_PER_M2 = 16021.766
 
@@ -33,7 +34,7 @@ def fcc111_interface(symbol, a, layers=12, shift=(0.0, 0.0)):
 
 def energy(model, atoms, relax_z=False):
     atoms = atoms.copy()
-    atoms.calc = model.interface_calculator(atoms)
+    atoms.calc = make_calculator(model, atoms)
     if relax_z:
         atoms.set_constraint(FixCartesian(range(len(atoms)), mask=(True, True, False)))
         BFGS(atoms, logfile=None).run(fmax=1e-5, steps=500)
@@ -66,7 +67,7 @@ def test_same_coupling_is_the_bulk_potential_across_the_interface():
     del single.arrays["layer"]
     assert energy(model, perfect) == pytest.approx(energy(model, single), abs=1e-10)
     cu = bulk("Cu", "fcc", a=3.615, cubic=True)
-    cu.calc = model.bulk_calculator(cu)
+    cu.calc = bulk_calculator(model, cu)
     assert cu.get_potential_energy() / len(cu) == pytest.approx(-3.54, abs=0.005)
 
 
@@ -80,7 +81,7 @@ def test_ni_and_al_presets_give_their_cohesive_energies(preset, symbol, a, cohes
     from flatcontact.elastic import relax_cell
 
     crystal = bulk(symbol, "fcc", a=a, cubic=True)
-    calc = InteractionModel(preset=preset).bulk_calculator(crystal)
+    calc = bulk_calculator(InteractionModel(preset=preset), crystal)
     relaxed = relax_cell(crystal, calc)
     relaxed.calc = calc
     assert -relaxed.get_potential_energy() / len(relaxed) == pytest.approx(cohesive_ev, abs=0.01)

@@ -11,7 +11,8 @@ from ase.calculators.lj import LennardJones
 
 from flatcontact.config import build_config, load_config
 from flatcontact.errors import InputError
-from flatcontact.potentials import PRESETS, InteractionModel, parse_kwargs
+from flatcontact.potentials import PRESETS, InteractionModel, make_calculator, parse_kwargs
+from flatcontact.potentials.engines import bulk_calculator, calculator_factory
 from flatcontact.potentials.lj import lj_cross_energy_forces, lj_table
 
 
@@ -30,7 +31,7 @@ def carbon_bilayer(d=3.4, shift=(1 / 3, 1 / 3)):
 
 def energy(model, atoms):
     atoms = atoms.copy()
-    atoms.calc = model.interface_calculator(atoms)
+    atoms.calc = make_calculator(model, atoms)
     return atoms.get_potential_energy(), atoms.get_forces()
 
 
@@ -40,7 +41,7 @@ def test_presets_round_trip_pickle_and_fingerprint_by_content(name):
     again = InteractionModel.model_validate_json(model.model_dump_json())
     assert again == model and hash(again) == hash(model)
     assert pickle.loads(pickle.dumps(model)) == model
-    factory = model.calculator_factory()
+    factory = calculator_factory(model)
     clone = pickle.loads(pickle.dumps(factory))
     assert clone.fingerprint == factory.fingerprint and clone.label == model.label
     fp = model.fingerprint()
@@ -86,7 +87,7 @@ def test_element_the_model_lacks_is_refused_naming_both_before_lammps(monkeypatc
             model.check_atoms(atoms)
         assert "\n" not in str(info.value)
         with pytest.raises(InputError, match="Si"):
-            model.interface_calculator(atoms)
+            make_calculator(model, atoms)
 
 
 def test_default_lj_takes_carbon_and_every_element_of_the_ts_table():
@@ -153,7 +154,7 @@ def test_bulk_calculator_stress_is_the_strain_derivative_of_the_energy():
     """σ_j = (1/V) dE/de_j (Voigt, engineering shear), by central differences written here."""
     cu = bulk("Cu", "fcc", a=3.60, cubic=True)
     cu.rattle(0.02, seed=1)
-    calc = InteractionModel(preset="cu-eam").bulk_calculator(cu)
+    calc = bulk_calculator(InteractionModel(preset="cu-eam"), cu)
     cu.calc = calc
     stress = cu.get_stress()
     h = 1e-5

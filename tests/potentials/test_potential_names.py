@@ -5,12 +5,9 @@ import shutil
 import pytest
 
 from flatcontact.errors import InputError
-from flatcontact.potentials.spec import (
-    BUNDLED_DIR,
-    PotentialSpec,
-    normalize_potential_name,
-    resolve_intra,
-)
+from flatcontact.potentials import PotentialSpec
+from flatcontact.potentials.files import BUNDLED_DIR
+from flatcontact.potentials.names import normalize_potential_name, resolve_intra
 
 BUNDLED = "sio2-snap"
 needs_bundled = pytest.mark.skipif(

@@ -6,6 +6,7 @@ from ase.filters import FrechetCellFilter
 from ase.optimize import BFGS
 
 from flatcontact.errors import InputError
+from flatcontact.potentials.engines import bulk_calculator
 from flatcontact.structures.bulk import QUARTZ_C_ANGSTROM, alpha_quartz
 from flatcontact.structures.dense import face_masks, verify_dense_slab
 from flatcontact.structures.slab import quartz_0001_slab
@@ -115,7 +116,7 @@ def _lateral_bulk_c(spec, a_angstrom: float) -> float:
     """c (Å) of α-quartz relaxed with ``spec`` at a fixed a (Frechet filter, zz free only):
     computed here independently of the builder's own bulk relaxation."""
     bulk = alpha_quartz(a_angstrom, QUARTZ_C_ANGSTROM)
-    bulk.calc = spec.bulk_calculator(bulk)
+    bulk.calc = bulk_calculator(spec, bulk)
     BFGS(FrechetCellFilter(bulk, mask=[0, 0, 1, 0, 0, 0]), logfile=None).run(fmax=1e-4, steps=500)
     return float(bulk.cell.array[2, 2])
 

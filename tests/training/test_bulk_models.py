@@ -4,13 +4,13 @@ import numpy as np
 import pytest
 from ase.build import bulk
 
+from flatcontact.potentials.engines import bulk_calculator
 from flatcontact.structures.bulk import alpha_quartz
 from flatcontact.training.lammps_bulk import (
     LammpsBulkCalculator,
     vashishta_calculator,
     vashishta_pair_commands,
 )
-from flatcontact.training.potentials import bulk_calculator
 
 
 def _efs(atoms, calc):

@@ -4,10 +4,12 @@ import json
 
 import pytest
 
-from flatcontact.training.potentials import bulk_calculator, bundled_dir, snapcoeff_path
+from flatcontact.potentials.engines import bulk_calculator
+from flatcontact.potentials.files import BUNDLED_DIR
+from flatcontact.potentials.names import snapcoeff_path
 from flatcontact.training.snapfiles import read_snapcoeff
 
-HERE = bundled_dir() / "sio2-snap"
+HERE = BUNDLED_DIR / "sio2-snap"
 
 
 @pytest.fixture(scope="module")

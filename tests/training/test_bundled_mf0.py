@@ -9,11 +9,11 @@ import json
 
 import pytest
 
+from flatcontact.potentials.files import BUNDLED_DIR
 from flatcontact.reference import QUARTZ_CIJ_EXPERIMENT_GPA, QUARTZ_LATTICE_EXPERIMENT_ANGSTROM
-from flatcontact.training.potentials import bundled_dir
 
 NAME = "sio2-snap-mf0"
-HERE = bundled_dir() / NAME
+HERE = BUNDLED_DIR / NAME
 
 
 @pytest.fixture(scope="module")
@@ -77,9 +77,9 @@ def test_heldout_errors_of_the_scan_groups_within_the_targets():
     Every group the scan uses is within the energy and force targets (10 meV/atom, 200 meV/Å);
     computed here from test.extxyz, independently of the fit's own report.
     """
+    from flatcontact.potentials.engines import bulk_calculator
     from flatcontact.training.dataset import read_dataset
     from flatcontact.training.fit import TARGET_ENERGY_MEV, TARGET_FORCE_MEV
-    from flatcontact.training.potentials import bulk_calculator
     from flatcontact.training.validate import dataset_errors
 
     frames = read_dataset(HERE / "test.extxyz", ["Si", "O"])
@@ -97,7 +97,7 @@ def test_heldout_errors_of_the_scan_groups_within_the_targets():
 
 def test_preset_runs_in_the_interface_engine():
     """``sio2-snap-mf0-lj``: the new SNAP in each slab + the default LJ across; Newton's third law."""
-    from flatcontact.potentials import InteractionModel
+    from flatcontact.potentials import InteractionModel, make_calculator
     from flatcontact.structures.interface import make_interface
     from flatcontact.training.validate import seeded_dense_slab
 
@@ -107,6 +107,6 @@ def test_preset_runs_in_the_interface_engine():
     slab = seeded_dense_slab()
     slab.pbc = (True, True, False)
     iface = make_interface(slab, 3.0, face_atoms=6)
-    iface.calc = model.interface_calculator(iface)
+    iface.calc = make_calculator(model, iface)
     f = iface.get_forces()
     assert abs(f.sum(axis=0)).max() < 1e-6

@@ -82,10 +82,10 @@ def test_bundled_reports_compare_with_the_one_experimental_set(name):
     """The stored vs_experiment blocks are what flatcontact.reference gives (|C14| compared)."""
     import json
 
-    from flatcontact.training.potentials import bundled_dir
+    from flatcontact.potentials.files import BUNDLED_DIR
     from flatcontact.training.validate import experiment_moduli, vs_experiment
 
-    report = json.loads((bundled_dir() / name / "validation.json").read_text())
+    report = json.loads((BUNDLED_DIR / name / "validation.json").read_text())
     stored, now = report["vs_experiment"], vs_experiment(report["potential"])
     for k, v in now["cij_rel"].items():
         assert stored["cij_rel"][k] == pytest.approx(v, abs=1e-12), k

@@ -1,4 +1,4 @@
-"""The one registry of offline teachers (flatcontact.training.teachers); no torch needed."""
+"""The one registry of offline teachers (flatcontact.potentials.teachers); no torch needed."""
 
 import importlib
 
@@ -6,7 +6,7 @@ import pytest
 from tests.cli.cli_helpers import one_error_line, run_cli
 
 from flatcontact.errors import InputError
-from flatcontact.training import teachers as reg
+from flatcontact.potentials import teachers as reg
 
 #: What each registered teacher must say about itself: (package, checkpoint, head, functional).
 EXPECTED = {
@@ -66,8 +66,8 @@ def test_train_snap_refuses_unknown_teacher_before_any_work(tmp_path, capsys):
 
 def test_every_consumer_resolves_teachers_through_the_registry():
     """ISPES specs, bulk potentials and labelling see the same names and factories."""
+    from flatcontact.potentials.names import snapcoeff_path
     from flatcontact.training import ispes_check, label
-    from flatcontact.training.potentials import snapcoeff_path
 
     assert ispes_check.TEACHERS is reg.TEACHERS and label.TEACHERS is reg.TEACHERS
     assert label.teacher_calculator is reg.teacher_calculator

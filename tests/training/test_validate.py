@@ -79,7 +79,7 @@ def test_cli_validate_with_reference_file(tmp_path, capsys):
 )
 def test_classical_potentials_relax_to_known_lattices(name, a_ref, c_ref):
     """NOTES.md (LAMMPS box/relax): Vashishta 4.829/5.309 Å, Tersoff SiO 5.082/5.528 Å."""
-    from flatcontact.training.potentials import bulk_calculator
+    from flatcontact.potentials.engines import bulk_calculator
     from flatcontact.training.validate import quartz_lattice
 
     _, lat = quartz_lattice(bulk_calculator(name))

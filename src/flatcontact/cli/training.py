@@ -13,20 +13,20 @@ from flatcontact.cli.app import app, check_out_dir, console, err_console
 
 
 def _bulk_potential(potential: str, flag: str) -> str:
-    """``potential`` in any spelling of :func:`~flatcontact.potentials.spec.normalize_potential_name`
+    """``potential`` in any spelling of :func:`~flatcontact.potentials.names.normalize_potential_name`
     as the name or ``.snapcoeff`` path that the bulk calculators take (offline teachers of
-    :mod:`flatcontact.training.teachers` pass through).
+    :mod:`flatcontact.potentials.teachers` pass through).
     """
     from flatcontact.errors import InputError
-    from flatcontact.potentials.spec import normalize_potential_name, resolve_intra
-    from flatcontact.training.teachers import is_teacher
+    from flatcontact.potentials.names import normalize_potential_name, resolve_intra
+    from flatcontact.potentials.teachers import is_teacher
 
     if is_teacher(potential):
         return potential.strip()
     try:
         resolved = resolve_intra(potential)
     except InputError as exc:
-        from flatcontact.training.teachers import TEACHERS
+        from flatcontact.potentials.teachers import TEACHERS
 
         raise InputError(f"{flag}: {exc}; or an offline teacher ({', '.join(TEACHERS)})") from None
     if resolved.style in ("vashishta", "tersoff"):
@@ -90,7 +90,7 @@ def train_snap_cmd(
 ) -> None:
     """Fit a SNAP (LAMMPS .snapcoeff/.snapparam) to a dataset or a generated recipe."""
     from flatcontact.errors import InputError
-    from flatcontact.training.teachers import get_teacher
+    from flatcontact.potentials.teachers import get_teacher
     from flatcontact.training.train import train_snap
 
     check_base_name(name)
@@ -208,8 +208,8 @@ def validate_potential_cmd(
     """
     from flatcontact.errors import InputError
     from flatcontact.fileio import write_json_atomic
+    from flatcontact.potentials.engines import bulk_calculator
     from flatcontact.training.dataset import read_dataset
-    from flatcontact.training.potentials import bulk_calculator
     from flatcontact.training.validate import validate_potential
 
     if out is not None:
@@ -269,8 +269,8 @@ def _ispes_model(name: str, flag: str, lj: dict):
     (``chgnet`` = ``chgnet-r2scan``) or any intra-slab potential name, with the shared LJ."""
     from flatcontact.errors import InputError
     from flatcontact.potentials import PotentialSpec
+    from flatcontact.potentials.teachers import get_teacher, is_teacher
     from flatcontact.training.ispes_check import teacher_spec
-    from flatcontact.training.teachers import get_teacher, is_teacher
 
     name = name.strip()
     if is_teacher(name):

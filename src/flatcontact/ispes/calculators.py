@@ -5,8 +5,8 @@ grid point it relaxes. A factory is a small frozen object that pickles to any
 worker process (local pool or Dask) and has a JSON ``fingerprint`` that the point
 store records, so a store is never mixed across interaction models.
 
-The factory of every interaction model is ``model.calculator_factory()``
-(:class:`flatcontact.potentials.factory.ModelFactory`). Earlier names kept here:
+The factory of every interaction model is ``calculator_factory(model)``
+(:class:`flatcontact.potentials.engines.ModelFactory`). Earlier names kept here:
 
 - :class:`PotentialFactory`: ``PotentialFactory.from_spec(model)``, the same factory;
 - :class:`CalculatorFactory`: a whole-interface ASE calculator ``"module:callable"`` plus
@@ -22,7 +22,7 @@ from typing import Any
 from ase import Atoms
 from ase.calculators.calculator import Calculator
 
-from flatcontact.potentials.factory import ModelFactory
+from flatcontact.potentials.engines import ModelFactory, calculator_factory
 
 
 @dataclasses.dataclass(frozen=True)
@@ -63,7 +63,7 @@ class CalculatorFactory:
 
     @property
     def fingerprint(self) -> str:
-        return self.model().calculator_factory().fingerprint
+        return calculator_factory(self.model()).fingerprint
 
     @property
     def label(self) -> str:

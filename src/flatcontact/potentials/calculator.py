@@ -9,7 +9,8 @@
 
 The first two are created once per worker and reused: a call on Atoms with the same species,
 order, slab/layer labels, cell and pbc only updates positions; anything else rebuilds the
-engine. ``calc.force_calls`` counts energy+force evaluations (cumulative).
+engine. ``calc.force_calls`` counts energy+force evaluations (cumulative). Which calculator a
+model gets is decided in :mod:`flatcontact.potentials.engines`.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from ase.calculators.calculator import Calculator, all_changes
 
 from flatcontact.errors import InputError
 from flatcontact.potentials.lammps_engine import LammpsEngine
+from flatcontact.potentials.lammps_setup import compile_setup
 from flatcontact.potentials.lj import lj_cross_energy_forces
 from flatcontact.potentials.loader import call_factory
 from flatcontact.potentials.model import InteractionModel, slab_ids
@@ -41,11 +43,6 @@ def _signature(atoms: Atoms) -> tuple:
         np.round(atoms.cell.array if atoms.pbc[2] else atoms.cell.array[:2], 10).tobytes(),
         np.asarray(atoms.pbc, dtype=bool).tobytes(),
     )
-
-
-def check_elements(model: InteractionModel, atoms: Atoms) -> None:
-    """``model.check_atoms(atoms)`` (kept for callers of the earlier API)."""
-    model.check_atoms(atoms)
 
 
 class InterfaceCalculator(Calculator):
@@ -169,7 +166,7 @@ class LammpsInterfaceCalculator(InterfaceCalculator):
     """The LAMMPS engine with the model's setup (see :mod:`flatcontact.potentials.lammps_setup`)."""
 
     def _build(self, atoms: Atoms) -> None:
-        setup = self.spec.lammps_setup(atoms, bulk=self.bulk)
+        setup = compile_setup(self.spec, atoms, bulk=self.bulk)
         self.engine = LammpsEngine(setup, atoms.cell.array, atoms.pbc, label=self.spec.label)
         self._signature = _signature(atoms)
 
@@ -236,34 +233,3 @@ class AseInterfaceCalculator(InterfaceCalculator):
             energy += e_lj
             forces += f_lj
         return energy, forces
-
-
-def model_calculator(model: InteractionModel, atoms: Atoms):
-    """The calculator of ``model`` for ``atoms`` (InputError on an element mismatch first)."""
-    if model.engine == "ase-interface":
-        model.check_atoms(atoms)
-        c = model.calculator
-        return call_factory(c.target, atoms, c.kwargs)
-    if model.engine == "ase-slab":
-        return AseInterfaceCalculator(model, atoms)
-    return LammpsInterfaceCalculator(model, atoms)
-
-
-def bulk_model_calculator(model: InteractionModel, atoms: Atoms):
-    """Energy, forces and stress of a single crystal with ``model`` (no coupling, no slabs)."""
-    if model.calculator is not None:
-        c = model.calculator
-        return call_factory(c.target, atoms, c.kwargs)
-    if model.engine == "ase-slab":
-        return call_factory(model.intra.removeprefix("ase:"), None, {})
-    if not model.intra_styles:
-        raise InputError(f"potential {model.label}: no intra model to compute a bulk crystal with")
-    return LammpsInterfaceCalculator(model, atoms, bulk=True)
-
-
-def make_calculator(spec: InteractionModel, atoms: Atoms):
-    """The calculator for ``spec`` on an interface (or, without a ``slab`` array, a single body).
-
-    Raises :class:`InputError` on an element mismatch before any LAMMPS instance is created.
-    """
-    return model_calculator(spec, atoms)

@@ -12,6 +12,7 @@ Each factory takes no arguments and returns a fresh ASE calculator for a single 
 from __future__ import annotations
 
 from flatcontact.potentials.calculator import LammpsInterfaceCalculator
+from flatcontact.potentials.chgnet import chgnet_calculator
 from flatcontact.potentials.model import InteractionModel
 
 
@@ -27,6 +28,4 @@ def tersoff():
 
 def chgnet_r2scan():
     """CHGNet with the r2SCAN weights, CPU; raises InputError if not installed."""
-    from flatcontact.potentials.chgnet import chgnet_calculator
-
     return chgnet_calculator("r2scan", on_isolated_atoms="ignore")

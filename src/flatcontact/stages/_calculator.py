@@ -1,8 +1,8 @@
 """The run's interaction model as the stages see it: the one place they touch
 :class:`flatcontact.potentials.InteractionModel` (``settings.potential``).
 
-Everything goes through the model's API (``label``, ``fingerprint()``, ``check_atoms``,
-``calculator_factory()``, ``bulk_calculator``); nothing here branches on the kind of model
+Everything goes through the model's API (``label``, ``fingerprint()``, ``check_atoms``) and
+its engines (:mod:`flatcontact.potentials.engines`); nothing here branches on the kind of model
 except the report's reading of it (:func:`intra`, :func:`lj`).
 """
 
@@ -33,7 +33,11 @@ def fingerprint(settings) -> dict:
 
 def factory(settings) -> Any:
     """The picklable calculator factory of the scan workers (``factory(atoms)``)."""
-    return settings.potential.calculator_factory()
+    # imported here: `flatcontact --help` imports this module (cli/build.py -> stages/build.py)
+    # and must not load numpy, ASE and pydantic before the CLI has set its thread settings
+    from flatcontact.potentials.engines import calculator_factory
+
+    return calculator_factory(settings.potential)
 
 
 def check_atoms(settings, atoms) -> None:

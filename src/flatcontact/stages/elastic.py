@@ -134,7 +134,7 @@ def run_elastic(
 ) -> ElasticResult:
     """Cij of the relaxed bulk crystal of the slabs (:func:`bulk_crystal`) by finite strains
     (``elastic.strain``) and its contact moduli, with the run's model as a single crystal
-    (:meth:`InteractionModel.bulk_calculator`)."""
+    (:func:`flatcontact.potentials.engines.bulk_calculator`)."""
     from flatcontact.elastic import crystal_contact_moduli, quartz_contact_moduli
 
     atoms, record = bulk_crystal(settings.structure)

@@ -17,6 +17,7 @@ from flatcontact import limits
 from flatcontact.config import RunConfig
 from flatcontact.contact.measured import load_stiffness_csv
 from flatcontact.errors import InputError
+from flatcontact.potentials.engines import calculator_factory
 from flatcontact.potentials.loader import load_callable
 from flatcontact.stages import _calculator
 from flatcontact.stages.build import structure_elements
@@ -51,7 +52,7 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
     calc = cfg.potential.calculator
     if calc is not None:
         try:
-            cfg.potential.calculator_factory()
+            calculator_factory(cfg.potential)
             load_callable(calc.target)
         except InputError as exc:
             raise InputError(f"{source}: potential.calculator.target: {exc}") from None

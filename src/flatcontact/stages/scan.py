@@ -94,7 +94,8 @@ def built_with_other_model(reference, settings) -> str | None:
     whole ``PotentialSpec`` (``potential_spec``; older files only its label ``potential``, of
     which the intra-slab part is compared). A recipe naming no potential gives ``None``.
     """
-    from flatcontact.potentials.spec import PotentialSpec, normalize_potential_name
+    from flatcontact.potentials import PotentialSpec
+    from flatcontact.potentials.names import normalize_potential_name
 
     try:
         recipe = json.loads(reference.info.get("recipe", "{}") or "{}")

@@ -25,6 +25,7 @@ Pipeline of :func:`build_quartz_interface` (deterministic; no random numbers):
 from __future__ import annotations
 
 import json
+from functools import partial
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
@@ -113,13 +114,14 @@ def thicken_shipped_slab(
     mid-height. The caller relaxes and verifies the result. Returns (slab, JSON-ready record, the bulk cell).
     """
     from flatcontact.potentials import make_calculator
+    from flatcontact.potentials.engines import bulk_calculator
 
     repeats = (layers - SHIPPED_LAYERS) // UNITS_PER_REPEAT
     start = slab.copy()
     start.calc = None
     pre = relax(start, make_calculator(spec, start), fmax_ev_per_angstrom=fmax_ev_per_angstrom)
     start.calc = None
-    bulk, bulk_record = lateral_bulk(spec.bulk_calculator, start.cell.array[:2, :2])
+    bulk, bulk_record = lateral_bulk(partial(bulk_calculator, spec), start.cell.array[:2, :2])
     thick, insertion = insert_bulk_repeats(start, bulk, repeats)
     return (
         thick,
@@ -426,7 +428,7 @@ def interface_from_slab(
     or ``face_depth_angstrom``), and the interface relaxed with ``spec`` (no surface check:
     the dense-silica verification applies only to quartz).
     """
-    from flatcontact.potentials import check_elements, make_calculator
+    from flatcontact.potentials import make_calculator
 
     require(normal_axis in (0, 1, 2), f"normal_axis={normal_axis}: expected 0, 1 or 2")
     atoms = slab.copy()
@@ -441,7 +443,7 @@ def interface_from_slab(
     )
     standard, _ = atoms.cell.__class__(cell).standard_form()
     atoms = Atoms(atoms.numbers, scaled_positions=scaled, cell=standard, pbc=(True, True, False))
-    check_elements(spec, atoms)
+    spec.check_atoms(atoms)
     interface = make_interface(
         atoms,
         gap_angstrom,

@@ -17,7 +17,7 @@ A model is a :class:`~flatcontact.potentials.PotentialSpec` (intra-slab model + 
 cross-interface LJ: this isolates the intra-slab potential, which is what a surrogate
 replaces), a factory with ``fingerprint`` (:mod:`flatcontact.ispes.calculators`), or
 anything with ``calculator_factory()``. Offline teachers come from their one registry,
-:mod:`flatcontact.training.teachers` (CHGNet r2SCAN, SevenNet-0, SevenNet-MF-0 with its
+:mod:`flatcontact.potentials.teachers` (CHGNet r2SCAN, SevenNet-0, SevenNet-MF-0 with its
 r2SCAN and PBE heads; weights ship in the wheels, nothing is downloaded); they need
 ``torch`` (CPU) plus ``chgnet``/``sevenn``.
 """
@@ -35,8 +35,8 @@ import pandas as pd
 from ase import Atoms
 
 from flatcontact.errors import InputError, require
+from flatcontact.potentials.teachers import TEACHERS, get_teacher, teacher_calculator  # noqa: F401
 from flatcontact.reference import QUARTZ_CIJ_EXPERIMENT_GPA, QUARTZ_LATTICE_EXPERIMENT_ANGSTROM
-from flatcontact.training.teachers import TEACHERS, get_teacher, teacher_calculator  # noqa: F401
 
 #: Experimental α-quartz Cij (GPa) as compared here: :data:`flatcontact.reference.QUARTZ_CIJ_EXPERIMENT_GPA`
 #: with |C14| (a model's C14 sign depends on its axes).

@@ -1,6 +1,6 @@
 """Labelling configurations with a reference ("teacher") model.
 
-Teachers are named in :mod:`flatcontact.training.teachers` (their one home; the default is
+Teachers are named in :mod:`flatcontact.potentials.teachers` (their one home; the default is
 CHGNet's r2SCAN model, ``sevennet-mf-0-r2scan`` the stiffer alternative). They are optional
 extras imported only when asked. Any ASE calculator can label instead.
 """
@@ -11,12 +11,12 @@ from collections.abc import Callable, Sequence
 
 from ase import Atoms
 
-from flatcontact.training.dataset import labelled
-from flatcontact.training.teachers import (  # noqa: F401 - re-exported for callers of .label
+from flatcontact.potentials.teachers import (  # noqa: F401 - re-exported for callers of .label
     TEACHERS,
     teacher_calculator,
     teacher_info,
 )
+from flatcontact.training.dataset import labelled
 
 
 def label_frames(

@@ -22,13 +22,17 @@ from ase.calculators.calculator import Calculator, all_changes
 from ase.calculators.lammps import Prism
 
 from flatcontact.errors import InputError
+from flatcontact.potentials.engines import bulk_calculator
 from flatcontact.potentials.lammps_box import (  # noqa: F401 - re-exported for training modules
     VOIGT_PAIRS,
+    LammpsBox,
     create_box,
     tensor_to_voigt,
     voigt_to_tensor,
 )
 from flatcontact.potentials.lammps_runtime import lammps_potential_file, new_lammps
+from flatcontact.potentials.model import InteractionModel
+from flatcontact.potentials.styles import LammpsStyle
 
 
 def setup_box(lmp, atoms: Atoms, elements: Sequence[str]) -> Prism:
@@ -65,12 +69,6 @@ def vashishta_pair_commands(elements: Sequence[str] = ("Si", "O")) -> list[str]:
     return ["pair_style vashishta", f"pair_coeff * * {path} {' '.join(elements)}"]
 
 
-def tersoff_pair_commands(elements: Sequence[str] = ("Si", "O")) -> list[str]:
-    """Tersoff SiO potential (Munetoh et al. 2007) as shipped with LAMMPS (``SiO.tersoff``)."""
-    path = lammps_potential_file("SiO.tersoff")
-    return ["pair_style tersoff", f"pair_coeff * * {path} {' '.join(elements)}"]
-
-
 class LammpsBulkCalculator(Calculator):
     """ASE calculator for one periodic body with raw LAMMPS pair commands.
 
@@ -85,7 +83,7 @@ class LammpsBulkCalculator(Calculator):
     Notes
     -----
     For hand-written pair commands; a potential of :mod:`flatcontact.potentials` gives its
-    bulk calculator through ``InteractionModel.bulk_calculator``. Each calculation rebuilds
+    bulk calculator through :func:`flatcontact.potentials.engines.bulk_calculator`. Each calculation rebuilds
     the box (bulk cells are small). ``force_calls`` counts evaluations.
     """
 
@@ -100,8 +98,6 @@ class LammpsBulkCalculator(Calculator):
 
     def calculate(self, atoms=None, properties=("energy",), system_changes=all_changes):
         super().calculate(atoms, properties, system_changes)
-        from flatcontact.potentials.lammps_box import LammpsBox
-
         lmp = self._lmp
         lmp.command("clear")
         setup_box(lmp, self.atoms, self.elements)
@@ -124,19 +120,15 @@ class LammpsBulkCalculator(Calculator):
 
 def snap_calculator(coeff_file: str | Path, param_file: str | Path | None = None):
     """The bulk calculator of a SNAP ``.snapcoeff`` (``.snapparam`` beside it, or given)."""
-    from flatcontact.potentials import InteractionModel, LammpsStyle
-
     coeff_file = Path(coeff_file)
     param_file = Path(param_file) if param_file else coeff_file.with_suffix(".snapparam")
     for path in (coeff_file, param_file):
         if not path.is_file():
             raise InputError(f"{path}: SNAP file not found")
     style = LammpsStyle(pair_style="snap", pair_coeff=(str(coeff_file), str(param_file)))
-    return InteractionModel(intra=(style,), coupling="none").bulk_calculator(None)
+    return bulk_calculator(InteractionModel(intra=(style,), coupling="none"), None)
 
 
 def vashishta_calculator():
     """The bulk calculator of the Vashishta (1990) SiO2 potential."""
-    from flatcontact.potentials import InteractionModel
-
-    return InteractionModel(intra="vashishta", coupling="none").bulk_calculator(None)
+    return bulk_calculator(InteractionModel(intra="vashishta", coupling="none"), None)

@@ -65,9 +65,9 @@ def build_recipe_dataset(
     recipe: str, seed: int, label: str, scale: float, say: Callable[[str], None]
 ) -> tuple[list, dict, object]:
     """Generate and label the recipe's frames; return (frames, info with timings, teacher)."""
+    from flatcontact.potentials.teachers import teacher_calculator, teacher_info
     from flatcontact.training.label import label_frames
     from flatcontact.training.recipe import RECIPES, sio2_recipe
-    from flatcontact.training.teachers import teacher_calculator, teacher_info
 
     if recipe not in RECIPES:
         raise InputError(f"--recipe {recipe!r}: expected one of {list(RECIPES)}")
@@ -195,7 +195,7 @@ def train_snap(
 ) -> dict:
     """Train a SNAP from ``data`` (extxyz) or ``recipe`` labelled by ``label``; write ``out``.
 
-    ``label`` names an offline teacher of :mod:`flatcontact.training.teachers`
+    ``label`` names an offline teacher of :mod:`flatcontact.potentials.teachers`
     (``chgnet``/``chgnet-r2scan``, ``sevennet-0``, ``sevennet-mf-0-r2scan``,
     ``sevennet-mf-0-pbe``); it is checked before any work and recorded in
     ``provenance.json`` with its package versions.
@@ -215,7 +215,7 @@ def train_snap(
     if active_rounds < 0:
         raise InputError(f"active_rounds {active_rounds!r}: expected >= 0")
     if recipe is not None:
-        from flatcontact.training.teachers import get_teacher
+        from flatcontact.potentials.teachers import get_teacher
 
         get_teacher(label, "--label")
     out = Path(out)

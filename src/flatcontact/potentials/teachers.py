@@ -3,6 +3,7 @@
 A teacher is an ASE calculator whose weights ship inside its Python wheel (nothing is
 downloaded at run time), run on the CPU with one torch thread. Every place that needs a
 teacher by name — ``flatcontact train-snap --label``, ``validate-potential --reference``,
+``flatcontact elastic --potential`` (:func:`flatcontact.potentials.engines.bulk_calculator`),
 the ISPES comparison (:mod:`flatcontact.training.ispes_check`) and the labelling helpers
 (:mod:`flatcontact.training.label`) — resolves it here, so a new teacher is one entry in
 :data:`TEACHERS`.
@@ -28,6 +29,8 @@ from dataclasses import asdict, dataclass
 from types import MappingProxyType
 
 from flatcontact.errors import InputError
+from flatcontact.potentials.chgnet import chgnet_calculator
+from flatcontact.potentials.loader import load_callable
 
 
 @dataclass(frozen=True)
@@ -82,8 +85,6 @@ def _torch_one_thread() -> None:
 
 def chgnet_r2scan():
     """CHGNet 0.4 with its r2SCAN weights, CPU, one torch thread."""
-    from flatcontact.potentials.chgnet import chgnet_calculator
-
     return chgnet_calculator("r2scan", threads=1)
 
 
@@ -188,8 +189,6 @@ def get_teacher(name: str, field: str = "teacher") -> Teacher:
 
 def teacher_calculator(name: str = "chgnet-r2scan", field: str = "teacher"):
     """A fresh CPU ASE calculator of the teacher ``name`` (one torch thread)."""
-    from flatcontact.potentials.loader import load_callable
-
     teacher = get_teacher(name, field)
     return load_callable(teacher.factory, f"{field} {teacher.name}")()
 

@@ -1,0 +1,134 @@
+"""From an interaction model (or a potential's name) to the ASE calculators that evaluate it.
+
+- :func:`make_calculator`: the calculator of an :class:`~flatcontact.potentials.model.InteractionModel`
+  for an interface, a slab or a bulk crystal (LAMMPS, ASE per slab + LJ, or the user's ASE
+  calculator for the whole interface);
+- :func:`calculator_factory`: the same as a picklable factory (:class:`ModelFactory`) for scan
+  workers and Dask;
+- :func:`bulk_calculator`: energy, forces and stress of a single crystal, from a model or from a
+  potential's name (a bundled SNAP, a ``.snapcoeff`` path, ``vashishta``, ``tersoff``, a preset,
+  or an offline teacher of :mod:`flatcontact.potentials.teachers`), so training, validation
+  and the elastic stage use the same model as the scan.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from functools import cached_property
+
+from ase import Atoms
+
+from flatcontact.errors import InputError
+from flatcontact.potentials.calculator import AseInterfaceCalculator, LammpsInterfaceCalculator
+from flatcontact.potentials.loader import call_factory
+from flatcontact.potentials.model import InteractionModel
+from flatcontact.potentials.names import CLASSICAL, snapcoeff_path
+from flatcontact.potentials.presets import PRESETS
+from flatcontact.potentials.teachers import is_teacher, teacher_calculator
+
+
+def make_calculator(model: InteractionModel, atoms: Atoms):
+    """The calculator of ``model`` for ``atoms`` (an interface, a slab or a bulk crystal).
+
+    Raises :class:`InputError` on an element mismatch before any LAMMPS instance is created.
+    """
+    if model.engine == "ase-interface":
+        model.check_atoms(atoms)
+        c = model.calculator
+        return call_factory(c.target, atoms, c.kwargs)
+    if model.engine == "ase-slab":
+        return AseInterfaceCalculator(model, atoms)
+    return LammpsInterfaceCalculator(model, atoms)
+
+
+@dataclasses.dataclass(frozen=True)
+class ModelFactory:
+    """``factory(atoms)`` -> the model's ASE calculator; built from the model's JSON form.
+
+    Attributes
+    ----------
+    model_json
+        ``InteractionModel.model_dump_json()``; pickles as a string to any worker.
+    """
+
+    model_json: str
+
+    @cached_property
+    def model(self) -> InteractionModel:
+        return InteractionModel.model_validate_json(self.model_json)
+
+    def spec(self) -> InteractionModel:
+        """The :class:`~flatcontact.potentials.model.InteractionModel` (earlier name)."""
+        return self.model
+
+    def __call__(self, atoms):
+        return make_calculator(self.model, atoms)
+
+    @cached_property
+    def fingerprint(self) -> str:
+        """JSON of :meth:`InteractionModel.fingerprint` (content-based, no absolute paths).
+
+        Computed once per factory (it reads and hashes the model's files) and pickled with
+        it, so a scan worker, which gets a fresh copy with every task, keys its calculator
+        cache by the driver's fingerprint without validating the model again (that cost
+        about 1 ms per grid point).
+        """
+        return json.dumps({"potential": self.model.fingerprint()}, sort_keys=True)
+
+    @property
+    def label(self) -> str:
+        return self.model.label
+
+    def __getstate__(self):
+        return {"model_json": self.model_json, "fingerprint": self.fingerprint}
+
+    def __setstate__(self, state):
+        object.__setattr__(self, "model_json", state["model_json"])
+        if "fingerprint" in state:
+            self.__dict__["fingerprint"] = state["fingerprint"]
+
+
+def calculator_factory(model: InteractionModel) -> ModelFactory:
+    """A picklable factory: ``factory(atoms)`` -> ASE calculator; ``.label``, ``.fingerprint``."""
+    return ModelFactory(model.model_dump_json())
+
+
+def _named_model(name_or_path: str) -> InteractionModel:
+    """The model of a potential's name or ``.snapcoeff`` path (its intra model alone)."""
+    if name_or_path not in CLASSICAL:
+        coeff = None
+        try:
+            coeff = snapcoeff_path(name_or_path)
+        except InputError:
+            if name_or_path not in PRESETS:
+                raise
+        if coeff is not None:
+            param = coeff.with_suffix(".snapparam")
+            if not param.is_file():
+                raise InputError(f"{param}: the .snapparam beside {coeff.name} is missing")
+            name_or_path = f"snap:{coeff}"
+    return InteractionModel(intra=name_or_path)
+
+
+def bulk_calculator(model: InteractionModel | str, atoms: Atoms | None = None):
+    """An ASE calculator (energy, forces, stress) for a single crystal ``atoms``.
+
+    ``model`` is an :class:`~flatcontact.potentials.model.InteractionModel` or a potential's
+    name (module docstring). The intra model alone (no slab split, no coupling); for an
+    interlayer model the layers (``atoms.arrays["layer"]``, or atomic planes found along z)
+    get the interlayer potential between them. An ASE calculator model gives its calculator,
+    a teacher's name a fresh CPU calculator of that teacher.
+    """
+    if isinstance(model, str):
+        if is_teacher(model):
+            return teacher_calculator(model)
+        model = _named_model(model)
+    if model.calculator is not None:
+        c = model.calculator
+        return call_factory(c.target, atoms, c.kwargs)
+    if model.engine == "ase-slab":
+        return call_factory(model.intra.removeprefix("ase:"), None, {})
+    if not model.intra_styles:
+        raise InputError(f"potential {model.label}: no intra model to compute a bulk crystal with")
+    return LammpsInterfaceCalculator(model, atoms, bulk=True)
