@@ -73,15 +73,6 @@ def sheet_layers(atoms: Atoms, source: str = "slab") -> np.ndarray:
     return layers
 
 
-def is_single_sheet(atoms: Atoms) -> bool:
-    """True if ``atoms`` (a periodic-in-plane cell) is one bonded component confined in z.
-
-    Used to accept a 2D monolayer file: one component, its bonds never crossing the
-    (non-periodic or large) z direction.
-    """
-    return int(bonded_components(atoms).max()) == 0
-
-
 def atomic_planes(z: np.ndarray, tol_angstrom: float = PLANE_TOLERANCE_ANGSTROM) -> np.ndarray:
     """Plane index (0..P-1 from the bottom) of each height: consecutive sorted heights closer than ``tol``."""
     order = np.argsort(z, kind="stable")

@@ -224,8 +224,3 @@ def apply_supercell(slab: Atoms, p: np.ndarray, cell: np.ndarray) -> Atoms:
     big.set_cell(new, scale_atoms=True)
     big.wrap()
     return big
-
-
-def rotated_cell(a: np.ndarray, angle_deg: float) -> np.ndarray:
-    """Rows of ``a`` rotated counter-clockwise by ``angle_deg``."""
-    return np.asarray(a, float)[:, :2] @ rotation(angle_deg).T
