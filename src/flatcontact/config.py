@@ -1114,7 +1114,7 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
     from flatcontact.stages.contact import check_moduli_source
 
     if cfg.structure.kind == "file":
-        from flatcontact.structures.interface import read_interface
+        from flatcontact.structures.interface_io import read_interface
 
         _calculator.check_atoms(cfg, read_interface(cfg.structure.file))
     check_moduli_source(cfg, structure_elements(cfg.structure))
@@ -1130,7 +1130,7 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
 
 def _check_structure_file(cfg: RunConfig, source: str) -> None:
     """structure.file: readable, within the ``atoms`` bound, and (kind file) an interface."""
-    from flatcontact.structures.interface import read_interface
+    from flatcontact.structures.interface_io import read_interface
 
     file = Path(cfg.structure.file)
     field = f"{source}: structure.file"

@@ -167,7 +167,8 @@ def test_build_then_scan_chain_with_the_run_model(tmp_path, monkeypatch, capsys)
     import json
 
     from flatcontact.config import load_config
-    from flatcontact.structures.interface import read_interface, thickness
+    from flatcontact.structures.interface_contract import thickness
+    from flatcontact.structures.interface_io import read_interface
 
     monkeypatch.chdir(tmp_path)
     code, _, err = _run(["build"], capsys)

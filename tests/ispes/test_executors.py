@@ -50,7 +50,7 @@ SCAN_DRIVER = textwrap.dedent(
     from flatcontact.ispes.grid import GridSpec
     from flatcontact.ispes.scan import run_scan
     from flatcontact.ispes.toy import toy_interface
-    from flatcontact.structures.interface import thickness
+    from flatcontact.structures.interface_contract import thickness
 
     ref = toy_interface(layers=3)
     factory = CalculatorFactory.from_target("flatcontact.ispes.toy:toy_calculator")

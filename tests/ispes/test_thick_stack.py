@@ -10,7 +10,7 @@ homogeneously compressed stack and the relaxed point carries the load.
 
 import pytest
 
-import flatcontact.structures.interface as interface_module
+import flatcontact.structures.placement as placement_module
 from flatcontact.errors import InputError
 from flatcontact.ispes.calculators import CalculatorFactory
 from flatcontact.ispes.grid import GridSpec
@@ -59,6 +59,6 @@ def test_a_compliant_stack_reaches_the_load_a_rigid_placement_cannot(stack, tmp_
 
 
 def test_without_the_spread_the_same_request_is_refused(stack, tmp_path, monkeypatch):
-    monkeypatch.setattr(interface_module, "MAX_SPREAD_STRAIN", 0.0)
+    monkeypatch.setattr(placement_module, "MAX_SPREAD_STRAIN", 0.0)
     with pytest.raises(InputError, match="overlap before the load reaches"):
         _scan(stack, tmp_path / "rigid")

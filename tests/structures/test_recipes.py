@@ -10,7 +10,7 @@ from ase.neighborlist import neighbor_list
 
 from flatcontact.errors import InputError
 from flatcontact.structures.construct import build_interface
-from flatcontact.structures.interface import thickness
+from flatcontact.structures.interface_contract import thickness
 from flatcontact.structures.match import twist_angle_deg
 from flatcontact.structures.recipe import parse_recipe
 
@@ -250,7 +250,7 @@ def test_slab_files_monolayer_sheets_and_metal(tmp_path):
     """A monolayer file (the case that once could not be tagged), a 3-sheet file, a Cu slab."""
     from ase.build import fcc111, graphene
 
-    from flatcontact.structures.interface import validate_interface
+    from flatcontact.structures.interface_contract import validate_interface
 
     mono = graphene(formula="C2", a=2.46, vacuum=8.0)
     write(tmp_path / "g1.extxyz", mono)

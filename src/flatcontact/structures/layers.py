@@ -26,6 +26,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from flatcontact.errors import InputError
+from flatcontact.structures.interface_contract import fixed_mask
 
 #: Atomic heights closer than this (Å) belong to one atomic plane.
 PLANE_TOLERANCE_ANGSTROM = 0.3
@@ -125,8 +126,6 @@ def interface_layers(atoms: Atoms) -> np.ndarray:
     atoms are 2D sheets (bonded components not overlapping in height) when there are
     several, else atomic planes (heights within :data:`PLANE_TOLERANCE_ANGSTROM`).
     """
-    from flatcontact.structures.interface import fixed_mask
-
     slab = np.asarray(atoms.arrays["slab"])
     held = fixed_mask(atoms)
     z = atoms.positions[:, 2]
