@@ -98,7 +98,6 @@ STAGE_CODE: dict[str, tuple[str, ...]] = {
         "stages/_calculator.py",
         "structures",
         "potentials",
-        "ispes/toy.py",
         *_SHARED,
     ),
     "scan": (

@@ -16,8 +16,8 @@ from flatcontact.ispes.calculators import CalculatorFactory
 from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.relax import RelaxSettings
 from flatcontact.ispes.scan import run_scan
-from flatcontact.ispes.toy import toy_interface
-from flatcontact.structures.interface import place_slab2
+from flatcontact.structures.placement import place_slab2
+from flatcontact.structures.toy import toy_interface
 
 UNIFORM = {"eps_cross_ev": 0.1}  # = the toy's in-slab ε: one LJ crystal, cut in two
 P_HI_GPA = 6.0

@@ -287,7 +287,8 @@ def test_slab_files_monolayer_sheets_and_metal(tmp_path):
 def test_reference_relaxation_with_a_calculator_or_a_factory():
     """With a calculator the interface is relaxed once (nothing held); the recipe records the
     relaxed thickness. The toy LJ minimum (2^(1/6)·2.5 Å) is wider than Cu's spacing."""
-    from flatcontact.ispes.toy import ToyPairCalculator, toy_calculator
+    from flatcontact.ispes.toy import toy_calculator
+    from flatcontact.structures.toy import ToyPairCalculator
 
     recipe = {"kind": "fcc111", "element": "Cu", "layers": 3, "fmax_ev_per_angstrom": 1e-3}
     ideal, _ = build_interface(recipe)

@@ -2,7 +2,7 @@
 
 :func:`build_interface` is the build stage's entry point for every ``kind``: the quartz
 builder for ``quartz-dense``, the contract reader for ``file``, the toy
-(:mod:`~flatcontact.ispes.toy`) for ``toy-lj``, and for ``sheets``, ``crystal``,
+(:mod:`~flatcontact.structures.toy`) for ``toy-lj``, and for ``sheets``, ``crystal``,
 ``fcc111`` and ``slab`` the slab sources (:mod:`~flatcontact.structures.sources`), the
 common in-plane cell (:mod:`~flatcontact.structures.match`) and the tagging
 (:mod:`~flatcontact.structures.assemble`). Every check of the input runs before any
@@ -53,6 +53,7 @@ from flatcontact.structures.sheets import (
     rotation_centre,
 )
 from flatcontact.structures.sources import crystal_source, fcc111_source, sheet_source
+from flatcontact.structures.toy import toy_interface
 
 
 # --------------------------------------------------------------------------- sources
@@ -344,12 +345,12 @@ def build_interface(
             "thickness_angstrom": thickness(atoms),
         }
     if isinstance(recipe, ToyRecipe):
-        from flatcontact.ispes.toy import toy_interface
-
         atoms = toy_interface(recipe.layers, **recipe.params)
         atoms.arrays["held"] = np.isin(atoms.arrays["surface"], (1, 4))
         atoms.arrays["layer"] = np.arange(1, len(atoms) + 1)
         atoms.info["material"] = "toy LJ fcc(111)"
+        # the label names the module the toy was first built in; kept so that build.json
+        # stays byte-identical
         return atoms, {
             "source": "flatcontact.ispes.toy",
             "n_atoms": len(atoms),

@@ -228,7 +228,7 @@ class SlabFileRecipe(_Model):
 
 
 class ToyRecipe(_Model):
-    """The toy two-slab Lennard-Jones interface (flatcontact.ispes.toy)."""
+    """The toy two-slab Lennard-Jones interface (:mod:`flatcontact.structures.toy`)."""
 
     kind: Literal["toy-lj"] = Field("toy-lj", description="recipe kind")
     layers: int = Field(3, ge=3, description="atomic layers per slab (>= 3)")
