@@ -262,7 +262,7 @@ def subset(intra: str, tmp: Path) -> dict:
     d_e = float(np.abs(cold["dataset"].energy - warm["dataset"].energy).max())
     d_p = float(np.abs(cold["dataset"].normal_stress - warm["dataset"].normal_stress).max())
     from flatcontact.ispes.contract import cell_area
-    from flatcontact.structures.interface import fixed_mask
+    from flatcontact.structures.interface_contract import fixed_mask
     from flatcontact.units import EV_PER_A3_TO_GPA
 
     # scale of the load error a relaxation to fmax allows: free atoms of slab 2 x fmax / A

@@ -27,7 +27,7 @@ def main() -> None:
     from flatcontact.ispes.relax import RelaxSettings
     from flatcontact.ispes.scan import run_scan
     from flatcontact.potentials import PotentialSpec
-    from flatcontact.structures.interface import read_interface
+    from flatcontact.structures.interface_io import read_interface
 
     interface = read_interface(RUNS / "ref" / "01-build" / "interface.extxyz")
     base = build_config({}, "paper").potential.model_dump()

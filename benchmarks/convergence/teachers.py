@@ -75,7 +75,7 @@ def ispes(names: list[str], reuse: list[str] = ()) -> None:
     of ``names``; e.g. CHGNet, whose store predates the current store fingerprint.
     """
     from flatcontact.potentials import PotentialSpec
-    from flatcontact.structures.interface import read_interface
+    from flatcontact.structures.interface_io import read_interface
     from flatcontact.training.ispes_check import compare_ispes, comparison_table, teacher_spec
 
     interface = read_interface(RUNS / "ref" / "01-build" / "interface.extxyz")

@@ -287,7 +287,7 @@ class Pipeline:
             The interface (``slab``/``surface`` arrays, ``a1``/``a2``/``recipe`` info).
         """
         from flatcontact.stages.build import INTERFACE, BuildInputs, run_build
-        from flatcontact.structures.interface import read_interface
+        from flatcontact.structures.interface_io import read_interface
 
         cfg = self.config
         # the file by name and content (file_sha256), not by where it is

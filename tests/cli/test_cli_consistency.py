@@ -103,9 +103,10 @@ def test_min_layers_leaves_one_inner_layer_between_fixed_and_sliding_faces():
     relaxed) unit; with one unit fewer the two face layers would touch and the interface
     cannot even be tagged."""
     from flatcontact.errors import InputError
+    from flatcontact.structures.assemble import make_interface
     from flatcontact.structures.build import MIN_LAYERS, SYMMETRIC_CUT
     from flatcontact.structures.dense import DENSE_FACE_LAYERS, QUARTZ_ATOMS_PER_LAYER
-    from flatcontact.structures.interface import fixed_mask, make_interface
+    from flatcontact.structures.interface_contract import fixed_mask
     from flatcontact.structures.slab import quartz_0001_slab
 
     assert MIN_LAYERS == 2 * DENSE_FACE_LAYERS + 1 == 5
@@ -145,7 +146,8 @@ def test_build_and_config_refuse_the_same_layer_counts(tmp_path, monkeypatch, ca
 def test_build_writes_the_run_build_stage_names(tmp_path, capsys):
     """`flatcontact build` writes what the run's 01-build/ holds: interface.extxyz, build.json,
     fig1_interface.png (+ .svg); build.json's thickness is the written interface's."""
-    from flatcontact.structures.interface import read_interface, thickness
+    from flatcontact.structures.interface_contract import thickness
+    from flatcontact.structures.interface_io import read_interface
 
     out = tmp_path / "b"
     code, stdout, err = _run(["build", "--potential", "vashishta", "--out", str(out)], capsys)

@@ -167,7 +167,8 @@ def test_build_then_scan_chain_with_the_run_model(tmp_path, monkeypatch, capsys)
     import json
 
     from flatcontact.config import load_config
-    from flatcontact.structures.interface import read_interface, thickness
+    from flatcontact.structures.interface_contract import thickness
+    from flatcontact.structures.interface_io import read_interface
 
     monkeypatch.chdir(tmp_path)
     code, _, err = _run(["build"], capsys)
@@ -196,8 +197,9 @@ def test_build_then_scan_chain_with_the_run_model(tmp_path, monkeypatch, capsys)
 def test_failed_scan_leaves_no_store(tmp_path, monkeypatch, capsys, existing_dir):
     from flatcontact.errors import InputError
     from flatcontact.ispes import executors
-    from flatcontact.ispes.toy import toy_interface
-    from flatcontact.structures.interface import thickness, write_interface
+    from flatcontact.structures.interface_contract import thickness
+    from flatcontact.structures.interface_io import write_interface
+    from flatcontact.structures.toy import toy_interface
 
     reference = toy_interface(layers=3)
     iface = str(write_interface(reference, tmp_path / "interface.extxyz"))
@@ -227,8 +229,9 @@ def test_failed_scan_leaves_no_store(tmp_path, monkeypatch, capsys, existing_dir
 
 
 def test_scan_warns_without_repulsive_branch(tmp_path, capsys):
-    from flatcontact.ispes.toy import toy_interface
-    from flatcontact.structures.interface import thickness, write_interface
+    from flatcontact.structures.interface_contract import thickness
+    from flatcontact.structures.interface_io import write_interface
+    from flatcontact.structures.toy import toy_interface
 
     reference = toy_interface(layers=3)
     iface = str(write_interface(reference, tmp_path / "interface.extxyz"))

@@ -110,8 +110,8 @@ def test_halving_the_thickness_spacing_of_a_toy_scan_moves_tau_and_sigma_below_o
     from flatcontact.ispes.grid import GridSpec
     from flatcontact.ispes.relax import RelaxSettings
     from flatcontact.ispes.scan import run_scan
-    from flatcontact.ispes.toy import toy_interface
-    from flatcontact.structures.interface import thickness
+    from flatcontact.structures.interface_contract import thickness
+    from flatcontact.structures.toy import toy_interface
 
     ref = toy_interface(layers=3)
     z = thickness(ref) + np.linspace(-0.3, 1.5, 13)

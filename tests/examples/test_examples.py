@@ -180,7 +180,7 @@ def test_graphene_kc_ispes_equals_plain_lammps_point_by_point(tmp_path):
     cfg = cfg.model_copy(update={"scan": scan})
     run_build(cfg, BuildInputs(), tmp_path / "build")
     run_scan_stage(cfg, ScanInputs(tmp_path / "build" / "interface.extxyz"), tmp_path / "scan")
-    from flatcontact.structures.interface import read_interface
+    from flatcontact.structures.interface_io import read_interface
 
     reference = read_interface(tmp_path / "build" / "interface.extxyz")
     ds = open_ispes(tmp_path / "scan" / "ispes.nc")
@@ -332,7 +332,7 @@ def _constant_load_zero(reference, shift, name, bracket) -> float:
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ["graphene-bilayer-kc", "graphene-bilayer-ilp"])
 def test_graphene_run_stacking_energies_match_plain_lammps_at_zero_load(tmp_path, name):
-    from flatcontact.structures.interface import read_interface
+    from flatcontact.structures.interface_io import read_interface
 
     root = _run(name, tmp_path / name)
     named = _stackings(root / "03-analyze" / "friction.csv")[0.0]
@@ -369,7 +369,7 @@ def test_build_cli_takes_a_monolayer_slab_file_and_a_config(tmp_path):
     from typer.testing import CliRunner
 
     from flatcontact.cli.app import app
-    from flatcontact.structures.interface import read_interface
+    from flatcontact.structures.interface_io import read_interface
 
     graphene(a=2.46, vacuum=5.0).write(tmp_path / "g.extxyz")
     runner = CliRunner()

@@ -46,7 +46,7 @@ def _with_file(field_section: str, name: str, data: bytes, extra: str = ""):
 def _iface_without_slab(d: Path) -> Path:
     from ase.io import write
 
-    from flatcontact.ispes.toy import toy_interface
+    from flatcontact.structures.toy import toy_interface
 
     atoms = toy_interface(layers=3)
     del atoms.arrays["slab"]

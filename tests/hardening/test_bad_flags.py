@@ -12,8 +12,8 @@ TOY = ["--calculator", "flatcontact.ispes.toy:toy_calculator"]
 
 
 def _files(d: Path) -> dict[str, Path]:
-    from flatcontact.ispes.toy import toy_interface
-    from flatcontact.structures.interface import write_interface
+    from flatcontact.structures.interface_io import write_interface
+    from flatcontact.structures.toy import toy_interface
 
     (d / "adir").mkdir()
     (d / "binary.csv").write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(range(256)))

@@ -3,7 +3,7 @@
 import pytest
 
 from flatcontact.ispes.calculators import CalculatorFactory
-from flatcontact.ispes.toy import toy_interface
+from flatcontact.structures.toy import toy_interface
 
 
 @pytest.fixture(scope="session")

@@ -9,7 +9,7 @@ from flatcontact.cli.scan import resolve_config
 from flatcontact.config import default_potential, load_config, preset
 from flatcontact.ispes.contract import open_ispes
 from flatcontact.ispes.geometry import thickness
-from flatcontact.structures.interface import write_interface
+from flatcontact.structures.interface_io import write_interface
 
 TOY = "flatcontact.ispes.toy:toy_calculator"
 

@@ -49,8 +49,8 @@ SCAN_DRIVER = textwrap.dedent(
     from flatcontact.ispes.calculators import CalculatorFactory
     from flatcontact.ispes.grid import GridSpec
     from flatcontact.ispes.scan import run_scan
-    from flatcontact.ispes.toy import toy_interface
-    from flatcontact.structures.interface import thickness
+    from flatcontact.structures.interface_contract import thickness
+    from flatcontact.structures.toy import toy_interface
 
     ref = toy_interface(layers=3)
     factory = CalculatorFactory.from_target("flatcontact.ispes.toy:toy_calculator")

@@ -4,12 +4,9 @@ import numpy as np
 import pytest
 from ase.neighborlist import neighbor_list
 
-from flatcontact.structures.interface import (
-    interslab_min_distance,
-    make_interface,
-    place_slab2,
-    thickness,
-)
+from flatcontact.structures.assemble import make_interface
+from flatcontact.structures.interface_contract import thickness
+from flatcontact.structures.placement import interslab_min_distance, place_slab2
 from flatcontact.structures.slab import quartz_0001_slab
 
 

@@ -10,8 +10,8 @@ from flatcontact.errors import InputError
 from flatcontact.ispes.contract import cell_area
 from flatcontact.ispes.geometry import fixed_mask, in_plane_vectors, place_slab2, thickness
 from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point
-from flatcontact.ispes.toy import ToyPairCalculator
 from flatcontact.structures.construct import build_interface
+from flatcontact.structures.toy import ToyPairCalculator
 from flatcontact.units import EV_PER_A3_TO_GPA
 
 TIGHT = RelaxSettings(fmax_ev_per_a=1e-5, optimizer="BFGS", max_steps=5000)

@@ -159,7 +159,7 @@ KILLED_RUN = textwrap.dedent(
     from flatcontact.ispes.grid import GridSpec
     from flatcontact.ispes.relax import RelaxSettings
     from flatcontact.ispes.scan import run_scan
-    from flatcontact.ispes.toy import toy_interface
+    from flatcontact.structures.toy import toy_interface
 
     ref = toy_interface(layers=3)
     z0 = thickness(ref)

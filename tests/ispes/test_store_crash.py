@@ -7,7 +7,7 @@ import sys
 import textwrap
 
 from flatcontact.ispes.store import PointStore
-from flatcontact.ispes.toy import toy_interface
+from flatcontact.structures.toy import toy_interface
 
 WRITER = textwrap.dedent(
     """
@@ -15,7 +15,7 @@ WRITER = textwrap.dedent(
     import numpy as np
     from flatcontact.ispes.relax import PointResult
     from flatcontact.ispes.store import PointStore
-    from flatcontact.ispes.toy import toy_interface
+    from flatcontact.structures.toy import toy_interface
 
     ref = toy_interface(layers=3)
     store = PointStore(sys.argv[1], {"test": "crash"}, ref)

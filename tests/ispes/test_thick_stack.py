@@ -10,14 +10,14 @@ homogeneously compressed stack and the relaxed point carries the load.
 
 import pytest
 
-import flatcontact.structures.interface as interface_module
+import flatcontact.structures.placement as placement_module
 from flatcontact.errors import InputError
 from flatcontact.ispes.calculators import CalculatorFactory
 from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.relax import RelaxSettings
 from flatcontact.ispes.scan import run_scan
-from flatcontact.ispes.toy import toy_interface
-from flatcontact.structures.interface import place_slab2
+from flatcontact.structures.placement import place_slab2
+from flatcontact.structures.toy import toy_interface
 
 UNIFORM = {"eps_cross_ev": 0.1}  # = the toy's in-slab ε: one LJ crystal, cut in two
 P_HI_GPA = 6.0
@@ -59,6 +59,6 @@ def test_a_compliant_stack_reaches_the_load_a_rigid_placement_cannot(stack, tmp_
 
 
 def test_without_the_spread_the_same_request_is_refused(stack, tmp_path, monkeypatch):
-    monkeypatch.setattr(interface_module, "MAX_SPREAD_STRAIN", 0.0)
+    monkeypatch.setattr(placement_module, "MAX_SPREAD_STRAIN", 0.0)
     with pytest.raises(InputError, match="overlap before the load reaches"):
         _scan(stack, tmp_path / "rigid")

@@ -547,7 +547,7 @@ def test_each_stage_through_the_cli_writes_the_files_of_the_run(tiny_run, tmp_pa
     write the run's files, with the same names and contents (wall times excepted)."""
     import shutil
 
-    from flatcontact.structures.interface import read_interface
+    from flatcontact.structures.interface_io import read_interface
 
     src, _, _ = tiny_run
     config = tmp_path / "tiny.yaml"

@@ -1,6 +1,8 @@
 import pytest
 
-from flatcontact.structures.interface import make_interface, place_slab2, thickness
+from flatcontact.structures.assemble import make_interface
+from flatcontact.structures.interface_contract import thickness
+from flatcontact.structures.placement import place_slab2
 from flatcontact.structures.slab import quartz_0001_slab
 
 

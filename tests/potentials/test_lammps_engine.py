@@ -7,7 +7,7 @@ from ase import Atoms
 from flatcontact.errors import InputError
 from flatcontact.potentials import PotentialSpec, make_calculator
 from flatcontact.potentials.lj import lj_cross_energy_forces
-from flatcontact.structures.interface import interslab_min_distance
+from flatcontact.structures.placement import interslab_min_distance
 
 CLASSICAL = ["vashishta", "tersoff"]
 

@@ -82,7 +82,7 @@ def test_verification_flags_a_broken_bond(vashishta_dense):
 @pytest.mark.slow
 def test_build_quartz_interface_vashishta_seed():
     from flatcontact.structures.build import build_quartz_interface
-    from flatcontact.structures.interface import fixed_mask
+    from flatcontact.structures.interface_contract import fixed_mask
 
     interface, report = build_quartz_interface(PotentialSpec(intra="vashishta"), 6, source="seed")
     assert all(v["dense"] for v in report["interface_verification"].values())

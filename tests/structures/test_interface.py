@@ -8,16 +8,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from flatcontact.errors import InputError
-from flatcontact.structures.interface import (
+from flatcontact.structures.assemble import make_interface
+from flatcontact.structures.interface_contract import fixed_mask, thickness
+from flatcontact.structures.interface_io import read_interface, write_interface
+from flatcontact.structures.placement import (
     MAX_SPREAD_STRAIN,
     MIN_INTERSLAB_DISTANCE_ANGSTROM,
-    fixed_mask,
     interslab_min_distance,
-    make_interface,
     place_slab2,
-    read_interface,
-    thickness,
-    write_interface,
 )
 from flatcontact.structures.slab import quartz_0001_slab
 

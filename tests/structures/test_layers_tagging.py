@@ -8,18 +8,12 @@ from ase.build import bulk
 from ase.io import write
 
 from flatcontact.errors import InputError
+from flatcontact.structures.assemble import face_tags, make_interface
 from flatcontact.structures.build import load_shipped_dense_slab
 from flatcontact.structures.construct import build_interface
 from flatcontact.structures.dense import DENSE_FACE_LAYERS, QUARTZ_ATOMS_PER_LAYER
-from flatcontact.structures.interface import (
-    face_tags,
-    fixed_mask,
-    make_interface,
-    read_interface,
-    thickness,
-    validate_interface,
-    write_interface,
-)
+from flatcontact.structures.interface_contract import fixed_mask, thickness, validate_interface
+from flatcontact.structures.interface_io import read_interface, write_interface
 from flatcontact.structures.layers import atomic_planes, chunk_layers, sheet_layers
 
 

@@ -10,7 +10,7 @@ from ase.neighborlist import neighbor_list
 
 from flatcontact.errors import InputError
 from flatcontact.structures.construct import build_interface
-from flatcontact.structures.interface import thickness
+from flatcontact.structures.interface_contract import thickness
 from flatcontact.structures.match import twist_angle_deg
 from flatcontact.structures.recipe import parse_recipe
 
@@ -250,7 +250,7 @@ def test_slab_files_monolayer_sheets_and_metal(tmp_path):
     """A monolayer file (the case that once could not be tagged), a 3-sheet file, a Cu slab."""
     from ase.build import fcc111, graphene
 
-    from flatcontact.structures.interface import validate_interface
+    from flatcontact.structures.interface_contract import validate_interface
 
     mono = graphene(formula="C2", a=2.46, vacuum=8.0)
     write(tmp_path / "g1.extxyz", mono)
@@ -287,7 +287,8 @@ def test_slab_files_monolayer_sheets_and_metal(tmp_path):
 def test_reference_relaxation_with_a_calculator_or_a_factory():
     """With a calculator the interface is relaxed once (nothing held); the recipe records the
     relaxed thickness. The toy LJ minimum (2^(1/6)·2.5 Å) is wider than Cu's spacing."""
-    from flatcontact.ispes.toy import ToyPairCalculator, toy_calculator
+    from flatcontact.ispes.toy import toy_calculator
+    from flatcontact.structures.toy import ToyPairCalculator
 
     recipe = {"kind": "fcc111", "element": "Cu", "layers": 3, "fmax_ev_per_angstrom": 1e-3}
     ideal, _ = build_interface(recipe)

@@ -127,7 +127,7 @@ def test_nine_layer_slab_has_dense_faces_and_a_bulk_like_interior(snap_builds):
     the SNAP's own bulk at the same a (measured: ≤ 0.9 %), their mean within 1 % (−0.5 %); the
     inserted repeat adds one bulk c between the face-Si planes within 2 % (−1.1 %); each face
     layer keeps the 6-layer slab's geometry within 0.2 Å (0.10 Å)."""
-    from flatcontact.structures.interface import validate_interface
+    from flatcontact.structures.interface_contract import validate_interface
 
     spec, builds = snap_builds
     nine, report = builds[9]

@@ -85,7 +85,7 @@ def test_dense_surface_reported_stable(report):
 def test_works_in_the_interface_engine():
     """The bundled files run in flatcontact.potentials' two-slab LAMMPS engine."""
     from flatcontact.potentials import PotentialSpec, make_calculator
-    from flatcontact.structures.interface import make_interface
+    from flatcontact.structures.assemble import make_interface
     from flatcontact.training.validate import seeded_dense_slab
 
     slab = seeded_dense_slab()

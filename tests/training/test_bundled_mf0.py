@@ -98,7 +98,7 @@ def test_heldout_errors_of_the_scan_groups_within_the_targets():
 def test_preset_runs_in_the_interface_engine():
     """``sio2-snap-mf0-lj``: the new SNAP in each slab + the default LJ across; Newton's third law."""
     from flatcontact.potentials import InteractionModel, make_calculator
-    from flatcontact.structures.interface import make_interface
+    from flatcontact.structures.assemble import make_interface
     from flatcontact.training.validate import seeded_dense_slab
 
     model = InteractionModel(preset="sio2-snap-mf0-lj")

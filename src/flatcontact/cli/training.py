@@ -340,7 +340,7 @@ def _ispes_check(
     models = dict(pairs)
     require(len(models) == len(named), "--ispes: the models to compare must be distinct")
     if interface is not None:
-        from flatcontact.structures.interface import read_interface
+        from flatcontact.structures.interface_io import read_interface
 
         require(interface.is_file(), f"--interface {str(interface)!r}: file not found")
         atoms = read_interface(interface)

@@ -1,8 +1,8 @@
 """Geometry of a scan point: where slab 2 goes and how a warm start is carried over.
 
-The interface contract (``interface.extxyz``, see ``DESIGN.md``) is implemented by
-:mod:`flatcontact.structures.interface` (``fixed_mask``, ``thickness``,
-``place_slab2``). This module re-exports those three functions and adds what only the
+The interface contract (``interface.extxyz``) is implemented by
+:mod:`flatcontact.structures.interface_contract` (``fixed_mask``, ``thickness``) and
+:mod:`flatcontact.structures.placement` (``place_slab2``). This module re-exports those three functions and adds what only the
 scan needs: the fractional lateral displacement between two grid points with the
 periodic minimum image, and the transfer of a relaxed neighbour's free-atom positions
 to a new point (:func:`warm_start_positions`).
@@ -23,13 +23,13 @@ from __future__ import annotations
 import numpy as np
 from ase import Atoms
 
-from flatcontact.structures.interface import (
+from flatcontact.structures.interface_contract import (
     fixed_mask,
     in_plane_vectors,
-    place_slab2,
     thickness,
     validate_interface,
 )
+from flatcontact.structures.placement import place_slab2
 
 __all__ = [
     "fixed_mask",

@@ -87,7 +87,7 @@ def run_build(settings, inputs: BuildInputs, folder: Path | None, progress=None)
     check). Errors name the settings path (``structure.bulk``, ``structure.miller``, ...).
     """
     from flatcontact.structures.construct import build_interface
-    from flatcontact.structures.interface import write_interface
+    from flatcontact.structures.interface_io import write_interface
     from flatcontact.structures.recipe import QuartzDenseRecipe, ToyRecipe
 
     s = settings.structure

@@ -23,7 +23,7 @@ from flatcontact.stages import _calculator
 from flatcontact.stages.build import structure_elements
 from flatcontact.stages.contact import check_fit_settings, check_moduli_source
 from flatcontact.stages.elastic import bulk_crystal
-from flatcontact.structures.interface import read_interface
+from flatcontact.structures.interface_io import read_interface
 
 
 def check_inputs(cfg: RunConfig, source: str = "config") -> None:

@@ -153,7 +153,7 @@ def run_scan_stage(
     """
     from flatcontact.ispes.scan import run_scan
     from flatcontact.plots.scan import figure_scan_columns
-    from flatcontact.structures.interface import read_interface
+    from flatcontact.structures.interface_io import read_interface
 
     s = settings.scan
     reference = read_interface(inputs.interface)

@@ -19,7 +19,7 @@ Pipeline of :func:`build_quartz_interface` (deterministic; no random numbers):
 3. Two copies facing each other at ``gap_angstrom``, faces tagged (the dense face layer of
    6 atoms per cell = surfaces 1–4), the whole interface relaxed with the potential + LJ (no
    atoms fixed: slab 2 settles into its equilibrium registry and separation); both slabs
-   verified again. This is the reference for :func:`~flatcontact.structures.interface.place_slab2`.
+   verified again. This is the reference for :func:`~flatcontact.structures.placement.place_slab2`.
 """
 
 from __future__ import annotations
@@ -31,9 +31,14 @@ from pathlib import Path
 
 import numpy as np
 from ase import Atoms
-from ase.io import read
+from ase.io import read, write
 
 from flatcontact.errors import InputError, require
+from flatcontact.fileio import atomic_path, write_json_atomic
+from flatcontact.potentials import InteractionModel, make_calculator
+from flatcontact.potentials.engines import bulk_calculator
+from flatcontact.potentials.factories import chgnet_r2scan
+from flatcontact.structures.assemble import make_interface
 from flatcontact.structures.dense import (
     DENSE_FACE_LAYERS,
     QUARTZ_ATOMS_PER_LAYER,
@@ -41,7 +46,7 @@ from flatcontact.structures.dense import (
     relax,
     verify_dense_slab,
 )
-from flatcontact.structures.interface import make_interface, thickness
+from flatcontact.structures.interface_contract import thickness
 from flatcontact.structures.layers import chunk_layers
 from flatcontact.structures.slab import quartz_0001_slab
 from flatcontact.structures.thicken import (
@@ -113,9 +118,6 @@ def thicken_shipped_slab(
     cell (c and ions free), registered on the ``spec``-relaxed slab's interior and inserted at
     mid-height. The caller relaxes and verifies the result. Returns (slab, JSON-ready record, the bulk cell).
     """
-    from flatcontact.potentials import make_calculator
-    from flatcontact.potentials.engines import bulk_calculator
-
     repeats = (layers - SHIPPED_LAYERS) // UNITS_PER_REPEAT
     start = slab.copy()
     start.calc = None
@@ -143,8 +145,6 @@ def _version(name: str) -> str | None:
 
 
 def _single_slab_calculator(spec):
-    from flatcontact.potentials import make_calculator
-
     return lambda atoms: make_calculator(spec, atoms)
 
 
@@ -208,14 +208,8 @@ def regenerate_shipped_dense_slab(layers: int = 6, fmax_ev_per_angstrom: float =
     brings to a verified dense surface is relaxed again with CHGNet r2SCAN and verified; the
     lowest CHGNet energy wins. Deterministic (no random numbers; CHGNet on CPU).
     """
-    from ase.io import write
-
-    from flatcontact.fileio import atomic_path, write_json_atomic
-    from flatcontact.potentials import PotentialSpec
-    from flatcontact.potentials.factories import chgnet_r2scan
-
     check_layers(layers)
-    vashishta = PotentialSpec(intra="vashishta")
+    vashishta = InteractionModel(intra="vashishta")
     base = quartz_0001_slab(layers=layers, cut=SYMMETRIC_CUT)
     calc = chgnet_r2scan()
     trials = []
@@ -290,7 +284,7 @@ def build_quartz_interface(
     Parameters
     ----------
     spec
-        :class:`~flatcontact.potentials.PotentialSpec` used to relax slab and interface.
+        :class:`~flatcontact.potentials.InteractionModel` used to relax slab and interface.
     layers
         O–Si–O layers per slab, at least :data:`MIN_LAYERS` (5): two face layers of two
         units each (outer one fixed in a scan, inner one sliding) and at least one inner unit.
@@ -302,8 +296,6 @@ def build_quartz_interface(
     gap_angstrom
         Initial vertical gap between the slabs before the interface relaxation.
     """
-    from flatcontact.potentials import make_calculator
-
     check_layers(layers)
     require(
         source in ("auto", "shipped", "seed"), f"source='{source}': expected auto, shipped or seed"
@@ -428,8 +420,6 @@ def interface_from_slab(
     or ``face_depth_angstrom``), and the interface relaxed with ``spec`` (no surface check:
     the dense-silica verification applies only to quartz).
     """
-    from flatcontact.potentials import make_calculator
-
     require(normal_axis in (0, 1, 2), f"normal_axis={normal_axis}: expected 0, 1 or 2")
     atoms = slab.copy()
     atoms.calc = None

@@ -1,6 +1,6 @@
 """Bulk crystals: α-quartz in ASE's setting of space group P3₂21 (No. 154).
 
-Wyckoff positions (ASE's origin choice for No. 154; see NOTES.md): Si 3a at
+Wyckoff positions (ASE's origin choice for No. 154): Si 3a at
 (0.4697, 0, 2/3), O 6c at (0.4135, 0.2669, 0.7858). The often-quoted
 Si (0.4697, 0, 0) / O (0.4135, 0.2669, 0.1191) belong to a different origin and
 give a wrong 12-atom cell in ASE's setting. Lattice: a = 4.916 Å, c = 5.405 Å

@@ -1,10 +1,10 @@
 """Building the interface of a recipe (:mod:`flatcontact.structures.recipe`).
 
 :func:`build_interface` is the build stage's entry point for every ``kind``: the quartz
-builder for ``quartz-dense``, the contract reader for ``file``, the toy for ``toy-lj``, and
-for ``sheets``, ``crystal``, ``fcc111`` and ``slab`` the slab sources
-(:mod:`~flatcontact.structures.sources`), the common in-plane cell
-(:mod:`~flatcontact.structures.match`) and the tagging
+builder for ``quartz-dense``, the contract reader for ``file``, the toy
+(:mod:`~flatcontact.structures.toy`) for ``toy-lj``, and for ``sheets``, ``crystal``,
+``fcc111`` and ``slab`` the slab sources (:mod:`~flatcontact.structures.sources`), the
+common in-plane cell (:mod:`~flatcontact.structures.match`) and the tagging
 (:mod:`~flatcontact.structures.assemble`). Every check of the input runs before any
 relaxation.
 """
@@ -17,8 +17,24 @@ from typing import Any
 
 import numpy as np
 from ase import Atoms
+from ase.io import read
 
 from flatcontact.errors import InputError, require
+from flatcontact.structures.assemble import finish_interface, layer_plane, split_stack, stack_pair
+from flatcontact.structures.build import build_quartz_interface
+from flatcontact.structures.cell2d import lattice_is_invariant, standard_slab
+from flatcontact.structures.crystal import file_record, orient, read_bulk
+from flatcontact.structures.dense import relax
+from flatcontact.structures.interface_contract import thickness
+from flatcontact.structures.interface_io import read_interface
+from flatcontact.structures.layers import slab_layers
+from flatcontact.structures.match import (
+    apply_supercell,
+    atom_count,
+    coincidence_match,
+    identity_match,
+    twist_match,
+)
 from flatcontact.structures.recipe import (
     SECTION,
     CrystalRecipe,
@@ -29,22 +45,25 @@ from flatcontact.structures.recipe import (
     ToyRecipe,
     parse_recipe,
 )
+from flatcontact.structures.sheets import (
+    BUILTIN_SHEETS,
+    builtin_sheet,
+    check_sheet,
+    rotate_in_plane,
+    rotation_centre,
+)
+from flatcontact.structures.sources import crystal_source, fcc111_source, sheet_source
+from flatcontact.structures.toy import toy_interface
 
 
 # --------------------------------------------------------------------------- sources
 def _sheet_source(sheet: str, stacking: str, interlayer: float | None, field: str):
-    from flatcontact.structures.crystal import file_record
-    from flatcontact.structures.sheets import BUILTIN_SHEETS, builtin_sheet, check_sheet
-    from flatcontact.structures.sources import sheet_source
-
     if sheet in BUILTIN_SHEETS:
         atoms = builtin_sheet(sheet)
         record = {"sheet": sheet, "a_angstrom": BUILTIN_SHEETS[sheet].a_angstrom}
         interlayer = interlayer or BUILTIN_SHEETS[sheet].interlayer_angstrom
         material = sheet
     else:
-        from ase.io import read
-
         path = Path(sheet)
         require(
             path.is_file(),
@@ -68,9 +87,6 @@ def _sheet_source(sheet: str, stacking: str, interlayer: float | None, field: st
 
 
 def _crystal_source(bulk: str, miller, termination: int, field: str):
-    from flatcontact.structures.crystal import file_record, orient, read_bulk
-    from flatcontact.structures.sources import crystal_source
-
     atoms = read_bulk(bulk, f"{field}.bulk")
     oriented = orient(atoms, miller, f"{field}.miller")
     material = f"{atoms.get_chemical_formula(mode='hill', empirical=True)}({''.join(str(v) for v in oriented.miller)})"
@@ -85,8 +101,6 @@ def _crystal_source(bulk: str, miller, termination: int, field: str):
 
 def _sources(recipe) -> tuple[Any, Any | None, int, int]:
     """(source of slab 1, source of slab 2 or None for the same material, layers 1, layers 2)."""
-    from flatcontact.structures.sources import fcc111_source
-
     if isinstance(recipe, SheetsRecipe):
         s1 = _sheet_source(recipe.sheet, recipe.stacking, recipe.interlayer_angstrom, SECTION)
         s2 = None
@@ -135,8 +149,6 @@ def _spacing(recipe, s1, s2) -> tuple[float, str]:
 
 def _flip(slab: Atoms, field: str) -> Atoms:
     """``slab`` rotated by 180° about the x axis (a1): z → −z, y → −y, layers renumbered."""
-    from flatcontact.structures.cell2d import lattice_is_invariant
-
     require(
         lattice_is_invariant(slab.cell.array[:2, :2], np.diag([1.0, -1.0])),
         f"{field}.flip: the in-plane lattice is not symmetric under y -> -y; slab 2 cannot be "
@@ -155,13 +167,6 @@ def _flip(slab: Atoms, field: str) -> Atoms:
 
 def build_from_slab_file(recipe: SlabFileRecipe) -> tuple[Atoms, dict]:
     """Two copies of a slab file facing each other (slab 2 translated, or flipped)."""
-    from ase.io import read
-
-    from flatcontact.structures.assemble import finish_interface, stack_pair
-    from flatcontact.structures.cell2d import standard_slab
-    from flatcontact.structures.crystal import file_record
-    from flatcontact.structures.layers import slab_layers
-
     path = Path(recipe.file)
     require(path.is_file(), f"{SECTION}.file: '{path}' not found")
     try:
@@ -201,16 +206,6 @@ def build_from_slab_file(recipe: SlabFileRecipe) -> tuple[Atoms, dict]:
 
 def build_generic(recipe) -> tuple[Atoms, dict]:
     """Interface of a ``sheets``, ``crystal`` or ``fcc111`` recipe (unrelaxed) and its report."""
-    from flatcontact.structures.assemble import finish_interface, split_stack, stack_pair
-    from flatcontact.structures.match import (
-        apply_supercell,
-        atom_count,
-        coincidence_match,
-        identity_match,
-        twist_match,
-    )
-    from flatcontact.structures.sheets import rotate_in_plane, rotation_centre
-
     s1, s2, n1, n2 = _sources(recipe)
     for which, n in ((1, n1), (2, n2)):
         require(
@@ -243,8 +238,6 @@ def build_generic(recipe) -> tuple[Atoms, dict]:
             f"{(n1 + n2) * s1.atoms_per_layer} atoms",
         )
         stack = s1.make(n1 + n2)
-        from flatcontact.structures.assemble import layer_plane
-
         if by == "planes":
             natural = layer_plane(stack, n1 + 1) - layer_plane(stack, n1)
         else:
@@ -332,8 +325,6 @@ def build_interface(
     if isinstance(recipe, dict):
         recipe = parse_recipe(recipe)
     if isinstance(recipe, QuartzDenseRecipe):
-        from flatcontact.structures.build import build_quartz_interface
-
         require(
             potential is not None,
             f"{SECTION}.kind=quartz-dense needs a potential to relax the dense slabs",
@@ -347,9 +338,6 @@ def build_interface(
         )
         return atoms, report
     if isinstance(recipe, FileRecipe):
-        from flatcontact.structures.crystal import file_record
-        from flatcontact.structures.interface import read_interface, thickness
-
         atoms = read_interface(recipe.file)
         return atoms, {
             "source": file_record(recipe.file),
@@ -357,13 +345,12 @@ def build_interface(
             "thickness_angstrom": thickness(atoms),
         }
     if isinstance(recipe, ToyRecipe):
-        from flatcontact.ispes.toy import toy_interface
-        from flatcontact.structures.interface import thickness
-
         atoms = toy_interface(recipe.layers, **recipe.params)
         atoms.arrays["held"] = np.isin(atoms.arrays["surface"], (1, 4))
         atoms.arrays["layer"] = np.arange(1, len(atoms) + 1)
         atoms.info["material"] = "toy LJ fcc(111)"
+        # the label names the module the toy was first built in; kept so that build.json
+        # stays byte-identical
         return atoms, {
             "source": "flatcontact.ispes.toy",
             "n_atoms": len(atoms),
@@ -379,8 +366,6 @@ def build_interface(
         "material": atoms.info["material"],
     }
     if relax_calculator is not None:
-        from flatcontact.structures.dense import relax
-
         calc = (
             relax_calculator(atoms)
             if callable(relax_calculator) and not hasattr(relax_calculator, "get_potential_energy")
@@ -390,8 +375,6 @@ def build_interface(
             atoms, calc, fmax_ev_per_angstrom=recipe.fmax_ev_per_angstrom
         )
         atoms.calc = None
-    from flatcontact.structures.interface import thickness
-
     record["thickness_angstrom"] = thickness(atoms)
     atoms.info["recipe"] = json.dumps(record, sort_keys=True)
     report["thickness_angstrom"] = thickness(atoms)

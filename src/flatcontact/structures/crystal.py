@@ -30,11 +30,13 @@ from ase import Atoms
 from ase.build import fcc111
 from ase.build import surface as ase_surface
 from ase.data import atomic_numbers, reference_states
+from ase.io import read
 
 from flatcontact.errors import InputError, require
 from flatcontact.fileio import file_sha256
 from flatcontact.structures.cell2d import standard_slab
 from flatcontact.structures.layers import repeat_layers
+from flatcontact.structures.slab import cleavage_heights
 
 
 @dataclass
@@ -57,8 +59,6 @@ def file_record(path: str | Path) -> dict:
 
 def read_bulk(path: str | Path, field_name: str = "bulk") -> Atoms:
     """A fully periodic bulk crystal from any file ASE reads; one-line InputError otherwise."""
-    from ase.io import read
-
     path = Path(path)
     require(path.is_file(), f"{field_name}: file '{path}' not found")
     try:
@@ -121,8 +121,6 @@ def primitive_with_miller(
 
 def orient(bulk: Atoms, miller, field_name: str = "miller") -> OrientedBulk:
     """Orient ``bulk`` for the surface ``miller`` (indices in ``bulk``'s own cell)."""
-    from flatcontact.structures.slab import cleavage_heights
-
     hkl = check_miller(miller, field_name)
     prim, hkl_p = primitive_with_miller(bulk, hkl)
     try:

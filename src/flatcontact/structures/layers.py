@@ -26,6 +26,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from flatcontact.errors import InputError
+from flatcontact.structures.interface_contract import fixed_mask
 
 #: Atomic heights closer than this (Å) belong to one atomic plane.
 PLANE_TOLERANCE_ANGSTROM = 0.3
@@ -71,15 +72,6 @@ def sheet_layers(atoms: Atoms, source: str = "slab") -> np.ndarray:
                 f"{lo2:.2f}-{hi2:.2f} Å); expected separate 2D sheets stacked along z"
             )
     return layers
-
-
-def is_single_sheet(atoms: Atoms) -> bool:
-    """True if ``atoms`` (a periodic-in-plane cell) is one bonded component confined in z.
-
-    Used to accept a 2D monolayer file: one component, its bonds never crossing the
-    (non-periodic or large) z direction.
-    """
-    return int(bonded_components(atoms).max()) == 0
 
 
 def atomic_planes(z: np.ndarray, tol_angstrom: float = PLANE_TOLERANCE_ANGSTROM) -> np.ndarray:
@@ -134,8 +126,6 @@ def interface_layers(atoms: Atoms) -> np.ndarray:
     atoms are 2D sheets (bonded components not overlapping in height) when there are
     several, else atomic planes (heights within :data:`PLANE_TOLERANCE_ANGSTROM`).
     """
-    from flatcontact.structures.interface import fixed_mask
-
     slab = np.asarray(atoms.arrays["slab"])
     held = fixed_mask(atoms)
     z = atoms.positions[:, 2]

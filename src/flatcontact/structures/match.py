@@ -28,7 +28,12 @@ from ase import Atoms
 from ase.build import make_supercell
 
 from flatcontact.errors import InputError
-from flatcontact.structures.cell2d import integer_matrix, is_hexagonal, rotation
+from flatcontact.structures.cell2d import (
+    integer_matrix,
+    is_hexagonal,
+    lattice_is_invariant,
+    rotation,
+)
 
 
 @dataclass(frozen=True)
@@ -193,8 +198,6 @@ def coincidence_match(
 def _without_lattice_rotation(match: Match, a2: np.ndarray, field: str) -> Match:
     """The same match with slab 2's supercell re-chosen so that it is not rotated, when the
     rotation the match puts on slab 2 is a symmetry of slab 2's lattice (e.g. 60° hexagonal)."""
-    from flatcontact.structures.cell2d import lattice_is_invariant
-
     angle = strain_and_rotation(match.deformation(2, a2))[1]
     if abs(angle) < 1e-6 or not lattice_is_invariant(a2, rotation(angle)):
         return match
@@ -224,8 +227,3 @@ def apply_supercell(slab: Atoms, p: np.ndarray, cell: np.ndarray) -> Atoms:
     big.set_cell(new, scale_atoms=True)
     big.wrap()
     return big
-
-
-def rotated_cell(a: np.ndarray, angle_deg: float) -> np.ndarray:
-    """Rows of ``a`` rotated counter-clockwise by ``angle_deg``."""
-    return np.asarray(a, float)[:, :2] @ rotation(angle_deg).T

@@ -30,6 +30,8 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationError, model_validator
 
 from flatcontact.errors import InputError
+from flatcontact.structures.build import MIN_LAYERS, check_shipped_layers
+from flatcontact.structures.sheets import BUILTIN_SHEETS
 
 #: Name of the config section, the prefix of every field named in an error.
 SECTION = "structure"
@@ -187,15 +189,11 @@ class QuartzDenseRecipe(_Model):
 
     @model_validator(mode="after")
     def _layers(self) -> QuartzDenseRecipe:
-        from flatcontact.structures.build import MIN_LAYERS
-
         if self.layers < MIN_LAYERS:
             raise ValueError(
                 f"layers={self.layers}: the dense quartz interface needs >= {MIN_LAYERS}"
             )
         if self.source == "shipped":
-            from flatcontact.structures.build import check_shipped_layers
-
             try:
                 check_shipped_layers(self.layers)
             except InputError as exc:
@@ -230,7 +228,7 @@ class SlabFileRecipe(_Model):
 
 
 class ToyRecipe(_Model):
-    """The toy two-slab Lennard-Jones interface (flatcontact.ispes.toy)."""
+    """The toy two-slab Lennard-Jones interface (:mod:`flatcontact.structures.toy`)."""
 
     kind: Literal["toy-lj"] = Field("toy-lj", description="recipe kind")
     layers: int = Field(3, ge=3, description="atomic layers per slab (>= 3)")
@@ -277,8 +275,6 @@ def parse_recipe(data: dict[str, Any], field: str = SECTION) -> Any:
 
 def input_files(recipe: Any) -> list[Path]:
     """Files whose content enters the interface (for fingerprints): bulk, sheet and interface files."""
-    from flatcontact.structures.sheets import BUILTIN_SHEETS
-
     out = []
     for dotted in FILE_FIELDS:
         obj = recipe
@@ -293,8 +289,6 @@ def input_files(recipe: Any) -> list[Path]:
 
 def resolve_paths(recipe: Any, base_dir: str | Path) -> Any:
     """A copy of ``recipe`` with relative file fields made relative to ``base_dir``."""
-    from flatcontact.structures.sheets import BUILTIN_SHEETS
-
     base = Path(base_dir)
 
     def fix(value: str) -> str:

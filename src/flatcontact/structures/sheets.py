@@ -33,9 +33,15 @@ from dataclasses import dataclass
 import numpy as np
 from ase import Atoms
 from ase.build import graphene, mx2
+from ase.neighborlist import neighbor_list
 
 from flatcontact.errors import InputError
-from flatcontact.structures.cell2d import is_hexagonal, lattice_is_invariant, standard_slab
+from flatcontact.structures.cell2d import (
+    is_hexagonal,
+    lattice_is_invariant,
+    rotation,
+    standard_slab,
+)
 from flatcontact.structures.layers import bonded_components
 
 
@@ -106,8 +112,6 @@ def parse_stacking(stacking: str, field: str = "stacking") -> list[tuple[str, bo
 
 def rotation_centre(sheet: Atoms) -> np.ndarray:
     """In-plane midpoint of the sheet's shortest bond between unlike atoms (any bond if one species)."""
-    from ase.neighborlist import neighbor_list
-
     i, j, d, vec = neighbor_list("ijdD", sheet, 4.0)
     numbers = sheet.numbers
     unlike = numbers[i] != numbers[j]
@@ -123,8 +127,6 @@ def rotate_in_plane(atoms: Atoms, angle_deg: float, centre_xy: np.ndarray) -> At
 
     InputError unless the rotation maps the in-plane lattice onto itself.
     """
-    from flatcontact.structures.cell2d import rotation
-
     rot = rotation(angle_deg)
     if not lattice_is_invariant(atoms.cell.array[:2, :2], rot):
         raise InputError(

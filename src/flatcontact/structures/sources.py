@@ -15,6 +15,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from ase import Atoms
 
+from flatcontact.structures.crystal import crystal_slab, fcc111_slab
+from flatcontact.structures.sheets import parse_stacking, stack_sheets
+
 
 @dataclass
 class SlabSource:
@@ -53,8 +56,6 @@ def sheet_source(
     field_name: str,
 ) -> SlabSource:
     """A stack of ``sheet`` monolayers with ``stacking`` letters and interlayer distance."""
-    from flatcontact.structures.sheets import parse_stacking, stack_sheets
-
     parse_stacking(stacking, field_name)
     return SlabSource(
         material=material,
@@ -69,7 +70,6 @@ def crystal_source(
     oriented, termination: int, material: str, record: dict, field_name: str
 ) -> SlabSource:
     """Cuts of an oriented bulk crystal at one termination (bulk repeats as layers)."""
-    from flatcontact.structures.crystal import crystal_slab
 
     def make(n: int) -> Atoms:
         return crystal_slab(oriented, n, termination, field_name)
@@ -83,8 +83,6 @@ def crystal_source(
 
 def fcc111_source(element: str, a_angstrom: float | None, record: dict) -> SlabSource:
     """fcc(111) close-packed planes in ABC stacking, spacing a/√3."""
-    from flatcontact.structures.crystal import fcc111_slab
-
     _, a = fcc111_slab(element, 1, a_angstrom)
     record = {**record, "a_angstrom": a}
     return SlabSource(

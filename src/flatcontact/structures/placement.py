@@ -1,0 +1,157 @@
+"""Placing slab 2 of a reference interface: the geometry of one scan point.
+
+:func:`place_slab2` moves slab 2 of the reference to a lateral shift (fractions of the
+in-plane vectors a1, a2) and a thickness z (Å, :func:`~flatcontact.structures.interface_contract.thickness`);
+:func:`interslab_min_distance` is the overlap guard it (and the scan, at every grid point)
+applies.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from ase import Atoms
+from scipy.spatial import cKDTree
+
+from flatcontact.errors import InputError, require
+from flatcontact.structures.interface_contract import (
+    DEFAULT_VACUUM_ANGSTROM,
+    fixed_mask,
+    in_plane_vectors,
+    per_atom_array,
+    set_vertical_cell,
+    thickness,
+    validate_interface,
+)
+
+#: Closest allowed distance (Å) between an atom of slab 1 and one of slab 2 in
+#: :func:`place_slab2`; shorter means the slabs overlap (a Si–O bond is 1.6 Å).
+MIN_INTERSLAB_DISTANCE_ANGSTROM = 1.0
+#: Largest compressive strain −dz/z_ref of the stack between the held layers that
+#: :func:`place_slab2` spreads homogeneously when a rigid placement would overlap (10 %: a
+#: stack of quartz slabs carries about 5 GPa at 5 %; beyond, the request is a mistake).
+MAX_SPREAD_STRAIN = 0.10
+
+
+def interslab_min_distance(atoms: Atoms, cutoff_angstrom: float = 4.0) -> float:
+    """Closest distance (Å) between an atom of slab 1 and one of slab 2 (lateral PBC).
+
+    Returns ``inf`` if no pair is closer than ``cutoff_angstrom``.
+
+    Only cross pairs are searched (a k-d tree over slab 1's atoms within ``cutoff_angstrom``
+    in z of slab 2 and their periodic images, queried with the facing atoms of slab 2): the
+    scan runs this for every grid point, and a neighbour list of all pairs cost more than a
+    force call on small cells.
+    """
+    slab = per_atom_array(atoms, "slab")
+    pos = atoms.positions
+    p1, p2 = pos[slab == 1], pos[slab != 1]
+    if not len(p1) or not len(p2):
+        return float("inf")
+    p1 = p1[p1[:, 2] >= p2[:, 2].min() - cutoff_angstrom]
+    if not len(p1):
+        return float("inf")
+    p2 = p2[p2[:, 2] <= p1[:, 2].max() + cutoff_angstrom]
+    if not len(p2):
+        return float("inf")
+    cell = atoms.cell.array
+    pbc = np.asarray(atoms.pbc, dtype=bool)
+    # wrap both into the cell along periodic directions; images of slab 1 covering the cutoff
+    frac1, frac2 = np.linalg.solve(cell.T, p1.T).T, np.linalg.solve(cell.T, p2.T).T
+    frac1[:, pbc] -= np.floor(frac1[:, pbc])
+    frac2[:, pbc] -= np.floor(frac2[:, pbc])
+    p1, p2 = frac1 @ cell, frac2 @ cell
+    volume = abs(np.linalg.det(cell))
+    reach = []
+    for k in range(3):
+        if not pbc[k]:
+            reach.append((0,))
+            continue
+        height = volume / np.linalg.norm(np.cross(cell[(k + 1) % 3], cell[(k + 2) % 3]))
+        n = int(np.ceil(cutoff_angstrom / height)) + 1
+        reach.append(tuple(range(-n, n + 1)))
+    shifts = np.array([[i, j, k] for i in reach[0] for j in reach[1] for k in reach[2]]) @ cell
+    images = (p1[None, :, :] + shifts[:, None, :]).reshape(-1, 3)
+    d, _ = cKDTree(images).query(p2, k=1, distance_upper_bound=cutoff_angstrom)
+    closest = float(d.min())
+    return closest if closest < cutoff_angstrom else float("inf")
+
+
+def place_slab2(
+    reference: Atoms,
+    shift_a: float,
+    shift_b: float,
+    thickness_angstrom: float,
+    *,
+    min_distance_angstrom: float = MIN_INTERSLAB_DISTANCE_ANGSTROM,
+    spread_compression: bool = True,
+) -> Atoms:
+    """A copy of ``reference`` with slab 2 moved to lateral shift (a, b) and thickness z.
+
+    Slab 2 is translated by shift_a·a1 + shift_b·a2 (fractions of the primitive
+    in-plane vectors; atoms wrapped back into the cell) and vertically so that
+    ``thickness(result) == thickness_angstrom``. Slab 1 is untouched.
+
+    Held atoms (``fixed_mask``) are always placed rigidly: slab 1's stay, slab 2's move by
+    the lateral shift and by dz = z − z(reference). Free atoms are placed rigidly with their
+    slab too, unless that would make the slabs overlap under compression (dz < 0) and
+    ``spread_compression`` is true: then the compression is spread homogeneously over the
+    stack between the held layers (each free atom's height h becomes h₁ + (h − h₁)·z/z_ref,
+    h₁ the mean height of slab 1's held atoms; lateral positions as rigid), the
+    way a compressed elastic stack shares it. A rigid placement puts the whole compression
+    into the interfacial gap, which caps how far a thick (compliant) slab can be loaded;
+    the spread start removes that cap. It is only a starting geometry: a relaxed point
+    depends on it only through the basin it starts in, and every placement that does not
+    overlap rigidly is the rigid one, so scans that ran before are unchanged.
+
+    Parameters
+    ----------
+    min_distance_angstrom
+        Closest allowed inter-slab distance (Å) of the placed structure.
+    spread_compression
+        Allow the homogeneous spread when the rigid placement overlaps (the scan passes
+        false in its ``rigid`` relax mode, where the slabs are never deformed). The spread
+        is refused beyond :data:`MAX_SPREAD_STRAIN` compressive strain.
+
+    Raises
+    ------
+    InputError
+        If the shifts or thickness are not finite, or the slabs would overlap (closest
+        inter-slab distance below ``min_distance_angstrom``) with the allowed placement.
+    """
+    validate_interface(reference, "reference interface")
+    for name, value in (
+        ("shift_a", shift_a),
+        ("shift_b", shift_b),
+        ("thickness", thickness_angstrom),
+    ):
+        require(np.isfinite(value), f"{name}={value}: expected a finite number")
+    atoms = reference.copy()
+    upper = atoms.arrays["slab"] == 2
+    a1, a2 = in_plane_vectors(atoms)
+    lateral = shift_a * a1 + shift_b * a2
+    z_reference = thickness(reference)
+    dz = thickness_angstrom - z_reference
+    atoms.positions[upper] += np.array([lateral[0], lateral[1], dz])
+    atoms.wrap()
+    set_vertical_cell(atoms, DEFAULT_VACUUM_ANGSTROM, keep_at_least=reference.cell.array[2, 2])
+    closest = _closest_interslab(atoms, min_distance_angstrom)
+    if closest < min_distance_angstrom and spread_compression and dz < 0:
+        held = fixed_mask(reference)
+        free = ~held
+        if -dz / z_reference <= MAX_SPREAD_STRAIN and free.any():
+            h1 = float(reference.positions[held & ~upper, 2].mean())
+            heights = reference.positions[free, 2]
+            spread = atoms.copy()
+            spread.positions[free, 2] = h1 + (heights - h1) * (thickness_angstrom / z_reference)
+            if _closest_interslab(spread, min_distance_angstrom) >= min_distance_angstrom:
+                return spread
+    if closest < min_distance_angstrom:
+        raise InputError(
+            f"thickness {thickness_angstrom:.3f} Å at shift ({shift_a:.4g}, {shift_b:.4g}) makes the slabs "
+            f"overlap: closest inter-slab distance {closest:.3f} Å < {min_distance_angstrom} Å"
+        )
+    return atoms
+
+
+def _closest_interslab(atoms: Atoms, min_distance_angstrom: float) -> float:
+    return interslab_min_distance(atoms, cutoff_angstrom=max(2.0 * min_distance_angstrom, 2.0))
