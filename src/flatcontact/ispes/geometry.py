@@ -1,6 +1,6 @@
 """Geometry of a scan point: where slab 2 goes and how a warm start is carried over.
 
-The interface contract (``interface.extxyz``, see ``DESIGN.md``) is implemented by
+The interface contract (``interface.extxyz``) is stated and implemented by
 :mod:`flatcontact.structures.interface` (``fixed_mask``, ``thickness``,
 ``place_slab2``). This module re-exports those three functions and adds what only the
 scan needs: the fractional lateral displacement between two grid points with the
