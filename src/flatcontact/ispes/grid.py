@@ -32,9 +32,9 @@ class GridSpec:
     (``(lo, hi, n)``: n thicknesses whose loads at the lowest-energy stacking are
     evenly spaced from lo to hi GPa) is given. With ``bracket_all_stackings`` (default)
     the extreme stackings are probed too and thicknesses are added until every one of
-    them brackets the loads (:func:`probe_thicknesses`); ``False`` probes the
-    lowest-energy stacking only (the rule before; it enters the store fingerprint only
-    when ``False``).
+    them brackets the loads (:func:`flatcontact.ispes.thicknesses.probe_thicknesses`);
+    ``False`` probes the lowest-energy stacking only (the rule before; it enters the store
+    fingerprint only when ``False``).
     """
 
     n_a: int

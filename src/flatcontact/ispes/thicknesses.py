@@ -146,14 +146,15 @@ def probe_thicknesses(
 ) -> tuple[dict, list[str]]:
     """Probe the extreme columns and choose the thicknesses of a pressure-range grid.
 
-    The columns of :func:`probed_stackings` are probed along z (:func:`probe_column`;
+    The columns of :func:`flatcontact.ispes.probe.probed_stackings` are probed along z
+    (:func:`flatcontact.ispes.probe.probe_column`;
     all but the first stop stretching once their load is at most LO or past their
     tensile maximum); the thicknesses bracket the requested loads at every one of them
     (:func:`thicknesses_spanning_columns`). The adhesion is that of the lowest-energy
     column (the paper's z-scan).
 
     The columns are independent chains of relaxations: ``probe_columns(specs)``, given the
-    list of ``(shift, p_hi_gpa, stop_at_gpa)``, returns their :class:`ColumnProbe` in the
+    list of ``(shift, p_hi_gpa, stop_at_gpa)``, returns their :class:`~flatcontact.ispes.probe.ColumnProbe` in the
     same order (the scan driver runs them on its workers); by default they run here, one
     after the other, with ``relax``.
 
