@@ -2,7 +2,7 @@
 
 The grid is the synthetic Morse model with a broken-symmetry three-cosine
 pattern (closed-form, see :mod:`flatcontact.analysis.synthetic`). Prints the
-time of each stage of :func:`flatcontact.analysis.pipeline.analyze_ispes` for both
+time of each stage of :func:`flatcontact.analysis.analyze.analyze_ispes` for both
 load sources (``energy``: p = -(1/A) dU/dz of the spline of U; ``stress``: the stored
 normal_stress) and their ratio (best of ``REPEATS``), the number of interpolant
 evaluations per path, and the same with the string-method MEP.
@@ -16,9 +16,9 @@ import warnings
 import numpy as np
 
 from flatcontact.analysis import synthetic as syn
+from flatcontact.analysis.analyze import LOAD_SOURCES, analyze_ispes
 from flatcontact.analysis.diagnostics import AnalysisWarning
 from flatcontact.analysis.periodic import PeriodicSurface
-from flatcontact.analysis.pipeline import LOAD_SOURCES, analyze_ispes
 
 P_GPA = np.linspace(0.0, 4.5, 10)
 #: Timings are the best of this many runs (the machine is shared).

@@ -338,7 +338,7 @@ def analyze_grid(ds, analysis) -> tuple[list[dict], dict, list[str], float]:
     """τ, σ_MSS, G_int per load and the laws of ``ds`` with the run's analysis settings.
 
     The same call as the pipeline's analyze and laws stages
-    (:func:`flatcontact.analysis.pipeline.analyze_ispes`), without figures and the symmetry
+    (:func:`flatcontact.analysis.analyze.analyze_ispes`), without figures and the symmetry
     report (neither changes a number). Returns (rows, laws, warnings, seconds).
     """
     import io
@@ -346,9 +346,9 @@ def analyze_grid(ds, analysis) -> tuple[list[dict], dict, list[str], float]:
 
     import pandas as pd
 
+    from flatcontact.analysis.analyze import analyze_ispes
     from flatcontact.analysis.diagnostics import AnalysisWarning
     from flatcontact.analysis.outputs import friction_csv_text
-    from flatcontact.analysis.pipeline import analyze_ispes
 
     t0 = time.perf_counter()
     with warnings.catch_warnings(record=True) as caught:

@@ -19,11 +19,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from flatcontact.analysis import synthetic as syn
+from flatcontact.analysis.analyze import analyze_ispes
 from flatcontact.analysis.diagnostics import DegenerateMinimaWarning
 from flatcontact.analysis.friction import friction_along_path
 from flatcontact.analysis.path import zero_perpendicular_force_path
 from flatcontact.analysis.periodic import PeriodicSurface
-from flatcontact.analysis.pipeline import analyze_ispes
 from flatcontact.analysis.starts import (
     DEGENERACY_FLOOR_MEV_PER_A2,
     TAU_TIE_RTOL,

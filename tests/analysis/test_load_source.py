@@ -5,9 +5,9 @@ import pytest
 
 from flatcontact import units
 from flatcontact.analysis import synthetic as syn
+from flatcontact.analysis.analyze import analyze_ispes
 from flatcontact.analysis.constant_pressure import constant_pressure
 from flatcontact.analysis.friction import merge_shallow_minima
-from flatcontact.analysis.pipeline import analyze_ispes
 from flatcontact.errors import InputError
 
 A1, A2 = syn.hexagonal_cell()

@@ -29,9 +29,9 @@ from hypothesis import strategies as st
 from scipy.optimize import minimize
 
 from flatcontact.analysis import synthetic as syn
+from flatcontact.analysis.analyze import analyze_ispes
 from flatcontact.analysis.path import minimum_energy_path
 from flatcontact.analysis.periodic import PeriodicSurface
-from flatcontact.analysis.pipeline import analyze_ispes
 from flatcontact.analysis.stackings import analyze_stackings, lattice_kind
 from flatcontact.analysis.starts import (
     degeneracy_tolerance_ev_per_a2,

@@ -104,8 +104,8 @@ def test_halving_the_thickness_spacing_of_a_toy_scan_moves_tau_and_sigma_below_o
 
     import pandas as pd
 
+    from flatcontact.analysis.analyze import analyze_ispes
     from flatcontact.analysis.outputs import friction_csv_text
-    from flatcontact.analysis.pipeline import analyze_ispes
     from flatcontact.ispes.calculators import CalculatorFactory
     from flatcontact.ispes.grid import GridSpec
     from flatcontact.ispes.relax import RelaxSettings

@@ -9,7 +9,7 @@ work P·A·Δz done against the load when the gap changes along the path
 P = 0 and differ by the load-dependent gap corrugation above it; their slopes k and μ
 can differ by an order of magnitude.
 
-:func:`laws_both_forms` runs :func:`flatcontact.analysis.pipeline.analyze_ispes` on the same
+:func:`laws_both_forms` runs :func:`flatcontact.analysis.analyze.analyze_ispes` on the same
 grid with both forms (everything else equal) and returns per form the per-load table and
 the fitted laws, plus a side-by-side table for the report.
 """
@@ -22,6 +22,9 @@ from collections.abc import Sequence
 
 import pandas as pd
 
+from flatcontact.analysis.analyze import analyze_ispes
+from flatcontact.analysis.diagnostics import AnalysisWarning
+from flatcontact.analysis.outputs import friction_csv_text
 from flatcontact.errors import require
 
 FORMS = ("internal", "enthalpy")
@@ -53,7 +56,7 @@ def laws_both_forms(
     ds
         An ISPES grid (``ispes.nc`` contract, :func:`flatcontact.ispes.contract.open_ispes`).
     p_gpa, direction_deg, threshold_gpa, load_source, energy_zero, allow_missing
-        As :func:`flatcontact.analysis.pipeline.analyze_ispes` (same for both forms).
+        As :func:`flatcontact.analysis.analyze.analyze_ispes` (same for both forms).
     forms
         Which forms (default both, internal first).
 
@@ -64,10 +67,6 @@ def laws_both_forms(
         "warnings": [str]}}, "table": [per-load dict with <column>_<form> keys],
         "laws_table": [one dict per law coefficient with one value and stderr per form]}``.
     """
-    from flatcontact.analysis.diagnostics import AnalysisWarning
-    from flatcontact.analysis.outputs import friction_csv_text
-    from flatcontact.analysis.pipeline import analyze_ispes
-
     require(len(forms) >= 1, "forms: expected at least one of internal, enthalpy")
     for form in forms:
         require(form in FORMS, f"forms: {form!r}: expected internal or enthalpy")

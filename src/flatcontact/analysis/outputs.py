@@ -1,4 +1,4 @@
-"""Files of the analysis stage (contract in ``DESIGN.md``), all written atomically.
+"""Files of the analysis stage, all written atomically.
 
 - ``friction.csv``: one row per load: ``p_gpa``, ``tau_mpa``,
   ``sigma_mss_mpa``, ``shear_stiffness_gpa_per_nm`` and path diagnostics;
@@ -26,9 +26,9 @@ import numpy as np
 import xarray as xr
 
 from flatcontact import __version__, units
+from flatcontact.analysis.analyze import AnalysisResult
 from flatcontact.analysis.friction import EV_PER_A4_TO_GPA_PER_NM
 from flatcontact.analysis.noise import BARRIER_NOISE_FACTOR
-from flatcontact.analysis.pipeline import AnalysisResult
 
 CSV_COLUMNS = (
     "p_gpa",

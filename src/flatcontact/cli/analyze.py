@@ -119,9 +119,9 @@ def analyze_command(
     as_json: Annotated[bool, typer.Option("--json", help="Print the results as JSON.")] = False,
 ) -> None:
     """Constant-pressure ISPES, sliding path, τ, σ_MSS, shear stiffness and load laws."""
+    from flatcontact.analysis.analyze import ENERGY_ZEROS
     from flatcontact.analysis.constant_pressure import FORMS, LOAD_SOURCES
     from flatcontact.analysis.outputs import per_pressure_rows, summary_json
-    from flatcontact.analysis.pipeline import ENERGY_ZEROS
     from flatcontact.cli.settings import FLAGS_SOURCE, flag_errors
     from flatcontact.config import build_config
     from flatcontact.stages.analyze import FRICTION_CSV, AnalyzeInputs, run_analyze

@@ -22,7 +22,9 @@ from typing import Any
 from ase import Atoms
 from ase.calculators.calculator import Calculator
 
+from flatcontact.potentials import InteractionModel
 from flatcontact.potentials.engines import ModelFactory, calculator_factory
+from flatcontact.potentials.loader import call_factory, load_callable
 
 
 @dataclasses.dataclass(frozen=True)
@@ -44,19 +46,13 @@ class CalculatorFactory:
         return factory
 
     def resolve(self):
-        from flatcontact.potentials.loader import load_callable
-
         return load_callable(self.target, "calculator")
 
     def __call__(self, atoms: Atoms) -> Calculator:
-        from flatcontact.potentials.loader import call_factory
-
         return call_factory(self.target, atoms, json.loads(self.kwargs_json))
 
     def model(self):
         """The equivalent :class:`~flatcontact.potentials.model.InteractionModel`."""
-        from flatcontact.potentials import InteractionModel
-
         return InteractionModel(
             calculator={"target": self.target, "kwargs": json.loads(self.kwargs_json)}
         )

@@ -28,6 +28,7 @@ from collections.abc import Callable, Iterable
 from typing import Any
 
 from flatcontact.errors import InputError
+from flatcontact.ispes.relax import worker_calculator
 
 
 def default_workers() -> int:
@@ -148,8 +149,6 @@ def one_blas_thread_in_workers() -> None:
 
 def warm_worker(factory: Any, reference: Any) -> None:
     """Build this worker's calculator for ``factory`` (cached for its later points)."""
-    from flatcontact.ispes.relax import worker_calculator
-
     worker_calculator(factory, reference)
 
 

@@ -2,8 +2,8 @@
 
 The interface contract (``interface.extxyz``) is implemented by
 :mod:`flatcontact.structures.interface_contract` (``fixed_mask``, ``thickness``) and
-:mod:`flatcontact.structures.placement` (``place_slab2``). This module re-exports those three functions and adds what only the
-scan needs: the fractional lateral displacement between two grid points with the
+:mod:`flatcontact.structures.placement` (``place_slab2``). This module re-exports those
+three functions and adds what only the scan needs: the fractional lateral displacement between two grid points with the
 periodic minimum image, and the transfer of a relaxed neighbour's free-atom positions
 to a new point (:func:`warm_start_positions`).
 

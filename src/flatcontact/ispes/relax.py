@@ -194,6 +194,8 @@ def reaction_stress_gpa(atoms: Atoms, forces: np.ndarray, fixed: np.ndarray) -> 
 
 
 def _optimizer_class(name: str):
+    # ASE's optimisers (≈0.4 s of scipy imports) only for optimizer != "LBFGS": kept out of
+    # the scan workers that run the built-in L-BFGS
     import ase.optimize
 
     return getattr(ase.optimize, name)
@@ -353,6 +355,7 @@ def point_evaluator(calc, atoms: Atoms):
 
 def _relax_with_ase(atoms, calc, fixed, free, groups, settings: RelaxSettings) -> int:
     """Relax ``atoms`` in place with an ASE optimiser and constraint objects; the steps."""
+    # ase.constraints (≈0.4 s of scipy imports, also behind rigid_layers) only on this path
     from ase.constraints import FixAtoms, FixCartesian
 
     from flatcontact.ispes.rigid_layers import RigidLayersAlongZ
@@ -375,6 +378,8 @@ def free_layer_groups(atoms: Atoms, free: np.ndarray) -> list[np.ndarray]:
     if "layer" in atoms.arrays:
         layer = np.asarray(atoms.arrays["layer"])
     else:
+        # only for an interface without layer ids: keeps scipy.sparse and ase.neighborlist
+        # (≈0.2 s of imports) out of the scan workers
         from flatcontact.structures.layers import interface_layers
 
         layer = interface_layers(atoms)

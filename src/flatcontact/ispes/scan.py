@@ -26,9 +26,11 @@ import numpy as np
 from ase import Atoms
 
 from flatcontact.errors import InputError
-from flatcontact.ispes import grid as grid_mod
+from flatcontact.ispes.executors import make_executor
 from flatcontact.ispes.geometry import in_plane_vectors, thickness, validate_interface
+from flatcontact.ispes.grid import GridSpec, check_thicknesses
 from flatcontact.ispes.order import PREFERENCES, search_tree
+from flatcontact.ispes.probe import probe_column, rigid_stackings
 from flatcontact.ispes.relax import (
     PointTask,
     RelaxSettings,
@@ -38,6 +40,7 @@ from flatcontact.ispes.relax import (
     worker_calculator,
 )
 from flatcontact.ispes.store import PointStore, discard_store, interface_hash
+from flatcontact.ispes.thicknesses import probe_thicknesses
 
 POINTS_DB = "points.db"
 ISPES_NC = "ispes.nc"
@@ -69,9 +72,7 @@ def check_interface(atoms: Atoms) -> None:
     validate_interface(atoms, "interface")
 
 
-def scan_settings(
-    reference: Atoms, factory: Any, grid: grid_mod.GridSpec, relax: RelaxSettings
-) -> dict:
+def scan_settings(reference: Atoms, factory: Any, grid: GridSpec, relax: RelaxSettings) -> dict:
     """The store fingerprint of a scan (everything that changes the numbers)."""
     return {
         "interface_sha256": interface_hash(reference),
@@ -84,11 +85,12 @@ def scan_settings(
 def _probe(
     reference: Atoms,
     factory: Any,
-    grid: grid_mod.GridSpec,
+    grid: GridSpec,
     relax: RelaxSettings,
     executor: Any = None,
 ) -> tuple[dict, list[str]]:
-    """Resolve the thicknesses of a pressure-range grid (:func:`grid_mod.probe_thicknesses`).
+    """Resolve the thicknesses of a pressure-range grid
+    (:func:`flatcontact.ispes.thicknesses.probe_thicknesses`).
 
     The single points of every stacking run here; the probed columns, independent chains,
     run on the executor's workers when it has more than one (they are the serial part of a
@@ -97,7 +99,7 @@ def _probe(
     """
     calc = worker_calculator(factory, reference)
     relax_one = functools.partial(relax_column_point, reference, calc, relax)
-    rigid = grid_mod.rigid_stackings(reference, calc, grid)
+    rigid = rigid_stackings(reference, calc, grid)
     probe_columns = None
     if executor is not None and getattr(executor, "workers", 1) > 1:
         context = ScanContext(reference, factory, relax)
@@ -106,7 +108,7 @@ def _probe(
             handles = [executor.submit(probe_column_task, context, *spec) for spec in specs]
             return [executor.result(h) for h in handles]
 
-    return grid_mod.probe_thicknesses(relax_one, reference, rigid, grid, probe_columns)
+    return probe_thicknesses(relax_one, reference, rigid, grid, probe_columns)
 
 
 def relax_column_point(reference, calc, relax, a, b, z, start, start_z) -> tuple:
@@ -117,19 +119,17 @@ def relax_column_point(reference, calc, relax, a, b, z, start, start_z) -> tuple
 
 
 def probe_column_task(context: ScanContext, shift, p_hi_gpa, stop_at_gpa):
-    """Worker entry point: one probed column (:func:`grid_mod.probe_column`) with this
-    worker's cached calculator."""
+    """Worker entry point: one probed column (:func:`flatcontact.ispes.probe.probe_column`)
+    with this worker's cached calculator."""
     calc = worker_calculator(context.factory, context.reference)
     relax_one = functools.partial(relax_column_point, context.reference, calc, context.settings)
-    return grid_mod.probe_column(
-        relax_one, context.reference, shift, p_hi_gpa, stop_at_gpa=stop_at_gpa
-    )
+    return probe_column(relax_one, context.reference, shift, p_hi_gpa, stop_at_gpa=stop_at_gpa)
 
 
 def run_scan(
     reference: Atoms,
     factory: Any,
-    grid: grid_mod.GridSpec,
+    grid: GridSpec,
     out_dir: str | Path,
     relax: RelaxSettings | None = None,
     order: str = "columns",
@@ -170,15 +170,13 @@ def run_scan(
     -------
     ScanResult
     """
-    from flatcontact.ispes.executors import make_executor
-
     t0 = time.perf_counter()
     relax = relax or RelaxSettings()
     if order not in PREFERENCES:
         raise InputError(f"order: expected one of {', '.join(PREFERENCES)}, got {order!r}")
     check_interface(reference)
     if grid.thickness_angstrom is not None:
-        grid_mod.check_thicknesses(
+        check_thicknesses(
             reference, grid, grid.thickness_angstrom, spread_compression=relax.mode != "rigid"
         )
     out_dir = Path(out_dir)
@@ -218,9 +216,7 @@ def run_scan(
                 notes = list(resolved.get("notes", notes))
                 z = np.asarray(resolved["thickness_angstrom"], dtype=float)
                 if grid.thickness_angstrom is None:
-                    grid_mod.check_thicknesses(
-                        reference, grid, z, spread_compression=relax.mode != "rigid"
-                    )
+                    check_thicknesses(reference, grid, z, spread_compression=relax.mode != "rigid")
                 shape = (grid.n_a, grid.n_b, z.size)
                 sa, sb = grid.shifts()
                 root = (0, 0, int(np.argmin(np.abs(z - thickness(reference)))))

@@ -155,6 +155,8 @@ class PointStore:
         reference: Atoms,
         commit_interval_s: float = 0.0,
     ):
+        # ase.db (≈0.2 s of imports, ase.io) only where a store is opened: the driver's;
+        # scan workers import this module for its records but never open a store
         import ase.db
 
         self.commit_interval_s = float(commit_interval_s)

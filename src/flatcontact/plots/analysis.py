@@ -17,8 +17,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from flatcontact import units
+from flatcontact.analysis.analyze import AnalysisResult, PressureAnalysis
 from flatcontact.analysis.laws import LoadLaws
-from flatcontact.analysis.pipeline import AnalysisResult, PressureAnalysis
 
 MEV = units.EV_PER_A2_TO_MEV_PER_A2
 

@@ -21,7 +21,7 @@ FRICTION_CSV = "friction.csv"
 FRICTION_NC = "friction.nc"
 ANALYZE_JSON = "analyze.json"
 
-#: Parameters of :func:`flatcontact.analysis.pipeline.analyze_ispes` -> the settings path.
+#: Parameters of :func:`flatcontact.analysis.analyze.analyze_ispes` -> the settings path.
 SETTINGS_NAMES = {
     "p_gpa": "analysis.p_gpa",
     "direction_deg": "analysis.direction_deg",
@@ -43,7 +43,7 @@ class AnalyzeInputs:
 
 @dataclass
 class AnalyzeResult:
-    """The analysis (:class:`flatcontact.analysis.pipeline.AnalysisResult`, ``laws`` None)
+    """The analysis (:class:`flatcontact.analysis.analyze.AnalysisResult`, ``laws`` None)
     and the analysis warnings raised while computing it (``"Category: message"``)."""
 
     analysis: Any
@@ -79,8 +79,8 @@ def run_analyze(
         One line; a bad value names its settings path (``analysis.energy_form``), which the
         CLI translates to its flag.
     """
+    from flatcontact.analysis.analyze import analyze_ispes
     from flatcontact.analysis.diagnostics import AnalysisWarning
-    from flatcontact.analysis.pipeline import analyze_ispes
     from flatcontact.ispes.contract import open_ispes
 
     s = settings.analysis

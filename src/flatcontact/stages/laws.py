@@ -53,7 +53,7 @@ class LawsInputs:
 
     @classmethod
     def from_analysis(cls, analysis) -> LawsInputs:
-        """The loads and columns of a :class:`flatcontact.analysis.pipeline.AnalysisResult`."""
+        """The loads and columns of a :class:`flatcontact.analysis.analyze.AnalysisResult`."""
         return cls(
             tuple(analysis.p_gpa),
             tuple(analysis.column("tau_mpa")),

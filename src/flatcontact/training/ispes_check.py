@@ -9,7 +9,7 @@ Two measurements for any SiO₂ model that has an ASE calculator (issue 12):
 * :func:`compare_ispes`: the ISPES of ONE interface (the same reference geometry and
   lateral cell) scanned with each model on the same lateral grid and load range, then
   analysed identically (constant-pressure ISPES, zero-perpendicular-force path, τ and
-  σ_MSS as in the paper, :func:`flatcontact.analysis.pipeline.analyze_ispes`). The
+  σ_MSS as in the paper, :func:`flatcontact.analysis.analyze.analyze_ispes`). The
   result is one row per (model, load) with τ, σ_MSS, G_int, the work of separation W
   and their differences from the first model (the reference, e.g. the teacher).
 
@@ -172,8 +172,8 @@ def scan_and_analyze(
         ``force_noise_mpa``), ``laws`` (``laws.json`` form), ``work_of_separation_j_per_m2``,
         ``force_calls``, ``seconds``, ``label``.
     """
+    from flatcontact.analysis.analyze import analyze_ispes
     from flatcontact.analysis.outputs import friction_csv_text
-    from flatcontact.analysis.pipeline import analyze_ispes
     from flatcontact.ispes.grid import GridSpec
     from flatcontact.ispes.relax import RelaxSettings
     from flatcontact.ispes.scan import run_scan

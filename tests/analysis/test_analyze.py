@@ -5,7 +5,7 @@ import pytest
 
 from flatcontact import units
 from flatcontact.analysis import synthetic as syn
-from flatcontact.analysis.pipeline import analyze_ispes
+from flatcontact.analysis.analyze import analyze_ispes
 from flatcontact.errors import InputError
 
 A = 4.916
