@@ -38,9 +38,7 @@ from flatcontact.ispes.relax import (
     worker_calculator,
 )
 from flatcontact.ispes.store import PointStore, discard_store, interface_hash
-
-POINTS_DB = "points.db"
-ISPES_NC = "ispes.nc"
+from flatcontact.layout import ISPES_NC, POINTS_DB
 
 
 @dataclasses.dataclass
