@@ -7,7 +7,9 @@ from flatcontact.cli import (  # noqa: F401  (imported for their @app.command re
     analyze,
     build,
     contact,
+    elastic,
     run,
     scan,
-    training,
+    train,
+    validate,
 )
