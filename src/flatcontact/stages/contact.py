@@ -6,7 +6,7 @@ per-p0 results, the same with the paper's laws, and the measured-data comparison
 figures ``fig4_traction``, ``fig5_force_stiffness`` (amplitude), ``fig5_force_stiffness_rms``
 and, with ``contact.experiment_csv``, ``fig6_experiment`` (PNG, + SVG with ``report.svg``).
 
-With ``contact.cycle`` (issue 13) the steady load-controlled cycle of ``contact.model`` at the
+With ``contact.cycle`` the steady load-controlled cycle of ``contact.model`` at the
 force amplitudes ``contact.cycle_amplitude_fractions`` (or ``cycle_amplitudes_un``) of every p0:
 ``summary.json`` gains ``cycle`` (one row per p0 and amplitude: W per cycle, lock-in k′ =
 Q_amp/u′₁, quadrature u″₁, ...), ``contact.nc`` the loops (``cycle_*`` variables), Fig. 5b and
