@@ -74,8 +74,6 @@ CORE_DEPENDENCIES: dict[str, frozenset[str]] = {
 #: its fix lands (``test_known_violations_still_exist`` says which are gone).
 KNOWN_VIOLATIONS: frozenset[str] = frozenset(
     {
-        "flatcontact.report.content -> flatcontact.stages._calculator",
-        "flatcontact.report.content -> flatcontact.stages.contact",
         # the settings (foundation) read the data classes of the potential and structure
         # sections from the physics packages that own them
         "flatcontact.config.load -> flatcontact.structures.recipe",

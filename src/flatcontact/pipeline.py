@@ -16,21 +16,14 @@ stages it reads, so that
 Settings that do not change numbers (``scan.executor``, ``scan.workers``,
 ``scan.dask_address``) are not part of any fingerprint.
 
-Run directory layout (files of ``DESIGN.md``)::
+The run directory's folders and file names are :mod:`flatcontact.layout`.
 
-    run.json  config.yaml  versions.json  run.log  report.html
-    01-build/    interface.extxyz  build.json  fig1_interface.{png,svg}
-    02-scan/     points.db  ispes.nc  scan.json  fig_scan_columns.{png,svg}
-    03-analyze/  friction.csv  friction.nc  analyze.json  fig2_p<P>gpa.{png,svg}
-    04-laws/     laws.json  fig3_laws.{png,svg}
-    05-elastic/  elastic.json                       (only with elastic.enabled)
-    06-contact/  contact.nc  summary.json  fig4_traction, fig5_force_stiffness(_rms), fig6_experiment
-    07-report/   report.html  stage.json
-
-This module keeps only the order of the stages, their fingerprints and the console. What a
-stage computes and writes is :mod:`flatcontact.stages` (``run_<stage>(settings, inputs,
-folder)``), which ``flatcontact <stage>`` calls too; figures are in :mod:`flatcontact.plots`,
-the report's content in :mod:`flatcontact.report`.
+This module keeps only the order of the stages and their fingerprints. What a stage computes
+and writes is :mod:`flatcontact.stages` (``run_<stage>(settings, inputs, folder)``), which
+``flatcontact <stage>`` calls too; figures are in :mod:`flatcontact.plots`, the report's
+content in :mod:`flatcontact.report`. The pipeline prints nothing: it tells an observer
+(``on_event``, called with a :class:`StageEvent`) when a stage starts and ends, and
+``flatcontact run`` (:mod:`flatcontact.cli.run`) shows these on the console.
 
 Every stage is a public method returning Python objects (ASE Atoms, xarray Datasets,
 pandas DataFrames, dicts), so a notebook can run the stages one by one::
@@ -52,14 +45,36 @@ import json
 import logging
 import shutil
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+import pandas as pd
+import xarray as xr
 
 from flatcontact import __version__
 from flatcontact.codegraph import SOURCE_ROOT, closure_digest, import_closure
 from flatcontact.config import RunConfig, recipe_files, to_yaml
 from flatcontact.errors import InputError
 from flatcontact.fileio import file_sha256, write_json_atomic, write_text_atomic
+from flatcontact.ispes.contract import open_ispes
+from flatcontact.layout import (
+    CONFIG_YAML,
+    CONTACT_NC,
+    ELASTIC_JSON,
+    FRICTION_CSV,
+    FRICTION_NC,
+    INTERFACE,
+    ISPES_NC,
+    LAWS_JSON,
+    REPORT_HTML,
+    RUN_LOG,
+    RUN_MARKER,
+    SCAN_JSON,
+    STAGES,
+    SUMMARY_JSON,
+    VERSIONS_JSON,
+)
 from flatcontact.rundir import (
     RunDirectory,
     RunLock,
@@ -69,22 +84,25 @@ from flatcontact.rundir import (
     writable,
 )
 from flatcontact.stages import _calculator
+from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
+from flatcontact.stages.build import BuildInputs, run_build
+from flatcontact.stages.contact import (
+    ContactInputs,
+    check_contact,
+    contact_parameters,
+    run_contact,
+)
+from flatcontact.stages.elastic import ElasticInputs, run_elastic
+from flatcontact.stages.laws import LawsInputs, run_laws
 from flatcontact.stages.preflight import check_inputs
+from flatcontact.stages.report import ReportInputs, run_report
+from flatcontact.stages.scan import ScanInputs, run_scan
+from flatcontact.structures.interface_io import read_interface
 
-__all__ = ["STAGES", "STAGE_MODULES", "Pipeline", "run", "stage_code", "stage_code_digest"]
+__all__ = ["STAGES", "STAGE_MODULES", "Pipeline", "StageEvent", "run", "stage_code", "stage_code_digest"]
 
 log = logging.getLogger("flatcontact.run")
 
-#: Stage names and their folder indices.
-STAGES = {
-    "build": 1,
-    "scan": 2,
-    "analyze": 3,
-    "laws": 4,
-    "elastic": 5,
-    "contact": 6,
-    "report": 7,
-}
 #: The module of each stage; the flatcontact code a stage runs is that module's import
 #: closure (:func:`flatcontact.codegraph.import_closure`): every flatcontact module it imports,
 #: directly or not, at module or function level, with their parent packages' ``__init__``.
@@ -119,10 +137,28 @@ def stage_code_digest(name: str, root: Path = SOURCE_ROOT) -> str:
     return closure_digest(stage_code(name, root), root)
 
 
-RUN_MARKER = "run.json"
 RUN_FORMAT = "flatcontact.run/1"
 #: Scan settings that change how, not what, is computed (kept out of the fingerprint).
 EXECUTION_ONLY = ("executor", "workers", "dask_address", "jobqueue")
+
+
+@dataclass(frozen=True)
+class StageEvent:
+    """One step of a run, for the observer of :class:`Pipeline` (``on_event``).
+
+    ``kind`` is ``"start"`` (the stage begins: its fingerprint is being checked),
+    ``"end"`` (``action`` is ``"ran"``, ``"resumed"`` or ``"skipped"``, ``seconds`` its
+    wall time), ``"failed"`` (an exception, ``"interrupted"`` for Ctrl-C, leaves the stage;
+    it propagates after the event) or ``"off"`` (a disabled stage; ``message`` says what
+    replaces it). ``index`` is the stage's folder index (:data:`flatcontact.layout.STAGES`).
+    """
+
+    kind: str
+    name: str
+    index: int
+    action: str | None = None
+    seconds: float | None = None
+    message: str = ""
 
 
 class Pipeline:
@@ -135,9 +171,9 @@ class Pipeline:
     root
         The run directory; created if missing. A non-empty directory that is not a
         flatcontact run is refused.
-    console
-        Where progress lines go: an object with ``print`` and ``status`` like a rich Console
-        (``None``: no progress output).
+    on_event
+        Observer of the run, called as ``on_event(StageEvent(...))`` when a stage starts,
+        ends, fails or is off (``None``: nobody is told; the run log has every stage).
     scan_progress
         Observer of the scan, called as ``scan_progress(done, total)``; if it is a context
         manager the scan stage runs inside it (the CLI's progress bar).
@@ -147,12 +183,12 @@ class Pipeline:
         self,
         config: RunConfig,
         root: str | Path,
-        console: Any = None,
+        on_event: Callable[[StageEvent], None] | None = None,
         scan_progress: Callable[[int, int], None] | None = None,
     ):
         self.config = config
         self.root = Path(root)
-        self.console = console
+        self.on_event = on_event
         self.scan_progress = scan_progress
         self._check_root()
         self._check_config()
@@ -171,8 +207,8 @@ class Pipeline:
         write_json_atomic(
             self.root / RUN_MARKER, {"format": RUN_FORMAT, "flatcontact_version": __version__}
         )
-        write_text_atomic(self.root / "config.yaml", to_yaml(config))
-        write_json_atomic(self.root / "versions.json", package_versions())
+        write_text_atomic(self.root / CONFIG_YAML, to_yaml(config))
+        write_json_atomic(self.root / VERSIONS_JSON, package_versions())
 
     # ---- setup -------------------------------------------------------------------------
     def _check_root(self) -> None:
@@ -201,7 +237,7 @@ class Pipeline:
         check_inputs(self.config)
 
     def _open_log(self) -> None:
-        handler = logging.FileHandler(self.root / "run.log", encoding="utf-8")
+        handler = logging.FileHandler(self.root / RUN_LOG, encoding="utf-8")
         handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
         logger = logging.getLogger("flatcontact")
         logger.addHandler(handler)
@@ -247,34 +283,26 @@ class Pipeline:
     def _json(self, name: str, file: str) -> dict:
         return json.loads((self._upstream(name).folder / file).read_text())
 
-    def _say(self, *args, **kwargs) -> None:
-        if self.console is not None:
-            self.console.print(*args, **kwargs)
+    def _tell(self, kind: str, name: str, **details: Any) -> None:
+        if self.on_event is not None:
+            self.on_event(StageEvent(kind, name, STAGES[name], **details))
 
     def _run(self, name: str, inputs: dict, work: Callable[[Path], Any]) -> StageResult:
         index = STAGES[name]
         inputs = {**inputs, "code_sha256": stage_code_digest(name)}
-        self._say(f"[bold]{index}. {name}[/]", highlight=False)
+        self._tell("start", name)
         try:
-            if self.console is not None and name != "scan":
-                with self.console.status(f"{name} ..."):
-                    result = self.rundir.run_stage(index, name, inputs, work)
-            else:
-                result = self.rundir.run_stage(index, name, inputs, work)
+            result = self.rundir.run_stage(index, name, inputs, work)
         except KeyboardInterrupt:
             log.warning("stage %s: interrupted; rerun to resume", name)
+            self._tell("failed", name, action="interrupted")
             raise
         except Exception as exc:
             log.error("stage %s: failed: %s", name, exc)
+            self._tell("failed", name, message=str(exc))
             raise
         self.results[name] = result
-        detail = {"skipped": "unchanged, skipped", "resumed": "resumed", "ran": "done"}[
-            result.action
-        ]
-        self._say(
-            f"   {detail}" + (f" in {result.seconds:.1f} s" if result.action != "skipped" else ""),
-            highlight=False,
-        )
+        self._tell("end", name, action=result.action, seconds=result.seconds)
         return result
 
     # ---- stages ------------------------------------------------------------------------
@@ -286,9 +314,6 @@ class Pipeline:
         ase.Atoms
             The interface (``slab``/``surface`` arrays, ``a1``/``a2``/``recipe`` info).
         """
-        from flatcontact.stages.build import INTERFACE, BuildInputs, run_build
-        from flatcontact.structures.interface_io import read_interface
-
         cfg = self.config
         # the file by name and content (file_sha256), not by where it is
         structure = portable(cfg.section("structure"), "file")
@@ -316,11 +341,6 @@ class Pipeline:
         xarray.Dataset
             The ``ispes.nc`` contract (energy, normal_stress, converged, force_calls).
         """
-        from flatcontact.ispes.contract import open_ispes
-        from flatcontact.ispes.scan import ISPES_NC
-        from flatcontact.stages.build import INTERFACE
-        from flatcontact.stages.scan import ScanInputs, run_scan_stage
-
         cfg = self.config
         build = self._upstream("build")
         scan_inputs = {k: v for k, v in cfg.section("scan").items() if k not in EXECUTION_ONLY}
@@ -331,17 +351,15 @@ class Pipeline:
             bar = self.scan_progress
             if hasattr(bar, "__enter__"):
                 with bar:
-                    run_scan_stage(cfg, stage_inputs, folder, progress=bar)
+                    run_scan(cfg, stage_inputs, folder, progress=bar)
             else:
-                run_scan_stage(cfg, stage_inputs, folder, progress=bar)
+                run_scan(cfg, stage_inputs, folder, progress=bar)
 
         result = self._run("scan", inputs, work)
         return open_ispes(result.folder / ISPES_NC)
 
     def scan_summary(self) -> dict:
         """``02-scan/scan.json``: counts, force calls, thicknesses, adhesion (work of separation)."""
-        from flatcontact.stages.scan import SCAN_JSON
-
         return self._json("scan", SCAN_JSON)
 
     def analyze(self):
@@ -355,11 +373,6 @@ class Pipeline:
         xarray.Dataset
             ``friction.nc`` (per-load values, paths, constant-pressure maps).
         """
-        import xarray as xr
-
-        from flatcontact.ispes.scan import ISPES_NC
-        from flatcontact.stages.analyze import FRICTION_NC, AnalyzeInputs, run_analyze
-
         cfg = self.config
         scan = self._upstream("scan")
         a = cfg.section("analysis")
@@ -375,10 +388,6 @@ class Pipeline:
 
     def friction_table(self):
         """``03-analyze/friction.csv`` as a pandas DataFrame (one row per load)."""
-        import pandas as pd
-
-        from flatcontact.stages.analyze import FRICTION_CSV
-
         return pd.read_csv(self._upstream("analyze").folder / FRICTION_CSV)
 
     def laws(self) -> dict:
@@ -390,10 +399,6 @@ class Pipeline:
             ``laws.json`` (``k_mpa_per_gpa``, ``tau0_mpa``, ``mu_mpa_per_gpa``, ``sigma0_mpa``,
             standard errors, fitted range, end of the linear regime, warnings).
         """
-        from flatcontact.ispes.scan import ISPES_NC
-        from flatcontact.stages.analyze import FRICTION_CSV
-        from flatcontact.stages.laws import LAWS_JSON, LawsInputs, run_laws
-
         cfg = self.config
         analyze = self._upstream("analyze")
         scan = self._upstream("scan")
@@ -415,15 +420,13 @@ class Pipeline:
         Returns ``None`` when ``elastic.enabled`` is false (the contact stage then uses
         ``contact.contact_modulus_gpa`` and ``contact.shear_modulus_gpa``).
         """
-        from flatcontact.stages.elastic import ELASTIC_JSON, ElasticInputs, run_elastic
-
         cfg = self.config
         if not cfg.elastic.enabled:
-            self._say(
-                f"[bold]{STAGES['elastic']}. elastic[/]\n   off: the contact model takes "
-                f"E* = {cfg.contact.contact_modulus_gpa:g} GPa, G* = "
-                f"{cfg.contact.shear_modulus_gpa:g} GPa from the configuration",
-                highlight=False,
+            self._tell(
+                "off",
+                "elastic",
+                message=f"the contact model takes E* = {cfg.contact.contact_modulus_gpa:g} GPa, "
+                f"G* = {cfg.contact.shear_modulus_gpa:g} GPa from the configuration",
             )
             return None
         inputs = {"elastic": cfg.section("elastic"), "model": self._model_inputs()}
@@ -433,10 +436,6 @@ class Pipeline:
         return self._json("elastic", ELASTIC_JSON)
 
     def _contact_inputs(self):
-        from flatcontact.stages.contact import ContactInputs
-        from flatcontact.stages.elastic import ELASTIC_JSON
-        from flatcontact.stages.laws import LAWS_JSON
-
         adhesion = self.scan_summary().get("adhesion") or {}
         return ContactInputs(
             laws=self._json("laws", LAWS_JSON),
@@ -448,8 +447,6 @@ class Pipeline:
     def contact_parameters(self):
         """The :class:`~flatcontact.contact.parameters.ContactParameters` the contact stage uses
         and their provenance (see :func:`flatcontact.stages.contact.contact_parameters`)."""
-        from flatcontact.stages.contact import contact_parameters
-
         return contact_parameters(self.config, self._contact_inputs())
 
     def contact(self):
@@ -462,15 +459,6 @@ class Pipeline:
         xarray.Dataset
             ``contact.nc``: Q(u) and stiffness curves and the per-p0 scalars.
         """
-        import xarray as xr
-
-        from flatcontact.stages.contact import (
-            CONTACT_NC,
-            check_contact,
-            contact_parameters,
-            run_contact,
-        )
-
         cfg = self.config
         laws = self._upstream("laws")
         scan = self._upstream("scan")
@@ -495,14 +483,10 @@ class Pipeline:
 
     def contact_summary(self) -> dict:
         """``06-contact/summary.json``: parameters, their provenance and the per-p0 results."""
-        from flatcontact.stages.contact import SUMMARY_JSON
-
         return self._json("contact", SUMMARY_JSON)
 
     def report(self) -> Path:
         """Stage 7: ``report.html`` (self-contained) in ``07-report/`` and the run directory."""
-        from flatcontact.stages.report import REPORT_HTML, ReportInputs, run_report
-
         cfg = self.config
         names = ["build", "scan", "analyze", "laws", "contact"]
         ups = {name: self._upstream(name) for name in names}
@@ -510,7 +494,7 @@ class Pipeline:
         if cfg.elastic.enabled:  # the report tables the elastic stage's Cij
             inputs["elastic"] = self._upstream("elastic").fingerprint
         folders = {name: self.folder(name) for name in STAGES}
-        versions = json.loads((self.root / "versions.json").read_text())
+        versions = json.loads((self.root / VERSIONS_JSON).read_text())
 
         def work(folder: Path) -> None:
             run_report(cfg, ReportInputs(folders, versions), folder)
@@ -519,7 +503,7 @@ class Pipeline:
         target = self.root / REPORT_HTML
         if self.rundir.read_only is not None:  # a finished run on a read-only mount
             return target if target.is_file() else result.folder / REPORT_HTML
-        tmp = target.with_name(".report.html.tmp")
+        tmp = target.with_name(f".{REPORT_HTML}.tmp")
         shutil.copyfile(result.folder / REPORT_HTML, tmp)
         tmp.replace(target)
         return target
@@ -531,7 +515,9 @@ class Pipeline:
         return self.report()
 
 
-def run(config: RunConfig, root: str | Path, console: Any = None) -> Path:
+def run(
+    config: RunConfig, root: str | Path, on_event: Callable[[StageEvent], None] | None = None
+) -> Path:
     """Run the whole pipeline of ``config`` in ``root``; returns the report path."""
-    with Pipeline(config, root, console=console) as pipe:
+    with Pipeline(config, root, on_event=on_event) as pipe:
         return pipe.run()

@@ -72,3 +72,20 @@ QUARTZ_CIJ_EXPERIMENT_GPA = MappingProxyType(
 QUARTZ_LATTICE_EXPERIMENT_ANGSTROM = MappingProxyType({"a": 4.916, "c": 5.405})
 #: Density of α-quartz, experiment (g/cm³).
 QUARTZ_DENSITY_EXPERIMENT_G_CM3 = 2.648
+
+#: The elements of the paper's material (α-quartz): the only one the default moduli are for.
+PAPER_ELEMENTS = frozenset({"Si", "O"})
+
+
+def is_paper_material(settings, elements=None) -> bool:
+    """Whether the run's slabs are the paper's α-quartz, the material of the default E*, G*.
+
+    ``quartz-dense`` always; ``toy-lj`` (a demonstration model, no material) takes the
+    defaults too; another recipe only when its atoms (``elements``, known after reading the
+    structure) are Si and O alone. ``settings`` is the run configuration (its
+    ``structure.kind`` is read).
+    """
+    kind = settings.structure.kind
+    if kind in ("quartz-dense", "toy-lj"):
+        return True
+    return elements is not None and set(elements) <= PAPER_ELEMENTS

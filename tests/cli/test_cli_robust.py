@@ -136,8 +136,8 @@ def snap_copy(tmp_path):
 
 def test_every_command_reads_every_spelling(snap_copy):
     from flatcontact.cli.build import _potential_spec
+    from flatcontact.cli.bulk_models import bulk_potential as _bulk_potential
     from flatcontact.cli.scan import _potential_section, resolve_config
-    from flatcontact.cli.training import _bulk_potential
 
     groups = {
         "snap:sio2-snap": ["sio2-snap", "snap:sio2-snap"],

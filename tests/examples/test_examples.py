@@ -171,7 +171,7 @@ def test_graphene_kc_ispes_equals_plain_lammps_point_by_point(tmp_path):
     LAMMPS energies of the geometry built here, to round-off; AB = BA exactly."""
     from flatcontact.ispes.contract import open_ispes
     from flatcontact.stages.build import BuildInputs, run_build
-    from flatcontact.stages.scan import ScanInputs, run_scan_stage
+    from flatcontact.stages.scan import ScanInputs, run_scan
 
     cfg = load_config(EXAMPLES / "graphene-bilayer-kc.yaml")
     scan = cfg.scan.model_copy(
@@ -179,7 +179,7 @@ def test_graphene_kc_ispes_equals_plain_lammps_point_by_point(tmp_path):
     )
     cfg = cfg.model_copy(update={"scan": scan})
     run_build(cfg, BuildInputs(), tmp_path / "build")
-    run_scan_stage(cfg, ScanInputs(tmp_path / "build" / "interface.extxyz"), tmp_path / "scan")
+    run_scan(cfg, ScanInputs(tmp_path / "build" / "interface.extxyz"), tmp_path / "scan")
     from flatcontact.structures.interface_io import read_interface
 
     reference = read_interface(tmp_path / "build" / "interface.extxyz")

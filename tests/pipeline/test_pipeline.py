@@ -26,7 +26,8 @@ import xarray as xr
 from flatcontact.config import build_config
 from flatcontact.errors import InputError
 from flatcontact.ispes.contract import open_ispes
-from flatcontact.pipeline import STAGES, Pipeline
+from flatcontact.layout import STAGES
+from flatcontact.pipeline import Pipeline
 
 TINY = {
     "structure": {"kind": "quartz-dense", "layers": 5, "source": "seed"},
@@ -215,7 +216,7 @@ def test_a_change_reruns_exactly_the_dependent_stages(tiny_run, tmp_path, change
         ("analysis/friction.py", {"analyze", "laws", "contact", "report"}),
         ("ispes/relax.py", {"scan", "analyze", "laws", "contact", "report"}),
         # the report's wording and the contact figures are in no upstream stage's digest
-        ("report/content.py", {"report"}),
+        ("report/sections/laws.py", {"report"}),
         ("plots/contact.py", {"contact", "report"}),
         ("analysis/laws.py", {"analyze", "laws", "contact", "report"}),
     ],
@@ -254,7 +255,7 @@ def test_each_stage_digest_covers_its_stage_module_and_nothing_of_the_report():
     for name in STAGES:
         modules = stage_code(name)
         assert f"flatcontact.stages.{name}" in modules, name
-        assert ("flatcontact.report.content" in modules) == (name == "report"), name
+        assert ("flatcontact.report.assemble" in modules) == (name == "report"), name
         assert "flatcontact.pipeline" not in modules, name
 
 

@@ -32,7 +32,7 @@ def test_monotonicity_paragraph_names_drops_beyond_noise_and_their_mechanism():
     a drop within the noise is not; a monotonic τ(P) says so."""
     import pandas as pd
 
-    from flatcontact.report.content import monotonicity_paragraph
+    from flatcontact.report.sections.analysis import monotonicity_paragraph
 
     table = pd.DataFrame(
         {

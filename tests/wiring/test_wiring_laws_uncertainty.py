@@ -18,9 +18,10 @@ from flatcontact import units
 from flatcontact.analysis import synthetic as syn
 from flatcontact.config import MEASURED_LAW_UNCERTAINTY, build_config
 from flatcontact.contact import mindlin
-from flatcontact.stages.analyze import FRICTION_CSV, AnalyzeInputs, run_analyze
+from flatcontact.layout import FRICTION_CSV, LAWS_JSON
+from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
 from flatcontact.stages.contact import ContactInputs, run_contact
-from flatcontact.stages.laws import LAWS_JSON, LawsInputs, run_laws
+from flatcontact.stages.laws import LawsInputs, run_laws
 
 A = 4.916
 A1, A2 = syn.hexagonal_cell(A)

@@ -124,7 +124,8 @@ def analyze_command(
     from flatcontact.analysis.outputs import per_pressure_rows, summary_json
     from flatcontact.cli.settings import FLAGS_SOURCE, flag_errors
     from flatcontact.config import build_config
-    from flatcontact.stages.analyze import FRICTION_CSV, AnalyzeInputs, run_analyze
+    from flatcontact.layout import FRICTION_CSV
+    from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
     from flatcontact.stages.laws import LawsInputs, run_laws
 
     for flag, value, allowed in (

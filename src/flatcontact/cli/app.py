@@ -38,6 +38,11 @@ def print_warning(message: object) -> None:
     err_console.print(Text("warning: ", style="bold yellow") + Text(str(message)))
 
 
+def print_progress(message: object) -> None:
+    """A progress line of a long command (dim, on stderr, so ``--json`` output stays clean)."""
+    err_console.print(message, style="dim")
+
+
 def check_out_dir(path: str | Path, flag: str = "--out") -> Path:
     """Refuse an output directory that cannot be used, before any work starts.
 

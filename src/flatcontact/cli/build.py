@@ -14,7 +14,7 @@ import typer
 
 from flatcontact.cli.app import app, check_out_dir, console, print_warning
 from flatcontact.errors import InputError
-from flatcontact.stages.build import BUILD_JSON as BUILD_REPORT
+from flatcontact.layout import BUILD_JSON
 
 #: Settings path -> the flag that sets it, to name the flag in errors.
 _FLAG_OF = {
@@ -219,7 +219,7 @@ def _print(result, out: Path) -> None:
     figures = [f for f in result.files if f.name.startswith("fig1_")]
     console.print(
         f"wrote {out / 'interface.extxyz'} ({len(result.atoms)} atoms, thickness "
-        f"{result.report['thickness_angstrom']:.3f} Å), {out / BUILD_REPORT}, "
+        f"{result.report['thickness_angstrom']:.3f} Å), {out / BUILD_JSON}, "
         + ", ".join(str(f) for f in figures),
         highlight=False,
         soft_wrap=True,

@@ -1,6 +1,7 @@
 """Import every command module so that its commands register on the app.
 
-Add a line here when a new command module is written.
+Add a line here when a new command module is written. The order of registration is the
+order of ``flatcontact --help``.
 """
 
 from flatcontact.cli import (  # noqa: F401  (imported for their @app.command registrations)
@@ -9,5 +10,9 @@ from flatcontact.cli import (  # noqa: F401  (imported for their @app.command re
     contact,
     run,
     scan,
-    training,
+    train,
+    validate,
 )
+
+# isort: split
+from flatcontact.cli import elastic  # noqa: F401  (listed after validate-potential)

@@ -14,6 +14,8 @@ from typing import Annotated
 import typer
 
 from flatcontact.cli.app import app, check_out_dir, console, err_console
+from flatcontact.cli.progress import ScanBar, StageLines
+from flatcontact.layout import RUN_MARKER
 
 _PRESET_HELP = "quick (default: minutes on a 2-core laptop) or paper (the paper's grids and loads)."
 
@@ -33,15 +35,17 @@ def run_command(
 
     Rerunning skips stages whose inputs did not change and resumes an interrupted scan.
     """
-    from flatcontact.cli.progress import ScanBar
     from flatcontact.config import load_config
     from flatcontact.pipeline import Pipeline
     from flatcontact.stages import _calculator
 
     cfg = load_config(config, preset)
-    if not (out / "run.json").is_file():  # an existing run may be read-only: Pipeline decides
+    if not (out / RUN_MARKER).is_file():  # an existing run may be read-only: Pipeline decides
         check_out_dir(out)
-    with Pipeline(cfg, out, console=console, scan_progress=ScanBar(console)) as pipe:
+    with (
+        StageLines(console) as lines,
+        Pipeline(cfg, out, on_event=lines, scan_progress=ScanBar(console)) as pipe,
+    ):
         console.print(
             f"flatcontact run: preset {cfg.preset}, {cfg.structure.kind}, "
             f"{_calculator.label(cfg)} -> {out}",

@@ -2,7 +2,7 @@
 
 Thin: reads the run configuration (:func:`flatcontact.config.load_config`, the file
 ``flatcontact run`` reads; its ``potential``/``calculator`` and ``scan`` sections), lays the
-flags over it, runs the scan stage (:func:`flatcontact.stages.scan.run_scan_stage`, the one
+flags over it, runs the scan stage (:func:`flatcontact.stages.scan.run_scan`, the one
 ``flatcontact run`` runs: ``points.db``, ``ispes.nc``, ``scan.json`` and
 ``fig_scan_columns.png``, + ``.svg`` with ``report.svg``) with a progress bar and prints its
 summary and warnings.
@@ -18,6 +18,7 @@ import typer
 
 from flatcontact.cli.app import app, check_out_dir, console, err_console, parse_floats
 from flatcontact.errors import InputError
+from flatcontact.layout import INTERFACE
 
 #: Config field (dotted path) -> the flag that sets it, to name the flag in errors.
 _FLAG_OF = {
@@ -39,7 +40,7 @@ _FLAG_OF = {
     "scan.dask_address": "--dask-address",
 }
 #: Where ``flatcontact build`` writes the interface by default (``--out build``).
-DEFAULT_INTERFACE = "build/interface.extxyz"
+DEFAULT_INTERFACE = f"build/{INTERFACE}"
 
 
 def _floats(values: list[str] | None, flag: str) -> list[float] | None:
@@ -198,7 +199,7 @@ def scan_command(
     from flatcontact.cli.progress import ScanBar
     from flatcontact.ispes.scan import ScanInterrupted
     from flatcontact.rundir import RunLock
-    from flatcontact.stages.scan import ScanInputs, run_scan_stage
+    from flatcontact.stages.scan import ScanInputs, run_scan
 
     if thickness and p_range_gpa is not None:
         raise InputError("give either --thickness or --p-range-gpa, not both")
@@ -237,9 +238,7 @@ def scan_command(
     lock = RunLock(out_dir).acquire()  # one writer per --out (a run or another scan)
     try:
         with ScanBar(console) as bar:
-            result = run_scan_stage(
-                cfg, ScanInputs(where), out_dir, progress=None if as_json else bar
-            )
+            result = run_scan(cfg, ScanInputs(where), out_dir, progress=None if as_json else bar)
     except ScanInterrupted as stop:
         r = stop.result
         err_console.print(

@@ -41,9 +41,7 @@ from flatcontact.ispes.relax import (
 )
 from flatcontact.ispes.store import PointStore, discard_store, interface_hash
 from flatcontact.ispes.thicknesses import probe_thicknesses
-
-POINTS_DB = "points.db"
-ISPES_NC = "ispes.nc"
+from flatcontact.layout import ISPES_NC, POINTS_DB
 
 
 @dataclasses.dataclass

@@ -1,9 +1,15 @@
-"""Figures of every stage (matplotlib), one module per stage, and how they are saved."""
+"""Figures of every stage (matplotlib, the file-only Agg backend), one module per stage, and
+how they are saved."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")  # figures are written to files: the non-interactive backend
+import matplotlib.pyplot as plt
 
 from flatcontact.fileio import atomic_path
 
@@ -15,8 +21,6 @@ def save_figure(
 
     Returns the paths written. ``bbox_inches="tight"`` keeps labels inside the image.
     """
-    import matplotlib.pyplot as plt
-
     stem = Path(stem)
     written = []
     for ext in formats:

@@ -10,15 +10,13 @@ Fig. 3: τ and σ against P with their linear fits over the fitted range.
 
 from __future__ import annotations
 
-import matplotlib
-
-matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
 from flatcontact import units
 from flatcontact.analysis.analyze import AnalysisResult, PressureAnalysis
 from flatcontact.analysis.laws import LoadLaws
+from flatcontact.analysis.uncertainty import propagate_box
 
 MEV = units.EV_PER_A2_TO_MEV_PER_A2
 
@@ -105,8 +103,6 @@ def law_band(
     """Lower and upper edge of the law c(P) = slope·P + intercept over the box of its
     coefficients (each ± its half-width), at every P: the extremes are at the box corners
     (:func:`flatcontact.analysis.uncertainty.propagate_box`, exact for a linear law)."""
-    from flatcontact.analysis.uncertainty import propagate_box
-
     p = np.asarray(p_gpa, dtype=float)
     box = propagate_box(
         lambda x: {i: x["s"] * pi + x["c"] for i, pi in enumerate(p)},

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import matplotlib.pyplot as plt
 import numpy as np
 
 from flatcontact import units
@@ -12,8 +13,6 @@ def figure_scan_columns(ds, adhesion: dict | None = None):
 
     Each thin line is one lateral shift; p rises as z falls on the repulsive branch.
     """
-    import matplotlib.pyplot as plt
-
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.2))
     z = ds["thickness"].values
     p = ds["normal_stress"].values.reshape(-1, z.size)

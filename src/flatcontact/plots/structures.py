@@ -5,16 +5,16 @@ Drawn by the build stage (``01-build/fig1_interface``) and ``flatcontact build``
 
 from __future__ import annotations
 
+import matplotlib.pyplot as plt
 import numpy as np
+from ase.data import atomic_numbers, covalent_radii
+from matplotlib.patches import Circle
 
 
 def _draw_atoms(
     ax, xy: np.ndarray, symbols, depth: np.ndarray, palette: dict, scale: float
 ) -> None:
     """Atoms as circles in data units (covalent radius × ``scale``), far ones drawn first."""
-    from ase.data import atomic_numbers, covalent_radii
-    from matplotlib.patches import Circle
-
     for i in np.argsort(depth):
         r = scale * covalent_radii[atomic_numbers[symbols[i]]]
         ax.add_patch(
@@ -26,8 +26,6 @@ def figure_interface(atoms):
     """Fig. 1 style: (a) side view of the interface (3 cells along a1, seen along y) with
     surfaces 1–4 marked, (b) top view of slab 1's inner face (surface 2) over 4×4 cells
     with the primitive cell dashed. Si blue, O red (other elements grey)."""
-    import matplotlib.pyplot as plt
-
     palette = {"Si": "#3b6ea5", "O": "#d62728"}
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 5.5), gridspec_kw={"width_ratios": [1, 1.3]})
     cell = atoms.cell.array

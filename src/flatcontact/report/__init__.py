@@ -1,4 +1,5 @@
-"""The HTML report: its rendering (:mod:`.html`) and its content (:mod:`.content`)."""
+"""The HTML report: its rendering (:mod:`.html`) and its content (:mod:`.assemble`, one
+section per stage in :mod:`.sections`, numbers written by :mod:`.format`)."""
 
 from flatcontact.report.html import (
     Figure,

@@ -2,8 +2,7 @@
 :class:`flatcontact.potentials.InteractionModel` (``settings.potential``).
 
 Everything goes through the model's API (``label``, ``fingerprint()``, ``check_atoms``) and
-its engines (:mod:`flatcontact.potentials.engines`); nothing here branches on the kind of model
-except the report's reading of it (:func:`intra`, :func:`lj`).
+its engines (:mod:`flatcontact.potentials.engines`); nothing here branches on the kind of model.
 """
 
 from __future__ import annotations
@@ -70,18 +69,6 @@ def same_intra(settings, intra: str) -> bool:
     """Whether an interface's recorded intra-slab name (older recipes) is the run's."""
     m = settings.potential
     return m.calculator is None and m.intra == intra
-
-
-def lj(settings) -> Any:
-    """The cross-interface LJ of the model, or ``None`` when it has none."""
-    m = settings.potential
-    return m.lj if m.coupling == "lj" and m.engine != "ase-interface" else None
-
-
-def intra(settings) -> str | None:
-    """The legacy intra-slab name (``vashishta``, ``snap:...``) of a LAMMPS model, else ``None``."""
-    m = settings.potential
-    return m.intra if m.engine == "lammps" and isinstance(m.intra, str) else None
 
 
 def check(settings) -> None:

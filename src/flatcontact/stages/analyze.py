@@ -15,11 +15,8 @@ from pathlib import Path
 from typing import Any
 
 from flatcontact.fileio import atomic_path, write_json_atomic, write_text_atomic
+from flatcontact.layout import ANALYZE_JSON, FRICTION_CSV, FRICTION_NC, analyze_figure
 from flatcontact.stages._common import captured, renamed_errors, save
-
-FRICTION_CSV = "friction.csv"
-FRICTION_NC = "friction.nc"
-ANALYZE_JSON = "analyze.json"
 
 #: Parameters of :func:`flatcontact.analysis.analyze.analyze_ispes` -> the settings path.
 SETTINGS_NAMES = {
@@ -56,7 +53,7 @@ class AnalyzeResult:
         return {
             "warnings": list(self.warnings),
             "timings_s": result.timings_s,
-            "fig2": [f"fig2_p{pa.p_gpa:g}gpa" for pa in result.pressures],
+            "fig2": [analyze_figure(pa.p_gpa) for pa in result.pressures],
             "symmetry": {
                 f"{pa.p_gpa:g}": pa.symmetry.to_json()
                 for pa in result.pressures
@@ -119,5 +116,5 @@ def _write(result: AnalyzeResult, folder: Path, svg: bool) -> None:
         friction_dataset(analysis).to_netcdf(tmp, engine="h5netcdf")
     result.files.append(folder / FRICTION_NC)
     for pa in analysis.pressures:
-        result.files += save(figure_pressure(pa, analysis), folder, f"fig2_p{pa.p_gpa:g}gpa", svg)
+        result.files += save(figure_pressure(pa, analysis), folder, analyze_figure(pa.p_gpa), svg)
     result.files.append(write_json_atomic(folder / ANALYZE_JSON, result.to_json()))

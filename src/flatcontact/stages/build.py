@@ -12,12 +12,10 @@ from pathlib import Path
 from typing import Any
 
 from flatcontact.fileio import write_json_atomic
+from flatcontact.layout import BUILD_FIGURE, BUILD_JSON, INTERFACE
 from flatcontact.stages import _calculator
 from flatcontact.stages._common import save
 
-INTERFACE = "interface.extxyz"
-BUILD_JSON = "build.json"
-FIGURE_STEM = "fig1_interface"
 #: Recipes whose interface is relaxed once with the run's model (cut surfaces reconstruct).
 RELAXED_KINDS = ("slab", "crystal")
 #: Recipes kept at their ideal geometry: a relaxation at the reference stacking would imprint
@@ -112,7 +110,7 @@ def run_build(settings, inputs: BuildInputs, folder: Path | None, progress=None)
         folder.mkdir(parents=True, exist_ok=True)
         result.files.append(write_interface(atoms, folder / INTERFACE))
         result.files.append(write_json_atomic(folder / BUILD_JSON, result.to_json()))
-        result.files += save(figure_interface(atoms), folder, FIGURE_STEM, settings.report.svg)
+        result.files += save(figure_interface(atoms), folder, BUILD_FIGURE, settings.report.svg)
     return result
 
 

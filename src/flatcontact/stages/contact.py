@@ -31,12 +31,21 @@ import numpy as np
 
 from flatcontact.errors import InputError
 from flatcontact.fileio import atomic_path, file_sha256, write_json_atomic
-from flatcontact.reference import PAPER, PAPER_LAW_KEYS
+from flatcontact.layout import (
+    CONTACT_NC,
+    FIG4_TRACTION,
+    FIG5_FORCE_STIFFNESS,
+    FIG5_FORCE_STIFFNESS_RMS,
+    FIG5C_CYCLE_LOOPS,
+    FIG6_EXPERIMENT,
+    FIG6_FIT,
+    FIG6_LOCKIN,
+    FIT_JSON,
+    SUMMARY_JSON,
+)
+from flatcontact.reference import PAPER, PAPER_LAW_KEYS, is_paper_material
 from flatcontact.stages._common import rename, renamed_errors, save
 
-SUMMARY_JSON = "summary.json"
-CONTACT_NC = "contact.nc"
-FIT_JSON = "fit.json"
 #: ContactParameters fields -> the settings path that sets them.
 SETTINGS_NAMES = {
     name: f"contact.{name}"
@@ -132,27 +141,10 @@ def contact_parameters(settings, inputs: ContactInputs):
     return params, provenance
 
 
-#: The elements of the paper's material (α-quartz): the only one the default moduli are for.
-PAPER_ELEMENTS = frozenset({"Si", "O"})
-
-
 def moduli_given(settings) -> bool:
     """Whether the run sets E* and G* itself: the elastic stage, or both contact moduli given."""
     given = settings.contact.model_fields_set
     return settings.elastic.enabled or {"contact_modulus_gpa", "shear_modulus_gpa"} <= given
-
-
-def is_paper_material(settings, elements=None) -> bool:
-    """Whether the run's slabs are the paper's α-quartz, the material of the default E*, G*.
-
-    ``quartz-dense`` always; ``toy-lj`` (a demonstration model, no material) takes the
-    defaults too; another recipe only when its atoms (``elements``, known after reading the
-    structure) are Si and O alone.
-    """
-    kind = settings.structure.kind
-    if kind in ("quartz-dense", "toy-lj"):
-        return True
-    return elements is not None and set(elements) <= PAPER_ELEMENTS
 
 
 def check_moduli_source(settings, elements=None) -> None:
@@ -485,14 +477,12 @@ def _write(result: ContactResult, settings, folder: Path, measured, comparison) 
 
         lockin = [lockin_curve(p * GPA_TO_PA, params, c.cycle.model) for p in analysis.p0_gpa]
     figs = {
-        "fig4_traction": fig4_traction(params, p0_fig4),
-        "fig5_force_stiffness": fig5_force_and_stiffness(
-            analysis, "amplitude", lockin, result.bands
-        ),
-        "fig5_force_stiffness_rms": fig5_force_and_stiffness(analysis, "rms", lockin, result.bands),
+        FIG4_TRACTION: fig4_traction(params, p0_fig4),
+        FIG5_FORCE_STIFFNESS: fig5_force_and_stiffness(analysis, "amplitude", lockin, result.bands),
+        FIG5_FORCE_STIFFNESS_RMS: fig5_force_and_stiffness(analysis, "rms", lockin, result.bands),
     }
     if comparison is not None:
-        figs["fig6_experiment"] = fig6_overlay(
+        figs[FIG6_EXPERIMENT] = fig6_overlay(
             measured,
             c.experiment.p0_gpa,
             {
@@ -507,14 +497,14 @@ def _write(result: ContactResult, settings, folder: Path, measured, comparison) 
         from flatcontact.plots.cycle import fig_lockin_overlay, fig_loops
 
         shown = sorted({p0_fig4, max(analysis.p0_gpa)})
-        figs["fig5c_cycle_loops"] = fig_loops(
+        figs[FIG5C_CYCLE_LOOPS] = fig_loops(
             params, shown, c.cycle.amplitude_fractions, model=c.cycle.model
         )
-        figs["fig6_lockin"] = fig_lockin_overlay(params, analysis.p0_gpa, model=c.cycle.model)
+        figs[FIG6_LOCKIN] = fig_lockin_overlay(params, analysis.p0_gpa, model=c.cycle.model)
     if result.fit is not None:
         from flatcontact.plots.cycle import fig_fit
 
-        figs["fig6_fit"] = fig_fit(result.fit)
+        figs[FIG6_FIT] = fig_fit(result.fit)
         result.files.append(write_json_atomic(folder / FIT_JSON, result.fit_json()))
     for name, fig in figs.items():
         result.files += save(fig, folder, name, settings.report.svg)

@@ -28,9 +28,8 @@ from pathlib import Path
 
 from flatcontact.errors import InputError
 from flatcontact.fileio import write_json_atomic
+from flatcontact.layout import ELASTIC_JSON
 from flatcontact.stages import _calculator
-
-ELASTIC_JSON = "elastic.json"
 
 #: The convention of the layered crystals' moduli (elastic.json ``crystal.convention``).
 LAYERED_CONVENTION = (

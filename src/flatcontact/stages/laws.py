@@ -20,10 +20,9 @@ from typing import Any
 import numpy as np
 
 from flatcontact.fileio import write_json_atomic
+from flatcontact.layout import LAWS_FIGURE, LAWS_JSON
 from flatcontact.stages._common import captured, save
 
-LAWS_JSON = "laws.json"
-FIGURE_STEM = "fig3_laws"
 _COLUMNS = ("p_gpa", "tau_mpa", "sigma_mss_mpa")
 FORMS = ("internal", "enthalpy")
 
@@ -173,7 +172,7 @@ def run_laws(settings, inputs: LawsInputs, folder: Path | None, progress=None) -
         folder.mkdir(parents=True, exist_ok=True)
         result.files.append(write_json_atomic(folder / LAWS_JSON, result.to_json()))
         fig = figure_laws(p, tau, sigma, laws, half_widths=result.half_widths(result.form))
-        result.files += save(fig, folder, FIGURE_STEM, settings.report.svg)
+        result.files += save(fig, folder, LAWS_FIGURE, settings.report.svg)
     return result
 
 

@@ -1,6 +1,7 @@
 """Stage 7, report: one self-contained ``report.html`` from the other stages' folders.
 
-Content in :mod:`flatcontact.report.content`, rendering in :mod:`flatcontact.report.html`.
+Content in :mod:`flatcontact.report.assemble` (one section per stage,
+:mod:`flatcontact.report.sections`), rendering in :mod:`flatcontact.report.html`.
 """
 
 from __future__ import annotations
@@ -8,13 +9,13 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-REPORT_HTML = "report.html"
+from flatcontact.layout import REPORT_HTML
 
 
 @dataclass(frozen=True)
 class ReportInputs:
     """The folders of the stages to report (``folders[name]``, name as in
-    :data:`flatcontact.pipeline.STAGES`; ``elastic`` optional) and the package versions."""
+    :data:`flatcontact.layout.STAGES`; ``elastic`` optional) and the package versions."""
 
     folders: dict[str, Path]
     versions: dict[str, str] = field(default_factory=dict)
@@ -32,7 +33,7 @@ class ReportResult:
 
 
 def _stage_rows(folders: dict[str, Path]) -> list[tuple[str, str, str, str]]:
-    from flatcontact.report.content import fmt
+    from flatcontact.report.format import fmt
     from flatcontact.rundir import RunDirectory
 
     rows = []
@@ -47,7 +48,7 @@ def _stage_rows(folders: dict[str, Path]) -> list[tuple[str, str, str, str]]:
 def run_report(settings, inputs: ReportInputs, folder: Path | None, progress=None) -> ReportResult:
     """Write ``folder/report.html`` (title ``report.title``) from ``inputs.folders``."""
     from flatcontact import __version__
-    from flatcontact.report.content import build_sections
+    from flatcontact.report.assemble import build_sections
     from flatcontact.report.html import write_report
 
     sections = build_sections(settings, inputs.folders, _stage_rows(inputs.folders))

@@ -17,13 +17,12 @@ import numpy as np
 
 from flatcontact.errors import InputError
 from flatcontact.fileio import write_json_atomic
+from flatcontact.ispes import scan as ispes_scan
 from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.relax import RelaxSettings
+from flatcontact.layout import SCAN_FIGURE, SCAN_JSON
 from flatcontact.stages import _calculator
 from flatcontact.stages._common import save
-
-SCAN_JSON = "scan.json"
-FIGURE_STEM = "fig_scan_columns"
 
 log = logging.getLogger("flatcontact.run")
 
@@ -137,7 +136,7 @@ def _no_repulsive_branch(ds) -> str | None:
     return None
 
 
-def run_scan_stage(
+def run_scan(
     settings,
     inputs: ScanInputs,
     folder: Path,
@@ -151,7 +150,6 @@ def run_scan_stage(
     not the scan model's), in ``scan.json`` and on the console. Ctrl-C raises
     :class:`flatcontact.ispes.scan.ScanInterrupted` after the store is consistent.
     """
-    from flatcontact.ispes.scan import run_scan
     from flatcontact.plots.scan import figure_scan_columns
     from flatcontact.structures.interface_io import read_interface
 
@@ -168,7 +166,7 @@ def run_scan_stage(
             "relaxed ones of the scan's model"
         )
         log.warning("scan: %s", warnings[-1])
-    scan = run_scan(
+    scan = ispes_scan.run_scan(
         reference,
         factory,
         grid_spec(s),
@@ -186,6 +184,6 @@ def run_scan_stage(
     result = ScanStageResult(scan, warnings, [scan.store_path, scan.ispes_path])
     result.files.append(write_json_atomic(folder / SCAN_JSON, result.to_json()))
     result.files += save(
-        figure_scan_columns(scan.dataset, scan.adhesion), folder, FIGURE_STEM, settings.report.svg
+        figure_scan_columns(scan.dataset, scan.adhesion), folder, SCAN_FIGURE, settings.report.svg
     )
     return result

@@ -1,0 +1,40 @@
+"""The report's section on the scan stage: grid, convergence, adhesion and the p(z), U(z) figure."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from flatcontact.layout import SCAN_FIGURE, png
+from flatcontact.report.format import fmt
+from flatcontact.report.html import Figure, Section, Table
+
+
+def scan_section(scan: dict, folder: Path) -> Section:
+    """Section 2: the scan's counts, thicknesses and adhesion (``scan``: the scan stage's
+    ``scan.json``), its notes and warnings, and its figure from ``folder``."""
+    adh = scan.get("adhesion") or {}
+    scan_rows = [
+        ("grid points", f"{scan['points_done']} of {scan['points_total']}"),
+        ("converged", str(scan["converged"])),
+        ("force calls (total)", str(scan["force_calls_total"])),
+        ("thicknesses z (Å)", ", ".join(f"{z:.4f}" for z in scan["thickness_angstrom"])),
+    ]
+    for key, label in (
+        ("equilibrium_thickness_angstrom", "z at p = 0 (Å)"),
+        ("max_tension_gpa", "maximum tension (GPa)"),
+        ("work_of_separation_j_per_m2", "work of separation, energy (J/m²)"),
+        ("work_of_separation_integral_j_per_m2", "work of separation, −∫p dz (J/m²)"),
+    ):
+        if key in adh:
+            scan_rows.append((label, fmt(adh[key])))
+    return Section(
+        "2. ISPES scan",
+        tables=[Table(("quantity", "value"), scan_rows)],
+        notes=[*scan.get("notes", []), *scan.get("warnings", [])],
+        figures=[
+            Figure(
+                folder / png(SCAN_FIGURE),
+                "p(z) and U(z) at every lateral shift: the load rises as the slabs are pressed together.",
+            )
+        ],
+    )
