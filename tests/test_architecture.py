@@ -38,7 +38,17 @@ LAYERS: tuple[tuple[str, frozenset[str]], ...] = (
     (
         "foundation",
         frozenset(
-            {"config", "reference", "units", "errors", "limits", "fileio", "rundir", "codegraph"}
+            {
+                "config",
+                "reference",
+                "units",
+                "errors",
+                "limits",
+                "fileio",
+                "rundir",
+                "codegraph",
+                "layout",
+            }
         ),
     ),
     (

@@ -19,8 +19,8 @@ def _ispes_model(name: str, flag: str, lj: dict):
     """The interaction model of ``name`` for the ISPES comparison: an offline teacher
     (``chgnet`` = ``chgnet-r2scan``) or any intra-slab potential name, with the shared LJ."""
     from flatcontact.potentials import PotentialSpec
-    from flatcontact.training.ispes_check import teacher_spec
     from flatcontact.potentials.teachers import get_teacher, is_teacher
+    from flatcontact.training.ispes_check import teacher_spec
 
     name = name.strip()
     if is_teacher(name):

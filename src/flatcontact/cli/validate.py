@@ -99,8 +99,8 @@ def validate_potential_cmd(
     W per load) against a reference model on the same interface
     (:func:`flatcontact.training.ispes_check.compare_ispes`).
     """
-    from flatcontact.training.dataset import read_dataset
     from flatcontact.potentials.engines import bulk_calculator
+    from flatcontact.training.dataset import read_dataset
     from flatcontact.training.validate import validate_potential
 
     if out is not None:

@@ -12,11 +12,11 @@ from typing import Any
 
 from flatcontact.config import BUNDLED_SNAP
 from flatcontact.errors import InputError
+from flatcontact.potentials.files import BUNDLED_DIR
 from flatcontact.potentials.lj import (
     ALPHA_QUARTZ_NUMBER_DENSITY_PER_NM3,
     pairwise_hamaker_constant_zj,
 )
-from flatcontact.potentials.files import BUNDLED_DIR
 from flatcontact.reference import (
     PAPER,
     PAPER_THRESHOLD_GPA,
