@@ -26,7 +26,7 @@ import numpy as np
 from ase import Atoms
 
 from flatcontact.errors import InputError
-from flatcontact.ispes.executors import make_executor
+from flatcontact.ispes import executors
 from flatcontact.ispes.geometry import in_plane_vectors, thickness, validate_interface
 from flatcontact.ispes.grid import GridSpec, check_thicknesses
 from flatcontact.ispes.order import PREFERENCES, search_tree
@@ -187,7 +187,7 @@ def run_scan(
         ) as store:
             own_executor = executor is None
             if own_executor:
-                executor = make_executor(**(executor_options or {}))
+                executor = executors.make_executor(**(executor_options or {}))
             known = store.resolved
             if hasattr(executor, "prestart") and (
                 known is None or len(store) < grid.n_a * grid.n_b * len(known["thickness_angstrom"])
