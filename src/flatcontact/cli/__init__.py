@@ -35,7 +35,7 @@ import typer
 
 from flatcontact import __version__
 from flatcontact.cli import commands as _commands  # noqa: F401  (registers the sub-commands)
-from flatcontact.cli.app import app, console, print_error
+from flatcontact.cli.app import app, check_out_flags, console, print_error
 from flatcontact.errors import InputError
 
 __all__ = ["app", "main", "usage_error_line"]
@@ -106,6 +106,7 @@ def main(argv: list[str] | None = None) -> None:
     # ASE's note on reading its own extxyz files (info it cannot hash): noise, not news
     warnings.filterwarnings("ignore", message="Skipping unhashable information")
     try:
+        check_out_flags([str(a) for a in (sys.argv[1:] if argv is None else argv)])
         rv = app(args=argv, standalone_mode=False, prog_name="flatcontact")
     except InputError as exc:
         print_error(exc)
