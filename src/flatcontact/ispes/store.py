@@ -38,9 +38,9 @@ Validation when a store is opened (a store is never used unchecked):
   and ``thickness`` equal to the grid's values at that index, finite energy, stresses
   and positions, the reference's atom count, and one row per index. A row that fails
   is deleted, one warning (:class:`PointStoreRepaired`) names the file, the count and
-  the first defect, and the scan recomputes exactly those points (the rest are kept: they
-  do not depend on a bad point's numbers, only a warm start might, and a warm start
-  changes how a point is reached, not where it ends). Identical duplicates are
+  the first defect, and the scan recomputes exactly those points; the other rows are kept
+  (each was final when it was stored: a later change to another row does not alter it).
+  Identical duplicates are
   collapsed to one row.
 """
 
