@@ -208,3 +208,14 @@ def test_an_atomic_write_replaces_a_planted_link_instead_of_writing_through(tmp_
     # a long target name still gets a temporary name within NAME_MAX
     write_text_atomic(tmp_path / "out" / ("n" * 255), "x")
     assert (tmp_path / "out" / ("n" * 255)).read_text() == "x"
+
+
+def test_a_refused_command_leaves_the_folder_above_out_untouched(tmp_path, monkeypatch, capsys):
+    """``--out`` is probed (created, written, removed) before the command fails later."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "parent").mkdir()
+    before = (tmp_path / "parent").stat().st_mtime_ns
+    argv = ["contact", "--experiment", tmp_path / "missing.csv", "--out", "parent/new/run"]
+    assert_refused_cleanly(argv, capsys, tmp_path, ["missing.csv"])
+    assert (tmp_path / "parent").stat().st_mtime_ns == before
+    assert list((tmp_path / "parent").iterdir()) == []

@@ -44,7 +44,9 @@ def check_out_dir(path: str | Path, flag: str = "--out") -> Path:
     ``path`` must be an existing writable directory or one that can be created (its nearest
     existing ancestor is a writable directory). The check really creates the missing
     directories and a probe file and removes them again, so it holds for root and for
-    special file systems (``/proc``) where permission bits say nothing.
+    special file systems (``/proc``) where permission bits say nothing; it then restores the
+    modification time of the directory it probed in, so a command refused later has changed
+    nothing outside ``path``.
 
     Returns
     -------
@@ -77,6 +79,7 @@ def check_out_dir(path: str | Path, flag: str = "--out") -> Path:
         probe = probe.parent
     if not probe.is_dir():
         raise InputError(f"{flag} {str(out)!r}: {str(probe)!r} is not a directory")
+    before = probe.stat()  # the probe leaves no trace: not even a changed mtime
     try:
         for d in reversed(created):
             d.mkdir()
@@ -93,6 +96,10 @@ def check_out_dir(path: str | Path, flag: str = "--out") -> Path:
                 d.rmdir()
             except OSError:
                 pass
+        try:
+            os.utime(probe, ns=(before.st_atime_ns, before.st_mtime_ns))
+        except OSError:  # not the owner: the time stays changed, nothing else does
+            pass
     return out
 
 
