@@ -1,22 +1,147 @@
 """Small file helpers shared by every stage: atomic writes, checked reads of user files,
 the SHA-256 of a file's content.
 
-A file a stage produces either appears whole or not at all: write to a
-temporary sibling, then ``os.replace`` it into place.
+A file a stage produces either appears whole or not at all: write to a temporary sibling,
+then ``os.replace`` it into place. No write follows a symbolic link: the temporary sibling is
+created with ``O_CREAT | O_EXCL | O_NOFOLLOW`` in the target's own folder (a folder that is a
+link is refused), ``os.replace`` swaps the directory entry (a link planted at the target is
+replaced, its target never written) and files appended to in place are opened with
+``O_NOFOLLOW`` (:func:`open_nofollow`). Temporary files are named ``.<name>.<random>.part``;
+they are removed on every exit path that Python sees and swept by :func:`sweep_temporary`
+on the next run after a ``kill -9``.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import hashlib
 import json
 import os
-import tempfile
+import secrets
+import stat
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 from flatcontact.errors import InputError
+
+#: Longest file or folder name in bytes (``NAME_MAX`` of Linux and macOS file systems).
+NAME_MAX = 255
+#: Longest path in bytes (``PATH_MAX`` of Linux).
+PATH_MAX = 4096
+#: Suffixes of the temporary files this package writes (always hidden: ``.<name>.*``).
+TEMPORARY_SUFFIXES = (".part", ".tmp")
+_PART_SUFFIX = ".part"
+_RANDOM_CHARS = 8
+
+
+def check_path_length(path: str | os.PathLike[str], what: str) -> None:
+    """Refuse a path with a name over :data:`NAME_MAX` or a length over :data:`PATH_MAX` bytes.
+
+    Parameters
+    ----------
+    path
+        The path as the user wrote it.
+    what
+        How the user named it, first in the message (``"--out"``, ``"config file"``).
+
+    Raises
+    ------
+    InputError
+        One line naming ``what``, the offending name (shortened) and the limit.
+    """
+    raw = os.fsencode(path)
+    if len(raw) > PATH_MAX:
+        raise InputError(f"{what}: path of {len(raw)} bytes is longer than {PATH_MAX} bytes")
+    for part in raw.split(b"/"):
+        if len(part) > NAME_MAX:
+            shown = os.fsdecode(part[:40])
+            raise InputError(
+                f"{what}: name {shown!r}... is {len(part)} bytes, longer than the "
+                f"{NAME_MAX} bytes a file system allows for one name"
+            )
+
+
+def refuse_link(path: str | os.PathLike[str], what: str = "") -> None:
+    """Refuse ``path`` if it is a symbolic link (flatcontact never writes through one).
+
+    Raises
+    ------
+    InputError
+        One line naming the path and where the link points.
+    """
+    path = Path(path)
+    if path.is_symlink():
+        try:
+            where = os.readlink(path)
+        except OSError:
+            where = "?"
+        kind = f" ({what})" if what else ""
+        raise InputError(
+            f"{path}: is a symbolic link{kind} to {where!r}; flatcontact does not write through "
+            "links: remove the link and rerun"
+        )
+
+
+def open_nofollow(
+    path: str | os.PathLike[str], append: bool = False, readable: bool = False, mode: int = 0o666
+) -> int:
+    """Open ``path`` for writing without following a symbolic link; return the descriptor.
+
+    ``append`` keeps what is there (``O_APPEND``), otherwise the file is created or truncated;
+    ``readable`` opens it for reading too. The file is created if missing, with ``mode`` less
+    the umask.
+
+    Raises
+    ------
+    InputError
+        If ``path`` is a symbolic link (``ELOOP``) or not a regular file.
+    """
+    flags = (os.O_RDWR if readable else os.O_WRONLY) | os.O_CREAT | os.O_CLOEXEC
+    flags |= os.O_APPEND if append else os.O_TRUNC
+    return _open_checked(path, flags, mode)
+
+
+def _open_checked(path: str | os.PathLike[str], flags: int, mode: int) -> int:
+    """``os.open`` with ``O_NOFOLLOW``; a link or a non-regular file is one InputError line."""
+    try:
+        fd = os.open(path, flags | os.O_NOFOLLOW | os.O_NONBLOCK, mode)
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            refuse_link(path)
+        if exc.errno == errno.ENXIO:  # a FIFO without a reader
+            raise InputError(f"{path}: is not a regular file; remove it and rerun") from None
+        raise
+    if not stat.S_ISREG(os.fstat(fd).st_mode):  # a FIFO, a device planted there
+        os.close(fd)
+        raise InputError(f"{path}: is not a regular file; remove it and rerun")
+    os.set_blocking(fd, True)
+    return fd
+
+
+def sweep_temporary(folder: str | os.PathLike[str], recursive: bool = False) -> list[Path]:
+    """Remove the temporary files an interrupted writer left in ``folder``; return them.
+
+    Temporary files are hidden files ending in one of :data:`TEMPORARY_SUFFIXES`
+    (``.<name>.<random>.part`` of :func:`atomic_path`, ``.report.html.tmp``). Call it only
+    while holding the folder's writer lock: another writer's files would go too. Links are
+    removed as links, never followed.
+    """
+    folder = Path(folder)
+    removed = []
+    if not folder.is_dir() or folder.is_symlink():
+        return removed
+    for dirpath, dirnames, filenames in os.walk(folder):
+        for name in filenames + [d for d in dirnames if (Path(dirpath) / d).is_symlink()]:
+            if name.startswith(".") and name.endswith(TEMPORARY_SUFFIXES):
+                path = Path(dirpath) / name
+                with contextlib.suppress(FileNotFoundError):
+                    path.unlink()
+                    removed.append(path)
+        if not recursive:
+            break
+    return removed
 
 
 def _umask() -> int:
@@ -30,16 +155,24 @@ def _umask() -> int:
 def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     """Yield a temporary path next to ``path``; move it onto ``path`` on success.
 
-    On an exception the temporary file is removed and ``path`` is untouched.
+    On an exception the temporary file is removed and ``path`` is untouched. The temporary
+    file is created ``O_EXCL | O_NOFOLLOW`` in ``path``'s folder; ``os.replace`` then swaps
+    the directory entry, so a symbolic link planted at ``path`` is replaced, not written
+    through.
+
+    Raises
+    ------
+    InputError
+        If ``path``'s name is longer than :data:`NAME_MAX` bytes or its folder is a link.
     """
     target = Path(path)
+    check_path_length(target.name, str(target.parent))
     target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".part", dir=target.parent)
-    os.close(fd)
-    tmp = Path(tmp_name)
+    refuse_link(target.parent, "a folder flatcontact writes into")
+    tmp = _create_temporary(target)
     try:
         yield tmp
-        if tmp.exists():  # mkstemp makes 0600 files; give the result the usual permissions
+        if tmp.exists():  # the temporary file is 0600; give the result the usual permissions
             os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, target)
     finally:
@@ -58,6 +191,29 @@ def file_sha256(path: str | os.PathLike[str]) -> str:
         for block in iter(lambda: handle.read(1 << 20), b""):
             digest.update(block)
     return digest.hexdigest()
+
+
+def _create_temporary(target: Path) -> Path:
+    """A new empty hidden file ``.<name>.<random>.part`` beside ``target`` (name <= NAME_MAX)."""
+    room = NAME_MAX - len(_PART_SUFFIX) - _RANDOM_CHARS - 2
+    stem = os.fsdecode(os.fsencode(target.name)[:room])
+    for _ in range(100):
+        tmp = target.parent / f".{stem}.{secrets.token_hex(_RANDOM_CHARS // 2)}{_PART_SUFFIX}"
+        try:
+            fd = _open_checked(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        except FileExistsError:
+            continue
+        os.close(fd)
+        return tmp
+    raise FileExistsError(errno.EEXIST, "no free temporary name", str(target))
+
+
+def copy_file_atomic(source: str | os.PathLike[str], path: str | os.PathLike[str]) -> Path:
+    """Copy ``source`` onto ``path`` atomically (see :func:`atomic_path`); return ``path``."""
+    with atomic_path(path) as tmp, open(source, "rb") as src, open(tmp, "wb") as dst:
+        while block := src.read(1 << 20):
+            dst.write(block)
+    return Path(path)
 
 
 def write_text_atomic(path: str | os.PathLike[str], text: str) -> Path:
@@ -87,10 +243,11 @@ def read_text_file(path: str | Path, what: str, max_bytes: int) -> str:
     Raises
     ------
     InputError
-        Missing, a directory, unreadable (permissions, ``/proc/self/mem``), larger than
+        A name longer than :data:`NAME_MAX` bytes, missing, a directory, unreadable (permissions, ``/proc/self/mem``), larger than
         ``max_bytes`` or not UTF-8 text.
     """
     path = Path(path)
+    check_path_length(path, str(path) if len(os.fsencode(path)) <= 200 else what)
     if not path.exists():
         raise InputError(f"{path}: no such {what}")
     if path.is_dir():

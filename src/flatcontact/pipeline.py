@@ -56,7 +56,13 @@ from flatcontact import __version__
 from flatcontact.codegraph import SOURCE_ROOT, closure_digest, import_closure
 from flatcontact.config import RunConfig, recipe_files, to_yaml
 from flatcontact.errors import InputError
-from flatcontact.fileio import file_sha256, write_json_atomic, write_text_atomic
+from flatcontact.fileio import (
+    copy_file_atomic,
+    file_sha256,
+    open_nofollow,
+    write_json_atomic,
+    write_text_atomic,
+)
 from flatcontact.ispes.contract import open_ispes
 from flatcontact.layout import (
     CONFIG_YAML,
@@ -99,7 +105,15 @@ from flatcontact.stages.report import ReportInputs, run_report
 from flatcontact.stages.scan import ScanInputs, run_scan
 from flatcontact.structures.interface_io import read_interface
 
-__all__ = ["STAGES", "STAGE_MODULES", "Pipeline", "StageEvent", "run", "stage_code", "stage_code_digest"]
+__all__ = [
+    "STAGES",
+    "STAGE_MODULES",
+    "Pipeline",
+    "StageEvent",
+    "run",
+    "stage_code",
+    "stage_code_digest",
+]
 
 log = logging.getLogger("flatcontact.run")
 
@@ -140,6 +154,13 @@ def stage_code_digest(name: str, root: Path = SOURCE_ROOT) -> str:
 RUN_FORMAT = "flatcontact.run/1"
 #: Scan settings that change how, not what, is computed (kept out of the fingerprint).
 EXECUTION_ONLY = ("executor", "workers", "dask_address", "jobqueue")
+
+
+class _NoFollowFileHandler(logging.FileHandler):
+    """The run log, appended to without following a link planted at ``run.log``."""
+
+    def _open(self):
+        return open(open_nofollow(self.baseFilename, append=True), "a", encoding=self.encoding)
 
 
 @dataclass(frozen=True)
@@ -237,7 +258,7 @@ class Pipeline:
         check_inputs(self.config)
 
     def _open_log(self) -> None:
-        handler = logging.FileHandler(self.root / RUN_LOG, encoding="utf-8")
+        handler = _NoFollowFileHandler(self.root / RUN_LOG, encoding="utf-8")
         handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
         logger = logging.getLogger("flatcontact")
         logger.addHandler(handler)
@@ -503,10 +524,7 @@ class Pipeline:
         target = self.root / REPORT_HTML
         if self.rundir.read_only is not None:  # a finished run on a read-only mount
             return target if target.is_file() else result.folder / REPORT_HTML
-        tmp = target.with_name(f".{REPORT_HTML}.tmp")
-        shutil.copyfile(result.folder / REPORT_HTML, tmp)
-        tmp.replace(target)
-        return target
+        return copy_file_atomic(result.folder / REPORT_HTML, target)
 
     def run(self) -> Path:
         """Every stage in order; returns the path of ``report.html``."""

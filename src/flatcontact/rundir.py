@@ -27,6 +27,14 @@ Hence
 Fingerprints hold content, never absolute paths (input files enter by name and SHA-256),
 so a run directory or its configuration folder can be moved without rerunning anything.
 
+Nothing is written through a symbolic link: a run directory holds only what flatcontact
+wrote, so a link among its entries (a stage folder, ``run.log``, ``.flatcontact.lock``,
+``.report.html.tmp``) or inside the folder of a stage about to run is refused in one line
+naming it, before anything is written (the run directory itself may be a link the user
+made). Temporary files (``.<name>.<random>.part``, ``.*.tmp``) that a killed writer left
+are swept when the next writer takes the lock (the run directory's own) and before and
+after each stage runs (the stage's folder).
+
 One writer per run directory: :class:`RunLock` holds an advisory ``flock`` on
 ``.flatcontact.lock`` (with the writer's pid in it) for as long as the run lives; a second
 writer is refused in one line, and the kernel drops the lock when the first dies, however
@@ -47,6 +55,7 @@ import logging
 import os
 import platform
 import shutil
+import tempfile
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -55,7 +64,13 @@ from pathlib import Path
 from typing import Any
 
 from flatcontact.errors import InputError
-from flatcontact.fileio import file_sha256, write_json_atomic
+from flatcontact.fileio import (
+    file_sha256,
+    open_nofollow,
+    refuse_link,
+    sweep_temporary,
+    write_json_atomic,
+)
 
 RECORD_NAME = "stage.json"
 LOCK_NAME = ".flatcontact.lock"
@@ -171,8 +186,14 @@ class RunLock:
         self._handle = None
 
     def acquire(self) -> RunLock:
-        """Take the lock or raise a one-line :class:`InputError` naming the live writer."""
-        handle = open(self.path, "a+")
+        """Take the lock or raise a one-line :class:`InputError` naming the live writer.
+
+        The lock file is opened without following a link (a link planted there is refused in
+        one line). Once the lock is held, temporary files that a killed writer left directly
+        in the directory are removed (:func:`~flatcontact.fileio.sweep_temporary`).
+        """
+        fd = open_nofollow(self.path, append=True, readable=True)
+        handle = open(fd, "a+", closefd=True)
         try:
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
@@ -190,6 +211,7 @@ class RunLock:
         handle.write(f"{os.getpid()}\n")
         handle.flush()
         self._handle = handle
+        sweep_temporary(self.path.parent)
         return self
 
     def release(self, tidy: bool | str = False) -> None:
@@ -224,8 +246,6 @@ def writable(root: Path) -> OSError | None:
     Tries for real (permission bits say nothing for root or a read-only mount). A full disk
     (ENOSPC) counts as writable: it is reported where a write fails.
     """
-    import tempfile
-
     try:
         fd, name = tempfile.mkstemp(prefix=".flatcontact-probe.", dir=root)
     except OSError as exc:
@@ -235,6 +255,22 @@ def writable(root: Path) -> OSError | None:
     os.close(fd)
     os.unlink(name)
     return None
+
+
+def _refuse_links(folder: Path) -> None:
+    """Refuse a stage folder that is a symbolic link or holds one (one line naming it)."""
+    refuse_link(folder, "a stage folder")
+    if folder.is_dir():
+        for dirpath, dirnames, filenames in os.walk(folder):
+            for entry in sorted(dirnames + filenames):
+                refuse_link(Path(dirpath) / entry, "in a stage folder")
+
+
+def _sweep(folder: Path) -> None:
+    """Remove the temporary files of ``folder`` (a killed or failed writer's) and log them."""
+    removed = sweep_temporary(folder, recursive=True)
+    if removed:
+        log.info("%s: removed %d temporary file(s) of an interrupted write", folder, len(removed))
 
 
 @dataclass(frozen=True)
@@ -255,12 +291,20 @@ class RunDirectory:
     ----------
     root
         The run directory; created if missing.
+
+    Raises
+    ------
+    InputError
+        If ``root`` exists and is not a directory, or one of its entries is a symbolic link.
     """
 
     def __init__(self, root: str | Path, read_only: OSError | None = None):
         self.root = Path(root)
         if self.root.exists() and not self.root.is_dir():
             raise InputError(f"{self.root}: exists and is not a directory")
+        if self.root.is_dir():
+            for entry in sorted(self.root.iterdir()):
+                refuse_link(entry, "in a run directory")
         #: why the directory cannot be written (then only finished stages can be read)
         self.read_only = read_only
         if read_only is None:
@@ -313,6 +357,7 @@ class RunDirectory:
         partial state of an interrupted earlier attempt with the same inputs.
         """
         folder = self.folder(index, name)
+        _refuse_links(folder)
         digest = fingerprint(inputs)
         record = self.read_record(folder) if folder.exists() else None
         if record is not None and record.get("stage") != name:
@@ -350,6 +395,7 @@ class RunDirectory:
                 folder.rename(previous)
                 log.info("stage %s: inputs changed, previous results moved to %s", name, previous)
         folder.mkdir(parents=True, exist_ok=True)
+        _sweep(folder)
         base = {
             "stage": name,
             "fingerprint": digest,
@@ -360,7 +406,10 @@ class RunDirectory:
         write_json_atomic(folder / RECORD_NAME, {**base, "state": STATE_RUNNING})
         log.info("stage %s: %s", name, "resuming" if action == "resumed" else "running")
         start = time.perf_counter()
-        work(folder)
+        try:
+            work(folder)
+        finally:  # whatever a failed or interrupted write left half-done
+            _sweep(folder)
         seconds = time.perf_counter() - start
         write_json_atomic(
             folder / RECORD_NAME,

@@ -7,6 +7,8 @@ or a boxed multi-line message:
 - :class:`~flatcontact.errors.InputError` raised by a command (bad values, files, configs);
 - a full disk (``ENOSPC``, ``EDQUOT``) in any stage: one line saying to free space and
   rerun (the rerun resumes: stage records and scan points are written atomically);
+- a resource limit of the process: the file-size limit (``ulimit -f``, ``EFBIG``) and the
+  memory limit (``ulimit -v``, ``MemoryError``), one line naming the limit and the file;
 - click's own usage errors (``--layers abc``, a missing argument, an unknown option),
   printed as click's one-line message followed by where to find help.
 
@@ -26,6 +28,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import errno
 import logging
+import resource
 import sqlite3
 import sys
 import warnings
@@ -35,7 +38,7 @@ import typer
 
 from flatcontact import __version__
 from flatcontact.cli import commands as _commands  # noqa: F401  (registers the sub-commands)
-from flatcontact.cli.app import app, console, print_error
+from flatcontact.cli.app import app, check_out_flags, console, print_error
 from flatcontact.errors import InputError
 
 __all__ = ["app", "main", "usage_error_line"]
@@ -85,9 +88,34 @@ _DISK_FULL = (errno.ENOSPC, errno.EDQUOT)
 def disk_full_line(exc: OSError) -> str:
     """One line for a write that failed because the disk (or the quota) is full."""
     where = f" writing {exc.filename}" if exc.filename else ""
+    soft, _ = resource.getrlimit(resource.RLIMIT_FSIZE)
+    limit = (
+        f" or the file size limit of this process ({soft} bytes, ulimit -f) reached"
+        if soft != resource.RLIM_INFINITY
+        else ""
+    )
     return (
-        f"no space left on the device{where} ({exc.strerror or 'disk full'}); free some space "
-        "and rerun the same command: finished stages and scan points are kept"
+        f"no space left on the device{where}{limit} ({exc.strerror or 'disk full'}); free some "
+        "space and rerun the same command: finished stages and scan points are kept"
+    )
+
+
+def file_size_line(exc: OSError) -> str:
+    """One line for a write stopped by the process's file-size limit (``ulimit -f``)."""
+    where = f" writing {exc.filename}" if exc.filename else ""
+    return (
+        f"file size limit of this process reached{where} ({exc.strerror or 'File too large'}); "
+        "raise it (ulimit -f) and rerun the same command: finished stages and scan points are kept"
+    )
+
+
+def memory_line(exc: MemoryError) -> str:
+    """One line for an allocation refused by the memory limit (``ulimit -v``) or the machine."""
+    said = " ".join(str(exc).split())
+    detail = f" ({said})" if said else ""
+    return (
+        f"out of memory{detail}; raise the memory limit (ulimit -v) or run a smaller study, "
+        "then rerun the same command: finished stages and scan points are kept"
     )
 
 
@@ -106,14 +134,21 @@ def main(argv: list[str] | None = None) -> None:
     # ASE's note on reading its own extxyz files (info it cannot hash): noise, not news
     warnings.filterwarnings("ignore", message="Skipping unhashable information")
     try:
+        check_out_flags([str(a) for a in (sys.argv[1:] if argv is None else argv)])
         rv = app(args=argv, standalone_mode=False, prog_name="flatcontact")
     except InputError as exc:
         print_error(exc)
         sys.exit(2)
     except OSError as exc:
+        if exc.errno == errno.EFBIG:
+            print_error(file_size_line(exc))
+            sys.exit(2)
         if exc.errno not in _DISK_FULL:
             raise
         print_error(disk_full_line(exc))
+        sys.exit(2)
+    except MemoryError as exc:  # numpy's _ArrayMemoryError included
+        print_error(memory_line(exc))
         sys.exit(2)
     except sqlite3.OperationalError as exc:  # the scan's point store on a full disk
         if "full" not in str(exc):

@@ -49,7 +49,9 @@ def check_out_dir(path: str | Path, flag: str = "--out") -> Path:
     ``path`` must be an existing writable directory or one that can be created (its nearest
     existing ancestor is a writable directory). The check really creates the missing
     directories and a probe file and removes them again, so it holds for root and for
-    special file systems (``/proc``) where permission bits say nothing.
+    special file systems (``/proc``) where permission bits say nothing; it then restores the
+    modification time of the directory it probed in, so a command refused later has changed
+    nothing outside ``path``.
 
     Returns
     -------
@@ -59,14 +61,19 @@ def check_out_dir(path: str | Path, flag: str = "--out") -> Path:
     Raises
     ------
     InputError
-        One line naming ``flag`` and the path: exists and is not a directory, or not creatable
-        / not writable (with the operating system's reason).
+        One line naming ``flag`` and the path: empty, a name longer than 255 bytes, exists and
+        is not a directory, or not creatable / not writable (with the operating system's
+        reason).
     """
     import os
     import tempfile
 
     from flatcontact.errors import InputError
+    from flatcontact.fileio import check_path_length
 
+    if not str(path).strip():
+        raise InputError(f"{flag} {str(path)!r}: empty path; name a directory (. for this one)")
+    check_path_length(path, flag)
     out = Path(path).expanduser()
     if out.exists() and not out.is_dir():
         raise InputError(f"{flag} {str(out)!r}: exists and is not a directory")
@@ -77,6 +84,7 @@ def check_out_dir(path: str | Path, flag: str = "--out") -> Path:
         probe = probe.parent
     if not probe.is_dir():
         raise InputError(f"{flag} {str(out)!r}: {str(probe)!r} is not a directory")
+    before = probe.stat()  # the probe leaves no trace: not even a changed mtime
     try:
         for d in reversed(created):
             d.mkdir()
@@ -93,7 +101,34 @@ def check_out_dir(path: str | Path, flag: str = "--out") -> Path:
                 d.rmdir()
             except OSError:
                 pass
+        try:
+            os.utime(probe, ns=(before.st_atime_ns, before.st_mtime_ns))
+        except OSError:  # not the owner: the time stays changed, nothing else does
+            pass
     return out
+
+
+def check_out_flags(argv: list[str], flags: tuple[str, ...] = ("--out",)) -> None:
+    """Refuse an empty or over-long value of an output flag in ``argv``, before any command runs.
+
+    ``--out ''`` would otherwise become the working directory (a path type turns ``''`` into
+    ``.``), and a name over 255 bytes fails in the first ``stat``. Both are one line naming
+    the flag; nothing is touched.
+    """
+    from flatcontact.errors import InputError
+    from flatcontact.fileio import check_path_length
+
+    for i, token in enumerate(argv):
+        for flag in flags:
+            if token == flag and i + 1 < len(argv):
+                value = argv[i + 1]
+            elif token.startswith(flag + "="):
+                value = token[len(flag) + 1 :]
+            else:
+                continue
+            if not value.strip():
+                raise InputError(f"{flag} {value!r}: empty path; name a directory (. for this one)")
+            check_path_length(value, flag)
 
 
 def split_list(values: list[str] | None, flag: str, *, whitespace: bool = True) -> list[str]:

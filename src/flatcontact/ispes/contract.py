@@ -19,17 +19,30 @@ attrs
     ``flatcontact_version``.
 
 Points not computed yet are NaN with ``converged = False``.
+
+Reading (:func:`open_ispes`, the one reader of the file) checks, in this order, each failure
+one :class:`~flatcontact.errors.InputError` line naming the file and the defect, never a
+warning line: the file opens as netCDF4/HDF5 (anything h5netcdf cannot read, including
+plain HDF5 without dimensions, is "not a readable netCDF file" or a missing dimension);
+the three dimensions exist and their sizes are within the run bounds of
+:mod:`flatcontact.limits` (``grid_axis`` per lateral axis, ``thicknesses``, ``scan_points``
+for the product) before any variable is read into memory; then :func:`validate_ispes`:
+the required variables exist on exactly the three dimensions with numeric values;
+``a1``, ``a2`` are vectors of at least two finite numbers, ``area`` one finite number equal
+to |a1 × a2|; the shift coordinates are the equally spaced fractions; the thicknesses are
+finite and distinct; units are known.
 """
 
 from __future__ import annotations
 
 import os
+import warnings
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from flatcontact import __version__
+from flatcontact import __version__, limits
 from flatcontact.errors import InputError
 from flatcontact.fileio import atomic_path
 
@@ -139,19 +152,27 @@ def validate_ispes(ds: xr.Dataset, source: str = "ISPES grid") -> xr.Dataset:
             raise InputError(
                 f"{source}: variable '{var}' must have dims {DIMS}, has {ds[var].dims}"
             )
+        if not _numeric(ds[var].dtype):
+            raise InputError(f"{source}: variable '{var}' must hold numbers, holds {ds[var].dtype}")
+    for name in (*DIMS, VAR_CONVERGED, VAR_FORCE_CALLS):
+        if name in ds.variables and not _numeric(ds[name].dtype, bool_ok=True):
+            raise InputError(f"{source}: '{name}' must hold numbers, holds {ds[name].dtype}")
     for attr in REQUIRED_ATTRS:
         if attr not in ds.attrs:
             raise InputError(f"{source}: missing attribute '{attr}' (Å vectors a1, a2 and area Å²)")
-    a1 = np.asarray(ds.attrs["a1"], dtype=float).ravel()
-    a2 = np.asarray(ds.attrs["a2"], dtype=float).ravel()
+    a1 = _finite_attr(ds, "a1", source, "an in-plane vector of 2 numbers in Å")
+    a2 = _finite_attr(ds, "a2", source, "an in-plane vector of 2 numbers in Å")
+    stored_area = _finite_attr(ds, "area", source, "one number in Å²")
     if a1.size < 2 or a2.size < 2:
         raise InputError(f"{source}: attributes a1, a2 must be in-plane 2-vectors in Å")
+    if stored_area.size != 1:
+        raise InputError(f"{source}: attribute 'area' must be one number in Å²")
     area = cell_area(a1, a2)
     if not area > 0:
         raise InputError(f"{source}: a1 and a2 are parallel (zero cell area)")
-    if not np.isclose(float(ds.attrs["area"]), area, rtol=_AREA_RTOL):
+    if not np.isclose(float(stored_area[0]), area, rtol=_AREA_RTOL):
         raise InputError(
-            f"{source}: attribute area={float(ds.attrs['area']):.6g} Å² differs from |a1 × a2| = {area:.6g} Å²"
+            f"{source}: attribute area={float(stored_area[0]):.6g} Å² differs from |a1 × a2| = {area:.6g} Å²"
         )
     for dim in (DIM_A, DIM_B):
         s = np.asarray(ds[dim].values, dtype=float)
@@ -170,6 +191,40 @@ def validate_ispes(ds: xr.Dataset, source: str = "ISPES grid") -> xr.Dataset:
         ds[VAR_CONVERGED] = np.isfinite(ds[VAR_ENERGY]) & np.isfinite(ds[VAR_STRESS])
     ds = ds.transpose(*DIMS, ...)
     return ds
+
+
+def _numeric(dtype: Any, bool_ok: bool = False) -> bool:
+    """Whether ``dtype`` holds real numbers (booleans only with ``bool_ok``)."""
+    if np.issubdtype(dtype, np.bool_):
+        return bool_ok
+    return np.issubdtype(dtype, np.integer) or np.issubdtype(dtype, np.floating)
+
+
+def _finite_attr(ds: xr.Dataset, name: str, source: str, expected: str) -> np.ndarray:
+    """Attribute ``name`` as a flat float array; InputError unless it is finite numbers."""
+    value = ds.attrs[name]
+    try:
+        if isinstance(value, str | bytes):
+            raise ValueError(name)
+        array = np.asarray(value, dtype=float).ravel()
+    except (TypeError, ValueError):
+        kind = "text" if isinstance(value, str | bytes) else type(value).__name__
+        raise InputError(f"{source}: attribute '{name}' must be {expected}, is {kind}") from None
+    if array.size == 0 or not np.all(np.isfinite(array)):
+        raise InputError(f"{source}: attribute '{name}' must be {expected} (finite)")
+    return array
+
+
+def _check_dims(ds: xr.Dataset, source: str) -> None:
+    """The three dimensions exist and their sizes are within the run bounds (before loading)."""
+    for dim in DIMS:
+        if dim not in ds.dims:
+            raise InputError(f"{source}: missing dimension '{dim}' (expected dims {DIMS})")
+    n_a, n_b, n_z = (int(ds.sizes[d]) for d in DIMS)
+    limits.check("grid_axis", n_a, f"{source}: dimension '{DIM_A}'", "grid points")
+    limits.check("grid_axis", n_b, f"{source}: dimension '{DIM_B}'", "grid points")
+    limits.check("thicknesses", n_z, f"{source}: dimension '{DIM_Z}'", "thicknesses")
+    limits.check("scan_points", n_a * n_b * n_z, f"{source}: grid", "points × thicknesses")
 
 
 def _to_contract_units(ds: xr.Dataset, source: str) -> xr.Dataset:
@@ -195,18 +250,29 @@ def _to_contract_units(ds: xr.Dataset, source: str) -> xr.Dataset:
 
 
 def open_ispes(path: str | os.PathLike[str]) -> xr.Dataset:
-    """Read and validate an ``ispes.nc`` file into memory."""
+    """Read and validate an ``ispes.nc`` file into memory (the checks: see the module docstring).
+
+    Raises
+    ------
+    InputError
+        One line naming ``path`` and the first defect; no warning reaches the user.
+    """
     import xarray as xr
 
     path = Path(path)
     if not path.is_file():
         raise InputError(f"{path}: no such ISPES file")
     try:
-        with xr.open_dataset(path, engine="h5netcdf") as ds:
-            ds = ds.load()
-    except (OSError, ValueError) as exc:
+        with warnings.catch_warnings():  # h5netcdf on plain HDF5, xarray decoding notes
+            warnings.simplefilter("ignore")
+            with xr.open_dataset(path, engine="h5netcdf") as ds:
+                _check_dims(ds, str(path))  # sizes first: nothing is read into memory yet
+                ds = ds.load()
+            return validate_ispes(ds, source=str(path))
+    except InputError:
+        raise
+    except (OSError, ValueError, TypeError, KeyError, AttributeError, RuntimeError) as exc:
         raise InputError(f"{path}: not a readable netCDF file ({exc.__class__.__name__})") from None
-    return validate_ispes(ds, source=str(path))
 
 
 def write_ispes(ds: xr.Dataset, path: str | os.PathLike[str]) -> Path:
