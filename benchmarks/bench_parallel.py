@@ -104,11 +104,11 @@ def main(argv: list[str] | None = None) -> None:
 
 def _force_loop(seconds_out, ready, start, steps: int) -> None:
     """One process: LAMMPS's own force loop on the quartz interface (no Python per call)."""
-    from flatcontact.potentials import PotentialSpec
+    from flatcontact.potentials import InteractionModel
     from flatcontact.potentials.calculator import LammpsInterfaceCalculator
     from flatcontact.structures.build import build_quartz_interface
 
-    spec = PotentialSpec(intra="snap:sio2-snap")
+    spec = InteractionModel(intra="snap:sio2-snap")
     reference, _ = build_quartz_interface(spec, layers=6, source="shipped")
     calc = LammpsInterfaceCalculator(spec, reference)
     calc.engine.compute(reference.positions)

@@ -4,7 +4,7 @@ System
 ------
 The verified dense α-quartz (0001) interface of the paper: two 6-layer slabs, 1×1
 primitive cell, 36 atoms, built with
-``build_quartz_interface(PotentialSpec(intra=...), layers=6, source="shipped")`` (the
+``build_quartz_interface(InteractionModel(intra=...), layers=6, source="shipped")`` (the
 shipped CHGNet-relaxed dense slab, relaxed again and verified with each potential).
 
 Measured
@@ -198,10 +198,10 @@ def calls_by_start(db_path: Path) -> dict[str, str]:
 
 def build(intra: str):
     from flatcontact.ispes.calculators import PotentialFactory
-    from flatcontact.potentials import PotentialSpec
+    from flatcontact.potentials import InteractionModel
     from flatcontact.structures.build import build_quartz_interface
 
-    spec = PotentialSpec(intra=intra)
+    spec = InteractionModel(intra=intra)
     t0 = time.perf_counter()
     reference, report = build_quartz_interface(spec, layers=6, source="shipped")
     dense = all(v["dense"] for v in report["interface_verification"].values())
@@ -327,12 +327,12 @@ def main() -> None:
             summaries[intra] = subset(intra, tmp)
 
         spec6, reference, _ = build(f"snap:{SNAP_BUNDLED}")
-        from flatcontact.potentials import PotentialSpec
+        from flatcontact.potentials import InteractionModel
 
-        spec8 = PotentialSpec(intra=f"snap:{twoj8_standin(tmp)}")
+        spec8 = InteractionModel(intra=f"snap:{twoj8_standin(tmp)}")
         t6 = seconds_per_call(spec6, reference)
         t8 = seconds_per_call(spec8, reference)
-        tv = seconds_per_call(PotentialSpec(intra="vashishta"), reference)
+        tv = seconds_per_call(InteractionModel(intra="vashishta"), reference)
         print(
             f"seconds per force call, {len(reference)} atoms, 1 core: sio2-snap (2J=6, quadratic) "
             f"{t6 * 1e3:.2f} ms; TIMING-ONLY 2J=8 quadratic stand-in "

@@ -35,11 +35,11 @@ def cu_interface(n: int):
 
 
 def quartz_interface(n: int):
-    from flatcontact.potentials import PotentialSpec
+    from flatcontact.potentials import InteractionModel
     from flatcontact.structures.build import build_quartz_interface
 
     ref, _ = build_quartz_interface(
-        PotentialSpec(intra="snap:sio2-snap"), layers=6, source="shipped"
+        InteractionModel(intra="snap:sio2-snap"), layers=6, source="shipped"
     )
     return ref.repeat((n, n, 1))
 
@@ -48,7 +48,7 @@ def one_point(system: str, n: int, threads: int) -> dict:
     """Build, relax one point, report seconds, calls and memory."""
     from flatcontact.ispes.geometry import thickness
     from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point
-    from flatcontact.potentials import InteractionModel, PotentialSpec
+    from flatcontact.potentials import InteractionModel
     from flatcontact.potentials.calculator import LammpsInterfaceCalculator
 
     rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
@@ -58,7 +58,7 @@ def one_point(system: str, n: int, threads: int) -> dict:
         shift = (1 / (3 * n), 1 / (3 * n))
     else:
         ref = quartz_interface(n)
-        model = PotentialSpec(intra="snap:sio2-snap")
+        model = InteractionModel(intra="snap:sio2-snap")
         shift = (1 / (2 * n), 0.0)
     t0 = time.perf_counter()
     calc = LammpsInterfaceCalculator(model, ref)

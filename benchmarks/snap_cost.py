@@ -50,15 +50,15 @@ def random_snap(twojmax: int, folder: Path) -> Path:
 
 def ms_per_call(intra: str, lateral: int) -> tuple[list[float], int]:
     """CPU ms per force call (repeats) and atoms of ``snap:<intra>`` + LJ, quartz interface ``lateral``²."""
-    from flatcontact.potentials import PotentialSpec
+    from flatcontact.potentials import InteractionModel
     from flatcontact.potentials.calculator import LammpsInterfaceCalculator
     from flatcontact.structures.build import build_quartz_interface
 
     ref, _ = build_quartz_interface(
-        PotentialSpec(intra="snap:sio2-snap"), layers=6, source="shipped"
+        InteractionModel(intra="snap:sio2-snap"), layers=6, source="shipped"
     )
     big = ref.repeat((lateral, lateral, 1))
-    calc = LammpsInterfaceCalculator(PotentialSpec(intra=f"snap:{intra}"), big)
+    calc = LammpsInterfaceCalculator(InteractionModel(intra=f"snap:{intra}"), big)
     atoms = big.copy()
     atoms.calc = calc
     atoms.get_forces()

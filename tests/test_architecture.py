@@ -22,6 +22,7 @@ empty it as they do. Any violation not in it fails with the importing module and
 
 from __future__ import annotations
 
+import ast
 import collections
 import textwrap
 from dataclasses import dataclass
@@ -250,6 +251,40 @@ def test_known_violations_still_exist():
     keys = {v.key for v in check(import_graph(SOURCE_ROOT))}
     gone = sorted(KNOWN_VIOLATIONS - keys)
     assert not gone, "fixed, remove from KNOWN_VIOLATIONS:\n" + "\n".join(gone)
+
+
+def _lazy_packages(root: Path) -> set[str]:
+    """The sub-packages whose ``__init__`` exports names lazily (``lazy_loader.attach``)."""
+    found = set()
+    for init in (root / PACKAGE).rglob("__init__.py"):
+        if "lazy_loader.attach" in init.read_text(encoding="utf-8"):
+            found.add(".".join(init.parent.relative_to(root).parts))
+    return found
+
+
+def test_code_imports_names_from_their_module_not_through_a_lazy_package():
+    """Inside flatcontact a name is imported from the module that defines it
+    (``from flatcontact.potentials.model import InteractionModel``), never through a lazy
+    package ``__init__`` (``from flatcontact.potentials import InteractionModel``): the lazy
+    map is for users, and the static graph, hence the layer contract and the stage digests,
+    only sees real imports."""
+    lazy = _lazy_packages(SOURCE_ROOT) - {PACKAGE}
+    assert {"flatcontact.potentials", "flatcontact.contact"} <= lazy
+    offenders = []
+    for path in sorted((SOURCE_ROOT / PACKAGE).rglob("*.py")):
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for node in ast.walk(tree):
+            if not (isinstance(node, ast.ImportFrom) and node.level == 0 and node.module in lazy):
+                continue
+            folder = SOURCE_ROOT.joinpath(*node.module.split("."))
+            for alias in node.names:
+                is_module = (folder / f"{alias.name}.py").is_file() or (
+                    folder / alias.name / "__init__.py"
+                ).is_file()
+                if not is_module:
+                    rel = path.relative_to(SOURCE_ROOT)
+                    offenders.append(f"{rel}:{node.lineno} from {node.module} import {alias.name}")
+    assert not offenders, "import these from their defining module:\n" + "\n".join(offenders)
 
 
 def test_function_level_imports_are_counted():

@@ -26,14 +26,16 @@ def main() -> None:
     from flatcontact.ispes.grid import GridSpec
     from flatcontact.ispes.relax import RelaxSettings
     from flatcontact.ispes.scan import run_scan
-    from flatcontact.potentials import PotentialSpec
+    from flatcontact.potentials import InteractionModel
     from flatcontact.structures.interface_io import read_interface
 
     interface = read_interface(RUNS / "ref" / "01-build" / "interface.extxyz")
     base = build_config({}, "paper").potential.model_dump()
     rows = []
     for rc in CUTOFFS_ANGSTROM:
-        spec = PotentialSpec.model_validate({**base, "lj": {**base["lj"], "cutoff_angstrom": rc}})
+        spec = InteractionModel.model_validate(
+            {**base, "lj": {**base["lj"], "cutoff_angstrom": rc}}
+        )
         res = run_scan(
             interface,
             PotentialFactory.from_spec(spec),

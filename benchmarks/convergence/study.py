@@ -12,7 +12,8 @@ analyze, laws) into ``$FLATCONTACT_CONVERGENCE_RUNS/<name>`` (default
 ``/tmp/flatcontact-convergence``). The result file keeps per load τ, σ_MSS, G_int, the
 path facts (what limits τ, jumps, where τ is reached), the load noise, the work of
 separation W, the fitted laws with standard errors and the wall time of each stage.
-The comparison (:func:`flatcontact.analysis.convergence.compare_runs`) is done by ``table``.
+The comparison (:func:`flatcontact.analysis.convergence.per_load_changes`,
+:func:`~flatcontact.analysis.convergence.law_changes`) is done by ``table``.
 """
 
 from __future__ import annotations

@@ -74,7 +74,7 @@ def ispes(names: list[str], reuse: list[str] = ()) -> None:
     written (``results/ispes_compare_<form>.json``) instead of being scanned, in the order
     of ``names``; e.g. CHGNet, whose store predates the current store fingerprint.
     """
-    from flatcontact.potentials import PotentialSpec
+    from flatcontact.potentials import InteractionModel
     from flatcontact.structures.interface_io import read_interface
     from flatcontact.training.ispes_check import compare_ispes, comparison_table, teacher_spec
 
@@ -98,7 +98,9 @@ def ispes(names: list[str], reuse: list[str] = ()) -> None:
         if name in reuse:
             continue
         models[name] = (
-            PotentialSpec.model_validate(snap.model_dump() | {"intra": f"snap:{SURROGATES[name]}"})
+            InteractionModel.model_validate(
+                snap.model_dump() | {"intra": f"snap:{SURROGATES[name]}"}
+            )
             if name in SURROGATES
             else teacher_spec(name, lj)
         )

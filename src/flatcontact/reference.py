@@ -1,7 +1,7 @@
 """One home for the paper's values and the literature constants flatcontact compares with.
 
 Everything here is a published number, not a setting: the run configuration's defaults
-(:class:`flatcontact.config.ContactConfig`), the ``flatcontact contact`` flag defaults,
+(:class:`flatcontact.config.contact.ContactConfig`), the ``flatcontact contact`` flag defaults,
 :class:`flatcontact.contact.parameters.ContactParameters` and the report's comparison
 table all read it from here, so a corrected value changes every place at once.
 

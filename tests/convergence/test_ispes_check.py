@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from flatcontact.errors import InputError
-from flatcontact.potentials import PotentialSpec
+from flatcontact.potentials import InteractionModel
 from flatcontact.training.ispes_check import (
     QUARTZ_CIJ_EXPERIMENT_GPA,
     compare_ispes,
@@ -24,7 +24,7 @@ pytestmark = pytest.mark.filterwarnings("ignore::flatcontact.analysis.diagnostic
 def interface():
     from flatcontact.structures.build import build_quartz_interface
 
-    atoms, _ = build_quartz_interface(PotentialSpec(intra="vashishta"), 6, source="shipped")
+    atoms, _ = build_quartz_interface(InteractionModel(intra="vashishta"), 6, source="shipped")
     return atoms
 
 
@@ -35,9 +35,9 @@ def committee(interface, tmp_path_factory):
 
     lj = {**default_potential()["lj"], "cutoff_angstrom": 8.0}
     models = {
-        "vashishta": PotentialSpec(intra="vashishta", lj=lj),
-        "tersoff": PotentialSpec(intra="tersoff", lj=lj),
-        "vashishta-again": PotentialSpec(intra="vashishta", lj=lj),
+        "vashishta": InteractionModel(intra="vashishta", lj=lj),
+        "tersoff": InteractionModel(intra="tersoff", lj=lj),
+        "vashishta-again": InteractionModel(intra="vashishta", lj=lj),
     }
     results = {}
     table = compare_ispes(
@@ -103,12 +103,12 @@ def test_comparison_table_round_trips_through_json(committee):
 
 def test_bad_models_are_refused_before_any_scan(interface, tmp_path):
     with pytest.raises(InputError, match="label"):
-        compare_ispes({"a/b": PotentialSpec(intra="vashishta")}, interface, tmp_path)
-    with pytest.raises(InputError, match="expected a PotentialSpec"):
+        compare_ispes({"a/b": InteractionModel(intra="vashishta")}, interface, tmp_path)
+    with pytest.raises(InputError, match="expected a InteractionModel"):
         compare_ispes({"x": "vashishta"}, interface, tmp_path)
     with pytest.raises(InputError, match="exactly one"):
         compare_ispes(
-            {"v": PotentialSpec(intra="vashishta")},
+            {"v": InteractionModel(intra="vashishta")},
             interface,
             tmp_path,
             p_range_gpa=None,

@@ -13,7 +13,7 @@ import shutil
 from pathlib import Path
 
 import pytest
-from flatcontact.structures.interface import write_interface
+from flatcontact.structures.interface_io import write_interface
 from tests.hardening.helpers import TOY_YAML, assert_refused_cleanly, refused, run_cli, tree
 from tests.hardening.test_run_directory import _same_content
 

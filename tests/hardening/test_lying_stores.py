@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 import xarray as xr
 from ase.calculators.singlepoint import SinglePointCalculator
-from flatcontact.structures.interface import write_interface
+from flatcontact.structures.interface_io import write_interface
 from tests.hardening.helpers import assert_refused_cleanly, refused, run_cli, tree
 from tests.hardening.test_run_directory import _same_content
 

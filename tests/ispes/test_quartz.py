@@ -16,10 +16,10 @@ TIGHT = RelaxSettings(fmax_ev_per_a=1e-4, optimizer="LBFGS", max_steps=5000)
 
 @pytest.fixture(scope="module")
 def quartz():
-    from flatcontact.potentials import PotentialSpec, make_calculator
+    from flatcontact.potentials import InteractionModel, make_calculator
     from flatcontact.structures.build import build_quartz_interface
 
-    spec = PotentialSpec(intra="vashishta")
+    spec = InteractionModel(intra="vashishta")
     atoms, _report = build_quartz_interface(
         spec, layers=6, source="shipped"
     )  # raises unless verified

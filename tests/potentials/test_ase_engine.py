@@ -4,14 +4,14 @@ import numpy as np
 import pytest
 
 from flatcontact.errors import InputError
-from flatcontact.potentials import LJSpec, PotentialSpec, make_calculator
+from flatcontact.potentials import InteractionModel, LJSpec, make_calculator
 
 
 @pytest.mark.parametrize("model", ["vashishta", "tersoff"])
 def test_ase_engine_agrees_with_lammps_engine(close_interface, model):
     lj = LJSpec(cutoff_angstrom=9.0)
-    lammps_spec = PotentialSpec(intra=model, lj=lj)
-    ase_spec = PotentialSpec(intra=f"ase:flatcontact.potentials.factories:{model}", lj=lj)
+    lammps_spec = InteractionModel(intra=model, lj=lj)
+    ase_spec = InteractionModel(intra=f"ase:flatcontact.potentials.factories:{model}", lj=lj)
     assert ase_spec.kind == "ase"
     results = []
     for spec in (lammps_spec, ase_spec):
@@ -25,7 +25,7 @@ def test_ase_engine_agrees_with_lammps_engine(close_interface, model):
 
 
 def test_ase_factory_errors_are_one_line():
-    spec = PotentialSpec(intra="ase:flatcontact.potentials.factories:no_such_factory")
+    spec = InteractionModel(intra="ase:flatcontact.potentials.factories:no_such_factory")
     with pytest.raises(InputError, match="no_such_factory"):
         from ase.build import bulk
 

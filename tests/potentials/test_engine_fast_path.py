@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from ase.build import bulk
 
-from flatcontact.potentials import InteractionModel, PotentialSpec, make_calculator
+from flatcontact.potentials import InteractionModel, make_calculator
 from flatcontact.potentials.calculator import LammpsInterfaceCalculator
 from flatcontact.potentials.lammps_engine import LammpsEngine
 from flatcontact.potentials.lammps_setup import compile_setup
@@ -72,7 +72,7 @@ def _check_views(engine):
 
 @pytest.mark.parametrize("intra", ["vashishta", "tersoff"])
 def test_quartz_interface_path_equals_fresh_setups(close_interface, intra):
-    _check_path(PotentialSpec(intra=intra), close_interface)
+    _check_path(InteractionModel(intra=intra), close_interface)
 
 
 def test_interlayer_bilayer_path_equals_fresh_setups():
@@ -91,7 +91,7 @@ def test_bulk_stress_path_equals_fresh_setups():
 
 def test_calculator_reports_position_only_changes(close_interface):
     atoms = close_interface.copy()
-    calc = make_calculator(PotentialSpec(intra="tersoff"), atoms)
+    calc = make_calculator(InteractionModel(intra="tersoff"), atoms)
     atoms.calc = calc
     atoms.get_forces()
     assert calc.check_state(atoms) == []
@@ -106,7 +106,7 @@ def test_vertical_cell_change_keeps_the_engine(close_interface):
     """A slab's vertical cell vector (the scan resizes it with z) is not part of the LAMMPS box:
     changing it keeps the engine and the numbers; an in-plane change rebuilds it."""
     atoms = close_interface.copy()
-    calc = make_calculator(PotentialSpec(intra="tersoff"), atoms)
+    calc = make_calculator(InteractionModel(intra="tersoff"), atoms)
     assert isinstance(calc, LammpsInterfaceCalculator)
     atoms.calc = calc
     e0, f0 = atoms.get_potential_energy(), atoms.get_forces()

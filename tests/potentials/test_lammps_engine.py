@@ -5,7 +5,7 @@ import pytest
 from ase import Atoms
 
 from flatcontact.errors import InputError
-from flatcontact.potentials import PotentialSpec, make_calculator
+from flatcontact.potentials import InteractionModel, make_calculator
 from flatcontact.potentials.lj import lj_cross_energy_forces
 from flatcontact.structures.placement import interslab_min_distance
 
@@ -25,7 +25,7 @@ def _slab_alone(atoms, which):
 
 @pytest.mark.parametrize("intra", CLASSICAL)
 def test_energy_is_slab1_plus_slab2_plus_cross_lj(close_interface, intra):
-    spec = PotentialSpec(intra=intra)
+    spec = InteractionModel(intra=intra)
     # slabs close enough that the intra-slab cutoffs would reach across if not NULL-mapped
     assert interslab_min_distance(close_interface) < 3.0
     e_total, f_total, _ = _energy_forces(spec, close_interface)
@@ -49,7 +49,7 @@ def test_energy_is_slab1_plus_slab2_plus_cross_lj(close_interface, intra):
 
 @pytest.mark.parametrize("intra", [*CLASSICAL, "none"])
 def test_forces_match_finite_differences(close_interface, intra):
-    spec = PotentialSpec(intra=intra)
+    spec = InteractionModel(intra=intra)
     atoms = close_interface.copy()
     atoms.calc = make_calculator(spec, atoms)
     forces = atoms.get_forces()
@@ -68,7 +68,7 @@ def test_forces_match_finite_differences(close_interface, intra):
 
 
 def test_lj_only_engine_matches_numpy_lj(close_interface):
-    spec = PotentialSpec(intra="none")
+    spec = InteractionModel(intra="none")
     e, f, _ = _energy_forces(spec, close_interface)
     table = spec.lj.table(["O", "Si"], ["O", "Si"])
     e_np, f_np = lj_cross_energy_forces(
@@ -80,7 +80,7 @@ def test_lj_only_engine_matches_numpy_lj(close_interface):
 
 @pytest.mark.parametrize("reflect", [False, True])
 def test_frame_invariance_rotation_reflection_and_cell_choice(close_interface, reflect):
-    spec = PotentialSpec(intra="vashishta")
+    spec = InteractionModel(intra="vashishta")
     e0, f0, _ = _energy_forces(spec, close_interface)
     theta = 0.7
     r = np.array([[np.cos(theta), -np.sin(theta), 0], [np.sin(theta), np.cos(theta), 0], [0, 0, 1]])
@@ -103,7 +103,7 @@ def test_frame_invariance_rotation_reflection_and_cell_choice(close_interface, r
 
 
 def test_calculator_reuse_counts_calls_and_rebuilds_on_new_structure(close_interface):
-    spec = PotentialSpec(intra="tersoff")
+    spec = InteractionModel(intra="tersoff")
     atoms = close_interface.copy()
     calc = make_calculator(spec, atoms)
     atoms.calc = calc
@@ -126,5 +126,5 @@ def test_element_mismatch_is_one_line_input_error(close_interface):
     atoms = close_interface.copy()
     atoms.symbols[0] = "Ge"
     with pytest.raises(InputError, match="Ge") as info:
-        make_calculator(PotentialSpec(intra="vashishta"), atoms)
+        make_calculator(InteractionModel(intra="vashishta"), atoms)
     assert "\n" not in str(info.value)

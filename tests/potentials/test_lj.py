@@ -8,7 +8,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from flatcontact.errors import InputError
-from flatcontact.potentials import LJSpec, PotentialSpec
+from flatcontact.potentials import InteractionModel, LJSpec
 from flatcontact.potentials.lj import (
     BOHR_TO_ANGSTROM,
     HARTREE_BOHR6_TO_EV_A6,
@@ -84,9 +84,11 @@ def test_user_c6_and_hirshfeld_scaling():
 
 
 def test_spec_is_frozen_picklable_hashable_and_validates():
-    spec = PotentialSpec(intra="tersoff", lj=LJSpec(c6_ev_a6={"Si-O": 12.0}, cutoff_angstrom=8.0))
+    spec = InteractionModel(
+        intra="tersoff", lj=LJSpec(c6_ev_a6={"Si-O": 12.0}, cutoff_angstrom=8.0)
+    )
     assert pickle.loads(pickle.dumps(spec)) == spec
-    assert hash(spec) == hash(PotentialSpec.model_validate_json(spec.model_dump_json()))
+    assert hash(spec) == hash(InteractionModel.model_validate_json(spec.model_dump_json()))
     assert spec.lj.c6_ev_a6 == {"O-Si": 12.0}
     assert "tersoff" in spec.label and "rc=8" in spec.label
     with pytest.raises(Exception):  # noqa: B017 - pydantic's frozen error
@@ -99,10 +101,10 @@ def test_spec_is_frozen_picklable_hashable_and_validates():
         ("ase:justmodule", "ase:module:factory"),
     ]:
         with pytest.raises(InputError, match=pattern) as info:
-            PotentialSpec(intra=bad)
+            InteractionModel(intra=bad)
         assert "\n" not in str(info.value)
     with pytest.raises(InputError, match="cutoff"):
-        PotentialSpec(lj={"cutoff_angstrom": 0})
+        InteractionModel(lj={"cutoff_angstrom": 0})
 
 
 def test_pairwise_hamaker_constant_by_hand():

@@ -5,7 +5,7 @@ import shutil
 import pytest
 
 from flatcontact.errors import InputError
-from flatcontact.potentials import PotentialSpec
+from flatcontact.potentials import InteractionModel
 from flatcontact.potentials.files import BUNDLED_DIR
 from flatcontact.potentials.names import normalize_potential_name, resolve_intra
 
@@ -29,7 +29,7 @@ def snap_copy(tmp_path):
 def test_bundled_spellings_agree():
     assert normalize_potential_name(BUNDLED) == normalize_potential_name(f"snap:{BUNDLED}")
     assert normalize_potential_name(f" {BUNDLED} ") == f"snap:{BUNDLED}"
-    assert PotentialSpec(intra=BUNDLED) == PotentialSpec(intra=f"snap:{BUNDLED}")
+    assert InteractionModel(intra=BUNDLED) == InteractionModel(intra=f"snap:{BUNDLED}")
 
 
 @needs_bundled
@@ -49,7 +49,7 @@ def test_path_spellings_agree(snap_copy):
 def test_normalize_is_idempotent(name):
     once = normalize_potential_name(name)
     assert normalize_potential_name(once) == once
-    assert PotentialSpec(intra=name).intra == once
+    assert InteractionModel(intra=name).intra == once
 
 
 @pytest.mark.parametrize(

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from ase import Atoms
 
-from flatcontact.potentials import PotentialSpec, make_calculator
+from flatcontact.potentials import InteractionModel, make_calculator
 from flatcontact.potentials.lj import lj_cross_energy_forces
 
 N_COEFF = 6  # 2J = 2: five bispectrum components + the constant
@@ -31,7 +31,7 @@ def snap_files(tmp_path_factory):
 
 
 def test_snap_per_slab_decomposition_and_forces(snap_files, close_interface):
-    spec = PotentialSpec(intra=f"snap:{snap_files}")
+    spec = InteractionModel(intra=f"snap:{snap_files}")
     assert spec.resolved.elements == ("O", "Si")
     atoms = close_interface.copy()
     atoms.calc = make_calculator(spec, atoms)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from flatcontact.potentials import PotentialSpec
+from flatcontact.potentials import InteractionModel
 from flatcontact.structures.build import _single_slab_calculator, reconstruct_dense_slab
 from flatcontact.structures.bulk import alpha_quartz
 from flatcontact.structures.dense import verify_dense_slab
@@ -37,12 +37,12 @@ def test_cleavage_planes_and_slab_stoichiometry():
 
 @pytest.fixture(scope="module")
 def vashishta_dense():
-    spec = PotentialSpec(intra="vashishta")
+    spec = InteractionModel(intra="vashishta")
     return reconstruct_dense_slab(4, _single_slab_calculator(spec), model_label="vashishta")
 
 
 def test_vashishta_reaches_and_keeps_the_dense_surface(vashishta_dense):
-    spec = PotentialSpec(intra="vashishta")
+    spec = InteractionModel(intra="vashishta")
     slab, record = vashishta_dense
     assert slab is not None
     verdict = verify_dense_slab(slab)
@@ -62,7 +62,7 @@ def test_vashishta_reaches_and_keeps_the_dense_surface(vashishta_dense):
 
 
 def test_tersoff_cannot_hold_the_dense_surface():
-    spec = PotentialSpec(intra="tersoff")
+    spec = InteractionModel(intra="tersoff")
     slab, record = reconstruct_dense_slab(4, _single_slab_calculator(spec), model_label="tersoff")
     assert slab is None and not any(t["dense"] for t in record["trials"])
 
@@ -84,7 +84,9 @@ def test_build_quartz_interface_vashishta_seed():
     from flatcontact.structures.build import build_quartz_interface
     from flatcontact.structures.interface_contract import fixed_mask
 
-    interface, report = build_quartz_interface(PotentialSpec(intra="vashishta"), 6, source="seed")
+    interface, report = build_quartz_interface(
+        InteractionModel(intra="vashishta"), 6, source="seed"
+    )
     assert all(v["dense"] for v in report["interface_verification"].values())
     assert fixed_mask(interface).sum() == 12
 
@@ -97,7 +99,7 @@ def test_shipped_chgnet_slab_is_dense_and_survives_relaxation(intra):
     slab, provenance = load_shipped_dense_slab()
     assert provenance["verification"]["dense"] and "CHGNet" in provenance["model"]
     assert verify_dense_slab(slab)["dense"]
-    spec = PotentialSpec(intra=intra)
+    spec = InteractionModel(intra=intra)
     relax(slab, _single_slab_calculator(spec)(slab))
     verdict = verify_dense_slab(slab)
     assert verdict["dense"], verdict["failures"]

@@ -122,10 +122,10 @@ def test_quartz_interface_tags_unchanged():
 
 def test_quartz_recipe_is_the_dense_builder():
     """build_interface(quartz-dense) = build_quartz_interface (same positions, tags, thickness)."""
-    from flatcontact.potentials import PotentialSpec
+    from flatcontact.potentials import InteractionModel
     from flatcontact.structures.build import QUARTZ_MATERIAL, build_quartz_interface
 
-    spec = PotentialSpec(intra="vashishta")
+    spec = InteractionModel(intra="vashishta")
     atoms, report = build_interface({"kind": "quartz-dense", "source": "shipped"}, potential=spec)
     direct, _ = build_quartz_interface(spec, layers=6, source="shipped")
     np.testing.assert_array_equal(atoms.positions, direct.positions)

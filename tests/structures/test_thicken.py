@@ -69,7 +69,7 @@ def test_an_interior_that_is_not_quartz_is_refused():
 
 @pytest.mark.parametrize("layers", [7, 8, 10])
 def test_layer_counts_the_shipped_slab_cannot_reach_are_one_line_errors(layers):
-    from flatcontact.potentials import PotentialSpec
+    from flatcontact.potentials import InteractionModel
     from flatcontact.structures.build import build_quartz_interface
     from flatcontact.structures.recipe import parse_recipe
 
@@ -78,7 +78,7 @@ def test_layer_counts_the_shipped_slab_cannot_reach_are_one_line_errors(layers):
     text = str(err.value)
     assert "\n" not in text and f"layers={layers}" in text and "expected 6, 9, 12" in text
     with pytest.raises(InputError, match=f"layers={layers}: the shipped dense slab"):
-        build_quartz_interface(PotentialSpec(intra="vashishta"), layers, source="shipped")
+        build_quartz_interface(InteractionModel(intra="vashishta"), layers, source="shipped")
 
 
 SNAP = {"intra": "snap:sio2-snap"}
@@ -87,10 +87,10 @@ SNAP = {"intra": "snap:sio2-snap"}
 @pytest.fixture(scope="module")
 def snap_builds():
     """6-, 9- and 12-layer interfaces built from the shipped slab with the bundled SNAP (+ LJ)."""
-    from flatcontact.potentials import PotentialSpec
+    from flatcontact.potentials import InteractionModel
     from flatcontact.structures.build import build_quartz_interface
 
-    spec = PotentialSpec(**SNAP)
+    spec = InteractionModel(**SNAP)
     return spec, {n: build_quartz_interface(spec, n, source="shipped") for n in (6, 9, 12)}
 
 
@@ -197,7 +197,7 @@ def test_from_nine_layers_on_a_repeat_adds_exactly_the_bulk_energy(snap_builds):
 def test_a_thickened_slab_whose_interior_is_not_bulk_like_is_refused(monkeypatch):
     """The build refuses a thickened slab whose interior unit spacing deviates more than
     INTERIOR_MAX_SPACING_DEV from c/3 (the check is forced here by a doctored report)."""
-    from flatcontact.potentials import PotentialSpec
+    from flatcontact.potentials import InteractionModel
     from flatcontact.structures import build
 
     real = build.interior_report
@@ -209,7 +209,7 @@ def test_a_thickened_slab_whose_interior_is_not_bulk_like_is_refused(monkeypatch
 
     monkeypatch.setattr(build, "interior_report", doctored)
     with pytest.raises(InputError, match="interior is not bulk-like") as err:
-        build.build_quartz_interface(PotentialSpec(**SNAP), 9, source="shipped")
+        build.build_quartz_interface(InteractionModel(**SNAP), 9, source="shipped")
     assert "\n" not in str(err.value)
 
 

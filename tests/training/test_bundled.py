@@ -84,14 +84,14 @@ def test_dense_surface_reported_stable(report):
 
 def test_works_in_the_interface_engine():
     """The bundled files run in flatcontact.potentials' two-slab LAMMPS engine."""
-    from flatcontact.potentials import PotentialSpec, make_calculator
+    from flatcontact.potentials import InteractionModel, make_calculator
     from flatcontact.structures.assemble import make_interface
     from flatcontact.training.validate import seeded_dense_slab
 
     slab = seeded_dense_slab()
     slab.pbc = (True, True, False)
     iface = make_interface(slab, 3.0, face_atoms=6)
-    iface.calc = make_calculator(PotentialSpec(intra="snap:sio2-snap"), iface)
+    iface.calc = make_calculator(InteractionModel(intra="snap:sio2-snap"), iface)
     f = iface.get_forces()
     assert f.shape == (len(iface), 3)
     assert abs(f.sum(axis=0)).max() < 1e-6  # Newton's third law across the whole interface

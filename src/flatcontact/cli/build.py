@@ -39,7 +39,7 @@ def _positive_finite(value: float, flag: str, unit: str) -> float:
 
 
 def _potential_spec(potential: str | None, lj_cutoff_angstrom: float | None):
-    """The :class:`~flatcontact.potentials.PotentialSpec` of the flags; errors name the flag.
+    """The :class:`~flatcontact.potentials.InteractionModel` of the flags; errors name the flag.
 
     The run's default model (:func:`flatcontact.config.default_potential`: the bundled SNAP and
     the Hamaker-calibrated TS-vdW LJ) with ``--potential`` replacing its intra-slab model and
@@ -47,7 +47,7 @@ def _potential_spec(potential: str | None, lj_cutoff_angstrom: float | None):
     the model that ``flatcontact run`` and ``flatcontact scan`` use.
     """
     from flatcontact.config import default_potential
-    from flatcontact.potentials import PotentialSpec
+    from flatcontact.potentials.model import InteractionModel
 
     section = default_potential()
     if potential is not None:
@@ -59,7 +59,7 @@ def _potential_spec(potential: str | None, lj_cutoff_angstrom: float | None):
             lj_cutoff_angstrom, "--lj-cutoff-angstrom", "Å"
         )
     try:
-        return PotentialSpec(**section)
+        return InteractionModel(**section)
     except InputError as exc:
         text = str(exc)
         if text.startswith("potential lj.cutoff_angstrom"):

@@ -18,7 +18,7 @@ from flatcontact.errors import InputError, require
 def _ispes_model(name: str, flag: str, lj: dict):
     """The interaction model of ``name`` for the ISPES comparison: an offline teacher
     (``chgnet`` = ``chgnet-r2scan``) or any intra-slab potential name, with the shared LJ."""
-    from flatcontact.potentials import PotentialSpec
+    from flatcontact.potentials.model import InteractionModel
     from flatcontact.potentials.teachers import get_teacher, is_teacher
     from flatcontact.training.ispes_check import teacher_spec
 
@@ -27,7 +27,7 @@ def _ispes_model(name: str, flag: str, lj: dict):
         name = get_teacher(name).name
         return name, teacher_spec(name, lj)
     try:
-        return name, PotentialSpec(intra=name, lj=lj)
+        return name, InteractionModel(intra=name, lj=lj)
     except InputError as exc:
         raise InputError(f"{flag} {name!r}: {exc}") from None
 

@@ -59,9 +59,11 @@ def _potential_section(potential: str) -> dict[str, Any]:
         except ValueError:
             raise InputError(f"--potential {potential}: not valid JSON") from None
         if not isinstance(data, dict):
-            raise InputError(f"--potential {potential}: expected a JSON object (a PotentialSpec)")
+            raise InputError(
+                f"--potential {potential}: expected a JSON object (a InteractionModel)"
+            )
         return data
-    return {"intra": potential}  # any spelling: PotentialSpec normalizes it
+    return {"intra": potential}  # any spelling: InteractionModel normalizes it
 
 
 def resolve_config(config: Path | None, preset: str | None, flags: dict[str, Any]):
@@ -98,7 +100,7 @@ def scan_command(
             "--potential",
             help="potential.intra: vashishta | tersoff | [snap:]NAME | [snap:]path/X.snapcoeff | "
             "ase:module:factory; or a "
-            "PotentialSpec .json whose fields replace the potential section's (default "
+            "InteractionModel .json whose fields replace the potential section's (default "
             "snap:sio2-snap, "
             "vashishta if that is not installed).",
         ),

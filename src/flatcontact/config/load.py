@@ -61,7 +61,7 @@ def build_config(
         return RunConfig.model_validate(merged)
     except ValidationError as exc:
         raise one_line(exc, source) from None
-    except InputError as exc:  # PotentialSpec's own one-line errors ("potential intra: ...")
+    except InputError as exc:  # InteractionModel's own one-line errors ("potential intra: ...")
         text = str(exc)
         if text.startswith("potential "):
             text = "potential." + text.removeprefix("potential ")

@@ -73,6 +73,6 @@ def one_line(exc: ValidationError, source: str) -> InputError:
         field, sep, rest = msg.partition(": ")
         if sep and field.isidentifier() and field.islower() and where:
             where, msg = f"{where}.{field}", rest  # a model check naming its field
-        if where == "potential" and msg.startswith("potential "):  # PotentialSpec's InputError
+        if where == "potential" and msg.startswith("potential "):  # InteractionModel's InputError
             return InputError(f"{source}: potential.{msg.removeprefix('potential ')}")
     return InputError(f"{source}: {where}: {msg}" if where else f"{source}: {msg}")

@@ -22,9 +22,9 @@ from typing import Any
 from ase import Atoms
 from ase.calculators.calculator import Calculator
 
-from flatcontact.potentials import InteractionModel
 from flatcontact.potentials.engines import ModelFactory, calculator_factory
 from flatcontact.potentials.loader import call_factory, load_callable
+from flatcontact.potentials.model import InteractionModel
 
 
 @dataclasses.dataclass(frozen=True)

@@ -1,4 +1,4 @@
-"""ASE calculator factories for ``PotentialSpec(intra="ase:flatcontact.potentials.factories:<name>")``.
+"""ASE calculator factories for ``InteractionModel(intra="ase:flatcontact.potentials.factories:<name>")``.
 
 Each factory takes no arguments and returns a fresh ASE calculator for a single slab.
 

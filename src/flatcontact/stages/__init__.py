@@ -25,3 +25,18 @@ contact    :func:`.contact.run_contact`           contact.nc, summary.json, fig4
 report     :func:`.report.run_report`             report.html
 =========  =====================================  ==========================================
 """
+
+import lazy_loader
+
+__getattr__, __dir__, __all__ = lazy_loader.attach(
+    __name__,
+    submod_attrs={
+        "analyze": ["AnalyzeInputs", "run_analyze"],
+        "build": ["BuildInputs", "run_build"],
+        "contact": ["ContactInputs", "run_contact"],
+        "elastic": ["ElasticInputs", "run_elastic"],
+        "laws": ["LawsInputs", "run_laws"],
+        "report": ["ReportInputs", "run_report"],
+        "scan": ["ScanInputs", "run_scan"],
+    },
+)

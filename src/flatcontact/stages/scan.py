@@ -90,10 +90,10 @@ def built_with_other_model(reference, settings) -> str | None:
     """The model an interface's recipe names when it is not the run's, else ``None``.
 
     The recipe (``info["recipe"]``, written by :mod:`flatcontact.structures.build`) holds the
-    whole ``PotentialSpec`` (``potential_spec``; older files only its label ``potential``, of
+    whole ``InteractionModel`` (``potential_spec``; older files only its label ``potential``, of
     which the intra-slab part is compared). A recipe naming no potential gives ``None``.
     """
-    from flatcontact.potentials import PotentialSpec
+    from flatcontact.potentials.model import InteractionModel
     from flatcontact.potentials.names import normalize_potential_name
 
     try:
@@ -104,7 +104,7 @@ def built_with_other_model(reference, settings) -> str | None:
         return None
     if isinstance(recipe.get("potential_spec"), dict):
         try:
-            built = PotentialSpec(**recipe["potential_spec"])
+            built = InteractionModel(**recipe["potential_spec"])
         except (InputError, TypeError):
             return str(recipe["potential_spec"].get("intra", "an unknown model"))
         return None if _calculator.same_model(settings, built) else built.label

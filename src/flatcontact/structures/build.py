@@ -35,9 +35,9 @@ from ase.io import read, write
 
 from flatcontact.errors import InputError, require
 from flatcontact.fileio import atomic_path, write_json_atomic
-from flatcontact.potentials import InteractionModel, make_calculator
-from flatcontact.potentials.engines import bulk_calculator
+from flatcontact.potentials.engines import bulk_calculator, make_calculator
 from flatcontact.potentials.factories import chgnet_r2scan
+from flatcontact.potentials.model import InteractionModel
 from flatcontact.structures.assemble import make_interface
 from flatcontact.structures.dense import (
     DENSE_FACE_LAYERS,

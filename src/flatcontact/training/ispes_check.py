@@ -13,7 +13,7 @@ Two measurements for any SiO₂ model that has an ASE calculator (issue 12):
   result is one row per (model, load) with τ, σ_MSS, G_int, the work of separation W
   and their differences from the first model (the reference, e.g. the teacher).
 
-A model is a :class:`~flatcontact.potentials.PotentialSpec` (intra-slab model + the same
+A model is a :class:`~flatcontact.potentials.InteractionModel` (intra-slab model + the same
 cross-interface LJ: this isolates the intra-slab potential, which is what a surrogate
 replaces), a factory with ``fingerprint`` (:mod:`flatcontact.ispes.calculators`), or
 anything with ``calculator_factory()``. Offline teachers come from their one registry,
@@ -46,13 +46,13 @@ ISPES_QUANTITIES = ("tau_mpa", "sigma_mss_mpa", "shear_stiffness_gpa_per_nm")
 
 
 def teacher_spec(name: str, lj: Mapping | None = None):
-    """``PotentialSpec`` with teacher ``name`` inside each slab and the given (default) LJ across."""
+    """``InteractionModel`` with teacher ``name`` inside each slab and the given (default) LJ across."""
     from flatcontact.config import default_potential
-    from flatcontact.potentials import PotentialSpec
+    from flatcontact.potentials.model import InteractionModel
 
     teacher = get_teacher(name)
     lj = dict(lj if lj is not None else default_potential()["lj"])
-    return PotentialSpec(intra=f"ase:{teacher.factory}", lj=lj)
+    return InteractionModel(intra=f"ase:{teacher.factory}", lj=lj)
 
 
 # --------------------------------------------------------------------------- elasticity
@@ -134,16 +134,16 @@ def elastic_table(reports: Sequence[Mapping]) -> pd.DataFrame:
 def _factory_of(model: Any):
     """A scan factory (callable(atoms) -> calculator, with ``fingerprint``) for ``model``."""
     from flatcontact.ispes.calculators import PotentialFactory
-    from flatcontact.potentials import PotentialSpec
+    from flatcontact.potentials.model import InteractionModel
 
-    if isinstance(model, PotentialSpec):
+    if isinstance(model, InteractionModel):
         return PotentialFactory.from_spec(model)
     if hasattr(model, "calculator_factory"):
         return model.calculator_factory()
     if callable(model) and hasattr(model, "fingerprint"):
         return model
     raise InputError(
-        f"model {model!r}: expected a PotentialSpec, an interaction model or a calculator "
+        f"model {model!r}: expected a InteractionModel, an interaction model or a calculator "
         "factory with a 'fingerprint'"
     )
 
@@ -246,7 +246,7 @@ def compare_ispes(
     Parameters
     ----------
     models
-        Label -> model (``PotentialSpec``, interaction model or scan factory). The FIRST
+        Label -> model (``InteractionModel``, interaction model or scan factory). The FIRST
         is the reference (e.g. the teacher); every other row carries its difference from it.
     interface
         The relaxed reference interface (interface contract of ``DESIGN.md``): every model
