@@ -13,12 +13,12 @@ import shutil
 from pathlib import Path
 
 import pytest
-from flatcontact.structures.interface_io import write_interface
 from tests.hardening.helpers import TOY_YAML, assert_refused_cleanly, refused, run_cli, tree
 from tests.hardening.test_run_directory import _same_content
 
 from flatcontact.ispes.geometry import thickness
 from flatcontact.ispes.toy import toy_interface
+from flatcontact.structures.interface_io import write_interface
 
 TOY = ["--calculator", "flatcontact.ispes.toy:toy_calculator"]
 OUTPUTS = ("02-scan/ispes.nc", "03-analyze/friction.nc", "06-contact/summary.json")

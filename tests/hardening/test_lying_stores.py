@@ -18,12 +18,12 @@ import numpy as np
 import pytest
 import xarray as xr
 from ase.calculators.singlepoint import SinglePointCalculator
-from flatcontact.structures.interface_io import write_interface
 from tests.hardening.helpers import assert_refused_cleanly, refused, run_cli, tree
 from tests.hardening.test_run_directory import _same_content
 
 from flatcontact.ispes.geometry import thickness
 from flatcontact.ispes.toy import toy_interface
+from flatcontact.structures.interface_io import write_interface
 
 TOY = ["--calculator", "flatcontact.ispes.toy:toy_calculator"]
 
