@@ -17,8 +17,8 @@ from tests.hardening.helpers import TOY_YAML, assert_refused_cleanly, refused, r
 from tests.hardening.test_run_directory import _same_content
 
 from flatcontact.ispes.geometry import thickness
-from flatcontact.ispes.toy import toy_interface
 from flatcontact.structures.interface_io import write_interface
+from flatcontact.structures.toy import toy_interface
 
 TOY = ["--calculator", "flatcontact.ispes.toy:toy_calculator"]
 OUTPUTS = ("02-scan/ispes.nc", "03-analyze/friction.nc", "06-contact/summary.json")

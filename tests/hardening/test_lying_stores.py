@@ -22,8 +22,8 @@ from tests.hardening.helpers import assert_refused_cleanly, refused, run_cli, tr
 from tests.hardening.test_run_directory import _same_content
 
 from flatcontact.ispes.geometry import thickness
-from flatcontact.ispes.toy import toy_interface
 from flatcontact.structures.interface_io import write_interface
+from flatcontact.structures.toy import toy_interface
 
 TOY = ["--calculator", "flatcontact.ispes.toy:toy_calculator"]
 
