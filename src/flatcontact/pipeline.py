@@ -28,8 +28,7 @@ content in :mod:`flatcontact.report`. The pipeline prints nothing: it tells an o
 Every stage is a public method returning Python objects (ASE Atoms, xarray Datasets,
 pandas DataFrames, dicts), so a notebook can run the stages one by one::
 
-    from flatcontact.config import load_config
-    from flatcontact.pipeline import Pipeline
+    from flatcontact import Pipeline, load_config
     pipe = Pipeline(load_config("run.yaml"), "my-run")
     atoms = pipe.build()
     ispes = pipe.scan()            # xarray Dataset (ispes.nc)
