@@ -115,6 +115,9 @@ def test_pipeline_warns_and_reports_the_largest_tau_for_exactly_degenerate_minim
     tau_low_top, tau_high_top = (t * EV_PER_A3_TO_MPA for t in _analytic_taus())
     msg = str(rec[0].message)
     assert f"{tau_low_top:.4g} MPa" in msg and f"{tau_high_top:.4g} MPa" in msg
+    # the message states how far apart the starts are, not only the tolerance
+    spread = max(o.above_lowest_mev_per_a2 for o in res.pressures[0].starts)
+    assert f"up to {spread:.2g} meV/Å² apart" in msg
     for pa in res.pressures:
         assert sorted(o.tau_mpa for o in pa.starts) == pytest.approx(
             [tau_low_top, tau_high_top], rel=1e-4

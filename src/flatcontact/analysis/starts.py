@@ -290,7 +290,13 @@ def warn_if_tau_depends_on_start(
     tolerance_ev_per_a2: float,
     source: str,
 ) -> None:
-    """:class:`DegenerateMinimaWarning` naming every start's τ if they differ noticeably."""
+    """:class:`DegenerateMinimaWarning` naming every start's τ if they differ noticeably.
+
+    The message states how far apart the starts' energies are (the largest energy above the
+    lowest, meV/Å²) next to the degeneracy tolerance: a start symmetry-equivalent to a
+    near-degenerate one is a start whatever its energy (module rule, step 2), so the two
+    numbers differ when pinning or round-off splits equivalent stackings.
+    """
     if len(outcomes) < 2:
         return
     taus = np.array([o.tau_mpa for o in outcomes])
@@ -306,10 +312,11 @@ def warn_if_tau_depends_on_start(
             f"({o.above_lowest_mev_per_a2:.2g} meV/Å² above the lowest; σ_MSS = "
             f"{o.friction.sigma_mss_mpa:.4g} MPa)"
         )
+    spread = max(o.above_lowest_mev_per_a2 for o in outcomes)
     warnings.warn(
-        f"{source} at P = {p_gpa:g} GPa: {len(outcomes)} minima lie within "
-        f"{tolerance_ev_per_a2 * mev:.2g} meV/Å² of each other or are symmetry-equivalent, "
-        "so the slider's τ depends on "
+        f"{source} at P = {p_gpa:g} GPa: {len(outcomes)} minima, up to {spread:.2g} meV/Å² "
+        f"apart, are near-degenerate (within {tolerance_ev_per_a2 * mev:.2g} meV/Å² of the "
+        "lowest) or symmetry-equivalent to one that is, so the slider's τ depends on "
         f"which one it sits in: " + "; ".join(parts) + f". Reported τ = "
         f"{outcomes[selected].tau_mpa:.4g} MPa, the largest (the pull that starts sliding from "
         "either)",

@@ -34,6 +34,7 @@ from flatcontact.report.sections.contact import contact_section
 from flatcontact.report.sections.laws import laws_section
 from flatcontact.report.sections.scan import scan_section
 from flatcontact.report.sections.summary import summary_section
+from flatcontact.report.stacking_names import stacking_family
 
 
 def _json(path: Path) -> dict:
@@ -54,7 +55,9 @@ def build_sections(
 
     ``stage_rows``: (stage, state, seconds, finished) of the summary table. The section
     next to the summary compares the run with the paper when its slabs are the paper's
-    α-quartz (:func:`flatcontact.reference.is_paper_material`), else shows its results alone.
+    α-quartz (:func:`flatcontact.reference.is_paper_material`), else shows its results alone;
+    only then does any section show a value of the paper. Stackings are named for the
+    interface's family (:func:`flatcontact.report.stacking_names.stacking_family`).
     """
     f_build, f_scan = folders["build"], folders["scan"]
     f_an, f_laws, f_ct = folders["analyze"], folders["laws"], folders["contact"]
@@ -67,16 +70,20 @@ def build_sections(
     interface = read(f_build / INTERFACE)
     model = cfg.potential.label
     material = interface_material(interface)
+    paper = is_paper_material(cfg, set(interface.get_chemical_symbols()))
+    family = stacking_family(build)
     sections = [summary_section(cfg, material, model, scan, stage_rows)]
-    if is_paper_material(cfg, set(interface.get_chemical_symbols())):
+    if paper:
         sections.append(paper_section(cfg, laws, scan, contact))
     else:
-        sections.append(own_results_section(cfg, material, model, laws, scan, contact, table))
+        sections.append(
+            own_results_section(cfg, material, model, laws, scan, contact, table, family)
+        )
     return [
         *sections,
-        interface_section(cfg, build, f_build),
+        interface_section(cfg, build, f_build, interface, paper),
         scan_section(scan, f_scan),
-        analysis_section(cfg, analyze, table, f_an),
-        laws_section(laws, f_laws),
+        analysis_section(cfg, analyze, table, f_an, family),
+        laws_section(laws, f_laws, paper),
         contact_section(cfg, contact, _elastic(cfg, folders.get("elastic")), f_ct),
     ]

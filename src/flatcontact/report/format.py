@@ -1,7 +1,9 @@
-"""How the report writes numbers: table cells and values with their standard errors."""
+"""How the report writes numbers and warnings: table cells, values with their standard
+errors, and the stages' warnings one box per kind."""
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import numpy as np
@@ -29,3 +31,50 @@ def pm(value: float | None, err: float | None) -> str:
     if value is None:
         return "n/a"
     return f"{value:.3g} ± {err:.2g}" if err is not None else f"{value:.3g}"
+
+
+#: A stage warning ``"Category: <source> at P = <p> GPa<detail>: <message>"``.
+_WARNING = re.compile(
+    r"^(?P<kind>[A-Za-z]+): (?:.*? )?at P = (?P<p>[-+0-9.eE]+) GPa(?P<detail>[^:]*): (?P<body>.*)$",
+    re.DOTALL,
+)
+
+
+def _kind_words(kind: str) -> str:
+    """``DegenerateMinimaWarning`` → ``Degenerate minima``."""
+    words = re.findall(r"[A-Z][a-z]*|[a-z]+", kind.removesuffix("Warning"))
+    text = " ".join(w.lower() for w in words)
+    return text[:1].upper() + text[1:]
+
+
+def grouped_warnings(lines: list[str]) -> list[str]:
+    """One box per warning kind: the kind, the loads it occurs at, then each load's message.
+
+    ``lines`` are a stage's warnings as stored (``"Category: message"``); a message of the
+    form ``"<source> at P = <p> GPa<detail>: <text>"`` is grouped with the others of its
+    category under ``"<Kind> at P = p1, p2 GPa:"`` with one line ``"P = p GPa<detail>:
+    <text>"`` per load (the file path of the source left out); any other line is kept as it
+    is, repeated lines once. Lines of a box are separated by newlines.
+    """
+    groups: dict[str, list[tuple[str, str]]] = {}
+    out: list[str] = []
+    slots: dict[str, int] = {}
+    for line in lines:
+        m = _WARNING.match(line)
+        if m is None:
+            if line not in out:
+                out.append(line)
+            continue
+        kind = m.group("kind")
+        if kind not in slots:
+            slots[kind] = len(out)
+            out.append("")
+        groups.setdefault(kind, []).append(
+            (m.group("p"), f"P = {m.group('p')} GPa{m.group('detail')}: {m.group('body')}")
+        )
+    for kind, items in groups.items():
+        loads = ", ".join(dict.fromkeys(p for p, _ in items))
+        out[slots[kind]] = "\n".join(
+            [f"{_kind_words(kind)} at P = {loads} GPa:", *(text for _, text in items)]
+        )
+    return out

@@ -49,7 +49,8 @@ class Figure:
 
 @dataclass
 class Section:
-    """A report section: heading, paragraphs, tables, figures and highlighted notes."""
+    """A report section: heading, paragraphs, tables, figures and highlighted notes (one box
+    per note; a newline in a note breaks its line)."""
 
     title: str
     paragraphs: list[str] = field(default_factory=list)
@@ -96,7 +97,9 @@ def render_html(title: str, sections: Sequence[Section], footer: str = "") -> st
     for section in sections:
         parts.append(f"<h2>{html.escape(section.title)}</h2>")
         parts += [f"<p>{html.escape(p)}</p>" for p in section.paragraphs]
-        parts += [f'<p class="note">{html.escape(n)}</p>' for n in section.notes]
+        parts += [
+            f'<p class="note">{html.escape(n).replace(chr(10), "<br>")}</p>' for n in section.notes
+        ]
         parts += [_table_html(t) for t in section.tables]
         parts += [_figure_html(f) for f in section.figures]
     if footer:

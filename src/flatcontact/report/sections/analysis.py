@@ -12,8 +12,9 @@ import numpy as np
 
 from flatcontact.analysis.convergence import monotonic_violations
 from flatcontact.layout import analyze_figure, png
-from flatcontact.report.format import fmt
+from flatcontact.report.format import fmt, grouped_warnings
 from flatcontact.report.html import Figure, Section, Table
+from flatcontact.report.stacking_names import display_names
 
 #: Where the load at each thickness comes from, by ``analysis.load_source``.
 LOAD_SOURCE_TEXT = {
@@ -28,14 +29,23 @@ ENERGY_ZERO_TEXT = {
 }
 
 
-def monotonicity_paragraph(table) -> str:
+def row_energies(row) -> dict[str, float]:
+    """The named stackings' energies of one ``friction.csv`` row (``name=value;...``, meV/Å²)."""
+    text = str(getattr(row, "stacking_energies_mev_per_a2", ""))
+    if text in ("", "nan"):
+        return {}
+    return {k: float(v) for k, v in (item.split("=") for item in text.split(";") if "=" in item)}
+
+
+def monotonicity_paragraph(table, family: str = "analysis") -> str:
     """Where τ(P) falls with load by more than its noise, and what limits τ on each side.
 
     A drop from P_i to P_i+1 counts when τ_i − τ_i+1 > √(ν_i² + ν_i+1²), ν the per-load force
     noise (``force_noise_mpa``; :func:`flatcontact.analysis.convergence.monotonic_violations`).
     For each drop the paragraph names the mechanism that sets τ at both loads (the barrier
-    top of the path, a jump, or the path's end), the number of jumps and the start stacking,
-    so a reader can tell a change of mechanism (the model's physics) from scatter.
+    top of the path, a jump, or the path's end), the number of jumps and the start stacking
+    (named for ``family``, :func:`flatcontact.report.stacking_names.display_names`), so a
+    reader can tell a change of mechanism (the model's physics) from scatter.
     """
     if "tau_mpa" not in table or len(table) < 2:
         return ""
@@ -48,6 +58,8 @@ def monotonicity_paragraph(table) -> str:
     def side(p):
         r = by_p[p]
         start = getattr(r, "start_stacking", "")
+        if isinstance(start, str) and start:
+            start = display_names({start: 0.0} | row_energies(r), family).get(start, start)
         jumps = int(r.n_jumps) if np.isfinite(r.n_jumps) else 0
         return (
             f"{fmt(r.tau_mpa)} MPa at {p:g} GPa (limited by the {r.tau_limited_by}, {jumps} "
@@ -75,18 +87,21 @@ def direction_text(cfg, table) -> str:
     return "auto: the lowest-barrier direction at the lowest load"
 
 
-def stacking_rows(table) -> list[tuple[str, ...]]:
-    """(P, name=energy ...) rows of the named stackings (friction.csv), meV/Å² above the lowest."""
+def stacking_rows(table, family: str = "analysis") -> list[tuple[str, ...]]:
+    """(P, name energy, ...) rows of the named stackings (friction.csv), meV/Å² above the
+    lowest, named for ``family`` (:func:`flatcontact.report.stacking_names.display_names`)."""
     if "stacking_energies_mev_per_a2" not in table:
         return []
     rows = []
     for r in table.itertuples():
-        text = str(r.stacking_energies_mev_per_a2)
-        if text in ("", "nan"):
+        energies = row_energies(r)
+        if not energies:
             continue
-        pairs = [item.split("=") for item in text.split(";") if "=" in item]
-        low = min(float(v) for _, v in pairs)
-        named = ", ".join(f"{k} {float(v) - low:.4g}" for k, v in pairs)
+        names = display_names(energies, family)
+        low = min(energies.values())
+        named = ", ".join(
+            f"{names[k]} {v - low:.4g}" for k, v in sorted(energies.items(), key=lambda kv: kv[1])
+        )
         rows.append((f"{r.p_gpa:g}", named, fmt(getattr(r, "lowest_barrier_mev_per_a2", None))))
     return rows
 
@@ -112,10 +127,12 @@ def symmetry_table(symmetry: dict) -> Table:
     )
 
 
-def analysis_section(cfg, analyze: dict, table, folder: Path) -> Section:
+def analysis_section(cfg, analyze: dict, table, folder: Path, family: str = "analysis") -> Section:
     """Section 3: the per-load table of ``table`` (``friction.csv`` as a DataFrame), the
-    warnings and symmetry of ``analyze`` (the stage's ``analyze.json``) and Fig. 2 at
-    ``report.fig2_p_gpa`` (default: the lowest, middle and highest load) from ``folder``."""
+    warnings (one box per kind, :func:`flatcontact.report.format.grouped_warnings`) and
+    symmetry of ``analyze`` (the stage's ``analyze.json``) and Fig. 2 at
+    ``report.fig2_p_gpa`` (default: the lowest, middle and highest load) from ``folder``;
+    stackings named for ``family`` (:mod:`flatcontact.report.stacking_names`)."""
     ps = cfg.report.fig2_p_gpa
     if ps is None:
         allp = cfg.analysis.p_gpa
@@ -152,9 +169,9 @@ def analysis_section(cfg, analyze: dict, table, folder: Path) -> Section:
             "(always ≥ σ_MSS). The load laws use τ.",
             f"Load at each z from {LOAD_SOURCE_TEXT[analyze.get('load_source', 'stress')]}. "
             f"Energy zero of the maps and profiles: {ENERGY_ZERO_TEXT[cfg.analysis.energy_zero]}.",
-            monotonicity_paragraph(table),
+            monotonicity_paragraph(table, family),
         ],
-        notes=analyze.get("warnings", []),
+        notes=grouped_warnings(analyze.get("warnings", [])),
         tables=[
             Table(
                 (

@@ -1,14 +1,38 @@
-"""The report's section on the build stage: the interface, its relaxation and Fig. 1."""
+"""The report's section on the build stage: what the interface is, how it relaxes, Fig. 1.
+
+What the interface is comes from the build stage's record (``build.json``: the recipe's
+slabs, layers, twist and coincidence match) and from ``interface.extxyz`` (which layers the
+scan holds); how the free layers relax is ``scan.relax_mode``.
+"""
 
 from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 from ase import Atoms
 
 from flatcontact.layout import BUILD_FIGURE, png
 from flatcontact.report.format import fmt
 from flatcontact.report.html import Figure, Section
+
+#: How the free atoms of each grid point relax, by ``scan.relax_mode``.
+RELAX_MODE_TEXT = {
+    "full": "relax in all three directions at every grid point (scan.relax_mode = full)",
+    "normal": "relax along z only at every grid point, their lateral positions held with "
+    "their layer's shift (scan.relax_mode = normal, the generalized-stacking-fault convention)",
+    "rigid-layers": "move along z at every grid point, each layer as a rigid body "
+    "(scan.relax_mode = rigid-layers)",
+    "rigid": "do not relax (scan.relax_mode = rigid)",
+}
+#: Why τ of a commensurate cell is an upper bound.
+COMMENSURATE_WARNING = (
+    "The scan's cell is commensurate: the two surfaces are locked in registry over the whole "
+    "cell, so every atom climbs the same barrier at the same time. An incommensurate or "
+    "misaligned contact of the same materials (another twist, an unstrained lattice "
+    "mismatch) averages the registry out and slides far more easily (structural lubricity): "
+    "τ and σ here overstate those of an incommensurate contact."
+)
 
 
 def interface_material(atoms: Atoms) -> str:
@@ -17,31 +41,157 @@ def interface_material(atoms: Atoms) -> str:
     return str(atoms.info.get("material") or atoms.get_chemical_formula(mode="hill"))
 
 
-def interface_section(cfg, build: dict, folder: Path) -> Section:
-    """Section 1: atoms, thickness and relaxation of the interface (``build``: the build
-    stage's ``build.json``) and Fig. 1 from ``folder``."""
-    rel = build.get("interface_relaxation", {})
+def plural(n: int, word: str) -> str:
+    """``1 layer``, ``2 layers``."""
+    return f"{n} {word}{'' if n == 1 else 's'}"
+
+
+def _ordinals(numbers: list[int]) -> str:
+    return ", ".join(str(n) for n in numbers[:-1]) + (
+        f" and {numbers[-1]}" if len(numbers) > 1 else str(numbers[-1])
+    )
+
+
+def held_layers(atoms: Atoms) -> dict[int, tuple[list[int], list[int]]]:
+    """Per slab (1, 2): its layers counted from its outer face (1 = outermost), split into
+    held and free (``arrays['layer']``, ``arrays['held']``; default held: surfaces 1 and 4)."""
+    slab = np.asarray(atoms.arrays["slab"], int)
+    if "held" in atoms.arrays:
+        held = np.asarray(atoms.arrays["held"], bool)
+    else:
+        held = np.isin(np.asarray(atoms.arrays["surface"], int), (1, 4))
+    layer = (
+        np.asarray(atoms.arrays["layer"], int)
+        if "layer" in atoms.arrays
+        else np.asarray(atoms.arrays["surface"], int)
+    )
+    out = {}
+    for s in (1, 2):
+        ids = sorted(set(layer[slab == s]), reverse=(s == 2))  # outer face first
+        h = [i + 1 for i, lid in enumerate(ids) if held[(layer == lid) & (slab == s)].all()]
+        f = [i + 1 for i in range(len(ids)) if i + 1 not in h]
+        out[s] = (h, f)
+    return out
+
+
+def relaxation_text(atoms: Atoms, relax_mode: str) -> str:
+    """Which layers of each slab the scan holds and which relax, and how (``relax_mode``)."""
+    parts = []
+    any_free = False
+    for s, (held, free) in held_layers(atoms).items():
+        n = len(held) + len(free)
+        if not free:
+            parts.append(
+                f"slab {s}: {plural(n, 'layer')}, all held (rigid)"
+                if n > 1
+                else f"slab {s}: 1 layer, held (rigid)"
+            )
+            continue
+        any_free = True
+        parts.append(
+            f"slab {s}: {plural(n, 'layer')}, {'layer' if len(held) == 1 else 'layers'} "
+            f"{_ordinals(held)} from the outer face held, {'layer' if len(free) == 1 else 'layers'} "
+            f"{_ordinals(free)} free"
+        )
+    text = "Layers during the scan: " + "; ".join(parts) + ". "
+    if not any_free:
+        return text + (
+            "Every atom is held: the layers move as rigid bodies at the imposed shift and gap, "
+            "nothing relaxes."
+        )
+    if relax_mode == "rigid":
+        return text + "The free layers " + RELAX_MODE_TEXT["rigid"] + "."
+    return (
+        text
+        + "Held layers move as rigid bodies; the free layers "
+        + RELAX_MODE_TEXT.get(relax_mode, f"relax (scan.relax_mode = {relax_mode})")
+        + "."
+    )
+
+
+def structure_paragraphs(build: dict) -> list[str]:
+    """What the interface is, from ``build.json``'s recipe record: slabs and layers per slab,
+    slab 2's operation, the twist angle, and the strain and coincidence cell of a locked
+    hetero pair. Empty without a recipe record (the paper's quartz builder)."""
+    rec = build.get("recipe")
+    if not isinstance(rec, dict):
+        layers = build.get("layers")
+        return [f"Each slab has {plural(int(layers), 'layer')}."] if layers else []
+    s1, s2 = rec.get("slab1") or {}, rec.get("slab2") or {}
+    out = [
+        f"Slab 1: {s1.get('material', '?')}, {plural(int(s1.get('layers', 0)), 'layer')}; "
+        f"slab 2: {s2.get('material', '?')}, {plural(int(s2.get('layers', 0)), 'layer')}"
+        + (f" ({rec['slab2_operation']})" if rec.get("slab2_operation") else "")
+        + (
+            f". Interface spacing {fmt(rec['interface_spacing_angstrom'])} Å between "
+            f"{rec.get('spacing_measured_between', 'the facing planes')}."
+            if rec.get("interface_spacing_angstrom") is not None
+            else "."
+        )
+    ]
+    if rec.get("twist_angle_deg") is not None:
+        out.append(
+            f"Twisted bilayer: slab 2 is rotated by θ = {rec['twist_angle_deg']:.4f}° against "
+            "slab 1 (commensurate twist cell)."
+        )
+    match = rec.get("match") or {}
+    if match.get("kind") == "coincidence":
+        strains = [
+            f"slab {i} {', '.join(f'{v:+.3g}' for v in match.get(f'slab{i}_strain_percent', []))} %"
+            for i in (1, 2)
+            if any(abs(v) > 1e-9 for v in match.get(f"slab{i}_strain_percent", []))
+        ]
+        rot = [
+            f"slab {i} rotated {match[f'slab{i}_rotation_deg']:.3g}°"
+            for i in (1, 2)
+            if abs(match.get(f"slab{i}_rotation_deg", 0.0)) > 1e-9
+        ]
+        out.append(
+            "Hetero pair locked in a coincidence cell: supercell "
+            f"{match.get('slab1_supercell')} of slab 1 on {match.get('slab2_supercell')} of "
+            f"slab 2, {match.get('n_atoms', '?')} atoms; principal strains put on the "
+            "slabs to make them commensurate: "
+            + ("; ".join(strains) if strains else "none")
+            + (f"; {'; '.join(rot)}" if rot else "")
+            + "."
+        )
+    return out
+
+
+def interface_section(
+    cfg, build: dict, folder: Path, atoms: Atoms | None = None, paper: bool = False
+) -> Section:
+    """Section 1: what the interface is (``build``: the build stage's ``build.json``,
+    :func:`structure_paragraphs`), its atoms, thickness and relaxation, which layers the
+    scan holds and how the others relax (``atoms``: ``interface.extxyz``;
+    ``cfg.scan.relax_mode``), the warning that a commensurate lock overstates τ (not for
+    the paper's quartz, ``paper``) and Fig. 1 from ``folder``."""
+    rel = build.get("interface_relaxation") or {}
     checks = build.get("interface_verification") or {}
     verified = bool(checks) and all(v.get("dense") for v in checks.values())
+    paragraphs = [
+        *structure_paragraphs(build),
+        f"{build.get('n_atoms', '?')} atoms; reference thickness z = {fmt(build.get('thickness_angstrom'))} Å"
+        + (
+            f"; interface relaxation {'converged' if rel.get('converged') else 'NOT converged'}"
+            f" in {rel.get('steps', '?')} steps to "
+            f"{getattr(cfg.structure, 'fmax_ev_per_angstrom', float('nan')):g} eV/Å"
+            if rel
+            else ""
+        )
+        + (
+            "; the dense surface verified on both slabs after the interface relaxation"
+            if verified
+            else ""
+        )
+        + ".",
+    ]
+    if atoms is not None:
+        paragraphs.append(relaxation_text(atoms, getattr(cfg.scan, "relax_mode", "full")))
     return Section(
         "1. Interface",
-        paragraphs=[
-            f"{build.get('n_atoms', '?')} atoms; reference thickness z = {fmt(build.get('thickness_angstrom'))} Å"
-            + (
-                f"; interface relaxation {'converged' if rel.get('converged') else 'NOT converged'}"
-                f" in {rel.get('steps', '?')} steps to "
-                f"{getattr(cfg.structure, 'fmax_ev_per_angstrom', float('nan')):g} eV/Å"
-                if rel
-                else ""
-            )
-            + (
-                "; the dense surface verified on both slabs after the interface relaxation"
-                if verified
-                else ""
-            )
-            + ". Surfaces 1 and 4 (outer faces) are held fixed during the scan; surfaces 2, 3 and the "
-            "inner atoms relax at every grid point.",
-        ],
+        paragraphs=paragraphs,
+        notes=[] if paper else [COMMENSURATE_WARNING],
         figures=[
             Figure(
                 folder / png(BUILD_FIGURE),

@@ -99,10 +99,19 @@ def paper_section(cfg, laws: dict, scan: dict, contact: dict) -> Section:
 
 
 def own_results_section(
-    cfg, material: str, model: str, laws: dict, scan: dict, contact: dict, table
+    cfg,
+    material: str,
+    model: str,
+    laws: dict,
+    scan: dict,
+    contact: dict,
+    table,
+    family: str = "generic",
 ) -> Section:
-    """The laws, W, stackings and contact results of a material other than the paper's: no
-    comparison with the paper's α-quartz numbers, which are not about this material."""
+    """The laws, W, stackings (named for ``family``,
+    :mod:`flatcontact.report.stacking_names`) and contact results of a material other than
+    the paper's: no comparison with the paper's α-quartz numbers, which are not about this
+    material."""
     rows = [
         ("k (MPa/GPa)", pm(laws.get("k_mpa_per_gpa"), laws.get("k_stderr_mpa_per_gpa"))),
         ("τ0 (MPa)", pm(laws.get("tau0_mpa"), laws.get("tau0_stderr_mpa"))),
@@ -123,20 +132,20 @@ def own_results_section(
     moduli = contact.get("provenance", {}).get("moduli", "config")
     params = contact.get("parameters", {})
     tables = [Table(("quantity", "this run"), rows)]
-    stackings = stacking_rows(table)
+    stackings = stacking_rows(table, family)
     if stackings:
         tables.append(
             Table(
                 ("P (GPa)", "named stackings (meV/Å² above the lowest)", "barrier (meV/Å²)"),
                 stackings,
-                "High-symmetry stackings of the lattice and the minimum-energy-path barrier",
+                "Stationary stackings of the landscape, lowest first, and the "
+                "minimum-energy-path barrier",
             )
         )
     return Section(
         f"Results for {material}",
         paragraphs=[
-            f"Material: {material}; interaction model: {model}. The paper's numbers are for "
-            "α-quartz (0001) and are not compared here. Load laws τ = k·P + τ0 and "
+            f"Material: {material}; interaction model: {model}. Load laws τ = k·P + τ0 and "
             f"σ = μ·P + σ0 fitted on P ≤ {cfg.analysis.threshold_gpa:g} GPa.",
             f"Contact moduli E* = {fmt(params.get('contact_modulus_gpa'))} GPa, G* = "
             f"{fmt(params.get('shear_modulus_gpa'))} GPa ({moduli}).",

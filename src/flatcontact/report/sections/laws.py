@@ -6,9 +6,11 @@ from pathlib import Path
 
 from flatcontact.layout import LAWS_FIGURE, png
 from flatcontact.reference import PAPER
-from flatcontact.report.format import LAW_COEFFICIENTS, fmt, pm
+from flatcontact.report.format import LAW_COEFFICIENTS, fmt, grouped_warnings, pm
 from flatcontact.report.html import Figure, Section, Table
 
+#: The header of the paper's column in the laws table (quartz runs only).
+PAPER_COLUMN = "paper (internal)"
 #: Which energy form is the lateral force at constant load, and why the paper's differs.
 ENERGY_FORMS_PARAGRAPH = (
     "Which form is the lateral force at constant load: the enthalpy form. At a fixed normal "
@@ -24,9 +26,10 @@ ENERGY_FORMS_PARAGRAPH = (
 )
 
 
-def laws_tables(laws: dict) -> list:
+def laws_tables(laws: dict, paper: bool = False) -> list:
     """The laws of both energy forms side by side, each coefficient with its standard error
-    and its interval (fit, convergence and model spread), and what the interval is made of."""
+    and its interval (fit, convergence and model spread), and what the interval is made of;
+    with the paper's column only when ``paper`` (the run's slabs are the paper's α-quartz)."""
     forms = [f for f in ("internal", "enthalpy") if isinstance(laws.get(f), dict)]
     if not forms:
         return []
@@ -39,13 +42,15 @@ def laws_tables(laws: dict) -> list:
             iv = d.get("intervals", {}).get(key)
             row.append(pm(d.get(key), d.get(err)))
             row.append(f"[{iv['low']:.3g}, {iv['high']:.3g}]" if iv else "n/a")
-        row.append(f"{PAPER[key]:g}")
+        if paper:
+            row.append(f"{PAPER[key]:g}")
         rows.append(tuple(row))
     header = ["coefficient"]
     for form in forms:
         tag = f"{form}{' (used)' if form == configured else ''}"
         header += [f"{tag} ± s.e.", f"{form} interval"]
-    header.append("paper (internal)")
+    if paper:
+        header.append(PAPER_COLUMN)
     u = laws.get("uncertainty", {})
     parts = "fit standard error"
     if any(u.get(f"convergence_{f}") for f in forms):
@@ -60,9 +65,10 @@ def laws_tables(laws: dict) -> list:
     return [Table(tuple(header), rows, caption)]
 
 
-def laws_section(laws: dict, folder: Path) -> Section:
+def laws_section(laws: dict, folder: Path, paper: bool = False) -> Section:
     """Section 4: the laws of ``laws`` (the stage's ``laws.json``) with their standard
-    errors, the range they hold in, both energy forms side by side and Fig. 3 from ``folder``."""
+    errors, the range they hold in, both energy forms side by side and Fig. 3 from ``folder``;
+    the paper's laws beside them only when ``paper`` (:func:`laws_tables`)."""
     section = Section(
         "4. Load laws",
         paragraphs=[
@@ -73,8 +79,8 @@ def laws_section(laws: dict, folder: Path) -> Section:
             f"{fmt(laws.get('p_max_gpa'))} GPa (± one standard error). τ linear up to "
             f"{fmt(laws.get('tau_linear_until_gpa'))} GPa, σ up to {fmt(laws.get('sigma_linear_until_gpa'))} GPa.",
         ],
-        notes=laws.get("warnings", []),
-        tables=laws_tables(laws),
+        notes=grouped_warnings(laws.get("warnings", [])),
+        tables=laws_tables(laws, paper),
         figures=[
             Figure(
                 folder / png(LAWS_FIGURE),

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from flatcontact.layout import SCAN_FIGURE, png
-from flatcontact.report.format import fmt
+from flatcontact.report.format import fmt, grouped_warnings
 from flatcontact.report.html import Figure, Section, Table
 
 
@@ -30,7 +30,7 @@ def scan_section(scan: dict, folder: Path) -> Section:
     return Section(
         "2. ISPES scan",
         tables=[Table(("quantity", "value"), scan_rows)],
-        notes=[*scan.get("notes", []), *scan.get("warnings", [])],
+        notes=grouped_warnings([*scan.get("notes", []), *scan.get("warnings", [])]),
         figures=[
             Figure(
                 folder / png(SCAN_FIGURE),

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from flatcontact.report.html import Section, Table
+from flatcontact.report.sections.build import plural
 
 
 def summary_section(
@@ -17,7 +18,7 @@ def summary_section(
             f"Material: {material}. Interaction model: {model}. Structure: "
             f"{cfg.structure.kind}"
             + (
-                f", {cfg.structure.layers} layers per slab"
+                f", {plural(int(cfg.structure.layers), 'layer')} per slab"
                 if getattr(cfg.structure, "layers", None) is not None
                 else ""
             )
