@@ -133,11 +133,11 @@ def elastic_table(reports: Sequence[Mapping]) -> pd.DataFrame:
 
 def _factory_of(model: Any):
     """A scan factory (callable(atoms) -> calculator, with ``fingerprint``) for ``model``."""
-    from flatcontact.ispes.calculators import PotentialFactory
+    from flatcontact.potentials.engines import calculator_factory
     from flatcontact.potentials.model import InteractionModel
 
     if isinstance(model, InteractionModel):
-        return PotentialFactory.from_spec(model)
+        return calculator_factory(model)
     if hasattr(model, "calculator_factory"):
         return model.calculator_factory()
     if callable(model) and hasattr(model, "fingerprint"):
