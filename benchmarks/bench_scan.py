@@ -197,8 +197,8 @@ def calls_by_start(db_path: Path) -> dict[str, str]:
 
 
 def build(intra: str):
-    from flatcontact.ispes.calculators import PotentialFactory
     from flatcontact.potentials import InteractionModel
+    from flatcontact.potentials.engines import calculator_factory
     from flatcontact.structures.build import build_quartz_interface
 
     spec = InteractionModel(intra=intra)
@@ -210,7 +210,7 @@ def build(intra: str):
         f"both slabs dense: {dense}, built in {time.perf_counter() - t0:.1f} s",
         flush=True,
     )
-    return spec, reference, PotentialFactory.from_spec(spec)
+    return spec, reference, calculator_factory(spec)
 
 
 def probe(reference, factory, lateral, out):

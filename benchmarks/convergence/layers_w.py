@@ -23,10 +23,10 @@ CUTOFFS_ANGSTROM = (10.0, 18.0)
 
 def main() -> None:
     from flatcontact.config import build_config
-    from flatcontact.ispes.calculators import PotentialFactory
     from flatcontact.ispes.grid import GridSpec
     from flatcontact.ispes.relax import RelaxSettings
     from flatcontact.ispes.scan import run_scan
+    from flatcontact.potentials.engines import calculator_factory
     from flatcontact.structures.construct import build_interface
 
     rows = []
@@ -45,7 +45,7 @@ def main() -> None:
             p = THICK_SLAB_P_RANGE.get(layers, {"lo_gpa": -0.3, "hi_gpa": 5.5, "n": 20})
             res = run_scan(
                 interface,
-                PotentialFactory.from_spec(cfg.potential),
+                calculator_factory(cfg.potential),
                 GridSpec(1, 1, p_range_gpa=(p["lo_gpa"], p["hi_gpa"], p["n"])),
                 RUNS / "layers_w" / f"L{layers}_rc{rc:g}",
                 RelaxSettings(cfg.scan.fmax_ev_per_angstrom),

@@ -22,11 +22,11 @@ CUTOFFS_ANGSTROM = (10.0, 14.0, 18.0, 24.0)
 
 def main() -> None:
     from flatcontact.config import build_config
-    from flatcontact.ispes.calculators import PotentialFactory
     from flatcontact.ispes.grid import GridSpec
     from flatcontact.ispes.relax import RelaxSettings
     from flatcontact.ispes.scan import run_scan
     from flatcontact.potentials import InteractionModel
+    from flatcontact.potentials.engines import calculator_factory
     from flatcontact.structures.interface_io import read_interface
 
     interface = read_interface(RUNS / "ref" / "01-build" / "interface.extxyz")
@@ -38,7 +38,7 @@ def main() -> None:
         )
         res = run_scan(
             interface,
-            PotentialFactory.from_spec(spec),
+            calculator_factory(spec),
             GridSpec(1, 1, p_range_gpa=(-0.3, 5.5, 20)),
             RUNS / "lj_tail" / f"probe_rc{rc:g}",
             RelaxSettings(0.005),

@@ -106,16 +106,19 @@ def test_halving_the_thickness_spacing_of_a_toy_scan_moves_tau_and_sigma_below_o
 
     from flatcontact.analysis.analyze import analyze_ispes
     from flatcontact.analysis.outputs import friction_csv_text
-    from flatcontact.ispes.calculators import CalculatorFactory
     from flatcontact.ispes.grid import GridSpec
     from flatcontact.ispes.relax import RelaxSettings
     from flatcontact.ispes.scan import run_scan
+    from flatcontact.potentials.engines import calculator_factory
+    from flatcontact.potentials.model import InteractionModel
     from flatcontact.structures.interface_contract import thickness
     from flatcontact.structures.toy import toy_interface
 
     ref = toy_interface(layers=3)
     z = thickness(ref) + np.linspace(-0.3, 1.5, 13)
-    factory = CalculatorFactory.from_target("flatcontact.ispes.toy:toy_calculator")
+    factory = calculator_factory(
+        InteractionModel(calculator={"target": "flatcontact.ispes.toy:toy_calculator"})
+    )
     ds = run_scan(
         ref,
         factory,

@@ -104,7 +104,7 @@ def test_comparison_table_round_trips_through_json(committee):
 def test_bad_models_are_refused_before_any_scan(interface, tmp_path):
     with pytest.raises(InputError, match="label"):
         compare_ispes({"a/b": InteractionModel(intra="vashishta")}, interface, tmp_path)
-    with pytest.raises(InputError, match="expected a InteractionModel"):
+    with pytest.raises(InputError, match="expected an InteractionModel"):
         compare_ispes({"x": "vashishta"}, interface, tmp_path)
     with pytest.raises(InputError, match="exactly one"):
         compare_ispes(

@@ -2,7 +2,8 @@
 
 import pytest
 
-from flatcontact.ispes.calculators import CalculatorFactory
+from flatcontact.potentials.engines import calculator_factory
+from flatcontact.potentials.model import InteractionModel
 from flatcontact.structures.toy import toy_interface
 
 
@@ -13,4 +14,6 @@ def toy_reference():
 
 @pytest.fixture(scope="session")
 def toy_factory():
-    return CalculatorFactory.from_target("flatcontact.ispes.toy:toy_calculator")
+    return calculator_factory(
+        InteractionModel(calculator={"target": "flatcontact.ispes.toy:toy_calculator"})
+    )

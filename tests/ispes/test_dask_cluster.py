@@ -18,12 +18,13 @@ import numpy as np
 import psutil
 import pytest
 
-from flatcontact.ispes.calculators import CalculatorFactory
 from flatcontact.ispes.executors import DaskExecutor, SerialExecutor
 from flatcontact.ispes.geometry import thickness
 from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.relax import RelaxSettings
 from flatcontact.ispes.scan import run_scan
+from flatcontact.potentials.engines import calculator_factory
+from flatcontact.potentials.model import InteractionModel
 
 SETTINGS = RelaxSettings(fmax_ev_per_a=1e-4, optimizer="FIRE")
 
@@ -110,7 +111,9 @@ def cluster(tmp_path):
 
 def test_scan_on_a_separate_scheduler_survives_a_killed_worker(cluster, tmp_path, toy_reference):
     address, worker_cmd = cluster
-    factory = CalculatorFactory.from_target("tests.ispes.slow_toy:slow_toy")
+    factory = calculator_factory(
+        InteractionModel(calculator={"target": "tests.ispes.slow_toy:slow_toy"})
+    )
     z0 = thickness(toy_reference)
     grid = GridSpec(3, 3, thickness_angstrom=(z0 - 0.2, z0, z0 + 0.3))
     total = grid.n_a * grid.n_b * len(grid.thickness_angstrom)
@@ -141,7 +144,9 @@ def test_scan_on_a_separate_scheduler_survives_a_killed_worker(cluster, tmp_path
     assert bool(scanned["converged"].all()), "points were lost with the killed worker"
     assert _rows(out / "points.db") == total
 
-    plain = CalculatorFactory.from_target("flatcontact.ispes.toy:toy_calculator")
+    plain = calculator_factory(
+        InteractionModel(calculator={"target": "flatcontact.ispes.toy:toy_calculator"})
+    )
     serial = run_scan(
         toy_reference, plain, grid, tmp_path / "serial", SETTINGS, executor=SerialExecutor()
     )

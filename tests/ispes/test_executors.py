@@ -46,14 +46,16 @@ def test_workers_die_when_the_driver_is_killed():
 SCAN_DRIVER = textwrap.dedent(
     """
     import os, sys
-    from flatcontact.ispes.calculators import CalculatorFactory
+    from flatcontact.potentials.engines import calculator_factory
+    from flatcontact.potentials.model import InteractionModel
     from flatcontact.ispes.grid import GridSpec
     from flatcontact.ispes.scan import run_scan
     from flatcontact.structures.interface_contract import thickness
     from flatcontact.structures.toy import toy_interface
 
     ref = toy_interface(layers=3)
-    factory = CalculatorFactory.from_target("flatcontact.ispes.toy:toy_calculator")
+    toy = InteractionModel(calculator={"target": "flatcontact.ispes.toy:toy_calculator"})
+    factory = calculator_factory(toy)
     z = thickness(ref)
     r = run_scan(ref, factory, GridSpec(2, 2, thickness_angstrom=(z, z + 0.3)), sys.argv[1],
                  executor_options={"kind": "processes", "workers": 2})

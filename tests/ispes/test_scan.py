@@ -153,7 +153,8 @@ def test_warm_start_orders_agree_within_tolerance(tmp_path, toy_reference, toy_f
 KILLED_RUN = textwrap.dedent(
     """
     import sys
-    from flatcontact.ispes.calculators import CalculatorFactory
+    from flatcontact.potentials.engines import calculator_factory
+    from flatcontact.potentials.model import InteractionModel
     from flatcontact.ispes.executors import SerialExecutor
     from flatcontact.ispes.geometry import thickness
     from flatcontact.ispes.grid import GridSpec
@@ -163,7 +164,8 @@ KILLED_RUN = textwrap.dedent(
 
     ref = toy_interface(layers=3)
     z0 = thickness(ref)
-    run_scan(ref, CalculatorFactory.from_target("flatcontact.ispes.toy:toy_calculator"),
+    toy = InteractionModel(calculator={"target": "flatcontact.ispes.toy:toy_calculator"})
+    run_scan(ref, calculator_factory(toy),
              GridSpec(6, 6, thickness_angstrom=(z0 - 0.25, z0 + 0.3)), sys.argv[1],
              RelaxSettings(fmax_ev_per_a=1e-4, optimizer="FIRE"), executor=SerialExecutor())
     """

@@ -12,10 +12,11 @@ import pytest
 
 import flatcontact.structures.placement as placement_module
 from flatcontact.errors import InputError
-from flatcontact.ispes.calculators import CalculatorFactory
 from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.relax import RelaxSettings
 from flatcontact.ispes.scan import run_scan
+from flatcontact.potentials.engines import calculator_factory
+from flatcontact.potentials.model import InteractionModel
 from flatcontact.structures.placement import place_slab2
 from flatcontact.structures.toy import toy_interface
 
@@ -29,7 +30,11 @@ def stack():
 
 
 def _scan(stack, out):
-    factory = CalculatorFactory.from_target("flatcontact.ispes.toy:toy_calculator", kwargs=UNIFORM)
+    factory = calculator_factory(
+        InteractionModel(
+            calculator={"target": "flatcontact.ispes.toy:toy_calculator", "kwargs": UNIFORM}
+        )
+    )
     return run_scan(
         stack,
         factory,

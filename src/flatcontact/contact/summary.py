@@ -9,7 +9,6 @@ an xarray Dataset (:meth:`ContactAnalysis.to_dataset`) written atomically as
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -19,7 +18,6 @@ from flatcontact import __version__, units
 from flatcontact.contact import adhesion, mindlin
 from flatcontact.contact.oscillation import StiffnessCurve, stiffness_curve
 from flatcontact.contact.parameters import ContactParameters
-from flatcontact.fileio import atomic_path
 
 #: Points of each Q(u) curve, on u in [0, 1.5·u_fs].
 N_DISPLACEMENT = 301
@@ -196,13 +194,6 @@ class ContactAnalysis:
         ds.attrs["model"] = "modified Mindlin (Dong et al.), q0 = G* u/(pi a)"
         ds.attrs["flatcontact_version"] = __version__
         return ds
-
-    def write_netcdf(self, path: str | Path) -> Path:
-        """Write ``contact.nc`` atomically (h5netcdf)."""
-        ds = self.to_dataset()
-        with atomic_path(path) as tmp:
-            ds.to_netcdf(tmp, engine="h5netcdf")
-        return Path(path)
 
 
 _SUFFIXES = {

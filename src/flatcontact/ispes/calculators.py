@@ -1,77 +1,67 @@
-"""Picklable calculator factories for scan workers, and force-call counting.
+"""Force-call counting for scan workers, and the dated aliases of the old factory names.
 
-A scan worker builds its calculator once from a factory and reuses it for every
-grid point it relaxes. A factory is a small frozen object that pickles to any
-worker process (local pool or Dask) and has a JSON ``fingerprint`` that the point
-store records, so a store is never mixed across interaction models.
+A scan worker builds its calculator once from a factory and reuses it for every grid point
+it relaxes; the factory of every interaction model is
+:func:`flatcontact.potentials.engines.calculator_factory` (a picklable
+:class:`~flatcontact.potentials.engines.ModelFactory` with a JSON ``fingerprint`` that the
+point store records). :func:`count_force_calls` makes any ASE calculator count its
+evaluations.
 
-The factory of every interaction model is ``calculator_factory(model)``
-(:class:`flatcontact.potentials.engines.ModelFactory`). Earlier names kept here:
+Deprecated since 2026-11-25 (each call raises a :class:`DeprecationWarning`):
 
-- :class:`PotentialFactory`: ``PotentialFactory.from_spec(model)``, the same factory;
-- :class:`CalculatorFactory`: a whole-interface ASE calculator ``"module:callable"`` plus
-  JSON keyword arguments (the model ``{calculator: {target, kwargs}}``).
+- ``PotentialFactory.from_spec(model)``: use ``calculator_factory(model)``;
+- ``CalculatorFactory.from_target(target, **kwargs)``: use
+  ``calculator_factory(InteractionModel(calculator={"target": target, "kwargs": kwargs}))``.
 """
 
 from __future__ import annotations
 
-import dataclasses
-import json
+import warnings
 from typing import Any
 
-from ase import Atoms
 from ase.calculators.calculator import Calculator
 
 from flatcontact.potentials.engines import ModelFactory, calculator_factory
-from flatcontact.potentials.loader import call_factory, load_callable
+from flatcontact.potentials.loader import load_callable
 from flatcontact.potentials.model import InteractionModel
 
+#: The date the old factory names were deprecated.
+FACTORY_NAMES_DEPRECATED = "2026-11-25"
 
-@dataclasses.dataclass(frozen=True)
+
+def _deprecated(old: str, new: str) -> None:
+    warnings.warn(
+        f"{old} is deprecated since {FACTORY_NAMES_DEPRECATED}: use {new}",
+        DeprecationWarning,
+        stacklevel=3,
+    )
+
+
+class PotentialFactory:
+    """Deprecated since 2026-11-25: use
+    :func:`~flatcontact.potentials.engines.calculator_factory` of the model."""
+
+    @staticmethod
+    def from_spec(spec: InteractionModel) -> ModelFactory:
+        """``calculator_factory(spec)``, with a :class:`DeprecationWarning`."""
+        _deprecated("PotentialFactory.from_spec(model)", "calculator_factory(model)")
+        return calculator_factory(spec)
+
+
 class CalculatorFactory:
-    """Build ``callable(**kwargs)`` from ``target = "module:callable"`` (a whole-interface model).
+    """Deprecated since 2026-11-25: use
+    :func:`~flatcontact.potentials.engines.calculator_factory` of
+    ``InteractionModel(calculator={"target": target, "kwargs": kwargs})``."""
 
-    Kept for callers of the earlier API; the same as the factory of
-    ``InteractionModel(calculator={"target": target, "kwargs": kwargs})`` (one loader:
-    :func:`flatcontact.potentials.loader.call_factory`).
-    """
-
-    target: str
-    kwargs_json: str = "{}"
-
-    @classmethod
-    def from_target(cls, target: str, **kwargs: Any) -> CalculatorFactory:
-        factory = cls(target, json.dumps(kwargs, sort_keys=True))
-        factory.resolve()  # fail now, not in a worker
-        return factory
-
-    def resolve(self):
-        return load_callable(self.target, "calculator")
-
-    def __call__(self, atoms: Atoms) -> Calculator:
-        return call_factory(self.target, atoms, json.loads(self.kwargs_json))
-
-    def model(self):
-        """The equivalent :class:`~flatcontact.potentials.model.InteractionModel`."""
-        return InteractionModel(
-            calculator={"target": self.target, "kwargs": json.loads(self.kwargs_json)}
+    @staticmethod
+    def from_target(target: str, **kwargs: Any) -> ModelFactory:
+        """The factory of the whole-interface calculator ``target(**kwargs)``, with a warning."""
+        _deprecated(
+            "CalculatorFactory.from_target(target, **kwargs)",
+            'calculator_factory(InteractionModel(calculator={"target": target, "kwargs": kwargs}))',
         )
-
-    @property
-    def fingerprint(self) -> str:
-        return calculator_factory(self.model()).fingerprint
-
-    @property
-    def label(self) -> str:
-        return f"{self.target} {self.kwargs_json}"
-
-
-class PotentialFactory(ModelFactory):
-    """The factory of an interaction model (earlier name of :class:`ModelFactory`)."""
-
-    @classmethod
-    def from_spec(cls, spec: Any) -> PotentialFactory:
-        return cls(spec.model_dump_json())
+        load_callable(target, "calculator")  # fail now, not in a worker
+        return calculator_factory(InteractionModel(calculator={"target": target, "kwargs": kwargs}))
 
 
 def count_force_calls(calc: Calculator) -> Calculator:

@@ -33,15 +33,10 @@ Validation when a store is opened (a store is never used unchecked):
   one line naming it and the defect (remove it to recompute the scan);
 - the metadata: ``format``, ``settings`` equal to the current ones, ``resolved`` with
   finite thicknesses and in-plane vectors;
-- every row: the keys ``i_a``, ``i_b``, ``i_z`` present and integers inside the grid
-  (a negative index is out of range), the record keys present, ``shift_a``, ``shift_b``
-  and ``thickness`` equal to the grid's values at that index, finite energy, stresses
-  and positions, the reference's atom count, and one row per index. A row that fails
-  is deleted, one warning (:class:`PointStoreRepaired`) names the file, the count and
-  the first defect, and the scan recomputes exactly those points; the other rows are kept
-  (each was final when it was stored: a later change to another row does not alter it).
-  Identical duplicates are
-  collapsed to one row.
+- every row against the store contract (:mod:`flatcontact.ispes.store_checks`): a row
+  that fails is deleted with one warning
+  (:class:`~flatcontact.ispes.store_checks.PointStoreRepaired`) and the scan recomputes
+  exactly those points; the other rows are kept.
 """
 
 from __future__ import annotations
@@ -49,14 +44,12 @@ from __future__ import annotations
 import fcntl
 import hashlib
 import json
-import math
 import os
 import sqlite3
 import time
 import types
-import warnings
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from ase import Atoms
@@ -66,6 +59,12 @@ from flatcontact.errors import InputError
 from flatcontact.fileio import refuse_link
 from flatcontact.ispes import contract
 from flatcontact.ispes.relax import Index, PointResult
+from flatcontact.ispes.store_checks import (
+    quick_check,
+    repair_rows,
+    resolved_defect,
+    settings_difference,
+)
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -73,26 +72,6 @@ if TYPE_CHECKING:
 FORMAT = "flatcontact.points/1"
 #: Side files of a store (SQLite journals, the driver lock); never links.
 SIDE_SUFFIXES = ("-wal", "-shm", "-journal", ".driver")
-#: Keys every row must hold (the index and the record :meth:`PointStore._record` reads).
-ROW_KEYS = (
-    "i_a",
-    "i_b",
-    "i_z",
-    "shift_a",
-    "shift_b",
-    "thickness",
-    "normal_stress_gpa",
-    "force_calls",
-    "converged",
-)
-#: Row keys that must be finite numbers.
-FINITE_KEYS = ("shift_a", "shift_b", "thickness", "normal_stress_gpa")
-_SHIFT_ATOL = 1e-9
-_THICKNESS_ATOL = 1e-6
-
-
-class PointStoreRepaired(UserWarning):
-    """Rows of a ``points.db`` failed validation, were deleted and will be recomputed."""
 
 
 def _acquire_driver_lock(path: Path):
@@ -134,29 +113,6 @@ def interface_hash(atoms: Atoms) -> str:
     return h.hexdigest()
 
 
-def _flatten(d: Any, prefix: str = "") -> dict[str, Any]:
-    if isinstance(d, dict):
-        out: dict[str, Any] = {}
-        for k, v in d.items():
-            out.update(_flatten(v, f"{prefix}.{k}" if prefix else str(k)))
-        return out
-    return {prefix: d}
-
-
-def settings_difference(stored: dict, current: dict) -> str | None:
-    """The first difference between two settings dicts as ``key: stored vs current``, or None."""
-    a, b = _flatten(json.loads(json.dumps(stored))), _flatten(json.loads(json.dumps(current)))
-    for key in sorted(set(a) | set(b)):
-        if a.get(key, "<absent>") != b.get(key, "<absent>"):
-            sa, sb = json.dumps(a.get(key, "<absent>")), json.dumps(b.get(key, "<absent>"))
-            if len(sa) > 60:
-                sa = sa[:57] + "..."
-            if len(sb) > 60:
-                sb = sb[:57] + "..."
-            return f"{key}: {sa} in the store vs {sb} now"
-    return None
-
-
 def discard_store(path: str | os.PathLike[str], remove_parent: bool = False) -> None:
     """Remove the store ``path`` and its side files (SQLite journals, ``.driver`` lock).
 
@@ -176,105 +132,6 @@ def discard_store(path: str | os.PathLike[str], remove_parent: bool = False) -> 
 
 def _one_line(exc: BaseException) -> str:
     return " ".join(f"{exc.__class__.__name__}: {exc}".split())
-
-
-def _finite_number(value: Any) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
-
-
-def _resolved_defect(resolved: Any) -> str | None:
-    """What is wrong with the ``resolved`` metadata (None if absent or sound)."""
-    if resolved is None:
-        return None
-    if not isinstance(resolved, dict):
-        return "is not a map"
-    z = resolved.get("thickness_angstrom")
-    if not isinstance(z, list) or not z or not all(_finite_number(v) and v > 0 for v in z):
-        return "'thickness_angstrom' is not a non-empty list of positive finite numbers"
-    if len(set(z)) != len(z):
-        return "'thickness_angstrom' repeats a thickness"
-    for key in ("a1", "a2"):
-        v = resolved.get(key)
-        if not isinstance(v, list) or len(v) < 2 or not all(_finite_number(x) for x in v):
-            return f"{key!r} is not a vector of finite numbers"
-    if not isinstance(resolved.get("potential_label"), str):
-        return "'potential_label' is not text"
-    return None
-
-
-def _row_defect(
-    row: Any, shape: tuple[int | None, ...], z: list[float] | None, n_atoms: int
-) -> str | None:
-    """What is wrong with one stored row (None if it keeps the contract).
-
-    ``shape`` holds the grid's size along each axis, ``None`` where it is not known (then
-    the index along it need only be non-negative); ``z`` the thicknesses (Å) or ``None``.
-    """
-    where = f"row {row.id}"
-    missing = [k for k in ROW_KEYS if k not in row.key_value_pairs]
-    if missing:
-        return f"{where} has no {', '.join(missing)}"
-    index = [row.get(k) for k in ("i_a", "i_b", "i_z")]
-    if not all(isinstance(i, int) and not isinstance(i, bool) for i in index):
-        return f"{where}: index {index} is not three integers"
-    if not all(0 <= i and (n is None or i < n) for i, n in zip(index, shape, strict=True)):
-        return f"{where}: index {tuple(index)} is outside the grid {_shown(shape)}"
-    for key in FINITE_KEYS:
-        if not _finite_number(row.get(key)):
-            return f"{where}: {key} = {row.get(key)!r} is not a finite number"
-    energy = row.get("energy")
-    if not _finite_number(energy):
-        return f"{where}: energy = {energy!r} is not a finite number"
-    reaction = row.get("reaction_stress_gpa")
-    if reaction is not None and not _finite_number(reaction):
-        return f"{where}: reaction_stress_gpa = {reaction!r} is not a finite number"
-    if not _finite_number(row.get("force_calls")) or row.get("force_calls") < 0:
-        return f"{where}: force_calls = {row.get('force_calls')!r} is not a count"
-    ia, ib, iz = index
-    if (
-        (shape[0] is not None and abs(row.get("shift_a") - ia / shape[0]) > _SHIFT_ATOL)
-        or (shape[1] is not None and abs(row.get("shift_b") - ib / shape[1]) > _SHIFT_ATOL)
-        or (z is not None and abs(row.get("thickness") - z[iz]) > _THICKNESS_ATOL)
-    ):
-        return f"{where}: shift or thickness differs from the grid's at index {tuple(index)}"
-    start = row.get("start", "")
-    if start and not _start_index(start, shape):
-        return f"{where}: start {start!r} is not an index of the grid"
-    positions = row.get("positions")
-    if positions is None or np.shape(positions) != (n_atoms, 3):
-        return f"{where}: positions are not {n_atoms} × 3"
-    if not np.all(np.isfinite(positions)):
-        return f"{where}: positions are not finite"
-    return None
-
-
-def _start_index(text: Any, shape: tuple[int, int, int]) -> tuple[int, ...] | None:
-    """The index ``"i_a,i_b,i_z"`` of a warm start if it is one of the grid, else None."""
-    if not isinstance(text, str):
-        return None
-    try:
-        index = tuple(int(s) for s in text.split(","))
-    except ValueError:
-        return None
-    if len(index) != 3 or not all(
-        0 <= i and (n is None or i < n) for i, n in zip(index, shape, strict=True)
-    ):
-        return None
-    return index
-
-
-def _shown(shape: tuple[int | None, ...]) -> str:
-    return " × ".join("?" if n is None else str(n) for n in shape)
-
-
-def _same_point(a: Any, b: Any) -> bool:
-    """Whether two rows hold the same point (every record key, energy and positions equal)."""
-    keys = (*ROW_KEYS, "reaction_stress_gpa", "steps", "max_force_ev_per_a", "start")
-    return (
-        all(a.get(k) == b.get(k) for k in keys)
-        and a.get("energy") == b.get("energy")
-        and np.array_equal(a.positions, b.positions)
-    )
 
 
 class PointStore:
@@ -319,7 +176,7 @@ class PointStore:
             self._db = ase.db.connect(str(self.path), type="db", append=True, use_lock_file=False)
             n_rows = self._db.count()  # creates the tables of a new store
             if n_rows:
-                self._quick_check()
+                quick_check(self.path)
             meta = self._db.metadata
             rows = list(self._db.select()) if n_rows else []
         except InputError:
@@ -355,19 +212,21 @@ class PointStore:
             meta = {"format": FORMAT, "settings": self.settings}
             self._db.metadata = meta
         self._meta = meta
-        defect = _resolved_defect(meta.get("resolved"))
+        defect = resolved_defect(meta.get("resolved"))
         if defect is not None:
             self.close()
             raise InputError(f"{self.path}: metadata 'resolved' {defect}; remove it to rescan")
-        self._done: dict[Index, dict] = {}
         try:
-            self._load_rows(rows)
+            kept = repair_rows(
+                self._db, rows, self.settings, meta.get("resolved"), len(self.reference), self.path
+            )
         except sqlite3.Error as exc:
             self.close()
             raise InputError(
                 f"{self.path}: not a writable points database ({_one_line(exc)}); remove it "
                 "to recompute the scan"
             ) from None
+        self._done: dict[Index, dict] = {index: self._record(row) for index, row in kept.items()}
         # one connection for the store's lifetime, one commit per point: ASE otherwise opens
         # a connection and commits (an fsync each) several times inside every write
         self._db.__enter__()
@@ -376,65 +235,6 @@ class PointStore:
         self._db.connection.commit()
         self._db.connection.execute("PRAGMA journal_mode=WAL")
         self._db.connection.execute("PRAGMA synchronous=NORMAL")
-
-    def _quick_check(self) -> None:
-        """Refuse a file whose pages SQLite finds damaged (``PRAGMA quick_check``)."""
-        with sqlite3.connect(str(self.path)) as con:
-            found = [r[0] for r in con.execute("PRAGMA quick_check(3)")]
-        con.close()
-        if found != ["ok"]:
-            said = " ".join(
-                "; ".join(map(str, found)).replace("*** in database main ***", "").split()
-            )
-            raise InputError(
-                f"{self.path}: damaged points database ({said[:200]}); "
-                "remove it to recompute the scan"
-            )
-
-    def _load_rows(self, rows: list) -> None:
-        """Check every row against the store's contract; delete and report the bad ones.
-
-        The grid's axes are known from ``settings["grid"]`` (``n_a``, ``n_b``) and
-        ``resolved["thickness_angstrom"]``; a store of a scan that has rows but no resolved
-        thicknesses has lost its grid, and every row fails. A store without a grid in its
-        settings (a bare store) checks indices for being non-negative only.
-        """
-        grid = self.settings.get("grid")
-        resolved = self._meta.get("resolved")
-        z = list(resolved["thickness_angstrom"]) if resolved else None
-        if isinstance(grid, dict):
-            shape = (int(grid.get("n_a", 0)), int(grid.get("n_b", 0)), len(z or ()))
-        else:
-            shape = (None, None, None if z is None else len(z))
-        bad: dict[int, str] = {}
-        seen: dict[Index, Any] = {}
-        for row in rows:
-            defect = _row_defect(row, shape, z, len(self.reference))
-            if defect is not None:
-                bad[row.id] = defect
-                continue
-            index = (int(row.i_a), int(row.i_b), int(row.i_z))
-            first = seen.get(index)
-            if first is None:
-                seen[index] = row
-            elif _same_point(first, row):
-                bad[row.id] = ""  # an identical copy: dropped without loss
-            else:
-                defect = f"two different rows for point {index}"
-                bad[row.id] = bad[first.id] = defect
-        for index, row in seen.items():
-            if row.id not in bad:
-                self._done[index] = self._record(row)
-        if bad:
-            self._db.delete(list(bad))
-            lost = [d for d in bad.values() if d]
-            if lost:
-                warnings.warn(
-                    f"{self.path}: {len(lost)} stored point(s) failed validation (first: "
-                    f"{lost[0]}); they were deleted and are recomputed",
-                    PointStoreRepaired,
-                    stacklevel=3,
-                )
 
     def _commit(self) -> None:
         if self._db.connection is not None:

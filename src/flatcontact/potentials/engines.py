@@ -58,10 +58,6 @@ class ModelFactory:
     def model(self) -> InteractionModel:
         return InteractionModel.model_validate_json(self.model_json)
 
-    def spec(self) -> InteractionModel:
-        """The :class:`~flatcontact.potentials.model.InteractionModel` (earlier name)."""
-        return self.model
-
     def __call__(self, atoms):
         return make_calculator(self.model, atoms)
 

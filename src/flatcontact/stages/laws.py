@@ -1,6 +1,6 @@
 """Stage 4, laws: τ = k·P + τ0 and σ = μ·P + σ0 fitted on P ≤ ``analysis.threshold_gpa``.
 
-Both energy forms side by side (issue 12): the configured ``analysis.energy_form`` from the
+Both energy forms side by side: the configured ``analysis.energy_form`` from the
 analyze stage's table, the other from the same ISPES (when the inputs carry it); each with
 intervals c ± h_c, h_c = coverage·√(se_fit² + δ_conv² + δ_model²) from the fit and the
 ``uncertainty`` section (:mod:`flatcontact.analysis.uncertainty`).

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from ase import Atoms
 
-from flatcontact.errors import InputError, require
+from flatcontact.errors import require
 from flatcontact.training.dataset import labels
 from flatcontact.training.descriptors import DesignBlock, SnapDescriptors
 from flatcontact.training.snapfiles import SnapCoefficients, SnapHyper
@@ -450,11 +450,3 @@ def default_settings(group_weights: dict | None = None) -> list[FitSettings]:
         FitSettings(energy_weight=we, stress_weight=ws, group_weights=gw)
         for we, ws in itertools.product((30.0, 100.0), (300.0, 1000.0))
     ]
-
-
-def check_elements(frames: Sequence[Atoms], elements: Sequence[str]) -> None:
-    """Raise :class:`InputError` when a frame has an element outside ``elements``."""
-    for k, a in enumerate(frames):
-        extra = set(a.get_chemical_symbols()) - set(elements)
-        if extra:
-            raise InputError(f"frame {k}: element(s) {sorted(extra)} not among {list(elements)}")

@@ -1,6 +1,6 @@
 """The potential's error on the quantities of interest: same interface, several models, one table.
 
-Two measurements for any SiO₂ model that has an ASE calculator (issue 12):
+Two measurements for any SiO₂ model that has an ASE calculator:
 
 * :func:`quartz_elastic_vs_experiment`: zero-stress α-quartz lattice and relaxed-ion
   Cij (:func:`flatcontact.training.validate.quartz_lattice`,
@@ -15,11 +15,11 @@ Two measurements for any SiO₂ model that has an ASE calculator (issue 12):
 
 A model is a :class:`~flatcontact.potentials.InteractionModel` (intra-slab model + the same
 cross-interface LJ: this isolates the intra-slab potential, which is what a surrogate
-replaces), a factory with ``fingerprint`` (:mod:`flatcontact.ispes.calculators`), or
-anything with ``calculator_factory()``. Offline teachers come from their one registry,
-:mod:`flatcontact.potentials.teachers` (CHGNet r2SCAN, SevenNet-0, SevenNet-MF-0 with its
-r2SCAN and PBE heads; weights ship in the wheels, nothing is downloaded); they need
-``torch`` (CPU) plus ``chgnet``/``sevenn``.
+replaces) or a scan factory: a callable ``factory(atoms)`` -> ASE calculator with a
+``fingerprint`` (:func:`flatcontact.potentials.engines.calculator_factory`). Offline
+teachers come from their one registry, :mod:`flatcontact.potentials.teachers` (CHGNet
+r2SCAN, SevenNet-0, SevenNet-MF-0 with its r2SCAN and PBE heads; weights ship in the
+wheels, nothing is downloaded); they need ``torch`` (CPU) plus ``chgnet``/``sevenn``.
 """
 
 from __future__ import annotations
@@ -101,7 +101,8 @@ def quartz_elastic_vs_experiment(calc, label: str, strain: float = 0.005) -> dic
 
 def elastic_table(reports: Sequence[Mapping]) -> pd.DataFrame:
     """One row per model (and one for experiment): a, c, the seven Cij, E*, and the
-    largest relative error of C11, C33, C44 (the 15 % target of issue 12)."""
+    largest relative error of C11, C33, C44 (a bundled potential's target is 15 %,
+    ``flatcontact.training.validate.TARGETS['cij_rel']``)."""
     rows = [
         {
             "model": "experiment",
@@ -133,18 +134,16 @@ def elastic_table(reports: Sequence[Mapping]) -> pd.DataFrame:
 
 def _factory_of(model: Any):
     """A scan factory (callable(atoms) -> calculator, with ``fingerprint``) for ``model``."""
-    from flatcontact.ispes.calculators import PotentialFactory
+    from flatcontact.potentials.engines import calculator_factory
     from flatcontact.potentials.model import InteractionModel
 
     if isinstance(model, InteractionModel):
-        return PotentialFactory.from_spec(model)
-    if hasattr(model, "calculator_factory"):
-        return model.calculator_factory()
+        return calculator_factory(model)
     if callable(model) and hasattr(model, "fingerprint"):
         return model
     raise InputError(
-        f"model {model!r}: expected a InteractionModel, an interaction model or a calculator "
-        "factory with a 'fingerprint'"
+        f"model {model!r}: expected an InteractionModel or a calculator factory with a "
+        "'fingerprint'"
     )
 
 
@@ -246,11 +245,11 @@ def compare_ispes(
     Parameters
     ----------
     models
-        Label -> model (``InteractionModel``, interaction model or scan factory). The FIRST
-        is the reference (e.g. the teacher); every other row carries its difference from it.
+        Label -> model (an ``InteractionModel`` or a scan factory). The FIRST is the
+        reference (e.g. the teacher); every other row carries its difference from it.
     interface
-        The relaxed reference interface (interface contract of ``DESIGN.md``): every model
-        scans the same atoms, lateral cell and held layers.
+        The relaxed reference interface (:mod:`flatcontact.structures.interface_contract`):
+        every model scans the same atoms, lateral cell and held layers.
     out_dir
         One resumable scan folder per model, ``out_dir/<label>``.
     grid, p_range_gpa, thickness_angstrom, fmax_ev_per_angstrom
