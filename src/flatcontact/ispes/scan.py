@@ -144,7 +144,7 @@ def run_scan(
         The relaxed reference interface (slab 2 at shift (0, 0)), interface contract.
     factory
         A picklable calculator factory with a ``fingerprint`` (see
-        :mod:`flatcontact.potentials.engines.calculator_factory`).
+        :func:`flatcontact.potentials.engines.calculator_factory`).
     grid
         The lateral grid and thicknesses or pressure range.
     out_dir
