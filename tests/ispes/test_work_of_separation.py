@@ -20,7 +20,7 @@ from flatcontact.ispes.geometry import fixed_mask, in_plane_vectors, place_slab2
 from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.relax import RelaxSettings
 from flatcontact.ispes.scan import run_scan
-from flatcontact.ispes.work_of_separation import ideal_work_of_separation, slab_alone
+from flatcontact.ispes.work_of_separation import ideal_work_of_separation
 from flatcontact.potentials.engines import calculator_factory
 from flatcontact.potentials.lammps_runtime import lammps_potential_file
 from flatcontact.potentials.model import InteractionModel
@@ -134,9 +134,9 @@ def test_toy_relaxed_work_of_separation_matches_an_ase_relaxation():
             FixCartesian(top_held, mask=(True, True, False)),
         ],
     )
-    e_slabs = sum(
-        relaxed(s, [FixAtoms(mask=fixed_mask(s))]) for s in (slab_alone(ref, 1), slab_alone(ref, 2))
-    )
+    # each slab alone: its atoms in the same cell, the other slab removed
+    alone = [ref[ref.arrays["slab"] == k] for k in (1, 2)]
+    e_slabs = sum(relaxed(s, [FixAtoms(mask=fixed_mask(s))]) for s in alone)
     a1, a2 = in_plane_vectors(ref)
     area = abs(a1[0] * a2[1] - a1[1] * a2[0])
     expected = (e_slabs - e_int) / area * EV_PER_A2_TO_J_PER_M2
@@ -173,3 +173,30 @@ def test_hand_written_thicknesses_keep_the_work_of_separation(tmp_path):
     assert auto.adhesion["pull_off_work_j_per_m2"] > 0
     assert "pull_off_work_j_per_m2" not in given.adhesion
     assert given.dataset.attrs["work_of_separation_j_per_m2"] == pytest.approx(w_auto, rel=1e-12)
+
+
+@pytest.mark.parametrize("name", ["graphene-bilayer-kc", "graphene-bilayer-ilp"])
+def test_interlayer_work_of_separation_is_the_depth_of_the_plain_lammps_curve(name):
+    """Two rigid graphene sheets (REBO inside, KC or ILP across):
+    W = −[min_z E(z) − E(apart)]/A with E from plain LAMMPS (rigid layers, shift 0)."""
+    from scipy.optimize import minimize_scalar
+    from tests.examples.test_examples import EXAMPLES, plain_energy_per_area
+
+    from flatcontact.config import load_config
+
+    cfg = load_config(EXAMPLES / f"{name}.yaml")
+    ref, _ = build_interface(cfg.structure)
+    w = ideal_work_of_separation(
+        ref, calculator_factory(cfg.potential), RelaxSettings(mode=cfg.scan.relax_mode), (0, 0)
+    )
+    well = minimize_scalar(
+        lambda z: plain_energy_per_area(ref, (0, 0), z, name),
+        bounds=(3.0, 4.0),
+        method="bounded",
+        options={"xatol": 1e-5},
+    )
+    apart = plain_energy_per_area(ref, (0, 0), 60.0, name)
+    assert w.zero_load_thickness_angstrom == pytest.approx(well.x, abs=1e-3)
+    assert w.work_of_separation_j_per_m2 == pytest.approx(
+        (apart - well.fun) * EV_PER_A2_TO_J_PER_M2, rel=1e-6
+    )

@@ -10,10 +10,15 @@ W = [E(slab 1 alone) + E(slab 2 alone) − E(interface at zero load)] / A, in J/
   safeguarded secant on p(z) (regula falsi with the Illinois modification) between two
   thicknesses that bracket p = 0, every point relaxed as a grid point
   (:func:`flatcontact.ispes.relax.relax_point`: held layers held, the scan's mode).
-- A slab alone is the interface's atoms of that slab (``arrays["slab"]``) in the same
-  periodic cell, the other slab removed, relaxed with the same settings
-  (:func:`flatcontact.ispes.relax.relax_structure`): its held layers stay held, its
-  interface surface relaxes as the mode allows.
+- The slabs alone: both in the same periodic cell, slab 2 lifted rigidly by a distance D
+  beyond every interaction between them, relaxed with the same settings as a grid point
+  (held layers held, the interface surfaces relax as the mode allows), so E(apart) =
+  E(slab 1 alone) + E(slab 2 alone). D is the first of ``SEPARATIONS_ANGSTROM`` at which the
+  rigid reference's energy no longer changes (E at z_ref + D and z_ref + 2D agree to
+  ``APART_TOL_J_PER_M2`` per area). Computed with the interface's own calculator, the
+  structure has the same atoms, types and layers as every grid point: a calculator built
+  for one slab without the other need not accept it (a LAMMPS interlayer Coulomb
+  sub-style with one layer has nothing to act on; a monolayer gives a box of zero height).
 
 This is one cut: the surface energies of the two new surfaces plus the interface energy,
 W = γ1 + γ2 − γ12 (Dupré); for a crystal cut across a plane of itself (coupling ``same``,
@@ -33,8 +38,8 @@ from ase import Atoms
 
 from flatcontact.errors import InputError
 from flatcontact.ispes.contract import cell_area
-from flatcontact.ispes.geometry import in_plane_vectors, thickness
-from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point, relax_structure
+from flatcontact.ispes.geometry import in_plane_vectors, place_slab2, thickness
+from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point
 from flatcontact.units import EV_PER_A2_TO_J_PER_M2
 
 #: first step (Å) away from the reference thickness when bracketing p = 0; doubled each time
@@ -47,6 +52,10 @@ XTOL_ANGSTROM = 1e-4
 #: or until |p| is below this load (GPa)
 PTOL_GPA = 1e-6
 MAX_ITERATIONS = 60
+#: distances (Å, added to the reference thickness) tried for the slabs apart
+SEPARATIONS_ANGSTROM = (20.0, 40.0, 80.0, 160.0)
+#: the slabs are apart when the rigid energy changes by less than this per area (J/m²)
+APART_TOL_J_PER_M2 = 1e-6
 
 
 @dataclasses.dataclass(frozen=True)
@@ -54,13 +63,15 @@ class WorkOfSeparation:
     """The ideal work of separation and the states it compares (energies in eV)."""
 
     work_of_separation_j_per_m2: float
+    #: distance (Å) added to the reference thickness for the slabs apart
+    separation_angstrom: float
     #: lateral stacking (fractions of a1, a2) and thickness (Å) of the zero-load interface
     zero_load_shift: tuple[float, float]
     zero_load_thickness_angstrom: float
     #: the load left at that thickness (GPa), a measure of how well p = 0 was located
     zero_load_stress_gpa: float
     interface_energy_ev: float
-    slab_energies_ev: tuple[float, float]
+    apart_energy_ev: float
     area_angstrom2: float
     #: every relaxation met the force tolerance
     converged: bool
@@ -74,13 +85,9 @@ class WorkOfSeparation:
             "work_of_separation_shift_b": self.zero_load_shift[1],
             "work_of_separation_thickness_angstrom": self.zero_load_thickness_angstrom,
             "work_of_separation_residual_stress_gpa": self.zero_load_stress_gpa,
+            "work_of_separation_apart_angstrom": self.separation_angstrom,
             "work_of_separation_converged": self.converged,
         }
-
-
-def slab_alone(reference: Atoms, slab: int) -> Atoms:
-    """The atoms of slab ``slab`` (1 or 2) of the interface, in the same cell, the other removed."""
-    return reference[np.asarray(reference.arrays["slab"]) == slab]
 
 
 def ideal_work_of_separation(
@@ -98,7 +105,7 @@ def ideal_work_of_separation(
         The reference interface (interface contract).
     factory
         The scan's calculator factory: ``factory(atoms)`` -> ASE calculator; called for the
-        interface (unless ``calc`` is given) and for each slab alone.
+        interface unless ``calc`` is given.
     relax
         The scan's relaxation settings (tolerance, optimiser, mode).
     shift
@@ -110,25 +117,56 @@ def ideal_work_of_separation(
     area = cell_area(a1, a2)
     calc = factory(reference) if calc is None else calc
     z_eq, e_int, p_eq, ok, calls = zero_load_interface(reference, calc, relax, shift)
-    slab_energies = []
-    for k in (1, 2):
-        atoms = slab_alone(reference, k)
-        e, converged, n = relax_structure(atoms, factory(atoms), relax)
-        slab_energies.append(e)
-        ok = ok and converged
-        calls += n
-    w = (sum(slab_energies) - e_int) / area * EV_PER_A2_TO_J_PER_M2
+    d, e_apart, converged, n = slabs_apart(reference, calc, relax, shift, area)
+    w = (e_apart - e_int) / area * EV_PER_A2_TO_J_PER_M2
     return WorkOfSeparation(
         work_of_separation_j_per_m2=float(w),
+        separation_angstrom=float(d),
         zero_load_shift=(float(shift[0]), float(shift[1])),
         zero_load_thickness_angstrom=float(z_eq),
         zero_load_stress_gpa=float(p_eq),
         interface_energy_ev=float(e_int),
-        slab_energies_ev=(float(slab_energies[0]), float(slab_energies[1])),
+        apart_energy_ev=float(e_apart),
         area_angstrom2=float(area),
-        converged=bool(ok),
-        force_calls=int(calls),
+        converged=bool(ok and converged),
+        force_calls=int(calls + n),
     )
+
+
+def slabs_apart(
+    reference: Atoms, calc: Any, relax: RelaxSettings, shift: tuple[float, float], area: float
+) -> tuple[float, float, bool, int]:
+    """E(slab 1 alone) + E(slab 2 alone): the slabs relaxed a distance D apart.
+
+    Returns
+    -------
+    separation_angstrom, energy_ev, converged, force_calls
+    """
+    a, b = float(shift[0]), float(shift[1])
+    z_ref = thickness(reference)
+    tol_ev = APART_TOL_J_PER_M2 / EV_PER_A2_TO_J_PER_M2 * area
+
+    def rigid_energy(z: float) -> float:
+        atoms = place_slab2(reference, a, b, z, spread_compression=False)
+        atoms.calc = calc
+        try:
+            return float(atoms.get_potential_energy())
+        finally:
+            atoms.calc = None
+
+    change = np.nan
+    for d in SEPARATIONS_ANGSTROM:
+        change = rigid_energy(z_ref + 2 * d) - rigid_energy(z_ref + d)
+        if abs(change) < tol_ev:
+            break
+    else:
+        raise InputError(
+            f"work of separation: the slabs still interact {SEPARATIONS_ANGSTROM[-1]:.4g} Å "
+            f"apart (the energy changes by {change / area * EV_PER_A2_TO_J_PER_M2:.3g} J/m² "
+            "when the distance doubles); give contact.work_of_adhesion_j_m2"
+        )
+    r = relax_point(reference, calc, PointTask((0, 0, 0), a, b, z_ref + d), relax)
+    return d, r.energy_ev, r.converged, r.force_calls
 
 
 def zero_load_interface(
