@@ -297,46 +297,6 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
     return result
 
 
-def relax_structure(atoms: Atoms, calc, settings: RelaxSettings) -> tuple[float, bool, int]:
-    """Relax ``atoms`` in place as a grid point is relaxed, without placing slab 2.
-
-    The held atoms (``fixed_mask``) stay where they are and ``settings.mode`` constrains
-    the free ones exactly as in :func:`relax_point` (``rigid``: a single evaluation).
-    For structures that are not a grid point, e.g. one slab of the interface alone.
-
-    Returns
-    -------
-    energy_ev, converged, force_calls
-    """
-    fixed = fixed_mask(atoms)
-    free = ~fixed
-    relaxing = settings.mode != "rigid" and bool(free.any())
-    calc = count_force_calls(calc)
-    calls0 = calc.force_calls
-    groups = free_layer_groups(atoms, free) if settings.mode == "rigid-layers" else []
-    project = constraint_projector(fixed, settings.mode, groups)
-    if relaxing and settings.optimizer == "LBFGS":
-        outcome = lbfgs_relax(
-            point_evaluator(calc, atoms),
-            atoms.positions,
-            project,
-            settings.fmax_ev_per_a,
-            settings.max_steps,
-        )
-        atoms.positions = outcome.positions
-        energy, forces = outcome.energy_ev, outcome.forces
-    elif relaxing:
-        _relax_with_ase(atoms, calc, fixed, free, groups, settings)
-        forces = atoms.get_forces(apply_constraint=False)
-        energy = float(atoms.get_potential_energy())
-        atoms.calc = None
-        atoms.set_constraint()
-    else:
-        energy, forces = point_evaluator(calc, atoms)(atoms.positions)
-    converged = not relaxing or largest_atomic_norm(project(forces)) < settings.fmax_ev_per_a
-    return float(energy), bool(converged), int(calc.force_calls - calls0)
-
-
 def constraint_projector(fixed: np.ndarray, mode: str, groups: list[np.ndarray]):
     """The linear projector P of a relaxation mode, for forces and steps ((n, 3) arrays).
 
