@@ -191,10 +191,7 @@ def zero_load_interface(
 
     def load(z: float) -> float:
         nonlocal calls
-        start = None
-        if done:
-            near = min(done, key=lambda zz: abs(zz - z))
-            start = near
+        start = min(done, key=lambda zz: abs(zz - z)) if done else None
         task = PointTask(
             (0, 0, 0),
             a,
@@ -215,7 +212,7 @@ def zero_load_interface(
         done[z] = (r.energy_ev, r.normal_stress_gpa, r.positions, r.converged)
         return r.normal_stress_gpa
 
-    z0 = thickness(reference)
+    z0 = z_ref = thickness(reference)
     p0 = load(z0)
     direction = 1.0 if p0 > 0 else -1.0
     step = FIRST_STEP_ANGSTROM
@@ -224,8 +221,8 @@ def zero_load_interface(
         if step > MAX_REACH_ANGSTROM:
             raise InputError(
                 f"work of separation: the load at shift ({a:.4g}, {b:.4g}) stays "
-                f"{'compressive' if p0 > 0 else 'tensile'} from z = {z0:.4g} to {z1:.4g} Å "
-                f"(p = {p0:.3g} .. {p1:.3g} GPa); no zero-load thickness"
+                f"{'compressive' if p0 > 0 else 'tensile'} from z = {z_ref:.4g} to {z1:.4g} Å "
+                f"(p = {done[z_ref][1]:.3g} .. {p1:.3g} GPa); no zero-load thickness"
             )
         z0, p0 = z1, p1
         z1 = z0 + direction * step
