@@ -19,8 +19,8 @@ def test_adhesion_of_an_analytic_curve():
         / probe.area_angstrom2
         * EV_PER_A2_TO_J_PER_M2
     )
-    assert adh.work_of_separation_j_per_m2 == pytest.approx(expected, rel=1e-6)
-    assert adh.work_of_separation_integral_j_per_m2 == pytest.approx(expected, rel=1e-3)
+    assert adh.pull_off_work_j_per_m2 == pytest.approx(expected, rel=1e-6)
+    assert adh.pull_off_work_integral_j_per_m2 == pytest.approx(expected, rel=1e-3)
     # tensile maximum: the minimum of the exact p(z) on a fine grid
     zz = np.linspace(10.0, 14.0, 400001)
     s = 10.0 / zz

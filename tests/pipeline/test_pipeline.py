@@ -112,11 +112,12 @@ def test_scan_is_physical(tiny_run):
     scan = json.loads((root / "02-scan" / "scan.json").read_text())
     adh = scan["adhesion"]
     assert adh["separated"]
-    # work of separation: energy difference and -∫p dz agree (both J/m², positive)
-    assert adh["work_of_separation_j_per_m2"] > 0
-    assert adh["work_of_separation_integral_j_per_m2"] == pytest.approx(
-        adh["work_of_separation_j_per_m2"], rel=0.02
+    # the probe's pull-off work: energy difference and -∫p dz agree (both J/m², positive)
+    assert adh["pull_off_work_j_per_m2"] > 0
+    assert adh["pull_off_work_integral_j_per_m2"] == pytest.approx(
+        adh["pull_off_work_j_per_m2"], rel=0.02
     )
+    assert adh["work_of_separation_j_per_m2"] > 0
 
 
 def test_friction_and_laws_are_physical(tiny_run):

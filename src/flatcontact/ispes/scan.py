@@ -30,7 +30,7 @@ from flatcontact.ispes import executors
 from flatcontact.ispes.geometry import in_plane_vectors, thickness, validate_interface
 from flatcontact.ispes.grid import GridSpec, check_thicknesses
 from flatcontact.ispes.order import PREFERENCES, search_tree
-from flatcontact.ispes.probe import probe_column, rigid_stackings
+from flatcontact.ispes.probe import extreme_stackings, probe_column, rigid_stackings
 from flatcontact.ispes.relax import (
     PointTask,
     RelaxSettings,
@@ -41,6 +41,7 @@ from flatcontact.ispes.relax import (
 )
 from flatcontact.ispes.store import PointStore, discard_store, interface_hash
 from flatcontact.ispes.thicknesses import probe_thicknesses
+from flatcontact.ispes.work_of_separation import ideal_work_of_separation
 from flatcontact.layout import ISPES_NC, POINTS_DB
 
 
@@ -107,6 +108,33 @@ def _probe(
             return [executor.result(h) for h in handles]
 
     return probe_thicknesses(relax_one, reference, rigid, grid, probe_columns)
+
+
+def adhesion_record(
+    reference: Atoms,
+    factory: Any,
+    grid: GridSpec,
+    relax: RelaxSettings,
+    pull_off: dict | None = None,
+) -> dict:
+    """The ``adhesion`` entry of a scan: the ideal work of separation and the probe's pull-off.
+
+    W (``work_of_separation_j_per_m2``) is that of the lowest rigid energy among the grid's
+    lateral shifts (:func:`flatcontact.ispes.work_of_separation.ideal_work_of_separation`),
+    whatever the thicknesses; ``pull_off`` is the probe's record
+    (:class:`flatcontact.ispes.separation.Adhesion`, absent for given thicknesses). A
+    record of an older scan whose ``work_of_separation_*`` keys were the pull-off's is
+    renamed to ``pull_off_*``.
+    """
+    calc = worker_calculator(factory, reference)
+    shift = extreme_stackings(rigid_stackings(reference, calc, grid).energy_ev, grid)[0]
+    pulled = {}
+    for key, value in (pull_off or {}).items():
+        if key.startswith("work_of_separation"):
+            key = key.replace("work_of_separation", "pull_off_work", 1)
+        pulled[key] = value
+    w = ideal_work_of_separation(reference, factory, relax, shift, calc=calc)
+    return {**pulled, **w.record()}
 
 
 def relax_column_point(reference, calc, relax, a, b, z, start, start_z) -> tuple:
@@ -209,8 +237,19 @@ def run_scan(
                     else:
                         extra, notes = _probe(reference, factory, grid, relax, executor)
                         resolved.update(extra)
+                    resolved["adhesion"] = adhesion_record(
+                        reference, factory, grid, relax, resolved.get("adhesion")
+                    )
                     store.set_resolved(resolved)
                 resolved = store.resolved
+                if "work_of_separation_shift_a" not in (resolved.get("adhesion") or {}):
+                    # a store resolved before the ideal W existed: its W was the pull-off's
+                    resolved = {
+                        **resolved,
+                        "adhesion": adhesion_record(
+                            reference, factory, grid, relax, resolved.get("adhesion")
+                        ),
+                    }
                 notes = list(resolved.get("notes", notes))
                 z = np.asarray(resolved["thickness_angstrom"], dtype=float)
                 if grid.thickness_angstrom is None:

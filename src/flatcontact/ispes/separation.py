@@ -1,10 +1,15 @@
-"""Equilibrium thickness, tensile strength and work of separation of a probed column.
+"""Equilibrium thickness, tensile strength and pull-off work of a probed column.
 
-Work of separation (per area, J/m²) from the probed column (the paper's z-scan):
-W = [U(z_sep) - U(z_eq)] / A = -∫_{z_eq}^{z_sep} p dz, with z_eq the thickness of
+Pull-off work (per area, J/m²) from the probed column (the paper's z-scan):
+W_pull = [U(z_sep) - U(z_eq)] / A = -∫_{z_eq}^{z_sep} p dz, with z_eq the thickness of
 zero load and z_sep a thickness where the slabs no longer interact (p ≈ 0 beyond the
 tensile maximum). Both forms are reported; they agree when the cross-interface
 potential is continuous at its cutoff and the relaxations are converged.
+
+It is a diagnostic: with the inner planes free, a column pulled apart between its held
+layers may open more than one gap (two for a bonded metal: ≈ 4γ instead of 2γ). The work
+of separation of the interface, one cut, is
+:mod:`flatcontact.ispes.work_of_separation`.
 """
 
 from __future__ import annotations
@@ -20,13 +25,13 @@ from flatcontact.units import EV_PER_A2_TO_J_PER_M2, EV_PER_A3_TO_GPA
 
 @dataclasses.dataclass(frozen=True)
 class Adhesion:
-    """Equilibrium, tensile strength and work of separation of a probed column."""
+    """Equilibrium, tensile strength and pull-off work of a probed column."""
 
     equilibrium_thickness_angstrom: float
     max_tension_gpa: float
     max_tension_thickness_angstrom: float
-    work_of_separation_j_per_m2: float
-    work_of_separation_integral_j_per_m2: float
+    pull_off_work_j_per_m2: float
+    pull_off_work_integral_j_per_m2: float
     separated: bool
 
     def as_dict(self) -> dict:
@@ -34,11 +39,11 @@ class Adhesion:
 
 
 def adhesion(probe: ColumnProbe) -> Adhesion:
-    """Equilibrium thickness (p = 0), maximum tension and work of separation of a column.
+    """Equilibrium thickness (p = 0), maximum tension and pull-off work of a column.
 
     z_eq is the zero of p(z) between the last compressed and first tensile sample
     (linear interpolation); U(z_eq) is interpolated linearly (U is stationary there).
-    W = [U(z_last) - U(z_eq)]/A and W_int = -∫ p dz (trapezoid from z_eq to z_last), in
+    W_pull = [U(z_last) - U(z_eq)]/A and W_int = -∫ p dz (trapezoid from z_eq to z_last), in
     J/m² (``EV_PER_A2_TO_J_PER_M2``; p in GPa -> eV/Å³ by division with
     ``EV_PER_A3_TO_GPA``).
     """
@@ -60,9 +65,7 @@ def adhesion(probe: ColumnProbe) -> Adhesion:
         equilibrium_thickness_angstrom=float(z_eq),
         max_tension_gpa=float(p[i_min]),
         max_tension_thickness_angstrom=float(z[i_min]),
-        work_of_separation_j_per_m2=float(
-            (e[-1] - e_eq) / probe.area_angstrom2 * EV_PER_A2_TO_J_PER_M2
-        ),
-        work_of_separation_integral_j_per_m2=integral * EV_PER_A2_TO_J_PER_M2,
+        pull_off_work_j_per_m2=float((e[-1] - e_eq) / probe.area_angstrom2 * EV_PER_A2_TO_J_PER_M2),
+        pull_off_work_integral_j_per_m2=integral * EV_PER_A2_TO_J_PER_M2,
         separated=bool(i_min < len(p) - 1 and abs(p[-1]) < 0.01 * abs(p[i_min])),
     )

@@ -32,7 +32,7 @@ def figure_scan_columns(ds, adhesion: dict | None = None):
     ax.set_xlabel("thickness z, surface 1 to 4 (Å)")
     ax.set_ylabel("normal load p (GPa, + = compression)")
     ax.set_title(f"(a) p(z) at all {p.shape[0]} lateral shifts")
-    if adhesion:
+    if adhesion and "equilibrium_thickness_angstrom" in adhesion:
         ax.axvline(
             adhesion["equilibrium_thickness_angstrom"],
             color="k",

@@ -22,8 +22,9 @@ def scan_section(scan: dict, folder: Path) -> Section:
     for key, label in (
         ("equilibrium_thickness_angstrom", "z at p = 0 (Å)"),
         ("max_tension_gpa", "maximum tension (GPa)"),
-        ("work_of_separation_j_per_m2", "work of separation, energy (J/m²)"),
-        ("work_of_separation_integral_j_per_m2", "work of separation, −∫p dz (J/m²)"),
+        ("work_of_separation_j_per_m2", "work of separation, slabs apart vs zero load (J/m²)"),
+        ("pull_off_work_j_per_m2", "probe pull-off work, energy (J/m², may open two gaps)"),
+        ("pull_off_work_integral_j_per_m2", "probe pull-off work, −∫p dz (J/m²)"),
     ):
         if key in adh:
             scan_rows.append((label, fmt(adh[key])))
