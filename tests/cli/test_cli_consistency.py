@@ -104,9 +104,10 @@ def test_min_layers_leaves_one_inner_layer_between_fixed_and_sliding_faces():
     cannot even be tagged."""
     from flatcontact.errors import InputError
     from flatcontact.structures.assemble import make_interface
-    from flatcontact.structures.build import MIN_LAYERS, SYMMETRIC_CUT
-    from flatcontact.structures.dense import DENSE_FACE_LAYERS, QUARTZ_ATOMS_PER_LAYER
+    from flatcontact.structures.build import SYMMETRIC_CUT
+    from flatcontact.structures.dense import QUARTZ_ATOMS_PER_LAYER
     from flatcontact.structures.interface_contract import fixed_mask
+    from flatcontact.structures.quartz_layers import DENSE_FACE_LAYERS, MIN_LAYERS
     from flatcontact.structures.slab import quartz_0001_slab
 
     assert MIN_LAYERS == 2 * DENSE_FACE_LAYERS + 1 == 5
@@ -128,7 +129,7 @@ def test_min_layers_leaves_one_inner_layer_between_fixed_and_sliding_faces():
 def test_build_and_config_refuse_the_same_layer_counts(tmp_path, monkeypatch, capsys):
     from pydantic import ValidationError
 
-    from flatcontact.structures.build import MIN_LAYERS, check_layers
+    from flatcontact.structures.quartz_layers import MIN_LAYERS, check_layers
     from flatcontact.structures.recipe import QuartzDenseRecipe
 
     monkeypatch.chdir(tmp_path)

@@ -11,10 +11,11 @@ from flatcontact.errors import InputError
 from flatcontact.structures.assemble import face_tags, make_interface
 from flatcontact.structures.build import load_shipped_dense_slab
 from flatcontact.structures.construct import build_interface
-from flatcontact.structures.dense import DENSE_FACE_LAYERS, QUARTZ_ATOMS_PER_LAYER
+from flatcontact.structures.dense import QUARTZ_ATOMS_PER_LAYER
 from flatcontact.structures.interface_contract import fixed_mask, thickness, validate_interface
 from flatcontact.structures.interface_io import read_interface, write_interface
 from flatcontact.structures.layers import atomic_planes, chunk_layers, sheet_layers
+from flatcontact.structures.quartz_layers import DENSE_FACE_LAYERS
 
 
 def test_graphene_bilayer_of_monolayers_is_one_held_layer_per_slab():

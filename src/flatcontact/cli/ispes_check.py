@@ -94,7 +94,8 @@ def ispes_check(
         atoms = read_interface(interface)
         source = str(interface)
     else:
-        from flatcontact.structures.build import MIN_LAYERS, build_quartz_interface
+        from flatcontact.structures.build import build_quartz_interface
+        from flatcontact.structures.quartz_layers import MIN_LAYERS
 
         if layers < MIN_LAYERS:
             raise InputError(f"--layers: expected >= {MIN_LAYERS}, got {layers}")

@@ -40,7 +40,6 @@ from flatcontact.potentials.factories import chgnet_r2scan
 from flatcontact.potentials.model import InteractionModel
 from flatcontact.structures.assemble import make_interface
 from flatcontact.structures.dense import (
-    DENSE_FACE_LAYERS,
     QUARTZ_ATOMS_PER_LAYER,
     dense_candidates,
     relax,
@@ -48,9 +47,16 @@ from flatcontact.structures.dense import (
 )
 from flatcontact.structures.interface_contract import thickness
 from flatcontact.structures.layers import chunk_layers
+from flatcontact.structures.quartz_layers import (
+    DENSE_FACE_LAYERS,
+    SHIPPED_LAYERS,
+    UNITS_PER_REPEAT,
+    check_layers,
+    check_shipped_layers,
+    shipped_reaches,
+)
 from flatcontact.structures.slab import quartz_0001_slab
 from flatcontact.structures.thicken import (
-    UNITS_PER_REPEAT,
     insert_bulk_repeats,
     interior_report,
     lateral_bulk,
@@ -62,51 +68,14 @@ SYMMETRIC_CUT = 2
 #: Directory of shipped structures.
 DATA_DIR = Path(__file__).resolve().parent / "data"
 SHIPPED_DENSE_SLAB = DATA_DIR / "quartz_0001_dense_6L.extxyz"
-#: O–Si–O layers of the shipped slab; thicker slabs insert whole bulk c-repeats (6, 9, 12, ...).
-SHIPPED_LAYERS = 6
 #: Largest relative deviation of an interior O–Si–O unit spacing of a thickened slab from the
 #: bulk's c/3 (same potential, same lateral cell) before the build refuses it (measured with
 #: the bundled SNAP: <= 1.4 % at 9 and 12 layers).
 INTERIOR_MAX_SPACING_DEV = 0.05
 DEFAULT_GAP_ANGSTROM = 3.0
-#: Fewest O–Si–O layers per slab of the dense quartz interface. Each slab has two tagged face
-#: layers of ``DENSE_FACE_LAYERS`` units each: the outer one (surface 1 or 4) is held fixed
-#: during a scan, the inner one (surface 2 or 3) is the sliding surface; the paper fully relaxes
-#: "surfaces 2, 3 and the inner atomic layers", so at least one bulk-like unit must lie between
-#: the two face layers (with 4 units the fixed face would bond directly to the sliding face and
-#: there would be no inner layer to relax). Used by ``flatcontact build`` and the run config.
-MIN_LAYERS = 2 * DENSE_FACE_LAYERS + 1
 DEFAULT_FMAX_EV_PER_ANGSTROM = 0.01
 #: ``info["material"]`` of the quartz interface.
 QUARTZ_MATERIAL = "SiO2 (alpha-quartz)"
-
-
-def check_layers(layers: object, name: str = "layers") -> int:
-    """``layers`` if it is an integer >= :data:`MIN_LAYERS`, else a one-line :class:`InputError`."""
-    require(
-        isinstance(layers, int) and not isinstance(layers, bool) and layers >= MIN_LAYERS,
-        f"{name}={layers!r}: expected an integer >= {MIN_LAYERS} O-Si-O layers per slab "
-        f"(a fixed outer and a sliding inner face layer of {DENSE_FACE_LAYERS} units each, "
-        "and at least one inner layer between them)",
-    )
-    return layers  # type: ignore[return-value]
-
-
-def shipped_reaches(layers: int) -> bool:
-    """True if the shipped slab, thickened by whole bulk c-repeats, has ``layers`` layers."""
-    return layers >= SHIPPED_LAYERS and (layers - SHIPPED_LAYERS) % UNITS_PER_REPEAT == 0
-
-
-def check_shipped_layers(layers: int, name: str = "layers") -> int:
-    """``layers`` if the shipped slab reaches it (6, 9, 12, ...), else a one-line :class:`InputError`."""
-    require(
-        shipped_reaches(layers),
-        f"{name}={layers}: the shipped dense slab has {SHIPPED_LAYERS} O-Si-O layers and grows "
-        f"by whole alpha-quartz c-repeats of {UNITS_PER_REPEAT} layers: expected "
-        f"{SHIPPED_LAYERS}, {SHIPPED_LAYERS + UNITS_PER_REPEAT}, "
-        f"{SHIPPED_LAYERS + 2 * UNITS_PER_REPEAT}, ... (or source: seed)",
-    )
-    return layers
 
 
 def thicken_shipped_slab(

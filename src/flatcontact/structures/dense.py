@@ -24,6 +24,7 @@ from ase import Atoms
 from ase.optimize import FIRE
 
 from flatcontact.errors import require
+from flatcontact.structures.quartz_layers import DENSE_FACE_LAYERS
 from flatcontact.structures.topology import bonds, coordination_defects, height_spread, ring_sizes
 
 #: Maximum height spread (Å) of the Si atoms of a face layer for it to count as flat.
@@ -32,8 +33,6 @@ FLAT_SI_SPREAD_ANGSTROM = 0.5
 SI_O_BOND_ANGSTROM = 1.61
 #: Atoms per O–Si–O unit in the 1×1 (0001) cell.
 QUARTZ_ATOMS_PER_LAYER = 3
-#: Dense face layer = the two outermost O–Si–O units.
-DENSE_FACE_LAYERS = 2
 
 
 def face_masks(slab: Atoms, face_atoms: int) -> tuple[np.ndarray, np.ndarray]:

@@ -30,8 +30,8 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationError, model_validator
 
 from flatcontact.errors import InputError
-from flatcontact.structures.build import MIN_LAYERS, check_shipped_layers
-from flatcontact.structures.sheets import BUILTIN_SHEETS
+from flatcontact.structures.quartz_layers import MIN_LAYERS, check_shipped_layers
+from flatcontact.structures.sheet_catalog import BUILTIN_SHEETS
 
 #: Name of the config section, the prefix of every field named in an error.
 SECTION = "structure"

@@ -28,7 +28,6 @@ a hexagonal lattice.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 
 import numpy as np
 from ase import Atoms
@@ -43,23 +42,7 @@ from flatcontact.structures.cell2d import (
     standard_slab,
 )
 from flatcontact.structures.layers import bonded_components
-
-
-@dataclass(frozen=True)
-class SheetData:
-    """A built-in monolayer: ASE builder arguments and its bulk interlayer distance."""
-
-    formula: str
-    a_angstrom: float
-    interlayer_angstrom: float
-    thickness_angstrom: float = 0.0
-
-
-BUILTIN_SHEETS: dict[str, SheetData] = {
-    "graphene": SheetData("C2", 2.46, 3.35),
-    "h-BN": SheetData("BN", 2.504, 3.33),
-    "MoS2": SheetData("MoS2", 3.16, 6.15, 3.17),
-}
+from flatcontact.structures.sheet_catalog import BUILTIN_SHEETS
 
 _TOKEN = re.compile(r"([ABC])('?)")
 #: fractional in-plane offsets of the stacking letters (120° hexagonal convention)

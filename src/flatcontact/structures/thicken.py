@@ -33,10 +33,9 @@ from ase.units import GPa
 
 from flatcontact.errors import InputError, require
 from flatcontact.structures.bulk import QUARTZ_C_ANGSTROM, alpha_quartz
-from flatcontact.structures.dense import DENSE_FACE_LAYERS, QUARTZ_ATOMS_PER_LAYER, face_masks
+from flatcontact.structures.dense import QUARTZ_ATOMS_PER_LAYER, face_masks
+from flatcontact.structures.quartz_layers import DENSE_FACE_LAYERS, UNITS_PER_REPEAT
 
-#: O–Si–O units per c-repeat of α-quartz along [0001].
-UNITS_PER_REPEAT = 3
 #: Largest RMS distance (Å) between the slab's interior atoms and the registered bulk for the
 #: interior to count as α-quartz (a wrong registration or another phase gives > 1 Å; the
 #: surface-strained interior of the shipped 6-layer slab relaxed with the bundled SNAP, 0.40 Å).
