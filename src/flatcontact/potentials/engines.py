@@ -3,6 +3,8 @@
 - :func:`make_calculator`: the calculator of an :class:`~flatcontact.potentials.model.InteractionModel`
   for an interface, a slab or a bulk crystal (LAMMPS, ASE per slab + LJ, or the user's ASE
   calculator for the whole interface);
+- :func:`check_setup`: the model set up for a structure without computing anything, so a
+  setup its engine refuses (LAMMPS pair commands) is one line before any work;
 - :func:`calculator_factory`: the same as a picklable factory (:class:`ModelFactory`) for scan
   workers and Dask;
 - :func:`bulk_calculator`: energy, forces and stress of a single crystal, from a model or from a
@@ -40,6 +42,26 @@ def make_calculator(model: InteractionModel, atoms: Atoms):
     if model.engine == "ase-slab":
         return AseInterfaceCalculator(model, atoms)
     return LammpsInterfaceCalculator(model, atoms)
+
+
+def check_setup(model: InteractionModel, atoms: Atoms) -> None:
+    """Refuse, in one line, a structure ``model`` cannot compute or whose setup fails.
+
+    The element and LJ checks of :meth:`InteractionModel.check_atoms`; for the LAMMPS engine
+    also its setup for ``atoms`` (box, types, ``pair_style``/``pair_coeff``: LAMMPS reads the
+    potential files and checks the element map), then closed without computing. ASE
+    calculators are not instantiated (some load models for seconds).
+    """
+    model.check_atoms(atoms)
+    if model.engine != "lammps":
+        return
+    try:
+        calc = LammpsInterfaceCalculator(model, atoms)
+    except InputError as exc:
+        lines = [ln.strip() for ln in str(exc).splitlines() if ln.strip()]
+        kept = [ln for ln in lines if not ln.startswith("For more information")]
+        raise InputError("; ".join(kept)) from None
+    calc.close()
 
 
 @dataclasses.dataclass(frozen=True)

@@ -26,6 +26,19 @@ def check_element(symbol: str, where: str) -> None:
         raise ValueError(f"{where}: '{symbol}' is not a chemical element symbol (e.g. 'Si', 'O')")
 
 
+#: Accelerator suffixes of LAMMPS pair styles (``eam/opt`` is ``eam``).
+ACCELERATOR_SUFFIXES = ("gpu", "intel", "kk", "omp", "opt")
+#: Styles whose ``pair_coeff * * file`` takes no element map: ``eam`` reads one
+#: single-element funcfl file and applies it to the types named by ``I J``.
+NO_MAP_STYLES = frozenset({"eam"})
+
+
+def base_style(name: str) -> str:
+    """The pair style without its accelerator suffix: ``eam/opt`` → ``eam``."""
+    head, _, tail = name.rpartition("/")
+    return head if head and tail in ACCELERATOR_SUFFIXES else name
+
+
 def is_file_token(token: str) -> bool:
     """A ``pair_coeff`` token names a file when it has a '.' or '/' and is not a number."""
     try:
@@ -119,6 +132,13 @@ class LammpsStyle(BaseModel):
 
     @model_validator(mode="after")
     def _files_exist(self) -> LammpsStyle:
+        if self.map_elements and base_style(self.name) in NO_MAP_STYLES:
+            given = " ".join(self.pair_coeff) or "file"
+            raise ValueError(
+                f"pair_style {self.name} reads one single-element funcfl file and "
+                f"'pair_coeff * * {given}' takes no element map (LAMMPS refuses one: "
+                "'Incorrect args for pair coefficients'); set map_elements: false"
+            )
         for token in self.pair_coeff:
             if is_file_token(token):
                 require_potential_file(token, f"pair_style {self.name}")

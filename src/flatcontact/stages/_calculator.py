@@ -44,6 +44,14 @@ def check_atoms(settings, atoms) -> None:
     settings.potential.check_atoms(atoms)
 
 
+def check_setup(settings, atoms) -> None:
+    """:func:`check_atoms` and the engine's setup for ``atoms``, nothing computed (one line)."""
+    # imported here for the same reason as in :func:`factory`
+    from flatcontact.potentials.engines import check_setup as check_model_setup
+
+    check_model_setup(settings.potential, atoms)
+
+
 def toy_kwargs(settings) -> dict:
     """Keyword arguments of the toy interface: the toy calculator's (they set its LJ)."""
     calc = settings.potential.calculator

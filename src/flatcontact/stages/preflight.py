@@ -1,10 +1,13 @@
 """Pre-run checks: everything a run would refuse that needs the run's files or the physics cores.
 
 The settings (:mod:`flatcontact.config`) check values alone; :func:`check_inputs` then reads
-what they name (the interface file, the measured CSVs, the calculator's module) and asks the
-stages' own checks (the model's elements, the contact moduli's material, the elastic crystal),
-so ``flatcontact config --check`` and :class:`flatcontact.pipeline.Pipeline` refuse a run
-before its first stage, with one line naming the field and the file.
+what they name (the interface file, the measured CSVs, the calculator's module), builds the
+recipe's interface as the build stage does but without its relaxation (milliseconds: the
+relaxation is the build's only expensive part), sets the model up for it (for LAMMPS: the
+``pair_style``/``pair_coeff`` commands, files read and element map checked, nothing
+computed) and asks the stages' own checks (the contact moduli's material, the elastic
+crystal), so ``flatcontact config --check`` and :class:`flatcontact.pipeline.Pipeline`
+refuse a run before its first stage, with one line naming the field and the file.
 """
 
 from __future__ import annotations
@@ -23,7 +26,10 @@ from flatcontact.stages import _calculator
 from flatcontact.stages.build import structure_elements
 from flatcontact.stages.contact import check_fit_settings, check_moduli_source
 from flatcontact.stages.elastic import bulk_crystal
+from flatcontact.structures.bulk import alpha_quartz
+from flatcontact.structures.construct import build_interface
 from flatcontact.structures.interface_io import read_interface
+from flatcontact.structures.recipe import FileRecipe, QuartzDenseRecipe, ToyRecipe
 
 
 def check_inputs(cfg: RunConfig, source: str = "config") -> None:
@@ -32,8 +38,9 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
     ``flatcontact config --check`` and :class:`flatcontact.pipeline.Pipeline` both call it,
     so the check refuses what a run would refuse before its first stage: an interface file
     that does not follow the contract (or has more atoms than the ``atoms`` bound), a
-    measured stiffness CSV that does not parse, a calculator that does not import, a model
-    that cannot compute the elastic stage's crystal.
+    recipe the builder refuses, a model that cannot compute the built interface or whose
+    LAMMPS setup fails on it, a measured stiffness CSV that does not parse, a calculator
+    that does not import, a model that cannot compute the elastic stage's crystal.
 
     Raises
     ------
@@ -56,8 +63,7 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
             load_callable(calc.target)
         except InputError as exc:
             raise InputError(f"{source}: potential.calculator.target: {exc}") from None
-    if cfg.structure.kind == "file":
-        _calculator.check_atoms(cfg, read_interface(cfg.structure.file))
+    _check_structure(cfg, source)
     check_moduli_source(cfg, structure_elements(cfg.structure))
     if cfg.elastic.enabled:
         bulk, _ = bulk_crystal(cfg.structure)
@@ -95,3 +101,25 @@ def _check_structure_file(cfg: RunConfig, source: str) -> None:
             ) from None
     if n > limits.bound("atoms"):
         raise InputError(f"{field}: {limits.message('atoms', n, f'atoms in {file.name}')}")
+
+
+def _check_structure(cfg: RunConfig, source: str) -> None:
+    """The recipe's interface, built unrelaxed, and the model set up for it (one line)."""
+    recipe = cfg.structure
+    if isinstance(recipe, QuartzDenseRecipe):  # its builder relaxes; the material is fixed
+        atoms = alpha_quartz()
+    elif isinstance(recipe, FileRecipe):
+        atoms = read_interface(recipe.file)
+    else:
+        if isinstance(recipe, ToyRecipe) and not recipe.params:  # as the build stage does
+            recipe = recipe.model_copy(update={"params": _calculator.toy_kwargs(cfg)})
+        try:
+            atoms, _ = build_interface(recipe)
+        except InputError as exc:
+            raise InputError(f"{source}: {exc}") from None
+    try:
+        _calculator.check_setup(cfg, atoms)
+    except InputError as exc:
+        text = str(exc)
+        where = "" if text.startswith("potential") else "potential: "
+        raise InputError(f"{source}: {where}{text}") from None

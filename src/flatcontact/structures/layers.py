@@ -3,9 +3,10 @@
 Two rules, one per kind of material:
 
 - **2D sheets** (graphene, h-BN, MoS₂, ...): a layer is a connected component of the
-  bond graph, bonds being pairs closer than the sum of ASE's natural covalent radii
-  (``ase.neighborlist.natural_cutoffs``) with the lateral periodic images included. An
-  S–Mo–S sheet is one layer; sheets 3 Å apart (van der Waals gap) are separate layers.
+  bond graph, bonds being pairs closer than 1.2 × the sum of the covalent radii
+  (:func:`flatcontact.structures.topology.bond_radii`) with the lateral periodic images
+  included. An S–Mo–S sheet is one layer; sheets 3 Å apart (van der Waals gap) are
+  separate layers.
 - **3D crystals** (metals, oxides): a layer is one bulk repeat along the surface
   normal: the atoms with height in ``[z0 + k·d, z0 + (k+1)·d)``, where ``d`` is the
   repeat of the oriented bulk along z and ``z0`` the cut (a height between two atomic
@@ -21,23 +22,26 @@ from itertools import pairwise
 
 import numpy as np
 from ase import Atoms
-from ase.neighborlist import natural_cutoffs, neighbor_list
+from ase.neighborlist import neighbor_list
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from flatcontact.errors import InputError
 from flatcontact.structures.interface_contract import fixed_mask
+from flatcontact.structures.topology import BOND_TOLERANCE, bond_radii
 
 #: Atomic heights closer than this (Å) belong to one atomic plane.
 PLANE_TOLERANCE_ANGSTROM = 0.3
 
 
-def bonded_components(atoms: Atoms, mult: float = 1.0) -> np.ndarray:
-    """Connected components of the bond graph (natural cutoffs × ``mult``), lateral images included.
+def bonded_components(atoms: Atoms, tolerance: float = BOND_TOLERANCE) -> np.ndarray:
+    """Connected components of the bond graph, lateral images included.
 
-    Returns one integer label per atom (0, 1, ...; order of ASE's labelling).
+    Bonded: closer than ``tolerance`` × the sum of the two covalent radii
+    (:func:`~flatcontact.structures.topology.bond_radii`). Returns one integer label per
+    atom (0, 1, ...; order of ASE's labelling).
     """
-    i, j = neighbor_list("ij", atoms, natural_cutoffs(atoms, mult=mult))
+    i, j = neighbor_list("ij", atoms, bond_radii(atoms, tolerance))
     n = len(atoms)
     graph = coo_matrix((np.ones(i.size), (i, j)), shape=(n, n))
     _, labels = connected_components(graph, directed=False)
