@@ -42,6 +42,8 @@ PACKAGES = [
     "flatcontact.contact",
     "flatcontact.stages",
     "flatcontact.report",
+    "flatcontact.training",
+    "flatcontact.plots",
 ]
 
 

@@ -13,6 +13,8 @@ import matplotlib.pyplot as plt
 
 from flatcontact.fileio import atomic_path
 
+__all__ = ["save_figure"]
+
 
 def save_figure(
     fig, stem: str | Path, formats: Sequence[str] = ("png", "svg"), dpi: int = 150
