@@ -17,6 +17,8 @@ bound                  default  why
 ``layers``             200      layers per slab (``structure.layers``, ``build --layers``)
 ``atoms``              100000   atoms in an interface file (structure.file) — a few GB of
                                 neighbour lists per LAMMPS worker beyond that
+``structure_mb``       200      size of a structure file in MB (10⁶ bytes): 100 000 atoms of
+                                extended XYZ with a dozen per-atom columns is ~20 MB
 ``workers``            4×cores  local worker processes (more only share the same cores)
 ``loads``              1000     pressures per list (``analysis.p_gpa``, ``contact.p0_gpa``)
 =====================  =======  ==========================================================
@@ -38,6 +40,7 @@ DEFAULTS: dict[str, int] = {
     "thicknesses": 500,
     "layers": 200,
     "atoms": 100_000,
+    "structure_mb": 200,
     "workers_per_core": 4,
     "loads": 1000,
 }

@@ -175,10 +175,11 @@ def build(
         section = {
             "kind": "slab",
             "file": str(structure),
-            "normal_axis": normal_axis,
             "gap_angstrom": gap_angstrom,
             "fmax_ev_per_angstrom": fmax_ev_per_angstrom,
         }
+        if normal_axis != 2:  # the default is the only axis taken (no deprecation warning)
+            section["normal_axis"] = normal_axis
     data = {
         "structure": section,
         "potential": spec.model_dump(mode="json"),

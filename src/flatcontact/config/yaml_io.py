@@ -4,6 +4,15 @@ In: :func:`parse_yaml` reads with ``yaml.SafeLoader`` (no Python objects), refus
 given twice in one mapping and nesting deeper than :data:`MAX_CONFIG_DEPTH`; the file itself
 is read within :data:`MAX_CONFIG_BYTES` (:func:`flatcontact.fileio.read_text_file`).
 
+Anchors and aliases (``&name`` / ``*name``) are allowed, but the document they expand to is
+bounded: before anything is constructed, the composed node graph is counted as the tree the
+aliases expand to (each alias counts every node below its anchor, memoised per node, so the
+count itself is linear in the file) and a document of more than :data:`MAX_CONFIG_NODES`
+expanded nodes, or an alias that refers to a node containing it, is refused in one line
+naming the file. A run configuration has a few hundred nodes; the bound stops a
+"billion laughs" document (nested aliases, 10⁹ nodes from a few hundred bytes) before it
+reaches the settings.
+
 Out: :func:`to_yaml` prints a configuration with every field's description as a comment
 above it (``flatcontact config --show-default``).
 """
@@ -31,6 +40,10 @@ from flatcontact.potentials.model import InteractionModel
 MAX_CONFIG_BYTES = 1_000_000
 #: Deepest nesting of a configuration (sections are 3 levels deep; kwargs a few more).
 MAX_CONFIG_DEPTH = 32
+#: Most nodes a configuration may expand to once its aliases are expanded (scalars, lists
+#: and mappings each count one; a run configuration has a few hundred, a 1000-load list
+#: about a thousand).
+MAX_CONFIG_NODES = 100_000
 
 
 class StrictLoader(yaml.SafeLoader):
@@ -52,6 +65,10 @@ class StrictLoader(yaml.SafeLoader):
             seen[key] = key_node.start_mark.line + 1
         return super().construct_mapping(node, deep=deep)
 
+    def construct_document(self, node):
+        _check_expansion(node)
+        return super().construct_document(node)
+
 
 StrictLoader.add_constructor(
     yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, StrictLoader.construct_mapping
@@ -62,6 +79,53 @@ class _DuplicateKey(Exception):
     def __init__(self, key: Any, line: int, first: int):
         super().__init__(key, line, first)
         self.key, self.line, self.first = key, line, first
+
+
+class _Expansion(Exception):
+    """A document whose aliases expand past :data:`MAX_CONFIG_NODES` or into themselves."""
+
+
+def _check_expansion(root: yaml.Node) -> None:
+    """Refuse ``root`` if its aliases expand past :data:`MAX_CONFIG_NODES` or loop.
+
+    The composer shares one node object per anchor, so the graph is a DAG (or, for an alias
+    inside its own anchor, cyclic); the expanded size of a node is 1 + the sizes of its
+    children, memoised by node identity: linear in the number of distinct nodes.
+    """
+    sizes: dict[int, int] = {}
+    open_nodes: set[int] = set()
+    # iterative post-order walk: (node, children visited?)
+    stack: list[tuple[yaml.Node, bool]] = [(root, False)]
+    while stack:
+        node, done = stack.pop()
+        key = id(node)
+        if done:
+            children = _children(node)
+            sizes[key] = 1 + sum(sizes[id(c)] for c in children)
+            open_nodes.discard(key)
+            if sizes[key] > MAX_CONFIG_NODES:
+                raise _Expansion(
+                    f"its aliases expand to more than {MAX_CONFIG_NODES} values "
+                    f"(line {node.start_mark.line + 1}); expected a plain run configuration"
+                )
+            continue
+        if key in sizes:
+            continue
+        if key in open_nodes:
+            raise _Expansion(
+                f"an alias refers to a node that contains it (line {node.start_mark.line + 1})"
+            )
+        open_nodes.add(key)
+        stack.append((node, True))
+        stack.extend((c, False) for c in _children(node) if id(c) not in sizes)
+
+
+def _children(node: yaml.Node) -> list[yaml.Node]:
+    if isinstance(node, yaml.MappingNode):
+        return [n for pair in node.value for n in pair]
+    if isinstance(node, yaml.SequenceNode):
+        return list(node.value)
+    return []
 
 
 def _depth(value: Any, limit: int, level: int = 0) -> int:
@@ -81,6 +145,8 @@ def parse_yaml(text: str, source: str) -> Any:
     """YAML ``text`` as data; duplicate keys, bad syntax and deep nesting are one-line errors."""
     try:
         data = yaml.load(text, Loader=StrictLoader)
+    except _Expansion as exc:
+        raise InputError(f"{source}: {exc}") from None
     except _DuplicateKey as dup:
         raise InputError(
             f"{source}: key {show(dup.key)} given twice (lines {dup.first} and {dup.line}); "

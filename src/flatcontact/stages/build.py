@@ -117,17 +117,9 @@ def run_build(settings, inputs: BuildInputs, folder: Path | None, progress=None)
 def structure_elements(recipe) -> set[str] | None:
     """The elements of a recipe read from its files (``file``, ``slab``, ``crystal``), cheaply
     and before any work; ``None`` when only the build knows them."""
-    from ase.io import read
-
-    from flatcontact.errors import InputError
+    from flatcontact.structures.structure_file import read_structure
 
     path = {"file": "file", "slab": "file", "crystal": "bulk"}.get(recipe.kind)
     if path is None:
         return None
-    try:
-        return set(read(getattr(recipe, path)).get_chemical_symbols())
-    except Exception as exc:  # any reader error, named with the field
-        raise InputError(
-            f"structure.{path}: {getattr(recipe, path)} is not a structure file ASE can read "
-            f"({type(exc).__name__})"
-        ) from None
+    return set(read_structure(getattr(recipe, path), f"structure.{path}").get_chemical_symbols())

@@ -103,15 +103,14 @@ def bulk_crystal(recipe):
 
 
 def _layered_bulk(recipe):
-    from ase.io import read
-
     from flatcontact.structures.sheets import BUILTIN_SHEETS, builtin_sheet, stack_sheets
+    from flatcontact.structures.structure_file import read_structure
 
     if recipe.sheet in BUILTIN_SHEETS:
         sheet = builtin_sheet(recipe.sheet)
         d = recipe.interlayer_angstrom or BUILTIN_SHEETS[recipe.sheet].interlayer_angstrom
     else:
-        sheet = read(recipe.sheet)
+        sheet = read_structure(recipe.sheet, "structure.sheet")
         d = recipe.interlayer_angstrom
     stacking = recipe.stacking if len(recipe.stacking.replace("'", "")) >= 2 else "AB"
     atoms = stack_sheets(sheet, 2, stacking, d, "structure.stacking")

@@ -14,8 +14,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import ase.io
-
 from flatcontact import limits
 from flatcontact.config import RunConfig
 from flatcontact.contact.measured import load_stiffness_csv
@@ -30,6 +28,7 @@ from flatcontact.structures.bulk import alpha_quartz
 from flatcontact.structures.construct import build_interface
 from flatcontact.structures.interface_io import read_interface
 from flatcontact.structures.recipe import FileRecipe, QuartzDenseRecipe, ToyRecipe
+from flatcontact.structures.structure_file import read_structure
 
 
 def check_inputs(cfg: RunConfig, source: str = "config") -> None:
@@ -93,12 +92,7 @@ def _check_structure_file(cfg: RunConfig, source: str) -> None:
             ) from None
         n = len(atoms)
     else:
-        try:
-            n = len(ase.io.read(file))
-        except Exception as exc:  # ASE readers raise anything on garbage
-            raise InputError(
-                f"{field}: {file}: not a structure file ASE can read ({type(exc).__name__})"
-            ) from None
+        n = len(read_structure(file, field))
     if n > limits.bound("atoms"):
         raise InputError(f"{field}: {limits.message('atoms', n, f'atoms in {file.name}')}")
 

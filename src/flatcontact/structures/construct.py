@@ -17,7 +17,6 @@ from typing import Any
 
 import numpy as np
 from ase import Atoms
-from ase.io import read
 
 from flatcontact.errors import InputError, require
 from flatcontact.structures.assemble import finish_interface, layer_plane, split_stack, stack_pair
@@ -53,6 +52,7 @@ from flatcontact.structures.sheets import (
     rotation_centre,
 )
 from flatcontact.structures.sources import crystal_source, fcc111_source, sheet_source
+from flatcontact.structures.structure_file import read_structure
 from flatcontact.structures.toy import toy_interface
 
 
@@ -69,12 +69,7 @@ def _sheet_source(sheet: str, stacking: str, interlayer: float | None, field: st
             path.is_file(),
             f"{field}.sheet: '{sheet}' is neither a built-in sheet ({', '.join(BUILTIN_SHEETS)}) nor a file",
         )
-        try:
-            raw = read(path)
-        except Exception as exc:  # any reader error
-            raise InputError(
-                f"{field}.sheet: '{path}' is not a structure file ASE can read ({type(exc).__name__}: {exc})"
-            ) from None
+        raw = read_structure(path, f"{field}.sheet")
         atoms = check_sheet(raw, f"{field}.sheet '{path.name}'")
         require(
             interlayer is not None,
@@ -169,12 +164,7 @@ def build_from_slab_file(recipe: SlabFileRecipe) -> tuple[Atoms, dict]:
     """Two copies of a slab file facing each other (slab 2 translated, or flipped)."""
     path = Path(recipe.file)
     require(path.is_file(), f"{SECTION}.file: '{path}' not found")
-    try:
-        raw = read(path)
-    except Exception as exc:  # any reader error
-        raise InputError(
-            f"{SECTION}.file: '{path}' is not a structure file ASE can read ({type(exc).__name__}: {exc})"
-        ) from None
+    raw = read_structure(path, f"{SECTION}.file")
     raw.pbc = (True, True, False)
     try:
         slab = standard_slab(raw)

@@ -30,13 +30,13 @@ from ase import Atoms
 from ase.build import fcc111
 from ase.build import surface as ase_surface
 from ase.data import atomic_numbers, reference_states
-from ase.io import read
 
 from flatcontact.errors import InputError, require
 from flatcontact.fileio import file_sha256
 from flatcontact.structures.cell2d import standard_slab
 from flatcontact.structures.layers import repeat_layers
 from flatcontact.structures.slab import cleavage_heights
+from flatcontact.structures.structure_file import read_structure
 
 
 @dataclass
@@ -58,16 +58,11 @@ def file_record(path: str | Path) -> dict:
 
 
 def read_bulk(path: str | Path, field_name: str = "bulk") -> Atoms:
-    """A fully periodic bulk crystal from any file ASE reads; one-line InputError otherwise."""
+    """A fully periodic bulk crystal from any file ASE reads, checked by
+    :func:`~flatcontact.structures.structure_file.read_structure`; one-line InputError otherwise."""
     path = Path(path)
     require(path.is_file(), f"{field_name}: file '{path}' not found")
-    try:
-        atoms = read(path)
-    except Exception as exc:  # any reader error is the user's file to fix
-        raise InputError(
-            f"{field_name}: '{path}' is not a structure file ASE can read ({type(exc).__name__}: {exc})"
-        ) from None
-    require(len(atoms) > 0, f"{field_name}: '{path}' holds no atoms")
+    atoms = read_structure(path, field_name)
     require(
         abs(atoms.cell.volume) > 1e-6,
         f"{field_name}: '{path}' has no 3D cell (a bulk crystal needs three lattice vectors)",

@@ -11,9 +11,9 @@ from pathlib import Path
 
 import numpy as np
 from ase import Atoms
-from ase.io import read, write
+from ase.io import write
 
-from flatcontact.errors import InputError, require
+from flatcontact.errors import require
 from flatcontact.fileio import atomic_path
 from flatcontact.structures.interface_contract import (
     fixed_mask,
@@ -21,6 +21,7 @@ from flatcontact.structures.interface_contract import (
     validate_interface,
 )
 from flatcontact.structures.layers import interface_layers
+from flatcontact.structures.structure_file import read_structure
 
 
 def write_interface(atoms: Atoms, path: str | os.PathLike[str]) -> Path:
@@ -50,18 +51,16 @@ def write_interface(atoms: Atoms, path: str | os.PathLike[str]) -> Path:
 def read_interface(path: str | os.PathLike[str]) -> Atoms:
     """Read an ``interface.extxyz`` and validate it (one-line :class:`InputError` if not valid).
 
+    The file is read by :func:`flatcontact.structures.structure_file.read_structure` (size,
+    atom count, finite positions, cell shape, minimum distance) before the contract's checks.
+
     A file without ``layer`` gets one found from the structure
     (:func:`flatcontact.structures.layers.interface_layers`); without ``held`` the
     contract's default (surfaces 1 and 4) is stored explicitly.
     """
     path = Path(path)
     require(path.is_file(), f"{path}: interface file not found")
-    try:
-        atoms = read(path, format="extxyz", index=-1)
-    except Exception as exc:  # malformed file: report it as the user's to fix
-        raise InputError(
-            f"{path}: not a readable extended XYZ file ({type(exc).__name__}: {exc})"
-        ) from None
+    atoms = read_structure(path, format="extxyz", index=-1)
     validate_interface(atoms, str(path))
     atoms.arrays["slab"] = np.asarray(atoms.arrays["slab"], dtype=int)
     atoms.arrays["surface"] = np.asarray(atoms.arrays["surface"], dtype=int)
