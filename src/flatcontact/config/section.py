@@ -8,6 +8,7 @@ from pydantic import BaseModel, ConfigDict
 
 from flatcontact import limits
 from flatcontact.config.messages import show
+from flatcontact.config.numbers import field_bounds
 
 
 class Section(BaseModel):
@@ -19,6 +20,16 @@ class Section(BaseModel):
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    @classmethod
+    def __pydantic_init_subclass__(cls, **kwargs: Any) -> None:
+        """State the bounds of every :func:`~flatcontact.config.numbers.physical` field in its
+        description (printed by ``flatcontact config --show-default``)."""
+        super().__pydantic_init_subclass__(**kwargs)
+        for field in cls.model_fields.values():
+            bounds = field_bounds(field)
+            if bounds is not None and bounds.text() not in (field.description or ""):
+                field.description = f"{field.description or ''} [{bounds.text()}]".strip()
 
 
 def positive_pair(value: Any, what: str) -> tuple[int, int]:

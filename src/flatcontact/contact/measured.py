@@ -13,6 +13,15 @@ N, mN, µN (uN), nN, kN and length in m, mm, µm (um), nm (e.g. N/m, mN/m, µN/n
 Lines starting with ``#`` are comments. Which column is which is decided by its
 unit.
 
+Cells and rows
+--------------
+A cell is a plain decimal number (``12``, ``-0.5``, ``1.2e3``): no digit separators
+(``1_0``), no hex, no NaN or inf, no subnormal magnitude. Stresses and stiffnesses are
+>= 0 (0: gross sliding), loads > 0. The rows are put in one canonical order (by load, stress, stiffness), so a
+shuffled file reads as the sorted one; a row repeated exactly is kept once; two rows with
+the same stress (and load) but different stiffnesses are refused, as is a curve whose
+stresses or stiffnesses are all equal. Every refusal names the file and the data line.
+
 Several loads (:func:`load_fit_data`)
 -------------------------------------
 Either one two-column CSV per load (the p0 of each file given alongside) or one CSV
@@ -29,6 +38,7 @@ from __future__ import annotations
 
 import math
 import re
+import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -50,6 +60,77 @@ _BRACKET = re.compile(r"^(?P<name>.*?)\s*[\[(](?P<unit>[^\])]+)[\])]\s*$")
 _SNAKE_STIFF = re.compile(r"^(?P<name>.+?)_(?P<f>kn|mn|un|nn|n)_per_(?P<l>mm|um|nm|m)$")
 _SNAKE_PRESS = re.compile(r"^(?P<name>.+?)_(?P<u>kpa|mpa|gpa|pa)$")
 _LOAD_NAME = re.compile(r"p0|peak|load", re.IGNORECASE)
+#: A plain decimal number: what a CSV cell may hold (no ``1_0``, ``0x1p3``, ``inf``).
+_DECIMAL = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+
+
+def parse_cell(cell: str, where: str) -> float:
+    """The number in one CSV cell: a plain decimal, finite and not subnormal.
+
+    Raises
+    ------
+    InputError
+        One line naming ``where`` (file and data line) and the cell.
+    """
+    text = cell.strip()
+    if text.lower().lstrip("+-") in ("nan", "inf", "infinity"):
+        raise InputError(f"{where} has NaN or inf: {text!r}")
+    if not _DECIMAL.fullmatch(text):
+        raise InputError(f"{where} is not numeric: {text!r} is not a plain decimal number")
+    value = float(text)
+    if not math.isfinite(value):
+        raise InputError(f"{where} has a number out of range: {text!r}")
+    if value != 0.0 and abs(value) < sys.float_info.min:
+        raise InputError(f"{where} has a subnormal number: {text!r}")
+    return value
+
+
+def _canonical_rows(
+    rows: list[tuple[int, list[float]]], key: Sequence[int], name: str
+) -> list[list[float]]:
+    """``rows`` ((data line, values)) sorted by the columns ``key`` then the rest, exact
+    repeats dropped; two rows equal on ``key[:-1]`` + stress but not otherwise are refused.
+
+    ``key`` lists the column indices in sort order, ending with the stress column; the
+    remaining column is the stiffness.
+    """
+    width = len(rows[0][1]) if rows else 0
+    order = list(key) + [i for i in range(width) if i not in key]
+    ranked = sorted(rows, key=lambda r: ([r[1][i] for i in order], r[0]))
+    out: list[list[float]] = []
+    prev: tuple[int, list[float]] | None = None
+    for line, vals in ranked:
+        if prev is not None and [prev[1][i] for i in key] == [vals[i] for i in key]:
+            if prev[1] == vals:
+                continue  # an exact repeat
+            raise InputError(
+                f"{name}: data lines {prev[0]} and {line} give the same stress with different "
+                f"values ({prev[1]} and {vals}): merge or remove one"
+            )
+        out.append(vals)
+        prev = (line, vals)
+    return out
+
+
+def _check_curve(stress: FloatArray, stiff: FloatArray, name: str, at: str = "") -> None:
+    """Refuse a curve without a range: all stresses or all stiffnesses equal."""
+    require(
+        np.ptp(stress) > 0.0,
+        f"{name}: every row{at} has the same stress ({stress[0]:g} Pa): a stiffness curve "
+        "needs a range of stresses",
+    )
+    require(
+        np.ptp(stiff) > 0.0,
+        f"{name}: every row{at} has the same stiffness ({stiff[0]:g} N/m): the curve has no "
+        "collapse to compare with",
+    )
+
+
+def _check_row(vals: list[float], i_stress: int, i_stiff: int, where: str, line: str) -> None:
+    """Refuse a physically impossible row: stress < 0 or stiffness < 0 (0 is a contact in
+    gross sliding)."""
+    require(vals[i_stress] >= 0.0, f"{where}: the stress must be >= 0, got {line!r}")
+    require(vals[i_stiff] >= 0.0, f"{where}: the stiffness must be >= 0, got {line!r}")
 
 
 def _normalise_unit(text: str) -> str:
@@ -150,28 +231,20 @@ def load_stiffness_csv(path: str | Path) -> MeasuredStiffness:
     i_stress = kinds.index("stress")
     rows = []
     for n, ln in enumerate(lines[1:], start=2):
+        where = f"{p.name}: data line {n}"
         cells = [c.strip() for c in ln.split(",")]
-        require(len(cells) == 2, f"{p.name}: data line {n} has {len(cells)} cells, expected 2")
-        try:
-            vals = [float(c) for c in cells]
-        except ValueError:
-            raise InputError(f"{p.name}: data line {n} is not numeric: {ln.strip()!r}") from None
-        require(
-            all(math.isfinite(v) for v in vals),
-            f"{p.name}: data line {n} has NaN or inf: {ln.strip()!r}",
-        )
-        rows.append(vals)
-    require(len(rows) >= 4, f"{p.name}: need at least 4 data rows, got {len(rows)}")
-    data = np.array(rows)
+        require(len(cells) == 2, f"{where} has {len(cells)} cells, expected 2")
+        vals = [parse_cell(c, where) for c in cells]
+        _check_row(vals, i_stress, 1 - i_stress, where, ln.strip())
+        rows.append((n, vals))
+    data = np.array(_canonical_rows(rows, [i_stress], p.name)).reshape(-1, 2)
+    require(len(data) >= 4, f"{p.name}: need at least 4 distinct data rows, got {len(data)}")
     stress = data[:, i_stress] * cols[i_stress][2]
     stiff = data[:, 1 - i_stress] * cols[1 - i_stress][2]
-    require(
-        bool(np.all(stress >= 0.0)), f"{p.name}: stress must be >= 0 (column {header[i_stress]!r})"
-    )
-    order = np.argsort(stress, kind="stable")
+    _check_curve(stress, stiff, p.name)
     return MeasuredStiffness(
-        stress_pa=stress[order],
-        stiffness_n_per_m=stiff[order],
+        stress_pa=stress,
+        stiffness_n_per_m=stiff,
         source=p.name,
         stress_column=header[i_stress],
         stiffness_column=header[1 - i_stress],
@@ -252,17 +325,17 @@ def read_table(path: str | Path, params: ContactParameters) -> list[LoadCurve] |
         sorted(cols) == ["stiffness", "stress"],
         f"{p.name}: need one stress and one stiffness column besides the load, got {header}",
     )
+    i_stress, i_stiff = cols["stress"][0], cols["stiffness"][0]
     rows = []
     for n, ln in enumerate(lines[1:], start=2):
+        where = f"{p.name}: data line {n}"
         cells = [c.strip() for c in ln.split(",")]
-        require(len(cells) == 3, f"{p.name}: data line {n} has {len(cells)} cells, expected 3")
-        try:
-            vals = [float(c) for c in cells]
-        except ValueError:
-            raise InputError(f"{p.name}: data line {n} is not numeric: {ln.strip()!r}") from None
-        require(all(math.isfinite(v) for v in vals), f"{p.name}: data line {n} has NaN or inf")
-        rows.append(vals)
-    data = np.array(rows)
+        require(len(cells) == 3, f"{where} has {len(cells)} cells, expected 3")
+        vals = [parse_cell(c, where) for c in cells]
+        require(vals[li] > 0.0, f"{where}: the load must be > 0, got {ln.strip()!r}")
+        _check_row(vals, i_stress, i_stiff, where, ln.strip())
+        rows.append((n, vals))
+    data = np.array(_canonical_rows(rows, [li, i_stress], p.name)).reshape(-1, 3)
     load = data[:, li] * f_load
     p0_pa = load if kind_load == "p0" else _p0_from_load_pa(load, params)
     stress = data[:, cols["stress"][0]] * cols["stress"][1]
@@ -272,8 +345,9 @@ def read_table(path: str | Path, params: ContactParameters) -> list[LoadCurve] |
     out = []
     for p0 in np.unique(np.round(p0_pa / units.GPA_TO_PA, 9)):
         sel = np.isclose(p0_pa / units.GPA_TO_PA, p0, rtol=1e-9, atol=0)
-        order = np.argsort(stress[sel], kind="stable")
+        order = np.lexsort((stiff[sel], stress[sel]))
         require(int(sel.sum()) >= 4, f"{p.name}: need at least 4 rows at p0 = {p0:g} GPa")
+        _check_curve(stress[sel], stiff[sel], p.name, f" at p0 = {p0:g} GPa")
         out.append(
             LoadCurve(
                 p0_gpa=float(p0),
