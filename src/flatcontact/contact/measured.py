@@ -103,9 +103,10 @@ def _canonical_rows(
         if prev is not None and [prev[1][i] for i in key] == [vals[i] for i in key]:
             if prev[1] == vals:
                 continue  # an exact repeat
+            first, second = sorted(((prev[0], prev[1]), (line, vals)))
             raise InputError(
-                f"{name}: data lines {prev[0]} and {line} give the same stress with different "
-                f"values ({prev[1]} and {vals}): merge or remove one"
+                f"{name}: data lines {first[0]} and {second[0]} give the same stress with "
+                f"different values ({first[1]} and {second[1]}): merge or remove one"
             )
         out.append(vals)
         prev = (line, vals)
