@@ -54,6 +54,11 @@ CONTACT_CASES = {
     "sigma0-huge": (["--sigma0-mpa", "1e300"], "--sigma0-mpa"),
     "k-subnormal": (["--k-mpa-per-gpa", SUBNORMAL], "--k-mpa-per-gpa"),
     "work-of-adhesion-huge": (["--work-of-adhesion-j-m2", "1e300"], "--work-of-adhesion-j-m2"),
+    # tiny but normal: with λ its cohesive-zone width overflowed; 0 (no adhesion) stays valid
+    "work-of-adhesion-tiny": (
+        ["--work-of-adhesion-j-m2", "1e-300", "--maugis-lambda", "1"],
+        "--work-of-adhesion-j-m2",
+    ),
     "maugis-lambda-subnormal": (
         ["--work-of-adhesion-j-m2", "0.1", "--maugis-lambda", SUBNORMAL],
         "--maugis-lambda",
@@ -116,6 +121,11 @@ def test_config_field_at_the_edge_is_one_line(section, field, tmp_path, capsys):
         ["--p0-gpa", "1e-6,1e3", "--tau0-mpa", "1e5", "--sigma0-mpa", "1e5"],
         ["--work-of-adhesion-j-m2", "100", "--maugis-lambda", "1e-3"],
         ["--work-of-adhesion-j-m2", "100", "--maugis-lambda", "1e3", "--radius-um", "1e4"],
+        [
+            *("--work-of-adhesion-j-m2", "1e-6", "--maugis-lambda", "1e-3", "--radius-um", "1e4"),
+            *("--contact-modulus-gpa", "1e4", "--shear-modulus-gpa", "0.01", "--p0-gpa", "1e3"),
+        ],
+        ["--work-of-adhesion-j-m2", "0", "--tau0-mpa", "0", "--sigma0-mpa", "0"],
     ],
 )
 def test_contact_at_the_bounds_runs_clean(argv, capsys):

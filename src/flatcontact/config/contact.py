@@ -33,8 +33,8 @@ PressureGPa = physical(1e-6, 1e3, "GPa")
 Fraction = physical(1e-3, 0.999)
 #: Contact moduli E*, G* (from soft polymers to beyond diamond).
 ModulusGPa = physical(0.01, 1e4, "GPa")
-#: Stresses of the laws (τ0, σ0): at most 100 GPa.
-StressMPa = physical(0.0, 1e5, "MPa")
+#: Stresses of the laws (τ0, σ0): 1 Pa to 100 GPa, or 0.
+StressMPa = physical(1e-6, 1e5, "MPa", or_zero=True)
 #: Slopes of the laws (k, μ), either sign.
 SlopeMPaPerGPa = physical(-1e5, 1e5, "MPa/GPa")
 
@@ -151,7 +151,7 @@ class ContactConfig(Section):
         "null: fitted",
     )
     sigma0_mpa: StressMPa | None = Field(None, description="override σ0 (MPa); null: fitted")
-    work_of_adhesion_j_m2: physical(0.0, 100.0, "J/m²") | None = Field(
+    work_of_adhesion_j_m2: physical(1e-6, 100.0, "J/m²", or_zero=True) | None = Field(
         None,
         description="work of adhesion w (J/m²) for DMT/JKR radii; null: the work of separation "
         "measured by the scan",

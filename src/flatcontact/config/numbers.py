@@ -8,7 +8,8 @@ overflow and underflow. The bounds are part of the schema: :class:`~flatcontact.
 appends them to the field's description, so ``flatcontact config --show-default`` prints them,
 and a value outside them is one line naming the field, the bounds and the value.
 
-``nonzero=True`` refuses 0 inside signed bounds (a scale that divides).
+``or_zero=True`` also admits exactly 0 below a positive lower bound: "none" (no adhesion,
+no offset) is physics, 1e-300 J/m² is not (it drives a cohesive-zone width to overflow).
 """
 
 from __future__ import annotations
@@ -26,23 +27,23 @@ NORMAL_MIN = sys.float_info.min
 
 @dataclass(frozen=True)
 class Bounds:
-    """Closed bounds ``lo <= x <= hi`` (in ``unit``) of a float field; ``nonzero``: x != 0."""
+    """Closed bounds ``lo <= x <= hi`` (in ``unit``) of a float field; ``or_zero``: or x == 0."""
 
     lo: float
     hi: float
     unit: str = ""
-    nonzero: bool = False
+    or_zero: bool = False
 
     def text(self) -> str:
         """The bounds as printed in descriptions and errors: ``1e-03..1e+04 µm``."""
         unit = f" {self.unit}" if self.unit else ""
-        zero = ", != 0" if self.nonzero else ""
+        zero = " or 0" if self.or_zero else ""
         return f"{self.lo:g}..{self.hi:g}{unit}{zero}"
 
     def expected(self) -> str:
         """The bounds as an error states them: ``expected 0.001 <= value <= 10000 µm``."""
         unit = f" {self.unit}" if self.unit else ""
-        zero = " and != 0" if self.nonzero else ""
+        zero = " (or 0)" if self.or_zero else ""
         return f"expected {self.lo:g} <= value <= {self.hi:g}{unit}{zero}"
 
     def check(self, value: float) -> float:
@@ -54,14 +55,14 @@ class Bounds:
             raise ValueError(
                 f"{self.expected()}, got the subnormal {x!r} (magnitude below {NORMAL_MIN:.3g})"
             )
-        if not self.lo <= x <= self.hi or (self.nonzero and x == 0.0):
+        if not (self.lo <= x <= self.hi or (self.or_zero and x == 0.0)):
             raise ValueError(f"{self.expected()}, got {x:g}")
         return x
 
 
-def physical(lo: float, hi: float, unit: str = "", *, nonzero: bool = False) -> Any:
+def physical(lo: float, hi: float, unit: str = "", *, or_zero: bool = False) -> Any:
     """The annotated float type of a field with bounds ``lo..hi`` (``unit``): see the module."""
-    bounds = Bounds(float(lo), float(hi), unit, nonzero)
+    bounds = Bounds(float(lo), float(hi), unit, or_zero)
     return Annotated[float, AfterValidator(bounds.check), bounds]
 
 

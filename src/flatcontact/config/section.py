@@ -1,4 +1,5 @@
-"""The base of every settings section: frozen, unknown keys refused, every float finite."""
+"""The base of every settings section: frozen, unknown keys refused, every float finite
+and, where typed with bounds, within them."""
 
 from __future__ import annotations
 
@@ -16,7 +17,9 @@ class Section(BaseModel):
 
     Frozen, so a validated configuration cannot drift; ``extra="forbid"``, so a misspelt key
     is an error naming its path; ``allow_inf_nan=False``, so NaN or inf in the YAML is
-    refused naming its path.
+    refused naming its path. A float field typed with
+    :func:`~flatcontact.config.numbers.physical` is also refused when subnormal or out of
+    its bounds, and the bounds are appended to its description.
     """
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
