@@ -26,6 +26,7 @@ from flatcontact.config.numbers import field_bounds
 from flatcontact.config.scan import ScanConfig
 from flatcontact.contact import experiment as ex
 from flatcontact.contact.parameters import ContactParameters
+from flatcontact.errors import InputError
 
 SUBNORMAL = "1e-320"  # nonzero, below the smallest normal double (2.2e-308)
 
@@ -235,12 +236,14 @@ def test_shuffled_and_repeated_csv_gives_the_sorted_result(tmp_path, capsys):
         ("1,1000\n2,1_0\n3,500\n4,10\n", "line 3", ["1_0", "plain decimal"]),
         ("1,1000\n2,0x10\n3,500\n4,10\n", "line 3", ["0x10"]),
         ("1,1000\n2,1e-320\n3,500\n4,10\n", "line 3", ["subnormal"]),
-        ("1,1000\n2,900\n3,-500\n4,10\n", "line 4", ["stiffness", ">= 0"]),
-        ("1,1000\n-2,900\n3,500\n4,10\n", "line 3", ["stress", ">= 0"]),
+        ("1,1000\n2,900\n3,-500\n4,10\n", "line 4", ["stiffness", "0..1e+12 N/m"]),
+        ("1,1000\n-2,900\n3,500\n4,10\n", "line 3", ["stress", "0..100000 MPa"]),
         ("1,1000\n2,900\n2,800\n4,10\n", "lines 3 and 4", ["same stress"]),
         ("1,0\n2,0\n3,0\n4,0\n", None, ["same stiffness"]),
         ("1,1000\n2,1000\n3,1000\n4,1000\n", None, ["same stiffness"]),
         ("2,1000\n2,900\n2,500\n2,10\n", None, ["same stress"]),
+        ("1,1000\n2,900\n1e303,500\n4,10\n", "line 4", ["stress", "100000 MPa"]),
+        ("1,1000\n2,900\n3,1e308\n4,10\n", "line 4", ["stiffness", "N/m"]),
     ],
 )
 def test_impossible_csv_is_one_line_naming_file_and_row(body, line, words, tmp_path, capsys):
@@ -250,6 +253,25 @@ def test_impossible_csv_is_one_line_naming_file_and_row(body, line, words, tmp_p
     text = _clean_refusal(code, err, "measured.csv", *words)
     if line is not None:
         assert line in text
+
+
+@pytest.mark.parametrize(
+    "load,cell,words",
+    [("p0 [GPa]", "1e300", ["load", "1000] GPa"]), ("normal load [uN]", "1e300", ["10000] N"])],
+)
+def test_fit_table_load_beyond_bounds_names_the_line(load, cell, words, tmp_path):
+    from flatcontact.contact.measured import read_table
+
+    path = tmp_path / "table.csv"
+    path.write_text(
+        f"mean shear stress [MPa],lateral stiffness [N/m],{load}\n1,1000,1\n2,900,{cell}\n"
+    )
+    with pytest.raises(InputError) as info:
+        read_table(path, ContactParameters())
+    text = str(info.value)
+    assert "table.csv: data line 3" in text and "\n" not in text
+    for word in words:
+        assert word in text, text
 
 
 def test_fit_table_rows_in_any_order_read_the_same(tmp_path):

@@ -16,11 +16,13 @@ unit.
 Cells and rows
 --------------
 A cell is a plain decimal number (``12``, ``-0.5``, ``1.2e3``): no digit separators
-(``1_0``), no hex, no NaN or inf, no subnormal magnitude. Stresses and stiffnesses are
->= 0 (0: gross sliding), loads > 0. The rows are put in one canonical order (by load, stress, stiffness), so a
-shuffled file reads as the sorted one; a row repeated exactly is kept once; two rows with
-the same stress (and load) but different stiffnesses are refused, as is a curve whose
-stresses or stiffnesses are all equal. Every refusal names the file and the data line.
+(``1_0``), no hex, no NaN or inf, no subnormal magnitude. Stresses (at most 100 GPa) and
+stiffnesses (at most 1e12 N/m) are >= 0 (0: gross sliding); loads are > 0 (p0 at most
+1 TPa, a normal load at most 1e4 N). The rows are put in one canonical order (by load,
+stress, stiffness), so a shuffled file reads as the sorted one; a row repeated exactly is
+kept once; two rows with the same stress (and load) but different stiffnesses are refused,
+as is a curve whose stresses or stiffnesses are all equal. Every refusal names the file
+and the data line.
 
 Several loads (:func:`load_fit_data`)
 -------------------------------------
@@ -60,6 +62,13 @@ _BRACKET = re.compile(r"^(?P<name>.*?)\s*[\[(](?P<unit>[^\])]+)[\])]\s*$")
 _SNAKE_STIFF = re.compile(r"^(?P<name>.+?)_(?P<f>kn|mn|un|nn|n)_per_(?P<l>mm|um|nm|m)$")
 _SNAKE_PRESS = re.compile(r"^(?P<name>.+?)_(?P<u>kpa|mpa|gpa|pa)$")
 _LOAD_NAME = re.compile(r"p0|peak|load", re.IGNORECASE)
+#: Largest measured stress (100 GPa, the settings' bound on τ0 and σ0) and lateral stiffness
+#: (1e12 N/m, beyond any contact) a row may hold; larger is a unit error, not a measurement.
+MAX_STRESS_PA = 1.0e11
+MAX_STIFFNESS_N_PER_M = 1.0e12
+#: Largest load of a load column: p0 1 TPa (the settings' bound), normal load 1e4 N.
+MAX_P0_PA = 1.0e12
+MAX_LOAD_N = 1.0e4
 #: A plain decimal number: what a CSV cell may hold (no ``1_0``, ``0x1p3``, ``inf``).
 _DECIMAL = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 
@@ -127,11 +136,17 @@ def _check_curve(stress: FloatArray, stiff: FloatArray, name: str, at: str = "")
     )
 
 
-def _check_row(vals: list[float], i_stress: int, i_stiff: int, where: str, line: str) -> None:
-    """Refuse a physically impossible row: stress < 0 or stiffness < 0 (0 is a contact in
-    gross sliding)."""
-    require(vals[i_stress] >= 0.0, f"{where}: the stress must be >= 0, got {line!r}")
-    require(vals[i_stiff] >= 0.0, f"{where}: the stiffness must be >= 0, got {line!r}")
+def _check_row(stress_pa: float, stiffness_n_per_m: float, where: str, line: str) -> None:
+    """Refuse a physically impossible row (SI values): stress outside 0..:data:`MAX_STRESS_PA`
+    or stiffness outside 0..:data:`MAX_STIFFNESS_N_PER_M` (0 is a contact in gross sliding)."""
+    require(
+        0.0 <= stress_pa <= MAX_STRESS_PA,
+        f"{where}: the stress must be in 0..{MAX_STRESS_PA / units.MPA_TO_PA:g} MPa, got {line!r}",
+    )
+    require(
+        0.0 <= stiffness_n_per_m <= MAX_STIFFNESS_N_PER_M,
+        f"{where}: the stiffness must be in 0..{MAX_STIFFNESS_N_PER_M:g} N/m, got {line!r}",
+    )
 
 
 def _normalise_unit(text: str) -> str:
@@ -236,7 +251,12 @@ def load_stiffness_csv(path: str | Path) -> MeasuredStiffness:
         cells = [c.strip() for c in ln.split(",")]
         require(len(cells) == 2, f"{where} has {len(cells)} cells, expected 2")
         vals = [parse_cell(c, where) for c in cells]
-        _check_row(vals, i_stress, 1 - i_stress, where, ln.strip())
+        _check_row(
+            vals[i_stress] * cols[i_stress][2],
+            vals[1 - i_stress] * cols[1 - i_stress][2],
+            where,
+            ln.strip(),
+        )
         rows.append((n, vals))
     data = np.array(_canonical_rows(rows, [i_stress], p.name)).reshape(-1, 2)
     require(len(data) >= 4, f"{p.name}: need at least 4 distinct data rows, got {len(data)}")
@@ -333,8 +353,17 @@ def read_table(path: str | Path, params: ContactParameters) -> list[LoadCurve] |
         cells = [c.strip() for c in ln.split(",")]
         require(len(cells) == 3, f"{where} has {len(cells)} cells, expected 3")
         vals = [parse_cell(c, where) for c in cells]
-        require(vals[li] > 0.0, f"{where}: the load must be > 0, got {ln.strip()!r}")
-        _check_row(vals, i_stress, i_stiff, where, ln.strip())
+        top, unit = (MAX_P0_PA / units.GPA_TO_PA, "GPa") if kind_load == "p0" else (MAX_LOAD_N, "N")
+        require(
+            0.0 < vals[li] * f_load <= (MAX_P0_PA if kind_load == "p0" else MAX_LOAD_N),
+            f"{where}: the load must be in (0, {top:g}] {unit}, got {ln.strip()!r}",
+        )
+        _check_row(
+            vals[i_stress] * cols["stress"][1],
+            vals[i_stiff] * cols["stiffness"][1],
+            where,
+            ln.strip(),
+        )
         rows.append((n, vals))
     data = np.array(_canonical_rows(rows, [li, i_stress], p.name)).reshape(-1, 3)
     load = data[:, li] * f_load
