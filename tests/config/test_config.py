@@ -55,9 +55,15 @@ def test_file_overlays_preset_and_resolves_paths(tmp_path):
         ),
         ("scan:\n  grid: [4]\n", "c.yaml: scan.grid: expected two positive integers, got [4]"),
         ("scan:\n  gird: [4, 4]\n", "c.yaml: scan.gird: unknown field"),
-        ("contact:\n  radius_um: -5\n", "c.yaml: contact.radius_um: expected a value > 0"),
+        (
+            "contact:\n  radius_um: -5\n",
+            "c.yaml: contact.radius_um: expected 0.001 <= value <= 10000 µm, got -5",
+        ),
         ("contact:\n  radius_nm: 5\n", "c.yaml: contact.radius_nm: unknown field"),
-        ("contact:\n  p0_gpa: [1, -2]\n", "c.yaml: contact.p0_gpa: expected positive"),
+        (
+            "contact:\n  p0_gpa: [1, -2]\n",
+            "c.yaml: contact.p0_gpa.1: expected 1e-06 <= value <= 1000 GPa, got -2",
+        ),
         ("analysis:\n  p_gpa: [1.0]\n", "c.yaml: analysis.p_gpa: expected at least two"),
         ("scan:\n  fmax_ev_per_angstrom: fast\n", "scan.fmax_ev_per_angstrom: expected a number"),
         ("scan:\n  optimizer: SD\n", "c.yaml: scan.optimizer: expected one of"),

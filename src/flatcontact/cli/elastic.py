@@ -38,12 +38,14 @@ def elastic_cmd(
     With CONFIG this is the run's elastic stage (:func:`flatcontact.stages.elastic.run_elastic`)
     for any material; without it, alpha-quartz with ``--potential``.
     """
+    from flatcontact.config.elastic import ElasticConfig
+    from flatcontact.config.numbers import field_bounds
     from flatcontact.elastic import quartz_contact_moduli
 
-    if not 0 < strain < 0.05:  # the run's elastic.strain bounds
-        raise InputError(
-            f"--strain {strain:g}: expected a finite strain amplitude in (0, 0.05), e.g. 0.005"
-        )
+    try:  # the run's elastic.strain bounds
+        strain = field_bounds(ElasticConfig.model_fields["strain"]).check(strain)
+    except ValueError as exc:
+        raise InputError(f"--strain: {exc}") from None
     if config is not None:
         res = _elastic_stage(config, strain, out)
     else:

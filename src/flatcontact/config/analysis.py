@@ -8,6 +8,7 @@ from pydantic import Field, field_validator
 
 from flatcontact import limits
 from flatcontact.config.messages import show
+from flatcontact.config.numbers import physical
 from flatcontact.config.section import Section
 from flatcontact.reference import PAPER_THRESHOLD_GPA
 
@@ -15,11 +16,11 @@ from flatcontact.reference import PAPER_THRESHOLD_GPA
 class AnalysisConfig(Section):
     """Constant-pressure ISPES, sliding paths, τ, σ and the load laws (stages ``analyze``, ``laws``)."""
 
-    p_gpa: list[float] = Field(
+    p_gpa: list[physical(-1e3, 1e3, "GPa")] = Field(
         [0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0],
         description="target normal pressures P (GPa) at which the constant-pressure ISPES is analysed",
     )
-    direction_deg: float | Literal["auto"] = Field(
+    direction_deg: physical(-360.0, 360.0, "deg") | Literal["auto"] = Field(
         90.0,
         description="pulling direction, degrees from x (90 = y, the paper's), or auto: the "
         "lowest-barrier direction of the landscape at the lowest load (stated in the outputs)",
@@ -37,9 +38,8 @@ class AnalysisConfig(Section):
         "lowest-p",
         description="energy zero of the maps: global minimum at the lowest P, each, none",
     )
-    threshold_gpa: float = Field(
+    threshold_gpa: physical(1e-6, 1e3, "GPa") = Field(
         PAPER_THRESHOLD_GPA,
-        gt=0,
         description="fit the linear load laws on P <= this (GPa; the paper's 3 GPa)",
     )
     allow_missing: bool = Field(

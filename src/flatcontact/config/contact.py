@@ -17,13 +17,26 @@ from typing import Literal
 
 from pydantic import Field, field_validator
 
+from flatcontact import limits
 from flatcontact.config.messages import show
+from flatcontact.config.numbers import physical
 from flatcontact.config.section import Section
 from flatcontact.reference import DEFAULT_P0_GPA, PAPER, PAPER_EXPERIMENT_P0_GPA
 
 #: Force amplitudes of the cycle as fractions of the gross-sliding force
 #: (:data:`flatcontact.contact.cycle.DEFAULT_AMPLITUDE_FRACTIONS`; a test keeps them equal).
 CYCLE_AMPLITUDE_FRACTIONS: tuple[float, ...] = (0.2, 0.4, 0.6, 0.8, 0.9, 0.95)
+
+#: Peak Hertz pressure p0 (1 kPa .. 1 TPa).
+PressureGPa = physical(1e-6, 1e3, "GPa")
+#: A fraction strictly inside (0, 1), kept off both ends.
+Fraction = physical(1e-3, 0.999)
+#: Contact moduli E*, G* (from soft polymers to beyond diamond).
+ModulusGPa = physical(0.01, 1e4, "GPa")
+#: Stresses of the laws (τ0, σ0): 1 Pa to 100 GPa, or 0.
+StressMPa = physical(1e-6, 1e5, "MPa", or_zero=True)
+#: Slopes of the laws (k, μ), either sign.
+SlopeMPaPerGPa = physical(-1e5, 1e5, "MPa/GPa")
 
 
 class CycleConfig(Section):
@@ -39,12 +52,12 @@ class CycleConfig(Section):
         description="model of the cycle: modified (the paper's Mindlin model) or classical "
         "(Cattaneo-Mindlin, friction coefficient mu = k, Johnson's G*_J = G*/4)",
     )
-    amplitude_fractions: list[float] = Field(
+    amplitude_fractions: list[Fraction] = Field(
         list(CYCLE_AMPLITUDE_FRACTIONS),
         description="force amplitudes of the cycle as fractions of the gross-sliding force, "
         "each in (0, 1)",
     )
-    amplitudes_un: list[float] | None = Field(
+    amplitudes_un: list[physical(1e-6, 1e6, "µN")] | None = Field(
         None,
         description="force amplitudes of the cycle in uN (each below gross sliding at every "
         "p0); null: amplitude_fractions",
@@ -75,7 +88,7 @@ class FitConfig(Section):
         description="measured stiffness CSVs to fit at several loads at once (one per load, "
         "or with a load column 'p0 [GPa]'/'normal load [uN]'; relative to the config file)",
     )
-    p0_gpa: list[float] | None = Field(
+    p0_gpa: list[PressureGPa] | None = Field(
         None, description="p0 (GPa) of each fit.csv file without a load column, one per file"
     )
     free: list[str] = Field(
@@ -101,8 +114,8 @@ class ExperimentConfig(Section):
         description="measured stiffness CSV ('mean shear stress [MPa],lateral stiffness [N/m]') "
         "for the Fig. 6 overlay (relative to the config file)",
     )
-    p0_gpa: float = Field(
-        PAPER_EXPERIMENT_P0_GPA, gt=0, description="p0 of the measured data (GPa)"
+    p0_gpa: PressureGPa = Field(
+        PAPER_EXPERIMENT_P0_GPA, description="p0 of the measured data (GPa)"
     )
     stress_measure: Literal["amplitude", "rms"] = Field(
         "amplitude", description="stress of the data: amplitude Q_max/πa² or rms ⟨Q⟩/πa²"
@@ -112,49 +125,47 @@ class ExperimentConfig(Section):
 class ContactConfig(Section):
     """The modified Mindlin contact (stage ``contact``)."""
 
-    p0_gpa: list[float] = Field(list(DEFAULT_P0_GPA), description="peak Hertz pressures p0 (GPa)")
-    radius_um: float = Field(
-        PAPER["radius_um"], gt=0, le=1e4, description="tip radius R (µm; at most 1 cm)"
+    p0_gpa: list[PressureGPa] = Field(
+        list(DEFAULT_P0_GPA), description="peak Hertz pressures p0 (GPa)"
     )
-    contact_modulus_gpa: float = Field(
+    radius_um: physical(1e-3, 1e4, "µm") = Field(
+        PAPER["radius_um"], description="tip radius R (µm; 1 nm to 1 cm)"
+    )
+    contact_modulus_gpa: ModulusGPa = Field(
         PAPER["contact_modulus_gpa"],
-        gt=0,
         description="Hertz contact modulus E* (GPa; the paper's DFT value)",
     )
-    shear_modulus_gpa: float = Field(
+    shear_modulus_gpa: ModulusGPa = Field(
         PAPER["shear_modulus_gpa"],
-        gt=0,
         description="effective shear modulus G* (GPa) in the paper's q0 = G*·u/(π a) (= 4 × Johnson's G*_J)",
     )
-    k_mpa_per_gpa: float | None = Field(
+    k_mpa_per_gpa: SlopeMPaPerGPa | None = Field(
         None,
         description="override k of τ = k·P + τ0 (MPa/GPa; may be < 0, then p0 < τ0/|k|); "
         "null: the fitted law",
     )
-    tau0_mpa: float | None = Field(None, ge=0, description="override τ0 (MPa); null: fitted")
-    mu_mpa_per_gpa: float | None = Field(
+    tau0_mpa: StressMPa | None = Field(None, description="override τ0 (MPa); null: fitted")
+    mu_mpa_per_gpa: SlopeMPaPerGPa | None = Field(
         None,
         description="override μ of σ = μ·P + σ0 (MPa/GPa; may be < 0, then p0 <= σ0/|μ|); "
         "null: fitted",
     )
-    sigma0_mpa: float | None = Field(None, ge=0, description="override σ0 (MPa); null: fitted")
-    work_of_adhesion_j_m2: float | None = Field(
+    sigma0_mpa: StressMPa | None = Field(None, description="override σ0 (MPa); null: fitted")
+    work_of_adhesion_j_m2: physical(1e-6, 100.0, "J/m²", or_zero=True) | None = Field(
         None,
-        ge=0,
         description="work of adhesion w (J/m²) for DMT/JKR radii; null: the work of separation "
         "measured by the scan",
     )
-    maugis_lambda: float | None = Field(
+    maugis_lambda: physical(1e-3, 1e3) | None = Field(
         None,
-        gt=0,
         description="Maugis parameter λ: adds the Maugis–Dugdale radius and pull-off force "
         "(needs a work of adhesion > 0); null: none",
     )
-    knee_fraction: float = Field(
-        0.5, gt=0, lt=1, description="knee: stiffness falls to this fraction of its initial value"
+    knee_fraction: Fraction = Field(
+        0.5, description="knee: stiffness falls to this fraction of its initial value"
     )
-    collapse_fraction: float = Field(
-        0.2, gt=0, lt=1, description="collapse: stiffness first below this fraction of the plateau"
+    collapse_fraction: Fraction = Field(
+        0.2, description="collapse: stiffness first below this fraction of the plateau"
     )
     cycle: CycleConfig = Field(
         default_factory=CycleConfig, description="the oscillation cycle per p0 (off by default)"
@@ -174,4 +185,6 @@ class ContactConfig(Section):
     def _p0(cls, value: list[float]) -> list[float]:
         if not value or any(not v > 0 for v in value):
             raise ValueError(f"expected positive peak pressures in GPa, got {show(value)}")
+        if len(value) > limits.bound("loads"):
+            raise ValueError(limits.message("loads", len(value), "peak pressures"))
         return [float(v) for v in value]

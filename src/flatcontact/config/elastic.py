@@ -4,14 +4,15 @@ from __future__ import annotations
 
 from pydantic import Field
 
+from flatcontact.config.numbers import physical
 from flatcontact.config.section import Section
 
 
 class ElasticConfig(Section):
     """Self-consistent contact moduli E*, G* from the potential (stage ``elastic``, optional)."""
 
-    strain: float = Field(
-        0.005, gt=0, lt=0.05, description="finite strain of the central differences for C_ij"
+    strain: physical(1e-6, 0.05) = Field(
+        0.005, description="finite strain of the central differences for C_ij"
     )
     enabled: bool = Field(
         False,

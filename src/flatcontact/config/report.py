@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pydantic import Field
 
+from flatcontact.config.numbers import physical
 from flatcontact.config.section import Section
 
 
@@ -11,7 +12,7 @@ class ReportConfig(Section):
     """The HTML report (stage ``report``)."""
 
     title: str = Field("flatcontact run", description="report title")
-    fig2_p_gpa: list[float] | None = Field(
+    fig2_p_gpa: list[physical(-1e3, 1e3, "GPa")] | None = Field(
         None,
         description="pressures (GPa, among analysis.p_gpa) with a Fig. 2 panel; null: lowest, "
         "middle and highest",

@@ -13,6 +13,7 @@ from pydantic import Field, field_validator, model_validator
 
 from flatcontact import limits
 from flatcontact.config.messages import show
+from flatcontact.config.numbers import physical
 from flatcontact.config.section import Section, positive_pair
 
 #: ASE optimisers a scan point may use (:data:`flatcontact.ispes.relax.OPTIMIZERS`).
@@ -26,8 +27,10 @@ PREFERENCES: tuple[str, ...] = ("columns", "planes", "cold")
 class PressureRange(Section):
     """n loads evenly spaced from lo_gpa to hi_gpa at the probe stacking."""
 
-    lo_gpa: float = Field(description="lowest target load (GPa; negative = tension)")
-    hi_gpa: float = Field(gt=0, description="highest target load (GPa, compressive)")
+    lo_gpa: physical(-1e3, 1e3, "GPa") = Field(
+        description="lowest target load (GPa; negative = tension)"
+    )
+    hi_gpa: physical(1e-6, 1e3, "GPa") = Field(description="highest target load (GPa, compressive)")
     n: int = Field(ge=2, description="number of thicknesses")
 
     @model_validator(mode="after")
@@ -50,11 +53,11 @@ class ScanConfig(Section):
         description="choose the thicknesses z so that the loads at the probe stacking span "
         "lo_gpa..hi_gpa (n values); exclusive with thickness_angstrom",
     )
-    thickness_angstrom: list[float] | None = Field(
+    thickness_angstrom: list[physical(0.1, 1e3, "Å")] | None = Field(
         None, description="explicit thicknesses z (Å, surface 1 to surface 4)"
     )
-    fmax_ev_per_angstrom: float = Field(
-        0.005, gt=0, description="force tolerance on the free atoms at each point (eV/Å)"
+    fmax_ev_per_angstrom: physical(1e-6, 10.0, "eV/Å") = Field(
+        0.005, description="force tolerance on the free atoms at each point (eV/Å)"
     )
     optimizer: str = Field(
         DEFAULT_OPTIMIZER,

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pydantic import Field, field_validator
 
 from flatcontact.config.messages import show
+from flatcontact.config.numbers import physical
 from flatcontact.config.section import Section
 
 #: The law coefficients an uncertainty block may name (τ = k·P + τ0, σ = μ·P + σ0).
@@ -30,7 +31,9 @@ class UncertaintyConfig(Section):
     model_spread_enthalpy: dict[str, float] = Field(
         {}, description="δ_model per law coefficient, enthalpy form"
     )
-    coverage: float = Field(1.0, gt=0, description="multiple of the combined standard error")
+    coverage: physical(0.01, 100.0) = Field(
+        1.0, description="multiple of the combined standard error"
+    )
     source: str = Field("", description="where the δ_conv and δ_model numbers come from")
 
     @field_validator(

@@ -13,6 +13,17 @@ N, mN, µN (uN), nN, kN and length in m, mm, µm (um), nm (e.g. N/m, mN/m, µN/n
 Lines starting with ``#`` are comments. Which column is which is decided by its
 unit.
 
+Cells and rows
+--------------
+A cell is a plain decimal number (``12``, ``-0.5``, ``1.2e3``): no digit separators
+(``1_0``), no hex, no NaN or inf, no subnormal magnitude. Stresses (at most 100 GPa) and
+stiffnesses (at most 1e12 N/m) are >= 0 (0: gross sliding); loads are > 0 (p0 at most
+1 TPa, a normal load at most 1e4 N). The rows are put in one canonical order (by load,
+stress, stiffness), so a shuffled file reads as the sorted one; a row repeated exactly is
+kept once; two rows with the same stress (and load) but different stiffnesses are refused,
+as is a curve whose stresses or stiffnesses are all equal. Every refusal names the file
+and the data line.
+
 Several loads (:func:`load_fit_data`)
 -------------------------------------
 Either one two-column CSV per load (the p0 of each file given alongside) or one CSV
@@ -29,6 +40,7 @@ from __future__ import annotations
 
 import math
 import re
+import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -50,6 +62,91 @@ _BRACKET = re.compile(r"^(?P<name>.*?)\s*[\[(](?P<unit>[^\])]+)[\])]\s*$")
 _SNAKE_STIFF = re.compile(r"^(?P<name>.+?)_(?P<f>kn|mn|un|nn|n)_per_(?P<l>mm|um|nm|m)$")
 _SNAKE_PRESS = re.compile(r"^(?P<name>.+?)_(?P<u>kpa|mpa|gpa|pa)$")
 _LOAD_NAME = re.compile(r"p0|peak|load", re.IGNORECASE)
+#: Largest measured stress (100 GPa, the settings' bound on τ0 and σ0) and lateral stiffness
+#: (1e12 N/m, beyond any contact) a row may hold; larger is a unit error, not a measurement.
+MAX_STRESS_PA = 1.0e11
+MAX_STIFFNESS_N_PER_M = 1.0e12
+#: Largest load of a load column: p0 1 TPa (the settings' bound), normal load 1e4 N.
+MAX_P0_PA = 1.0e12
+MAX_LOAD_N = 1.0e4
+#: A plain decimal number: what a CSV cell may hold (no ``1_0``, ``0x1p3``, ``inf``).
+_DECIMAL = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+
+
+def parse_cell(cell: str, where: str) -> float:
+    """The number in one CSV cell: a plain decimal, finite and not subnormal.
+
+    Raises
+    ------
+    InputError
+        One line naming ``where`` (file and data line) and the cell.
+    """
+    text = cell.strip()
+    if text.lower().lstrip("+-") in ("nan", "inf", "infinity"):
+        raise InputError(f"{where} has NaN or inf: {text!r}")
+    if not _DECIMAL.fullmatch(text):
+        raise InputError(f"{where} is not numeric: {text!r} is not a plain decimal number")
+    value = float(text)
+    if not math.isfinite(value):
+        raise InputError(f"{where} has a number out of range: {text!r}")
+    if value != 0.0 and abs(value) < sys.float_info.min:
+        raise InputError(f"{where} has a subnormal number: {text!r}")
+    return value
+
+
+def _canonical_rows(
+    rows: list[tuple[int, list[float]]], key: Sequence[int], name: str
+) -> list[list[float]]:
+    """``rows`` ((data line, values)) sorted by the columns ``key`` then the rest, exact
+    repeats dropped; two rows equal on ``key[:-1]`` + stress but not otherwise are refused.
+
+    ``key`` lists the column indices in sort order, ending with the stress column; the
+    remaining column is the stiffness.
+    """
+    width = len(rows[0][1]) if rows else 0
+    order = list(key) + [i for i in range(width) if i not in key]
+    ranked = sorted(rows, key=lambda r: ([r[1][i] for i in order], r[0]))
+    out: list[list[float]] = []
+    prev: tuple[int, list[float]] | None = None
+    for line, vals in ranked:
+        if prev is not None and [prev[1][i] for i in key] == [vals[i] for i in key]:
+            if prev[1] == vals:
+                continue  # an exact repeat
+            first, second = sorted(((prev[0], prev[1]), (line, vals)))
+            raise InputError(
+                f"{name}: data lines {first[0]} and {second[0]} give the same stress with "
+                f"different values ({first[1]} and {second[1]}): merge or remove one"
+            )
+        out.append(vals)
+        prev = (line, vals)
+    return out
+
+
+def _check_curve(stress: FloatArray, stiff: FloatArray, name: str, at: str = "") -> None:
+    """Refuse a curve without a range: all stresses or all stiffnesses equal."""
+    require(
+        np.ptp(stress) > 0.0,
+        f"{name}: every row{at} has the same stress ({stress[0]:g} Pa): a stiffness curve "
+        "needs a range of stresses",
+    )
+    require(
+        np.ptp(stiff) > 0.0,
+        f"{name}: every row{at} has the same stiffness ({stiff[0]:g} N/m): the curve has no "
+        "collapse to compare with",
+    )
+
+
+def _check_row(stress_pa: float, stiffness_n_per_m: float, where: str, line: str) -> None:
+    """Refuse a physically impossible row (SI values): stress outside 0..:data:`MAX_STRESS_PA`
+    or stiffness outside 0..:data:`MAX_STIFFNESS_N_PER_M` (0 is a contact in gross sliding)."""
+    require(
+        0.0 <= stress_pa <= MAX_STRESS_PA,
+        f"{where}: the stress must be in 0..{MAX_STRESS_PA / units.MPA_TO_PA:g} MPa, got {line!r}",
+    )
+    require(
+        0.0 <= stiffness_n_per_m <= MAX_STIFFNESS_N_PER_M,
+        f"{where}: the stiffness must be in 0..{MAX_STIFFNESS_N_PER_M:g} N/m, got {line!r}",
+    )
 
 
 def _normalise_unit(text: str) -> str:
@@ -150,28 +247,25 @@ def load_stiffness_csv(path: str | Path) -> MeasuredStiffness:
     i_stress = kinds.index("stress")
     rows = []
     for n, ln in enumerate(lines[1:], start=2):
+        where = f"{p.name}: data line {n}"
         cells = [c.strip() for c in ln.split(",")]
-        require(len(cells) == 2, f"{p.name}: data line {n} has {len(cells)} cells, expected 2")
-        try:
-            vals = [float(c) for c in cells]
-        except ValueError:
-            raise InputError(f"{p.name}: data line {n} is not numeric: {ln.strip()!r}") from None
-        require(
-            all(math.isfinite(v) for v in vals),
-            f"{p.name}: data line {n} has NaN or inf: {ln.strip()!r}",
+        require(len(cells) == 2, f"{where} has {len(cells)} cells, expected 2")
+        vals = [parse_cell(c, where) for c in cells]
+        _check_row(
+            vals[i_stress] * cols[i_stress][2],
+            vals[1 - i_stress] * cols[1 - i_stress][2],
+            where,
+            ln.strip(),
         )
-        rows.append(vals)
-    require(len(rows) >= 4, f"{p.name}: need at least 4 data rows, got {len(rows)}")
-    data = np.array(rows)
+        rows.append((n, vals))
+    data = np.array(_canonical_rows(rows, [i_stress], p.name)).reshape(-1, 2)
+    require(len(data) >= 4, f"{p.name}: need at least 4 distinct data rows, got {len(data)}")
     stress = data[:, i_stress] * cols[i_stress][2]
     stiff = data[:, 1 - i_stress] * cols[1 - i_stress][2]
-    require(
-        bool(np.all(stress >= 0.0)), f"{p.name}: stress must be >= 0 (column {header[i_stress]!r})"
-    )
-    order = np.argsort(stress, kind="stable")
+    _check_curve(stress, stiff, p.name)
     return MeasuredStiffness(
-        stress_pa=stress[order],
-        stiffness_n_per_m=stiff[order],
+        stress_pa=stress,
+        stiffness_n_per_m=stiff,
         source=p.name,
         stress_column=header[i_stress],
         stiffness_column=header[1 - i_stress],
@@ -252,17 +346,26 @@ def read_table(path: str | Path, params: ContactParameters) -> list[LoadCurve] |
         sorted(cols) == ["stiffness", "stress"],
         f"{p.name}: need one stress and one stiffness column besides the load, got {header}",
     )
+    i_stress, i_stiff = cols["stress"][0], cols["stiffness"][0]
     rows = []
     for n, ln in enumerate(lines[1:], start=2):
+        where = f"{p.name}: data line {n}"
         cells = [c.strip() for c in ln.split(",")]
-        require(len(cells) == 3, f"{p.name}: data line {n} has {len(cells)} cells, expected 3")
-        try:
-            vals = [float(c) for c in cells]
-        except ValueError:
-            raise InputError(f"{p.name}: data line {n} is not numeric: {ln.strip()!r}") from None
-        require(all(math.isfinite(v) for v in vals), f"{p.name}: data line {n} has NaN or inf")
-        rows.append(vals)
-    data = np.array(rows)
+        require(len(cells) == 3, f"{where} has {len(cells)} cells, expected 3")
+        vals = [parse_cell(c, where) for c in cells]
+        top, unit = (MAX_P0_PA / units.GPA_TO_PA, "GPa") if kind_load == "p0" else (MAX_LOAD_N, "N")
+        require(
+            0.0 < vals[li] * f_load <= (MAX_P0_PA if kind_load == "p0" else MAX_LOAD_N),
+            f"{where}: the load must be in (0, {top:g}] {unit}, got {ln.strip()!r}",
+        )
+        _check_row(
+            vals[i_stress] * cols["stress"][1],
+            vals[i_stiff] * cols["stiffness"][1],
+            where,
+            ln.strip(),
+        )
+        rows.append((n, vals))
+    data = np.array(_canonical_rows(rows, [li, i_stress], p.name)).reshape(-1, 3)
     load = data[:, li] * f_load
     p0_pa = load if kind_load == "p0" else _p0_from_load_pa(load, params)
     stress = data[:, cols["stress"][0]] * cols["stress"][1]
@@ -272,8 +375,9 @@ def read_table(path: str | Path, params: ContactParameters) -> list[LoadCurve] |
     out = []
     for p0 in np.unique(np.round(p0_pa / units.GPA_TO_PA, 9)):
         sel = np.isclose(p0_pa / units.GPA_TO_PA, p0, rtol=1e-9, atol=0)
-        order = np.argsort(stress[sel], kind="stable")
+        order = np.lexsort((stiff[sel], stress[sel]))
         require(int(sel.sum()) >= 4, f"{p.name}: need at least 4 rows at p0 = {p0:g} GPa")
+        _check_curve(stress[sel], stiff[sel], p.name, f" at p0 = {p0:g} GPa")
         out.append(
             LoadCurve(
                 p0_gpa=float(p0),
