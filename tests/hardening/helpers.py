@@ -64,3 +64,16 @@ def assert_refused_cleanly(argv, capsys, where: Path, names, out: Path | None = 
     if out is not None:
         assert not any(out.glob("0*-*")), "a stage started"
     return line
+
+
+def finished_toy_run(base: Path) -> tuple[Path, Path]:
+    """(config folder, run directory) of one finished toy study (:data:`TOY_YAML`) in ``base``."""
+    from flatcontact.cli import main
+
+    conf = base / "conf"
+    conf.mkdir()
+    (conf / "run.yaml").write_text(TOY_YAML)
+    with pytest.raises(SystemExit) as info:
+        main(["run", str(conf / "run.yaml"), "--out", str(base / "run")])
+    assert info.value.code == 0
+    return conf, base / "run"

@@ -13,7 +13,13 @@ import shutil
 from pathlib import Path
 
 import pytest
-from tests.hardening.helpers import TOY_YAML, assert_refused_cleanly, refused, run_cli, tree
+from tests.hardening.helpers import (
+    assert_refused_cleanly,
+    finished_toy_run,
+    refused,
+    run_cli,
+    tree,
+)
 from tests.hardening.test_run_directory import _same_content
 
 from flatcontact.ispes.geometry import thickness
@@ -27,16 +33,7 @@ OUTPUTS = ("02-scan/ispes.nc", "03-analyze/friction.nc", "06-contact/summary.jso
 @pytest.fixture(scope="module")
 def finished(tmp_path_factory):
     """(config folder, run directory) of one finished toy study."""
-    from flatcontact.cli import main
-
-    base = tmp_path_factory.mktemp("finished")
-    conf = base / "conf"
-    conf.mkdir()
-    (conf / "run.yaml").write_text(TOY_YAML)
-    with pytest.raises(SystemExit) as info:
-        main(["run", str(conf / "run.yaml"), "--out", str(base / "run")])
-    assert info.value.code == 0
-    return conf, base / "run"
+    return finished_toy_run(tmp_path_factory.mktemp("finished"))
 
 
 @pytest.fixture

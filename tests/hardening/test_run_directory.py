@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
-from tests.hardening.helpers import TOY_YAML, refused, run_cli, tree
+from tests.hardening.helpers import finished_toy_run, refused, run_cli, tree
 
 STAGE_FOLDERS = ("01-build", "02-scan", "03-analyze", "04-laws", "06-contact", "07-report")
 
@@ -28,16 +28,7 @@ STAGE_FOLDERS = ("01-build", "02-scan", "03-analyze", "04-laws", "06-contact", "
 @pytest.fixture(scope="module")
 def finished(tmp_path_factory):
     """(config folder, run directory) of one finished toy study."""
-    base = tmp_path_factory.mktemp("finished")
-    conf = base / "conf"
-    conf.mkdir()
-    (conf / "run.yaml").write_text(TOY_YAML)
-    from flatcontact.cli import main
-
-    with pytest.raises(SystemExit) as info:
-        main(["run", str(conf / "run.yaml"), "--out", str(base / "run")])
-    assert info.value.code == 0
-    return conf, base / "run"
+    return finished_toy_run(tmp_path_factory.mktemp("finished"))
 
 
 @pytest.fixture
