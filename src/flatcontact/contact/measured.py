@@ -136,6 +136,17 @@ def _check_curve(stress: FloatArray, stiff: FloatArray, name: str, at: str = "")
     )
 
 
+def _data_rows(lines: list[str], name: str, n_cells: int):
+    """(line number, ``"<name>: data line N"``, parsed cells, line) for each data line after
+    the header; a line without exactly ``n_cells`` cells or with a cell :func:`parse_cell`
+    refuses is one InputError naming the file and line."""
+    for n, ln in enumerate(lines[1:], start=2):
+        where = f"{name}: data line {n}"
+        cells = [c.strip() for c in ln.split(",")]
+        require(len(cells) == n_cells, f"{where} has {len(cells)} cells, expected {n_cells}")
+        yield n, where, [parse_cell(c, where) for c in cells], ln
+
+
 def _check_row(stress_pa: float, stiffness_n_per_m: float, where: str, line: str) -> None:
     """Refuse a physically impossible row (SI values): stress outside 0..:data:`MAX_STRESS_PA`
     or stiffness outside 0..:data:`MAX_STIFFNESS_N_PER_M` (0 is a contact in gross sliding)."""
@@ -246,11 +257,7 @@ def load_stiffness_csv(path: str | Path) -> MeasuredStiffness:
     )
     i_stress = kinds.index("stress")
     rows = []
-    for n, ln in enumerate(lines[1:], start=2):
-        where = f"{p.name}: data line {n}"
-        cells = [c.strip() for c in ln.split(",")]
-        require(len(cells) == 2, f"{where} has {len(cells)} cells, expected 2")
-        vals = [parse_cell(c, where) for c in cells]
+    for n, where, vals, ln in _data_rows(lines, p.name, 2):
         _check_row(
             vals[i_stress] * cols[i_stress][2],
             vals[1 - i_stress] * cols[1 - i_stress][2],
@@ -348,14 +355,11 @@ def read_table(path: str | Path, params: ContactParameters) -> list[LoadCurve] |
     )
     i_stress, i_stiff = cols["stress"][0], cols["stiffness"][0]
     rows = []
-    for n, ln in enumerate(lines[1:], start=2):
-        where = f"{p.name}: data line {n}"
-        cells = [c.strip() for c in ln.split(",")]
-        require(len(cells) == 3, f"{where} has {len(cells)} cells, expected 3")
-        vals = [parse_cell(c, where) for c in cells]
-        top, unit = (MAX_P0_PA / units.GPA_TO_PA, "GPa") if kind_load == "p0" else (MAX_LOAD_N, "N")
+    load_max = MAX_P0_PA if kind_load == "p0" else MAX_LOAD_N
+    top, unit = (MAX_P0_PA / units.GPA_TO_PA, "GPa") if kind_load == "p0" else (MAX_LOAD_N, "N")
+    for n, where, vals, ln in _data_rows(lines, p.name, 3):
         require(
-            0.0 < vals[li] * f_load <= (MAX_P0_PA if kind_load == "p0" else MAX_LOAD_N),
+            0.0 < vals[li] * f_load <= load_max,
             f"{where}: the load must be in (0, {top:g}] {unit}, got {ln.strip()!r}",
         )
         _check_row(
