@@ -86,6 +86,18 @@ def _poly_integral(coeffs, lo, hi):
     return total
 
 
+def _ex(z):
+    """``z`` with a new last axis, to broadcast against the pieces of :func:`_pieces`."""
+    return np.asarray(z)[..., None]
+
+
+def _slipped_on_loading(x, kp, t0):
+    """The loading branch at drive X: the pieces [lo, hi] of s ∈ [0, 1] and ``member``, True on
+    the slipped set S₁ = {k p0 s² + τ0 s <= X}."""
+    lo, hi, mid = _pieces(*_roots01(kp, t0, x))
+    return lo, hi, _ex(kp) * mid**2 + t0 * mid <= _ex(x)
+
+
 def _pieces(*candidates):
     """Sorted breakpoints 0, candidates..., 1 along a new last axis; (lo, hi, mid)."""
     cands = np.broadcast_arrays(*candidates)
@@ -111,15 +123,11 @@ def unloading_decrement(
     r1, r2 = _roots01(kp, t0, x)
     r3, r4 = _roots01(kp + mp, t0 + s0, d)
     lo, hi, mid = _pieces(r1, r2, r3, r4)
-
-    def ex(z):
-        return np.asarray(z)[..., None]
-
-    member = (ex(kp) * mid**2 + t0 * mid <= ex(x)) & (
-        ex(kp + mp) * mid**2 + (t0 + s0) * mid <= ex(d)
+    member = (_ex(kp) * mid**2 + t0 * mid <= _ex(x)) & (
+        _ex(kp + mp) * mid**2 + (t0 + s0) * mid <= _ex(d)
     )
-    slipped = _poly_integral((0.0, 2.0 * s0, 2.0 * ex(mp)), lo, hi)
-    stuck = ex(d) * (hi - lo)
+    slipped = _poly_integral((0.0, 2.0 * s0, 2.0 * _ex(mp)), lo, hi)
+    stuck = _ex(d) * (hi - lo)
     return np.sum(np.where(member, slipped, stuck), axis=-1)
 
 
@@ -132,15 +140,9 @@ def loading_force_per_area(
     p0 = np.asarray(p0_pa, dtype=float)
     kp, mp = params.k * p0, params.mu * p0
     t0, s0 = params.tau0_pa, params.sigma0_pa
-    r1, r2 = _roots01(kp, t0, x)
-    lo, hi, mid = _pieces(r1, r2)
-
-    def ex(z):
-        return np.asarray(z)[..., None]
-
-    member = ex(kp) * mid**2 + t0 * mid <= ex(x)
-    slipped = _poly_integral((0.0, s0, ex(mp)), lo, hi)
-    return np.sum(np.where(member, slipped, ex(x) * (hi - lo)), axis=-1)
+    lo, hi, member = _slipped_on_loading(x, kp, t0)
+    slipped = _poly_integral((0.0, s0, _ex(mp)), lo, hi)
+    return np.sum(np.where(member, slipped, _ex(x) * (hi - lo)), axis=-1)
 
 
 def dissipated_energy(
@@ -151,19 +153,13 @@ def dissipated_energy(
     p0 = np.asarray(p0_pa, dtype=float)
     kp, mp = params.k * p0, params.mu * p0
     t0, s0 = params.tau0_pa, params.sigma0_pa
-    r1, r2 = _roots01(kp, t0, x)
-    lo, hi, mid = _pieces(r1, r2)
-
-    def ex(z):
-        return np.asarray(z)[..., None]
-
-    member = ex(kp) * mid**2 + t0 * mid <= ex(x)
-    m, n = ex(mp), s0  # σ s = m s² + n s
-    m2, n2 = ex(kp - mp), t0 - s0  # (τ − σ) s = m2 s² + n2 s
+    lo, hi, member = _slipped_on_loading(x, kp, t0)
+    m, n = _ex(mp), s0  # σ s = m s² + n s
+    m2, n2 = _ex(kp - mp), t0 - s0  # (τ − σ) s = m2 s² + n2 s
     coeffs = (
         0.0,
-        4.0 * ex(x) * n,
-        4.0 * ex(x) * m - 4.0 * n * n + n2 * n2,
+        4.0 * _ex(x) * n,
+        4.0 * _ex(x) * m - 4.0 * n * n + n2 * n2,
         -8.0 * m * n + 2.0 * m2 * n2,
         -4.0 * m * m + m2 * m2,
     )
