@@ -147,7 +147,10 @@ def test_flags_override_the_file_and_keep_the_rest(tmp_path):
         (["--calculator", TOY, "--grid", "0", "2"], "--grid: expected two positive integers"),
         (["--calculator", TOY, "--thickness", "5"], "overlap"),
         (["--calculator", TOY, "--thickness", "11,x"], "--thickness: 'x' is not a number"),
-        (["--calculator", TOY, "--thickness", "-1"], "--thickness (scan.thickness_angstrom.0): expected 0.1 <= value <= 1000 Å"),
+        (
+            ["--calculator", TOY, "--thickness", "-1"],
+            "--thickness (scan.thickness_angstrom.0): expected 0.1 <= value <= 1000 Å",
+        ),
         (["--calculator", TOY, "--p-range-gpa", "2", "1", "4"], "--p-range-gpa"),
         (["--calculator", TOY, "--thickness", "11", "--p-range-gpa", "0", "1", "3"], "not both"),
         (
