@@ -1,15 +1,14 @@
-"""Figures of every stage (matplotlib, the file-only Agg backend), one module per stage, and
-how they are saved."""
+"""Figures of every stage, one module per stage, and how they are saved.
+
+Every figure is a bare :class:`matplotlib.figure.Figure` (no pyplot state): saving renders it
+with the file format's own canvas, so importing flatcontact never changes the user's
+matplotlib backend (a notebook keeps its inline or interactive backend) and no figure stays
+registered with pyplot after it is written."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-
-import matplotlib
-
-matplotlib.use("Agg")  # figures are written to files: the non-interactive backend
-import matplotlib.pyplot as plt
 
 from flatcontact.fileio import atomic_path
 
@@ -19,7 +18,7 @@ __all__ = ["save_figure"]
 def save_figure(
     fig, stem: str | Path, formats: Sequence[str] = ("png", "svg"), dpi: int = 150
 ) -> list[Path]:
-    """Save ``fig`` as ``stem.<format>`` for each format, atomically, then close it.
+    """Save ``fig`` as ``stem.<format>`` for each format, atomically.
 
     Returns the paths written. ``bbox_inches="tight"`` keeps labels inside the image.
     """
@@ -30,5 +29,4 @@ def save_figure(
         with atomic_path(target) as tmp:
             fig.savefig(tmp, format=ext, dpi=dpi, bbox_inches="tight")
         written.append(target)
-    plt.close(fig)
     return written

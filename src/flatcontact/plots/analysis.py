@@ -10,8 +10,8 @@ Fig. 3: τ and σ against P with their linear fits over the fitted range.
 
 from __future__ import annotations
 
-import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.figure import Figure
 
 from flatcontact import units
 from flatcontact.analysis.analyze import AnalysisResult, PressureAnalysis
@@ -21,9 +21,10 @@ from flatcontact.analysis.uncertainty import propagate_box
 MEV = units.EV_PER_A2_TO_MEV_PER_A2
 
 
-def figure_pressure(pa: PressureAnalysis, result: AnalysisResult) -> plt.Figure:
+def figure_pressure(pa: PressureAnalysis, result: AnalysisResult) -> Figure:
     """The three panels of Fig. 2 at one load."""
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.4))
+    fig = Figure(figsize=(15, 4.4))
+    axes = fig.subplots(1, 3)
     surf, path, fr = pa.surface, pa.path, pa.friction
     xy = path.xy_angstrom
     r0 = pa.minimum_xy_angstrom
@@ -116,11 +117,12 @@ def law_band(
 
 def figure_laws(
     p_gpa, tau_mpa, sigma_mss_mpa, laws: LoadLaws, half_widths: dict | None = None
-) -> plt.Figure:
+) -> Figure:
     """Fig. 3: τ and σ vs P (one value per load, GPa and MPa) with the linear fits ``laws``;
     with ``half_widths`` (coefficient -> half-width, ``laws.json``) the band of each law over
     its coefficient box (fit, convergence and model spread)."""
-    fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    fig = Figure(figsize=(5.5, 4.2))
+    ax = fig.subplots()
     p = np.asarray(p_gpa, dtype=float)
     hw = half_widths or {}
     for y, law, style, label, keys in (

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.figure import Figure
 
 from flatcontact import units
 
@@ -13,7 +13,8 @@ def figure_scan_columns(ds, adhesion: dict | None = None):
 
     Each thin line is one lateral shift; p rises as z falls on the repulsive branch.
     """
-    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig = Figure(figsize=(11, 4.2))
+    ax, bx = fig.subplots(1, 2)
     z = ds["thickness"].values
     p = ds["normal_stress"].values.reshape(-1, z.size)
     e = ds["energy"].values.reshape(-1, z.size)

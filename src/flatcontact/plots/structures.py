@@ -5,9 +5,9 @@ Drawn by the build stage (``01-build/fig1_interface``) and ``flatcontact build``
 
 from __future__ import annotations
 
-import matplotlib.pyplot as plt
 import numpy as np
 from ase.data import atomic_numbers, covalent_radii
+from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
 
@@ -27,7 +27,8 @@ def figure_interface(atoms):
     surfaces 1–4 marked, (b) top view of slab 1's inner face (surface 2) over 4×4 cells
     with the primitive cell dashed. Si blue, O red (other elements grey)."""
     palette = {"Si": "#3b6ea5", "O": "#d62728"}
-    fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 5.5), gridspec_kw={"width_ratios": [1, 1.3]})
+    fig = Figure(figsize=(12, 5.5))
+    ax, bx = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1, 1.3]})
     cell = atoms.cell.array
     side = atoms.repeat((3, 1, 1))
     pos = side.positions

@@ -99,10 +99,11 @@ def build_recipe_dataset(
 
 def parity_plot(result: FitResult, path: Path, split: str = "test") -> Path:
     """Energy / force / stress parity plots of ``split`` (PNG, written atomically)."""
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     p = result.predictions.get(split) or result.predictions["validation"]
-    fig, axes = plt.subplots(1, 3, figsize=(12, 4))
+    fig = Figure(figsize=(12, 4))
+    axes = fig.subplots(1, 3)
     pairs = [
         ("energy (eV/atom)", p["energy_ref"], p["energy_pred"]),
         ("force component (eV/Å)", p["force_ref"], p["force_pred"]),
@@ -123,7 +124,6 @@ def parity_plot(result: FitResult, path: Path, split: str = "test") -> Path:
     fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)
     return path
 
 
