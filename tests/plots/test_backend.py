@@ -45,3 +45,23 @@ def test_a_saved_figure_is_a_real_png_and_svg(tmp_path):
     assert [w.suffix for w in written] == [".png", ".svg"]
     assert written[0].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert b"<svg" in written[1].read_bytes()[:400]
+
+
+def test_no_module_of_the_package_imports_pyplot():
+    """pyplot is global state (a backend, a registry of open figures): the package never uses it."""
+    import ast
+    from pathlib import Path
+
+    import flatcontact
+
+    offenders = []
+    for path in Path(flatcontact.__file__).parent.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = []
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.module:
+                names = [node.module] + [f"{node.module}.{a.name}" for a in node.names]
+            if any(n == "matplotlib.pyplot" for n in names):
+                offenders.append(f"{path.name}:{node.lineno}")
+    assert not offenders, offenders
