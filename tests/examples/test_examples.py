@@ -15,6 +15,7 @@ Cu(111) zero-load ISPES has the intrinsic stacking-fault energy of Mishin et al.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -138,7 +139,7 @@ def test_every_example_loads_and_its_model_knows_its_elements(path):
     from flatcontact.structures.construct import build_interface
 
     cfg = load_config(path)
-    assert cfg.structure.kind in ("quartz-dense", "sheets", "fcc111")
+    assert cfg.structure.kind in ("quartz-dense", "sheets", "fcc111", "crystal")
     if cfg.structure.kind == "quartz-dense":
         assert {"Si", "O"} <= set(cfg.potential.elements or {"Si", "O"})
         check_moduli_source(cfg)
@@ -157,6 +158,7 @@ def test_expected_examples_are_present():
         "hbn-bilayer-ilp",
         "mos2-bilayer-ilp",
         "cu111-eam",
+        "au111-cif-eam",
         "quartz-paper",
         "graphene-hbn-ilp",
     }
@@ -360,6 +362,50 @@ def test_cu111_gamma_surface_has_mishins_stacking_fault_energy(tmp_path):
     isf_mj_m2 = energies[1] * 16.021766  # meV/Å² -> mJ/m²
     assert isf_mj_m2 == pytest.approx(44.4, rel=0.1)
 
+
+
+def _ase_eam_stacking_energy_mev_per_a2(potential_file: str, a_angstrom: float, shift) -> float:
+    """An fcc(111) stack of 8 planes (ASE's ``fcc111``, vacuum on both sides) whose upper four
+    planes are shifted by ``shift`` (fractions of a1, a2), every atom relaxed along z only
+    (ASE's own EAM calculator and BFGS, not LAMMPS), energy per area above the unshifted stack."""
+    from ase.build import fcc111
+    from ase.calculators.eam import EAM
+    from ase.constraints import FixedLine
+    from ase.optimize import BFGS
+
+    def energy_per_area(frac):
+        stack = fcc111("Au", size=(1, 1, 8), a=a_angstrom, vacuum=10.0, orthogonal=False)
+        cell = stack.cell.array
+        upper = stack.positions[:, 2] > stack.positions[:, 2].mean()
+        stack.positions[upper, :2] += frac[0] * cell[0, :2] + frac[1] * cell[1, :2]
+        stack.calc = EAM(potential=potential_file)
+        stack.set_constraint([FixedLine(i, [0, 0, 1]) for i in range(len(stack))])
+        BFGS(stack, logfile=None).run(fmax=1e-4)
+        return stack.get_potential_energy() / np.linalg.norm(np.cross(cell[0], cell[1]))
+
+    return (energy_per_area(shift) - energy_per_area((0.0, 0.0))) * MEV
+
+
+@pytest.mark.slow
+def test_au111_from_a_cif_has_the_stacking_energies_of_an_independent_ase_eam_stack(tmp_path):
+    """The metal-from-a-CIF example end to end (automatic thicknesses, W from the relaxed
+    slabs): its zero-load stackings equal an 8-plane Au(111) stack computed here with ASE's
+    own EAM reader of the same ``Au_u3.eam`` (relaxed along z): the intrinsic stacking fault
+    at (1/3, 1/3) and the on-top stacking at (2/3, 2/3). Measured: 0.2959 vs 0.2978 and
+    34.511 vs 34.479 meV/Å² (the run holds its outer planes; the stack relaxes them)."""
+    root = _run("au111-cif-eam", tmp_path / "au")
+    named = _stackings(root / "03-analyze" / "friction.csv")[0.0]
+    pot = f("Au_u3.eam")
+    isf = _ase_eam_stacking_energy_mev_per_a2(pot, 4.078, (1 / 3, 1 / 3))
+    on_top = _ase_eam_stacking_energy_mev_per_a2(pot, 4.078, (2 / 3, 2 / 3))
+    assert min(named.values()) == pytest.approx(0.0, abs=1e-9)
+    assert named["BA"] == pytest.approx(isf, rel=0.02)
+    assert named["AA"] == pytest.approx(on_top, rel=0.005)
+    scan = json.loads((root / "02-scan" / "scan.json").read_text())
+    # the ideal work of separation of a bonded metal is 2γ(111) > 0, never 0 or 4γ
+    assert 1.0 < scan["adhesion"]["work_of_separation_j_per_m2"] < 2.0
+    html = (root / "report.html").read_text()
+    assert "intrinsic stacking fault" in html
 
 def test_build_cli_takes_a_monolayer_slab_file_and_a_config(tmp_path):
     """`build --structure graphene_1L --potential graphene-rebo-kc`: the slab recipe finds the
