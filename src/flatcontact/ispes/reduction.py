@@ -40,8 +40,8 @@ class SymmetrySettings:
     enabled: bool = True
     verify_points: int = 2
     tolerance_angstrom: float = 1e-3
-    energy_tolerance_mev_per_a2: float = 1e-3
-    stress_tolerance_gpa: float = 1e-3
+    energy_tolerance_mev_per_a2: float = 1e-2
+    stress_tolerance_gpa: float = 0.5
 
     def __post_init__(self) -> None:
         if int(self.verify_points) != self.verify_points or self.verify_points < 0:

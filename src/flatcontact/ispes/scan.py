@@ -31,14 +31,13 @@ from flatcontact.ispes.contract import cell_area
 from flatcontact.ispes.geometry import in_plane_vectors, thickness, validate_interface
 from flatcontact.ispes.grid import GridSpec, check_thicknesses
 from flatcontact.ispes.order import PREFERENCES, search_tree
+from flatcontact.ispes.probe import extreme_stackings, probe_column, rigid_stackings
 from flatcontact.ispes.reduction import (
     SymmetrySettings,
     plan_reduction,
     symmetry_broken,
     verification,
 )
-from flatcontact.ispes.shift_symmetry import shift_space_group
-from flatcontact.ispes.probe import extreme_stackings, probe_column, rigid_stackings
 from flatcontact.ispes.relax import (
     PointTask,
     RelaxSettings,
@@ -47,6 +46,7 @@ from flatcontact.ispes.relax import (
     run_task,
     worker_calculator,
 )
+from flatcontact.ispes.shift_symmetry import shift_space_group
 from flatcontact.ispes.store import PointStore, discard_store, interface_hash
 from flatcontact.ispes.thicknesses import probe_thicknesses
 from flatcontact.ispes.work_of_separation import ideal_work_of_separation
