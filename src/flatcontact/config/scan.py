@@ -45,10 +45,12 @@ class PressureRange(Section):
 class SymmetryConfig(Section):
     """Irreducible registries: one relaxation per orbit of the interface's shift-space group."""
 
-    enabled: bool = Field(
-        True,
+    enabled: bool | Literal["auto"] = Field(
+        "auto",
         description="relax one registry per orbit of the interface's shift-space group and fill "
-        "the grid by symmetry (false: relax every grid point)",
+        "the grid by symmetry; auto: on unless relax_mode is full (a full relaxation can break "
+        "the symmetry at unstable registries, which a few verified points may miss); false: "
+        "relax every grid point",
     )
     verify_points: int = Field(
         2, ge=0, le=64, description="mapped points also relaxed and compared with their registry"

@@ -5,9 +5,10 @@ restricted to the operations that map the lateral grid onto itself) the lateral 
 into orbits; every thickness has the same orbits. The scan relaxes one *representative* per
 orbit and thickness (the orbit's first point in the warm-start tree's visiting order, so the
 root is one) and fills the other points of the orbit with its energy and normal load
-(``mapped`` points). Verify, never trust: ``verify_points`` mapped points, lateral neighbours
-of a representative spread over the thicknesses from the most compressed, are relaxed as
-well and compared with their representative; the largest differences (energy per area in
+(``mapped`` points). Verify, never trust: ``verify_points`` mapped points, one in each of the
+orbits whose representative has the highest energy (where a symmetric registry is unstable
+and a relaxation breaks the symmetry; :func:`choose_verify`), are relaxed as well, warm-started
+from a relaxed lateral neighbour, and compared with their representative; the largest differences (energy per area in
 meV/Å², normal load in GPa) are reported. One above the tolerance means the relaxation
 breaks the symmetry: the scan then computes every point of the grid and says so.
 """
@@ -78,10 +79,8 @@ def plan_reduction(
     group: ShiftGroup,
     shape: tuple[int, int, int],
     visiting_order: list[Index],
-    thickness_angstrom: np.ndarray,
-    verify_points: int,
 ) -> Reduction:
-    """Representatives and verified points of the grid ``shape`` (see the module docstring).
+    """Representatives of the grid ``shape`` (see the module docstring); no verified point yet.
 
     ``visiting_order``: the full grid's warm-start tree in visiting order
     (:func:`flatcontact.ispes.order.search_tree`); ``group`` maps the lateral grid onto itself.
@@ -102,26 +101,44 @@ def plan_reduction(
         for ib in range(n_b)
         for iz in range(n_z)
     }
+    return Reduction(group, representative, ())
+
+
+def choose_verify(
+    reduction: Reduction, records: dict, shape: tuple[int, int, int], n: int
+) -> Reduction:
+    """The plan with ``n`` verified points chosen from the relaxed representatives.
+
+    Symmetric relaxations break where the registry is unstable: at the high-energy
+    stackings. So the orbits are ranked by their representative's energy (highest first,
+    every thickness), and each verified point is a mapped member of the orbit next to a
+    relaxed point of the same thickness (its warm start), one per orbit.
+    """
+    n_a, n_b, _ = shape
+    reps = set(reduction.representative.values())
+    members: dict[Index, list[Index]] = {}
+    for idx, rep in reduction.representative.items():
+        if idx != rep:
+            members.setdefault(rep, []).append(idx)
+    ranked = sorted(
+        (rep for rep in members if rep in records),
+        key=lambda r: (-records[r]["energy_ev"], r),
+    )
     verify: list[Index] = []
-    if group.order > 1 and verify_points > 0:
-        reps = set(lateral_rep.values())
-        candidates = []
-        for ia, ib, _ in visiting_order:
-            if (ia, ib) in reps or (ia, ib) in candidates:
-                continue
-            near = {
-                ((ia + 1) % n_a, ib),
-                ((ia - 1) % n_a, ib),
-                (ia, (ib + 1) % n_b),
-                (ia, (ib - 1) % n_b),
-            }
-            if near & reps:
-                candidates.append((ia, ib))
-        by_load = list(np.argsort(np.asarray(thickness_angstrom, float)))  # smallest z first
-        for k in range(min(verify_points, len(candidates) * n_z)):
-            ia, ib = candidates[k % len(candidates)]
-            verify.append((ia, ib, int(by_load[(k // len(candidates) + k) % n_z])))
-    return Reduction(group, representative, tuple(dict.fromkeys(verify)))
+    for rep in ranked:
+        if len(verify) >= n:
+            break
+        for ia, ib, iz in sorted(members[rep]):
+            near = [
+                ((ia + 1) % n_a, ib, iz),
+                ((ia - 1) % n_a, ib, iz),
+                (ia, (ib + 1) % n_b, iz),
+                (ia, (ib - 1) % n_b, iz),
+            ]
+            if any(q in reps for q in near):
+                verify.append((ia, ib, iz))
+                break
+    return dataclasses.replace(reduction, verify=tuple(verify))
 
 
 def verification(reduction: Reduction, records: dict, area_angstrom2: float) -> dict:

@@ -34,6 +34,7 @@ from flatcontact.ispes.order import PREFERENCES, search_tree
 from flatcontact.ispes.probe import extreme_stackings, probe_column, rigid_stackings
 from flatcontact.ispes.reduction import (
     SymmetrySettings,
+    choose_verify,
     plan_reduction,
     symmetry_broken,
     verification,
@@ -297,9 +298,7 @@ def run_scan(
                         symmetry.tolerance_angstrom,
                         spread_compression=relax.mode != "rigid",
                     ).for_grid(grid.n_a, grid.n_b)
-                    reduction = plan_reduction(
-                        group, shape, list(full_tree), z, symmetry.verify_points
-                    )
+                    reduction = plan_reduction(group, shape, list(full_tree))
                 context = ScanContext(reference, factory, relax)
                 recent = PositionsCache()
 
@@ -385,6 +384,10 @@ def run_scan(
                     if reduction is None or reduction.group.order == 1:
                         run_points(full_tree)
                     else:
+                        run_points(search_tree(shape, root, order, allowed=reduction.computed))
+                        reduction = choose_verify(
+                            reduction, store.done(), shape, symmetry.verify_points
+                        )
                         run_points(search_tree(shape, root, order, allowed=reduction.computed))
                         area = cell_area(*in_plane_vectors(reference))
                         check = verification(reduction, store.done(), area)

@@ -87,8 +87,9 @@ def grid_spec(scan) -> GridSpec:
 def symmetry_settings(scan) -> SymmetrySettings:
     """The irreducible-registry settings of the ``scan`` settings (:mod:`flatcontact.ispes.reduction`)."""
     y = scan.symmetry
+    enabled = scan.relax_mode != "full" if y.enabled == "auto" else bool(y.enabled)
     return SymmetrySettings(
-        y.enabled,
+        enabled,
         y.verify_points,
         y.tolerance_angstrom,
         y.energy_tolerance_mev_per_a2,
