@@ -13,6 +13,7 @@ Hand-derived group orders (operations s ↦ M s + t of the lateral shift, modulo
 
 import numpy as np
 import pytest
+from tests.examples.test_examples import EXAMPLES
 
 from flatcontact.config.load import load_config
 from flatcontact.ispes.executors import SerialExecutor
@@ -27,7 +28,6 @@ from flatcontact.structures.construct import build_interface
 from flatcontact.structures.interface_contract import thickness
 from flatcontact.structures.placement import place_slab2
 from flatcontact.structures.toy import ToyPairCalculator
-from tests.examples.test_examples import EXAMPLES
 
 
 def _example(name):
