@@ -19,6 +19,7 @@ from flatcontact.errors import InputError
 from flatcontact.fileio import write_json_atomic
 from flatcontact.ispes import scan as ispes_scan
 from flatcontact.ispes.grid import GridSpec
+from flatcontact.ispes.reduction import SymmetrySettings
 from flatcontact.ispes.relax import RelaxSettings
 from flatcontact.layout import SCAN_FIGURE, SCAN_JSON
 from flatcontact.stages import _calculator
@@ -55,6 +56,10 @@ class ScanStageResult:
             "points_total": r.points_total,
             "points_done": r.points_done,
             "points_computed": r.points_computed,
+            "grid_points": r.points_total,
+            "computed_points": r.points_stored,
+            "symmetry": r.symmetry
+            or {"order": 1, "operations": [], "note": "every grid point relaxed"},
             "converged": int(ds["converged"].sum()),
             "force_calls_total": int(np.nansum(ds["force_calls"].values)),
             "median_force_calls_per_point": float(np.median(calls)) if calls else None,
@@ -76,6 +81,19 @@ def grid_spec(scan) -> GridSpec:
         thickness_angstrom=tuple(scan.thickness_angstrom) if scan.thickness_angstrom else None,
         p_range_gpa=(r.lo_gpa, r.hi_gpa, r.n) if r else None,
         bracket_all_stackings=scan.bracket_all_stackings,
+    )
+
+
+def symmetry_settings(scan) -> SymmetrySettings:
+    """The irreducible-registry settings of the ``scan`` settings (:mod:`flatcontact.ispes.reduction`)."""
+    y = scan.symmetry
+    enabled = scan.relax_mode != "full" if y.enabled == "auto" else bool(y.enabled)
+    return SymmetrySettings(
+        enabled,
+        y.verify_points,
+        y.tolerance_angstrom,
+        y.energy_tolerance_mev_per_a2,
+        y.stress_tolerance_gpa,
     )
 
 
@@ -175,6 +193,7 @@ def run_scan(
         order=s.order,
         executor_options=s.executor_options(),
         progress=progress,
+        symmetry=symmetry_settings(s),
     )
     separated = _no_repulsive_branch(scan.dataset)
     if separated is not None:
