@@ -42,6 +42,7 @@ class ScanStageResult:
     scan: Any  # flatcontact.ispes.scan.ScanResult
     warnings: list[str] = field(default_factory=list)
     files: list[Path] = field(default_factory=list)
+    layer_slip: dict | None = None  # flatcontact.ispes.slip.SlipTable.to_json()
 
     @property
     def dataset(self):
@@ -49,7 +50,8 @@ class ScanStageResult:
         return self.scan.dataset
 
     def to_json(self) -> dict:
-        """``scan.json``: counts, force calls, thicknesses, adhesion, notes and warnings."""
+        """``scan.json``: counts, force calls, thicknesses, adhesion, notes, warnings and the
+        lateral slip of the planes inside each slab (``layer_slip``, :mod:`flatcontact.ispes.slip`)."""
         r, ds = self.scan, self.scan.dataset
         calls = r.force_calls_computed
         return {
@@ -69,6 +71,7 @@ class ScanStageResult:
             "adhesion": r.adhesion,
             "notes": list(r.notes),
             "warnings": list(self.warnings),
+            "layer_slip": self.layer_slip,
         }
 
 
@@ -201,6 +204,10 @@ def run_scan(
     for note in scan.notes:
         log.warning("scan: %s", note)
     result = ScanStageResult(scan, warnings, [scan.store_path, scan.ispes_path])
+    if "layer" in reference.arrays and "slab" in reference.arrays:
+        from flatcontact.ispes.slip import slip_table, store_points
+
+        result.layer_slip = slip_table(reference, store_points(scan.store_path)).to_json()
     result.files.append(write_json_atomic(folder / SCAN_JSON, result.to_json()))
     result.files += save(
         figure_scan_columns(scan.dataset, scan.adhesion), folder, SCAN_FIGURE, settings.report.svg
