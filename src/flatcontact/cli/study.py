@@ -55,6 +55,9 @@ def convergence_command(
     doc = run_convergence(cfg, out, on_done=_progress)
     write_study(doc, cfg, out, _command_line())
     for s, st in doc["settings"].items():
+        if st["state"] == "failed":
+            console.print(f"{s}: failed at step {st['steps']}: {st['error']}", highlight=False)
+            continue
         ch = st.get("last_change", {})
         console.print(
             f"{s}: {st['state']} after {st['steps']} step(s); last step moved "
@@ -76,7 +79,10 @@ def models_command(
     config: Annotated[Path, typer.Argument(help="Run configuration (YAML): interface and scan.")],
     models: Annotated[
         list[str],
-        typer.Option("--models", help="Potential presets or YAML files with a potential: section."),
+        typer.Option(
+            "--models",
+            help="Potential presets or YAML files with a potential: section (A,B or the flag repeated).",
+        ),
     ],
     out: Annotated[Path, _OUT] = Path("flatcontact-study"),
 ) -> None:

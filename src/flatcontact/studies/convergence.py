@@ -21,6 +21,7 @@ from pathlib import Path
 
 from flatcontact.analysis.uncertainty import LAW_COEFFICIENTS
 from flatcontact.config.run import RunConfig
+from flatcontact.errors import InputError
 from flatcontact.ispes.executors import make_executor
 from flatcontact.studies.compare import largest_change, law_changes
 from flatcontact.studies.runner import run_variant
@@ -43,7 +44,10 @@ def _run_round(executor, jobs: list[tuple], on_done: Callable | None) -> dict:
     while pending:
         done, pending = executor.wait_first(pending)
         for h in done:
-            out[handles[h]] = executor.result(h)
+            try:
+                out[handles[h]] = executor.result(h)
+            except InputError as exc:  # one variant the model or builder refuses: reported
+                out[handles[h]] = {"error": str(exc)}
             if on_done is not None:
                 on_done(handles[h], out[handles[h]])
     return out
@@ -87,6 +91,11 @@ def run_convergence(
             results.update(_run_round(executor, jobs, on_done))
             for s in open_:
                 v = ladder[s][level - 1]
+                status[s]["steps"] = level
+                if "error" in results[v.name] or "error" in results[previous[s]]:
+                    failed = results[v.name].get("error") or results[previous[s]].get("error")
+                    status[s].update(state="failed", error=failed, last_step=[previous[s], v.name])
+                    continue
                 change = largest_change(
                     results[previous[s]], results[v.name], r.tolerance_floor_mpa
                 )
@@ -112,8 +121,12 @@ def run_convergence(
             **results["base"],
         }
     ]
+    if "error" in results["base"]:
+        raise InputError(f"the base configuration failed: {results['base']['error']}")
     for s in settings:
         for v in ladder[s][: status[s]["steps"]]:
+            if "error" in results[v.name]:
+                continue
             variants.append(
                 {
                     "name": v.name,
@@ -133,6 +146,7 @@ def run_convergence(
                         results[status[s]["last_step"][0]], results[status[s]["last_step"][1]], form
                     )[key]
                     for s in settings
+                    if status[s]["state"] != "failed"
                 ),
                 default=0.0,
             )
@@ -153,6 +167,7 @@ def run_convergence(
         "settings": {s: {**status[s], "base_value": base_value(cfg, s)} for s in settings},
         "skipped_settings": skipped,
         "converged": all(status[s]["state"] == "converged" for s in settings),
+        "failed": {s: status[s]["error"] for s in settings if status[s]["state"] == "failed"},
         "variants": variants,
         "delta": {
             f: {k: (0.0 if math.isnan(v) else v) for k, v in d.items()} for f, d in delta.items()

@@ -47,6 +47,7 @@ def _slug(label: str) -> str:
 
 def run_models(cfg: RunConfig, models: list[str], out: str | Path, on_done=None) -> dict:
     """Run ``cfg`` with each of ``models`` into ``out``; returns the ``study.json`` document."""
+    models = [m for spec in models for m in spec.split(",") if m]  # --models A,B or repeated
     if len(models) < 2:
         raise InputError(f"--models: expected at least two models, got {len(models)}")
     out = Path(out)
