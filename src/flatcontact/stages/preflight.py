@@ -24,6 +24,7 @@ from flatcontact.stages import _calculator
 from flatcontact.stages.build import structure_elements
 from flatcontact.stages.contact import check_fit_settings, check_moduli_source
 from flatcontact.stages.elastic import bulk_crystal
+from flatcontact.stages.measured_on import check_measured_on
 from flatcontact.structures.bulk import alpha_quartz
 from flatcontact.structures.construct import build_interface
 from flatcontact.structures.interface_io import read_interface
@@ -63,6 +64,7 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
         except InputError as exc:
             raise InputError(f"{source}: potential.calculator.target: {exc}") from None
     _check_structure(cfg, source)
+    check_measured_on(cfg, source)
     check_moduli_source(cfg, structure_elements(cfg.structure))
     if cfg.elastic.enabled:
         bulk, _ = bulk_crystal(cfg.structure)
