@@ -252,3 +252,27 @@ def test_config_check_refuses_h_for_a_carbon_only_potential(diamond_cif, tmp_pat
         )
     )
     check_inputs(load_config(path), str(path))
+
+
+def test_preflight_elements_include_the_passivation_and_slab2(tmp_path):
+    """A hydroxylated quartz crystal or quartz against graphene is not the paper's α-quartz:
+    the moduli check sees H and C (it read only slab 1's bulk file before)."""
+    from flatcontact.config import load_config
+    from flatcontact.stages.build import structure_elements
+    from flatcontact.stages.contact import check_moduli_source
+
+    alpha_quartz().write(tmp_path / "q.cif")
+    for extra, want in (
+        ("", {"Si", "O"}),
+        (", passivate: OH, gap_angstrom: 2", {"Si", "O", "H"}),
+        (", gap_angstrom: 3, slab2: {sheet: graphene}", {"Si", "O", "C"}),
+    ):
+        path = tmp_path / "c.yaml"
+        path.write_text(f"structure: {{kind: crystal, bulk: q.cif, miller: [0, 0, 1]{extra}}}\n")
+        cfg = load_config(path)
+        assert structure_elements(cfg.structure) == want
+        if want == {"Si", "O"}:
+            check_moduli_source(cfg, want)
+        else:
+            with pytest.raises(InputError, match=r"contact\.contact_modulus_gpa"):
+                check_moduli_source(cfg, want)
