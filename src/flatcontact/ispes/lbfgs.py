@@ -30,7 +30,25 @@ triangular system (I + diag(ρ) U) a = ρ ∘ (S g), U_ij = s_i·y_j for j > i; 
 triangular system (I + diag(ρ) L) c = a - ρ ∘ (Y z0), L_ij = y_i·s_j for j < i; then
 H g = z0 + Sᵀc. Back and forward substitution perform the loops' own operations in the
 loops' order; only the sums inside each dot product are associated differently (round-off).
-The matrix S Yᵀ is kept up to date with two matrix-vector products per stored pair.
+
+Four matrix-vector products per step
+------------------------------------
+On a large cell the cost is reading the 2k stored vectors of length n (memory bandwidth:
+≈ 0.5 ms per 100×14,112 matrix on one core; a matrix product with a few right-hand sides
+is no cheaper in OpenBLAS, which packs the matrix). The memory keeps S Yᵀ and Y Yᵀ (k×k),
+so Y z0 = (Y g - (Y Yᵀ) a)/α needs no pass, and H g = g/α + Yᵀ(-a/α) + Sᵀc is one pass over
+S and Y. The new pair's products with the stored ones need none either (:meth:`TwoLoopMemory.push`):
+S y = S g - S g_prev and Y y = Y g - Y g_prev from the saved products of the last step, and
+Y s = t Y (H g_prev) because the step is s = t P(H g_prev) for the orthogonal projector P
+whose range holds every stored vector (t the step's scale). A step is then S g, Y g and the
+combination: four matrix-vector products where the loops took six (the two loops' four and
+two for the new pair), equal to the loops to round-off (``tests/ispes/test_lbfgs.py``).
+
+The memory
+----------
+ASE's 100 pairs on cells up to 1,000 atoms; beyond, :func:`memory_for` keeps m·n ≤ 300,000
+coordinates (at least 20 pairs), so the algebra stays near a tenth of a cheap force call;
+the measurements behind it are in its docstring and ``docs/performance.md``.
 """
 
 from __future__ import annotations
@@ -44,6 +62,29 @@ import numpy as np
 ASE_MEMORY = 100
 ASE_ALPHA_EV_PER_A2 = 70.0
 ASE_MAXSTEP_A = 0.2
+#: the memory rule (:func:`memory_for`): stored coordinates m·n kept at or below this budget…
+PAIR_BUDGET_COORDS = 300_000
+#: …but never fewer pairs than this
+MIN_LARGE_CELL_MEMORY = 20
+
+
+def memory_for(n_coords: int) -> int:
+    """L-BFGS memory for ``n_coords`` coordinates: ASE's 100 pairs up to 3,000 coordinates
+    (1,000 atoms), then ``PAIR_BUDGET_COORDS // n_coords``, never below 20.
+
+    Measured (``benchmarks/optimiser_cost.py``, ``docs/performance.md``): a step's algebra
+    reads the 2m stored vectors of length n twice (four matrix-vector products, ≈ 2 ns
+    per stored coordinate and pair on one core), while an EAM force call costs ≈ 0.25 µs per
+    coordinate; so 100 pairs cost ≈ 0.8 of a Cu EAM call on any cell larger than the cache,
+    and the tenth of a call takes m ≈ 12-20. Fewer pairs need more calls on the Cu(111)
+    stacking fault (116 calls at m = 100, 130 at 50, 132 at 20, 143-147 at 15-5) and on REBO+KC
+    graphene (19 calls for m ≥ 10, 23 at 5); at 4,704 Cu atoms CPU per point was lowest at
+    m = 20. Small cells (every preset and example below 1,000 atoms) keep ASE's memory and
+    their iterates.
+    """
+    if n_coords < 1:
+        raise ValueError(f"n_coords: expected a positive number of coordinates, got {n_coords}")
+    return int(min(ASE_MEMORY, max(MIN_LARGE_CELL_MEMORY, PAIR_BUDGET_COORDS // n_coords)))
 
 
 @dataclasses.dataclass
@@ -234,7 +275,7 @@ def lbfgs_relax(
     project: Callable[[np.ndarray], np.ndarray],
     fmax: float,
     max_steps: int,
-    memory: int = ASE_MEMORY,
+    memory: int | None = None,
     alpha: float = ASE_ALPHA_EV_PER_A2,
     maxstep: float = ASE_MAXSTEP_A,
     damping: float = 1.0,
@@ -255,7 +296,10 @@ def lbfgs_relax(
         Converged when the largest per-atom norm of P(F) is below ``fmax`` (eV/Å).
     max_steps
         Step cap (the outcome is then ``converged=False``).
-    memory, alpha, maxstep, damping
+    memory
+        Stored (s, y) pairs; ``None``: :func:`memory_for` the number of coordinates (ASE's
+        100 up to 1,000 atoms).
+    alpha, maxstep, damping
         ASE's ``LBFGS`` parameters (defaults: ASE's).
 
     Returns
@@ -269,7 +313,7 @@ def lbfgs_relax(
     f = project(forces)
     steps = 0
     converged = largest_atomic_norm(f) < fmax
-    history = TwoLoopMemory(x.size, memory, alpha)
+    history = TwoLoopMemory(x.size, memory_for(x.size) if memory is None else memory, alpha)
     x_prev = g_prev = None
     scale = 1.0  # s = scale · P(H g_prev): the factor of the last step
     while not converged and steps < max_steps:
