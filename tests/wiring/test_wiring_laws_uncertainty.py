@@ -1,7 +1,7 @@
 """Issue 12 wiring: both energy forms in the laws stage, the laws' uncertainty carried to the
 contact outputs, and ``validate-potential --ispes``.
 
-The cobblestone landscape (tests/convergence/test_energy_forms.py) has exact laws in each
+The cobblestone landscape (tests/studies/test_energy_forms.py) has exact laws in each
 form: internal k = 0, enthalpy k = 4π|δ|/a (δ the gap modulation), the same τ0.
 """
 

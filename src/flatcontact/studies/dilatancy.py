@@ -7,7 +7,7 @@ and a smaller τ at the same load. This splits ``z*`` into the interface gap and
 
 Usage (no torch; reads the scans, writes nothing else)::
 
-    python -m benchmarks.convergence.dilatancy OUT.json LABEL=DIR [LABEL=DIR ...]
+    python -m flatcontact.studies.dilatancy OUT.json LABEL=DIR [LABEL=DIR ...]
 
 Each ``DIR`` holds a scan's ``ispes.nc`` and ``points.db`` (the relaxed atoms); the first
 model is the reference of the ratios. Per load (0, 0.5, …, 3 GPa): the lateral mean of
@@ -54,11 +54,10 @@ def gap_and_slabs(folder: Path, shape: tuple[int, int, int]) -> tuple[np.ndarray
 
 def dilatancy(folder: Path) -> dict:
     """Per-load dilatancy figures of the scan in ``folder`` (see the module docstring)."""
-    import xarray as xr
-
     from flatcontact.analysis.constant_pressure import constant_pressure
+    from flatcontact.ispes.contract import open_ispes
 
-    ds = xr.open_dataset(folder / "ispes.nc")
+    ds = open_ispes(folder / "ispes.nc")
     cp = constant_pressure(ds, LOADS_GPA, form="enthalpy", source=str(folder / "ispes.nc"))
     z_grid = ds["thickness"].values
     gap, slabs = gap_and_slabs(folder, ds["energy"].shape)
@@ -98,7 +97,7 @@ def pattern_correlation(z: np.ndarray, z_ref: np.ndarray) -> list[float]:
 def main(argv: list[str] | None = None) -> None:
     argv = sys.argv[1:] if argv is None else argv
     if len(argv) < 2 or any("=" not in a for a in argv[1:]):
-        sys.exit("usage: python -m benchmarks.convergence.dilatancy OUT.json LABEL=DIR [...]")
+        sys.exit("usage: python -m flatcontact.studies.dilatancy OUT.json LABEL=DIR [...]")
     out = Path(argv[0])
     models = {}
     for item in argv[1:]:
