@@ -124,6 +124,7 @@ def test_a_refinement_that_does_not_converge_within_its_budget_is_reported(tmp_p
         assert (tmp_path / "s" / f).read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.slow
 def test_laws_json_intervals_are_the_fit_and_the_study_in_quadrature(
     thickness_study, tmp_path, capsys
 ):
@@ -134,7 +135,10 @@ def test_laws_json_intervals_are_the_fit_and_the_study_in_quadrature(
     block["model_spread_internal"] = {"k_mpa_per_gpa": 3.0, "tau0_mpa": 4.0}
     block["coverage"] = 2.0
     conf = tmp_path / "run.yaml"
-    conf.write_text(yaml.safe_dump({**TOY, "uncertainty": block}))
+    # the 3x3 toy breaks its symmetry by 36 % (validity gate, issue 20): the laws are what is
+    # tested here, so the contact stage goes on with them
+    contact = {**TOY["contact"], "accept_untrusted": ["broken_symmetry"]}
+    conf.write_text(yaml.safe_dump({**TOY, "contact": contact, "uncertainty": block}))
     code, _, err = run_cli(["run", conf, "--out", tmp_path / "run"], capsys)
     assert code == 0, err
     laws = json.loads((tmp_path / "run" / "04-laws" / "laws.json").read_text())
@@ -153,6 +157,7 @@ def test_laws_json_intervals_are_the_fit_and_the_study_in_quadrature(
     assert laws["uncertainty"]["measured_on"] == measured_on(cfg)
 
 
+@pytest.mark.slow
 def test_a_run_refuses_a_block_measured_on_another_structure_or_model(
     thickness_study, tmp_path, capsys
 ):

@@ -1,7 +1,7 @@
 """Issue 12 wiring: both energy forms in the laws stage, the laws' uncertainty carried to the
 contact outputs, and ``validate-potential --ispes``.
 
-The cobblestone landscape (tests/convergence/test_energy_forms.py) has exact laws in each
+The cobblestone landscape (tests/studies/test_energy_forms.py) has exact laws in each
 form: internal k = 0, enthalpy k = 4π|δ|/a (δ the gap modulation), the same τ0.
 """
 
@@ -148,6 +148,66 @@ def test_contact_intervals_contain_the_central_values_and_match_the_tau0_edges(s
         assert r["effective_shear_strength_mpa"]["value"] == pytest.approx(
             central[r["p0_gpa"]]["effective_shear_strength_mpa"], rel=1e-12
         )
+
+
+def test_contact_intervals_of_each_part_alone_and_the_report_shows_them(stages):
+    """Q_peak/πa² grows with τ0: over the box of one part alone (coverage × fit s.e., × δ_conv
+    or × δ_model of τ0) its edges are the values at τ0 ∓ that half-width, computed here; the
+    laws table and the contact table of the report show the parts beside the intervals."""
+    from flatcontact.report.sections.contact import interval_tables
+    from flatcontact.report.sections.laws import laws_tables
+
+    _, laws, _ = stages
+    doc = laws | {"tau0_mpa": 26.7}
+    doc["internal"] = laws["internal"] | {"tau0_mpa": 26.7}
+    cfg = build_config(
+        {
+            "contact": {
+                "p0_gpa": [1.0],
+                "k_mpa_per_gpa": 4.52,
+                "mu_mpa_per_gpa": 0.21,
+                "sigma0_mpa": 11.1,
+            },
+            "report": {"svg": False},
+        }
+    )
+    res = run_contact(cfg, ContactInputs(laws=doc), None)
+    iv = res.to_json()["intervals"]
+    parts = laws["internal"]["intervals"]["tau0_mpa"]["components"]
+    assert parts == pytest.approx(
+        {"fit": laws["internal"]["tau0_stderr_mpa"], "convergence": 3.0, "models": 4.0}
+    )
+    # k, μ, σ0 are set in contact: no part of theirs is carried
+    for part, hw in iv["component_half_widths"].items():
+        assert hw == pytest.approx(
+            {
+                "k_mpa_per_gpa": 0.0,
+                "tau0_mpa": UNC["coverage"] * parts[part],
+                "mu_mpa_per_gpa": 0.0,
+                "sigma0_mpa": 0.0,
+            }
+        )
+    (r,) = iv["results"]
+    p0 = r["p0_gpa"] * units.GPA_TO_PA
+    for part, (lo, hi) in r["effective_shear_strength_mpa"]["components"].items():
+        h = UNC["coverage"] * parts[part]
+        for got, sign in ((lo, -1), (hi, 1)):
+            prm = res.params.replace(tau0_mpa=max(26.7 + sign * h, 0.0))
+            a = float(mindlin.contact_radius(p0, prm))
+            want = float(mindlin.peak_force(p0, prm).force_n) / (np.pi * a**2) / 1e6
+            assert got == pytest.approx(want, rel=1e-9)
+    # the report: a fit / convergence / models column per form, the parts in the contact cells
+    (table,) = laws_tables(laws)
+    assert "internal: fit / convergence / models" in table.headers
+    row = dict(
+        zip(table.headers, next(r for r in table.rows if r[0].startswith("τ0")), strict=True)
+    )
+    fit = laws["internal"]["tau0_stderr_mpa"]
+    assert row["internal: fit / convergence / models"] == f"{fit:.3g} / 3 / 4"
+    (ct,) = interval_tables(res.to_json())
+    cell = ct.rows[0][1]
+    lo, hi = r["effective_shear_strength_mpa"]["components"]["models"]
+    assert f"models ±{(hi - lo) / 2:.2g}" in cell and "conv. ±" in cell and "fit ±" in cell
 
 
 def test_zero_input_error_gives_zero_width(capsys):

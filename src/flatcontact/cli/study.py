@@ -30,6 +30,9 @@ def _command_line() -> str:
 
 
 def _progress(name: str, result: dict) -> None:
+    if "error" in result:  # a variant the builder or model refused: the setting's failure
+        console.print(f"  {name}: failed: {result['error']}", highlight=False)
+        return
     console.print(
         f"  {name}: scan {result['scan_action']}, {result['force_calls']} force calls, "
         f"{result['seconds']:.1f} s",
@@ -100,3 +103,28 @@ def models_command(
         text = ", ".join(f"{k} {v:.3g}" for k, v in spread.items())
         console.print(f"spread ({form}): {text}", highlight=False)
     console.print(f"study: {(out / 'study.json').resolve()}", highlight=False)
+
+
+@study_app.command("export-uncertainty")
+def export_uncertainty_command(
+    studies: Annotated[
+        list[Path],
+        typer.Argument(
+            help="study.json files (or study directories) of convergence/models studies."
+        ),
+    ],
+    out: Annotated[Path, typer.Option("--out", help="Uncertainty data file (JSON) to write.")],
+    source: Annotated[
+        str | None,
+        typer.Option("--source", help="What the numbers are for (default: the studies')."),
+    ] = None,
+) -> None:
+    """One uncertainty file (the paper preset's data-file format) from the studies' blocks."""
+    from flatcontact.fileio import write_json_atomic
+    from flatcontact.studies.export import export_uncertainty
+
+    doc = export_uncertainty(studies, source, _command_line())
+    check_out_dir(out.parent, "--out")
+    write_json_atomic(out, doc)
+    blocks = [k for k in doc if k.startswith(("convergence_", "model_spread_"))]
+    console.print(f"wrote {out} ({', '.join(blocks)})", highlight=False)

@@ -3,8 +3,12 @@
 A preset is a plain nested mapping (:func:`preset`); a file's keys are merged over it
 (:mod:`flatcontact.config.merge`). The ``paper`` preset carries the measured law uncertainty
 :data:`MEASURED_LAW_UNCERTAINTY`, read from the package data file
-``data/measured/law_uncertainty.json`` (numbers, source and provenance: the study, the
-command that regenerates it, the date, the result files read).
+``data/measured/law_uncertainty.json`` (numbers, source, ``measured_on`` fingerprints of the
+paper preset's structure and model, and provenance: the study, the commands that regenerate
+it, the date, the result files read). The block is guarded twice: :func:`preset` carries it
+only when the bundled SNAP and the shipped slab are installed (else the preset's model or
+structure is another), and a run whose structure or potential differs from ``measured_on``
+is refused before any stage (:func:`flatcontact.stages.measured_on.check_measured_on`).
 
 The paths and numbers the default model needs are data here, not imports of the physics
 cores (a test keeps them equal to :data:`flatcontact.potentials.files.BUNDLED_DIR`,
@@ -30,8 +34,8 @@ BUNDLED_POTENTIALS_DIR = _PACKAGE / "data" / "potentials"
 #: The CHGNet-relaxed 6-layer dense α-quartz (0001) slab, when installed
 #: (:data:`flatcontact.structures.build.SHIPPED_DENSE_SLAB`).
 SHIPPED_DENSE_SLAB = _PACKAGE / "structures" / "data" / "quartz_0001_dense_6L.extxyz"
-#: The measured law uncertainty with its provenance (written by
-#: ``python -m benchmarks.convergence.uncertainty --write``).
+#: The measured law uncertainty with ``measured_on`` and provenance (the format written by
+#: ``flatcontact study export-uncertainty``; docs/convergence.md, "Regenerating").
 LAW_UNCERTAINTY_FILE = _PACKAGE / "data" / "measured" / "law_uncertainty.json"
 
 
@@ -45,7 +49,8 @@ def _law_uncertainty() -> dict:
 #: interface: per form (``convergence_internal``, ``convergence_enthalpy``) the largest change
 #: of each law coefficient under one refinement, and (``model_spread_<form>``) half the
 #: max − min range over the bundled SNAPs and their teachers; ``source`` says what they are
-#: for. The file's ``provenance`` block names the study, command, date and result files.
+#: for; ``measured_on`` the fingerprints of the structure and model measured. The file's
+#: ``provenance`` block names the study, the commands, the date and the result files.
 MEASURED_LAW_UNCERTAINTY: dict = _law_uncertainty()
 
 
@@ -123,9 +128,12 @@ def preset(name: str) -> dict:
         # over -0.3 ... 5.5 (the range of the convergence study's 9-layer runs).
         potential = default_potential()
         potential["lj"] = {**potential["lj"], "cutoff_angstrom": 18.0}
+        source = _dense_slab_source()
+        measured = potential["intra"] == f"snap:{BUNDLED_SNAP}" and source == "shipped"
+        uncertainty = copy.deepcopy(MEASURED_LAW_UNCERTAINTY) if measured else {}
         return {
             "preset": "paper",
-            "structure": {"kind": "quartz-dense", "layers": 9, "source": _dense_slab_source()},
+            "structure": {"kind": "quartz-dense", "layers": 9, "source": source},
             "potential": potential,
             "scan": {
                 "grid": [12, 12],
@@ -134,7 +142,7 @@ def preset(name: str) -> dict:
             },
             "analysis": {"p_gpa": [0.0, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0, 4.5]},
             "contact": {"p0_gpa": [0.5, 1.0, 1.5, 1.77, 2.0, 2.5, 3.0]},
-            "uncertainty": copy.deepcopy(MEASURED_LAW_UNCERTAINTY),
+            **({"uncertainty": uncertainty} if uncertainty else {}),
             "report": {"title": "flatcontact run (paper preset)", "fig2_p_gpa": [0.5, 1.0, 3.0]},
         }
     raise InputError(f"preset: expected quick or paper, got {name!r}")

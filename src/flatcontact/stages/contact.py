@@ -216,7 +216,34 @@ def law_half_widths_used(inputs: ContactInputs, provenance: dict) -> dict[str, f
     }
 
 
-def contact_intervals(settings, params, half_widths: dict[str, float]) -> dict:
+#: The parts of a law coefficient's uncertainty (``laws.json`` ``intervals.<c>.components``).
+COMPONENTS = ("fit", "convergence", "models")
+
+
+def law_components_used(inputs: ContactInputs, provenance: dict) -> dict[str, dict[str, float]]:
+    """Per part (fit, convergence, models) the half-widths of the law coefficients the contact
+    model takes from the fitted laws: coverage × the part (``laws.json`` ``intervals`` of the
+    configured form, :func:`flatcontact.analysis.uncertainty.law_components`); 0 for a
+    coefficient set in ``contact``. ``{}`` when laws.json carries no convergence or model part
+    (the fit alone: nothing to split)."""
+    laws = inputs.laws or {}
+    form = laws.get("energy_form")
+    intervals = (laws.get(form) or {}).get("intervals", {}) if form else {}
+    coverage = float((laws.get("uncertainty") or {}).get("coverage", 1.0))
+    out = {part: dict.fromkeys(PAPER_LAW_KEYS, 0.0) for part in COMPONENTS}
+    for key in PAPER_LAW_KEYS:
+        parts = (intervals.get(key) or {}).get("components")
+        if parts and provenance.get(key) == "fitted laws":
+            for part in COMPONENTS:
+                out[part][key] = coverage * float(parts.get(part) or 0.0)
+    if not any(v for part in ("convergence", "models") for v in out[part].values()):
+        return {}
+    return out
+
+
+def contact_intervals(
+    settings, params, half_widths: dict[str, float], components: dict | None = None
+) -> dict:
     """Intervals of the effective shear strength Q_peak/πa², the collapse stress (stiffness
     at ``contact.collapse_fraction``·k0) and the knee (``knee_fraction``·k0), amplitude stress,
     at every p0, over the box of the law coefficients ± ``half_widths``
@@ -224,7 +251,10 @@ def contact_intervals(settings, params, half_widths: dict[str, float]) -> dict:
 
     Returns ``{"half_widths", "method", "results": [{"p0_gpa", <quantity>: {"low", "value",
     "high"}}]}``, or with ``"unavailable"`` (the reason) when a corner of the box leaves the
-    model's domain (e.g. τ(centre) <= 0 for k < 0).
+    model's domain (e.g. τ(centre) <= 0 for k < 0). With ``components`` (part -> coefficient
+    -> half-width, :func:`law_components_used`) each quantity also carries
+    ``components: {part: [low, high]}``, the interval over the box of that part alone, and the
+    document ``component_half_widths``.
     """
     from flatcontact import units
     from flatcontact.analysis.uncertainty import propagate_box
@@ -266,6 +296,14 @@ def contact_intervals(settings, params, half_widths: dict[str, float]) -> dict:
         }
         for i, p0 in enumerate(p0s)
     ]
+    if components:
+        doc["component_half_widths"] = components
+        for part, hw in components.items():
+            # each part's box lies inside the full one (part <= the quadrature sum): in domain
+            sub = propagate_box(outputs, central, hw, nonnegative=("tau0_mpa", "sigma0_mpa"))
+            for i, row in enumerate(doc["results"]):
+                for n in names:
+                    row[n].setdefault("components", {})[part] = [sub[(i, n)][0], sub[(i, n)][2]]
     return doc
 
 
@@ -406,7 +444,9 @@ def run_contact(
     result = ContactResult(analysis, params, provenance, c.knee_fraction, paper)
     result.gates = inputs.gates
     half_widths = law_half_widths_used(inputs, provenance)
-    result.intervals = contact_intervals(settings, params, half_widths)
+    result.intervals = contact_intervals(
+        settings, params, half_widths, law_components_used(inputs, provenance)
+    )
     if any(h > 0 for h in half_widths.values()) and "unavailable" not in result.intervals:
         result.bands = _band_analyses(settings, params, half_widths)
     comparison = None

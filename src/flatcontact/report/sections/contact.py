@@ -190,6 +190,21 @@ def cycle_and_fit(contact: dict, folder: Path) -> tuple[list, list, list[str]]:
     return tables, figs, notes
 
 
+def _interval_cell(q: dict) -> str:
+    """``value [low, high]`` and, when the laws' parts are carried, ``(fit ±…, conv. ±…,
+    models ±…)``: the half-range of the quantity over the box of each part alone."""
+    text = f"{q['value']:.3g} [{q['low']:.3g}, {q['high']:.3g}]"
+    parts = q.get("components")
+    if parts:
+        short = {"fit": "fit", "convergence": "conv.", "models": "models"}
+        text += (
+            " ("
+            + ", ".join(f"{short.get(p, p)} ±{(hi - lo) / 2:.2g}" for p, (lo, hi) in parts.items())
+            + ")"
+        )
+    return text
+
+
 def interval_tables(contact: dict) -> list:
     """The contact outputs with the laws' uncertainty carried through (``summary.json``
     ``intervals``), when any law coefficient has a nonzero half-width."""
@@ -202,16 +217,14 @@ def interval_tables(contact: dict) -> list:
         "knee_stress_amplitude_mpa": "stiffness knee, amplitude (MPa)",
     }
     rows = [
-        (
-            label,
-            *(
-                f"{r[key]['value']:.3g} [{r[key]['low']:.3g}, {r[key]['high']:.3g}]"
-                for r in iv["results"]
-            ),
-        )
-        for key, label in labels.items()
+        (label, *(_interval_cell(r[key]) for r in iv["results"])) for key, label in labels.items()
     ]
     hw = ", ".join(f"{k} ± {v:.2g}" for k, v in iv["half_widths"].items() if v)
+    if iv.get("component_half_widths"):
+        hw += (
+            "; in parentheses the half-range over the box of each part alone: fit, "
+            "convergence, models"
+        )
     return [
         Table(
             ("quantity", *(f"p0 = {r['p0_gpa']:g} GPa" for r in iv["results"])),

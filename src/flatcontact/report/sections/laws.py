@@ -26,6 +26,19 @@ ENERGY_FORMS_PARAGRAPH = (
 )
 
 
+#: The parts of a coefficient's uncertainty as laws.json names them (``intervals.<c>.components``).
+COMPONENT_NAMES = ("fit", "convergence", "models")
+
+
+def _has_components(form_doc: dict) -> bool:
+    """Does this form's ``intervals`` carry a convergence or model part (a study's block)?"""
+    return any(
+        (iv.get("components") or {}).get(p)
+        for iv in (form_doc.get("intervals") or {}).values()
+        for p in ("convergence", "models")
+    )
+
+
 def laws_tables(laws: dict, paper: bool = False) -> list:
     """The laws of both energy forms side by side, each coefficient with its standard error
     and its interval (fit, convergence and model spread), and what the interval is made of;
@@ -34,6 +47,7 @@ def laws_tables(laws: dict, paper: bool = False) -> list:
     if not forms:
         return []
     configured = laws.get("energy_form")
+    split = {f: _has_components(laws[f]) for f in forms}
     rows = []
     for key, err, label in LAW_COEFFICIENTS:
         row = [label]
@@ -42,6 +56,9 @@ def laws_tables(laws: dict, paper: bool = False) -> list:
             iv = d.get("intervals", {}).get(key)
             row.append(pm(d.get(key), d.get(err)))
             row.append(f"[{iv['low']:.3g}, {iv['high']:.3g}]" if iv else "n/a")
+            if split[form]:
+                parts = (iv or {}).get("components") or {}
+                row.append(" / ".join(f"{parts.get(p, 0.0):.3g}" for p in COMPONENT_NAMES))
         if paper:
             row.append(f"{PAPER[key]:g}")
         rows.append(tuple(row))
@@ -49,6 +66,8 @@ def laws_tables(laws: dict, paper: bool = False) -> list:
     for form in forms:
         tag = f"{form}{' (used)' if form == configured else ''}"
         header += [f"{tag} ± s.e.", f"{form} interval"]
+        if split[form]:
+            header.append(f"{form}: fit / convergence / models")
     if paper:
         header.append(PAPER_COLUMN)
     u = laws.get("uncertainty", {})
@@ -60,6 +79,12 @@ def laws_tables(laws: dict, paper: bool = False) -> list:
     caption = (
         f"Load laws in both energy forms; intervals: coefficient ± {u.get('coverage', 1):g} × "
         f"the combined standard error ({parts}, in quadrature)"
+        + (
+            "; the fit / convergence / models columns are the parts before the coverage "
+            "multiple (coefficient units)"
+            if any(split.values())
+            else ""
+        )
         + (f"; {u['source']}" if u.get("source") else "")
     )
     return [Table(tuple(header), rows, caption)]

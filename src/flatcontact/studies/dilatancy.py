@@ -7,7 +7,7 @@ and a smaller τ at the same load. This splits ``z*`` into the interface gap and
 
 Usage (no torch; reads the scans, writes nothing else)::
 
-    python -m benchmarks.convergence.dilatancy OUT.json LABEL=DIR [LABEL=DIR ...]
+    python -m flatcontact.studies.dilatancy [--p-gpa=0,0.5,...] OUT.json LABEL=DIR [LABEL=DIR ...]
 
 Each ``DIR`` holds a scan's ``ispes.nc`` and ``points.db`` (the relaxed atoms); the first
 model is the reference of the ratios. Per load (0, 0.5, …, 3 GPa): the lateral mean of
@@ -33,8 +33,10 @@ MJ_PER_M2_PER_EV_PER_A2 = 16021.766
 
 
 def _lateral_range(x: np.ndarray) -> np.ndarray:
-    """max − min over the lateral grid, per load (arrays ``[load, a, b]``)."""
-    return x.max(axis=(1, 2)) - x.min(axis=(1, 2))
+    """max − min over the lateral grid, per load (arrays ``[load, a, b]``). NaN entries (points
+    an irreducible-registry scan did not store: images of stored ones by symmetry, with the
+    same values) are left out; the means stay NaN then (the images carry the weights)."""
+    return np.nanmax(x, axis=(1, 2)) - np.nanmin(x, axis=(1, 2))
 
 
 def gap_and_slabs(folder: Path, shape: tuple[int, int, int]) -> tuple[np.ndarray, np.ndarray]:
@@ -52,14 +54,15 @@ def gap_and_slabs(folder: Path, shape: tuple[int, int, int]) -> tuple[np.ndarray
     return gap, slabs
 
 
-def dilatancy(folder: Path) -> dict:
-    """Per-load dilatancy figures of the scan in ``folder`` (see the module docstring)."""
-    import xarray as xr
-
+def dilatancy(folder: Path, loads_gpa=LOADS_GPA) -> dict:
+    """Per-load dilatancy figures of the scan in ``folder`` at ``loads_gpa`` (GPa; default
+    :data:`LOADS_GPA`, the quartz comparison's; see the module docstring)."""
+    loads_gpa = np.asarray(loads_gpa, dtype=float)
     from flatcontact.analysis.constant_pressure import constant_pressure
+    from flatcontact.ispes.contract import open_ispes
 
-    ds = xr.open_dataset(folder / "ispes.nc")
-    cp = constant_pressure(ds, LOADS_GPA, form="enthalpy", source=str(folder / "ispes.nc"))
+    ds = open_ispes(folder / "ispes.nc")
+    cp = constant_pressure(ds, loads_gpa, form="enthalpy", source=str(folder / "ispes.nc"))
     z_grid = ds["thickness"].values
     gap, slabs = gap_and_slabs(folder, ds["energy"].shape)
     z_star = cp.thickness_angstrom
@@ -69,9 +72,9 @@ def dilatancy(folder: Path) -> dict:
             at_z[name][idx] = np.interp(z_star[idx], z_grid, grid[idx[1], idx[2]])
     z_mean = z_star.mean(axis=(1, 2))
     return {
-        "p_gpa": LOADS_GPA.tolist(),
+        "p_gpa": loads_gpa.tolist(),
         "z_mean_angstrom": z_mean.tolist(),
-        "dz_dp_angstrom_per_gpa": np.gradient(z_mean, LOADS_GPA).tolist(),
+        "dz_dp_angstrom_per_gpa": np.gradient(z_mean, loads_gpa).tolist(),
         "z_range_angstrom": _lateral_range(z_star).tolist(),
         "gap_range_angstrom": _lateral_range(at_z["gap"]).tolist(),
         "gap_mean_angstrom": at_z["gap"].mean(axis=(1, 2)).tolist(),
@@ -97,13 +100,20 @@ def pattern_correlation(z: np.ndarray, z_ref: np.ndarray) -> list[float]:
 
 def main(argv: list[str] | None = None) -> None:
     argv = sys.argv[1:] if argv is None else argv
+    loads = LOADS_GPA
+    if argv and argv[0].startswith("--p-gpa="):
+        loads = np.array([float(x) for x in argv[0].split("=", 1)[1].split(",")])
+        argv = argv[1:]
     if len(argv) < 2 or any("=" not in a for a in argv[1:]):
-        sys.exit("usage: python -m benchmarks.convergence.dilatancy OUT.json LABEL=DIR [...]")
+        sys.exit(
+            "usage: python -m flatcontact.studies.dilatancy [--p-gpa=0,0.5,...] OUT.json "
+            "LABEL=DIR [...]"
+        )
     out = Path(argv[0])
     models = {}
     for item in argv[1:]:
         label, folder = item.split("=", 1)
-        models[label] = dilatancy(Path(folder))
+        models[label] = dilatancy(Path(folder), loads)
     ref_label = next(iter(models))
     ref = models[ref_label]
     for m in models.values():

@@ -95,6 +95,7 @@ def test_monotonic_violations_ignore_drops_within_noise():
     assert [v["from_p_gpa"] for v in out] == [2.0]
 
 
+@pytest.mark.slow
 def test_halving_the_thickness_spacing_of_a_toy_scan_moves_tau_and_sigma_below_one_percent(
     tmp_path,
 ):

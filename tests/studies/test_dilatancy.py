@@ -1,0 +1,63 @@
+"""Dilatancy of a stored scan (flatcontact.studies.dilatancy) on a small toy scan: the load
+term of h, the compliance sign, the split of z* into gap and slabs, one model against itself."""
+
+import json
+
+import numpy as np
+import pytest
+
+from flatcontact.studies.dilatancy import dilatancy, main
+
+LOADS = [0.0, 0.25, 0.5]
+
+
+@pytest.fixture(scope="module")
+def scan(tmp_path_factory):
+    from flatcontact.ispes.grid import GridSpec
+    from flatcontact.ispes.relax import RelaxSettings
+    from flatcontact.ispes.scan import run_scan
+    from flatcontact.potentials.engines import calculator_factory
+    from flatcontact.potentials.model import InteractionModel
+    from flatcontact.structures.interface_contract import thickness
+    from flatcontact.structures.toy import toy_interface
+
+    out = tmp_path_factory.mktemp("dilatancy")
+    ref = toy_interface(layers=3)
+    z = thickness(ref) + np.linspace(-0.3, 1.5, 7)
+    factory = calculator_factory(
+        InteractionModel(calculator={"target": "flatcontact.ispes.toy:toy_calculator"})
+    )
+    res = run_scan(
+        ref,
+        factory,
+        GridSpec(3, 3, thickness_angstrom=tuple(z)),
+        out,
+        RelaxSettings(1e-3),
+        executor_options={"kind": "serial"},
+    )
+    res.dataset.to_netcdf(out / "ispes.nc", engine="h5netcdf")
+    return out
+
+
+def test_dilatancy_figures_obey_their_definitions(scan):
+    d = dilatancy(scan, LOADS)
+    # h = U/A + P z*: at P = 0 the two corrugations are the same; the load term grows it
+    assert d["h_range_mj_per_m2"][0] == pytest.approx(d["u_range_mj_per_m2"][0], rel=1e-9)
+    assert d["h_range_mj_per_m2"][2] > d["h_range_mj_per_m2"][1] > d["h_range_mj_per_m2"][0]
+    # the interface compresses under load
+    assert all(s < 0 for s in d["dz_dp_angstrom_per_gpa"])
+    # the toy's thickness is the atoms' z extent: gap + slabs = z*, point by point, so the
+    # linear interpolation at z* keeps it
+    np.testing.assert_allclose(
+        np.add(d["gap_mean_angstrom"], d["slabs_mean_angstrom"]), d["z_mean_angstrom"], rtol=1e-6
+    )
+
+
+def test_a_model_against_itself_has_correlation_one_and_ratios_one(scan, tmp_path):
+    out = tmp_path / "d.json"
+    main([f"--p-gpa={','.join(map(str, LOADS))}", str(out), f"a={scan}", f"b={scan}"])
+    doc = json.loads(out.read_text())
+    assert doc["reference"] == "a"
+    b = doc["models"]["b"]
+    np.testing.assert_allclose(b["z_pattern_correlation_with_reference"], 1.0, rtol=1e-12)
+    np.testing.assert_allclose(b["h_range_mj_per_m2_over_reference"], 1.0, rtol=1e-12)

@@ -1,0 +1,231 @@
+"""``flatcontact study export-uncertainty`` on cheap toy studies: it writes the format of the
+quartz data file the paper preset reads; ``--models`` entries that are YAML files with a
+``potential:`` section; a variant that fails is reported as its setting's failure."""
+
+from __future__ import annotations
+
+import copy
+import json
+
+import pytest
+import yaml
+
+from flatcontact.analysis.uncertainty import LAW_COEFFICIENTS
+from flatcontact.config.load import build_config
+from flatcontact.config.presets import LAW_UNCERTAINTY_FILE
+from flatcontact.config.uncertainty import UncertaintyConfig
+from flatcontact.errors import InputError
+from flatcontact.stages.measured_on import check_measured_on, measured_on
+from flatcontact.studies import convergence as convergence_module
+from flatcontact.studies.export import merge_studies, read_study
+
+TOY = {
+    "structure": {"kind": "toy-lj", "layers": 3},
+    "potential": {"calculator": {"target": "flatcontact.ispes.toy:toy_calculator"}},
+    "scan": {
+        "grid": [3, 3],
+        "p_range_gpa": {"lo_gpa": -0.2, "hi_gpa": 1.5, "n": 4},
+        "executor": "serial",
+    },
+    "analysis": {"p_gpa": [0.0, 0.5, 1.0]},
+    "contact": {"p0_gpa": [0.5, 1.0]},
+    "report": {"svg": False},
+}
+#: the toy's cross-interface LJ depth (flatcontact.ispes.toy): the second model doubles it
+EPS_CROSS = {"a": 0.01, "b": 0.02}
+
+
+def _write(path, data):
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def test_export_of_written_study_blocks_is_the_quartz_file_format(tmp_path):
+    """Fast: two study documents with the blocks write_study puts in study.json (numbers
+    made up), exported by the command; the file has the quartz data file's fields."""
+    from flatcontact.studies.output import uncertainty_block
+
+    cfg = build_config(copy.deepcopy(TOY), None, "toy")
+    numbers = {k: 0.5 + i for i, k in enumerate(LAW_COEFFICIENTS)}
+    conv = {
+        "study": "convergence",
+        "delta": {"internal": numbers, "enthalpy": {k: 2 * v for k, v in numbers.items()}},
+        "settings": {"thicknesses": {}},
+        "tolerance_pct": 3.0,
+        "converged": True,
+        "variants": [{"name": "base"}, {"name": "thicknesses1"}],
+    }
+    mod = {
+        "study": "models",
+        "spread": {"internal": numbers, "enthalpy": numbers},
+        "models": ["a", "b"],
+        "variants": [{"name": "a"}, {"name": "b"}],
+    }
+    paths = []
+    for name, doc in (("conv", conv), ("mod", mod)):
+        (tmp_path / name).mkdir()
+        doc["uncertainty"] = uncertainty_block(doc, cfg, f"flatcontact study {doc['study']}")
+        (tmp_path / name / "study.json").write_text(json.dumps(doc))
+        paths.append(tmp_path / name)
+    target = tmp_path / "u.json"
+    code, _out, err = _cli(["study", "export-uncertainty", *paths, "--out", target])
+    assert code == 0, err
+    exported = json.loads(target.read_text())
+    quartz = json.loads(LAW_UNCERTAINTY_FILE.read_text())
+    assert set(exported) == set(quartz)
+    assert exported["convergence_enthalpy"] == {
+        k: float(f"{2 * v:.3g}") for k, v in numbers.items()
+    }
+    assert exported["model_spread_internal"] == {k: float(f"{v:.3g}") for k, v in numbers.items()}
+    assert exported["measured_on"] == measured_on(cfg)
+    UncertaintyConfig.model_validate(exported)
+    check_measured_on(build_config({**copy.deepcopy(TOY), "uncertainty": exported}, None, "t"))
+
+
+@pytest.fixture(scope="module")
+def studies(tmp_path_factory):
+    """A one-step thickness refinement and a two-model study of the toy (4 runs, ~25 s each
+    on the loaded 2-core machine)."""
+    root = tmp_path_factory.mktemp("export")
+    conf = _write(
+        root / "toy.yaml",
+        {**TOY, "refine": {"settings": ["thicknesses"], "max_steps": 1}},
+    )
+    models = []
+    for label, eps in EPS_CROSS.items():
+        pot = copy.deepcopy(TOY["potential"])
+        pot["calculator"]["kwargs"] = {"eps_cross_ev": eps}
+        models.append(_write(root / f"toy-{label}.yaml", {"potential": pot}))
+    return root, conf, models
+
+
+def _cli(argv):
+    """Run the CLI in-process, returning (code, stdout, stderr) without a capsys fixture."""
+    import contextlib
+    import io
+
+    from flatcontact.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            main([str(a) for a in argv])
+            code = 0
+        except SystemExit as exc:
+            code = exc.code
+    return code, out.getvalue(), err.getvalue()
+
+
+@pytest.fixture(scope="module")
+def ran(studies):
+    root, conf, models = studies
+    code, _, err = _cli(["study", "convergence", conf, "--out", root / "conv"])
+    assert code == 0, err
+    code, out, err = _cli(
+        ["study", "models", conf, "--models", ",".join(map(str, models)), "--out", root / "mod"]
+    )
+    assert code == 0, err
+    return root, conf, models, out
+
+
+@pytest.mark.slow
+def test_models_given_as_yaml_files_with_a_potential_section_are_scanned_and_spread(ran):
+    root, _, models, _ = ran
+    doc = json.loads((root / "mod" / "study.json").read_text())
+    assert [v["name"] for v in doc["variants"]] == [m.stem for m in models]
+    # each model's laws are its own run's laws.json; the spread is half their range
+    laws = {
+        m.stem: json.loads((root / "mod" / "runs" / m.stem / "04-laws" / "laws.json").read_text())
+        for m in models
+    }
+    a, b = (laws[m.stem]["internal"] for m in models)
+    assert a["tau0_mpa"] != pytest.approx(b["tau0_mpa"], rel=1e-3)  # the models differ
+    for key in LAW_COEFFICIENTS:
+        assert doc["spread"]["internal"][key] == pytest.approx(abs(a[key] - b[key]) / 2)
+    # the second model's calculator kwargs reached its run (its settings say so)
+    run_cfg = yaml.safe_load((root / "mod" / "runs" / "toy-b" / "config.yaml").read_text())
+    assert run_cfg["potential"]["calculator"]["kwargs"] == {"eps_cross_ev": 0.02}
+
+
+@pytest.mark.slow
+def test_export_writes_the_format_of_the_quartz_data_file(ran):
+    root, _conf, _, _ = ran
+    target = root / "toy_law_uncertainty.json"
+    code, out, err = _cli(
+        ["study", "export-uncertainty", root / "conv", root / "mod" / "study.json", "--out", target]
+    )
+    assert code == 0, err
+    exported = json.loads(target.read_text())
+    quartz = json.loads(LAW_UNCERTAINTY_FILE.read_text())
+    assert set(exported) == set(quartz)  # the same blocks and fields
+    assert set(exported["provenance"]) >= {"command", "date"}
+    for doc in (exported, quartz):
+        UncertaintyConfig.model_validate(doc)
+        for block in ("convergence_internal", "model_spread_enthalpy"):
+            assert set(doc[block]) == set(LAW_COEFFICIENTS)
+    # the numbers are the studies' blocks, the fingerprints the toy's
+    conv = yaml.safe_load((root / "conv" / "uncertainty.yaml").read_text())["uncertainty"]
+    mod = yaml.safe_load((root / "mod" / "uncertainty.yaml").read_text())["uncertainty"]
+    assert exported["convergence_internal"] == conv["convergence_internal"]
+    assert exported["model_spread_enthalpy"] == mod["model_spread_enthalpy"]
+    cfg = build_config({**TOY, "uncertainty": exported}, None, "toy")
+    assert exported["measured_on"] == measured_on(cfg)
+    check_measured_on(cfg)
+    assert [s["blocks"] for s in exported["provenance"]["studies"]] == [
+        ["convergence_internal", "convergence_enthalpy"],
+        ["model_spread_internal", "model_spread_enthalpy"],
+    ]
+    assert "wrote" in out
+
+
+@pytest.mark.slow
+def test_export_refuses_studies_of_other_interfaces_or_the_same_block_twice(ran, tmp_path):
+    root, *_ = ran
+    conv = read_study(root / "conv")
+    other = copy.deepcopy(read_study(root / "mod"))
+    other["uncertainty"]["measured_on"]["structure_sha256"] = "0" * 64
+    with pytest.raises(InputError, match="different structures or models"):
+        merge_studies({"conv": conv, "other": other})
+    with pytest.raises(InputError, match="also measured by conv"):
+        merge_studies({"conv": conv, "again": copy.deepcopy(conv)})
+    bad = tmp_path / "study.json"
+    bad.write_text(json.dumps({"study": "convergence"}))
+    code, _, err = _cli(["study", "export-uncertainty", bad, "--out", tmp_path / "u.json"])
+    assert code == 2 and err.startswith("error: ") and err.count("\n") == 1
+    assert "no uncertainty block" in err and not (tmp_path / "u.json").exists()
+
+
+@pytest.mark.slow
+def test_a_variant_that_fails_is_reported_as_its_settings_failure(tmp_path, monkeypatch):
+    """A constructed failure: the layers step's run raises the one-line InputError a refusing
+    builder raises. The study goes on, study.json and the console name the failure, and the
+    other setting's verdict and δ_conv stand."""
+    real = convergence_module.run_variant
+
+    def refusing(config, folder, share=None):
+        if folder.endswith("layers1"):
+            raise InputError("probe column: p(z) is not monotonic (constructed)")
+        return real(config, folder, share)
+
+    monkeypatch.setattr(convergence_module, "run_variant", refusing)
+    conf = _write(
+        tmp_path / "toy.yaml",
+        {**TOY, "refine": {"settings": ["thicknesses", "layers"], "max_steps": 1}},
+    )
+    code, out, err = _cli(["study", "convergence", conf, "--out", tmp_path / "s"])
+    assert code == 0, err
+    doc = json.loads((tmp_path / "s" / "study.json").read_text())
+    assert doc["settings"]["layers"]["state"] == "failed"
+    assert doc["failed"] == {"layers": "probe column: p(z) is not monotonic (constructed)"}
+    assert doc["settings"]["thicknesses"]["state"] in ("converged", "not converged")
+    assert [v["name"] for v in doc["variants"]] == ["base", "thicknesses1"]
+    assert doc["converged"] is False
+    text = " ".join(out.split())
+    assert "layers1: failed: probe column" in text
+    assert "layers: failed at step 1: probe column" in text
+    # δ_conv comes from the setting that ran
+    by = {v["name"]: v for v in doc["variants"]}
+    for key in LAW_COEFFICIENTS:
+        a = by["base"]["laws"]["internal"][key]
+        b = by["thicknesses1"]["laws"]["internal"][key]
+        assert doc["delta"]["internal"][key] == pytest.approx(abs(b - a))
