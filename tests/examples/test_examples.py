@@ -366,7 +366,6 @@ def test_cu111_gamma_surface_has_mishins_stacking_fault_energy(tmp_path):
     assert isf_mj_m2 == pytest.approx(44.4, rel=0.1)
 
 
-
 def _ase_eam_stacking_energy_mev_per_a2(potential_file: str, a_angstrom: float, shift) -> float:
     """An fcc(111) stack of 8 planes (ASE's ``fcc111``, vacuum on both sides) whose upper four
     planes are shifted by ``shift`` (fractions of a1, a2), every atom relaxed along z only
@@ -409,6 +408,7 @@ def test_au111_from_a_cif_has_the_stacking_energies_of_an_independent_ase_eam_st
     assert 1.0 < scan["adhesion"]["work_of_separation_j_per_m2"] < 2.0
     html = (root / "report.html").read_text()
     assert "intrinsic stacking fault" in html
+
 
 def test_build_cli_takes_a_monolayer_slab_file_and_a_config(tmp_path):
     """`build --structure graphene_1L --potential graphene-rebo-kc`: the slab recipe finds the
