@@ -67,3 +67,34 @@ def test_contract_converts_declared_units_and_refuses_unknown_ones(tmp_path):
     odd["energy"].attrs["units"] = "kJ/mol"
     with pytest.raises(InputError, match="'energy' has units 'kJ/mol'"):
         contract.validate_ispes(odd)
+
+
+def test_a_file_without_mapped_points_or_group_reads_as_every_point_relaxed(tmp_path):
+    """ispes.nc written before irreducible registries (no ``mapped``, no ``symmetry_*``,
+    ``grid_points``, ``computed_points``) still reads, with the identity as its group, and a
+    scan's file with them round-trips."""
+    a1, a2 = _hex_vectors()
+    ds = contract.empty_grid(3, 3, [8.0, 9.0], a1, a2, potential="old")
+    ds["energy"][:] = np.random.default_rng(1).normal(size=ds.energy.shape)
+    ds["normal_stress"][:] = 0.0
+    assert "mapped" not in ds and "symmetry_order" not in ds.attrs
+    back = contract.open_ispes(contract.write_ispes(ds, tmp_path / "old.nc"))
+    ops = contract.symmetry_operations(back)
+    assert len(ops) == 1 and np.array_equal(ops[0][0], np.eye(2)) and not ops[0][1].any()
+    np.testing.assert_array_equal(back.energy.values, ds.energy.values)
+
+    c3 = [
+        {"matrix": [[1, 0], [0, 1]], "translation": [0.0, 0.0]},
+        {"matrix": [[0, -1], [1, -1]], "translation": [0.0, 0.0]},
+        {"matrix": [[-1, 1], [-1, 0]], "translation": [0.0, 0.0]},
+    ]
+    new = ds.assign_attrs(grid_points=18, computed_points=8, **contract.symmetry_attrs(c3))
+    new["mapped"] = (contract.DIMS, np.arange(18).reshape(3, 3, 2) % 2 == 0)
+    back = contract.open_ispes(contract.write_ispes(new, tmp_path / "new.nc"))
+    assert back["mapped"].dtype == bool
+    np.testing.assert_array_equal(back["mapped"].values, new["mapped"].values)
+    ops = contract.symmetry_operations(back)
+    assert [m.tolist() for m, _ in ops] == [op["matrix"] for op in c3]
+    with pytest.raises(InputError, match=r"new\.nc: symmetry attributes"):
+        broken = new.assign_attrs(symmetry_translations=np.zeros(4))
+        contract.open_ispes(contract.write_ispes(broken, tmp_path / "new.nc"))

@@ -147,3 +147,85 @@ def test_a_relaxation_that_breaks_the_symmetry_is_computed_in_full(tmp_path):
     assert any("breaks the interface's shift-space symmetry" in n for n in red.notes)
     assert red.points_stored == 72 and not red.dataset["mapped"].any()
     assert int(red.dataset.attrs["symmetry_order"]) == 1  # the analysis must not symmetrise
+
+
+def _reduced_toy_scan(out, **kwargs):
+    ref = toy_interface_3()
+    z0 = thickness(ref)
+    return run_scan(
+        ref,
+        _toy_factory(),
+        GridSpec(6, 6, thickness_angstrom=(z0 - 0.2, z0 + 0.3)),
+        out,
+        RelaxSettings(mode="normal"),
+        executor=SerialExecutor(),
+        symmetry=SymmetrySettings(verify_points=3),
+        **kwargs,
+    )
+
+
+@pytest.mark.parametrize("phase", ["representatives", "verified points"])
+def test_an_interrupted_and_resumed_reduced_scan_equals_an_uninterrupted_one(tmp_path, phase):
+    """Ctrl-C partway: the partial ispes.nc maps the orbits of the stored representatives (and
+    stores the group); the resumed scan writes the same ispes.nc as one that ran through."""
+    from flatcontact.ispes.contract import open_ispes
+    from flatcontact.ispes.scan import ScanInterrupted
+
+    whole = _reduced_toy_scan(tmp_path / "whole")
+    n_reps = whole.points_stored - 3
+    # progress calls: one at the start of each phase, one per stored point
+    stop_after = 5 if phase == "representatives" else n_reps + 2
+
+    def stop(done, total, count=[0]):  # noqa: B006 - counts the calls of this run
+        count[0] += 1
+        if count[0] > stop_after:
+            raise KeyboardInterrupt
+
+    out = tmp_path / "stopped"
+    with pytest.raises(ScanInterrupted) as info:
+        _reduced_toy_scan(out, progress=stop)
+    part = info.value.result.dataset
+    stored = info.value.result.points_stored
+    assert 0 < stored < whole.points_stored
+    assert int(part.attrs["symmetry_order"]) == 6
+    mapped = part["mapped"].values
+    # every point whose representative is stored is filled, and only those
+    assert mapped.sum() > 0
+    assert int(np.isfinite(part["energy"].values).sum()) == stored + int(mapped.sum())
+    on_disk = open_ispes(out / "ispes.nc")
+    assert bool((on_disk["mapped"].values == mapped).all())
+    resumed = _reduced_toy_scan(out)
+    assert resumed.symmetry["verify_points"] == whole.symmetry["verify_points"]
+    a, b = whole.dataset, resumed.dataset
+    for name in ("energy", "normal_stress", "converged", "mapped", "force_calls"):
+        np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
+    for key in ("symmetry_order", "computed_points", "points_done"):
+        np.testing.assert_array_equal(a.attrs[key], b.attrs[key], err_msg=key)
+
+
+def test_the_fallback_names_the_failing_points_and_why_the_whole_grid(tmp_path):
+    """A tolerance no relaxation meets: every verified point fails, scan.json-level record and
+    note name them, and the grid is computed in full (not only their orbits)."""
+    ref = toy_interface_3()
+    z0 = thickness(ref)
+    settings = SymmetrySettings(verify_points=2, energy_tolerance_mev_per_a2=1e-15)
+    red = run_scan(
+        ref,
+        _toy_factory(),
+        GridSpec(6, 6, thickness_angstrom=(z0 - 0.2, z0 + 0.3)),
+        tmp_path / "red",
+        RelaxSettings(mode="normal"),
+        executor=SerialExecutor(),
+        symmetry=settings,
+    )
+    sym = red.symmetry
+    checked = sym["verification"]["checked"]
+    assert sym["computed_in_full"] and len(checked) == 2
+    bad = [c for c in checked if c["energy_difference_mev_per_a2"] > 1e-15]
+    assert bad  # round-off alone exceeds 1e-15 meV/Å² somewhere
+    reason = sym["computed_in_full_reason"]
+    assert reason in red.notes
+    for c in bad:
+        assert str(tuple(c["point"])) in reason
+    assert "unverified orbits" in reason
+    assert red.points_stored == 72 and not red.dataset["mapped"].any()

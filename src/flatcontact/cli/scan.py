@@ -244,7 +244,8 @@ def scan_command(
     except ScanInterrupted as stop:
         r = stop.result
         err_console.print(
-            f"interrupted: {r.points_done} of {r.points_total} points stored in {r.store_path}; "
+            f"interrupted: {r.points_done} of {r.points_total} points done "
+            f"({r.points_stored} relaxed) in {r.store_path}; "
             "rerun the same command to continue",
             highlight=False,
         )

@@ -192,7 +192,7 @@ def validate_ispes(ds: xr.Dataset, source: str = "ISPES grid") -> xr.Dataset:
             )
         if not _numeric(ds[var].dtype):
             raise InputError(f"{source}: variable '{var}' must hold numbers, holds {ds[var].dtype}")
-    for name in (*DIMS, VAR_CONVERGED, VAR_FORCE_CALLS):
+    for name in (*DIMS, VAR_CONVERGED, VAR_FORCE_CALLS, VAR_MAPPED):
         if name in ds.variables and not _numeric(ds[name].dtype, bool_ok=True):
             raise InputError(f"{source}: '{name}' must hold numbers, holds {ds[name].dtype}")
     for attr in REQUIRED_ATTRS:
@@ -223,6 +223,10 @@ def validate_ispes(ds: xr.Dataset, source: str = "ISPES grid") -> xr.Dataset:
     z = np.asarray(ds[DIM_Z].values, dtype=float)
     if not np.all(np.isfinite(z)) or np.unique(z).size != z.size:
         raise InputError(f"{source}: coordinate 'thickness' must be finite and without repeats")
+    try:
+        symmetry_operations(ds)  # the analysis needs them; a bad set is refused here, early
+    except InputError as exc:
+        raise InputError(f"{source}: {exc}") from None
     ds = _to_contract_units(ds, source)
     ds = ds.sortby([DIM_A, DIM_B, DIM_Z])
     if VAR_CONVERGED not in ds:

@@ -35,6 +35,7 @@ from flatcontact.ispes.probe import extreme_stackings, probe_column, rigid_stack
 from flatcontact.ispes.reduction import (
     SymmetrySettings,
     choose_verify,
+    fallback_reason,
     plan_reduction,
     symmetry_broken,
     verification,
@@ -379,45 +380,44 @@ def run_scan(
                             if progress is not None:
                                 progress(stored, total)
 
-                symmetry_record = None
+                symmetry_record, mapping = None, None
                 try:
                     if reduction is None or reduction.group.order == 1:
                         run_points(full_tree)
                     else:
-                        run_points(search_tree(shape, root, order, allowed=reduction.computed))
-                        reduction = choose_verify(
-                            reduction, store.done(), shape, symmetry.verify_points
-                        )
-                        run_points(search_tree(shape, root, order, allowed=reduction.computed))
-                        area = cell_area(*in_plane_vectors(reference))
-                        check = verification(reduction, store.done(), area)
+                        # the record and the mapping exist from the start, so a scan stopped
+                        # partway writes the mapped points of its stored representatives
+                        mapping = reduction.representative
                         symmetry_record = {
                             **reduction.to_json(),
-                            "verification": check,
+                            "verification": None,
                             "computed_in_full": False,
                         }
-                        if all(idx in store for idx in reduction.computed) and symmetry_broken(
-                            check, symmetry
-                        ):
-                            symmetry_record["computed_in_full"] = True
-                            notes.append(
-                                f"symmetry: a verified point differs from its representative by "
-                                f"{check['max_energy_difference_mev_per_a2']:.3g} meV/Å², "
-                                f"{check['max_stress_difference_gpa']:.3g} GPa (tolerance "
-                                f"{symmetry.energy_tolerance_mev_per_a2:g} meV/Å², "
-                                f"{symmetry.stress_tolerance_gpa:g} GPa): the relaxation breaks "
-                                f"the interface's shift-space symmetry (order "
-                                f"{reduction.group.order}); every grid point is computed"
+                        run_points(search_tree(shape, root, order, allowed=reduction.computed))
+                        if all(rep in store for rep in reduction.computed):
+                            # chosen from the complete representatives only: a resumed scan
+                            # verifies the same points as an uninterrupted one
+                            reduction = choose_verify(
+                                reduction, store.done(), shape, symmetry.verify_points
                             )
-                            run_points(full_tree)
+                            symmetry_record.update(reduction.to_json())
+                            run_points(search_tree(shape, root, order, allowed=reduction.computed))
+                        if all(idx in store for idx in reduction.computed):
+                            area = cell_area(*in_plane_vectors(reference))
+                            check = verification(reduction, store.done(), area)
+                            symmetry_record["verification"] = check
+                            if symmetry_broken(check, symmetry):
+                                reason = fallback_reason(check, symmetry, reduction.group.order)
+                                symmetry_record["computed_in_full"] = True
+                                symmetry_record["computed_in_full_reason"] = reason
+                                notes.append(reason)
+                                mapping = None
+                                run_points(full_tree)
                 except KeyboardInterrupt:
                     interrupted = True
             finally:
                 if own_executor:
                     executor.close(cancel=True)
-            mapping = None
-            if symmetry_record is not None and not symmetry_record["computed_in_full"]:
-                mapping = reduction.representative
             ds = store.assemble(mapping, symmetry_record)
             path = contract.write_ispes(ds, out_dir / ISPES_NC)
             result = ScanResult(

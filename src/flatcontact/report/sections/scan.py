@@ -9,12 +9,27 @@ from flatcontact.report.format import fmt, grouped_warnings
 from flatcontact.report.html import Figure, Section, Table
 
 
+def _symmetry_rows(scan: dict) -> list[tuple[str, str]]:
+    """The reduced scan's rows: relaxed points and the shift-space group (none for a full scan
+    or a ``scan.json`` written before irreducible registries)."""
+    sym = scan.get("symmetry") or {}
+    order = int(sym.get("order", 1))
+    if order <= 1 or "computed_points" not in scan:
+        return []
+    if sym.get("computed_in_full"):
+        how = "every point relaxed: the verification found the symmetry broken (see the notes)"
+    else:
+        how = f"{scan['computed_points']} relaxed, the others mapped by symmetry"
+    return [("shift-space group order", str(order)), ("relaxed points", how)]
+
+
 def scan_section(scan: dict, folder: Path) -> Section:
     """Section 2: the scan's counts, thicknesses and adhesion (``scan``: the scan stage's
     ``scan.json``), its notes and warnings, and its figure from ``folder``."""
     adh = scan.get("adhesion") or {}
     scan_rows = [
         ("grid points", f"{scan['points_done']} of {scan['points_total']}"),
+        *_symmetry_rows(scan),
         ("converged", str(scan["converged"])),
         ("force calls (total)", str(scan["force_calls_total"])),
         ("thicknesses z (Å)", ", ".join(f"{z:.4f}" for z in scan["thickness_angstrom"])),
