@@ -166,7 +166,8 @@ def test_the_symmetry_gate_names_the_broken_operation_and_the_loads():
     broken = clean + 2.0 * np.ptp(clean) * lean
     found = gates.broken_symmetry(np.array([clean, broken]), [0.0, 1.0], A1, A2, ops)
     assert found is not None and found.gate == "broken_symmetry"
-    assert "rotation by 120°" in found.message and "P = 1 GPa" in found.message
+    assert "rotation by" in found.message and "P = 1 GPa" in found.message
+    assert " more" in found.message  # at most four operations named, the count of the rest
     assert "P = 0," not in found.message and "relax_mode: normal" in found.message
     # one point out of 144 off by a tenth of the range: the max norm sees it
     spot = clean.copy()
