@@ -469,6 +469,8 @@ class Pipeline:
                 scan_json=self._upstream("scan").folder / SCAN_JSON,
                 friction_nc=self._upstream("analyze").folder / FRICTION_NC,
                 laws_json=self._upstream("laws").folder / LAWS_JSON,
+                symmetry_tolerance_angstrom=self.config.scan.symmetry.tolerance_angstrom,
+                spread_compression=self.config.scan.relax_mode != "rigid",
             )
         )
 

@@ -1,9 +1,11 @@
-"""The validity gates (flatcontact.analysis.gates, .shift_symmetry, flatcontact.ispes.slip):
+"""The validity gates (flatcontact.analysis.gates, .operation_deviation, flatcontact.ispes.slip):
 each fires on a constructed case and not on a clean one.
 
-The structure's shift-space symmetry is checked against an energy computed independently in
-the test: a pair sum between the two slabs evaluated by brute force on the grid of shifts,
-which must keep every operation :func:`shift_operations` finds (E(s) = E(R s + t_B − t_T))."""
+The interface's shift-space group (:func:`flatcontact.ispes.shift_symmetry.shift_space_group`,
+the one finder the scan and the gate share) is checked against an energy computed
+independently in the test: a pair sum between the two slabs evaluated by brute force on the
+grid of shifts, which must keep every operation of the group (E(M s + t) = E(s)), slab swaps
+included."""
 
 from __future__ import annotations
 
@@ -12,77 +14,150 @@ import pytest
 from ase import Atoms
 
 from flatcontact.analysis import gates
+from flatcontact.analysis.operation_deviation import maps_grid, operation_deviation
 from flatcontact.analysis.periodic import PeriodicSurface
-from flatcontact.analysis.shift_symmetry import operation_deviation, shift_operations
 from flatcontact.config.contact import GATE_NAMES
+from flatcontact.ispes.shift_symmetry import shift_space_group
 from flatcontact.ispes.slip import SLIP_THRESHOLD_ANGSTROM, slip_table
 
 A = 2.5
 A1 = np.array([A, 0.0])
 A2 = np.array([-A / 2, A * np.sqrt(3) / 2])
+LAT = np.column_stack([A1, A2])
 
 
 def test_the_settings_name_the_gates_of_the_analysis():
     assert GATE_NAMES == gates.GATES
 
 
-def _pair_energy(bottom: np.ndarray, top: np.ndarray, shifts: np.ndarray) -> np.ndarray:
-    """Σ exp(-r²) between the slabs over lattice images, per shift (independent of the code)."""
-    lat = np.column_stack([A1, A2])
-    images = np.array([lat @ [i, j] for i in range(-3, 4) for j in range(-3, 4)])
+def _pair_energy(bottom, top, shifts, weight=None):
+    """Σ w(Z_i, Z_j) exp(-r²) between the slabs over lattice images, per Cartesian shift of
+    the top slab (independent of the code); ``bottom``, ``top``: (x, y, z, Z) rows."""
+    images = np.array([LAT @ [i, j] for i in range(-3, 4) for j in range(-3, 4)])
+    weight = weight or (lambda zi, zj: 1.0)
     out = []
     for s in shifts:
         e = 0.0
         for x in bottom:
             for y in top:
-                d = (y[:2] + s)[None, :] + images - x[:2]
+                d = (np.asarray(y[:2]) + s)[None, :] + images - np.asarray(x[:2])
                 r2 = np.sum(d**2, axis=1) + (y[2] - x[2]) ** 2
-                e += float(np.sum(np.exp(-r2)))
+                e += weight(x[3], y[3]) * float(np.sum(np.exp(-r2)))
         out.append(e)
     return np.array(out)
 
 
-def _grid_energy(bottom, top, n=12):
+def _grid_energy(bottom, top, n=12, weight=None):
     sa, sb = np.meshgrid(np.arange(n) / n, np.arange(n) / n, indexing="ij")
-    shifts = np.stack([sa.ravel(), sb.ravel()], -1) @ np.vstack([A1, A2])
-    return _pair_energy(bottom, top, shifts).reshape(n, n)
+    shifts = np.stack([sa.ravel(), sb.ravel()], -1) @ LAT.T
+    return _pair_energy(bottom, top, shifts, weight).reshape(n, n)
+
+
+def _interface(bottom, top) -> Atoms:
+    """Two one-layer slabs (every atom held, as rigid sheets) in the interface contract."""
+    rows = [*bottom, *top]
+    atoms = Atoms(
+        numbers=[int(r[3]) for r in rows],
+        positions=[r[:3] for r in rows],
+        cell=[[*A1, 0], [*A2, 0], [0, 0, 30.0]],
+        pbc=(True, True, False),
+    )
+    n1 = len(bottom)
+    atoms.arrays["slab"] = np.array([1] * n1 + [2] * len(top))
+    atoms.arrays["surface"] = np.array([2] * n1 + [3] * len(top))
+    atoms.arrays["layer"] = np.array([1] * n1 + [2] * len(top))
+    atoms.arrays["held"] = np.ones(len(rows), bool)
+    return atoms
+
+
+def _ops(atoms):
+    return [
+        (np.array(op.matrix), np.array(op.translation))
+        for op in shift_space_group(atoms).operations
+    ]
+
+
+def _keys(ops):
+    return {(tuple(m.ravel()), tuple(np.round(t % 1, 6) % 1)) for m, t in ops}
 
 
 @pytest.mark.parametrize(
-    ("top_xy", "n_ops"),
+    ("top_xy", "order"),
     [
-        ([(1 / 3, 2 / 3)], 11),  # one atom per layer: the whole hexagonal point group
-        # a second atom at a1/2: only the mirror normal to a1 keeps both top atoms
-        ([(1 / 3, 2 / 3), (0.5, 0.0)], 1),
+        ([(1 / 3, 2 / 3)], 12),  # one atom per layer: the whole hexagonal point group
+        # a second atom at a1/2: only the identity and the mirror normal to a1 keep both
+        ([(1 / 3, 2 / 3), (0.5, 0.0)], 2),
     ],
 )
-def test_every_structure_operation_is_kept_by_an_independent_pair_energy(top_xy, n_ops):
-    lat = np.column_stack([A1, A2])
-    bottom = np.array([[0.0, 0.0, 0.0]])
-    top = np.array([[*(lat @ f), 1.5 + 0.4 * k] for k, f in enumerate(top_xy)])
-    pos = np.vstack([bottom, top])
-    numbers = np.full(len(pos), 6)
-    slab = np.array([1] * len(bottom) + [2] * len(top))
-    ops = shift_operations(pos, numbers, slab, A1, A2)
-    assert ops, "a structure of atoms on the hexagonal sites has some symmetry"
+def test_every_structure_operation_is_kept_by_an_independent_pair_energy(top_xy, order):
+    bottom = [(0.0, 0.0, 0.0, 6)]
+    top = [(*(LAT @ f), 1.5 + 0.4 * k, 6) for k, f in enumerate(top_xy)]
+    ops = _ops(_interface(bottom, top))
+    assert len(ops) == order
     surface = PeriodicSurface(_grid_energy(bottom, top), A1, A2)
-    for op in ops:
-        assert operation_deviation(surface, op) < 1e-6, op.name
-    assert len(ops) == n_ops
-    if n_ops == 1:  # the operations the structure lacks, the energy breaks
-        names = {op.name for op in ops}
-        assert names == {"mirror at 90°"}
-        full = shift_operations(pos[:2], numbers[:2], slab[:2], A1, A2)
-        lacking = [op for op in full if op.name not in names]
-        assert lacking and all(operation_deviation(surface, op) > 1e-3 for op in lacking)
+    for m, t in ops:
+        assert maps_grid((12, 12), m, t)
+        assert operation_deviation(surface, m, t) < 1e-9, (m, t)
+    if order == 2:  # the operations the structure lacks, the energy breaks
+        assert gates.operation_name(*ops[1], A1, A2) == "mirror at 90°"
+        full = _ops(_interface(bottom, top[:1]))
+        lacking = [op for op in full if _keys([op]) - _keys(ops)]
+        assert len(lacking) == 10
+        assert all(operation_deviation(surface, m, t) > 1e-2 for m, t in lacking)
+
+
+def test_slab_swapping_operations_act_on_the_shift_with_their_sign():
+    """A two-atom (B, N) sheet of no symmetry of its own, and slab 2 its image under the
+    two-fold axis along x in the interface plane, (x, y, z) ↦ (x, −y, h − z): that axis swaps
+    the slabs and is the structure's only operation. The group carries the swap's sign in M
+    (s ↦ −M' s + t, M' the mirror y ↦ −y), and the independent pair energy keeps exactly
+    that map, not M' s + t."""
+    b, n = 5, 7
+    bottom = [(0.0, 0.0, 0.0, b), (*(LAT @ (0.3, 0.1)), 0.0, n)]
+    top = [(x, -y, 1.6, z) for x, y, _, z in bottom]
+
+    def weight(zi, zj):
+        return {frozenset([b]): 1.0, frozenset([n]): 0.3, frozenset([b, n]): 2.0}[
+            frozenset([zi, zj])
+        ]
+
+    group = shift_space_group(_interface(bottom, top))
+    swaps = [op for op in group.operations if op.swaps_slabs]
+    assert group.order == 2 and len(swaps) == 1
+    surface = PeriodicSurface(_grid_energy(bottom, top, weight=weight), A1, A2)
+    ops = [(np.array(op.matrix), np.array(op.translation)) for op in group.operations]
+    assert gates.broken_symmetry(np.array([surface.values]), [0.0], A1, A2, ops) is None
+    for op in swaps:
+        m, t = np.array(op.matrix), np.array(op.translation)
+        assert operation_deviation(surface, m, t) < 1e-9
+        # the space operation's in-plane part without the swap's sign is not a symmetry
+        assert operation_deviation(surface, -m, t) > 1e-2
+
+
+def test_a_symmetric_landscape_on_a_coarse_grid_reads_symmetric():
+    """On a 3×3 grid C3 maps the edge frequencies of the square index set outside it; the
+    samples obey the group exactly, and so does the measure (grid comparison). On a grid the
+    translation (1/3, 2/3) does not map onto itself, the interpolant is compared on the
+    frequencies that stay inside: small for a smooth symmetric landscape, large when the
+    landscape leans."""
+    bottom = [(0.0, 0.0, 0.0, 6)]
+    top = [(*(LAT @ (1 / 3, 2 / 3)), 2.2, 6)]
+    ops = _ops(_interface(bottom, top))
+    coarse = PeriodicSurface(_grid_energy(bottom, top, n=3), A1, A2)
+    assert max(operation_deviation(coarse, m, t) for m, t in ops) < 1e-9
+    off = [(m, t) for m, t in ops if not maps_grid((8, 8), m, t)]
+    assert off, "translation (1/3, 2/3) is not on an 8×8 grid"
+    smooth = _grid_energy(bottom, top, n=8)
+    assert max(operation_deviation(PeriodicSurface(smooth, A1, A2), m, t) for m, t in off) < 0.01
+    lean = np.cos(2 * np.pi * np.arange(8) / 8)[:, None] * np.ones(8)[None, :]
+    leaning = PeriodicSurface(smooth + 0.5 * np.ptp(smooth) * lean, A1, A2)
+    assert min(operation_deviation(leaning, m, t) for m, t in off) > 0.2
 
 
 def test_the_symmetry_gate_names_the_broken_operation_and_the_loads():
-    lat = np.column_stack([A1, A2])
-    bottom = np.array([[0.0, 0.0, 0.0]])
-    top = np.array([[*(lat @ [1 / 3, 2 / 3]), 1.5]])
-    pos = np.vstack([bottom, top])
-    ops = shift_operations(pos, [6, 6], [1, 2], A1, A2)
+    bottom = [(0.0, 0.0, 0.0, 6)]
+    top = [(*(LAT @ (1 / 3, 2 / 3)), 1.5, 6)]
+    ops = _ops(_interface(bottom, top))
     clean = _grid_energy(bottom, top)
     assert gates.broken_symmetry(np.array([clean, clean]), [0.0, 1.0], A1, A2, ops) is None
     # a landscape that leans along x at the second load only: every rotation breaks there
@@ -91,8 +166,13 @@ def test_the_symmetry_gate_names_the_broken_operation_and_the_loads():
     broken = clean + 2.0 * np.ptp(clean) * lean
     found = gates.broken_symmetry(np.array([clean, broken]), [0.0, 1.0], A1, A2, ops)
     assert found is not None and found.gate == "broken_symmetry"
-    assert "rotation by 120°" in found.message and "P = 1 GPa" in found.message
+    assert "rotation by" in found.message and "P = 1 GPa" in found.message
+    assert " more" in found.message  # at most four operations named, the count of the rest
     assert "P = 0," not in found.message and "relax_mode: normal" in found.message
+    # one point out of 144 off by a tenth of the range: the max norm sees it
+    spot = clean.copy()
+    spot[5, 2] += 0.1 * np.ptp(clean)
+    assert gates.broken_symmetry(np.array([spot]), [0.0], A1, A2, ops, tolerance=0.05)
 
 
 def _stack(layers_per_slab=3):

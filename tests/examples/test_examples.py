@@ -490,3 +490,23 @@ def test_h_diamond_on_graphene_adhesion_and_registries(tmp_path):
     assert barrier[0] == pytest.approx(barrier[1], rel=0.01)
     table = pd.read_csv(root / "03-analyze" / "friction.csv")
     assert (table.tau_mpa > 0).all() and (table.tau_mpa < 1000).all()
+    # the example's enthalpy form: a cobblestone contact (the H rides up over the saddle), so
+    # dτ/dP = π Δz*/a of the sinusoidal barrier, Δz* the saddle's gap above the minimum's
+    # (docs/analysis.md); measured 151 against 145-152 MPa/GPa. No gate fires.
+    summary = json.loads((root / "06-contact" / "summary.json").read_text())
+    assert summary["gates"]["fired"] == []
+    import xarray as xr
+
+    from flatcontact.analysis.periodic import PeriodicSurface
+
+    with xr.open_dataset(root / "03-analyze" / "friction.nc", engine="h5netcdf") as fr:
+        kinds = list(fr["stacking_kind"].values)
+        m, sp = kinds.index("minimum"), kinds.index("saddle")
+        dz = []
+        for i in range(fr.sizes["p_gpa"]):
+            gap = PeriodicSurface(fr["thickness_at_p"].values[i], fr.attrs["a1"], fr.attrs["a2"])
+            xy = np.stack([fr["stacking_x"].values[i], fr["stacking_y"].values[i]], -1)
+            dz.append(float(gap(xy[sp]) - gap(xy[m])))
+    laws = json.loads((root / "04-laws" / "laws.json").read_text())
+    assert laws["energy_form"] == "enthalpy"
+    assert laws["k_mpa_per_gpa"] == pytest.approx(1000 * np.pi * np.mean(dz) / a, rel=0.05)

@@ -16,16 +16,21 @@ from pathlib import Path
 import numpy as np
 
 from flatcontact.errors import InputError
+from flatcontact.ispes.shift_symmetry import DEFAULT_TOLERANCE_ANGSTROM
 
 
 @dataclass(frozen=True)
 class GateInputs:
-    """The files the gates read (any may be None: that gate is not checked)."""
+    """The files the gates read (any may be None: that gate is not checked), and how the
+    scan defines the interface's shift-space group (its structural tolerance, Å, and whether
+    it spread the compression over the stack: false in ``rigid`` mode)."""
 
     interface: Path | None = None
     scan_json: Path | None = None
     friction_nc: Path | None = None
     laws_json: Path | None = None
+    symmetry_tolerance_angstrom: float = DEFAULT_TOLERANCE_ANGSTROM
+    spread_compression: bool = True
 
 
 def evaluate_gates(inputs: GateInputs):
@@ -53,7 +58,7 @@ def evaluate_gates(inputs: GateInputs):
     if friction is None:
         not_checked += ["broken_symmetry", "degenerate_minima"]
     else:
-        findings += _landscape_gates(inputs.interface, friction, not_checked)
+        findings += _landscape_gates(inputs, friction, not_checked)
     kept = [f for f in findings if f is not None]
     kept.sort(key=lambda f: gates.GATES.index(f.gate))
     return gates.GateReport(kept, notes, not_checked)
@@ -74,8 +79,26 @@ def _read_friction(path: Path | None):
         return ds.load()
 
 
-def _landscape_gates(interface: Path | None, ds, not_checked: list[str]) -> list:
+def shift_group_operations(inputs: GateInputs) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The interface's shift-space group as plain ``(M, t)`` (fractional basis, a slab swap's
+    sign inside ``M``), found on ``inputs.interface`` the way the scan finds it
+    (:func:`flatcontact.ispes.shift_symmetry.shift_space_group`), every operation, not only
+    those that map the grid onto itself."""
+    from flatcontact.ispes.shift_symmetry import shift_space_group
+    from flatcontact.structures.interface_io import read_interface
+
+    group = shift_space_group(
+        read_interface(inputs.interface),
+        inputs.symmetry_tolerance_angstrom,
+        spread_compression=inputs.spread_compression,
+    )
+    return [(np.array(op.matrix, int), np.array(op.translation, float)) for op in group.operations]
+
+
+def _landscape_gates(inputs: GateInputs, ds, not_checked: list[str]) -> list:
     from flatcontact.analysis import gates
+
+    interface = inputs.interface
 
     a1, a2 = np.asarray(ds.attrs["a1"], float), np.asarray(ds.attrs["a2"], float)
     p = [float(v) for v in ds["p_gpa"].values]
@@ -84,12 +107,7 @@ def _landscape_gates(interface: Path | None, ds, not_checked: list[str]) -> list
     if interface is None or not Path(interface).is_file():
         not_checked.append("broken_symmetry")
     else:
-        from flatcontact.analysis.shift_symmetry import shift_operations
-        from flatcontact.structures.interface_io import read_interface
-
-        atoms = read_interface(interface)
-        ops = shift_operations(atoms.positions, atoms.numbers, atoms.arrays["slab"], a1, a2)
-        out.append(gates.broken_symmetry(maps, p, a1, a2, ops))
+        out.append(gates.broken_symmetry(maps, p, a1, a2, shift_group_operations(inputs)))
     start_xy = np.stack([ds["start_x"].values, ds["start_y"].values], axis=-1)
     out.append(
         gates.degenerate_minima(
