@@ -256,6 +256,26 @@ def test_a_slope_is_gated_only_when_its_whole_interval_is_negative():
     assert gates.negative_slope(old).message.startswith("significantly negative")
 
 
+
+def test_a_significant_but_immaterial_negative_slope_is_used_with_a_note():
+    """Cu(111) EAM, internal form (measured): μ = −0.486 (−0.535 .. −0.438) MPa/GPa against
+    σ0 = 1100 MPa falls 0.066 % over 0–1.5 GPa: used, with a note. The H-diamond/graphene
+    example's k = −3.66 (−4.27 .. −3.05) against τ0 = 295 MPa falls 1.9 %: gated."""
+    cu = _laws(2.0, 1.0, 3.0, mu=-0.486)
+    cu["intervals"]["mu_mpa_per_gpa"] = {"value": -0.486, "low": -0.535, "high": -0.438}
+    cu.update(p_max_gpa=1.5, tau0_mpa=3785.0, sigma0_mpa=1100.07)
+    assert gates.negative_slope(cu) is None
+    (note,) = gates.negative_slope_notes(cu)
+    assert "significantly negative" in note and "0.066 %" in note and "used as fitted" in note
+    diamond = _laws(-3.66, -4.27, -3.05)
+    diamond.update(p_max_gpa=1.5, tau0_mpa=294.8, sigma0_mpa=92.5)
+    found = gates.negative_slope(diamond)
+    assert found.gate == "negative_slope" and "τ falls 1.9 %" in found.message
+    assert gates.negative_slope_notes(diamond) == []
+    # the threshold is on the fall, not on the slope: the same slope under a small intercept
+    small = dict(cu, sigma0_mpa=20.0)
+    assert gates.negative_slope(small).gate == "negative_slope"
+
 def _two_site_map(depth_a, depth_b, n=16):
     """A square-lattice landscape with minima at (0.25, 0.25) and (0.75, 0.6) (fractions)."""
     s = np.arange(n) / n
