@@ -318,14 +318,13 @@ def constraint_projector(fixed: np.ndarray, mode: str, groups: list[np.ndarray])
             return out
 
         return project
-    lateral = mode == "normal"
+    # the components kept, as a mask broadcast over (n, 3): one pass per call, no copy first
+    keep = ~held[:, None]
+    if mode == "normal":
+        keep = keep & np.array([False, False, True])
 
     def project(v: np.ndarray) -> np.ndarray:
-        out = v.copy()
-        out[held] = 0.0
-        if lateral:
-            out[:, :2] = 0.0
-        return out
+        return np.where(keep, v, 0.0)
 
     return project
 

