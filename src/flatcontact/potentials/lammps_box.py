@@ -196,6 +196,16 @@ class LammpsBox:
             np.subtract(box, p, out=offsets)
         current[...] = box
 
+    def vectors_to_lammps(self, v: np.ndarray) -> np.ndarray:
+        """Per-atom vectors (or positions, unwrapped) from the caller's frame to LAMMPS's
+        (slab frame: the in-plane rotation Q; a new array)."""
+        v = np.array(v, dtype=float)
+        if self.bulk:
+            return self.prism.vector_to_lammps(v)
+        if not self._aligned:
+            v[:, :2] = v[:, :2] @ self.q.T
+        return v
+
     def vectors_to_caller(self, f: np.ndarray) -> np.ndarray:
         """Per-atom vectors (forces) from the LAMMPS frame back to the caller's."""
         f = np.asarray(f, dtype=float)

@@ -30,6 +30,9 @@ Threads: ``threads=N`` (> 1) loads LAMMPS's OPENMP package (``package omp N`` an
 from __future__ import annotations
 
 import ctypes
+import os
+import re
+import tempfile
 from dataclasses import dataclass
 
 import numpy as np
@@ -191,7 +194,10 @@ class LammpsEngine:
                 x[rows] = current
             lmp.command("run 1 pre no post no")
         else:
-            x[rows] = self.box.to_lammps(positions)
+            box = self.box.to_lammps(positions)
+            x[rows] = box
+            if not self.box.bulk:  # the lattice vectors the wrap added (LammpsBox.place)
+                self._offsets[...] = box - self.box.vectors_to_lammps(positions)
             lmp.command("run 0 post no")
             self._ready = True
         energy = float(lmp.get_thermo("pe"))
@@ -201,6 +207,71 @@ class LammpsEngine:
             return energy, forces
         p = [self.lmp.get_thermo(k) for k in ("pxx", "pyy", "pzz", "pyz", "pxz", "pxy")]
         return energy, forces, self.box.stress_to_caller(p)
+
+    def minimize(
+        self,
+        positions: np.ndarray,
+        held: np.ndarray,
+        fmax: float,
+        max_iterations: int,
+    ) -> tuple[np.ndarray, float, np.ndarray, int, int]:
+        """Relax ``positions`` (Å) with LAMMPS's own ``minimize`` (``min_style cg``).
+
+        ``held`` (n, 3, bool) marks the components that stay fixed: whole atoms (``fix
+        setforce 0 0 0``) or x and y only (``setforce 0 0 NULL``, the ``normal`` mode). The
+        tolerance is the scan's: ``min_modify norm max`` stops when the largest per-atom force
+        norm is below ``fmax`` (eV/Å; energy tolerance 0), or after ``max_iterations``
+        iterations (10× as many evaluations). The fixes are removed afterwards and the final
+        structure is evaluated once more without them (raw forces for the load: the held
+        atoms' reaction), so the next call runs the full setup.
+
+        Returns
+        -------
+        positions, energy_ev, forces, iterations, evaluations
+            Positions at the images nearest the input (caller's frame), energy and raw forces
+            at them, LAMMPS's iterations and force evaluations plus the final one.
+        """
+        if self.box.bulk:
+            raise InputError("LAMMPS minimize: only for slab/interface cells, not 3D-periodic ones")
+        held = np.asarray(held, dtype=bool).reshape(self.n, 3)
+        xy_only = held[:, 0] & held[:, 1] & ~held[:, 2]
+        if (held.any(axis=1) & ~held.all(axis=1) & ~xy_only).any():
+            raise InputError("LAMMPS minimize: held components must be whole atoms or x and y")
+        whole = np.flatnonzero(held.all(axis=1)) + 1
+        lateral = np.flatnonzero(xy_only) + 1
+        self.compute(positions)  # the start in LAMMPS's arrays (full setup on a first call)
+        lmp = self.lmp
+        fixes = []
+        for name, ids, values in (
+            ("fc_held", whole, "0.0 0.0 0.0"),
+            ("fc_lateral", lateral, "0.0 0.0 NULL"),
+        ):
+            if len(ids):
+                lmp.command(f"group {name} id " + " ".join(map(str, ids)))
+                lmp.command(f"fix {name} {name} setforce {values}")
+                fixes.append(name)
+        with tempfile.TemporaryDirectory() as tmp:
+            log = os.path.join(tmp, "minimize.log")
+            try:
+                lmp.commands_list(["min_style cg", "min_modify norm max", f"log {log}"])
+                lmp.command(f"minimize 0 {fmax!r} {int(max_iterations)} {10 * int(max_iterations)}")
+            finally:
+                lmp.command("log none")
+                for name in fixes:
+                    lmp.commands_list([f"unfix {name}", f"group {name} delete"])
+                self._ready = False  # fixes changed: the next evaluation runs the full setup
+            with open(log) as fh:
+                found = re.search(r"Iterations, force evaluations = (\d+) (\d+)", fh.read())
+        if found is None:  # pragma: no cover - a guard
+            raise RuntimeError("LAMMPS minimize: no iteration count in its log")
+        iterations, evaluations = int(found.group(1)), int(found.group(2))
+        rows, x, _ = self._views()
+        start = self.box.vectors_to_lammps(positions)
+        out = self.box.vectors_to_caller(self.box.nearest_images(np.array(x[rows]), start))
+        # held components exactly where they were (the image shifts above are round-off off)
+        out = np.where(held, np.asarray(positions, dtype=float), out)
+        energy, forces = self.compute(out)
+        return out, energy, forces, iterations, evaluations + 1
 
     def close(self) -> None:
         lmp = getattr(self, "lmp", None)
