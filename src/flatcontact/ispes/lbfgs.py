@@ -58,6 +58,8 @@ the measurements behind it are in its docstring and ``docs/performance.md``.
 from __future__ import annotations
 
 import dataclasses
+import functools
+import inspect
 from collections.abc import Callable
 
 import numpy as np
@@ -339,7 +341,9 @@ def lbfgs_relax(
     project
         The constraint projector P: (n, 3) -> (n, 3), linear, applied to the forces and to
         every step (held atoms get zero, constrained directions are removed); returns a
-        new array.
+        new array, or, if it takes an ``out`` argument, writes into ``out`` (two arrays
+        reused for forces and steps, zero at first: ``out`` must keep those zeros where P
+        keeps nothing) and returns it.
     fmax
         Converged when the largest per-atom norm of P(F) is below ``fmax`` (eV/Å).
     max_steps
@@ -358,7 +362,13 @@ def lbfgs_relax(
     shape = x.shape
     energy, forces = evaluate(x)
     calls = 1
-    f = project(forces)
+    if "out" in inspect.signature(project).parameters:  # projects into reused zeroed arrays
+        f_buf, step_buf = np.zeros(shape), np.zeros(shape)
+        project_force = functools.partial(project, out=f_buf)
+        project_step = functools.partial(project, out=step_buf)
+    else:
+        project_force = project_step = project
+    f = project_force(forces)
     steps = 0
     converged = largest_atomic_norm(f) < fmax
     if converged or max_steps < 1:
@@ -387,11 +397,11 @@ def lbfgs_relax(
         if damping != 1.0:
             dr *= damping
         x, x_prev = x_prev, x
-        np.add(x_prev, project(dr), out=x)
+        np.add(x_prev, project_step(dr), out=x)
         g, g_prev = g_prev, g
         steps += 1
         energy, forces = evaluate(x)
         calls += 1
-        f = project(forces)
+        f = project_force(forces)
         converged = largest_atomic_norm(f) < fmax
     return LbfgsOutcome(x, float(energy), forces, steps, calls, bool(converged))

@@ -326,7 +326,8 @@ def constraint_projector(fixed: np.ndarray, mode: str, groups: list[np.ndarray])
     its layer's mean (the generalised force on the layer's height per atom). These are the
     forces ASE's ``FixAtoms``, ``FixCartesian`` and
     :class:`~flatcontact.ispes.rigid_layers.RigidLayersAlongZ` return, and the
-    steps their ``adjust_positions`` allow.
+    steps their ``adjust_positions`` allow. ``full`` and ``normal`` also take ``out=``: an
+    array, zero where nothing is kept, written in place (:func:`lbfgs_relax`'s buffers).
     """
     held = np.asarray(fixed, dtype=bool)
     if mode == "rigid-layers":
@@ -343,9 +344,14 @@ def constraint_projector(fixed: np.ndarray, mode: str, groups: list[np.ndarray])
     keep = ~held[:, None]
     if mode == "normal":
         keep = keep & np.array([False, False, True])
+    keep = np.broadcast_to(keep, (len(held), 3))
 
-    def project(v: np.ndarray) -> np.ndarray:
-        return np.where(keep, v, 0.0)
+    def project(v: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        if out is None:
+            return np.where(keep, v, 0.0)
+        # ``out`` (reused by lbfgs_relax) keeps the zeros it was given where nothing is kept
+        np.copyto(out, v, where=keep)
+        return out
 
     return project
 

@@ -77,6 +77,7 @@ class LammpsBox:
 
     def __init__(self, cell, pbc):
         cell = np.asarray(cell, dtype=float)
+        self._scratch = None  # (box, difference) arrays of place()
         self.pbc = tuple(bool(p) for p in pbc)
         self.bulk = all(self.pbc)
         if self.bulk:
@@ -188,8 +189,13 @@ class LammpsBox:
         if not self._aligned:
             p = p.copy()
             p[:, :2] = positions[:, :2] @ self.q.T
-        box = p + offsets
-        d = current - box
+        # two scratch arrays kept between calls: a fresh (n, 3) array per call costs more than
+        # the arithmetic on a large cell (the allocator returns and re-faults its pages)
+        if self._scratch is None or self._scratch[0].shape != p.shape:
+            self._scratch = (np.empty(p.shape), np.empty(p.shape))
+        box, d = self._scratch
+        np.add(p, offsets, out=box)
+        np.subtract(current, box, out=d)
         lx, ly, lz = self._lattice[:3]
         if max(d.max(), -d.min()) >= 0.25 * min(lx, ly, lz or np.inf):  # an atom crossed
             box = self.nearest_images(box, current)
