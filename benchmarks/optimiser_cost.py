@@ -11,7 +11,9 @@ of one of the scan's calls), their ratios, and the L-BFGS memory the rule chose;
 algebra timed in isolation (:func:`algebra_ms`); and the same point relaxed by LAMMPS's own
 ``minimize`` (cg, the same max-norm tolerance, :func:`benchmarks.large_cells.lammps_minimize`):
 its force evaluations and CPU seconds against the scan's. System names
-as arguments run those only (``python -m benchmarks.optimiser_cost cu quartz``). With
+as arguments run those only (``python -m benchmarks.optimiser_cost cu quartz``), ``system:repeat``
+one size (``graphene:11``: REBO+KC costs ≈ 0.2 s per call at 1,452 atoms, the larger
+graphene cells take tens of minutes on the shared machine). With
 ``--write-docs`` it replaces the table between the markers in ``docs/performance.md``.
 
 CPU times on a shared machine are upper bounds; the ratio is taken within one process.
@@ -87,10 +89,11 @@ def table(rows: list[dict]) -> str:
 
 
 def main(argv: list[str]) -> None:
-    only = [a for a in argv if not a.startswith("--")]  # e.g. "cu quartz": those systems only
+    # e.g. "cu quartz": those systems only; "graphene:11": that lateral repeat only
+    only = [a for a in argv if not a.startswith("--")]
     rows = []
     for system, n in CASES:
-        if only and system not in only:
+        if only and system not in only and f"{system}:{n}" not in only:
             continue
         r = run(system, n)
         rows.append(r)
