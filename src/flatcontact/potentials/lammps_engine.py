@@ -239,7 +239,8 @@ class LammpsEngine:
             raise InputError("LAMMPS minimize: held components must be whole atoms or x and y")
         whole = np.flatnonzero(held.all(axis=1)) + 1
         lateral = np.flatnonzero(xy_only) + 1
-        self.compute(positions)  # the start in LAMMPS's arrays (full setup on a first call)
+        rows, x, _ = self._views()
+        x[rows] = self.box.to_lammps(positions)  # the start, wrapped: minimize's setup takes it
         lmp = self.lmp
         fixes = []
         for name, ids, values in (
