@@ -91,6 +91,13 @@ def one_point(system: str, n: int, threads: int) -> dict:
     t1 = time.process_time()
     lmp.command(f"run {calls} pre no post no")
     per_call_lammps = (time.process_time() - t1) / calls  # CPU time: the machine is shared
+    # the same with the energy on every step (``thermo 1``), as each of the scan's calls has it
+    # (``run N`` with ``thermo 0`` tallies the energy on its last step only)
+    lmp.command("thermo 1")
+    t1 = time.process_time()
+    lmp.command(f"run {calls} pre no post no")
+    per_call_lammps_energy = (time.process_time() - t1) / calls
+    cg = lammps_minimize(ref, model, task, calc)
     return {
         "system": system,
         "atoms": len(ref),
@@ -102,12 +109,58 @@ def one_point(system: str, n: int, threads: int) -> dict:
         "ms_per_call": 1e3 * wall / r.force_calls,
         "cpu_ms_per_call": 1e3 * cpu / r.force_calls,
         "ms_per_call_lammps": 1e3 * per_call_lammps,
+        "ms_per_call_lammps_energy": 1e3 * per_call_lammps_energy,
+        "cg_force_calls": cg["force_calls"],
+        "cg_cpu_seconds_point": cg["cpu_seconds"],
+        "cg_energy_ev": cg["energy_ev"],
         "build_s": t_build,
         "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
         "rss_start_mb": rss0 / 1024,
         "energy_ev": r.energy_ev,
         "load": os.getloadavg()[0],
     }
+
+
+def lammps_minimize(ref, model, task, calc) -> dict:
+    """The same point relaxed by LAMMPS's own minimiser from the same start: ``min_style cg``,
+    ``min_modify norm max`` (the largest per-atom force norm, the scan's criterion), ``fix
+    setforce`` on the held atoms, ``minimize 0 FMAX``; its force evaluations (from LAMMPS's
+    log), CPU seconds and final energy."""
+    import re
+    import tempfile
+
+    import numpy as np
+
+    from flatcontact.ispes.geometry import fixed_mask, place_slab2
+    from flatcontact.potentials.calculator import LammpsInterfaceCalculator
+
+    placed = place_slab2(ref, task.shift_a, task.shift_b, task.thickness)
+    held = np.flatnonzero(fixed_mask(placed)) + 1
+    calc = LammpsInterfaceCalculator(model, ref)
+    engine = calc.engine
+    engine.compute(placed.positions)
+    lmp = engine.lmp
+    with tempfile.TemporaryDirectory() as tmp:
+        log = f"{tmp}/min.log"
+        lmp.commands_list(
+            [
+                "group held id " + " ".join(map(str, held)),
+                "fix hold held setforce 0.0 0.0 0.0",
+                "min_style cg",
+                "min_modify norm max",
+                "thermo 0",
+                f"log {log}",
+            ]
+        )
+        t0 = time.process_time()
+        lmp.command(f"minimize 0 {FMAX} 100000 1000000")
+        cpu = time.process_time() - t0
+        lmp.command("log none")
+        text = open(log).read()
+    evals = int(re.search(r"Iterations, force evaluations = \d+ (\d+)", text).group(1))
+    energy = float(lmp.get_thermo("pe"))
+    engine.close()
+    return {"force_calls": evals, "cpu_seconds": cpu, "energy_ev": energy}
 
 
 def run(system: str, n: int, threads: int = 1) -> dict:

@@ -5,9 +5,15 @@ in its own process (:func:`benchmarks.large_cells.run`): the 36-atom quartz cell
 Cu(111) bicrystal (``cu-eam``) at 1,536, 4,704 and 20,184 atoms and AB bilayer graphene
 (``graphene-rebo-kc``, three sheets per slab) at 1,452, 4,800 and 20,172 atoms. It prints,
 per row, the force calls of the point, the CPU ms per call of the scan and of LAMMPS alone
-(``run N pre no post no`` on the relaxed cell), their ratio, and the L-BFGS memory the
-rule chose; then the per-step algebra timed in isolation (:func:`algebra_ms`). System names
-as arguments run those only (``python -m benchmarks.optimiser_cost cu quartz``). With
+(``run N pre no post no`` on the relaxed cell: with ``thermo 0`` LAMMPS tallies the energy on
+the last step only, so it is given also with the energy on every step, ``thermo 1``, the work
+of one of the scan's calls), their ratios, and the L-BFGS memory the rule chose; the per-step
+algebra timed in isolation (:func:`algebra_ms`); and the same point relaxed by LAMMPS's own
+``minimize`` (cg, the same max-norm tolerance, :func:`benchmarks.large_cells.lammps_minimize`):
+its force evaluations and CPU seconds against the scan's. System names
+as arguments run those only (``python -m benchmarks.optimiser_cost cu quartz``), ``system:repeat``
+one size (``graphene:11``: REBO+KC costs ≈ 0.2 s per call at 1,452 atoms, the larger
+graphene cells take tens of minutes on the shared machine). With
 ``--write-docs`` it replaces the table between the markers in ``docs/performance.md``.
 
 CPU times on a shared machine are upper bounds; the ratio is taken within one process.
@@ -65,32 +71,39 @@ def table(rows: list[dict]) -> str:
 
     lines = [
         "| system | atoms | L-BFGS memory | force calls | scan CPU ms/call | LAMMPS alone ms/call "
-        "| ratio | algebra ms/step (isolated) |",
-        "|---|---|---|---|---|---|---|---|",
+        "(forces; energy too) | ratio (forces; energy too) | algebra ms/step (isolated) "
+        "| LAMMPS `minimize` cg: calls | CPU s/point: scan, LAMMPS cg |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         m = memory_for(3 * r["atoms"])
+        scan = r["cpu_ms_per_call"]
+        alone, alone_e = r["ms_per_call_lammps"], r["ms_per_call_lammps_energy"]
         lines.append(
-            f"| {r['system']} | {r['atoms']:,} | {m} | {r['force_calls']} | "
-            f"{r['cpu_ms_per_call']:.2f} | {r['ms_per_call_lammps']:.2f} | "
-            f"{r['cpu_ms_per_call'] / r['ms_per_call_lammps']:.2f} | "
-            f"{algebra_ms(3 * r['atoms'], m):.3f} |"
+            f"| {r['system']} | {r['atoms']:,} | {m} | {r['force_calls']} | {scan:.2f} | "
+            f"{alone:.2f}; {alone_e:.2f} | {scan / alone:.2f}; {scan / alone_e:.2f} | "
+            f"{algebra_ms(3 * r['atoms'], m):.3f} | {r['cg_force_calls']} | "
+            f"{r['cpu_seconds_point']:.3f}, {r['cg_cpu_seconds_point']:.3f} |"
         )
     return "\n".join(lines)
 
 
 def main(argv: list[str]) -> None:
-    only = [a for a in argv if not a.startswith("--")]  # e.g. "cu quartz": those systems only
+    # e.g. "cu quartz": those systems only; "graphene:11": that lateral repeat only
+    only = [a for a in argv if not a.startswith("--")]
     rows = []
     for system, n in CASES:
-        if only and system not in only:
+        if only and system not in only and f"{system}:{n}" not in only:
             continue
         r = run(system, n)
         rows.append(r)
         print(
             f"{system:9s} {r['atoms']:6d} atoms: {r['force_calls']:4d} calls, scan "
             f"{r['cpu_ms_per_call']:.2f} ms/call, LAMMPS alone {r['ms_per_call_lammps']:.2f}, "
-            f"ratio {r['cpu_ms_per_call'] / r['ms_per_call_lammps']:.2f} (load {r['load']:.1f})",
+            f"ratio {r['cpu_ms_per_call'] / r['ms_per_call_lammps']:.2f} "
+            f"(energy each call: {r['ms_per_call_lammps_energy']:.2f}), LAMMPS cg "
+            f"{r['cg_force_calls']} calls {r['cg_cpu_seconds_point']:.3f} s vs scan "
+            f"{r['cpu_seconds_point']:.3f} s (load {r['load']:.1f})",
             flush=True,
         )
     text = table(rows)

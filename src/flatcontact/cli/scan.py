@@ -172,7 +172,7 @@ def scan_command(
         str | None,
         typer.Option(
             "--optimizer",
-            help="scan.optimizer: LBFGS (default), BFGS, FIRE, FIRE2, BFGSLineSearch.",
+            help="scan.optimizer: LBFGS (default), BFGS, FIRE, FIRE2, BFGSLineSearch, lammps-cg (LAMMPS models).",
         ),
     ] = None,
     max_steps: Annotated[

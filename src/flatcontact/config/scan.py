@@ -16,8 +16,9 @@ from flatcontact.config.messages import show
 from flatcontact.config.numbers import physical
 from flatcontact.config.section import Section, positive_pair
 
-#: ASE optimisers a scan point may use (:data:`flatcontact.ispes.relax.OPTIMIZERS`).
-OPTIMIZERS: tuple[str, ...] = ("FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch")
+#: Optimisers a scan point may use (:data:`flatcontact.ispes.relax.OPTIMIZERS`): ASE's, and
+#: ``lammps-cg`` (LAMMPS's own minimiser, LAMMPS models only).
+OPTIMIZERS: tuple[str, ...] = ("FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch", "lammps-cg")
 #: The default optimiser (:class:`flatcontact.ispes.relax.RelaxSettings`' default).
 DEFAULT_OPTIMIZER = "LBFGS"
 #: Warm-start orders of the scan (:data:`flatcontact.ispes.order.PREFERENCES`).
@@ -91,7 +92,7 @@ class ScanConfig(Section):
     )
     optimizer: str = Field(
         DEFAULT_OPTIMIZER,
-        description="ASE optimiser of each point: " + ", ".join(OPTIMIZERS),
+        description="Optimiser of each point: " + ", ".join(OPTIMIZERS),
     )
     max_steps: int = Field(2000, ge=1, description="optimiser step cap per point")
     relax_mode: Literal["full", "normal", "rigid-layers", "rigid"] = Field(

@@ -22,14 +22,18 @@ zeroed; see :mod:`flatcontact.ispes.relax`) and gradient g = -f:
 4. step dr = p, scaled by ``maxstep``/max_i |p_i| if the longest atomic step exceeds
    ``maxstep`` (Å), times ``damping``; x ← x + P(dr).
 
-The recursion as triangular solves
-----------------------------------
-The first loop (i = k-1 … 0) a_i = ρ_i s_i·(g - Σ_{j>i} a_j y_j) is the unit upper
-triangular system (I + diag(ρ) U) a = ρ ∘ (S g), U_ij = s_i·y_j for j > i; the second loop
-(i = 0 … k-1) c_i = a_i - ρ_i y_i·(z0 + Σ_{j<i} c_j s_j), z0 = (g - Yᵀa)/α, is the unit lower
-triangular system (I + diag(ρ) L) c = a - ρ ∘ (Y z0), L_ij = y_i·s_j for j < i; then
-H g = z0 + Sᵀc. Back and forward substitution perform the loops' own operations in the
-loops' order; only the sums inside each dot product are associated differently (round-off).
+The recursion as triangular products
+------------------------------------
+The first loop (i = k-1 … 0) a_i = ρ_i s_i·(g - Σ_{j>i} a_j y_j) is the upper triangular
+system R a = S g with R = triu(S Yᵀ), R_ij = s_i·y_j for j ≥ i (R_ii = 1/ρ_i); the second
+loop (i = 0 … k-1) c_i = a_i - ρ_i y_i·(z0 + Σ_{j<i} c_j s_j), z0 = (g - Yᵀa)/α, is the lower
+triangular system Rᵀ c = a/ρ - Y z0; then H g = z0 + Sᵀc (the compact form of Byrd,
+Nocedal & Schnabel, Math. Prog. 63, 129 (1994), eq. 3.1, with the same R). The memory keeps
+R⁻¹ up to date at O(k²) per pair (a new pair appends a column, the dropped oldest pair
+removes the first row and column: both keep it triangular, :meth:`TwoLoopMemory._store`),
+so each system is one k×k matrix-vector product where a general LU solve cost O(k³)
+(≈ 0.2 ms per step at k = 100, on any cell). Only the sums are associated differently from
+the loops (round-off: ``tests/ispes/test_lbfgs.py`` compares with the loops to 1e-12).
 
 Four matrix-vector products per step
 ------------------------------------
@@ -54,6 +58,8 @@ the measurements behind it are in its docstring and ``docs/performance.md``.
 from __future__ import annotations
 
 import dataclasses
+import functools
+import inspect
 from collections.abc import Callable
 
 import numpy as np
@@ -104,13 +110,14 @@ class LbfgsOutcome:
 
 
 class TwoLoopMemory:
-    """The L-BFGS memory (s, y, ρ) in a ring buffer, and H·g by two triangular solves.
+    """The L-BFGS memory (s, y, ρ) in a ring buffer, and H·g by two triangular products.
 
-    The long vectors live in two preallocated (memory, n) arrays S and Y; beside them the
-    memory keeps the k×k products S Yᵀ (s_i·y_j) and Y Yᵀ (y_i·y_j), and from the last
-    direction d = H g the k-vectors S g, Y g and Y d. A step of :func:`lbfgs_relax` (:meth:`push`)
-    then reads S and Y twice, in four matrix-vector products (module docstring, "Four
-    matrix-vector products per step").
+    The long vectors live in two preallocated (memory, n) arrays S and Y (ring order);
+    beside them, in chronological order, the memory keeps the k×k products S Yᵀ (s_i·y_j),
+    Y Yᵀ (y_i·y_j) and the inverse R⁻¹ of R = triu(S Yᵀ) (module docstring, "The recursion
+    as triangular products"), and from the last direction d = H g the k-vectors S g, Y g and
+    Y d. A step of :func:`lbfgs_relax` (:meth:`push_stored`) then reads S and Y twice, in
+    four matrix-vector products (module docstring, "Four matrix-vector products per step").
 
     Parameters
     ----------
@@ -125,16 +132,19 @@ class TwoLoopMemory:
     def __init__(self, n: int, memory: int = ASE_MEMORY, alpha: float = ASE_ALPHA_EV_PER_A2):
         if memory < 1:
             raise ValueError(f"memory: expected at least one stored pair, got {memory}")
-        self.memory = int(memory)
+        self.memory = m = int(memory)
         self.h0 = 1.0 / float(alpha)
-        self.s = np.zeros((self.memory, n))
-        self.y = np.zeros((self.memory, n))
-        self.rho = np.zeros(self.memory)
-        self.sy = np.zeros((self.memory, self.memory))  # sy[i, j] = s_i · y_j (slots)
-        self.yy = np.zeros((self.memory, self.memory))  # yy[i, j] = y_i · y_j (slots)
+        self.s = np.zeros((m, n))  # ring order: pair number p lives in slot p % memory
+        self.y = np.zeros((m, n))
+        # chronological (oldest first), the top-left size × size block in use
+        self.rho = np.zeros(m)
+        self.sy = np.zeros((m, m))  # sy[i, j] = s_i · y_j
+        self.yy = np.zeros((m, m))  # yy[i, j] = y_i · y_j
+        self.r_inv = np.zeros((m, m))  # R⁻¹, R = triu(sy) (diagonal included)
         self.count = 0  # pairs stored so far (all time)
-        # s_i·g, y_i·g and y_i·d (slots) of the last direction d = H g; None before the first
+        # s_i·g, y_i·g and y_i·d (chronological) of the last direction d = H g; None before it
         self._last: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._weights = np.zeros((2, m))
         self._tmp = np.empty(n)
 
     @property
@@ -142,32 +152,44 @@ class TwoLoopMemory:
         """Pairs currently held."""
         return min(self.count, self.memory)
 
-    def _slots(self) -> np.ndarray:
-        """Slots of the held pairs, oldest first."""
-        k = self.size
-        return (np.arange(self.count - k, self.count)) % self.memory
+    def _slots(self, count: int | None = None) -> np.ndarray:
+        """Slots of the pairs held when ``count`` pairs were stored, oldest first."""
+        count = self.count if count is None else count
+        k = min(count, self.memory)
+        return np.arange(count - k, count) % self.memory
 
-    def _store(
-        self, s: np.ndarray, y: np.ndarray, ys: np.ndarray, sy: np.ndarray, yy: np.ndarray
-    ) -> int:
-        """Write the pair into its slot given, for the k pairs held before it (slot order),
-        ys[i] = y_i·s, sy[i] = s_i·y and yy[i] = y_i·y; returns the slot."""
-        k = self.size
+    def next_pair(self) -> tuple[np.ndarray, np.ndarray]:
+        """Views (s, y) of the slot the next pair goes to, for :meth:`push_stored` (the
+        caller writes the pair there: no copy). The slot may hold the oldest pair still."""
         slot = self.count % self.memory
-        # a slot being overwritten gets its row and column replaced below
-        self.sy[slot, :k] = ys
-        self.sy[:k, slot] = sy
-        self.yy[slot, :k] = yy
-        self.yy[:k, slot] = yy
-        self.s[slot] = s
-        self.y[slot] = y
-        own = np.dot(y, s)
-        self.rho[slot] = 1.0 / own
-        self.sy[slot, slot] = own
-        self.yy[slot, slot] = np.dot(y, y)
+        return self.s[slot], self.y[slot]
+
+    def _store(self, ys: np.ndarray, sy: np.ndarray, yy: np.ndarray, own_sy: float, own_yy: float):
+        """Append the pair just written to :meth:`next_pair` to the chronological k×k products
+        given, for the k pairs held before it (oldest first), ys[i] = y_i·s, sy[i] = s_i·y and
+        yy[i] = y_i·y, and s·y, y·y. A full memory drops its oldest pair first: the trailing
+        block of a triangular matrix's inverse is the inverse of its trailing block, so R⁻¹
+        keeps its lower-right part; the new column of R⁻¹ is -R⁻¹ (S y)/(s·y) (block inverse
+        of [[R, S y], [0, s·y]])."""
+        k = self.size
+        if k == self.memory:
+            for mat in (self.sy, self.yy, self.r_inv):
+                mat[:-1, :-1] = mat[1:, 1:]
+            self.rho[:-1] = self.rho[1:]
+            ys, sy, yy = ys[1:], sy[1:], yy[1:]
+            k -= 1
+        self.sy[k, :k] = ys
+        self.sy[:k, k] = sy
+        self.sy[k, k] = own_sy
+        self.yy[k, :k] = yy
+        self.yy[:k, k] = yy
+        self.yy[k, k] = own_yy
+        self.rho[k] = 1.0 / own_sy
+        self.r_inv[k, :k] = 0.0
+        self.r_inv[:k, k] = self.r_inv[:k, :k] @ sy * (-1.0 / own_sy)
+        self.r_inv[k, k] = 1.0 / own_sy
         self.count += 1
         self._last = None
-        return slot
 
     def add(self, s: np.ndarray, y: np.ndarray) -> None:
         """Store the pair (s, y) with ρ = 1/(y·s), as ASE does (no curvature test).
@@ -175,98 +197,118 @@ class TwoLoopMemory:
         Every product is computed afresh (three matrix-vector products); :meth:`push` is the
         step's cheaper path.
         """
+        s_new, y_new = self.next_pair()
+        s_new[...] = s
+        y_new[...] = y
+        self._add_stored()
+
+    def _add_stored(self) -> None:
+        """:meth:`add` for the pair already written to :meth:`next_pair`. Over a full memory
+        the products with the slot it overwrote belong to the oldest pair, which is dropped."""
+        s, y = self.next_pair()
         k = self.size
-        self._store(s, y, self.y[:k] @ s, self.s[:k] @ y, self.y[:k] @ y)
+        order = self._slots()
+        self._store(
+            (self.y[:k] @ s)[order],
+            (self.s[:k] @ y)[order],
+            (self.y[:k] @ y)[order],
+            float(np.dot(s, y)),
+            float(np.dot(y, y)),
+        )
 
     def push(self, s: np.ndarray, y: np.ndarray, g: np.ndarray, step: float) -> np.ndarray:
         """Store the pair (s, y) and return H·g, as ``add(s, y)`` then
-        ``inverse_hessian_times(g)``, reading the stored vectors twice.
+        ``inverse_hessian_times(g)``, reading the stored vectors twice (:meth:`push_stored`
+        after copying the pair into its slot)."""
+        s_new, y_new = self.next_pair()
+        s_new[...] = s
+        y_new[...] = y
+        return self.push_stored(g, step)
+
+    def push_stored(self, g: np.ndarray, step: float, out: np.ndarray | None = None) -> np.ndarray:
+        """Store the pair already written to :meth:`next_pair` and return H·g.
 
         Valid for the L-BFGS step only: the last call returned d = H g_prev, y = g - g_prev,
         and s = ``step``·P(d) for an orthogonal projector P whose range holds every stored
         vector and g (so y_i·s = ``step`` (Y d)_i). The products with the new pair then follow
         from the saved k-vectors: S y = S g - S g_prev, Y y = Y g - Y g_prev, Y s = step·Y d;
-        the new pair's own products s·y, y·y, s·g, y·g are direct dot products.
-        Without a previous direction it falls back to :meth:`add`.
+        S g and Y g over the slots in use (the new pair's included: s·g and y·g come with
+        them, a slot being overwritten gives a product that is dropped with its pair) and
+        the new pair's s·y, y·y are the only long products. Without a previous direction it
+        falls back to the products computed afresh (:meth:`add`). ``out``: where H·g goes
+        (length n), else a new array.
         """
         if self._last is None:
-            self.add(s, y)
-            return self.inverse_hessian_times(g)
+            self._add_stored()
+            return self.inverse_hessian_times(g, out)
+        s_new, y_new = self.next_pair()
         k = self.size
         sg_prev, yg_prev, yd_prev = self._last
-        sg = np.zeros(self.memory)
-        yg = np.zeros(self.memory)
-        sg[:k] = self.s[:k] @ g
-        yg[:k] = self.y[:k] @ g
-        slot = self._store(s, y, step * yd_prev[:k], sg[:k] - sg_prev[:k], yg[:k] - yg_prev[:k])
-        sg[slot] = np.dot(s, g)
-        yg[slot] = np.dot(y, g)
-        return self._apply(g, sg, yg)
+        used = min(self.count + 1, self.memory)  # slots in use with the new pair
+        sg_slot = self.s[:used] @ g
+        yg_slot = self.y[:used] @ g
+        old = self._slots()  # the k pairs held before (their slots; one may now hold the new)
+        self._store(
+            step * yd_prev[:k],
+            sg_slot[old] - sg_prev[:k],
+            yg_slot[old] - yg_prev[:k],
+            float(np.dot(s_new, y_new)),
+            float(np.dot(y_new, y_new)),
+        )
+        order = self._slots()
+        sg, yg = sg_slot[order], yg_slot[order]
+        return self._apply(g, sg, yg, out)
 
-    def inverse_hessian_times(self, g: np.ndarray) -> np.ndarray:
-        """H·g of the L-BFGS two-loop recursion (module docstring), a new array."""
-        k = self.size
-        sg = np.zeros(self.memory)
-        yg = np.zeros(self.memory)
-        sg[:k] = self.s[:k] @ g
-        yg[:k] = self.y[:k] @ g
-        return self._apply(g, sg, yg)
+    def inverse_hessian_times(self, g: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """H·g of the L-BFGS two-loop recursion (module docstring), in ``out`` or a new array."""
+        order = self._slots()
+        return self._apply(g, self.s[order] @ g, self.y[order] @ g, out)
 
-    def _apply(self, g: np.ndarray, sg: np.ndarray, yg: np.ndarray) -> np.ndarray:
-        """H·g from the products sg[i] = s_i·g, yg[i] = y_i·g (slot order, length ``memory``).
+    def _apply(
+        self, g: np.ndarray, sg: np.ndarray, yg: np.ndarray, out: np.ndarray | None
+    ) -> np.ndarray:
+        """H·g from the chronological products sg[i] = s_i·g, yg[i] = y_i·g.
 
-        The long vectors are used in place (slot order); only the k-vectors and the k×k
-        matrices are put in chronological order, so a wrapped memory on a large cell copies
-        nothing of size n. Saves S g, Y g and Y·(H g) for the next :meth:`push`.
+        The long vectors are used in place (ring order); only k-vectors and k×k matrices
+        are chronological, so a wrapped memory on a large cell copies nothing of size n.
+        Saves S g, Y g and Y·(H g) for the next :meth:`push_stored`.
         """
         k = self.size
+        if out is None:
+            out = np.empty_like(g)
         if k == 0:
-            self._last = (sg, yg, np.zeros(self.memory))
-            return self.h0 * g
-        order = self._slots()  # chronological position -> slot
-        rho = self.rho[order]
-        idx = np.ix_(order, order)
-        a_mat = self.sy[idx]  # a_mat[i, j] = s_i · y_j, oldest first
-        eye = np.eye(k)
-        # first loop: (I + diag(rho) U) a = rho * (S g), U_ij = s_i·y_j for j > i
-        upper = eye + rho[:, None] * np.triu(a_mat, 1)
-        a = unit_upper_solve(upper, rho * sg[order])
+            self._last = (sg, yg, np.zeros(0))
+            return np.multiply(g, self.h0, out=out)
+        r_inv = self.r_inv[:k, :k]
+        # first loop: R a = S g
+        a = r_inv @ sg
         # z0 = (g - Yᵀa)/α is never formed: Y z0 = (Y g - (Y Yᵀ) a)/α
-        yy_a = self.yy[idx] @ a
-        y_z0 = (yg[order] - yy_a) * self.h0
-        # second loop: (I + diag(rho) L) c = a - rho * (Y z0), L_ij = y_i·s_j = a_mat[j, i], j < i;
-        # in reversed order (index k-1-i) that lower system is upper triangular
-        lower = eye + rho[:, None] * np.tril(a_mat.T, -1)
-        c = unit_upper_solve(lower[::-1, ::-1], (a - rho * y_z0)[::-1])[::-1]
+        y_z0 = (yg - self.yy[:k, :k] @ a) * self.h0
+        # second loop: Rᵀ c = diag(R) a - Y z0, i.e. c = R⁻ᵀ (a/ρ - Y z0)
+        c = (a / self.rho[:k] - y_z0) @ r_inv
         # H g = z0 + Sᵀc = g/α + Yᵀ(-a/α) + Sᵀc: the second pass over the stored vectors
-        weights = np.zeros((2, self.memory))
+        order = self._slots()
+        used = min(self.count, self.memory)
+        weights = self._weights[:, :used]
         weights[0, order] = c
         weights[1, order] = -self.h0 * a
-        out = np.dot(weights[0, :k], self.s[:k])
-        out += np.dot(weights[1, :k], self.y[:k], out=self._tmp)
-        out += self.h0 * g
+        np.dot(weights[0], self.s[:used], out=out)
+        out += np.dot(weights[1], self.y[:used], out=self._tmp)
+        out += np.multiply(g, self.h0, out=self._tmp)
         # Y (H g) = Y z0 + (Y Sᵀ) c, for the next pair's products y_i·s
-        yd = np.zeros(self.memory)
-        yd[order] = y_z0 + a_mat.T @ c
-        self._last = (sg, yg, yd)
+        self._last = (sg, yg, y_z0 + c @ self.sy[:k, :k])
         return out
 
 
-def unit_upper_solve(m: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """x with m x = b for a unit upper triangular ``m``: back substitution.
-
-    ``numpy.linalg.solve`` (LAPACK ``gesv``): partial pivoting finds nothing below the unit
-    diagonal to swap and the elimination multipliers are exact zeros, so the LU factors are
-    (I, m) exactly and the solve is back substitution with divisions by 1.
-    """
-    return np.linalg.solve(m, b)
-
-
 def largest_atomic_norm(vectors: np.ndarray) -> float:
-    """max_i |v_i| over atoms of an (n, 3) array (ASE's force and step norm)."""
+    """max_i |v_i| over atoms of an (n, 3) array (ASE's force and step norm).
+
+    The squared norms in one pass without a temporary array (``einsum``), the square root of
+    their maximum only (the root is monotonic and correctly rounded: the same number).
+    """
     if not len(vectors):
         return 0.0
-    return float(np.sqrt(np.add.reduce(vectors * vectors, axis=1)).max())
+    return float(np.sqrt(np.einsum("ij,ij->i", vectors, vectors).max()))
 
 
 def lbfgs_relax(
@@ -282,16 +324,26 @@ def lbfgs_relax(
 ) -> LbfgsOutcome:
     """Relax ``positions`` with ASE's L-BFGS iteration, one ``evaluate`` per step.
 
+    The long vectors of a step (positions, gradients, the direction, the pair s, y) live in
+    buffers allocated once: s and y are written straight into the memory's next slot
+    (:meth:`TwoLoopMemory.next_pair`), the direction into a reused array, and the positions
+    and gradients alternate between two arrays each.
+
     Parameters
     ----------
     evaluate
         ``evaluate(positions) -> (energy_ev, forces)``, positions and forces (n, 3) in Å
-        and eV/Å; called exactly once per visited structure.
+        and eV/Å; called exactly once per visited structure. The positions array is reused
+        two steps later: ``evaluate`` must copy what it keeps (the forces it returns are
+        not modified).
     positions
         Start (n, 3), Å; not modified.
     project
         The constraint projector P: (n, 3) -> (n, 3), linear, applied to the forces and to
-        every step (held atoms get zero, constrained directions are removed).
+        every step (held atoms get zero, constrained directions are removed); returns a
+        new array, or, if it takes an ``out`` argument, writes into ``out`` (two arrays
+        reused for forces and steps, zero at first: ``out`` must keep those zeros where P
+        keeps nothing) and returns it.
     fmax
         Converged when the largest per-atom norm of P(F) is below ``fmax`` (eV/Å).
     max_steps
@@ -310,30 +362,46 @@ def lbfgs_relax(
     shape = x.shape
     energy, forces = evaluate(x)
     calls = 1
-    f = project(forces)
+    if "out" in inspect.signature(project).parameters:  # projects into reused zeroed arrays
+        f_buf, step_buf = np.zeros(shape), np.zeros(shape)
+        project_force = functools.partial(project, out=f_buf)
+        project_step = functools.partial(project, out=step_buf)
+    else:
+        project_force = project_step = project
+    f = project_force(forces)
     steps = 0
     converged = largest_atomic_norm(f) < fmax
+    if converged or max_steps < 1:
+        return LbfgsOutcome(x, float(energy), forces, steps, calls, bool(converged))
     history = TwoLoopMemory(x.size, memory_for(x.size) if memory is None else memory, alpha)
-    x_prev = g_prev = None
+    x_prev = np.empty_like(x)
+    g, g_prev = np.empty(x.size), np.empty(x.size)
+    direction = np.empty(x.size)
+    dr = direction.reshape(shape)  # the step: a view of the direction's buffer
     scale = 1.0  # s = scale · P(H g_prev): the factor of the last step
     while not converged and steps < max_steps:
-        g = -f.ravel()
-        if x_prev is None:
-            direction = history.inverse_hessian_times(g)
+        np.negative(f.ravel(), out=g)
+        if steps == 0:
+            history.inverse_hessian_times(g, out=direction)
         else:
-            direction = history.push(x.ravel() - x_prev, g - g_prev, g, scale)
-        dr = -direction.reshape(shape)
+            s, y = history.next_pair()
+            np.subtract(x.ravel(), x_prev.ravel(), out=s)
+            np.subtract(g, g_prev, out=y)
+            history.push_stored(g, scale, out=direction)
+        np.negative(dr, out=dr)
         scale = -damping
         longest = largest_atomic_norm(dr)
         if longest >= maxstep:
             dr *= maxstep / longest
             scale *= maxstep / longest
-        dr *= damping
-        x_prev, g_prev = x.ravel().copy(), g
-        x = x + project(dr)
+        if damping != 1.0:
+            dr *= damping
+        x, x_prev = x_prev, x
+        np.add(x_prev, project_step(dr), out=x)
+        g, g_prev = g_prev, g
         steps += 1
         energy, forces = evaluate(x)
         calls += 1
-        f = project(forces)
+        f = project_force(forces)
         converged = largest_atomic_norm(f) < fmax
     return LbfgsOutcome(x, float(energy), forces, steps, calls, bool(converged))

@@ -80,8 +80,8 @@ from flatcontact.ispes.geometry import (
 from flatcontact.ispes.lbfgs import largest_atomic_norm, lbfgs_relax
 from flatcontact.units import EV_PER_A3_TO_GPA
 
-Optimizer = Literal["FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch"]
-OPTIMIZERS: tuple[str, ...] = ("FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch")
+Optimizer = Literal["FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch", "lammps-cg"]
+OPTIMIZERS: tuple[str, ...] = ("FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch", "lammps-cg")
 RelaxMode = Literal["full", "normal", "rigid-layers", "rigid"]
 RELAX_MODES: tuple[str, ...] = ("full", "normal", "rigid-layers", "rigid")
 
@@ -97,7 +97,11 @@ class RelaxSettings:
     fmax_ev_per_a
         Convergence when max |F| over the free atoms < fmax (eV/Å).
     optimizer
-        ASE optimiser name (see :data:`OPTIMIZERS`).
+        ``LBFGS`` (the built-in, ASE's steps: :mod:`flatcontact.ispes.lbfgs`), another ASE
+        optimiser name, or ``lammps-cg``: LAMMPS's own ``minimize`` (``min_style cg``, the
+        same max-norm tolerance; LAMMPS models, modes ``full`` and ``normal`` only). On large
+        cells of cheap potentials it takes fewer force calls than L-BFGS (measured in
+        ``docs/performance.md``); its iterates are not ASE's.
     max_steps
         Optimiser step cap; a point that hits it is stored with ``converged=False``.
     mode
@@ -122,6 +126,11 @@ class RelaxSettings:
             raise InputError(f"max_steps: expected at least 1 optimiser step, got {self.max_steps}")
         if self.mode not in RELAX_MODES:
             raise InputError(f"mode: '{self.mode}' is not one of {', '.join(RELAX_MODES)}")
+        if self.optimizer == "lammps-cg" and self.mode == "rigid-layers":
+            raise InputError(
+                "optimizer: 'lammps-cg' relaxes atoms (modes full, normal), not rigid layers; "
+                "use LBFGS with mode rigid-layers"
+            )
 
     def as_dict(self) -> dict[str, Any]:
         """The settings for the store fingerprint; ``mode`` only when it is not the default
@@ -261,6 +270,18 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
         )
         atoms.positions = outcome.positions
         energy, forces, steps = outcome.energy_ev, outcome.forces, outcome.steps
+    elif relaxing and settings.optimizer == "lammps-cg":
+        minimize = getattr(calc, "minimize_positions", None)
+        if minimize is None:
+            raise InputError(
+                "optimizer: 'lammps-cg' needs a LAMMPS interaction model (LAMMPS's own "
+                f"minimiser), not {type(calc).__name__}"
+            )
+        held = project(np.ones_like(atoms.positions)) == 0.0  # the components P removes
+        positions, energy, forces, steps, _ = minimize(
+            atoms, held, settings.fmax_ev_per_a, settings.max_steps
+        )
+        atoms.positions = positions
     elif relaxing:
         steps = _relax_with_ase(atoms, calc, fixed, free, groups, settings)
         forces = atoms.get_forces(apply_constraint=False)
@@ -305,7 +326,8 @@ def constraint_projector(fixed: np.ndarray, mode: str, groups: list[np.ndarray])
     its layer's mean (the generalised force on the layer's height per atom). These are the
     forces ASE's ``FixAtoms``, ``FixCartesian`` and
     :class:`~flatcontact.ispes.rigid_layers.RigidLayersAlongZ` return, and the
-    steps their ``adjust_positions`` allow.
+    steps their ``adjust_positions`` allow. ``full`` and ``normal`` also take ``out=``: an
+    array, zero where nothing is kept, written in place (:func:`lbfgs_relax`'s buffers).
     """
     held = np.asarray(fixed, dtype=bool)
     if mode == "rigid-layers":
@@ -318,13 +340,17 @@ def constraint_projector(fixed: np.ndarray, mode: str, groups: list[np.ndarray])
             return out
 
         return project
-    lateral = mode == "normal"
+    # the components kept, as a mask broadcast over (n, 3): one pass per call, no copy first
+    keep = ~held[:, None]
+    if mode == "normal":
+        keep = keep & np.array([False, False, True])
+    keep = np.broadcast_to(keep, (len(held), 3))
 
-    def project(v: np.ndarray) -> np.ndarray:
-        out = v.copy()
-        out[held] = 0.0
-        if lateral:
-            out[:, :2] = 0.0
+    def project(v: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        if out is None:
+            return np.where(keep, v, 0.0)
+        # ``out`` (reused by lbfgs_relax) keeps the zeros it was given where nothing is kept
+        np.copyto(out, v, where=keep)
         return out
 
     return project

@@ -178,6 +178,19 @@ class LammpsInterfaceCalculator(InterfaceCalculator):
         compute = self.engine.compute
         return lambda positions: compute(positions, stress=stress)
 
+    def minimize_positions(
+        self, atoms: Atoms, held: np.ndarray, fmax: float, max_iterations: int
+    ) -> tuple[np.ndarray, float, np.ndarray, int, int]:
+        """Relax ``atoms`` (not modified) with LAMMPS's own minimiser
+        (:meth:`~flatcontact.potentials.lammps_engine.LammpsEngine.minimize`); its evaluations
+        are counted in ``force_calls``. Returns positions, energy, raw forces, iterations,
+        evaluations."""
+        self._engine_for(atoms)
+        self.reset()
+        out = self.engine.minimize(atoms.positions, held, fmax, max_iterations)
+        self.force_calls += out[4]
+        return out
+
     def close(self) -> None:
         engine = getattr(self, "engine", None)
         if engine is not None:

@@ -77,6 +77,7 @@ class LammpsBox:
 
     def __init__(self, cell, pbc):
         cell = np.asarray(cell, dtype=float)
+        self._scratch = None  # (box, difference) arrays of place()
         self.pbc = tuple(bool(p) for p in pbc)
         self.bulk = all(self.pbc)
         if self.bulk:
@@ -166,6 +167,50 @@ class LammpsBox:
         box[:, 1] -= nb * ly + nc * yz
         box[:, 2] -= nc * lz
         return box
+
+    def place(self, positions: np.ndarray, current: np.ndarray, offsets: np.ndarray) -> None:
+        """Write ``positions`` (Å, caller's frame) into ``current`` (LAMMPS's own coordinates,
+        modified in place) at the images nearest to ``current``.
+
+        ``offsets`` (n, 3, LAMMPS frame, Å; the caller keeps it between calls, zeros at first)
+        holds the lattice vector by which each atom's LAMMPS copy differs from the caller's
+        (an atom at a lattice site on the cell boundary, or one LAMMPS re-wrapped at a
+        neighbour rebuild). A relaxation step moves atoms by far less than a quarter of the
+        cell, so usually the positions go in as positions + offsets without any wrapping:
+        one subtraction checks that no atom is a lattice vector away from LAMMPS's copy.
+        Otherwise (a first call, a re-wrap) the images come from :meth:`nearest_images` and
+        ``offsets`` is updated. 3D-periodic cells: :meth:`to_lammps` then
+        :meth:`nearest_images`, every call.
+        """
+        if self.bulk:
+            current[...] = self.nearest_images(self.to_lammps(positions), current)
+            return
+        p = np.asarray(positions, dtype=float)
+        if not self._aligned:
+            p = p.copy()
+            p[:, :2] = positions[:, :2] @ self.q.T
+        # two scratch arrays kept between calls: a fresh (n, 3) array per call costs more than
+        # the arithmetic on a large cell (the allocator returns and re-faults its pages)
+        if self._scratch is None or self._scratch[0].shape != p.shape:
+            self._scratch = (np.empty(p.shape), np.empty(p.shape))
+        box, d = self._scratch
+        np.add(p, offsets, out=box)
+        np.subtract(current, box, out=d)
+        lx, ly, lz = self._lattice[:3]
+        if max(d.max(), -d.min()) >= 0.25 * min(lx, ly, lz or np.inf):  # an atom crossed
+            box = self.nearest_images(box, current)
+            np.subtract(box, p, out=offsets)
+        current[...] = box
+
+    def vectors_to_lammps(self, v: np.ndarray) -> np.ndarray:
+        """Per-atom vectors (or positions, unwrapped) from the caller's frame to LAMMPS's
+        (slab frame: the in-plane rotation Q; a new array)."""
+        v = np.array(v, dtype=float)
+        if self.bulk:
+            return self.prism.vector_to_lammps(v)
+        if not self._aligned:
+            v[:, :2] = v[:, :2] @ self.q.T
+        return v
 
     def vectors_to_caller(self, f: np.ndarray) -> np.ndarray:
         """Per-atom vectors (forces) from the LAMMPS frame back to the caller's."""

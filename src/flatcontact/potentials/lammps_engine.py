@@ -30,6 +30,9 @@ Threads: ``threads=N`` (> 1) loads LAMMPS's OPENMP package (``package omp N`` an
 from __future__ import annotations
 
 import ctypes
+import os
+import re
+import tempfile
 from dataclasses import dataclass
 
 import numpy as np
@@ -97,6 +100,9 @@ class LammpsEngine:
         self._ready = False  # the first compute runs the full setup (``run 0``)
         self._extract = None  # lammps_extract_atom with a c_void_p result (see _views)
         self._cached_views = None
+        self._identity = False
+        # lattice vectors between LAMMPS's copy of each atom and the caller's (LammpsBox.place)
+        self._offsets = np.zeros((self.n, 3))
         try:
             self.box = create_box(
                 self.lmp,
@@ -127,7 +133,8 @@ class LammpsEngine:
 
     def _views(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(rows, x, f): numpy views of LAMMPS's own ``x`` and ``f`` arrays and the rows of the
-        caller's atoms in them, made once and remade only when LAMMPS moved its arrays.
+        caller's atoms in them, made once and remade only when LAMMPS moved its arrays
+        (``_identity``: the rows are 0 … n-1).
 
         One process owns every atom and sorting is off, so the rows are the identity in
         practice; they are read from the atom ids anyway.
@@ -160,6 +167,8 @@ class LammpsEngine:
         f = lmp.numpy.extract_atom("f", nelem=self.n, dim=3)
         rows = np.empty(self.n, dtype=np.intp)
         rows[np.asarray(ids, dtype=np.intp) - 1] = np.arange(self.n)
+        # LAMMPS's rows in the caller's order (the usual case): whole-array copies, no gather
+        self._identity = bool(np.array_equal(rows, np.arange(self.n)))
         views = (rows, x, f)
         if (ids.ctypes.data, x.ctypes.data, f.ctypes.data) == addresses:
             self._cached_views = (addresses, ids, np.array(ids), views)
@@ -169,25 +178,101 @@ class LammpsEngine:
         """Energy (eV) and forces (eV/Å, caller's frame) at ``positions`` (Å).
 
         With ``stress=True`` (3D-periodic cells only) also the stress (eV/Å³, ASE Voigt order
-        and sign): ``(energy, forces, stress)``.
+        and sign): ``(energy, forces, stress)``. After the first call the positions go
+        straight into LAMMPS's array at the images nearest its own
+        (:meth:`~flatcontact.potentials.lammps_box.LammpsBox.place`); the forces come back
+        in one copy.
         """
-        box = self.box.to_lammps(positions)
         lmp = self.lmp
         rows, x, _ = self._views()
         if self._ready:  # one force evaluation behind the neighbour check, no setup
-            x[rows] = self.box.nearest_images(box, x[rows])
+            if self._identity:
+                self.box.place(positions, x, self._offsets)
+            else:
+                current = x[rows]
+                self.box.place(positions, current, self._offsets)
+                x[rows] = current
             lmp.command("run 1 pre no post no")
         else:
+            box = self.box.to_lammps(positions)
             x[rows] = box
+            if not self.box.bulk:  # the lattice vectors the wrap added (LammpsBox.place)
+                self._offsets[...] = box - self.box.vectors_to_lammps(positions)
             lmp.command("run 0 post no")
             self._ready = True
         energy = float(lmp.get_thermo("pe"))
         rows, _, f = self._views()
-        forces = self.box.vectors_to_caller(f[rows])
+        forces = self.box.vectors_to_caller(f if self._identity else f[rows])
         if not stress:
             return energy, forces
         p = [self.lmp.get_thermo(k) for k in ("pxx", "pyy", "pzz", "pyz", "pxz", "pxy")]
         return energy, forces, self.box.stress_to_caller(p)
+
+    def minimize(
+        self,
+        positions: np.ndarray,
+        held: np.ndarray,
+        fmax: float,
+        max_iterations: int,
+    ) -> tuple[np.ndarray, float, np.ndarray, int, int]:
+        """Relax ``positions`` (Å) with LAMMPS's own ``minimize`` (``min_style cg``).
+
+        ``held`` (n, 3, bool) marks the components that stay fixed: whole atoms (``fix
+        setforce 0 0 0``) or x and y only (``setforce 0 0 NULL``, the ``normal`` mode). The
+        tolerance is the scan's: ``min_modify norm max`` stops when the largest per-atom force
+        norm is below ``fmax`` (eV/Å; energy tolerance 0), or after ``max_iterations``
+        iterations (10× as many evaluations). The fixes are removed afterwards and the final
+        structure is evaluated once more without them (raw forces for the load: the held
+        atoms' reaction), so the next call runs the full setup.
+
+        Returns
+        -------
+        positions, energy_ev, forces, iterations, evaluations
+            Positions at the images nearest the input (caller's frame), energy and raw forces
+            at them, LAMMPS's iterations and force evaluations plus the final one.
+        """
+        if self.box.bulk:
+            raise InputError("LAMMPS minimize: only for slab/interface cells, not 3D-periodic ones")
+        held = np.asarray(held, dtype=bool).reshape(self.n, 3)
+        xy_only = held[:, 0] & held[:, 1] & ~held[:, 2]
+        if (held.any(axis=1) & ~held.all(axis=1) & ~xy_only).any():
+            raise InputError("LAMMPS minimize: held components must be whole atoms or x and y")
+        whole = np.flatnonzero(held.all(axis=1)) + 1
+        lateral = np.flatnonzero(xy_only) + 1
+        rows, x, _ = self._views()
+        x[rows] = self.box.to_lammps(positions)  # the start, wrapped: minimize's setup takes it
+        lmp = self.lmp
+        fixes = []
+        for name, ids, values in (
+            ("fc_held", whole, "0.0 0.0 0.0"),
+            ("fc_lateral", lateral, "0.0 0.0 NULL"),
+        ):
+            if len(ids):
+                lmp.command(f"group {name} id " + " ".join(map(str, ids)))
+                lmp.command(f"fix {name} {name} setforce {values}")
+                fixes.append(name)
+        with tempfile.TemporaryDirectory() as tmp:
+            log = os.path.join(tmp, "minimize.log")
+            try:
+                lmp.commands_list(["min_style cg", "min_modify norm max", f"log {log}"])
+                lmp.command(f"minimize 0 {fmax!r} {int(max_iterations)} {10 * int(max_iterations)}")
+            finally:
+                lmp.command("log none")
+                for name in fixes:
+                    lmp.commands_list([f"unfix {name}", f"group {name} delete"])
+                self._ready = False  # fixes changed: the next evaluation runs the full setup
+            with open(log) as fh:
+                found = re.search(r"Iterations, force evaluations = (\d+) (\d+)", fh.read())
+        if found is None:  # pragma: no cover - a guard
+            raise RuntimeError("LAMMPS minimize: no iteration count in its log")
+        iterations, evaluations = int(found.group(1)), int(found.group(2))
+        rows, x, _ = self._views()
+        start = self.box.vectors_to_lammps(positions)
+        out = self.box.vectors_to_caller(self.box.nearest_images(np.array(x[rows]), start))
+        # held components exactly where they were (the image shifts above are round-off off)
+        out = np.where(held, np.asarray(positions, dtype=float), out)
+        energy, forces = self.compute(out)
+        return out, energy, forces, iterations, evaluations + 1
 
     def close(self) -> None:
         lmp = getattr(self, "lmp", None)
