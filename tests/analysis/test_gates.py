@@ -256,7 +256,6 @@ def test_a_slope_is_gated_only_when_its_whole_interval_is_negative():
     assert gates.negative_slope(old).message.startswith("significantly negative")
 
 
-
 def test_a_significant_but_immaterial_negative_slope_is_used_with_a_note():
     """Cu(111) EAM, internal form (measured): μ = −0.486 (−0.535 .. −0.438) MPa/GPa against
     σ0 = 1100 MPa falls 0.066 % over 0–1.5 GPa: used, with a note. The H-diamond/graphene
@@ -275,6 +274,7 @@ def test_a_significant_but_immaterial_negative_slope_is_used_with_a_note():
     # the threshold is on the fall, not on the slope: the same slope under a small intercept
     small = dict(cu, sigma0_mpa=20.0)
     assert gates.negative_slope(small).gate == "negative_slope"
+
 
 def _two_site_map(depth_a, depth_b, n=16):
     """A square-lattice landscape with minima at (0.25, 0.25) and (0.75, 0.6) (fractions)."""

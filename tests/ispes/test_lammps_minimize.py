@@ -56,3 +56,19 @@ def test_lammps_cg_needs_a_lammps_model(toy_reference):
     task = PointTask((0, 0, 0), 0.1, 0.0, thickness(toy_reference))
     with pytest.raises(InputError, match="LAMMPS interaction model"):
         relax_point(toy_reference, toy_calculator(), task, RelaxSettings(optimizer="lammps-cg"))
+
+
+def test_config_check_refuses_lammps_cg_with_an_ase_calculator_before_any_stage(tmp_path, capsys):
+    """The pre-run check (``config --check`` and the pipeline's first step) refuses
+    ``lammps-cg`` with an ASE calculator in one line, before the build."""
+    from tests.hardening.helpers import TOY_YAML, refused, run_cli
+
+    conf = tmp_path / "run.yaml"
+    conf.write_text(
+        TOY_YAML.replace("executor: serial", "executor: serial\n  optimizer: lammps-cg")
+    )
+    code, _, err = run_cli(["config", "--check", conf], capsys)
+    refused(code, err, "scan.optimizer", "lammps-cg", "toy_calculator")
+    code, _, err = run_cli(["run", conf, "--out", tmp_path / "run"], capsys)
+    refused(code, err, "scan.optimizer")
+    assert not any((tmp_path / "run").glob("0*-*"))

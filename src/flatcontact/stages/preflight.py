@@ -57,6 +57,16 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
     if cfg.contact.fit.csv:
         check_fit_settings(cfg)
     calc = cfg.potential.calculator
+    if calc is not None and cfg.scan.optimizer == "lammps-cg":
+        raise InputError(
+            f"{source}: scan.optimizer: 'lammps-cg' is LAMMPS's own minimiser and needs a "
+            f"LAMMPS interaction model, not the ASE calculator {calc.target!r}; use LBFGS"
+        )
+    if cfg.scan.optimizer == "lammps-cg" and cfg.scan.relax_mode == "rigid-layers":
+        raise InputError(
+            f"{source}: scan.optimizer: 'lammps-cg' relaxes atoms (relax_mode full or normal), "
+            "not rigid layers; use LBFGS"
+        )
     if calc is not None:
         try:
             calculator_factory(cfg.potential)
