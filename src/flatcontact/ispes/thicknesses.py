@@ -150,7 +150,8 @@ def merge_close_thicknesses(
     The smallest and the largest are kept; an inner thickness closer than the minimum to
     the last one kept below it, or to the largest, is dropped (the outer of two close
     thicknesses survives, so the range never shrinks). A list that respects the minimum is
-    returned as it is (sorted).
+    returned as it is (sorted); a list whose whole range is narrower than the minimum
+    keeps its two ends.
     """
     z = np.unique(np.asarray(z, dtype=float))
     if z.size <= 2 or np.all(np.diff(z) >= min_spacing_angstrom):
