@@ -148,7 +148,7 @@ def test_node_loads_are_the_derivative_of_the_energy():
 def test_a_column_short_of_p0_asks_for_a_thickness_beyond_the_largest():
     z = np.linspace(10.0, 11.0, 6)
     e, s = _grid_column(z, lambda x: 4.0 * (11.05 - x))  # still 0.2 GPa at z = 11
-    verdict = check_grid(z, e[None], s[None], 10.0, [(0.0, 0.0)], (0.0, 2.0, 4))
+    verdict = check_grid(z, e[None], s[None], 10.0, [(0.0, 0.0)], (0.0, 2.0, 4), [0.0, 1.0])
     assert verdict.folds == [] and verdict.short == []
     # aimed a margin past P = 0 along the last slope: 11 + (0.2 + 0.0667)/4
     assert verdict.z_above == pytest.approx(11.0 + (0.2 + 2 / 3 * 0.1) / 4.0, rel=1e-2)
@@ -182,3 +182,56 @@ def test_quartz_quick_preset_thicknesses_are_mains():
     c = thicknesses_spanning_columns(probes, lo, hi, n, [d["role"] for d in data["probes"]])
     assert c.thickness_angstrom.tolist() == data["thickness_angstrom"]
     assert c.notes == data["notes"] and c.load_folds == []
+
+
+# ------------------------------------------------------------------ the driver's extension
+
+
+def test_the_scan_extends_its_grid_until_every_column_brackets(
+    tmp_path, toy_reference, toy_factory
+):
+    """Toy LJ grid with loads to analyse beyond its HI: the driver adds a thickness below
+    the smallest (appended to the store's list, so stored points keep their index) and
+    one beyond the largest; ispes.nc is ascending, every column brackets the loads as the
+    analysis reads them, and a rerun on the store computes nothing and gives the same grid."""
+    from flatcontact.analysis.constant_pressure import invert_columns
+    from flatcontact.ispes.executors import SerialExecutor
+    from flatcontact.ispes.grid import GridSpec
+    from flatcontact.ispes.relax import RelaxSettings
+    from flatcontact.ispes.scan import run_scan
+
+    grid = GridSpec(2, 2, p_range_gpa=(0.0, 0.3, 4))
+    settings = RelaxSettings(fmax_ev_per_a=1e-4)
+    loads = [-0.01, 0.0, 0.2, 0.4]  # below P = 0 and above HI = 0.3 GPa
+    first = run_scan(
+        toy_reference,
+        toy_factory,
+        grid,
+        tmp_path / "s",
+        settings,
+        executor=SerialExecutor(),
+        bracket_loads_gpa=loads,
+    )
+    ds = first.dataset
+    z = ds.thickness.values
+    assert np.all(np.diff(z) >= MIN_THICKNESS_SPACING_ANGSTROM)
+    assert first.points_done == first.points_total == 4 * z.size
+    assert any("ends below 0.4 GPa" in n for n in first.notes), first.notes
+    assert any("ends above -0.01 GPa" in n for n in first.notes), first.notes
+    area = float(ds.attrs["area"])
+    e = ds.energy.values.reshape(-1, z.size) / area
+    s = ds.normal_stress.values.reshape(-1, z.size) / EV_PER_A3_TO_GPA
+    inv = invert_columns(z, e, s, np.asarray(loads) / EV_PER_A3_TO_GPA)
+    assert np.all(np.isfinite(inv.thickness_angstrom))
+    again = run_scan(
+        toy_reference,
+        toy_factory,
+        grid,
+        tmp_path / "s",
+        settings,
+        executor=SerialExecutor(),
+        bracket_loads_gpa=loads,
+    )
+    assert again.points_computed == 0
+    np.testing.assert_array_equal(again.dataset.energy.values, ds.energy.values)
+    np.testing.assert_array_equal(again.dataset.thickness.values, z)
