@@ -69,15 +69,19 @@ def bracket_margin_gpa(lo_gpa: float, hi_gpa: float, n: int) -> float:
 
 
 def bracket_targets_gpa(
-    p_range_gpa: tuple[float, float, int], loads_gpa: Sequence[float] | None = None
+    p_range_gpa: tuple[float, float, int],
+    loads_gpa: Sequence[float] | None = None,
+    tension_gpa: float | None = None,
 ) -> tuple[float, float]:
     """``(low, high)`` (GPa) the grid's columns must reach: ``min(0, LO, loads)`` and
     ``max(loads)``, or HI without ``loads_gpa`` (the loads the analysis will read, when the
-    scan knows them: ``flatcontact run`` passes ``analysis.p_gpa``)."""
+    scan knows them: ``flatcontact run`` passes ``analysis.p_gpa``). ``tension_gpa``: the
+    maximum tension the thickness choice raised LO to (LO below it); loads at or below it
+    cannot be carried and are left out of ``low`` (P = 0 always stays)."""
     lo, hi, _ = p_range_gpa
-    if loads_gpa is None or len(loads_gpa) == 0:
-        return min(0.0, lo), hi
-    return min(0.0, lo, *loads_gpa), max(loads_gpa)
+    loads = list(loads_gpa) if loads_gpa is not None and len(loads_gpa) else []
+    low = [v for v in (0.0, lo, *loads) if tension_gpa is None or v > tension_gpa]
+    return min(low), (max(loads) if loads else hi)
 
 
 def check_grid(
@@ -88,11 +92,12 @@ def check_grid(
     shifts: list[tuple[float, float]],
     p_range_gpa: tuple[float, float, int],
     loads_gpa: Sequence[float] | None = None,
+    tension_gpa: float | None = None,
 ) -> GridBracket:
     """Check every column of a finished grid against P = 0 and ``p_range_gpa`` (LO, HI, N).
 
     The targets are :func:`bracket_targets_gpa` (``loads_gpa``: the loads the analysis
-    reads, if known). ``z`` ascending (Å); ``energy_ev``, ``stress_gpa`` of shape ``(n_col, n_z)`` in the
+    reads, if known; ``tension_gpa``: the tension LO was raised to, if it was). ``z`` ascending (Å); ``energy_ev``, ``stress_gpa`` of shape ``(n_col, n_z)`` in the
     order of ``shifts`` (fractional lateral shifts, for the names). A column whose lowest
     node is its last and lies above the low target asks for a thickness beyond the largest,
     where its load extrapolated from its last node's slope is a margin
@@ -106,7 +111,7 @@ def check_grid(
     lo, hi, n = p_range_gpa
     z = np.asarray(z, dtype=float)
     requested = np.linspace(lo, hi, n)
-    target, top = bracket_targets_gpa(p_range_gpa, loads_gpa)
+    target, top = bracket_targets_gpa(p_range_gpa, loads_gpa, tension_gpa)
     margin = bracket_margin_gpa(lo, hi, n)
     stress = np.atleast_2d(np.asarray(stress_gpa, dtype=float))
     sources = {

@@ -219,7 +219,15 @@ def _extend(
     ``MAX_EXTENSIONS`` rounds). Otherwise the folds and the columns still short go into
     ``resolved`` (``load_folds``, ``notes``). Given thicknesses are never changed."""
     resolved = store.resolved
-    targets = list(bracket_targets_gpa(grid.p_range_gpa, loads_gpa)) if grid.p_range_gpa else None
+    tension = None
+    if grid.p_range_gpa is not None and resolved.get("bracket_gpa"):
+        raised = float(resolved["bracket_gpa"][0])
+        tension = raised if raised > grid.p_range_gpa[0] else None  # LO was raised to it
+    targets = (
+        list(bracket_targets_gpa(grid.p_range_gpa, loads_gpa, tension))
+        if grid.p_range_gpa
+        else None
+    )
     if (
         grid.p_range_gpa is None
         or max_new_points is not None
@@ -238,6 +246,7 @@ def _extend(
         [(float(a), float(b)) for a in ds[DIM_A].values for b in ds[DIM_B].values],
         grid.p_range_gpa,
         loads_gpa,
+        tension,
     )
     added = resolved.get("thicknesses_added_after_scan", 0)
     notes = list(resolved.get("notes", []))
