@@ -16,7 +16,11 @@ from flatcontact.ispes.probe import (
     probe_column,
     rigid_stackings,
 )
-from flatcontact.ispes.thicknesses import probe_thicknesses, thicknesses_for_pressures
+from flatcontact.ispes.thicknesses import (
+    MIN_THICKNESS_SPACING_ANGSTROM,
+    probe_thicknesses,
+    thicknesses_for_pressures,
+)
 from flatcontact.units import EV_PER_A3_TO_GPA
 
 
@@ -83,8 +87,8 @@ def test_thicknesses_bracket_the_loads_at_every_stacking(toy_reference, delta, l
     resolved, notes = probe_thicknesses(relax, toy_reference, rigid, grid)
     z = np.asarray(resolved["thickness_angstrom"])
     assert (0.0, 0.0) in [tuple(p["shift"]) for p in resolved["probes"]]  # g = 3: widest gap
-    # every lateral grid column (not only the probed ones) brackets [lo_c, hi]:
-    # p(z_min) >= hi and p(z_max) <= lo_c = max(lo, the maximum tension -αD/2), up to the
+    # every lateral grid column (not only the probed ones) brackets P = 0 and [lo_c, hi]:
+    # p(z_min) >= hi and p(z_max) <= lo_c = max(min(lo, 0), the maximum tension -αD/2), up to the
     # error of linear interpolation between probe samples (h <= 0.25 Å): h²/8 max|p''|
     tension = -model.alpha_per_angstrom * model.well_depth_ev_per_a2 / 2 * EV_PER_A3_TO_GPA
     zz = np.linspace(z.min() - 0.3, z.max() + 0.3, 2001)
@@ -93,12 +97,17 @@ def test_thicknesses_bracket_the_loads_at_every_stacking(toy_reference, delta, l
     tol = 0.25**2 / 8 * np.max(np.abs(np.gradient(np.gradient(pz, zz, axis=1), zz, axis=1)))
     slack = 0.01 * (hi - max(lo, tension))  # thicknesses.BRACKET_RTOL of the load range
     assert np.all(p_of(cols[:, 0], z.min()) >= hi - tol - slack)
-    assert np.all(p_of(cols[:, 0], z.max()) <= max(lo, tension) + tol + slack)
-    # the first n thicknesses are today's rule at the lowest-energy column, unchanged
+    assert np.all(p_of(cols[:, 0], z.max()) <= max(min(lo, 0.0), tension) + tol + slack)
+    # the first n thicknesses are today's rule at the lowest-energy column, unchanged unless
+    # an added one came closer than the minimum spacing (then the outer one is kept)
     low, _ = extreme_stackings(rigid.energy_ev, grid)
     z_old, _ = thicknesses_for_pressures(probe_column(relax, toy_reference, low, hi), lo, hi, n)
-    assert np.all(np.isin(np.round(z_old, 12), np.round(z, 12)))
-    assert (z.size > n) == any("added" in m for m in notes)
+    kept = np.isin(np.round(z_old, 12), np.round(z, 12))
+    gap = np.min(np.abs(z_old[:, None] - z[None, :]), axis=1)
+    assert np.all(kept | (gap < MIN_THICKNESS_SPACING_ANGSTROM))
+    assert kept.all() or any("closer than" in m for m in notes)
+    assert np.all(np.diff(z) >= MIN_THICKNESS_SPACING_ANGSTROM)
+    assert any("added" in m for m in notes) == (z.size > n or not kept.all())
 
 
 def test_no_extension_when_the_lowest_column_already_spans_the_loads(toy_reference):

@@ -18,7 +18,7 @@ import functools
 import heapq
 import json
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -27,9 +27,17 @@ from ase import Atoms
 
 from flatcontact.errors import InputError
 from flatcontact.ispes import contract, executors
-from flatcontact.ispes.contract import cell_area
+from flatcontact.ispes.contract import (
+    DIM_A,
+    DIM_B,
+    DIM_Z,
+    VAR_ENERGY,
+    VAR_STRESS,
+    cell_area,
+)
 from flatcontact.ispes.geometry import in_plane_vectors, thickness, validate_interface
 from flatcontact.ispes.grid import GridSpec, check_thicknesses
+from flatcontact.ispes.grid_bracket import MAX_EXTENSIONS, bracket_targets_gpa, check_grid
 from flatcontact.ispes.order import PREFERENCES, search_tree
 from flatcontact.ispes.probe import extreme_stackings, probe_column, rigid_stackings
 from flatcontact.ispes.reduction import (
@@ -75,6 +83,9 @@ class ScanResult:
     symmetry: dict | None = None
     #: relaxed points in the store (``points_done`` also counts the points filled by symmetry)
     points_stored: int = 0
+    #: folds of the probed and of the grid's columns and the loads they refuse
+    #: (:meth:`flatcontact.ispes.thicknesses.LoadFold.record`; ``scan.json`` ``load_folds``)
+    load_folds: list[dict] = dataclasses.field(default_factory=list)
 
 
 def check_interface(atoms: Atoms) -> None:
@@ -165,6 +176,130 @@ def adhesion_record(
     return {**pulled, **w.record()}
 
 
+def _tree_in_store_order(
+    z: np.ndarray, shape: tuple, root: tuple, order: str, allowed: set | None = None
+) -> dict:
+    """The warm-start tree (:func:`flatcontact.ispes.order.search_tree`) over the
+    thicknesses in ascending order, in the store's indices (``root``, ``allowed`` and the
+    result): ``i_z`` is the position in the resolved list, which a thickness added below
+    the smallest after the scan (:func:`_extend`) joins at its end. For an ascending list
+    (every scan before such an addition) this is the tree itself."""
+    rank = np.argsort(z, kind="stable")  # sorted position -> store index
+    if np.array_equal(rank, np.arange(z.size)):
+        return search_tree(shape, root, order, allowed=allowed)
+    position = np.empty_like(rank)
+    position[rank] = np.arange(z.size)  # store index -> sorted position
+
+    def to_sorted(idx):
+        return (idx[0], idx[1], int(position[idx[2]]))
+
+    def to_store(idx):
+        return None if idx is None else (idx[0], idx[1], int(rank[idx[2]]))
+
+    sorted_allowed = None if allowed is None else {to_sorted(i) for i in allowed}
+    tree = search_tree(shape, to_sorted(root), order, allowed=sorted_allowed)
+    return {to_store(idx): to_store(par) for idx, par in tree.items()}
+
+
+def _extend(
+    store,
+    reference: Atoms,
+    grid: GridSpec,
+    relax: RelaxSettings,
+    max_new_points,
+    loads_gpa,
+    ds,
+) -> bool:
+    """After a pressure-range grid ``ds`` (the store assembled, symmetry-mapped points
+    filled) is complete, check it brackets its loads
+    (:func:`flatcontact.ispes.grid_bracket.check_grid`): a thickness beyond the largest
+    if a column ends short of the low target, one below the smallest if a column ends
+    short of the high target (unless the slabs would overlap there), appended to the
+    resolved list so the stored points keep their ``i_z`` (:func:`_tree_in_store_order`);
+    True when one was added (the caller computes the new points, at most
+    ``MAX_EXTENSIONS`` rounds). Otherwise the folds and the columns still short go into
+    ``resolved`` (``load_folds``, ``notes``). Given thicknesses are never changed."""
+    resolved = store.resolved
+    tension = None
+    if grid.p_range_gpa is not None and resolved.get("bracket_gpa"):
+        raised = float(resolved["bracket_gpa"][0])
+        tension = raised if raised > grid.p_range_gpa[0] else None  # LO was raised to it
+    targets = (
+        list(bracket_targets_gpa(grid.p_range_gpa, loads_gpa, tension))
+        if grid.p_range_gpa
+        else None
+    )
+    if (
+        grid.p_range_gpa is None
+        or max_new_points is not None
+        or not np.all(np.isfinite(ds[VAR_ENERGY].values))
+        or resolved.get("grid_checked_gpa") == targets
+    ):
+        return False
+    low, high = targets
+    n_z = ds.sizes[DIM_Z]
+    z = ds[DIM_Z].values
+    verdict = check_grid(
+        z,
+        ds[VAR_ENERGY].values.reshape(-1, n_z),
+        ds[VAR_STRESS].values.reshape(-1, n_z),
+        float(ds.attrs["area"]),
+        [(float(a), float(b)) for a in ds[DIM_A].values for b in ds[DIM_B].values],
+        grid.p_range_gpa,
+        loads_gpa,
+        tension,
+    )
+    added = resolved.get("thicknesses_added_after_scan", 0)
+    notes = list(resolved.get("notes", []))
+    new = []
+    if added < MAX_EXTENSIONS:
+        if verdict.z_above is not None:
+            new.append(verdict.z_above)
+            notes.append(
+                f"p-range-gpa: a column of the grid ends above {low:g} GPa (P = 0, LO and "
+                f"the loads analysed) at z = {z.max():.4g} Å; added z = {verdict.z_above:.4g} Å"
+            )
+        if verdict.z_below is not None:
+            try:
+                check_thicknesses(
+                    reference, grid, [verdict.z_below], spread_compression=relax.mode != "rigid"
+                )
+            except InputError:
+                pass  # the slabs would overlap: the column stays short, noted below
+            else:
+                new.append(verdict.z_below)
+                notes.append(
+                    f"p-range-gpa: a column of the grid ends below {high:g} GPa (the highest "
+                    f"load analysed, else HI) at z = {z.min():.4g} Å; added z = "
+                    f"{verdict.z_below:.4g} Å"
+                )
+    if new:
+        store.set_resolved(
+            {
+                **resolved,
+                "thickness_angstrom": [*resolved["thickness_angstrom"], *new],
+                "notes": notes,
+                "thicknesses_added_after_scan": added + 1,
+            }
+        )
+        return True
+    folds = list(resolved.get("load_folds", [])) + [f.record() for f in verdict.folds]
+    notes += [f.message() for f in verdict.folds[:1]]
+    if len(verdict.folds) > 1:
+        notes.append(f"p-range-gpa: {len(verdict.folds)} grid columns fold (scan.json load_folds)")
+    if verdict.short and verdict.z_below is not None:
+        notes += verdict.short[:1]
+    if verdict.z_above is not None:
+        notes.append(
+            f"p-range-gpa: after {added} added thickness(es) a grid column still ends above "
+            f"{low:g} GPa at z = {z.max():.4g} Å; give scan.thickness_angstrom beyond it"
+        )
+    store.set_resolved(
+        {**resolved, "load_folds": folds, "notes": notes, "grid_checked_gpa": targets}
+    )
+    return False
+
+
 def relax_column_point(reference, calc, relax, a, b, z, start, start_z) -> tuple:
     """One probe point: ``(energy_ev, normal_stress_gpa, force_calls, positions)``."""
     task = PointTask((0, 0, 0), a, b, z, start, (a, b) if start is not None else None, start_z)
@@ -192,6 +327,7 @@ def run_scan(
     progress: Callable[[int, int], None] | None = None,
     max_new_points: int | None = None,
     symmetry: SymmetrySettings | None = None,
+    bracket_loads_gpa: Sequence[float] | None = None,
 ) -> ScanResult:
     """Compute the ISPES grid of ``reference`` with ``factory``'s calculator into ``out_dir``.
 
@@ -224,6 +360,11 @@ def run_scan(
         Irreducible registries (:mod:`flatcontact.ispes.reduction`): relax one point per orbit
         of the interface's shift-space group, verify some mapped points, fill the rest.
         ``None``: every point is relaxed (``SymmetrySettings(enabled=False)``).
+    bracket_loads_gpa
+        The loads the analysis will read (GPa), if known: a pressure-range grid is
+        extended until every column brackets them, P = 0 and LO (without them: P = 0, LO
+        and HI; :func:`flatcontact.ispes.grid_bracket.check_grid`). Not part of the store
+        fingerprint; a finished store is re-checked when they change.
 
     Returns
     -------
@@ -284,137 +425,160 @@ def run_scan(
                             reference, factory, grid, relax, resolved.get("adhesion")
                         ),
                     }
-                notes = list(resolved.get("notes", notes))
-                z = np.asarray(resolved["thickness_angstrom"], dtype=float)
-                if grid.thickness_angstrom is None:
-                    check_thicknesses(reference, grid, z, spread_compression=relax.mode != "rigid")
-                shape = (grid.n_a, grid.n_b, z.size)
                 sa, sb = grid.shifts()
-                root = (0, 0, int(np.argmin(np.abs(z - thickness(reference)))))
-                full_tree = search_tree(shape, root, order)
-                reduction = None
-                if symmetry.enabled:
-                    group = shift_space_group(
-                        reference,
-                        symmetry.tolerance_angstrom,
-                        spread_compression=relax.mode != "rigid",
-                    ).for_grid(grid.n_a, grid.n_b)
-                    reduction = plan_reduction(group, shape, list(full_tree))
                 context = ScanContext(reference, factory, relax)
                 recent = PositionsCache()
-
-                def converged(idx):
-                    return idx is not None and idx in store and store.record(idx)["converged"]
-
-                def positions(idx):
-                    cached = recent.get(idx)
-                    return cached if cached is not None else store.positions(idx)
-
-                def run_points(parent):
-                    """Relax the points of the tree ``parent`` missing from the store."""
-
-                    def make_task(idx):
-                        par = parent[idx]
-                        ia, ib, iz = idx
-                        if not converged(par):
-                            return PointTask(idx, float(sa[ia]), float(sb[ib]), float(z[iz]))
-                        pa, pb, pz = par
-                        grand = parent[par]
-                        previous = {}
-                        if converged(grand) and grand[:2] == par[:2] == idx[:2]:
-                            previous = {
-                                "previous_positions": positions(grand),
-                                "previous_thickness": float(z[grand[2]]),
-                            }
-                        return PointTask(
-                            idx,
-                            float(sa[ia]),
-                            float(sb[ib]),
-                            float(z[iz]),
-                            positions(par),
-                            (float(sa[pa]), float(sb[pb])),
-                            float(z[pz]),
-                            par,
-                            **previous,
+                while True:
+                    notes = list(resolved.get("notes", notes))
+                    z = np.asarray(resolved["thickness_angstrom"], dtype=float)
+                    if grid.thickness_angstrom is None:
+                        check_thicknesses(
+                            reference, grid, z, spread_compression=relax.mode != "rigid"
                         )
+                    shape = (grid.n_a, grid.n_b, z.size)
+                    root = (0, 0, int(np.argmin(np.abs(z - thickness(reference)))))
+                    full_tree = _tree_in_store_order(z, shape, root, order)
+                    reduction = None
+                    if symmetry.enabled:
+                        group = shift_space_group(
+                            reference,
+                            symmetry.tolerance_angstrom,
+                            spread_compression=relax.mode != "rigid",
+                        ).for_grid(grid.n_a, grid.n_b)
+                        reduction = plan_reduction(group, shape, list(full_tree))
 
-                    rank = {idx: k for k, idx in enumerate(parent)}
-                    pending = {idx for idx in parent if idx not in store}
-                    total = len(parent)
-                    stored = total - len(pending)
-                    if progress is not None:
-                        progress(stored, total)
-                    in_flight: dict[Any, tuple] = {}
-                    cap = 2 * max(1, getattr(executor, "workers", 1))
-                    queue = ReadyQueue(parent, rank, store, pending)
-                    while pending or in_flight:
-                        if (
-                            max_new_points is not None
-                            and len(computed_calls) + len(in_flight) >= max_new_points
-                            and not in_flight
-                        ):
-                            break
-                        while (
-                            queue
-                            and len(in_flight) < cap
-                            and (
-                                max_new_points is None
-                                or len(computed_calls) + len(in_flight) < max_new_points
-                            )
-                        ):
-                            idx = queue.pop()
-                            handle = executor.submit(run_task, context, make_task(idx))
-                            in_flight[handle] = idx
-                            pending.discard(idx)
-                        if not in_flight:
-                            break
-                        done, _ = executor.wait_first(in_flight)
-                        for handle in done:
-                            idx = in_flight.pop(handle)
-                            result = executor.result(handle)
-                            store.write(result)
-                            recent.put(idx, result.positions)
-                            queue.stored(idx)
-                            computed_calls.append(result.force_calls)
-                            stored += 1
-                            if progress is not None:
-                                progress(stored, total)
+                    def converged(idx):
+                        return idx is not None and idx in store and store.record(idx)["converged"]
 
-                symmetry_record, mapping = None, None
-                try:
-                    if reduction is None or reduction.group.order == 1:
-                        run_points(full_tree)
-                    else:
-                        # the record and the mapping exist from the start, so a scan stopped
-                        # partway writes the mapped points of its stored representatives
-                        mapping = reduction.representative
-                        symmetry_record = {
-                            **reduction.to_json(),
-                            "verification": None,
-                            "computed_in_full": False,
-                        }
-                        run_points(search_tree(shape, root, order, allowed=reduction.computed))
-                        if all(rep in store for rep in reduction.computed):
-                            # chosen from the complete representatives only: a resumed scan
-                            # verifies the same points as an uninterrupted one
-                            reduction = choose_verify(
-                                reduction, store.done(), shape, symmetry.verify_points
+                    def positions(idx):
+                        cached = recent.get(idx)
+                        return cached if cached is not None else store.positions(idx)
+
+                    def run_points(parent, z=z):
+                        """Relax the points of the tree ``parent`` missing from the store."""
+
+                        def make_task(idx):
+                            par = parent[idx]
+                            ia, ib, iz = idx
+                            if not converged(par):
+                                return PointTask(idx, float(sa[ia]), float(sb[ib]), float(z[iz]))
+                            pa, pb, pz = par
+                            grand = parent[par]
+                            previous = {}
+                            if converged(grand) and grand[:2] == par[:2] == idx[:2]:
+                                previous = {
+                                    "previous_positions": positions(grand),
+                                    "previous_thickness": float(z[grand[2]]),
+                                }
+                            return PointTask(
+                                idx,
+                                float(sa[ia]),
+                                float(sb[ib]),
+                                float(z[iz]),
+                                positions(par),
+                                (float(sa[pa]), float(sb[pb])),
+                                float(z[pz]),
+                                par,
+                                **previous,
                             )
-                            symmetry_record.update(reduction.to_json())
-                            run_points(search_tree(shape, root, order, allowed=reduction.computed))
-                        if all(idx in store for idx in reduction.computed):
-                            area = cell_area(*in_plane_vectors(reference))
-                            check = verification(reduction, store.done(), area)
-                            symmetry_record["verification"] = check
-                            if symmetry_broken(check, symmetry):
-                                reason = fallback_reason(check, symmetry, reduction.group.order)
-                                symmetry_record["computed_in_full"] = True
-                                symmetry_record["computed_in_full_reason"] = reason
-                                notes.append(reason)
-                                mapping = None
-                                run_points(full_tree)
-                except KeyboardInterrupt:
-                    interrupted = True
+
+                        rank = {idx: k for k, idx in enumerate(parent)}
+                        pending = {idx for idx in parent if idx not in store}
+                        total = len(parent)
+                        stored = total - len(pending)
+                        if progress is not None:
+                            progress(stored, total)
+                        in_flight: dict[Any, tuple] = {}
+                        cap = 2 * max(1, getattr(executor, "workers", 1))
+                        queue = ReadyQueue(parent, rank, store, pending)
+                        while pending or in_flight:
+                            if (
+                                max_new_points is not None
+                                and len(computed_calls) + len(in_flight) >= max_new_points
+                                and not in_flight
+                            ):
+                                break
+                            while (
+                                queue
+                                and len(in_flight) < cap
+                                and (
+                                    max_new_points is None
+                                    or len(computed_calls) + len(in_flight) < max_new_points
+                                )
+                            ):
+                                idx = queue.pop()
+                                handle = executor.submit(run_task, context, make_task(idx))
+                                in_flight[handle] = idx
+                                pending.discard(idx)
+                            if not in_flight:
+                                break
+                            done, _ = executor.wait_first(in_flight)
+                            for handle in done:
+                                idx = in_flight.pop(handle)
+                                result = executor.result(handle)
+                                store.write(result)
+                                recent.put(idx, result.positions)
+                                queue.stored(idx)
+                                computed_calls.append(result.force_calls)
+                                stored += 1
+                                if progress is not None:
+                                    progress(stored, total)
+
+                    symmetry_record, mapping = None, None
+                    try:
+                        if reduction is None or reduction.group.order == 1:
+                            run_points(full_tree)
+                        else:
+                            # the record and the mapping exist from the start, so a scan
+                            # stopped partway writes the mapped points of its stored
+                            # representatives
+                            mapping = reduction.representative
+                            symmetry_record = {
+                                **reduction.to_json(),
+                                "verification": None,
+                                "computed_in_full": False,
+                            }
+                            run_points(
+                                _tree_in_store_order(z, shape, root, order, reduction.computed)
+                            )
+                            if all(rep in store for rep in reduction.computed):
+                                # chosen from the complete representatives only: a resumed
+                                # scan verifies the same points as an uninterrupted one
+                                reduction = choose_verify(
+                                    reduction, store.done(), shape, symmetry.verify_points
+                                )
+                                symmetry_record.update(reduction.to_json())
+                                run_points(
+                                    _tree_in_store_order(z, shape, root, order, reduction.computed)
+                                )
+                            if all(idx in store for idx in reduction.computed):
+                                area = cell_area(*in_plane_vectors(reference))
+                                check = verification(reduction, store.done(), area)
+                                symmetry_record["verification"] = check
+                                if symmetry_broken(check, symmetry):
+                                    reason = fallback_reason(check, symmetry, reduction.group.order)
+                                    symmetry_record["computed_in_full"] = True
+                                    symmetry_record["computed_in_full_reason"] = reason
+                                    notes.append(reason)
+                                    mapping = None
+                                    run_points(full_tree)
+                    except KeyboardInterrupt:
+                        interrupted = True
+                    if interrupted:
+                        break
+                    if not _extend(
+                        store,
+                        reference,
+                        grid,
+                        relax,
+                        max_new_points,
+                        bracket_loads_gpa,
+                        store.assemble(mapping, symmetry_record),
+                    ):
+                        break
+                    resolved = store.resolved
+                kept = list(store.resolved.get("notes", []))
+                notes = kept + [n for n in notes if n not in kept]
             finally:
                 if own_executor:
                     executor.close(cancel=True)
@@ -434,6 +598,7 @@ def run_scan(
                 interrupted=interrupted,
                 symmetry=symmetry_record,
                 points_stored=len(store),
+                load_folds=list(store.resolved.get("load_folds", [])),
             )
     except Exception:
         # a run that failed before storing a point (executor not reachable, probe error)

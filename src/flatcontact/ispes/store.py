@@ -376,7 +376,7 @@ class PointStore:
         ds = contract.empty_grid(
             grid["n_a"],
             grid["n_b"],
-            z,
+            np.sort(z),  # i_z is the position in the resolved list, which need not be sorted
             resolved["a1"],
             resolved["a2"],
             resolved["potential_label"],

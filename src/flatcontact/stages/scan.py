@@ -50,8 +50,9 @@ class ScanStageResult:
         return self.scan.dataset
 
     def to_json(self) -> dict:
-        """``scan.json``: counts, force calls, thicknesses, adhesion, notes, warnings and the
-        lateral slip of the planes inside each slab (``layer_slip``, :mod:`flatcontact.ispes.slip`)."""
+        """``scan.json``: counts, force calls, thicknesses, adhesion, notes, warnings,
+        ``load_folds`` (columns whose load folds and the loads refused, docs/file-contracts.md)
+        and the lateral slip of the planes inside each slab (``layer_slip``, :mod:`flatcontact.ispes.slip`)."""
         r, ds = self.scan, self.scan.dataset
         calls = r.force_calls_computed
         return {
@@ -71,6 +72,7 @@ class ScanStageResult:
             "adhesion": r.adhesion,
             "notes": list(r.notes),
             "warnings": list(self.warnings),
+            "load_folds": list(getattr(r, "load_folds", [])),
             "layer_slip": self.layer_slip,
         }
 
@@ -197,6 +199,7 @@ def run_scan(
         executor_options=s.executor_options(),
         progress=progress,
         symmetry=symmetry_settings(s),
+        bracket_loads_gpa=list(settings.analysis.p_gpa),
     )
     separated = _no_repulsive_branch(scan.dataset)
     if separated is not None:
