@@ -276,6 +276,16 @@ def test_a_significant_but_immaterial_negative_slope_is_used_with_a_note():
     assert gates.negative_slope(small).gate == "negative_slope"
 
 
+def test_a_negative_slope_without_an_interval_is_not_significant():
+    """Two loads give a line but no standard error: the interval has no width, so the sign
+    of the slope is not significant either way; it is used as fitted, with a note."""
+    two_loads = _laws(-8.4, -8.4, -8.4)
+    two_loads.update(p_max_gpa=0.6, tau0_mpa=31.0, sigma0_mpa=7.0)
+    assert gates.negative_slope(two_loads) is None
+    (note,) = gates.negative_slope_notes(two_loads)
+    assert "without an interval" in note and "used as fitted" in note
+
+
 def _two_site_map(depth_a, depth_b, n=16):
     """A square-lattice landscape with minima at (0.25, 0.25) and (0.75, 0.6) (fractions)."""
     s = np.arange(n) / n

@@ -610,6 +610,8 @@ def test_each_stage_through_the_cli_writes_the_files_of_the_run(tiny_run, tmp_pa
     run = json.loads((src / "06-contact" / "summary.json").read_text())
     assert run.pop("provenance")["tau0_mpa"] == "fitted laws"
     assert ours.pop("provenance")["tau0_mpa"] == "config"
+    # the validity gates judge a run's own scan and laws; numbers given as flags have none
+    assert run.pop("gates")["fired"] == [] and "gates" not in ours
     # the fitted laws carry their intervals into the contact outputs; numbers given as flags
     # have none: same central values, zero width from the CLI
     ours_iv, run_iv = ours.pop("intervals"), run.pop("intervals")

@@ -175,9 +175,20 @@ def _relative_drop(laws: Mapping, key: str, slope: float) -> float:
     return abs(slope) * p_max / intercept
 
 
+def _resolved(iv: tuple[float, float, float]) -> bool:
+    """The interval has a width: a fit through two loads has no standard error, so its
+    slope's sign is not significant either way (it is used as fitted, with a note)."""
+    return iv[2] > iv[1]
+
+
 def _material(laws: Mapping, key: str, iv: tuple[float, float, float]) -> bool:
-    """Whole interval below 0 and a fall beyond :data:`NEGATIVE_SLOPE_MIN_RELATIVE_DROP`."""
-    return iv[2] < 0 and _relative_drop(laws, key, iv[0]) > NEGATIVE_SLOPE_MIN_RELATIVE_DROP
+    """Whole (resolved) interval below 0 and a fall beyond
+    :data:`NEGATIVE_SLOPE_MIN_RELATIVE_DROP`."""
+    return (
+        _resolved(iv)
+        and iv[2] < 0
+        and _relative_drop(laws, key, iv[0]) > NEGATIVE_SLOPE_MIN_RELATIVE_DROP
+    )
 
 
 def negative_slope(laws: Mapping) -> Finding | None:
@@ -209,6 +220,12 @@ def negative_slope_notes(laws: Mapping) -> list[str]:
     notes = []
     for key, name, what in _SLOPES:
         iv = _interval(laws, key)
+        if iv is not None and iv[0] < 0 and not _resolved(iv):
+            notes.append(
+                f"{name} = {iv[0]:.3g} MPa/GPa is negative, from a fit without an interval "
+                "(too few loads for a standard error; give 3 or more): used as fitted"
+            )
+            continue
         if iv is not None and iv[2] < 0 and not _material(laws, key, iv):
             drop = _relative_drop(laws, key, iv[0])
             notes.append(
