@@ -22,7 +22,7 @@ from tests.cli.cli_helpers import one_error_line, run_cli
 
 from flatcontact.config.contact import ContactConfig
 from flatcontact.config.elastic import ElasticConfig
-from flatcontact.config.numbers import field_bounds
+from flatcontact.numbers import field_bounds
 from flatcontact.config.scan import ScanConfig
 from flatcontact.contact import experiment as ex
 from flatcontact.contact.parameters import ContactParameters

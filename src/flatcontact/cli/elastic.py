@@ -39,7 +39,7 @@ def elastic_cmd(
     for any material; without it, alpha-quartz with ``--potential``.
     """
     from flatcontact.config.elastic import ElasticConfig
-    from flatcontact.config.numbers import field_bounds
+    from flatcontact.numbers import field_bounds
     from flatcontact.elastic import quartz_contact_moduli
 
     try:  # the run's elastic.strain bounds

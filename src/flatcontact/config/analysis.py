@@ -8,7 +8,7 @@ from pydantic import Field, field_validator
 
 from flatcontact import limits
 from flatcontact.config.messages import show
-from flatcontact.config.numbers import physical
+from flatcontact.numbers import physical
 from flatcontact.config.section import Section
 from flatcontact.reference import PAPER_THRESHOLD_GPA
 

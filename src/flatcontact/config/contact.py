@@ -19,7 +19,7 @@ from pydantic import Field, field_validator
 
 from flatcontact import limits
 from flatcontact.config.messages import show
-from flatcontact.config.numbers import physical
+from flatcontact.numbers import physical
 from flatcontact.config.section import Section
 from flatcontact.reference import DEFAULT_P0_GPA, PAPER, PAPER_EXPERIMENT_P0_GPA
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pydantic import Field
 
-from flatcontact.config.numbers import physical
+from flatcontact.numbers import physical
 from flatcontact.config.section import Section
 
 

@@ -13,7 +13,7 @@ from pydantic import Field, field_validator, model_validator
 
 from flatcontact import limits
 from flatcontact.config.messages import show
-from flatcontact.config.numbers import physical
+from flatcontact.numbers import physical
 from flatcontact.config.section import Section, positive_pair
 
 #: ASE optimisers a scan point may use (:data:`flatcontact.ispes.relax.OPTIMIZERS`).

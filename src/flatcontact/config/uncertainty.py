@@ -5,7 +5,7 @@ from __future__ import annotations
 from pydantic import Field, field_validator
 
 from flatcontact.config.messages import show
-from flatcontact.config.numbers import physical
+from flatcontact.numbers import physical
 from flatcontact.config.section import Section
 
 #: The law coefficients an uncertainty block may name (τ = k·P + τ0, σ = μ·P + σ0).
