@@ -13,8 +13,8 @@ from pydantic import Field, field_validator, model_validator
 
 from flatcontact import limits
 from flatcontact.config.messages import show
-from flatcontact.numbers import physical
 from flatcontact.config.section import Section, positive_pair
+from flatcontact.numbers import physical
 
 #: ASE optimisers a scan point may use (:data:`flatcontact.ispes.relax.OPTIMIZERS`).
 OPTIMIZERS: tuple[str, ...] = ("FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch")
@@ -63,7 +63,7 @@ class ScanConfig(Section):
         DEFAULT_OPTIMIZER,
         description="ASE optimiser of each point: " + ", ".join(OPTIMIZERS),
     )
-    max_steps: int = Field(2000, ge=1, description="optimiser step cap per point")
+    max_steps: int = Field(2000, ge=1, le=1_000_000, description="optimiser step cap per point")
     relax_mode: Literal["full", "normal", "rigid-layers", "rigid"] = Field(
         "full",
         # left out of the dumped config while default, so existing run fingerprints are unchanged

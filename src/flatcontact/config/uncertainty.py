@@ -5,8 +5,8 @@ from __future__ import annotations
 from pydantic import Field, field_validator
 
 from flatcontact.config.messages import show
-from flatcontact.numbers import physical
 from flatcontact.config.section import Section
+from flatcontact.numbers import physical
 
 #: The law coefficients an uncertainty block may name (τ = k·P + τ0, σ = μ·P + σ0).
 LAW_KEYS = ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa")
