@@ -7,6 +7,7 @@ keeps them equal), so the settings import no physics.
 
 from __future__ import annotations
 
+import re
 from typing import Any, Literal
 
 from pydantic import Field, field_validator, model_validator
@@ -22,6 +23,33 @@ OPTIMIZERS: tuple[str, ...] = ("FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch
 DEFAULT_OPTIMIZER = "LBFGS"
 #: Warm-start orders of the scan (:data:`flatcontact.ispes.order.PREFERENCES`).
 PREFERENCES: tuple[str, ...] = ("columns", "planes", "cold")
+
+
+#: Transports a Dask scheduler address may name (``tcp://host:8786``; bare ``host:8786`` is tcp).
+DASK_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
+_HOST_PORT = re.compile(
+    r"(?P<host>\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9](?:[A-Za-z0-9.-]*[A-Za-z0-9])?):(?P<port>\d{1,5})"
+)
+
+
+def parse_dask_address(address: str) -> tuple[str, str, int]:
+    """(scheme, host, port) of a Dask scheduler address, or ValueError saying what is expected.
+
+    The form is checked before anything connects (``garbage`` used to cost a 10 s
+    timeout): ``[scheme://]host:port`` with a scheme of :data:`DASK_SCHEMES`, a host name or
+    IP address (IPv6 in brackets) and a port 1..65535.
+    """
+    text = str(address).strip()
+    scheme, sep, rest = text.partition("://")
+    if not sep:
+        scheme, rest = "tcp", text
+    match = _HOST_PORT.fullmatch(rest)
+    if scheme not in DASK_SCHEMES or match is None or not 1 <= int(match["port"]) <= 65535:
+        raise ValueError(
+            f"expected a Dask scheduler address [{'|'.join(DASK_SCHEMES)}://]host:port "
+            f"(port 1..65535), e.g. tcp://10.0.0.5:8786, got {show(address)}"
+        )
+    return scheme, match["host"].strip("[]"), int(match["port"])
 
 
 class PressureRange(Section):
@@ -107,6 +135,13 @@ class ScanConfig(Section):
     def _order(cls, value: str) -> str:
         if value not in PREFERENCES:
             raise ValueError(f"expected one of {', '.join(PREFERENCES)}, got {show(value)}")
+        return value
+
+    @field_validator("dask_address")
+    @classmethod
+    def _dask_address(cls, value: str | None) -> str | None:
+        if value is not None:
+            parse_dask_address(value)
         return value
 
     @field_validator("grid", mode="before")
