@@ -78,13 +78,6 @@ class LJSpec(BaseModel):
             out["-".join(sorted(parts))] = float(c6)
         return dict(sorted(out.items()))
 
-    @field_validator("c6_scale", "hamaker_zj")
-    @classmethod
-    def _positive_scalar(cls, value: float | None) -> float | None:
-        if value is not None and not value > 0:
-            raise ValueError(f"expected > 0, got {value}")
-        return value
-
     @model_validator(mode="after")
     def _hamaker_needs_densities(self) -> LJSpec:
         if self.hamaker_zj is not None:
