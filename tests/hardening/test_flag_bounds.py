@@ -118,6 +118,44 @@ def test_a_number_flag_out_of_bounds_is_one_line_naming_it(case, tmp_path, capsy
     assert_refused_cleanly(argv, capsys, tmp_path, [flag])
 
 
+#: list-valued number flags (typed as text, parsed by the command): (argv, the flag)
+LIST_CASES = {
+    "analyze-p-nan": (["analyze", "{tmp}/ispes.nc", "--p-gpa", "nan"], "--p-gpa"),
+    "analyze-p-subnormal": (["analyze", "{tmp}/ispes.nc", "1e-320"], "--p-gpa"),
+    "analyze-p-huge": (["analyze", "{tmp}/ispes.nc", "--p-gpa", "0.5,1e300"], "--p-gpa"),
+    "validate-p-huge": (
+        [
+            "validate-potential",
+            "vashishta",
+            "--ispes",
+            "--reference",
+            "tersoff",
+            "--p-gpa",
+            "0,1e300",
+        ],
+        "--p-gpa",
+    ),
+    "contact-p0-nan": (["contact", "--out", "{tmp}/c", "--p0-gpa", "nan"], "--p0-gpa"),
+    "contact-fit-p0-subnormal": (
+        ["contact", "--out", "{tmp}/c", "--fit-p0-gpa", "1e-320"],
+        "--fit-p0-gpa",
+    ),
+    "scan-thickness-huge": (["scan", "--out", "{tmp}/s", "--thickness", "1e300"], "--thickness"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(LIST_CASES))
+def test_a_list_number_flag_out_of_bounds_is_one_line_naming_it(
+    case, tmp_path, capsys, monkeypatch
+):
+    """Number lists given as text (``--p-gpa 0.5,1``, positional loads) are held to the
+    bounds of the setting they fill, before any file is read."""
+    argv, flag = LIST_CASES[case]
+    (tmp_path / "ispes.nc").write_bytes(b"")
+    monkeypatch.chdir(tmp_path)
+    assert_refused_cleanly([a.format(tmp=tmp_path) for a in argv], capsys, tmp_path, [flag])
+
+
 #: structure: sections with one float out of its bound, and the field the line must name
 RECIPE_CASES = {
     "quartz-gap-huge": ("{kind: quartz-dense, gap_angstrom: 1e300}", "structure.gap_angstrom"),
