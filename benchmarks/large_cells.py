@@ -44,6 +44,14 @@ def quartz_interface(n: int):
     return ref.repeat((n, n, 1))
 
 
+def graphene_interface(n: int):
+    """AB bilayer graphene, three sheets per slab (the outer one held), repeated n×n."""
+    from flatcontact.structures.construct import build_interface
+
+    ref, _ = build_interface({"kind": "sheets", "sheet": "graphene", "layers": 3, "stacking": "AB"})
+    return ref.repeat((n, n, 1))
+
+
 def one_point(system: str, n: int, threads: int) -> dict:
     """Build, relax one point, report seconds, calls and memory."""
     from flatcontact.ispes.geometry import thickness
@@ -56,6 +64,10 @@ def one_point(system: str, n: int, threads: int) -> dict:
         ref = cu_interface(n)
         model = InteractionModel(preset="cu-eam")
         shift = (1 / (3 * n), 1 / (3 * n))
+    elif system == "graphene":
+        ref = graphene_interface(n)
+        model = InteractionModel(preset="graphene-rebo-kc")
+        shift = (1 / (6 * n), 1 / (6 * n))
     else:
         ref = quartz_interface(n)
         model = InteractionModel(intra="snap:sio2-snap")

@@ -62,7 +62,10 @@ LAYERS: tuple[tuple[str, frozenset[str]], ...] = (
     ),
     ("presentation", frozenset({"plots", "report"})),
     ("stages", frozenset({"stages"})),
-    ("front doors", frozenset({"cli", "pipeline"})),
+    # runs of the stages: one run (pipeline) and studies over many runs (studies import the
+    # pipeline; the CLI, above, imports both)
+    ("runs", frozenset({"pipeline", "studies"})),
+    ("front doors", frozenset({"cli"})),
 )
 
 #: Which other cores each physics core may import: a core package, or one module of it

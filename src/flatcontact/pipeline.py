@@ -96,6 +96,7 @@ from flatcontact.stages.contact import (
     run_contact,
 )
 from flatcontact.stages.elastic import ElasticInputs, run_elastic
+from flatcontact.stages.gates import GateInputs, check_gates, evaluate_gates
 from flatcontact.stages.laws import LawsInputs, run_laws
 from flatcontact.stages.preflight import check_inputs
 from flatcontact.stages.report import ReportInputs, run_report
@@ -457,13 +458,27 @@ class Pipeline:
         self._run("elastic", inputs, lambda folder: run_elastic(cfg, ElasticInputs(), folder))
         return self._json("elastic", ELASTIC_JSON)
 
-    def _contact_inputs(self):
+    def gates(self):
+        """The validity gates on the scan, the analysis and the laws
+        (:func:`flatcontact.stages.gates.evaluate_gates`; a
+        :class:`flatcontact.analysis.gates.GateReport`)."""
+        return evaluate_gates(
+            GateInputs(
+                interface=self._upstream("build").folder / INTERFACE,
+                scan_json=self._upstream("scan").folder / SCAN_JSON,
+                friction_nc=self._upstream("analyze").folder / FRICTION_NC,
+                laws_json=self._upstream("laws").folder / LAWS_JSON,
+            )
+        )
+
+    def _contact_inputs(self, gates: dict | None = None):
         adhesion = self.scan_summary().get("adhesion") or {}
         return ContactInputs(
             laws=self._json("laws", LAWS_JSON),
             work_of_separation_j_per_m2=adhesion.get("work_of_separation_j_per_m2"),
             from_scan=True,
             moduli=self._json("elastic", ELASTIC_JSON) if self.config.elastic.enabled else None,
+            gates=gates,
         )
 
     def contact_parameters(self):
@@ -485,8 +500,11 @@ class Pipeline:
         laws = self._upstream("laws")
         scan = self._upstream("scan")
         elastic = self._upstream("elastic") if cfg.elastic.enabled else None
-        stage_inputs = self._contact_inputs()
-        # before the stage folder is touched: a refused p0 keeps the previous results
+        # before the stage folder is touched: a gate that fired, or a refused p0, stops the
+        # run with the finished stages kept (rerun with contact.accept_untrusted to go on)
+        gates = self.gates()
+        check_gates(cfg, gates)
+        stage_inputs = self._contact_inputs(gates.to_json(cfg.contact.accept_untrusted))
         check_contact(cfg, contact_parameters(cfg, stage_inputs)[0])
         inputs = {
             "contact": portable(cfg.section("contact"), "experiment_csv", "fit_csv"),
@@ -494,6 +512,8 @@ class Pipeline:
             "scan": scan.fingerprint,
             "elastic": elastic.fingerprint if elastic else None,
         }
+        if stage_inputs.gates["fired"] or stage_inputs.gates["notes"]:
+            inputs["gates"] = stage_inputs.gates  # the recorded verdict (a clean run: no key)
         if cfg.contact.experiment.csv:
             inputs["experiment_sha256"] = file_sha256(cfg.contact.experiment.csv)
         if cfg.contact.fit.csv:

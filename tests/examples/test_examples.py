@@ -10,11 +10,14 @@ thickness); bad inputs are refused in one line naming the field before any work.
 Slow (end to end, ``flatcontact run examples/NAME.yaml``): the 2D examples' named stacking
 energies at P = 0 equal the plain-LAMMPS constant-load values (each stacking's rigid E(z)
 minimised over z with scipy), symmetry-equivalent stackings are equal to round-off, and the
-Cu(111) zero-load ISPES has the intrinsic stacking-fault energy of Mishin et al. (2001).
+Cu(111) zero-load ISPES has the intrinsic stacking-fault energy of Mishin et al. (2001); the
+H-terminated diamond(111)/graphene work of separation equals a plain-LAMMPS AIREBO energy
+difference and its ISPES has the H over the hexagon centre at the minimum, over a C at the maxima.
 """
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -138,7 +141,7 @@ def test_every_example_loads_and_its_model_knows_its_elements(path):
     from flatcontact.structures.construct import build_interface
 
     cfg = load_config(path)
-    assert cfg.structure.kind in ("quartz-dense", "sheets", "fcc111")
+    assert cfg.structure.kind in ("quartz-dense", "sheets", "fcc111", "crystal")
     if cfg.structure.kind == "quartz-dense":
         assert {"Si", "O"} <= set(cfg.potential.elements or {"Si", "O"})
         check_moduli_source(cfg)
@@ -157,8 +160,10 @@ def test_expected_examples_are_present():
         "hbn-bilayer-ilp",
         "mos2-bilayer-ilp",
         "cu111-eam",
+        "au111-cif-eam",
         "quartz-paper",
         "graphene-hbn-ilp",
+        "diamond111-h-graphene-airebo",
     }
 
 
@@ -361,6 +366,50 @@ def test_cu111_gamma_surface_has_mishins_stacking_fault_energy(tmp_path):
     assert isf_mj_m2 == pytest.approx(44.4, rel=0.1)
 
 
+
+def _ase_eam_stacking_energy_mev_per_a2(potential_file: str, a_angstrom: float, shift) -> float:
+    """An fcc(111) stack of 8 planes (ASE's ``fcc111``, vacuum on both sides) whose upper four
+    planes are shifted by ``shift`` (fractions of a1, a2), every atom relaxed along z only
+    (ASE's own EAM calculator and BFGS, not LAMMPS), energy per area above the unshifted stack."""
+    from ase.build import fcc111
+    from ase.calculators.eam import EAM
+    from ase.constraints import FixedLine
+    from ase.optimize import BFGS
+
+    def energy_per_area(frac):
+        stack = fcc111("Au", size=(1, 1, 8), a=a_angstrom, vacuum=10.0, orthogonal=False)
+        cell = stack.cell.array
+        upper = stack.positions[:, 2] > stack.positions[:, 2].mean()
+        stack.positions[upper, :2] += frac[0] * cell[0, :2] + frac[1] * cell[1, :2]
+        stack.calc = EAM(potential=potential_file)
+        stack.set_constraint([FixedLine(i, [0, 0, 1]) for i in range(len(stack))])
+        BFGS(stack, logfile=None).run(fmax=1e-4)
+        return stack.get_potential_energy() / np.linalg.norm(np.cross(cell[0], cell[1]))
+
+    return (energy_per_area(shift) - energy_per_area((0.0, 0.0))) * MEV
+
+
+@pytest.mark.slow
+def test_au111_from_a_cif_has_the_stacking_energies_of_an_independent_ase_eam_stack(tmp_path):
+    """The metal-from-a-CIF example end to end (automatic thicknesses, W from the relaxed
+    slabs): its zero-load stackings equal an 8-plane Au(111) stack computed here with ASE's
+    own EAM reader of the same ``Au_u3.eam`` (relaxed along z): the intrinsic stacking fault
+    at (1/3, 1/3) and the on-top stacking at (2/3, 2/3). Measured: 0.2959 vs 0.2978 and
+    34.511 vs 34.479 meV/Å² (the run holds its outer planes; the stack relaxes them)."""
+    root = _run("au111-cif-eam", tmp_path / "au")
+    named = _stackings(root / "03-analyze" / "friction.csv")[0.0]
+    pot = f("Au_u3.eam")
+    isf = _ase_eam_stacking_energy_mev_per_a2(pot, 4.078, (1 / 3, 1 / 3))
+    on_top = _ase_eam_stacking_energy_mev_per_a2(pot, 4.078, (2 / 3, 2 / 3))
+    assert min(named.values()) == pytest.approx(0.0, abs=1e-9)
+    assert named["BA"] == pytest.approx(isf, rel=0.02)
+    assert named["AA"] == pytest.approx(on_top, rel=0.005)
+    scan = json.loads((root / "02-scan" / "scan.json").read_text())
+    # the ideal work of separation of a bonded metal is 2γ(111) > 0, never 0 or 4γ
+    assert 1.0 < scan["adhesion"]["work_of_separation_j_per_m2"] < 2.0
+    html = (root / "report.html").read_text()
+    assert "intrinsic stacking fault" in html
+
 def test_build_cli_takes_a_monolayer_slab_file_and_a_config(tmp_path):
     """`build --structure graphene_1L --potential graphene-rebo-kc`: the slab recipe finds the
     single layer, tags it as both faces (2 / 3) and holds it; `build --config` builds a
@@ -384,3 +433,60 @@ def test_build_cli_takes_a_monolayer_slab_file_and_a_config(tmp_path):
     assert result.exit_code == 0, result.output
     cu = read_interface(tmp_path / "c" / "interface.extxyz")
     assert cu.info["material"].startswith("Cu") and len(cu) == 8
+
+
+def _lateral_distance_to_carbon(reference, shift) -> float:
+    """Lateral distance (Å) from slab 1's H to the nearest C of slab 2 moved by ``shift``."""
+    cell = reference.cell.array[:2, :2]
+    sym = np.array(reference.get_chemical_symbols())
+    top = reference.arrays["slab"] == 2
+    h = reference.positions[(sym == "H") & ~top][0, :2]
+    carbons = reference.positions[top, :2] + np.asarray(shift) @ cell
+    frac = np.linalg.solve(cell.T, (carbons - h).T).T
+    frac = (frac + 0.5) % 1.0 - 0.5
+    return float(np.linalg.norm(frac @ cell, axis=1).min())
+
+
+@pytest.mark.slow
+def test_h_diamond_on_graphene_adhesion_and_registries(tmp_path):
+    """``run examples/diamond111-h-graphene-airebo.yaml``: W equals E(slab 1) + E(slab 2) −
+    E(interface) of a plain LAMMPS AIREBO input on the built interface (rigid; the tool relaxes
+    each part, measured 0.3 % apart), at a van der Waals scale (graphite's interlayer binding is
+    0.2–0.4 J/m²); at the zero-load thickness the ISPES minimum puts the H over the hexagon centre
+    (a/√3 from every C) and the maxima put it over a C of either sublattice, equal by symmetry
+    (the held sheet is rigid, the diamond relaxes along z); τ positive at every load."""
+    import pandas as pd
+
+    from flatcontact.ispes.contract import open_ispes
+    from flatcontact.structures.interface_io import read_interface
+
+    root = _run("diamond111-h-graphene-airebo", tmp_path / "ch")
+    reference = read_interface(root / "01-build" / "interface.extxyz")
+    ds = open_ispes(root / "02-scan" / "ispes.nc")
+    area = float(ds.attrs["area"])
+    commands = ["pair_style airebo 3.0 1 1", f"pair_coeff * * {f('CH.airebo')} C H"]
+    slab = reference.arrays["slab"]
+
+    def energy(atoms):
+        types = [1 if s == "C" else 2 for s in atoms.get_chemical_symbols()]
+        return lammps_energy(atoms, types, commands, ntypes=2)
+
+    plain_w = energy(reference[slab == 1]) + energy(reference[slab == 2]) - energy(reference)
+    plain_w_j_m2 = plain_w / area * 16.0217663
+    w = float(ds.attrs["work_of_separation_j_per_m2"])
+    assert w == pytest.approx(plain_w_j_m2, rel=0.02)
+    assert 0.05 < w < 0.5
+    iz = int(np.argmin(np.abs(ds.thickness.values - ds.attrs["equilibrium_thickness_angstrom"])))
+    e = ds["energy"].values[:, :, iz]
+    a = float(np.linalg.norm(reference.cell.array[0]))
+    shifts = [(sa, sb) for sa in ds.shift_a.values for sb in ds.shift_b.values]
+    dist = np.array([_lateral_distance_to_carbon(reference, sh) for sh in shifts])
+    flat = e.ravel()
+    assert dist[np.argmin(flat)] == pytest.approx(a / np.sqrt(3.0), abs=1e-6)  # hollow
+    atop = np.isclose(dist, 0.0, atol=1e-6)
+    assert atop.sum() == 2  # over a C of each sublattice
+    assert atop[np.argmax(flat)]  # the highest point is over a C
+    barrier = flat[atop] - flat.min()
+    assert barrier[0] == pytest.approx(barrier[1], rel=0.01)
+    table = pd.read_csv(root / "03-analyze" / "friction.csv")
+    assert (table.tau_mpa > 0).all() and (table.tau_mpa < 1000).all()

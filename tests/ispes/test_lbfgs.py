@@ -168,3 +168,127 @@ def test_converged_start_costs_one_evaluation():
 
     out = lbfgs_relax(evaluate, atoms.positions, lambda v: v, 1e-3, 10)
     assert out.converged and out.steps == 0 and len(calls) == out.force_calls == 1
+
+
+def explicit_loops(pairs, g, alpha):
+    """ASE's two-loop recursion written out (Nocedal & Wright, Algorithm 7.4)."""
+    q = g.copy()
+    a = np.empty(len(pairs))
+    for i in range(len(pairs) - 1, -1, -1):
+        s, y = pairs[i]
+        a[i] = np.dot(s, q) / np.dot(y, s)
+        q -= a[i] * y
+    z = q / alpha
+    for i, (s, y) in enumerate(pairs):
+        b = np.dot(y, z) / np.dot(y, s)
+        z += s * (a[i] - b)
+    return z
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    n=st.integers(3, 90),
+    memory=st.integers(1, 12),
+    steps=st.integers(1, 30),
+    held=st.floats(0.0, 0.5),
+)
+def test_push_equals_the_loops_on_random_histories(seed, n, memory, steps, held):
+    """The step's path (four matrix-vector products, products of the new pair from the saved
+    ones) equals the loops to 1e-12 at every step of a random history: gradients of a random
+    convex quadratic plus noise, steps s = t P(H g) with random scales t and a random set of
+    held coordinates (P zeroes them), the ring wrapping when steps > memory."""
+    rng = np.random.default_rng(seed)
+    mask = rng.random(n) >= held
+    mask[: n // 2] = True  # at least half the coordinates free
+    q, _ = np.linalg.qr(rng.normal(size=(n, n)))
+    k = q @ np.diag(rng.uniform(0.5, 60.0, n)) @ q.T
+
+    def grad(x):
+        return mask * (k @ x + 1e-3 * rng.normal(size=n))
+
+    mem = TwoLoopMemory(n, memory=memory, alpha=70.0)
+    x = rng.normal(size=n) * mask
+    g = grad(x)
+    d = mem.inverse_hessian_times(g)
+    pairs = []
+    for _ in range(steps):
+        t = -rng.uniform(0.1, 1.0)
+        x_new = x + t * (mask * d)
+        g_new = grad(x_new)
+        s, y = x_new - x, g_new - g
+        pairs = [*pairs, (s, y)][-memory:]
+        d = mem.push(s, y, g_new, t)
+        want = explicit_loops(pairs, g_new, 70.0)
+        assert np.abs(d - want).max() <= 1e-12 * np.abs(want).max()
+        x, g = x_new, g_new
+
+
+def test_memory_rule():
+    """ASE's 100 pairs up to 1,000 atoms (every preset and example: their iterates stay);
+    beyond, the stored coordinates m·n stay within the budget, never below the floor."""
+    from flatcontact.ispes.lbfgs import (
+        ASE_MEMORY,
+        MIN_LARGE_CELL_MEMORY,
+        PAIR_BUDGET_COORDS,
+        memory_for,
+    )
+
+    assert memory_for(3 * 36) == memory_for(3 * 1000) == ASE_MEMORY
+    sizes = [3 * a for a in (1001, 1536, 4704, 10_000, 20_184, 100_000)]
+    got = [memory_for(n) for n in sizes]
+    assert got == sorted(got, reverse=True) and got[0] < ASE_MEMORY
+    for n, m in zip(sizes, got, strict=True):
+        assert m * n <= PAIR_BUDGET_COORDS or m == MIN_LARGE_CELL_MEMORY
+        assert (m + 1) * n > PAIR_BUDGET_COORDS
+    assert memory_for(3 * 4704) == 21 and memory_for(3 * 20_184) == MIN_LARGE_CELL_MEMORY
+    with pytest.raises(ValueError, match="n_coords"):
+        memory_for(0)
+
+
+@pytest.mark.parametrize("memory", [None, 3])
+def test_converges_on_a_large_quadratic(memory):
+    """E = ½ Σ k_i (x_i - x0_i)² on 4,000 atoms (the memory rule's regime: 12,000 coordinates,
+    25 pairs): converged means every atomic force below fmax, so |x - x0| < fmax/k_min per
+    component; held atoms stay put."""
+    rng = np.random.default_rng(5)
+    shape = (4000, 3)
+    kk = rng.uniform(1.0, 30.0, shape)
+    x0 = rng.normal(size=shape)
+    held = np.zeros(shape, dtype=bool)
+    held[:100] = True
+
+    def evaluate(x):
+        d = x - x0
+        return 0.5 * float(np.sum(kk * d * d)), -kk * d
+
+    def project(v):
+        out = v.copy()
+        out[held] = 0.0
+        return out
+
+    start = x0 + rng.normal(scale=0.3, size=shape)
+    out = lbfgs_relax(evaluate, start, project, 1e-4, 500, memory=memory)
+    assert out.converged and out.force_calls == out.steps + 1
+    free = ~held
+    assert np.abs(out.positions - x0)[free].max() < 1e-4 / 1.0
+    np.testing.assert_array_equal(out.positions[held], start[held])
+
+
+def test_converges_on_rosenbrock_pairs():
+    """Σ over atoms of the Rosenbrock valley (1 - u)² + 10 (v - u²)² + w² (u, v, w the atom's
+    coordinates): minimum at (1, 1, 0) for every atom, a curved valley that a fixed step
+    would crawl along. Both ASE's memory and the large-cell floor reach it."""
+    rng = np.random.default_rng(2)
+    start = rng.uniform(-1.5, 1.5, (50, 3))
+
+    def evaluate(x):
+        u, v, w = x[:, 0], x[:, 1], x[:, 2]
+        energy = np.sum((1 - u) ** 2 + 10 * (v - u * u) ** 2 + w * w)
+        grad = np.stack([-2 * (1 - u) - 40 * u * (v - u * u), 20 * (v - u * u), 2 * w], axis=1)
+        return float(energy), -grad
+
+    for memory in (100, 20):
+        out = lbfgs_relax(evaluate, start, lambda v: v.copy(), 1e-6, 2000, memory=memory)
+        assert out.converged and out.steps < 2000
+        np.testing.assert_allclose(out.positions, np.tile([1.0, 1.0, 0.0], (50, 1)), atol=1e-5)

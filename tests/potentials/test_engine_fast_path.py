@@ -118,3 +118,35 @@ def test_vertical_cell_change_keeps_the_engine(close_interface):
     atoms.set_cell(atoms.cell.array * [[1.01], [1.01], [1.0]], scale_atoms=True)
     atoms.get_forces()
     assert calc.engine is not engine
+
+
+def test_positions_keep_lammps_images_so_no_spurious_rebuild():
+    """Atoms on the cell boundary (Cu(111) lattice sites at fractional 0) are handed to LAMMPS
+    at the image LAMMPS holds: re-evaluating the same structure, or one moved by less than
+    the skin, moves no atom by a lattice vector (which forced a neighbour rebuild per call)."""
+    from flatcontact.structures.construct import build_interface
+
+    atoms, _ = build_interface({"kind": "fcc111", "element": "Cu", "layers": 4})
+    atoms = atoms.repeat((14, 14, 1))  # 1,568 atoms: here the wrap and LAMMPS disagree
+    setup = compile_setup(InteractionModel(preset="cu-eam"), atoms)
+    engine = LammpsEngine(setup, atoms.cell.array, atoms.pbc)
+    try:
+        engine.compute(atoms.positions)
+        rows, x, _ = engine._views()
+        before = x[rows].copy()
+        wrapped = engine.box.to_lammps(atoms.positions)
+        # the case the images matter for: LAMMPS and the plain wrap disagree on some atoms
+        assert np.abs(wrapped - before).max() > 1.0
+        engine.compute(atoms.positions)
+        rows, x, _ = engine._views()
+        assert np.abs(x[rows] - before).max() < 1e-12  # the same images, to round-off
+        rng = np.random.default_rng(1)
+        step = rng.normal(scale=0.05, size=atoms.positions.shape)
+        moved = engine.compute(atoms.positions + step)
+        rows, x, _ = engine._views()
+        assert np.abs(x[rows] - before).max() < 0.5  # every atom at its own image
+        want = _fresh(setup, atoms.cell.array, atoms.pbc, atoms.positions + step, False)
+        assert moved[0] == pytest.approx(want[0], rel=1e-11, abs=1e-9)
+        np.testing.assert_allclose(moved[1], want[1], rtol=0, atol=1e-9)
+    finally:
+        engine.close()

@@ -7,7 +7,8 @@ target load ``P``:
    per area, in eV/Å², zeroed at the global minimum of the landscape at the
    lowest requested ``P`` (``energy_zero="lowest-p"``, the default), at each
    load's own minimum (``"each"``), or left absolute (``"none"``);
-2. its exact periodic interpolant (:mod:`.periodic`);
+2. its exact periodic interpolant (:mod:`.periodic`), averaged over the interface's
+   shift-space group when the grid stores one (symmetry-equal stackings equal to round-off);
 3. the zero-perpendicular-force path from the global minimum along the pulling
    direction (:mod:`.path`) and, on request, the string-method MEP to the
    equivalent minimum that the path reaches; when other inequivalent minima
@@ -152,6 +153,7 @@ def analyze_ispes(
     source: str = "ISPES grid",
     load_source: str = DEFAULT_LOAD_SOURCE,
     with_stackings: bool = True,
+    symmetrise: bool = True,
 ) -> AnalysisResult:
     """Analyse an ISPES grid at the loads ``p_gpa`` (see module docstring).
 
@@ -196,6 +198,11 @@ def analyze_ispes(
         Find, classify and name the stationary points of each load's landscape and the
         minimum-energy-path barrier (:mod:`.stackings`); their symmetry classes make
         equivalent minima starts (:mod:`.starts`).
+    symmetrise
+        Average each load's interpolant over the shift-space group the grid stores
+        (``symmetry_*`` attributes of the scan, :func:`flatcontact.ispes.contract.symmetry_operations`;
+        :meth:`.periodic.PeriodicSurface.symmetrised`); a grid without them (identity only)
+        is interpolated as it is.
     """
     p = check_pressures(p_gpa)
     auto = isinstance(direction_deg, str)
@@ -241,10 +248,15 @@ def analyze_ispes(
     timings["constant_pressure"] = time.perf_counter() - clock
 
     a1, a2 = cp.a1, cp.a2
+    group = contract.symmetry_operations(ds) if symmetrise else []
+
+    def surface(values: np.ndarray) -> PeriodicSurface:
+        return PeriodicSurface(values, a1, a2).symmetrised(group)
+
     surfaces, minima = [], []
     clock = time.perf_counter()
     for i in range(p.size):
-        surf = PeriodicSurface(cp.energy_ev_per_a2[i], a1, a2)
+        surf = surface(cp.energy_ev_per_a2[i])
         surfaces.append(surf)
         minima.append(surf.global_minimum())
     if energy_zero == "lowest-p":
@@ -253,7 +265,7 @@ def analyze_ispes(
         refs = [m[1] for m in minima]
     else:
         refs = [0.0] * p.size
-    surfaces = [PeriodicSurface(s.values - r, a1, a2) for s, r in zip(surfaces, refs, strict=True)]
+    surfaces = [surface(s.values - r) for s, r in zip(surfaces, refs, strict=True)]
     timings["interpolation"] = time.perf_counter() - clock
 
     stackings: list[Stackings | None] = [None] * p.size

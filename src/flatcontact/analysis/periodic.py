@@ -102,6 +102,47 @@ class PeriodicSurface:
         self.k = k
         self.l = ll
 
+    # ------------------------------------------------------------------ symmetry
+    def symmetrised(self, operations: list[tuple[np.ndarray, np.ndarray]]) -> PeriodicSurface:
+        """The group average ``(1/|G|) Σ_g e(M_g s + t_g)`` of this interpolant.
+
+        ``operations``: the shift-space group as ``(M, t)`` in the fractional basis
+        (:func:`flatcontact.ispes.contract.symmetry_operations`). Since
+        ``e(M s + t) = Σ c_G e^{2πi G·t} e^{2πi (MᵀG)·s}``, the average has the coefficient
+        ``(1/|G|) Σ_g c_G e^{2πi G·t_g}`` at ``M_gᵀ G``: its frequency set is the union of the
+        orbits of the grid's (a set closed under the group, unlike the grid's own square set
+        on a hexagonal lattice), so symmetry-equal stackings are equal to round-off and no
+        artefact of the square set appears. If the samples obey the group on the grid it
+        still reproduces them exactly (each term interpolates the same samples); otherwise it
+        interpolates their group average. ``values`` becomes that average.
+        """
+        if len(operations) <= 1:
+            return self
+        ks, ls = np.meshgrid(self.k, self.l, indexing="ij")
+        g = np.stack([ks.ravel(), ls.ravel()], -1)
+        c = self.coefficients.ravel()
+        keep = c != 0
+        g, c = g[keep], c[keep]
+        mapped = [
+            (g @ np.asarray(m, float), c * np.exp(1j * TWO_PI * (g @ np.asarray(t, float))))
+            for m, t in operations
+        ]
+        kmax = int(max(np.max(np.abs(gm[:, 0])) for gm, _ in mapped))
+        lmax = int(max(np.max(np.abs(gm[:, 1])) for gm, _ in mapped))
+        coef = np.zeros((2 * kmax + 1, 2 * lmax + 1), complex)
+        for gm, cm in mapped:
+            gi = np.round(gm).astype(int)
+            np.add.at(coef, (gi[:, 0] + kmax, gi[:, 1] + lmax), cm / len(operations))
+        out = object.__new__(PeriodicSurface)
+        out.lattice, out.inverse = self.lattice, self.inverse
+        out.a1, out.a2 = self.a1, self.a2
+        out.coefficients = coef
+        out.k = np.arange(-kmax, kmax + 1, dtype=float)
+        out.l = np.arange(-lmax, lmax + 1, dtype=float)
+        n_a, n_b = self.values.shape
+        out.values = out.sample(np.arange(n_a) / n_a, np.arange(n_b) / n_b)
+        return out
+
     # ------------------------------------------------------------------ coordinates
     def fractional(self, xy: np.ndarray) -> np.ndarray:
         """Fractional coordinates of Cartesian points (Å)."""

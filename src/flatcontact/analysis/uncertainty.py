@@ -129,14 +129,47 @@ def law_half_widths(
     return out
 
 
-def law_intervals(laws: Mapping, half_widths: Mapping[str, float]) -> dict[str, dict]:
-    """``{coefficient: {"value", "low", "high", "half_width"}}`` for ``laws.json``."""
+def law_components(
+    laws: Mapping,
+    *,
+    convergence: Mapping[str, float] | None = None,
+    model: Mapping[str, float] | None = None,
+) -> dict[str, dict[str, float]]:
+    """The three parts of each coefficient's uncertainty, before the coverage multiple.
+
+    ``{coefficient: {"fit": se_fit, "convergence": δ_conv, "models": δ_model}}`` (units of the
+    coefficient); :func:`law_half_widths` is ``coverage · sqrt(fit² + convergence² + models²)``
+    of these.
+    """
+    convergence = convergence or {}
+    model = model or {}
+    return {
+        key: {
+            "fit": _num(laws.get(err), f"laws.{err}"),
+            "convergence": abs(float(convergence.get(key) or 0.0)),
+            "models": _num(model.get(key), f"model.{key}"),
+        }
+        for key, err in LAW_COEFFICIENTS.items()
+    }
+
+
+def law_intervals(
+    laws: Mapping,
+    half_widths: Mapping[str, float],
+    components: Mapping[str, Mapping[str, float]] | None = None,
+) -> dict[str, dict]:
+    """``{coefficient: {"value", "low", "high", "half_width"[, "components"]}}`` for ``laws.json``.
+
+    ``components`` (:func:`law_components`) are stored beside each interval, so a reader
+    sees how much of the half-width is the fit, the convergence and the model spread."""
     out = {}
     for key in LAW_COEFFICIENTS:
         if laws.get(key) is None:
             continue
         v, h = float(laws[key]), float(half_widths.get(key, 0.0))
         out[key] = {"value": v, "low": v - h, "high": v + h, "half_width": h}
+        if components is not None:
+            out[key]["components"] = dict(components[key])
     return out
 
 

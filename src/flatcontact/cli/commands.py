@@ -15,4 +15,7 @@ from flatcontact.cli import (  # noqa: F401  (imported for their @app.command re
 )
 
 # isort: split
-from flatcontact.cli import elastic  # noqa: F401  (listed after validate-potential)
+from flatcontact.cli import (
+    elastic,  # noqa: F401  (listed after validate-potential)
+    study,  # noqa: F401  (study convergence|models, last)
+)

@@ -27,6 +27,16 @@ from flatcontact.reference import DEFAULT_P0_GPA, PAPER, PAPER_EXPERIMENT_P0_GPA
 #: (:data:`flatcontact.contact.cycle.DEFAULT_AMPLITUDE_FRACTIONS`; a test keeps them equal).
 CYCLE_AMPLITUDE_FRACTIONS: tuple[float, ...] = (0.2, 0.4, 0.6, 0.8, 0.9, 0.95)
 
+#: The validity gates (:data:`flatcontact.analysis.gates.GATES`; a test keeps them equal).
+GATE_NAMES: tuple[str, ...] = (
+    "in_slab_slip",
+    "broken_symmetry",
+    "load_fold",
+    "negative_slope",
+    "degenerate_minima",
+)
+Gate = Literal[GATE_NAMES]
+
 #: Peak Hertz pressure p0 (1 kPa .. 1 TPa).
 PressureGPa = physical(1e-6, 1e3, "GPa")
 #: A fraction strictly inside (0, 1), kept off both ends.
@@ -167,6 +177,13 @@ class ContactConfig(Section):
     collapse_fraction: Fraction = Field(
         0.2, description="collapse: stiffness first below this fraction of the plateau"
     )
+    accept_untrusted: list[Gate] = Field(
+        [],
+        description="validity gates to pass although they fired (in_slab_slip, "
+        "broken_symmetry, load_fold, negative_slope, degenerate_minima): the contact stage "
+        "then runs on the numbers and the report says above its figures which are not to be "
+        "trusted and why; empty: a gate that fires stops the run before the contact stage",
+    )
     cycle: CycleConfig = Field(
         default_factory=CycleConfig, description="the oscillation cycle per p0 (off by default)"
     )
@@ -179,6 +196,11 @@ class ContactConfig(Section):
         description="a measured stiffness curve for the Fig. 6 overlay (off without "
         "experiment.csv)",
     )
+
+    @field_validator("accept_untrusted")
+    @classmethod
+    def _accepted(cls, value: list[str]) -> list[str]:
+        return list(dict.fromkeys(value))
 
     @field_validator("p0_gpa")
     @classmethod

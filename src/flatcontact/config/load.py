@@ -57,6 +57,12 @@ def build_config(
     if replaces_model(data.get("potential")):
         base.pop("potential")  # a preset, a calculator or new styles: not the default's LJ
     merged = merge_config(base, data)
+    if "uncertainty" in base and "uncertainty" not in data:
+        # the preset's measured uncertainty belongs to the preset's interface and model only
+        if merged.get("structure") != base.get("structure") or merged.get("potential") != base.get(
+            "potential"
+        ):
+            merged.pop("uncertainty")
     try:
         return RunConfig.model_validate(merged)
     except ValidationError as exc:

@@ -18,6 +18,7 @@ from flatcontact.config.analysis import AnalysisConfig
 from flatcontact.config.contact import ContactConfig
 from flatcontact.config.elastic import ElasticConfig
 from flatcontact.config.messages import show
+from flatcontact.config.refine import RefineConfig
 from flatcontact.config.report import ReportConfig
 from flatcontact.config.scan import PressureRange, ScanConfig
 from flatcontact.config.section import Section
@@ -81,6 +82,10 @@ class RunConfig(Section):
     )
     contact: ContactConfig = Field(
         default_factory=ContactConfig, description="modified Mindlin contact (stage contact)"
+    )
+    refine: RefineConfig = Field(
+        default_factory=RefineConfig,
+        description="what 'flatcontact study convergence' refines and how far (no stage reads it)",
     )
     report: ReportConfig = Field(
         default_factory=ReportConfig, description="the HTML report and figures (stage report)"

@@ -70,6 +70,36 @@ class PressureRange(Section):
         return self
 
 
+class SymmetryConfig(Section):
+    """Irreducible registries: one relaxation per orbit of the interface's shift-space group."""
+
+    enabled: bool | Literal["auto"] = Field(
+        "auto",
+        description="relax one registry per orbit of the interface's shift-space group and fill "
+        "the grid by symmetry; auto: on unless relax_mode is full (a full relaxation can break "
+        "the symmetry at unstable registries, which a few verified points may miss); false: "
+        "relax every grid point",
+    )
+    verify_points: int = Field(
+        2, ge=0, le=64, description="mapped points also relaxed and compared with their registry"
+    )
+    tolerance_angstrom: physical(1e-6, 0.1, "Å") = Field(
+        1e-3, description="structural tolerance of the group (Å per atom)"
+    )
+    energy_tolerance_mev_per_a2: physical(1e-9, 10.0, "meV/Å²") = Field(
+        1e-2,
+        description="largest accepted energy difference of a verified point (meV/Å²; two full "
+        "scans of Cu(111) at fmax 0.005 eV/Å differ by up to 9e-4); above it "
+        "the relaxation breaks the symmetry and every point is computed",
+    )
+    stress_tolerance_gpa: physical(1e-9, 10.0, "GPa") = Field(
+        0.5,
+        description="largest accepted normal-load difference of a verified point (GPa; the "
+        "reaction load is only as precise as fmax/area: two full scans of the 8-atom Cu(111) "
+        "cell differ by up to 0.19 GPa)",
+    )
+
+
 class ScanConfig(Section):
     """The ISPES grid (stage ``scan``)."""
 
@@ -109,6 +139,10 @@ class ScanConfig(Section):
     order: str = Field(
         "columns",
         description="warm-start tree: columns (walk each column along z), planes, cold",
+    )
+    symmetry: SymmetryConfig = Field(
+        default_factory=SymmetryConfig,
+        description="irreducible registries (shift-space symmetry of the interface)",
     )
     executor: Literal["serial", "processes", "dask"] = Field(
         "processes", description="serial, local processes, or Dask"

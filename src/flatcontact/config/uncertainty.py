@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 from pydantic import Field, field_validator
 
 from flatcontact.config.messages import show
@@ -10,6 +12,8 @@ from flatcontact.numbers import physical
 
 #: The law coefficients an uncertainty block may name (τ = k·P + τ0, σ = μ·P + σ0).
 LAW_KEYS = ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa")
+#: The fingerprints of ``measured_on`` (:mod:`flatcontact.stages.measured_on`).
+MEASURED_ON_KEYS = ("structure_sha256", "model_sha256")
 
 
 class UncertaintyConfig(Section):
@@ -35,6 +39,27 @@ class UncertaintyConfig(Section):
         1.0, description="multiple of the combined standard error"
     )
     source: str = Field("", description="where the δ_conv and δ_model numbers come from")
+    measured_on: dict[str, str] = Field(
+        {},
+        description="fingerprints of what the numbers were measured on (structure_sha256, "
+        "model_sha256; written by flatcontact study): a run whose structure or potential "
+        "differs refuses the block",
+    )
+    provenance: dict[str, Any] = Field(
+        {}, description="how the numbers were made (study, command, date, variants)"
+    )
+
+    @field_validator("measured_on")
+    @classmethod
+    def _measured_on(cls, value: dict[str, str]) -> dict[str, str]:
+        for key, v in value.items():
+            if key not in MEASURED_ON_KEYS:
+                raise ValueError(f"{key!r}: expected keys among {', '.join(MEASURED_ON_KEYS)}")
+            if not (
+                isinstance(v, str) and len(v) == 64 and all(c in "0123456789abcdef" for c in v)
+            ):
+                raise ValueError(f"{key} = {show(v)}: expected a SHA-256 hex digest")
+        return value
 
     @field_validator(
         "convergence_internal",

@@ -12,11 +12,17 @@ variables (all on ``(shift_a, shift_b, thickness)``)
     ``energy``: total potential energy of the cell, eV.
     ``normal_stress``: normal load per area, GPa, positive when the slabs are
     pressed together.
-    ``converged``: bool; ``force_calls``: int.
+    ``converged``: bool; ``force_calls``: int; ``mapped`` (optional, bool): the point was not
+    relaxed but filled from a symmetry-equal registry (a symmetry-reduced scan,
+    :mod:`flatcontact.ispes.reduction`).
 attrs
     ``a1``, ``a2``: in-plane primitive vectors (Å, 2-vectors in the x-y plane);
     ``area``: |a1 × a2| in Å²; ``potential``: description of the model;
-    ``flatcontact_version``.
+    ``flatcontact_version``; a scan adds ``grid_points``, ``computed_points`` (relaxed) and the
+    shift-space group the values obey (optional; absent means the identity only):
+    ``symmetry_order`` n, ``symmetry_matrices`` (4n integers: M row by row per operation) and
+    ``symmetry_translations`` (2n fractions t), each operation mapping the fractional shift
+    ``s`` to ``M s + t`` (mod 1) with E(M s + t) = E(s) (:func:`symmetry_operations`).
 
 Points not computed yet are NaN with ``converged = False``.
 
@@ -58,6 +64,7 @@ VAR_ENERGY = "energy"
 VAR_STRESS = "normal_stress"
 VAR_CONVERGED = "converged"
 VAR_FORCE_CALLS = "force_calls"
+VAR_MAPPED = "mapped"
 
 REQUIRED_VARIABLES = (VAR_ENERGY, VAR_STRESS)
 REQUIRED_ATTRS = ("a1", "a2", "area")
@@ -79,6 +86,37 @@ def fractional_shifts(n: int) -> np.ndarray:
     if n < 1:
         raise InputError(f"grid size must be at least 1 lateral point, got {n}")
     return np.arange(n) / n
+
+
+def symmetry_attrs(operations: list[dict]) -> dict:
+    """The ``symmetry_*`` attributes of a list of ``{"matrix": 2×2, "translation": 2}``."""
+    m = np.array([op["matrix"] for op in operations], dtype=np.int64).reshape(-1)
+    t = np.array([op["translation"] for op in operations], dtype=float).reshape(-1)
+    return {"symmetry_order": len(operations), "symmetry_matrices": m, "symmetry_translations": t}
+
+
+def symmetry_operations(ds: xr.Dataset) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The shift-space operations ``(M, t)`` a grid's values obey (identity only if none stored).
+
+    Raises
+    ------
+    InputError
+        If the ``symmetry_*`` attributes are inconsistent (sizes, non-integer M, |det M| ≠ 1).
+    """
+    n = int(np.asarray(ds.attrs.get("symmetry_order", 1)).ravel()[0])
+    if n <= 1 or "symmetry_matrices" not in ds.attrs:
+        return [(np.eye(2, dtype=int), np.zeros(2))]
+    m = np.asarray(ds.attrs["symmetry_matrices"], dtype=float).ravel()
+    t = np.asarray(ds.attrs.get("symmetry_translations", np.zeros(2 * n)), dtype=float).ravel()
+    if m.size != 4 * n or t.size != 2 * n or not np.allclose(m, np.round(m)):
+        raise InputError(
+            f"symmetry attributes: expected {4 * n} integer matrix entries and {2 * n} "
+            f"translations for symmetry_order {n}, got {m.size} and {t.size}"
+        )
+    ms = np.round(m).astype(int).reshape(n, 2, 2)
+    if not np.all(np.abs(np.abs(np.round(np.linalg.det(ms)))) == 1):
+        raise InputError("symmetry attributes: every matrix must have determinant ±1")
+    return [(ms[k], t[2 * k : 2 * k + 2]) for k in range(n)]
 
 
 def cell_area(a1: np.ndarray, a2: np.ndarray) -> float:

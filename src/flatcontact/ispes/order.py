@@ -49,25 +49,38 @@ def neighbours(
 
 
 def search_tree(
-    shape: tuple[int, int, int], root: Index, prefer: Preference = "columns"
+    shape: tuple[int, int, int],
+    root: Index,
+    prefer: Preference = "columns",
+    allowed: set[Index] | None = None,
 ) -> dict[Index, Index | None]:
     """Parent of every grid point in a breadth-first search from ``root`` (``None`` for roots).
 
     The returned dict is in visiting order. With ``prefer="cold"`` every point is a root.
+    ``allowed`` (the points a symmetry-reduced scan computes, :mod:`.shift_symmetry`)
+    restricts the tree to those points: the search walks only through them, and an allowed
+    point it cannot reach becomes a further root (a cold start), searched from in turn.
     """
     na, nb, nz = shape
     if prefer not in PREFERENCES:
         raise ValueError(f"order: expected one of {PREFERENCES}, got {prefer!r}")
+    every = [(a, b, z) for z in range(nz) for a in range(na) for b in range(nb)]
+    if allowed is not None:
+        every = [idx for idx in every if idx in allowed]
     if prefer == "cold":
-        return {(a, b, z): None for z in range(nz) for a in range(na) for b in range(nb)}
-    parent: dict[Index, Index | None] = {root: None}
-    queue = deque([root])
-    while queue:
-        node = queue.popleft()
-        for nxt in neighbours(node, shape, prefer):
-            if nxt not in parent:
-                parent[nxt] = node
-                queue.append(nxt)
+        return dict.fromkeys(every)
+    parent: dict[Index, Index | None] = {}
+    for start in [root, *every]:
+        if start in parent or (allowed is not None and start not in allowed):
+            continue
+        parent[start] = None
+        queue = deque([start])
+        while queue:
+            node = queue.popleft()
+            for nxt in neighbours(node, shape, prefer):
+                if nxt not in parent and (allowed is None or nxt in allowed):
+                    parent[nxt] = node
+                    queue.append(nxt)
     return parent
 
 

@@ -26,11 +26,19 @@ import numpy as np
 from ase import Atoms
 
 from flatcontact.errors import InputError
-from flatcontact.ispes import executors
+from flatcontact.ispes import contract, executors
+from flatcontact.ispes.contract import cell_area
 from flatcontact.ispes.geometry import in_plane_vectors, thickness, validate_interface
 from flatcontact.ispes.grid import GridSpec, check_thicknesses
 from flatcontact.ispes.order import PREFERENCES, search_tree
 from flatcontact.ispes.probe import extreme_stackings, probe_column, rigid_stackings
+from flatcontact.ispes.reduction import (
+    SymmetrySettings,
+    choose_verify,
+    plan_reduction,
+    symmetry_broken,
+    verification,
+)
 from flatcontact.ispes.relax import (
     PointTask,
     RelaxSettings,
@@ -39,6 +47,7 @@ from flatcontact.ispes.relax import (
     run_task,
     worker_calculator,
 )
+from flatcontact.ispes.shift_symmetry import shift_space_group
 from flatcontact.ispes.store import PointStore, discard_store, interface_hash
 from flatcontact.ispes.thicknesses import probe_thicknesses
 from flatcontact.ispes.work_of_separation import ideal_work_of_separation
@@ -60,6 +69,11 @@ class ScanResult:
     adhesion: dict | None
     notes: list[str]
     interrupted: bool = False
+    #: the shift-space group, the verification and whether the grid was computed in full
+    #: (:mod:`flatcontact.ispes.reduction`); None when the scan computed every point
+    symmetry: dict | None = None
+    #: relaxed points in the store (``points_done`` also counts the points filled by symmetry)
+    points_stored: int = 0
 
 
 def check_interface(atoms: Atoms) -> None:
@@ -71,14 +85,27 @@ def check_interface(atoms: Atoms) -> None:
     validate_interface(atoms, "interface")
 
 
-def scan_settings(reference: Atoms, factory: Any, grid: GridSpec, relax: RelaxSettings) -> dict:
-    """The store fingerprint of a scan (everything that changes the numbers)."""
-    return {
+def scan_settings(
+    reference: Atoms,
+    factory: Any,
+    grid: GridSpec,
+    relax: RelaxSettings,
+    symmetry: SymmetrySettings | None = None,
+) -> dict:
+    """The store fingerprint of a scan (everything that changes the numbers).
+
+    The symmetry settings enter only when the reduction is on, so a store of a scan that
+    computes every point keeps its fingerprint.
+    """
+    out = {
         "interface_sha256": interface_hash(reference),
         "potential": json.loads(factory.fingerprint),
         "relax": relax.as_dict(),
         "grid": grid.as_dict(),
     }
+    if symmetry is not None and symmetry.enabled:
+        out["symmetry"] = symmetry.as_dict()
+    return out
 
 
 def _probe(
@@ -163,6 +190,7 @@ def run_scan(
     executor_options: dict | None = None,
     progress: Callable[[int, int], None] | None = None,
     max_new_points: int | None = None,
+    symmetry: SymmetrySettings | None = None,
 ) -> ScanResult:
     """Compute the ISPES grid of ``reference`` with ``factory``'s calculator into ``out_dir``.
 
@@ -191,6 +219,10 @@ def run_scan(
         dynamics; the CLI draws its progress bar from it.
     max_new_points
         Stop after computing this many new points (benchmarks); the store stays resumable.
+    symmetry
+        Irreducible registries (:mod:`flatcontact.ispes.reduction`): relax one point per orbit
+        of the interface's shift-space group, verify some mapped points, fill the rest.
+        ``None``: every point is relaxed (``SymmetrySettings(enabled=False)``).
 
     Returns
     -------
@@ -198,6 +230,7 @@ def run_scan(
     """
     t0 = time.perf_counter()
     relax = relax or RelaxSettings()
+    symmetry = symmetry or SymmetrySettings(enabled=False)
     if order not in PREFERENCES:
         raise InputError(f"order: expected one of {', '.join(PREFERENCES)}, got {order!r}")
     check_interface(reference)
@@ -211,7 +244,7 @@ def run_scan(
     store = None
     try:
         with PointStore(
-            store_path, scan_settings(reference, factory, grid, relax), reference
+            store_path, scan_settings(reference, factory, grid, relax, symmetry), reference
         ) as store:
             own_executor = executor is None
             if own_executor:
@@ -257,17 +290,16 @@ def run_scan(
                 shape = (grid.n_a, grid.n_b, z.size)
                 sa, sb = grid.shifts()
                 root = (0, 0, int(np.argmin(np.abs(z - thickness(reference)))))
-                parent = search_tree(shape, root, order)
+                full_tree = search_tree(shape, root, order)
+                reduction = None
+                if symmetry.enabled:
+                    group = shift_space_group(
+                        reference,
+                        symmetry.tolerance_angstrom,
+                        spread_compression=relax.mode != "rigid",
+                    ).for_grid(grid.n_a, grid.n_b)
+                    reduction = plan_reduction(group, shape, list(full_tree))
                 context = ScanContext(reference, factory, relax)
-                rank = {idx: k for k, idx in enumerate(parent)}
-                todo = [idx for idx in parent if idx not in store]
-                total = len(parent)
-                if progress is not None:
-                    progress(len(store), total)
-                in_flight: dict[Any, tuple] = {}
-                cap = 2 * max(1, getattr(executor, "workers", 1))
-                pending = set(todo)
-                queue = ReadyQueue(parent, rank, store, pending)
                 recent = PositionsCache()
 
                 def converged(idx):
@@ -277,50 +309,62 @@ def run_scan(
                     cached = recent.get(idx)
                     return cached if cached is not None else store.positions(idx)
 
-                def make_task(idx):
-                    par = parent[idx]
-                    ia, ib, iz = idx
-                    if not converged(par):
-                        return PointTask(idx, float(sa[ia]), float(sb[ib]), float(z[iz]))
-                    pa, pb, pz = par
-                    grand = parent[par]
-                    previous = {}
-                    if converged(grand) and grand[:2] == par[:2] == idx[:2]:
-                        previous = {
-                            "previous_positions": positions(grand),
-                            "previous_thickness": float(z[grand[2]]),
-                        }
-                    return PointTask(
-                        idx,
-                        float(sa[ia]),
-                        float(sb[ib]),
-                        float(z[iz]),
-                        positions(par),
-                        (float(sa[pa]), float(sb[pb])),
-                        float(z[pz]),
-                        par,
-                        **previous,
-                    )
+                def run_points(parent):
+                    """Relax the points of the tree ``parent`` missing from the store."""
 
-                submitted = 0
-                try:
+                    def make_task(idx):
+                        par = parent[idx]
+                        ia, ib, iz = idx
+                        if not converged(par):
+                            return PointTask(idx, float(sa[ia]), float(sb[ib]), float(z[iz]))
+                        pa, pb, pz = par
+                        grand = parent[par]
+                        previous = {}
+                        if converged(grand) and grand[:2] == par[:2] == idx[:2]:
+                            previous = {
+                                "previous_positions": positions(grand),
+                                "previous_thickness": float(z[grand[2]]),
+                            }
+                        return PointTask(
+                            idx,
+                            float(sa[ia]),
+                            float(sb[ib]),
+                            float(z[iz]),
+                            positions(par),
+                            (float(sa[pa]), float(sb[pb])),
+                            float(z[pz]),
+                            par,
+                            **previous,
+                        )
+
+                    rank = {idx: k for k, idx in enumerate(parent)}
+                    pending = {idx for idx in parent if idx not in store}
+                    total = len(parent)
+                    stored = total - len(pending)
+                    if progress is not None:
+                        progress(stored, total)
+                    in_flight: dict[Any, tuple] = {}
+                    cap = 2 * max(1, getattr(executor, "workers", 1))
+                    queue = ReadyQueue(parent, rank, store, pending)
                     while pending or in_flight:
                         if (
                             max_new_points is not None
-                            and submitted >= max_new_points
+                            and len(computed_calls) + len(in_flight) >= max_new_points
                             and not in_flight
                         ):
                             break
                         while (
                             queue
                             and len(in_flight) < cap
-                            and (max_new_points is None or submitted < max_new_points)
+                            and (
+                                max_new_points is None
+                                or len(computed_calls) + len(in_flight) < max_new_points
+                            )
                         ):
                             idx = queue.pop()
                             handle = executor.submit(run_task, context, make_task(idx))
                             in_flight[handle] = idx
                             pending.discard(idx)
-                            submitted += 1
                         if not in_flight:
                             break
                         done, _ = executor.wait_first(in_flight)
@@ -331,27 +375,65 @@ def run_scan(
                             recent.put(idx, result.positions)
                             queue.stored(idx)
                             computed_calls.append(result.force_calls)
+                            stored += 1
                             if progress is not None:
-                                progress(len(store), total)
+                                progress(stored, total)
+
+                symmetry_record = None
+                try:
+                    if reduction is None or reduction.group.order == 1:
+                        run_points(full_tree)
+                    else:
+                        run_points(search_tree(shape, root, order, allowed=reduction.computed))
+                        reduction = choose_verify(
+                            reduction, store.done(), shape, symmetry.verify_points
+                        )
+                        run_points(search_tree(shape, root, order, allowed=reduction.computed))
+                        area = cell_area(*in_plane_vectors(reference))
+                        check = verification(reduction, store.done(), area)
+                        symmetry_record = {
+                            **reduction.to_json(),
+                            "verification": check,
+                            "computed_in_full": False,
+                        }
+                        if all(idx in store for idx in reduction.computed) and symmetry_broken(
+                            check, symmetry
+                        ):
+                            symmetry_record["computed_in_full"] = True
+                            notes.append(
+                                f"symmetry: a verified point differs from its representative by "
+                                f"{check['max_energy_difference_mev_per_a2']:.3g} meV/Å², "
+                                f"{check['max_stress_difference_gpa']:.3g} GPa (tolerance "
+                                f"{symmetry.energy_tolerance_mev_per_a2:g} meV/Å², "
+                                f"{symmetry.stress_tolerance_gpa:g} GPa): the relaxation breaks "
+                                f"the interface's shift-space symmetry (order "
+                                f"{reduction.group.order}); every grid point is computed"
+                            )
+                            run_points(full_tree)
                 except KeyboardInterrupt:
                     interrupted = True
             finally:
                 if own_executor:
                     executor.close(cancel=True)
-            ds = store.assemble()
-            path = store.write_ispes(out_dir / ISPES_NC)
+            mapping = None
+            if symmetry_record is not None and not symmetry_record["computed_in_full"]:
+                mapping = reduction.representative
+            ds = store.assemble(mapping, symmetry_record)
+            path = contract.write_ispes(ds, out_dir / ISPES_NC)
             result = ScanResult(
                 dataset=ds,
                 ispes_path=path,
                 store_path=store.path,
                 points_total=int(np.prod(shape)),
-                points_done=len(store),
+                points_done=int(ds.attrs["points_done"]),
                 points_computed=len(computed_calls),
                 seconds=time.perf_counter() - t0,
                 force_calls_computed=computed_calls,
                 adhesion=resolved.get("adhesion"),
                 notes=notes,
                 interrupted=interrupted,
+                symmetry=symmetry_record,
+                points_stored=len(store),
             )
     except Exception:
         # a run that failed before storing a point (executor not reachable, probe error)

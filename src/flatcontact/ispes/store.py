@@ -342,8 +342,16 @@ class PointStore:
         )
 
     # -- assembly -------------------------------------------------------------------
-    def assemble(self) -> xr.Dataset:
-        """The ``ispes.nc`` dataset of this store (missing points NaN, ``converged=False``)."""
+    def assemble(self, mapping: dict | None = None, symmetry: dict | None = None) -> xr.Dataset:
+        """The ``ispes.nc`` dataset of this store (missing points NaN, ``converged=False``).
+
+        ``mapping`` (a symmetry-reduced scan, :mod:`flatcontact.ispes.reduction`): grid index
+        -> the index of its representative; a point not stored takes its representative's
+        energy, normal stress and convergence, with ``mapped = True`` and ``force_calls = 0``.
+        ``symmetry``: the scan's group record; its operations are stored as attributes
+        (``symmetry_order``, ``symmetry_matrices``, ``symmetry_translations``, see
+        :mod:`flatcontact.ispes.contract`) when the points were mapped, else the identity.
+        """
         resolved = self.resolved
         if resolved is None:
             raise InputError(f"{self.path}: the grid is not resolved yet (no thicknesses recorded)")
@@ -354,8 +362,13 @@ class PointStore:
             "optimizer": self.settings["relax"]["optimizer"],
             "interface_sha256": self.settings["interface_sha256"],
             "points_total": int(grid["n_a"] * grid["n_b"] * z.size),
-            "points_done": len(self._done),
+            "grid_points": int(grid["n_a"] * grid["n_b"] * z.size),
+            "computed_points": len(self._done),
         }
+        ops = (symmetry or {}).get("operations") if mapping is not None else None
+        if not ops:
+            ops = [{"matrix": [[1, 0], [0, 1]], "translation": [0.0, 0.0]}]
+        extra.update(contract.symmetry_attrs(ops))
         for key, value in (resolved.get("adhesion") or {}).items():
             extra[key] = (
                 int(value) if isinstance(value, bool) else value
@@ -378,6 +391,17 @@ class PointStore:
             ds[contract.VAR_STRESS].values[ia, ib, k] = rec["normal_stress_gpa"]
             ds[contract.VAR_CONVERGED].values[ia, ib, k] = rec["converged"]
             ds[contract.VAR_FORCE_CALLS].values[ia, ib, k] = rec["force_calls"]
+        mapped = np.zeros(ds[contract.VAR_ENERGY].shape, dtype=bool)
+        for (ia, ib, iz), rep in (mapping or {}).items():
+            if (ia, ib, iz) in self._done or tuple(rep) not in self._done:
+                continue
+            rec, k = self._done[tuple(rep)], int(rank[iz])
+            ds[contract.VAR_ENERGY].values[ia, ib, k] = rec["energy_ev"]
+            ds[contract.VAR_STRESS].values[ia, ib, k] = rec["normal_stress_gpa"]
+            ds[contract.VAR_CONVERGED].values[ia, ib, k] = rec["converged"]
+            mapped[ia, ib, k] = True
+        ds[contract.VAR_MAPPED] = (contract.DIMS, mapped)
+        ds.attrs["points_done"] = len(self._done) + int(mapped.sum())
         return ds
 
     def write_ispes(self, path: str | os.PathLike[str]) -> Path:

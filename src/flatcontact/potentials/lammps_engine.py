@@ -174,10 +174,11 @@ class LammpsEngine:
         box = self.box.to_lammps(positions)
         lmp = self.lmp
         rows, x, _ = self._views()
-        x[rows] = box
         if self._ready:  # one force evaluation behind the neighbour check, no setup
+            x[rows] = self.box.nearest_images(box, x[rows])
             lmp.command("run 1 pre no post no")
         else:
+            x[rows] = box
             lmp.command("run 0 post no")
             self._ready = True
         energy = float(lmp.get_thermo("pe"))

@@ -31,6 +31,7 @@ from flatcontact.report.sections.analysis import analysis_section
 from flatcontact.report.sections.build import interface_material, interface_section
 from flatcontact.report.sections.comparison import own_results_section, paper_section
 from flatcontact.report.sections.contact import contact_section
+from flatcontact.report.sections.gates import gates_section
 from flatcontact.report.sections.laws import laws_section
 from flatcontact.report.sections.scan import scan_section
 from flatcontact.report.sections.summary import summary_section
@@ -56,7 +57,9 @@ def build_sections(
     ``stage_rows``: (stage, state, seconds, finished) of the summary table. The section
     next to the summary compares the run with the paper when its slabs are the paper's
     α-quartz (:func:`flatcontact.reference.is_paper_material`), else shows its results alone;
-    only then does any section show a value of the paper. Stackings are named for the
+    only then does any section show a value of the paper. A validity gate passed with
+    ``contact.accept_untrusted`` (``summary.json["gates"]``) puts a box above everything
+    (:mod:`flatcontact.report.sections.gates`). Stackings are named for the
     interface's family (:func:`flatcontact.report.stacking_names.stacking_family`).
     """
     f_build, f_scan = folders["build"], folders["scan"]
@@ -72,7 +75,9 @@ def build_sections(
     material = interface_material(interface)
     paper = is_paper_material(cfg, set(interface.get_chemical_symbols()))
     family = stacking_family(build)
-    sections = [summary_section(cfg, material, model, scan, stage_rows)]
+    gates = gates_section(contact)  # above everything: which numbers are not to be trusted
+    sections = [gates] if gates is not None else []
+    sections.append(summary_section(cfg, material, model, scan, stage_rows))
     if paper:
         sections.append(paper_section(cfg, laws, scan, contact))
     else:

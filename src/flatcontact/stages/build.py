@@ -122,4 +122,31 @@ def structure_elements(recipe) -> set[str] | None:
     path = {"file": "file", "slab": "file", "crystal": "bulk"}.get(recipe.kind)
     if path is None:
         return None
-    return set(read_structure(getattr(recipe, path), f"structure.{path}").get_chemical_symbols())
+    elements = set(
+        read_structure(getattr(recipe, path), f"structure.{path}").get_chemical_symbols()
+    )
+    if recipe.kind == "crystal":
+        elements |= _crystal_extra_elements(recipe)
+    return elements
+
+
+def _crystal_extra_elements(recipe) -> set[str]:
+    """Elements a crystal recipe adds to its bulk file: slab 2's material and the passivating
+    H (an OH adds O only where the crystal has O)."""
+    from ase.formula import Formula
+
+    from flatcontact.structures.sheet_catalog import BUILTIN_SHEETS
+    from flatcontact.structures.structure_file import read_structure
+
+    out: set[str] = set()
+    slab2 = recipe.slab2
+    if recipe.passivate != "none" or getattr(slab2, "passivate", "none") != "none":
+        out.add("H")
+    if slab2 is None:
+        return out
+    if hasattr(slab2, "bulk"):
+        atoms = read_structure(slab2.bulk, "structure.slab2.bulk")
+        return out | set(atoms.get_chemical_symbols())
+    if slab2.sheet in BUILTIN_SHEETS:
+        return out | set(Formula(BUILTIN_SHEETS[slab2.sheet].formula).count())
+    return out | set(read_structure(slab2.sheet, "structure.slab2.sheet").get_chemical_symbols())

@@ -75,13 +75,16 @@ class ContactInputs:
     ``laws``: ``laws.json`` of the laws stage (k, τ0, μ, σ0 where ``contact`` gives none);
     ``work_of_separation_j_per_m2``: the scan's (w where ``contact.work_of_adhesion_j_m2``
     is null; ``from_scan`` says a scan was read); ``moduli``: ``elastic.json`` of the elastic
-    stage (E*, G* replacing ``contact.contact_modulus_gpa``/``shear_modulus_gpa``).
+    stage (E*, G* replacing ``contact.contact_modulus_gpa``/``shear_modulus_gpa``);
+    ``gates``: the validity gates' report (:meth:`flatcontact.analysis.gates.GateReport.to_json`,
+    :mod:`flatcontact.stages.gates`), recorded in ``summary.json["gates"]``.
     """
 
     laws: dict | None = None
     work_of_separation_j_per_m2: float | None = None
     from_scan: bool = False
     moduli: dict | None = None
+    gates: dict | None = None
 
 
 def contact_parameters(settings, inputs: ContactInputs):
@@ -316,6 +319,7 @@ class ContactResult:
     fit_files: list[dict] = field(default_factory=list)
     intervals: dict | None = None  # contact_intervals: the laws' uncertainty carried through
     bands: tuple | None = None  # analyses at the lower and upper corner of the law box
+    gates: dict | None = None  # the validity gates that fired and which were overridden
     files: list[Path] = field(default_factory=list)
 
     def cycle_rows(self) -> list[dict]:
@@ -349,6 +353,8 @@ class ContactResult:
             doc["experiment"] = self.experiment
         if self.intervals is not None:
             doc["intervals"] = self.intervals
+        if self.gates is not None:
+            doc["gates"] = self.gates
         if self.cycles:
             doc["conventions"]["cycle"] = (
                 "Q(t) = Q_amp sin(theta); first harmonic u'_1 sin(theta) - u''_1 cos(theta); "
@@ -398,6 +404,7 @@ def run_contact(
             knee_fraction=c.knee_fraction,
         )
     result = ContactResult(analysis, params, provenance, c.knee_fraction, paper)
+    result.gates = inputs.gates
     half_widths = law_half_widths_used(inputs, provenance)
     result.intervals = contact_intervals(settings, params, half_widths)
     if any(h > 0 for h in half_widths.values()) and "unavailable" not in result.intervals:

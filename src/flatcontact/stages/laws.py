@@ -108,7 +108,7 @@ class LawsResult:
         ``intervals``, per-load ``loads``, ``warnings``), with ``uncertainty`` stating the
         inputs (fit standard errors, ``convergence_<form>``, ``model_spread_<form>``,
         ``coverage``, ``source``)."""
-        from flatcontact.analysis.uncertainty import law_intervals
+        from flatcontact.analysis.uncertainty import law_components, law_intervals
 
         doc = {**self.laws.to_json(), "warnings": self.warnings, "energy_form": self.form}
         loads = {
@@ -123,10 +123,15 @@ class LawsResult:
             warns[other_form(self.form)] = self.other["warnings"]
         for form, laws in self.form_laws().items():
             hw = self.half_widths(form)
+            parts = law_components(
+                laws,
+                convergence=self.uncertainty.get(f"convergence_{form}", {}),
+                model=self.uncertainty.get(f"model_spread_{form}", {}),
+            )
             doc[form] = {
                 **laws,
                 "half_widths": hw,
-                "intervals": law_intervals(laws, hw),
+                "intervals": law_intervals(laws, hw, parts),
                 "loads": loads[form],
                 "warnings": warns[form],
             }

@@ -25,6 +25,7 @@ from flatcontact.stages import _calculator
 from flatcontact.stages.build import structure_elements
 from flatcontact.stages.contact import check_fit_settings, check_moduli_source
 from flatcontact.stages.elastic import bulk_crystal
+from flatcontact.stages.measured_on import check_measured_on
 from flatcontact.structures.bulk import alpha_quartz
 from flatcontact.structures.construct import build_interface
 from flatcontact.structures.interface_io import read_interface
@@ -66,6 +67,7 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
     if cfg.scan.dask_address is not None:
         check_scheduler_address(cfg.scan.dask_address, field=f"{source}: scan.dask_address")
     _check_structure(cfg, source)
+    check_measured_on(cfg, source)
     check_moduli_source(cfg, structure_elements(cfg.structure))
     if cfg.elastic.enabled:
         bulk, _ = bulk_crystal(cfg.structure)

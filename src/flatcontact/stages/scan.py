@@ -19,6 +19,7 @@ from flatcontact.errors import InputError
 from flatcontact.fileio import write_json_atomic
 from flatcontact.ispes import scan as ispes_scan
 from flatcontact.ispes.grid import GridSpec
+from flatcontact.ispes.reduction import SymmetrySettings
 from flatcontact.ispes.relax import RelaxSettings
 from flatcontact.layout import SCAN_FIGURE, SCAN_JSON
 from flatcontact.stages import _calculator
@@ -41,6 +42,7 @@ class ScanStageResult:
     scan: Any  # flatcontact.ispes.scan.ScanResult
     warnings: list[str] = field(default_factory=list)
     files: list[Path] = field(default_factory=list)
+    layer_slip: dict | None = None  # flatcontact.ispes.slip.SlipTable.to_json()
 
     @property
     def dataset(self):
@@ -48,13 +50,18 @@ class ScanStageResult:
         return self.scan.dataset
 
     def to_json(self) -> dict:
-        """``scan.json``: counts, force calls, thicknesses, adhesion, notes and warnings."""
+        """``scan.json``: counts, force calls, thicknesses, adhesion, notes, warnings and the
+        lateral slip of the planes inside each slab (``layer_slip``, :mod:`flatcontact.ispes.slip`)."""
         r, ds = self.scan, self.scan.dataset
         calls = r.force_calls_computed
         return {
             "points_total": r.points_total,
             "points_done": r.points_done,
             "points_computed": r.points_computed,
+            "grid_points": r.points_total,
+            "computed_points": r.points_stored,
+            "symmetry": r.symmetry
+            or {"order": 1, "operations": [], "note": "every grid point relaxed"},
             "converged": int(ds["converged"].sum()),
             "force_calls_total": int(np.nansum(ds["force_calls"].values)),
             "median_force_calls_per_point": float(np.median(calls)) if calls else None,
@@ -64,6 +71,7 @@ class ScanStageResult:
             "adhesion": r.adhesion,
             "notes": list(r.notes),
             "warnings": list(self.warnings),
+            "layer_slip": self.layer_slip,
         }
 
 
@@ -76,6 +84,19 @@ def grid_spec(scan) -> GridSpec:
         thickness_angstrom=tuple(scan.thickness_angstrom) if scan.thickness_angstrom else None,
         p_range_gpa=(r.lo_gpa, r.hi_gpa, r.n) if r else None,
         bracket_all_stackings=scan.bracket_all_stackings,
+    )
+
+
+def symmetry_settings(scan) -> SymmetrySettings:
+    """The irreducible-registry settings of the ``scan`` settings (:mod:`flatcontact.ispes.reduction`)."""
+    y = scan.symmetry
+    enabled = scan.relax_mode != "full" if y.enabled == "auto" else bool(y.enabled)
+    return SymmetrySettings(
+        enabled,
+        y.verify_points,
+        y.tolerance_angstrom,
+        y.energy_tolerance_mev_per_a2,
+        y.stress_tolerance_gpa,
     )
 
 
@@ -175,6 +196,7 @@ def run_scan(
         order=s.order,
         executor_options=s.executor_options(),
         progress=progress,
+        symmetry=symmetry_settings(s),
     )
     separated = _no_repulsive_branch(scan.dataset)
     if separated is not None:
@@ -182,6 +204,10 @@ def run_scan(
     for note in scan.notes:
         log.warning("scan: %s", note)
     result = ScanStageResult(scan, warnings, [scan.store_path, scan.ispes_path])
+    if "layer" in reference.arrays and "slab" in reference.arrays:
+        from flatcontact.ispes.slip import slip_table, store_points
+
+        result.layer_slip = slip_table(reference, store_points(scan.store_path)).to_json()
     result.files.append(write_json_atomic(folder / SCAN_JSON, result.to_json()))
     result.files += save(
         figure_scan_columns(scan.dataset, scan.adhesion), folder, SCAN_FIGURE, settings.report.svg

@@ -39,6 +39,7 @@ from flatcontact.structures.recipe import (
     CrystalRecipe,
     FileRecipe,
     QuartzDenseRecipe,
+    SheetSlab,
     SheetsRecipe,
     SlabFileRecipe,
     ToyRecipe,
@@ -51,7 +52,12 @@ from flatcontact.structures.sheets import (
     rotate_in_plane,
     rotation_centre,
 )
-from flatcontact.structures.sources import crystal_source, fcc111_source, sheet_source
+from flatcontact.structures.sources import (
+    crystal_source,
+    fcc111_source,
+    passivated_crystal_source,
+    sheet_source,
+)
 from flatcontact.structures.structure_file import read_structure
 from flatcontact.structures.toy import toy_interface
 
@@ -81,7 +87,20 @@ def _sheet_source(sheet: str, stacking: str, interlayer: float | None, field: st
     return sheet_source(atoms, material, stacking, interlayer, record, f"{field}.stacking")
 
 
-def _crystal_source(bulk: str, miller, termination: int, field: str):
+def _faces(passivate_faces: str, interface_face: str) -> tuple[str, ...]:
+    """Faces (bottom, top) of a slab to passivate: its interface face, or both."""
+    return ("bottom", "top") if passivate_faces == "both" else (interface_face,)
+
+
+def _crystal_source(
+    bulk: str,
+    miller,
+    termination: int,
+    field: str,
+    passivate: str = "none",
+    faces: tuple[str, ...] = (),
+    same_material: bool = False,
+):
     atoms = read_bulk(bulk, f"{field}.bulk")
     oriented = orient(atoms, miller, f"{field}.miller")
     material = f"{atoms.get_chemical_formula(mode='hill', empirical=True)}({''.join(str(v) for v in oriented.miller)})"
@@ -91,6 +110,17 @@ def _crystal_source(bulk: str, miller, termination: int, field: str):
         termination < n,
         f"{field}.termination={termination}: expected 0..{n - 1} ({n} distinct terminations)",
     )
+    if passivate != "none":
+        return passivated_crystal_source(
+            oriented,
+            termination,
+            faces,
+            passivate,
+            material,
+            record,
+            f"{field}.passivate",
+            same_material,
+        )
     return crystal_source(oriented, termination, material, record, f"{field}.termination")
 
 
@@ -110,13 +140,29 @@ def _sources(recipe) -> tuple[Any, Any | None, int, int]:
             n2 = recipe.slab2.layers
         return s1, s2, recipe.layers, n2
     if isinstance(recipe, CrystalRecipe):
-        s1 = _crystal_source(recipe.bulk, recipe.miller, recipe.termination, SECTION)
-        if recipe.slab2 is None:
+        # slab 1's interface face is its top; slab 2's its bottom (its top before a flip)
+        args = (recipe.bulk, recipe.miller, recipe.termination, SECTION, recipe.passivate)
+        s1 = _crystal_source(*args, _faces(recipe.passivate_faces, "top"))
+        e2 = recipe.slab2
+        if e2 is None and recipe.passivate == "none":
             return s1, None, recipe.layers, recipe.layers
+        if e2 is None:  # the same crystal, its own interface face passivated
+            face2 = "top" if recipe.flip else "bottom"
+            s2 = _crystal_source(*args, _faces(recipe.passivate_faces, face2), same_material=True)
+            return s1, s2, recipe.layers, recipe.layers
+        if isinstance(e2, SheetSlab):
+            field2 = f"{SECTION}.slab2"
+            s2 = _sheet_source(e2.sheet, e2.stacking, e2.interlayer_angstrom, field2)
+            return s1, s2, recipe.layers, e2.layers
         s2 = _crystal_source(
-            recipe.slab2.bulk, recipe.slab2.miller, recipe.slab2.termination, f"{SECTION}.slab2"
+            e2.bulk,
+            e2.miller,
+            e2.termination,
+            f"{SECTION}.slab2",
+            e2.passivate,
+            _faces(e2.passivate_faces, "bottom"),
         )
-        return s1, s2, recipe.layers, recipe.slab2.layers
+        return s1, s2, recipe.layers, e2.layers
     s1 = fcc111_source(recipe.element, recipe.a_angstrom, {"element": recipe.element})
     if recipe.slab2 is None:
         return s1, None, recipe.layers, recipe.layers
@@ -214,8 +260,9 @@ def build_generic(recipe) -> tuple[Atoms, dict]:
         "interface_spacing_angstrom": spacing,
         "spacing_measured_between": "mean planes" if by == "planes" else "closest atoms",
     }
-    material = s1.material if s2 is None else f"{s1.material}/{s2.material}"
-    if recipe.twist is not None and s2 is not None:
+    other = s2 is not None and not s2.same_material  # another material as slab 2
+    material = f"{s1.material}/{s2.material}" if other else s1.material
+    if recipe.twist is not None and other:
         raise InputError(
             f"{SECTION}.twist: a twist needs the same material in both slabs (no slab2)"
         )
@@ -255,12 +302,12 @@ def build_generic(recipe) -> tuple[Atoms, dict]:
         operations.append(
             f"rotated {recipe.rotate_deg:g}° about z through ({centre[0]:.4f}, {centre[1]:.4f}) Å"
         )
-    na1, na2 = n1 * s1.atoms_per_layer, n2 * src2.atoms_per_layer
+    na1, na2 = len(slab1), len(slab2)  # n_i layers x atoms per layer, + passivating atoms
     if recipe.twist is not None:
         match, theta = twist_match(s1.cell2, *recipe.twist, field=f"{SECTION}.twist")
         operations.append(f"twisted by {theta:.6f}° (commensurate (m, n) = {list(recipe.twist)})")
         record["twist_angle_deg"] = theta
-    elif s2 is not None and not np.allclose(s1.cell2, s2.cell2, atol=1e-6):
+    elif other and not np.allclose(s1.cell2, s2.cell2, atol=1e-6):
         match = coincidence_match(
             s1.cell2,
             s2.cell2,
@@ -278,7 +325,9 @@ def build_generic(recipe) -> tuple[Atoms, dict]:
         n_atoms <= bounds.max_atoms,
         f"{SECTION}.match.max_atoms={bounds.max_atoms}: the interface has {n_atoms} atoms",
     )
-    record["slab2_operation"] = "; ".join(operations) or "none (another material)"
+    record["slab2_operation"] = "; ".join(operations) or (
+        "none (another material)" if other else "translated copy"
+    )
     record["match"] = match.report(s1.cell2, src2.cell2, na1, na2)
     slab1 = apply_supercell(slab1, match.p1, match.cell)
     slab2 = apply_supercell(slab2, match.p2, match.cell)

@@ -35,6 +35,7 @@ from flatcontact.errors import InputError, require
 from flatcontact.fileio import file_sha256
 from flatcontact.structures.cell2d import standard_slab
 from flatcontact.structures.layers import repeat_layers
+from flatcontact.structures.passivate import passivate_window
 from flatcontact.structures.slab import cleavage_heights
 from flatcontact.structures.structure_file import read_structure
 
@@ -196,6 +197,51 @@ def crystal_slab(
     )
     slab.cell[2] = (0.0, 0.0, float(np.ptp(slab.positions[:, 2])) + 1.0)
     return standard_slab(slab)
+
+
+def passivated_crystal_slab(
+    oriented: OrientedBulk,
+    layers: int,
+    termination: int,
+    faces: tuple[str, ...],
+    species: str,
+    field_name: str = "passivate",
+) -> tuple[Atoms, dict]:
+    """:func:`crystal_slab` with the dangling bonds of ``faces`` (``bottom``, ``top``) passivated.
+
+    The same window of ``layers`` bulk repeats, cut from a block one repeat deeper on both
+    sides, so the bonds the cut breaks are the bulk's own
+    (:func:`~flatcontact.structures.passivate.passivate_window`: H, or OH on oxides). An added
+    atom belongs to the layer of the atom it is bonded to (a face's H is part of the face
+    layer). Returns the standard slab and the passivation record.
+    """
+    n = len(oriented.cuts_angstrom)
+    require(
+        isinstance(termination, int) and 0 <= termination < n,
+        f"{field_name}: termination={termination}: expected 0..{n - 1}",
+    )
+    d = oriented.repeat_angstrom
+    big = ase_surface(oriented.atoms, oriented.miller_primitive, layers + 3, periodic=False)
+    z_cut = float(oriented.cuts_angstrom[termination]) + d  # one whole repeat below
+    z = big.positions[:, 2]
+    eps = 1e-6
+    lo, hi = z_cut + eps, z_cut + layers * d + eps
+    slab, parent, record = passivate_window(
+        big, (z >= lo) & (z < hi), lo, hi, faces, species, field_name
+    )
+    slab.arrays.pop("tags", None)
+    own = parent < 0
+    layer = np.zeros(len(slab), dtype=int)
+    layer[own] = repeat_layers(slab[own], d, z_cut)
+    layer[~own] = layer[parent[~own]]
+    slab.arrays["layer"] = layer
+    expected = layers * len(oriented.atoms)
+    require(
+        int(own.sum()) == expected and layer.max() == layers,
+        f"miller={list(oriented.miller)}: cut gave {int(own.sum())} atoms, expected {expected}",
+    )
+    slab.cell[2] = (0.0, 0.0, float(np.ptp(slab.positions[:, 2])) + 1.0)
+    return standard_slab(slab), record
 
 
 def fcc111_slab(element: str, layers: int, a_angstrom: float | None = None) -> tuple[Atoms, float]:

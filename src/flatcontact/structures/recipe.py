@@ -30,7 +30,9 @@ from typing import Annotated, Any, Literal
 from pydantic import (
     BaseModel,
     ConfigDict,
+    Discriminator,
     Field,
+    Tag,
     TypeAdapter,
     ValidationError,
     field_validator,
@@ -80,6 +82,17 @@ class _Model(BaseModel):
         """State the bounds of the recipe's bounded floats in their descriptions."""
         super().__pydantic_init_subclass__(**kwargs)
         state_bounds(cls)
+
+
+#: Surface passivation of a crystal cut (:mod:`flatcontact.structures.passivate`).
+Passivation = Literal["none", "H", "OH"]
+#: Which faces of a slab are passivated: the one towards the other slab, or both.
+PassivatedFaces = Literal["interface", "both"]
+_PASSIVATE_DOC = (
+    "none | H (one H per dangling bond) | OH (hydroxyl on oxides: OH on a cation missing an "
+    "O, H on an O missing a cation) on the dangling bonds of the cut"
+)
+_FACES_DOC = "interface: only the face towards the other slab; both: the held outer face too"
 
 
 class MatchSettings(_Model):
@@ -160,6 +173,20 @@ class CrystalSlab(_Model):
     termination: int = Field(
         0, ge=0, description="which cut (0 = widest gap between atomic planes)"
     )
+    passivate: Passivation = Field("none", description=_PASSIVATE_DOC)
+    passivate_faces: PassivatedFaces = Field("interface", description=_FACES_DOC)
+
+
+def _slab2_kind(value: Any) -> str:
+    has_sheet = isinstance(value, dict) and "sheet" in value
+    return "sheet" if has_sheet or isinstance(value, SheetSlab) else "bulk"
+
+
+#: slab 2 of a crystal recipe: a crystal (``bulk:``) or 2D sheets (``sheet:``).
+_CrystalOrSheetSlab = Annotated[
+    Annotated[CrystalSlab, Tag("bulk")] | Annotated[SheetSlab, Tag("sheet")],
+    Discriminator(_slab2_kind),
+]
 
 
 class CrystalRecipe(_PairOptions):
@@ -176,7 +203,26 @@ class CrystalRecipe(_PairOptions):
         None, description="highest atom of slab 1 to lowest of slab 2 (default: the bulk's)"
     )
     flip: bool = Field(False, description="slab 2 = slab 1 upside down (rotated 180° about a1)")
-    slab2: CrystalSlab | None = Field(None, description="another crystal for slab 2")
+    slab2: _CrystalOrSheetSlab | None = Field(
+        None, description="another crystal (bulk: ...) or 2D sheets (sheet: ...) for slab 2"
+    )
+    passivate: Passivation = Field(
+        "none", description=_PASSIVATE_DOC + " (slab 1; and slab 2 without slab2)"
+    )
+    passivate_faces: PassivatedFaces = Field("interface", description=_FACES_DOC)
+
+    @model_validator(mode="after")
+    def _gap_of_prepared_faces(self) -> CrystalRecipe:
+        prepared = self.passivate != "none" or (
+            isinstance(self.slab2, CrystalSlab) and self.slab2.passivate != "none"
+        )
+        if self.gap_angstrom is None and (prepared or isinstance(self.slab2, SheetSlab)):
+            raise ValueError(
+                "gap_angstrom: required with a passivated face or a sheet as slab 2 (the bulk's "
+                "gap across the cut is then not the distance between the faces), e.g. 2.6 for "
+                "H against graphene"
+            )
+        return self
 
 
 class Fcc111Slab(_Model):
@@ -320,6 +366,8 @@ def parse_recipe(data: dict[str, Any], field: str = SECTION) -> Any:
         parts = [str(p) for p in err["loc"]]
         if parts and parts[0] in KINDS:  # the union's tag, not a field
             parts = parts[1:]
+        if parts[:1] == ["slab2"] and parts[1:2] in (["bulk"], ["sheet"]):  # slab2's tag
+            parts = parts[:1] + parts[2:]
         loc = ".".join(parts)
         raise InputError(
             f"{field}.{loc}: {err['msg']}" if loc else f"{field}: {err['msg']}"

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from ase import Atoms
 
-from flatcontact.structures.crystal import crystal_slab, fcc111_slab
+from flatcontact.structures.crystal import crystal_slab, fcc111_slab, passivated_crystal_slab
 from flatcontact.structures.sheets import parse_stacking, stack_sheets
 
 
@@ -28,6 +28,8 @@ class SlabSource:
     spacing_angstrom: float
     spacing_by: str
     record: dict = field(default_factory=dict)
+    #: slab 2 made of slab 1's material (a passivated copy), not another material
+    same_material: bool = False
     _one: Atoms | None = None
 
     @property
@@ -79,6 +81,37 @@ def crystal_source(
     z = two.positions[:, 2]
     gap = float(z[layer == 2].min() - z[layer == 1].max())
     return SlabSource(material, make, gap, "atoms", record)
+
+
+def passivated_crystal_source(
+    oriented,
+    termination: int,
+    faces: tuple[str, ...],
+    species: str,
+    material: str,
+    record: dict,
+    field_name: str,
+    same_material: bool = False,
+) -> SlabSource:
+    """Cuts of an oriented bulk crystal with ``faces`` (bottom, top) passivated by ``species``.
+
+    The spacing is the bulk's gap (as :func:`crystal_source`); a recipe with a passivated face
+    gives its own gap. ``record["passivation"]`` is the record of a one-layer slab.
+    """
+
+    def make(n: int) -> Atoms:
+        return passivated_crystal_slab(oriented, n, termination, faces, species, field_name)[0]
+
+    _, passivation = passivated_crystal_slab(oriented, 1, termination, faces, species, field_name)
+    plain = crystal_source(oriented, termination, material, record, field_name)
+    return SlabSource(
+        material,
+        make,
+        plain.spacing_angstrom,
+        "atoms",
+        {**record, "passivation": passivation},
+        same_material,
+    )
 
 
 def fcc111_source(element: str, a_angstrom: float | None, record: dict) -> SlabSource:

@@ -1,0 +1,338 @@
+"""Validity gates: what the scan and the analysis say about whether the load laws can be
+trusted, checked before the contact stage takes them.
+
+Each gate is a pure function of what the earlier stages wrote (plain dicts and arrays) and
+returns the :class:`Finding` it fired with (one line: the cause, the points or loads, the
+remedy) or nothing. :data:`GATES` names them; a user who insists lists the names in
+``contact.accept_untrusted`` and the report then says, above the figures, which numbers are
+not to be trusted and why.
+
+``in_slab_slip``
+    A plane inside a slab (not the interface) moved sideways against its neighbour by more
+    than the scan's threshold (``scan.json["layer_slip"]``, :mod:`flatcontact.ispes.slip`):
+    the slab slid inside itself, and the energies and loads are those of another sliding
+    plane.
+``broken_symmetry``
+    The constant-pressure ISPES breaks a shift-space operation that both slabs have
+    (:mod:`.shift_symmetry`) by more than :data:`SYMMETRY_GATE_TOLERANCE` at some load.
+``load_fold``
+    A column's load p(z) folds (not monotonic), so loads beyond the fold were refused
+    (``scan.json["load_folds"]``, absent = none).
+``negative_slope``
+    k or μ is *significantly* negative: the whole interval c ± h_c of ``laws.json``
+    (:mod:`.uncertainty`) lies below 0. A negative slope whose interval reaches 0 is used
+    as fitted, with a note (:func:`negative_slope_notes`).
+``degenerate_minima``
+    The slider's rest position is not one minimum through the loads: the reported start
+    jumps between loads to a minimum that no symmetry of the landscape relates to the
+    previous one, or at one load inequivalent minima within the degeneracy tolerance give
+    τ differing by more than :data:`DEGENERATE_TAU_SPREAD`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from flatcontact.analysis.periodic import PeriodicSurface
+from flatcontact.analysis.shift_symmetry import ShiftOperation, operation_deviation
+from flatcontact.analysis.symmetry import lattice_point_operations
+
+#: The gates, in the order they are checked and reported.
+GATES: tuple[str, ...] = (
+    "in_slab_slip",
+    "broken_symmetry",
+    "load_fold",
+    "negative_slope",
+    "degenerate_minima",
+)
+#: A structure operation the constant-pressure ISPES breaks by more than this relative L2
+#: deviation fires ``broken_symmetry``.
+SYMMETRY_GATE_TOLERANCE = 0.25
+#: Two minima are the same site when closer than this fraction of the shortest lattice vector.
+SAME_SITE_FRACTION = 0.05
+#: Landscape operations relating two minima are kept below this deviation.
+LANDSCAPE_SYMMETRY_TOLERANCE = 0.05
+#: Inequivalent degenerate starts whose τ differ by more than this fraction of the largest
+#: fire ``degenerate_minima``.
+DEGENERATE_TAU_SPREAD = 0.05
+#: At most this many points or loads are named in one line.
+MAX_NAMED = 4
+
+
+@dataclass(frozen=True)
+class Finding:
+    """A gate that fired: its name and one line (cause, points or loads, remedy)."""
+
+    gate: str
+    message: str
+
+
+def _listed(items: Sequence[str], total: int | None = None) -> str:
+    shown = ", ".join(items[:MAX_NAMED])
+    more = (total if total is not None else len(items)) - min(len(items), MAX_NAMED)
+    return shown + (f" and {more} more" if more > 0 else "")
+
+
+def in_slab_slip(layer_slip: Mapping | None) -> Finding | None:
+    """``in_slab_slip`` from ``scan.json["layer_slip"]`` (None: not measured, no finding)."""
+    if not layer_slip or not layer_slip.get("n_slipped_points"):
+        return None
+    thr = float(layer_slip["threshold_angstrom"])
+    gaps = [g for g in layer_slip["gaps"] if g["max_slip_angstrom"] > thr]
+    planes = _listed(
+        [
+            f"layers {g['lower_layer']}-{g['upper_layer']} of slab {g['slab']} "
+            f"(up to {g['max_slip_angstrom']:.2f} Å)"
+            for g in gaps
+        ]
+    )
+    points = _listed(
+        [
+            f"shift ({p['shift'][0]:.3g}, {p['shift'][1]:.3g}) z = {p['thickness_angstrom']:.3f} Å"
+            for p in layer_slip["slipped_points"]
+        ],
+        int(layer_slip["n_slipped_points"]),
+    )
+    return Finding(
+        "in_slab_slip",
+        f"planes inside a slab slid sideways by more than {thr:g} Å at "
+        f"{layer_slip['n_slipped_points']} of {layer_slip['points_checked']} points: {planes}; "
+        f"at {points}. The slab slid inside itself, so those energies and loads are not the "
+        "interface's; use scan.relax_mode: normal (every plane held laterally) or hold more "
+        "layers (structure.held_layers)",
+    )
+
+
+def load_fold(scan: Mapping) -> Finding | None:
+    """``load_fold`` from ``scan.json["load_folds"]`` (absent or empty: none)."""
+    folds = scan.get("load_folds") or []
+    if not folds:
+        return None
+    parts = [
+        f"column {f['column']} at z = {f['z_angstrom']:.3f} Å (p = {f['p_gpa']:.3g} GPa; "
+        "loads refused: " + ", ".join(f"{p:g}" for p in f.get("loads_refused_gpa", [])) + " GPa)"
+        for f in folds
+    ]
+    return Finding(
+        "load_fold",
+        f"the load p(z) folds in {len(folds)} column(s): {_listed(parts)}; the loads beyond a "
+        "fold are not on one branch of the interface, so the laws miss them; scan finer "
+        "thicknesses around the fold, or lower analysis.p_gpa below it",
+    )
+
+
+_SLOPES = (("k_mpa_per_gpa", "k", "τ"), ("mu_mpa_per_gpa", "μ", "σ_MSS"))
+
+
+def _interval(laws: Mapping, key: str) -> tuple[float, float, float] | None:
+    """(value, low, high) of a coefficient: ``laws["intervals"]``, else value ± stderr."""
+    iv = (laws.get("intervals") or {}).get(key)
+    if iv is not None:
+        return float(iv["value"]), float(iv["low"]), float(iv["high"])
+    value = laws.get(key)
+    if value is None:
+        return None
+    err = {"k_mpa_per_gpa": "k_stderr_mpa_per_gpa", "mu_mpa_per_gpa": "mu_stderr_mpa_per_gpa"}
+    se = laws.get(err[key])
+    se = float(se) if se is not None and math.isfinite(float(se)) else 0.0
+    return float(value), float(value) - se, float(value) + se
+
+
+def negative_slope(laws: Mapping) -> Finding | None:
+    """``negative_slope``: k or μ whose whole interval of ``laws.json`` is below 0."""
+    bad = []
+    for key, name, what in _SLOPES:
+        iv = _interval(laws, key)
+        if iv is not None and iv[2] < 0:
+            bad.append(f"{name} = {iv[0]:.3g} MPa/GPa ({iv[1]:.3g} .. {iv[2]:.3g}): {what} falls")
+    if not bad:
+        return None
+    return Finding(
+        "negative_slope",
+        "significantly negative load slope, the whole interval below 0: "
+        + "; ".join(bad)
+        + f" with load on P <= {laws.get('threshold_gpa', float('nan')):g} GPa; check τ and "
+        "σ_MSS per load in 03-analyze/friction.csv (a fold, slip or a change of minimum "
+        "usually causes it), or give contact.k_mpa_per_gpa / contact.mu_mpa_per_gpa",
+    )
+
+
+def negative_slope_notes(laws: Mapping) -> list[str]:
+    """Notes for negative slopes whose interval reaches 0: used as fitted."""
+    notes = []
+    for key, name, _ in _SLOPES:
+        iv = _interval(laws, key)
+        if iv is not None and iv[0] < 0 <= iv[2]:
+            notes.append(
+                f"{name} = {iv[0]:.3g} MPa/GPa is negative but not significantly "
+                f"(interval {iv[1]:.3g} .. {iv[2]:.3g} reaches 0): used as fitted; the "
+                "contact model takes it where τ > 0 and σ >= 0 on the whole contact"
+            )
+    return notes
+
+
+def broken_symmetry(
+    maps: np.ndarray,
+    p_gpa: Sequence[float],
+    a1: np.ndarray,
+    a2: np.ndarray,
+    operations: Sequence[ShiftOperation],
+    tolerance: float = SYMMETRY_GATE_TOLERANCE,
+) -> Finding | None:
+    """``broken_symmetry``: the constant-pressure maps (shape (n_p, n_a, n_b), any energy
+    unit) against the structure's shift-space operations (:func:`.shift_symmetry.shift_operations`)."""
+    broken: dict[str, list[tuple[float, float]]] = {}
+    for p, values in zip(p_gpa, maps, strict=True):
+        if not np.all(np.isfinite(values)):
+            continue
+        surface = PeriodicSurface(values, a1, a2)
+        for op in operations:
+            dev = operation_deviation(surface, op)
+            if dev > tolerance:
+                broken.setdefault(op.name, []).append((float(p), dev))
+    if not broken:
+        return None
+    parts = [
+        f"{name} deviates {100 * max(d for _, d in rows):.0f} % (P = "
+        + ", ".join(f"{p:g}" for p, _ in rows)
+        + " GPa)"
+        for name, rows in broken.items()
+    ]
+    return Finding(
+        "broken_symmetry",
+        f"the ISPES breaks a symmetry both slabs have (tolerance {100 * tolerance:g} %): "
+        + "; ".join(parts)
+        + ". Equivalent stackings relaxed into different states (planes slipping, or a "
+        "relaxation branch that depends on the scan order); use scan.relax_mode: normal, "
+        "or a smaller scan.fmax_ev_per_angstrom",
+    )
+
+
+def _min_image(surface: PeriodicSurface, d: np.ndarray) -> float:
+    s = surface.fractional(np.asarray(d, float))
+    s -= np.round(s)
+    return float(np.linalg.norm(surface.cartesian(s)))
+
+
+def _equivalent(surface: PeriodicSurface, x: np.ndarray, y: np.ndarray, tol_xy: float) -> bool:
+    """Whether a lattice point operation, kept by ``surface``, maps minimum ``x`` onto ``y``."""
+    if _min_image(surface, y - x) < tol_xy:
+        return True
+    for r, m in lattice_point_operations(surface.a1, surface.a2):
+        op = ShiftOperation("", r, np.rint(m).astype(int), np.asarray(y) - r @ np.asarray(x))
+        if operation_deviation(surface, op) < LANDSCAPE_SYMMETRY_TOLERANCE:
+            return True
+    return False
+
+
+def degenerate_minima(
+    p_gpa: Sequence[float],
+    maps: np.ndarray,
+    a1: np.ndarray,
+    a2: np.ndarray,
+    start_xy: np.ndarray,
+    selected: Sequence[int],
+    tau_by_start: np.ndarray,
+    above_lowest: np.ndarray,
+    tolerance: Sequence[float],
+) -> Finding | None:
+    """``degenerate_minima`` from the analysis's per-load starts (``friction.nc``).
+
+    Parameters
+    ----------
+    p_gpa
+        The loads (GPa), increasing.
+    maps
+        Constant-pressure landscapes, shape (n_p, n_a, n_b).
+    a1, a2
+        Lattice vectors (Å).
+    start_xy
+        Start positions (Å), shape (n_p, n_start, 2), NaN-padded.
+    selected
+        Index of the reported start per load.
+    tau_by_start
+        τ (MPa) per load and start, NaN-padded.
+    above_lowest
+        Each start's energy above the lowest minimum (meV/Å²), NaN-padded.
+    tolerance
+        Degeneracy tolerance per load (meV/Å²).
+    """
+    scale = float(min(np.linalg.norm(a1), np.linalg.norm(a2)))
+    tol_xy = SAME_SITE_FRACTION * scale
+    reasons = []
+    prev = None
+    for i, p in enumerate(p_gpa):
+        if not np.all(np.isfinite(maps[i])):
+            prev = None
+            continue
+        surface = PeriodicSurface(maps[i], a1, a2)
+        xy = np.asarray(start_xy[i], float)
+        ok = np.all(np.isfinite(xy), axis=1)
+        k = int(selected[i])
+        here = xy[k]
+        # the previous rest position, relaxed on this landscape (a minimum that drifts with
+        # the load stays one site)
+        if prev is not None and not _equivalent(
+            surface, surface.local_minimum(prev[1])[0], here, tol_xy
+        ):
+            reasons.append(f"the rest position moves between P = {prev[0]:g} and {p:g} GPa")
+        prev = (float(p), here)
+        taus = np.asarray(tau_by_start[i], float)
+        near = np.flatnonzero(ok & (np.asarray(above_lowest[i], float) <= float(tolerance[i])))
+        for a in near:
+            for b in near:
+                if b <= a:
+                    continue
+                spread = abs(taus[a] - taus[b]) / max(abs(taus[a]), abs(taus[b]), 1e-300)
+                if spread > DEGENERATE_TAU_SPREAD and not _equivalent(
+                    surface, xy[a], xy[b], tol_xy
+                ):
+                    reasons.append(
+                        f"at P = {p:g} GPa two inequivalent minima within "
+                        f"{float(tolerance[i]):.2g} meV/Å² give τ = {taus[a]:.4g} and "
+                        f"{taus[b]:.4g} MPa"
+                    )
+    if not reasons:
+        return None
+    return Finding(
+        "degenerate_minima",
+        "the minimum the slider rests in is not one site through the loads: "
+        + _listed(list(dict.fromkeys(reasons)))
+        + "; τ(P) mixes different stackings, so the load law is not one interface's; "
+        "analyse fewer or lower loads (analysis.p_gpa), or refine the grid (scan.grid)",
+    )
+
+
+@dataclass
+class GateReport:
+    """The findings of every gate, the notes, and which gates had no data to check."""
+
+    findings: list[Finding]
+    notes: list[str]
+    not_checked: list[str]
+
+    @property
+    def fired(self) -> list[str]:
+        """Names of the gates that fired."""
+        return [f.gate for f in self.findings]
+
+    def refused(self, accepted: Sequence[str]) -> list[Finding]:
+        """The findings not in ``accepted`` (they stop the run)."""
+        return [f for f in self.findings if f.gate not in accepted]
+
+    def to_json(self, accepted: Sequence[str] = ()) -> dict:
+        """``summary.json["gates"]``: every finding with ``overridden``, the overridden names,
+        the notes and the gates left unchecked."""
+        return {
+            "fired": [
+                {"gate": f.gate, "message": f.message, "overridden": f.gate in accepted}
+                for f in self.findings
+            ],
+            "overridden": [f.gate for f in self.findings if f.gate in accepted],
+            "notes": list(self.notes),
+            "not_checked": list(self.not_checked),
+        }

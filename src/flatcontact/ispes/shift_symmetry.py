@@ -1,0 +1,377 @@
+"""The shift-space group of an interface: which lateral shifts of slab 2 give the same interface.
+
+Convention: the interface at fractional shift ``s = (s_a, s_b)`` is the reference with slab 2
+moved by ``d = L s`` (``L`` the 2×2 matrix of columns a1, a2, Å;
+:func:`flatcontact.structures.placement.place_slab2`). A *shift operation* ``g = (M, t)``
+maps ``s`` to ``g·s = M s + t`` (mod 1), ``M`` a 2×2 integer matrix in the fractional basis,
+``t`` a fractional translation. It belongs to the group when a Euclidean operation of space
+``x ↦ W x + τ(s)`` (``W = diag(R, σ)``, ``R`` a 2-D point operation of the lattice, ``σ = ±1``)
+maps the whole stack at ``s`` onto the stack at ``g·s``, modulo the in-plane lattice and a
+permutation of atoms that keeps the species, the held flag and the layer partition (so the
+scan's constraints and, in ``rigid-layers`` mode, its rigid bodies are mapped onto themselves).
+Every relaxation mode of the scan (full, normal = along z only, rigid layers, rigid) is
+invariant under such an operation, so the relaxed energy and normal load are equal at ``s``
+and ``g·s``: E(g·s) = E(s).
+
+Two kinds, from the symmetry of each slab (Cartesian, in-plane translations mod the lattice):
+
+- ``σ = +1`` (slabs stay in place): ``R S₁ + τ₁ ≡ S₁`` and ``R S₂ + τ₂ ≡ S₂`` with the same
+  ``R``; then ``g·s = M s + L⁻¹(τ₁ − τ₂)`` with ``M = L⁻¹ R L``.
+- ``σ = −1`` (the operation swaps the slabs, e.g. a two-fold axis in the interface plane):
+  ``W S₁ + τ_a ≡ S₂`` and ``W S₂ + τ_b ≡ S₁`` with equal z-components of ``τ_a``, ``τ_b``;
+  then ``g·s = −M s + L⁻¹(τ_b − τ_a)`` (derivation: apply ``τ = τ_b − R d`` to the stack at
+  ``d``). This assumes both slabs see the same potential (the same interaction model on
+  either side, as every bundled preset); the scan's verification relaxations catch a model
+  that is not.
+
+Each candidate is then checked on the atoms: the stack at two generic shifts, mapped by
+the Euclidean operation, must coincide with the stack at ``g·s`` to
+``tolerance_angstrom``. Only operations that map the scan's lateral grid onto itself
+(:meth:`ShiftGroup.for_grid`) are used by a scan.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from itertools import product
+
+import numpy as np
+from ase import Atoms
+from scipy.spatial import cKDTree
+
+from flatcontact.structures.interface_contract import fixed_mask, in_plane_vectors
+from flatcontact.structures.placement import place_slab2
+
+#: Default largest displacement (Å) between an atom mapped by an operation and its image.
+DEFAULT_TOLERANCE_ANGSTROM = 1e-3
+#: Generic shifts at which every candidate operation is checked on the whole stack.
+_CHECK_SHIFTS = ((0.1370, 0.2910), (0.6180, 0.0730))
+
+
+@dataclass(frozen=True)
+class ShiftOperation:
+    """One operation ``s ↦ M s + t`` (mod 1) of the shift-space group (fractional basis)."""
+
+    matrix: tuple[tuple[int, int], tuple[int, int]]  #: M, integer 2×2
+    translation: tuple[float, float]  #: t, fractional, in [0, 1)
+    swaps_slabs: bool  #: the space operation exchanges slab 1 and slab 2 (σ = −1)
+
+    def apply(self, s: np.ndarray) -> np.ndarray:
+        """``g·s`` reduced into [0, 1) for fractional shifts ``s`` (…, 2)."""
+        s = np.asarray(s, dtype=float)
+        out = s @ np.asarray(self.matrix, float).T + np.asarray(self.translation)
+        return out - np.floor(out + 1e-9)
+
+    @property
+    def is_identity(self) -> bool:
+        t = np.asarray(self.translation)
+        return np.array_equal(self.matrix, ((1, 0), (0, 1))) and bool(
+            np.all(np.minimum(t, 1 - t) < 1e-9)
+        )
+
+    def as_dict(self) -> dict:
+        return {
+            "matrix": [list(r) for r in self.matrix],
+            "translation": list(self.translation),
+            "swaps_slabs": self.swaps_slabs,
+        }
+
+
+@dataclass(frozen=True)
+class ShiftGroup:
+    """The operations of the shift-space group (identity first) and the tolerance used."""
+
+    operations: tuple[ShiftOperation, ...]
+    tolerance_angstrom: float
+
+    @property
+    def order(self) -> int:
+        return len(self.operations)
+
+    def for_grid(self, n_a: int, n_b: int) -> ShiftGroup:
+        """The subgroup whose operations map the ``n_a × n_b`` grid of shifts onto itself."""
+        ia, ib = np.meshgrid(np.arange(n_a), np.arange(n_b), indexing="ij")
+        s = np.stack([ia.ravel() / n_a, ib.ravel() / n_b], -1)
+        kept = []
+        for op in self.operations:
+            g = op.apply(s) * (n_a, n_b)
+            if np.allclose(g, np.round(g), atol=1e-6):
+                kept.append(op)
+        return ShiftGroup(tuple(kept), self.tolerance_angstrom)
+
+    def grid_images(self, n_a: int, n_b: int) -> np.ndarray:
+        """Index images ``out[k, ia, ib] = (ja, jb)`` of every grid point under operation k.
+
+        Shape ``(order, n_a, n_b, 2)``; the group must map the grid onto itself
+        (:meth:`for_grid`).
+        """
+        ia, ib = np.meshgrid(np.arange(n_a), np.arange(n_b), indexing="ij")
+        s = np.stack([ia / n_a, ib / n_b], -1)
+        out = []
+        for op in self.operations:
+            g = np.round(op.apply(s) * (n_a, n_b)).astype(int)
+            out.append(np.stack([g[..., 0] % n_a, g[..., 1] % n_b], -1))
+        return np.array(out)
+
+    def orbits(self, n_a: int, n_b: int) -> list[list[tuple[int, int]]]:
+        """The orbits of the lateral grid points, each sorted, in order of their first point."""
+        images = self.grid_images(n_a, n_b)
+        seen: set[tuple[int, int]] = set()
+        out = []
+        for ia in range(n_a):
+            for ib in range(n_b):
+                if (ia, ib) in seen:
+                    continue
+                orbit = sorted(
+                    {tuple(int(v) for v in images[k, ia, ib]) for k in range(self.order)}
+                )
+                seen.update(orbit)
+                out.append(orbit)
+        return out
+
+    def as_dict(self) -> dict:
+        return {
+            "order": self.order,
+            "tolerance_angstrom": self.tolerance_angstrom,
+            "operations": [op.as_dict() for op in self.operations],
+        }
+
+
+def identity_group(tolerance_angstrom: float = DEFAULT_TOLERANCE_ANGSTROM) -> ShiftGroup:
+    """The trivial group (symmetry off)."""
+    return ShiftGroup((ShiftOperation(((1, 0), (0, 1)), (0.0, 0.0), False),), tolerance_angstrom)
+
+
+# ----------------------------------------------------------------------------- atoms
+def _labels(atoms: Atoms) -> np.ndarray:
+    """Per-atom integer label: species and held flag (what an operation must keep)."""
+    return np.asarray(atoms.numbers, np.int64) * 2 + fixed_mask(atoms).astype(np.int64)
+
+
+class _Matcher:
+    """Nearest same-label atom of a target set, modulo the in-plane lattice."""
+
+    def __init__(self, positions: np.ndarray, labels: np.ndarray, lattice: np.ndarray):
+        self.lattice = lattice
+        self.inverse = np.linalg.inv(lattice)
+        self.labels = labels
+        self.trees = {}
+        images = np.array([[i, j] for i in (-1, 0, 1) for j in (-1, 0, 1)], float) @ lattice.T
+        for lab in np.unique(labels):
+            idx = np.flatnonzero(labels == lab)
+            p = self._wrap(positions[idx])
+            rep = np.concatenate([p + np.array([v[0], v[1], 0.0]) for v in images], axis=0)
+            self.trees[int(lab)] = (cKDTree(rep), np.tile(idx, len(images)))
+
+    def _wrap(self, p: np.ndarray) -> np.ndarray:
+        p = np.array(p, float, copy=True)
+        f = p[:, :2] @ self.inverse.T
+        f -= np.floor(f)
+        p[:, :2] = f @ self.lattice.T
+        return p
+
+    def match(self, positions: np.ndarray, labels: np.ndarray, tol: float) -> np.ndarray | None:
+        """Index of the matching target atom for each position, or None if one has none."""
+        p = self._wrap(positions)
+        out = np.empty(len(p), int)
+        for lab in np.unique(labels):
+            if int(lab) not in self.trees:
+                return None
+            tree, idx = self.trees[int(lab)]
+            sel = np.flatnonzero(labels == lab)
+            d, j = tree.query(p[sel], k=1, distance_upper_bound=tol)
+            if not np.all(np.isfinite(d)):
+                return None
+            out[sel] = idx[j]
+        if np.unique(out).size != out.size:
+            return None
+        return out
+
+
+def _keeps_layers(perm: np.ndarray, src_layer: np.ndarray, dst_layer: np.ndarray) -> bool:
+    """Whether the atom map sends every layer of the source onto one layer of the target."""
+    pairs = {}
+    for a, b in zip(src_layer.tolist(), dst_layer[perm].tolist(), strict=True):
+        if pairs.setdefault(a, b) != b:
+            return False
+    return len(set(pairs.values())) == len(pairs)
+
+
+def _translations(
+    src: np.ndarray,
+    src_lab: np.ndarray,
+    src_layer: np.ndarray,
+    dst: np.ndarray,
+    dst_lab: np.ndarray,
+    dst_layer: np.ndarray,
+    w: np.ndarray,
+    lattice: np.ndarray,
+    tol: float,
+) -> list[np.ndarray]:
+    """Every τ (3-vector, Å, in-plane part reduced to the cell) with ``W src + τ ≡ dst``."""
+    if len(src) != len(dst) or not np.array_equal(np.sort(src_lab), np.sort(dst_lab)):
+        return []
+    matcher = _Matcher(dst, dst_lab, lattice)
+    labels, counts = np.unique(src_lab, return_counts=True)
+    anchor_label = labels[np.argmin(counts)]
+    anchor = int(np.flatnonzero(src_lab == anchor_label)[0])
+    moved = src @ w.T
+    found: list[np.ndarray] = []
+    inv = np.linalg.inv(lattice)
+    for j in np.flatnonzero(dst_lab == anchor_label):
+        tau = dst[j] - moved[anchor]
+        f = inv @ tau[:2]
+        tau[:2] = lattice @ (f - np.floor(f + 1e-9))
+        perm = matcher.match(moved + tau, src_lab, tol)
+        if perm is None or not _keeps_layers(perm, src_layer, dst_layer):
+            continue
+        if not any(_same_translation(tau, t, lattice, tol) for t in found):
+            found.append(tau)
+    return found
+
+
+def _same_translation(t1: np.ndarray, t2: np.ndarray, lattice: np.ndarray, tol: float) -> bool:
+    d = np.asarray(t1) - np.asarray(t2)
+    f = np.linalg.inv(lattice) @ d[:2]
+    f -= np.round(f)
+    return bool(np.linalg.norm(lattice @ f) < tol and abs(d[2]) < tol)
+
+
+def _point_operations(lattice: np.ndarray, rtol: float = 1e-6) -> list[np.ndarray]:
+    """Cartesian 2×2 point operations R of the lattice (identity included): ``L⁻¹ R L`` integer."""
+    inv = np.linalg.inv(lattice)
+    ops = []
+    for entries in product((-1, 0, 1), repeat=4):
+        m = np.array(entries, float).reshape(2, 2)
+        if abs(abs(np.linalg.det(m)) - 1) > 0.5:
+            continue
+        r = lattice @ m @ inv
+        if np.allclose(r.T @ r, np.eye(2), atol=rtol):
+            ops.append(r)
+    return ops
+
+
+def _stack_maps(
+    reference: Atoms,
+    w: np.ndarray,
+    op: ShiftOperation,
+    tau_of_shift,
+    tol: float,
+    spread_compression: bool,
+) -> bool:
+    """Check ``W·stack(s) + τ(s) ≡ stack(g·s)`` on the placed atoms at generic shifts."""
+    from flatcontact.structures.interface_contract import thickness
+
+    lattice = np.column_stack(in_plane_vectors(reference))
+    labels = _labels(reference)
+    layer = np.asarray(reference.arrays.get("layer", np.zeros(len(reference), int)))
+    z = thickness(reference)
+    for s in _CHECK_SHIFTS:
+        s = np.asarray(s)
+        gs = op.apply(s)
+        a = place_slab2(
+            reference, float(s[0]), float(s[1]), z, spread_compression=spread_compression
+        )
+        b = place_slab2(
+            reference, float(gs[0]), float(gs[1]), z, spread_compression=spread_compression
+        )
+        moved = a.positions @ w.T + tau_of_shift(lattice @ s)
+        perm = _Matcher(b.positions, labels, lattice).match(moved, labels, tol)
+        if perm is None or not _keeps_layers(perm, layer, layer):
+            return False
+        slab = np.asarray(reference.arrays["slab"])
+        if op.swaps_slabs != bool(np.all(slab[perm] != slab)):
+            return False
+    return True
+
+
+def shift_space_group(
+    reference: Atoms,
+    tolerance_angstrom: float = DEFAULT_TOLERANCE_ANGSTROM,
+    *,
+    spread_compression: bool = True,
+) -> ShiftGroup:
+    """The shift-space group of ``reference`` (see the module docstring), identity first.
+
+    Parameters
+    ----------
+    reference
+        The reference interface (interface contract: slabs, held layers, layer ids).
+    tolerance_angstrom
+        Largest distance (Å) between a mapped atom and its image for an operation to count.
+    spread_compression
+        As the scan's placement of slab 2 (false in ``rigid`` mode).
+
+    Returns
+    -------
+    ShiftGroup
+        Operations ``s ↦ M s + t`` sorted with the identity first, then by (swaps, M, t).
+    """
+    tol = float(tolerance_angstrom)
+    lattice = np.column_stack(in_plane_vectors(reference))
+    inv = np.linalg.inv(lattice)
+    pos = reference.positions
+    lab = _labels(reference)
+    layer = np.asarray(reference.arrays.get("layer", np.zeros(len(reference), int)))
+    slab = np.asarray(reference.arrays["slab"])
+    one, two = slab == 1, slab == 2
+    parts = {k: (pos[m], lab[m], layer[m]) for k, m in ((1, one), (2, two))}
+    ops: dict[tuple, ShiftOperation] = {}
+
+    def fractional(v: np.ndarray) -> tuple[float, float]:
+        f = inv @ np.asarray(v, float)[:2]
+        f = f - np.floor(f + 1e-9)
+        f[np.abs(f - 1.0) < 1e-9] = 0.0
+        return (float(round(f[0], 12)) + 0.0, float(round(f[1], 12)) + 0.0)
+
+    def add(op: ShiftOperation, w: np.ndarray, tau_of_shift) -> None:
+        key = (op.matrix, tuple(round(x * 1e6) % 1000000 for x in op.translation), op.swaps_slabs)
+        if key in ops:
+            return
+        if _stack_maps(reference, w, op, tau_of_shift, tol, spread_compression):
+            ops[key] = op
+
+    for r in _point_operations(lattice):
+        m_int = np.round(inv @ r @ lattice).astype(int)
+        for sigma in (1, -1):
+            w = np.eye(3)
+            w[:2, :2] = r
+            w[2, 2] = sigma
+            if sigma == 1:
+                t1 = _translations(*parts[1], *parts[1], w, lattice, tol)
+                t2 = _translations(*parts[2], *parts[2], w, lattice, tol) if t1 else []
+                for tau1, tau2 in product(t1, t2):
+                    if abs(tau1[2]) > tol or abs(tau2[2]) > tol:
+                        continue
+                    m = tuple(tuple(int(v) for v in row) for row in m_int)
+                    op = ShiftOperation(m, fractional(tau1 - tau2), False)
+                    add(op, w, lambda d, tau1=tau1: tau1)
+            else:
+                ta = _translations(*parts[1], *parts[2], w, lattice, tol)
+                tb = _translations(*parts[2], *parts[1], w, lattice, tol) if ta else []
+                for tau_a, tau_b in product(ta, tb):
+                    if abs(tau_a[2] - tau_b[2]) > tol:
+                        continue
+                    m = tuple(tuple(int(-v) for v in row) for row in m_int)
+                    op = ShiftOperation(m, fractional(tau_b - tau_a), True)
+
+                    def tau_of_shift(d, tau_b=tau_b, r=r):
+                        out = tau_b.copy()
+                        out[:2] -= r @ d
+                        return out
+
+                    add(op, w, tau_of_shift)
+    found = sorted(
+        ops.values(),
+        key=lambda o: (not o.is_identity, o.matrix, o.translation, o.swaps_slabs),
+    )
+    # an operation that swaps the slabs and acts on shifts like one that does not is the same
+    # shift-space operation: keep one
+    unique: list[ShiftOperation] = []
+    for op in found:
+        if not any(
+            u.matrix == op.matrix and np.allclose(u.translation, op.translation, atol=1e-9)
+            for u in unique
+        ):
+            unique.append(op)
+    return ShiftGroup(tuple(unique), tol)

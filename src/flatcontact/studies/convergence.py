@@ -1,0 +1,183 @@
+"""``flatcontact study convergence``: refine one setting at a time until τ and σ_MSS stop moving.
+
+Rounds: round 0 runs the base (the configuration as given); round ``i`` runs, side by side
+through the scan's executor (``scan.executor``/``scan.workers``: local processes or Dask),
+level ``i`` of every setting still open (:func:`flatcontact.studies.variants.step`). After
+each round a setting whose step moved every per-load τ and σ_MSS by less than
+``refine.tolerance_pct`` (:func:`flatcontact.studies.compare.largest_change`) is
+``converged`` at its previous level; one still moving after ``refine.max_steps`` steps is
+``not converged`` within the budget, and the study says so (``study.json``, the console).
+
+The uncertainty it measures, per energy form and law coefficient c, is
+``δ_conv(c) = max over settings of |Δc|`` at each setting's last step (the change one more
+refinement makes), the rule of docs/convergence.md.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from pathlib import Path
+
+from flatcontact.analysis.uncertainty import LAW_COEFFICIENTS
+from flatcontact.config.run import RunConfig
+from flatcontact.errors import InputError
+from flatcontact.ispes.executors import make_executor
+from flatcontact.studies.compare import largest_change, law_changes
+from flatcontact.studies.runner import run_variant
+from flatcontact.studies.variants import (
+    base_value,
+    chosen_settings,
+    shares_build,
+    step,
+    variant_config,
+)
+
+FORMS = ("internal", "enthalpy")
+
+
+def _run_round(executor, jobs: list[tuple], on_done: Callable | None) -> dict:
+    """Run ``jobs`` = [(key, config dict, folder, share_from)] through ``executor``."""
+    handles = {executor.submit(run_variant, c, f, s): key for key, c, f, s in jobs}
+    out: dict = {}
+    pending = set(handles)
+    while pending:
+        done, pending = executor.wait_first(pending)
+        for h in done:
+            try:
+                out[handles[h]] = executor.result(h)
+            except InputError as exc:  # one variant the model or builder refuses: reported
+                out[handles[h]] = {"error": str(exc)}
+            if on_done is not None:
+                on_done(handles[h], out[handles[h]])
+    return out
+
+
+def run_convergence(
+    cfg: RunConfig, out: str | Path, on_done: Callable[[str, dict], None] | None = None
+) -> dict:
+    """Run the convergence study of ``cfg`` into ``out``; returns the ``study.json`` document.
+
+    ``on_done(name, result)`` is told when each variant finishes (the CLI prints a line).
+    """
+    out = Path(out)
+    settings, skipped = chosen_settings(cfg)
+    r = cfg.refine
+    # every variant's configuration first: a bad step is refused before any work
+    ladder = {s: [step(cfg, s, i) for i in range(1, r.max_steps + 1)] for s in settings}
+    configs = {
+        v.name: variant_config(cfg, v.overrides, f"refine ({v.label})").to_dict()
+        for steps in ladder.values()
+        for v in steps
+    }
+    runs_dir = out / "runs"
+    base_dir = runs_dir / "base"
+    executor = make_executor(
+        cfg.scan.executor, cfg.scan.workers, cfg.scan.dask_address, cfg.scan.jobqueue
+    )
+    try:
+        results = _run_round(executor, [("base", cfg.to_dict(), str(base_dir), None)], on_done)
+        status = {s: {"state": "open", "steps": 0} for s in settings}
+        previous = {s: "base" for s in settings}
+        for level in range(1, r.max_steps + 1):
+            open_ = [s for s in settings if status[s]["state"] == "open"]
+            if not open_:
+                break
+            jobs = []
+            for s in open_:
+                v = ladder[s][level - 1]
+                share = str(base_dir) if shares_build(s) else None
+                jobs.append((v.name, configs[v.name], str(runs_dir / v.name), share))
+            results.update(_run_round(executor, jobs, on_done))
+            for s in open_:
+                v = ladder[s][level - 1]
+                status[s]["steps"] = level
+                if "error" in results[v.name] or "error" in results[previous[s]]:
+                    failed = results[v.name].get("error") or results[previous[s]].get("error")
+                    status[s].update(state="failed", error=failed, last_step=[previous[s], v.name])
+                    continue
+                change = largest_change(
+                    results[previous[s]], results[v.name], r.tolerance_floor_mpa
+                )
+                status[s]["steps"] = level
+                status[s]["last_change"] = change
+                status[s]["last_step"] = [previous[s], v.name]
+                if change["max_pct"] < r.tolerance_pct:
+                    status[s]["state"] = "converged"
+                    status[s]["converged_at"] = previous[s]
+                elif level == r.max_steps:
+                    status[s]["state"] = "not converged"
+                previous[s] = v.name
+    finally:
+        executor.close()
+    variants = [
+        {
+            "name": "base",
+            "setting": "base",
+            "level": 0,
+            "label": "base",
+            "values": {s: base_value(cfg, s) for s in settings},
+            "overrides": {},
+            **results["base"],
+        }
+    ]
+    if "error" in results["base"]:
+        raise InputError(f"the base configuration failed: {results['base']['error']}")
+    for s in settings:
+        for v in ladder[s][: status[s]["steps"]]:
+            if "error" in results[v.name]:
+                continue
+            variants.append(
+                {
+                    "name": v.name,
+                    "setting": s,
+                    "level": v.level,
+                    "label": v.label,
+                    "values": {s: v.value},
+                    "overrides": v.overrides,
+                    **results[v.name],
+                }
+            )
+    delta = {
+        form: {
+            key: max(
+                (
+                    law_changes(
+                        results[status[s]["last_step"][0]], results[status[s]["last_step"][1]], form
+                    )[key]
+                    for s in settings
+                    if status[s]["state"] != "failed"
+                ),
+                default=0.0,
+            )
+            for key in LAW_COEFFICIENTS
+        }
+        for form in FORMS
+    }
+    spent = sum(v["force_calls_spent"] for v in variants)
+    stored = sum(v["force_calls"] for v in variants)
+    base_calls = results["base"]["force_calls"]
+    # each setting's ladder run on its own from scratch: its own base and builds
+    scratch = stored + base_calls * (len(settings) - 1) if settings else stored
+    return {
+        "study": "convergence",
+        "tolerance_pct": r.tolerance_pct,
+        "tolerance_floor_mpa": r.tolerance_floor_mpa,
+        "max_steps": r.max_steps,
+        "settings": {s: {**status[s], "base_value": base_value(cfg, s)} for s in settings},
+        "skipped_settings": skipped,
+        "converged": all(status[s]["state"] == "converged" for s in settings),
+        "failed": {s: status[s]["error"] for s in settings if status[s]["state"] == "failed"},
+        "variants": variants,
+        "delta": {
+            f: {k: (0.0 if math.isnan(v) else v) for k, v in d.items()} for f, d in delta.items()
+        },
+        "cost": {
+            "force_calls_study": spent,
+            "force_calls_stored": stored,
+            "force_calls_from_scratch": scratch,
+            "variants": len(variants),
+            "executor": executor.name,
+            "workers": executor.workers,
+        },
+    }

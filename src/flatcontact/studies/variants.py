@@ -1,0 +1,140 @@
+"""The refinement ladder of each setting: config overrides of step 1, 2, ... over the base.
+
+A step of setting ``s`` at level ``i`` is the base configuration with that one setting
+refined ``i`` times (:class:`flatcontact.config.refine.RefineConfig`); level 0 is the base
+itself, shared by every setting. :func:`applicable_settings` says which settings a recipe and
+model have, and why the others are left out (reported in ``study.json``).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+from pydantic import ValidationError
+
+from flatcontact.config.merge import merge_config
+from flatcontact.config.refine import REFINABLE
+from flatcontact.config.run import RunConfig
+from flatcontact.errors import InputError
+
+#: Recipe kinds whose ``layers`` field is a slab thickness a study may refine (``slab`` and
+#: ``file`` read their layers from the structure file).
+LAYERED_KINDS = ("quartz-dense", "sheets", "crystal", "fcc111", "toy-lj")
+#: Layer step of the dense quartz slab with the shipped source (one bulk c-repeat, 3 layers).
+QUARTZ_LAYER_STEP = 3
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One run of a study: its name, what it varies, the level, its x value and overrides."""
+
+    name: str
+    setting: str
+    level: int
+    value: float
+    label: str
+    overrides: dict
+
+
+def applicable_settings(cfg: RunConfig) -> dict[str, str]:
+    """Setting -> ``""`` if the study can refine it for ``cfg``, else why not."""
+    out = dict.fromkeys(REFINABLE, "")
+    if cfg.structure.kind not in LAYERED_KINDS:
+        out["layers"] = f"structure.kind {cfg.structure.kind} has no layer count to refine"
+    if cfg.scan.relax_mode == "rigid":
+        out["fmax"] = "scan.relax_mode rigid relaxes nothing"
+    if cfg.potential.calculator is not None or cfg.potential.coupling != "lj":
+        out["cutoff"] = (
+            f"the cross-interface coupling ({cfg.potential.coupling}) has no cutoff setting "
+            "of its own (only coupling: lj has potential.lj.cutoff_angstrom)"
+        )
+    return out
+
+
+def chosen_settings(cfg: RunConfig) -> tuple[list[str], dict[str, str]]:
+    """(settings to refine, {setting: why it is skipped}) from ``cfg.refine.settings``."""
+    why = applicable_settings(cfg)
+    asked = REFINABLE if cfg.refine.settings == "auto" else tuple(cfg.refine.settings)
+    skipped = {s: why[s] for s in REFINABLE if s in asked and why[s]}
+    if cfg.refine.settings != "auto" and skipped:
+        s, reason = next(iter(skipped.items()))
+        raise InputError(f"refine.settings: {s!r} cannot be refined here: {reason}")
+    return [s for s in asked if not why[s]], skipped
+
+
+def _midpoints(values: list[float]) -> list[float]:
+    out = [values[0]]
+    for a, b in itertools.pairwise(values):
+        out += [(a + b) / 2, b]
+    return out
+
+
+def step(cfg: RunConfig, setting: str, level: int) -> Variant:
+    """The variant of ``setting`` refined ``level`` times from ``cfg`` (level 0: the base)."""
+    r, scan = cfg.refine, cfg.scan
+    if level == 0:
+        return Variant("base", "base", 0, math.nan, "base", {})
+    if setting == "grid":
+        grid = [math.ceil(g * r.grid_factor**level - 1e-9) for g in scan.grid]
+        over, value, label = {"scan": {"grid": grid}}, float(grid[0]), f"grid {grid[0]}x{grid[1]}"
+    elif setting == "thicknesses":
+        if scan.p_range_gpa is not None:
+            n = math.ceil(scan.p_range_gpa.n * r.thickness_factor**level - 1e-9)
+            rng = {**cfg.section("scan")["p_range_gpa"], "n": n}
+            over, value = {"scan": {"p_range_gpa": rng}}, float(n)
+        else:
+            values = list(scan.thickness_angstrom)
+            for _ in range(level):
+                values = _midpoints(values)
+            over, value = {"scan": {"thickness_angstrom": values}}, float(len(values))
+        label = f"{int(value)} thicknesses"
+    elif setting == "layers":
+        add = r.layers_step
+        if cfg.structure.kind == "quartz-dense":
+            add = QUARTZ_LAYER_STEP * math.ceil(add / QUARTZ_LAYER_STEP)
+        layers = cfg.structure.layers + level * add
+        over, value, label = {"structure": {"layers": layers}}, float(layers), f"{layers} layers"
+    elif setting == "fmax":
+        fmax = scan.fmax_ev_per_angstrom * r.fmax_factor**level
+        over = {"scan": {"fmax_ev_per_angstrom": fmax}}
+        value, label = fmax, f"fmax {fmax:.3g} eV/Å"
+    elif setting == "cutoff":
+        rc = cfg.potential.lj.cutoff_angstrom + level * r.cutoff_step_angstrom
+        over = {"potential": {"lj": {"cutoff_angstrom": rc}}}
+        value, label = rc, f"LJ cutoff {rc:g} Å"
+    else:
+        raise InputError(
+            f"refine.settings: expected some of {', '.join(REFINABLE)}, got {setting!r}"
+        )
+    return Variant(f"{setting}{level}", setting, level, value, label, over)
+
+
+def base_value(cfg: RunConfig, setting: str) -> float:
+    """The x value of the base run for ``setting`` (the study's figures)."""
+    scan = cfg.scan
+    if setting == "grid":
+        return float(scan.grid[0])
+    if setting == "thicknesses":
+        return float(scan.p_range_gpa.n if scan.p_range_gpa else len(scan.thickness_angstrom))
+    if setting == "layers":
+        return float(cfg.structure.layers)
+    if setting == "fmax":
+        return float(scan.fmax_ev_per_angstrom)
+    return float(cfg.potential.lj.cutoff_angstrom)
+
+
+def variant_config(cfg: RunConfig, overrides: dict, source: str) -> RunConfig:
+    """``cfg`` with ``overrides`` laid over it, validated (one-line InputError naming ``source``)."""
+    from flatcontact.config.messages import one_line
+
+    try:
+        return RunConfig.model_validate(merge_config(cfg.to_dict(), overrides))
+    except ValidationError as exc:
+        raise one_line(exc, source) from None
+
+
+def shares_build(setting: str) -> bool:
+    """Does a step of ``setting`` leave the build stage's inputs (structure, model) as they are?"""
+    return setting in ("grid", "thicknesses", "fmax")
