@@ -48,7 +48,6 @@ from pathlib import Path
 from typing import Any
 
 import pandas as pd
-import xarray as xr
 
 from flatcontact import __version__
 from flatcontact.codegraph import SOURCE_ROOT, closure_digest, import_closure
@@ -101,6 +100,7 @@ from flatcontact.stages.gates import GateInputs, check_gates, evaluate_gates
 from flatcontact.stages.laws import LawsInputs, run_laws
 from flatcontact.stages.preflight import check_inputs
 from flatcontact.stages.report import ReportInputs, run_report
+from flatcontact.stages.result_files import CONTACT, FRICTION, open_result
 from flatcontact.stages.scan import ScanInputs, run_scan
 from flatcontact.structures.interface_io import read_interface
 
@@ -407,8 +407,7 @@ class Pipeline:
             run_analyze(cfg, AnalyzeInputs(scan.folder / ISPES_NC), folder)
 
         result = self._run("analyze", inputs, work)
-        with xr.open_dataset(result.folder / FRICTION_NC, engine="h5netcdf") as ds:
-            return ds.load()
+        return open_result(result.folder / FRICTION_NC, FRICTION, cfg.analysis.p_gpa)
 
     def friction_table(self):
         """``03-analyze/friction.csv`` as a pandas DataFrame (one row per load)."""
@@ -523,8 +522,7 @@ class Pipeline:
             inputs["fit_sha256"] = [file_sha256(f) for f in cfg.contact.fit.csv]
 
         result = self._run("contact", inputs, lambda f: run_contact(cfg, stage_inputs, f))
-        with xr.open_dataset(result.folder / CONTACT_NC, engine="h5netcdf") as ds:
-            return ds.load()
+        return open_result(result.folder / CONTACT_NC, CONTACT, cfg.contact.p0_gpa)
 
     def contact_summary(self) -> dict:
         """``06-contact/summary.json``: parameters, their provenance and the per-p0 results."""

@@ -22,11 +22,11 @@ from tests.cli.cli_helpers import one_error_line, run_cli
 
 from flatcontact.config.contact import ContactConfig
 from flatcontact.config.elastic import ElasticConfig
-from flatcontact.config.numbers import field_bounds
 from flatcontact.config.scan import ScanConfig
 from flatcontact.contact import experiment as ex
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.errors import InputError
+from flatcontact.numbers import field_bounds
 
 SUBNORMAL = "1e-320"  # nonzero, below the smallest normal double (2.2e-308)
 

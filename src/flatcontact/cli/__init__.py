@@ -9,6 +9,10 @@ or a boxed multi-line message:
   rerun (the rerun resumes: stage records and scan points are written atomically);
 - a resource limit of the process: the file-size limit (``ulimit -f``, ``EFBIG``) and the
   memory limit (``ulimit -v``, ``MemoryError``), one line naming the limit and the file;
+- Python warnings: flatcontact's own (analysis diagnostics, dated deprecations) as one
+  ``warning:`` line each; the libraries' numerical warnings (numpy, scipy, ASE) into the
+  run log and one summary line after a successful command
+  (:mod:`flatcontact.cli.warning_lines`);
 - click's own usage errors (``--layers abc``, a missing argument, an unknown option),
   printed as click's one-line message followed by where to find help.
 
@@ -31,7 +35,6 @@ import logging
 import resource
 import sqlite3
 import sys
-import warnings
 from typing import Annotated
 
 import typer
@@ -119,48 +122,50 @@ def memory_line(exc: MemoryError) -> str:
     )
 
 
-def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
-    """Python warnings (numpy, ASE, ...) as one ``warning:`` line, without source lines."""
-    from flatcontact.cli.app import print_warning
-
-    print_warning(" ".join(f"{category.__name__}: {message}".split()))
-
-
 def main(argv: list[str] | None = None) -> None:
     """Entry point of the ``flatcontact`` console script."""
+    from flatcontact.cli.app import print_warning
+    from flatcontact.cli.warning_lines import captured_warnings
+
     # a full disk under the run log must not print logging's own traceback on stderr
     logging.raiseExceptions = False
-    warnings.showwarning = _one_line_warning
-    # ASE's note on reading its own extxyz files (info it cannot hash): noise, not news
-    warnings.filterwarnings("ignore", message="Skipping unhashable information")
+    with captured_warnings(print_warning) as lines:
+        code = _run(argv)
+        if code == 0 and lines.summary() is not None:
+            print_warning(lines.summary())
+    sys.exit(code)
+
+
+def _run(argv: list[str] | None) -> int:
+    """Run the command; its exit status (an error is printed as one line here)."""
     try:
         check_out_flags([str(a) for a in (sys.argv[1:] if argv is None else argv)])
         rv = app(args=argv, standalone_mode=False, prog_name="flatcontact")
     except InputError as exc:
         print_error(exc)
-        sys.exit(2)
+        return 2
     except OSError as exc:
         if exc.errno == errno.EFBIG:
             print_error(file_size_line(exc))
-            sys.exit(2)
+            return 2
         if exc.errno not in _DISK_FULL:
             raise
         print_error(disk_full_line(exc))
-        sys.exit(2)
+        return 2
     except MemoryError as exc:  # numpy's _ArrayMemoryError included
         print_error(memory_line(exc))
-        sys.exit(2)
+        return 2
     except sqlite3.OperationalError as exc:  # the scan's point store on a full disk
         if "full" not in str(exc):
             raise
         print_error(disk_full_line(OSError(errno.ENOSPC, str(exc))))
-        sys.exit(2)
+        return 2
     except typer.TyperException as exc:  # typer's (vendored click's) usage errors
         code = getattr(exc, "exit_code", 2)
         if type(exc).__name__ != "NoArgsIsHelpError":  # that one has printed the help already
             print_error(usage_error_line(exc))
-        sys.exit(code)
+        return code
     except typer.Abort:
         print_error("aborted")
-        sys.exit(1)
-    sys.exit(rv if isinstance(rv, int) else 0)
+        return 1
+    return rv if isinstance(rv, int) else 0

@@ -18,7 +18,17 @@ from typing import Annotated
 
 import typer
 
-from flatcontact.cli.app import app, check_out_dir, console, print_warning, split_list
+from flatcontact import limits
+from flatcontact.cli.app import (
+    app,
+    bounded,
+    check_out_dir,
+    console,
+    print_warning,
+    setting_bounds,
+    split_list,
+)
+from flatcontact.config.analysis import AnalysisConfig
 from flatcontact.errors import InputError
 
 #: Settings paths and core parameters -> the flag that sets them, to name it in errors.
@@ -49,7 +59,10 @@ def _split_arguments(items: list[str], p_values: list[str] | None) -> tuple[Path
         )
     if not numbers:
         raise InputError("--p-gpa: give at least one target pressure in GPa (e.g. --p-gpa 0.5 1 2)")
-    return Path(files[0]), numbers
+    # the run's analysis.p_gpa bounds: the loads replace the setting without revalidating it
+    limits.check("loads", len(numbers), "--p-gpa", "loads")
+    bounds = setting_bounds(AnalysisConfig, "p_gpa")
+    return Path(files[0]), [bounded(x, "--p-gpa", bounds) for x in numbers]
 
 
 @app.command(

@@ -160,8 +160,9 @@ def split_list(values: list[str] | None, flag: str, *, whitespace: bool = True) 
     return items
 
 
-def parse_floats(values: list[str] | None, flag: str, unit: str = "") -> list[float]:
-    """The numbers of a list flag (see :func:`split_list`); a non-number is one line naming ``flag``."""
+def parse_floats(values: list[str] | None, flag: str, unit: str = "", bounds=None) -> list[float]:
+    """The numbers of a list flag (see :func:`split_list`); a non-number, or with ``bounds``
+    (:class:`~flatcontact.numbers.Bounds`) a number outside them, is one line naming ``flag``."""
     from flatcontact.errors import InputError
 
     out = []
@@ -171,4 +172,40 @@ def parse_floats(values: list[str] | None, flag: str, unit: str = "") -> list[fl
         except ValueError:
             what = f"a number{f' in {unit}' if unit else ''}"
             raise InputError(f"{flag}: {item!r} is not {what}") from None
-    return out
+    return out if bounds is None else [bounded(x, flag, bounds) for x in out]
+
+
+def bounded(value: float, flag: str, bounds) -> float:
+    """A float flag's value within ``bounds`` (:class:`~flatcontact.numbers.Bounds`: finite,
+    no subnormal, ``lo..hi``), else one :class:`~flatcontact.errors.InputError` line
+    naming ``flag``, the bounds and the value. For flags that do not pass through a bounded
+    setting; a flag that mirrors a setting takes the setting's bounds
+    (:func:`setting_bounds`)."""
+    from flatcontact.errors import InputError
+
+    try:
+        return bounds.check(value)
+    except ValueError as exc:
+        raise InputError(f"{flag}: {exc}") from None
+
+
+def bounded_int(value: int, flag: str, lo: int, hi: int, what: str = "") -> int:
+    """An integer flag's value within ``lo..hi``, else one line naming ``flag``."""
+    from flatcontact.errors import InputError
+
+    if not lo <= value <= hi:
+        detail = f" ({what})" if what else ""
+        raise InputError(f"{flag}: expected an integer from {lo} to {hi}{detail}, got {value}")
+    return int(value)
+
+
+def setting_bounds(model, field: str):
+    """The :class:`~flatcontact.numbers.Bounds` of the bounded float ``field`` of the
+    pydantic class ``model`` (a settings section, the recipe, the LJ): a flag that sets the
+    same quantity is held to the same bounds."""
+    from flatcontact.numbers import field_bounds
+
+    found = field_bounds(model.model_fields[field])
+    if found is None:
+        raise TypeError(f"{model.__name__}.{field} is not a bounded float")
+    return found

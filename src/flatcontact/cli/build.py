@@ -12,7 +12,16 @@ from pathlib import Path
 
 import typer
 
-from flatcontact.cli.app import app, check_out_dir, console, print_warning
+from flatcontact import limits
+from flatcontact.cli.app import (
+    app,
+    bounded,
+    bounded_int,
+    check_out_dir,
+    console,
+    print_warning,
+    setting_bounds,
+)
 from flatcontact.errors import InputError
 from flatcontact.layout import BUILD_JSON
 
@@ -29,13 +38,25 @@ _FLAG_OF = {
 }
 
 
-def _positive_finite(value: float, flag: str, unit: str) -> float:
-    """``value`` if it is a finite number > 0, else a one-line :class:`InputError` naming ``flag``."""
-    import math
+def _check_numbers(gap_angstrom, fmax_ev_per_angstrom, lj_cutoff_angstrom, normal_axis, face_depth):
+    """Every number flag of ``build`` within the bounds of the setting it sets (the recipe's
+    gap and force tolerance, the LJ cutoff), before anything is read or built."""
+    from flatcontact.numbers import Bounds
+    from flatcontact.potentials.coupling import LJSpec
+    from flatcontact.structures.recipe import QuartzDenseRecipe
 
-    if not (math.isfinite(value) and value > 0):
-        raise InputError(f"{flag}: expected a finite value > 0 {unit}, got {value!r}")
-    return value
+    bounded(gap_angstrom, "--gap-angstrom", setting_bounds(QuartzDenseRecipe, "gap_angstrom"))
+    bounded(
+        fmax_ev_per_angstrom,
+        "--fmax-ev-per-angstrom",
+        setting_bounds(QuartzDenseRecipe, "fmax_ev_per_angstrom"),
+    )
+    if lj_cutoff_angstrom is not None:
+        bounded(
+            lj_cutoff_angstrom, "--lj-cutoff-angstrom", setting_bounds(LJSpec, "cutoff_angstrom")
+        )
+    bounded_int(normal_axis, "--normal-axis", 0, 2, "a cell axis")
+    bounded(face_depth, "--face-depth-angstrom", Bounds(0.1, 20.0, "Å"))
 
 
 def _potential_spec(potential: str | None, lj_cutoff_angstrom: float | None):
@@ -55,9 +76,7 @@ def _potential_spec(potential: str | None, lj_cutoff_angstrom: float | None):
         # a preset is a whole model, not the quartz LJ's intra-slab part
         section = flag if "preset" in flag else {**section, **flag}
     if lj_cutoff_angstrom is not None:
-        section.setdefault("lj", {})["cutoff_angstrom"] = _positive_finite(
-            lj_cutoff_angstrom, "--lj-cutoff-angstrom", "Å"
-        )
+        section.setdefault("lj", {})["cutoff_angstrom"] = lj_cutoff_angstrom
     try:
         return InteractionModel(**section)
     except InputError as exc:
@@ -135,14 +154,14 @@ def build(
     from flatcontact.stages.build import BuildInputs, run_build
     from flatcontact.structures import build as builder
 
+    _check_numbers(
+        gap_angstrom, fmax_ev_per_angstrom, lj_cutoff_angstrom, normal_axis, face_depth_angstrom
+    )
     if structure is None:
         builder.check_layers(layers, "--layers")
+        limits.check("layers", layers, "--layers", "layers per slab")
         if source == "shipped":
             builder.check_shipped_layers(layers, "--layers")
-    _positive_finite(fmax_ev_per_angstrom, "--fmax-ev-per-angstrom", "eV/Å")
-    _positive_finite(gap_angstrom, "--gap-angstrom", "Å")
-    if structure is not None:
-        _positive_finite(face_depth_angstrom, "--face-depth-angstrom", "Å")
     if regenerate_dense:
         provenance = builder.regenerate_shipped_dense_slab(
             layers=layers, fmax_ev_per_angstrom=fmax_ev_per_angstrom

@@ -39,8 +39,8 @@ def elastic_cmd(
     for any material; without it, alpha-quartz with ``--potential``.
     """
     from flatcontact.config.elastic import ElasticConfig
-    from flatcontact.config.numbers import field_bounds
     from flatcontact.elastic import quartz_contact_moduli
+    from flatcontact.numbers import field_bounds
 
     try:  # the run's elastic.strain bounds
         strain = field_bounds(ElasticConfig.model_fields["strain"]).check(strain)

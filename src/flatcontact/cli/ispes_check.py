@@ -11,7 +11,15 @@ from pathlib import Path
 
 from rich.table import Table
 
-from flatcontact.cli.app import check_out_dir, console, parse_floats, print_progress
+from flatcontact.cli.app import (
+    bounded,
+    bounded_int,
+    check_out_dir,
+    console,
+    parse_floats,
+    print_progress,
+    setting_bounds,
+)
 from flatcontact.errors import InputError, require
 
 
@@ -48,10 +56,12 @@ def ispes_check(
     ispes_dir,
 ) -> dict:
     """``validate-potential --ispes``: checks every argument, then compare_ispes."""
-    import numpy as np
-
+    from flatcontact import limits
     from flatcontact.analysis.uncertainty import committee_spread
     from flatcontact.config import default_potential
+    from flatcontact.config.analysis import AnalysisConfig
+    from flatcontact.config.scan import PressureRange, ScanConfig
+    from flatcontact.potentials.coupling import LJSpec
     from flatcontact.training.ispes_check import compare_ispes
 
     require(reference is not None, "--ispes: give the reference model with --reference NAME")
@@ -63,24 +73,26 @@ def ispes_check(
         energy in ("internal", "enthalpy"),
         f"--energy: expected internal or enthalpy, got {energy!r}",
     )
-    require(
-        grid[0] >= 2 and grid[1] >= 2, f"--grid: expected at least 2 x 2, got {grid[0]} {grid[1]}"
-    )
+    for axis in grid:
+        bounded_int(axis, "--grid", 2, limits.bound("grid_axis"), "points along one axis")
     lo, hi, n = p_range_gpa
-    require(
-        np.isfinite(lo) and np.isfinite(hi) and lo < hi and n >= 3,
-        f"--p-range-gpa: expected LO < HI and N >= 3, got {lo:g} {hi:g} {n}",
+    bounded(lo, "--p-range-gpa", setting_bounds(PressureRange, "lo_gpa"))
+    bounded(hi, "--p-range-gpa", setting_bounds(PressureRange, "hi_gpa"))
+    bounded_int(n, "--p-range-gpa", 3, limits.bound("thicknesses"), "thicknesses N")
+    require(lo < hi, f"--p-range-gpa: expected LO < HI, got {lo:g} {hi:g}")
+    bounded(fmax, "--fmax-ev-per-angstrom", setting_bounds(ScanConfig, "fmax_ev_per_angstrom"))
+    loads = (
+        parse_floats(p_gpa, "--p-gpa", "GPa", setting_bounds(AnalysisConfig, "p_gpa"))
+        if p_gpa
+        else [0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0]
     )
-    require(np.isfinite(fmax) and fmax > 0, f"--fmax-ev-per-angstrom: expected > 0, got {fmax:g}")
-    loads = parse_floats(p_gpa, "--p-gpa", "GPa") if p_gpa else [0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0]
     require(len(loads) >= 2, "--p-gpa: expected at least two loads")
+    limits.check("loads", len(loads), "--p-gpa", "loads")
     lj = dict(default_potential()["lj"])
     if lj_cutoff_angstrom is not None:
-        require(
-            np.isfinite(lj_cutoff_angstrom) and lj_cutoff_angstrom > 0,
-            f"--lj-cutoff-angstrom: expected > 0, got {lj_cutoff_angstrom:g}",
+        lj["cutoff_angstrom"] = bounded(
+            lj_cutoff_angstrom, "--lj-cutoff-angstrom", setting_bounds(LJSpec, "cutoff_angstrom")
         )
-        lj["cutoff_angstrom"] = float(lj_cutoff_angstrom)
     named = [(reference, "--reference"), (potential, "POTENTIAL")]
     named += [(m, "--ispes-model") for m in extra]
     pairs = [_ispes_model(name, flag, lj) for name, flag in named]
@@ -97,8 +109,7 @@ def ispes_check(
         from flatcontact.structures.build import build_quartz_interface
         from flatcontact.structures.quartz_layers import MIN_LAYERS
 
-        if layers < MIN_LAYERS:
-            raise InputError(f"--layers: expected >= {MIN_LAYERS}, got {layers}")
+        bounded_int(layers, "--layers", MIN_LAYERS, limits.bound("layers"), "layers per slab")
         print_progress(
             f"building the dense alpha-quartz (0001) interface with {potential} ({layers} layers)"
         )

@@ -10,7 +10,14 @@ from pathlib import Path
 
 import typer
 
-from flatcontact.cli.app import app, check_out_dir, console, print_progress
+from flatcontact.cli.app import (
+    app,
+    bounded,
+    bounded_int,
+    check_out_dir,
+    console,
+    print_progress,
+)
 from flatcontact.errors import InputError
 
 
@@ -54,18 +61,18 @@ def train_snap_cmd(
     ),
 ) -> None:
     """Fit a SNAP (LAMMPS .snapcoeff/.snapparam) to a dataset or a generated recipe."""
+    from flatcontact.numbers import Bounds
     from flatcontact.potentials.teachers import get_teacher
     from flatcontact.training.train import train_snap
 
     check_base_name(name)
+    # a size factor of the recipe's random groups: 1e-3 leaves one frame per group, 100
+    # is ~10⁵ labelled frames (days of teacher time)
+    bounded(scale, "--scale", Bounds(1e-3, 100.0))
+    bounded_int(seed, "--seed", 0, 2**32 - 1, "a numpy seed")
+    bounded_int(active_rounds, "--active-rounds", 0, 50, "active-learning rounds")
     if recipe is not None:
         get_teacher(label, "--label")
-    if not (scale > 0 and scale <= 100):
-        raise InputError(
-            f"--scale {scale:g}: expected a size factor of the recipe's random groups in (0, 100]"
-        )
-    if not 0 <= active_rounds <= 50:
-        raise InputError(f"--active-rounds {active_rounds}: expected an integer from 0 to 50")
     check_out_dir(out)
     command = "flatcontact " + " ".join(shlex.quote(a) for a in sys.argv[1:])
     report = train_snap(

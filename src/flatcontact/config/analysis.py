@@ -8,8 +8,8 @@ from pydantic import Field, field_validator
 
 from flatcontact import limits
 from flatcontact.config.messages import show
-from flatcontact.config.numbers import physical
 from flatcontact.config.section import Section
+from flatcontact.numbers import physical
 from flatcontact.reference import PAPER_THRESHOLD_GPA
 
 

@@ -19,8 +19,8 @@ from pydantic import Field, field_validator
 
 from flatcontact import limits
 from flatcontact.config.messages import show
-from flatcontact.config.numbers import physical
 from flatcontact.config.section import Section
+from flatcontact.numbers import physical
 from flatcontact.reference import DEFAULT_P0_GPA, PAPER, PAPER_EXPERIMENT_P0_GPA
 
 #: Force amplitudes of the cycle as fractions of the gross-sliding force

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from pydantic import Field
 
-from flatcontact.config.numbers import physical
 from flatcontact.config.section import Section
+from flatcontact.numbers import physical
 
 
 class ElasticConfig(Section):

@@ -22,8 +22,8 @@ from typing import Literal
 
 from pydantic import Field
 
-from flatcontact.config.numbers import physical
 from flatcontact.config.section import Section
+from flatcontact.numbers import physical
 
 #: The settings a refinement study can refine, in the order they are reported.
 REFINABLE = ("grid", "thicknesses", "layers", "fmax", "cutoff")

@@ -7,14 +7,15 @@ keeps them equal), so the settings import no physics.
 
 from __future__ import annotations
 
+import re
 from typing import Any, Literal
 
 from pydantic import Field, field_validator, model_validator
 
 from flatcontact import limits
 from flatcontact.config.messages import show
-from flatcontact.config.numbers import physical
 from flatcontact.config.section import Section, positive_pair
+from flatcontact.numbers import physical
 
 #: Optimisers a scan point may use (:data:`flatcontact.ispes.relax.OPTIMIZERS`): ASE's, and
 #: ``lammps-cg`` (LAMMPS's own minimiser, LAMMPS models only).
@@ -23,6 +24,33 @@ OPTIMIZERS: tuple[str, ...] = ("FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch
 DEFAULT_OPTIMIZER = "LBFGS"
 #: Warm-start orders of the scan (:data:`flatcontact.ispes.order.PREFERENCES`).
 PREFERENCES: tuple[str, ...] = ("columns", "planes", "cold")
+
+
+#: Transports a Dask scheduler address may name (``tcp://host:8786``; bare ``host:8786`` is tcp).
+DASK_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
+_HOST_PORT = re.compile(
+    r"(?P<host>\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9](?:[A-Za-z0-9.-]*[A-Za-z0-9])?):(?P<port>\d{1,5})"
+)
+
+
+def parse_dask_address(address: str) -> tuple[str, str, int]:
+    """(scheme, host, port) of a Dask scheduler address, or ValueError saying what is expected.
+
+    The form is checked before anything connects (``garbage`` used to cost a 10 s
+    timeout): ``[scheme://]host:port`` with a scheme of :data:`DASK_SCHEMES`, a host name or
+    IP address (IPv6 in brackets) and a port 1..65535.
+    """
+    text = str(address).strip()
+    scheme, sep, rest = text.partition("://")
+    if not sep:
+        scheme, rest = "tcp", text
+    match = _HOST_PORT.fullmatch(rest)
+    if scheme not in DASK_SCHEMES or match is None or not 1 <= int(match["port"]) <= 65535:
+        raise ValueError(
+            f"expected a Dask scheduler address [{'|'.join(DASK_SCHEMES)}://]host:port "
+            f"(port 1..65535), e.g. tcp://10.0.0.5:8786, got {show(address)}"
+        )
+    return scheme, match["host"].strip("[]"), int(match["port"])
 
 
 class PressureRange(Section):
@@ -94,7 +122,7 @@ class ScanConfig(Section):
         DEFAULT_OPTIMIZER,
         description="Optimiser of each point: " + ", ".join(OPTIMIZERS),
     )
-    max_steps: int = Field(2000, ge=1, description="optimiser step cap per point")
+    max_steps: int = Field(2000, ge=1, le=1_000_000, description="optimiser step cap per point")
     relax_mode: Literal["full", "normal", "rigid-layers", "rigid"] = Field(
         "full",
         # left out of the dumped config while default, so existing run fingerprints are unchanged
@@ -142,6 +170,13 @@ class ScanConfig(Section):
     def _order(cls, value: str) -> str:
         if value not in PREFERENCES:
             raise ValueError(f"expected one of {', '.join(PREFERENCES)}, got {show(value)}")
+        return value
+
+    @field_validator("dask_address")
+    @classmethod
+    def _dask_address(cls, value: str | None) -> str | None:
+        if value is not None:
+            parse_dask_address(value)
         return value
 
     @field_validator("grid", mode="before")

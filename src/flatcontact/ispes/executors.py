@@ -19,6 +19,7 @@ to the driver, which alone writes the point store.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import contextlib
 import ctypes
 import multiprocessing
 import os
@@ -188,6 +189,44 @@ def jobqueue_cluster(spec: dict) -> Any:
     return cluster
 
 
+def check_scheduler_address(
+    address: str, timeout_s: float = 3.0, field: str = "dask-address"
+) -> None:
+    """Refuse a Dask scheduler address that is malformed or where nothing listens, in one
+    line naming it, within ``timeout_s`` (a refused port answers at once; an unroutable host
+    takes the timeout). Only the TCP-based transports are probed."""
+    import socket
+
+    from flatcontact.config.scan import parse_dask_address
+
+    try:
+        scheme, host, port = parse_dask_address(address)
+    except ValueError as exc:
+        raise InputError(f"{field}: {exc}") from None
+    if scheme not in ("tcp", "tls", "ws", "wss"):
+        return
+    try:
+        with socket.create_connection((host, port), timeout=timeout_s):
+            pass
+    except OSError as exc:
+        reason = exc.strerror or exc.__class__.__name__
+        raise InputError(
+            f"{field} {address}: no Dask scheduler reachable at {host}:{port} ({reason}); "
+            "start one (dask scheduler) or check the address"
+        ) from None
+
+
+def _abandon(client: Any) -> None:
+    """Mark a ``distributed.Client`` whose start failed as closed and stop its event loop, so
+    its finaliser does not wait 10 s on a scheduler that never answered and print a
+    traceback at exit."""
+    client.status = "closed"
+    runner = getattr(client, "_loop_runner", None)
+    if runner is not None:
+        with contextlib.suppress(Exception):
+            runner.stop()
+
+
 class DaskExecutor(SerialExecutor):
     """Tasks on a Dask distributed cluster.
 
@@ -208,18 +247,28 @@ class DaskExecutor(SerialExecutor):
         if (address is None) == (cluster is None):
             raise InputError("dask: give either a scheduler address or a cluster")
         self._own_cluster = None
+        if address is not None:
+            check_scheduler_address(address, timeout_s)
+        client = Client.__new__(Client)
         try:
-            self._client = Client(
+            client.__init__(
                 address if address is not None else cluster,
                 timeout=f"{timeout_s}s",
                 set_as_default=False,
             )
-        except (OSError, TimeoutError) as exc:
-            raise InputError(
-                f"dask-address {address}: no Dask scheduler reachable ({exc.__class__.__name__})"
-            ) from None
         except ValueError as exc:
+            _abandon(client)
             raise InputError(f"dask-address {address!r}: not a scheduler address ({exc})") from None
+        except Exception as exc:  # refused, timed out, or a peer that is no scheduler (its
+            # bytes read as a frame length: MemoryError), all the same to the user
+            _abandon(client)
+            said = " ".join(str(exc).split())[:120]
+            raise InputError(
+                f"dask-address {address}: no Dask scheduler answers there "
+                f"({exc.__class__.__name__}{': ' + said if said else ''}); start one "
+                "(dask scheduler) or check the address"
+            ) from None
+        self._client = client
 
     @property
     def workers(self) -> int:

@@ -14,6 +14,7 @@ from typing import Literal
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from flatcontact.errors import InputError
+from flatcontact.numbers import physical
 from flatcontact.potentials.lj import hamaker_c6_scale, lj_table, pair_key
 from flatcontact.potentials.styles import check_element
 
@@ -55,10 +56,12 @@ class LJSpec(BaseModel):
     c6_ev_a6: dict[str, float] = Field(default_factory=dict)
     r0_angstrom: dict[str, float] = Field(default_factory=dict)
     volume_ratio: dict[str, float] = Field(default_factory=dict)
-    c6_scale: float = 1.0
-    hamaker_zj: float | None = None
+    c6_scale: physical(1e-3, 1e3) = 1.0
+    hamaker_zj: physical(1.0, 1e4, "zJ") | None = None
     number_density_per_nm3: dict[str, float] = Field(default_factory=dict)
-    cutoff_angstrom: float = 10.0
+    #: 1..50 Å: below an atom's size the shift is the potential; beyond, a neighbour list
+    #: of every LAMMPS worker grows as rc³ with nothing left to converge (10 Å: 0.1 % of U)
+    cutoff_angstrom: physical(1.0, 50.0, "Å") = 10.0
 
     @field_validator("c6_ev_a6")
     @classmethod
@@ -74,13 +77,6 @@ class LJSpec(BaseModel):
                 raise ValueError(f"c6_ev_a6['{key}']={c6}: expected > 0 eV·Å⁶")
             out["-".join(sorted(parts))] = float(c6)
         return dict(sorted(out.items()))
-
-    @field_validator("c6_scale", "hamaker_zj")
-    @classmethod
-    def _positive_scalar(cls, value: float | None) -> float | None:
-        if value is not None and not value > 0:
-            raise ValueError(f"expected > 0, got {value}")
-        return value
 
     @model_validator(mode="after")
     def _hamaker_needs_densities(self) -> LJSpec:
@@ -123,13 +119,6 @@ class LJSpec(BaseModel):
             if not v > 0:
                 raise ValueError(f"value for '{key}' must be > 0, got {v}")
         return dict(sorted(value.items()))
-
-    @field_validator("cutoff_angstrom")
-    @classmethod
-    def _cutoff(cls, value: float) -> float:
-        if not value > 0:
-            raise ValueError(f"cutoff_angstrom={value}: expected > 0")
-        return value
 
     def __hash__(self) -> int:
         return hash(self.model_dump_json())

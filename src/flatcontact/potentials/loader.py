@@ -12,6 +12,7 @@ from __future__ import annotations
 import importlib
 import inspect
 import json
+import math
 from typing import Any
 
 import yaml
@@ -49,18 +50,86 @@ def accepts_atoms(fn: Any) -> bool:
         return False
 
 
+def is_calculator(obj: Any) -> bool:
+    """True for an ASE calculator: an object with callable ``get_potential_energy`` and
+    ``get_forces`` (what :class:`ase.Atoms` asks of ``atoms.calc``; ASE's own classes and
+    third-party ones that do not subclass them alike); a class is not one (its methods are
+    callable too, unbound)."""
+    return not isinstance(obj, type) and all(
+        callable(getattr(obj, name, None)) for name in ("get_potential_energy", "get_forces")
+    )
+
+
 def call_factory(target: str, atoms=None, kwargs: dict | None = None, what: str = "calculator"):
-    """``callable(**kwargs)`` (with ``atoms=atoms`` when it takes ``atoms``): an ASE calculator."""
+    """``callable(**kwargs)`` (with ``atoms=atoms`` when it takes ``atoms``): an ASE calculator.
+
+    Raises
+    ------
+    InputError
+        One line naming ``target`` when a keyword argument is not finite data, the callable
+        refuses its arguments or fails (the exception's type and message), or returns
+        something that is not an ASE calculator (``None``, a number, a class). A memory or
+        disk failure is passed on unchanged (the command line names the limit).
+    """
     fn = load_callable(target, what)
     kwargs = dict(kwargs or {})
+    check_finite_data(kwargs, f"{what} '{target}' keyword argument")
     if atoms is not None and "atoms" not in kwargs and accepts_atoms(fn):
         kwargs["atoms"] = atoms
     try:
-        return fn(**kwargs)
+        made = fn(**kwargs)
     except TypeError as exc:
         raise InputError(
             f"{what} '{target}': bad keyword arguments {sorted(kwargs)} ({exc})"
         ) from None
+    except (InputError, MemoryError, OSError):
+        raise
+    except Exception as exc:  # the user's factory failed: its message, in one line
+        said = " ".join(str(exc).split())[:200]
+        raise InputError(f"{what} '{target}' failed: {type(exc).__name__}: {said}") from None
+    if not is_calculator(made):
+        raise InputError(
+            f"{what} '{target}' returned {_describe(made)}, expected an ASE calculator "
+            "(an object with get_potential_energy and get_forces)"
+        )
+    return made
+
+
+def _describe(obj: Any) -> str:
+    """``None``, ``a float (1.0)``, ``the class EMT``: what a factory returned, briefly."""
+    if obj is None:
+        return "None"
+    if isinstance(obj, type):
+        return f"the class {obj.__name__} (call it: a factory returns an instance)"
+    text = repr(obj)
+    return f"a {type(obj).__name__} ({text[:40]}{'...' if len(text) > 40 else ''})"
+
+
+def _non_finite(item: Any) -> bool:
+    """NaN or ±inf, as a float or as a string a factory's ``float()`` would read so
+    (``"nan"``, ``"-inf"``: plain YAML reads ``x=nan`` as a string)."""
+    if isinstance(item, float):
+        return not math.isfinite(item)
+    if isinstance(item, str) and item.strip().lower().lstrip("+-") in ("nan", "inf", "infinity"):
+        return True
+    return False
+
+
+def check_finite_data(value: Any, name: str) -> None:
+    """Refuse NaN or ±inf anywhere in keyword-argument data (numbers, lists, mappings), in
+    one line naming ``name`` and the key path (``cutoff``, ``params.sigma``)."""
+
+    def walk(item: Any, path: str) -> None:
+        if _non_finite(item):
+            raise InputError(f"{name} {path}: expected a finite number, got {item!r}")
+        if isinstance(item, dict):
+            for key, sub in item.items():
+                walk(sub, f"{path}.{key}" if path else str(key))
+        elif isinstance(item, list | tuple):
+            for i, sub in enumerate(item):
+                walk(sub, f"{path}[{i}]")
+
+    walk(value, "")
 
 
 def parse_kwargs(
@@ -84,5 +153,6 @@ def parse_kwargs(
             json.dumps(value)
         except (yaml.YAMLError, TypeError, ValueError):
             raise InputError(f"{flag} {item!r}: the value is not plain YAML/JSON data") from None
+        check_finite_data({key: value}, flag)
         out[key] = value
     return out

@@ -16,8 +16,9 @@ from typing import Any, Literal
 from ase.data import chemical_symbols
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
+from flatcontact.errors import InputError
 from flatcontact.potentials.files import file_elements, require_potential_file
-from flatcontact.potentials.loader import load_callable
+from flatcontact.potentials.loader import check_finite_data, load_callable
 
 
 def check_element(symbol: str, where: str) -> None:
@@ -228,6 +229,10 @@ class AseCalculatorSpec(BaseModel):
     @field_validator("kwargs")
     @classmethod
     def _kwargs(cls, value: dict[str, Any]) -> dict[str, Any]:
+        try:
+            check_finite_data(value, "kwargs")
+        except InputError as exc:
+            raise ValueError(str(exc)) from None
         try:
             return json.loads(json.dumps(value, sort_keys=True))
         except (TypeError, ValueError):

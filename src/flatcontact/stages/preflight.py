@@ -18,6 +18,7 @@ from flatcontact import limits
 from flatcontact.config import RunConfig
 from flatcontact.contact.measured import load_stiffness_csv
 from flatcontact.errors import InputError
+from flatcontact.ispes.executors import check_scheduler_address
 from flatcontact.potentials.engines import calculator_factory
 from flatcontact.potentials.loader import load_callable
 from flatcontact.stages import _calculator
@@ -73,6 +74,8 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
             load_callable(calc.target)
         except InputError as exc:
             raise InputError(f"{source}: potential.calculator.target: {exc}") from None
+    if cfg.scan.dask_address is not None:
+        check_scheduler_address(cfg.scan.dask_address, field=f"{source}: scan.dask_address")
     _check_structure(cfg, source)
     check_measured_on(cfg, source)
     check_moduli_source(cfg, structure_elements(cfg.structure))

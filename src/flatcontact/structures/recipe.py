@@ -35,10 +35,12 @@ from pydantic import (
     Tag,
     TypeAdapter,
     ValidationError,
+    field_validator,
     model_validator,
 )
 
 from flatcontact.errors import InputError
+from flatcontact.numbers import Bounds, physical, state_bounds
 from flatcontact.structures.quartz_layers import MIN_LAYERS, check_shipped_layers
 from flatcontact.structures.sheet_catalog import BUILTIN_SHEETS
 
@@ -46,8 +48,40 @@ from flatcontact.structures.sheet_catalog import BUILTIN_SHEETS
 SECTION = "structure"
 
 
+#: Bounds of the recipe's floats (:func:`~flatcontact.numbers.physical`: finite, no
+#: subnormals, printed by ``flatcontact config --show-default``). A gap or spacing from
+#: touching cores (0.5 Å, below any bond) to twice the longest vdW cutoff (20 Å); an fcc
+#: lattice constant from 1 to 10 Å (Cu 3.61, Pb 4.95, Ca 5.58 Å); a relaxation's force
+#: tolerance as the scan's (1e-6..10 eV/Å); a rotation within one turn either way.
+GapAngstrom = physical(0.5, 20.0, "Å")
+LatticeAngstrom = physical(1.0, 10.0, "Å")
+FmaxEvPerAngstrom = physical(1e-6, 10.0, "eV/Å")
+AngleDeg = physical(-360.0, 360.0, "deg")
+StrainPercent = physical(1e-3, 20.0, "%")
+
+#: Parameters of the toy LJ (:class:`flatcontact.structures.toy.ToyPairCalculator` and
+#: :func:`~flatcontact.structures.toy.toy_interface`) and their bounds: well depths of a
+#: physisorbed or metallic pair (no cross-interface attraction: 0), σ of an atom, the cutoff
+#: in σ (below 1.2σ the shifted force has no minimum), the initial gap in layer spacings and
+#: the force tolerance of the initial relaxation.
+TOY_PARAMS: dict[str, Bounds] = {
+    "eps_intra_ev": Bounds(1e-4, 10.0, "eV"),
+    "eps_cross_ev": Bounds(1e-4, 10.0, "eV", or_zero=True),
+    "sigma_angstrom": Bounds(0.5, 10.0, "Å"),
+    "cutoff_sigma": Bounds(1.2, 5.0),
+    "gap_factor": Bounds(0.5, 5.0),
+    "relax_fmax_ev_per_a": Bounds(1e-8, 1.0, "eV/Å"),
+}
+
+
 class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    @classmethod
+    def __pydantic_init_subclass__(cls, **kwargs: Any) -> None:
+        """State the bounds of the recipe's bounded floats in their descriptions."""
+        super().__pydantic_init_subclass__(**kwargs)
+        state_bounds(cls)
 
 
 #: Surface passivation of a crystal cut (:mod:`flatcontact.structures.passivate`).
@@ -64,8 +98,8 @@ _FACES_DOC = "interface: only the face towards the other slab; both: the held ou
 class MatchSettings(_Model):
     """Bounds of the coincidence-lattice search (hetero-interfaces) and of the atom count."""
 
-    max_strain_percent: float = Field(
-        3.0, gt=0, le=20, description="largest principal strain put on either slab (%)"
+    max_strain_percent: StrainPercent = Field(
+        3.0, description="largest principal strain put on either slab (%)"
     )
     max_atoms: int = Field(400, ge=2, description="largest number of atoms of the interface")
     strain_on: Literal["slab2", "both"] = Field(
@@ -77,7 +111,7 @@ class MatchSettings(_Model):
 
 class _PairOptions(_Model):
     held_layers: int = Field(1, ge=1, description="outer layers held (rigid) per slab")
-    rotate_deg: float = Field(
+    rotate_deg: AngleDeg = Field(
         0.0,
         description="slab 2 rotated about z by this angle (a symmetry of its lattice, e.g. 180); "
         "for sheets about the midpoint of the shortest unlike bond",
@@ -91,9 +125,8 @@ class _PairOptions(_Model):
         default_factory=MatchSettings,
         description="bounds of the coincidence-lattice search and of the atom count",
     )
-    fmax_ev_per_angstrom: float = Field(
+    fmax_ev_per_angstrom: FmaxEvPerAngstrom = Field(
         0.01,
-        gt=0,
         description="force tolerance of the reference relaxation (when a calculator is given)",
     )
 
@@ -104,9 +137,8 @@ class SheetSlab(_Model):
     sheet: str = Field(description="built-in graphene | h-BN | MoS2, or a monolayer file")
     layers: int = Field(1, ge=1, description="sheets in this slab")
     stacking: str = Field("AB", description="stacking letters of this slab (see docs)")
-    interlayer_angstrom: float | None = Field(
+    interlayer_angstrom: GapAngstrom | None = Field(
         None,
-        gt=0,
         description="distance between adjacent sheets (mean planes); built-ins: bulk value",
     )
 
@@ -122,12 +154,11 @@ class SheetsRecipe(_PairOptions):
         description="letters A, B, C (optionally primed) for the whole stack, slab 1 then slab 2, "
         "repeated: AB = Bernal, AA' = h-BN AA′ / 2H-MoS2",
     )
-    interlayer_angstrom: float | None = Field(
-        None, gt=0, description="distance between adjacent sheets"
+    interlayer_angstrom: GapAngstrom | None = Field(
+        None, description="distance between adjacent sheets"
     )
-    interface_spacing_angstrom: float | None = Field(
+    interface_spacing_angstrom: GapAngstrom | None = Field(
         None,
-        gt=0,
         description="distance between the facing sheets of the two slabs (default: the interlayer distance, mean of the two materials)",
     )
     slab2: SheetSlab | None = Field(None, description="another material for slab 2")
@@ -168,8 +199,8 @@ class CrystalRecipe(_PairOptions):
     termination: int = Field(
         0, ge=0, description="which cut (0 = widest gap between atomic planes)"
     )
-    gap_angstrom: float | None = Field(
-        None, gt=0, description="highest atom of slab 1 to lowest of slab 2 (default: the bulk's)"
+    gap_angstrom: GapAngstrom | None = Field(
+        None, description="highest atom of slab 1 to lowest of slab 2 (default: the bulk's)"
     )
     flip: bool = Field(False, description="slab 2 = slab 1 upside down (rotated 180° about a1)")
     slab2: _CrystalOrSheetSlab | None = Field(
@@ -196,8 +227,8 @@ class CrystalRecipe(_PairOptions):
 
 class Fcc111Slab(_Model):
     element: str = Field(description="fcc element of slab 2")
-    a_angstrom: float | None = Field(
-        None, gt=0, description="lattice constant (default: ASE's reference)"
+    a_angstrom: LatticeAngstrom | None = Field(
+        None, description="lattice constant (default: ASE's reference)"
     )
     layers: int = Field(6, ge=1, description="close-packed planes of slab 2")
 
@@ -207,13 +238,12 @@ class Fcc111Recipe(_PairOptions):
 
     kind: Literal["fcc111"] = Field("fcc111", description="recipe kind")
     element: str = Field(description="Cu, Ni, Al, ... (fcc)")
-    a_angstrom: float | None = Field(
-        None, gt=0, description="lattice constant (default: ASE's reference)"
+    a_angstrom: LatticeAngstrom | None = Field(
+        None, description="lattice constant (default: ASE's reference)"
     )
     layers: int = Field(6, ge=1, description="close-packed planes per slab")
-    gap_angstrom: float | None = Field(
+    gap_angstrom: GapAngstrom | None = Field(
         None,
-        gt=0,
         description="distance between the facing planes (default a/√3: the perfect crystal)",
     )
     slab2: Fcc111Slab | None = Field(None, description="another fcc metal for slab 2")
@@ -233,11 +263,11 @@ class QuartzDenseRecipe(_Model):
         "seed (seeded dense reconstruction relaxed with the potential) or auto (shipped if "
         "present and it reaches layers, else seed)",
     )
-    gap_angstrom: float = Field(
-        3.0, gt=0, description="initial gap between the slabs before the interface relaxation (Å)"
+    gap_angstrom: GapAngstrom = Field(
+        3.0, description="initial gap between the slabs before the interface relaxation (Å)"
     )
-    fmax_ev_per_angstrom: float = Field(
-        0.01, gt=0, description="force tolerance of the slab and interface relaxations (eV/Å)"
+    fmax_ev_per_angstrom: FmaxEvPerAngstrom = Field(
+        0.01, description="force tolerance of the slab and interface relaxations (eV/Å)"
     )
 
     @model_validator(mode="after")
@@ -268,14 +298,13 @@ class SlabFileRecipe(_Model):
     file: str = Field(
         description="slab file (any format ASE reads), periodic along cell vectors 1, 2"
     )
-    gap_angstrom: float = Field(
-        3.0, gt=0, description="highest atom of slab 1 to lowest of slab 2 (Å)"
+    gap_angstrom: GapAngstrom = Field(
+        3.0, description="highest atom of slab 1 to lowest of slab 2 (Å)"
     )
     held_layers: int = Field(1, ge=1, description="outer layers held (rigid) per slab")
     flip: bool = Field(False, description="slab 2 = slab 1 upside down (rotated 180° about a1)")
-    fmax_ev_per_angstrom: float = Field(
+    fmax_ev_per_angstrom: FmaxEvPerAngstrom = Field(
         0.01,
-        gt=0,
         description="force tolerance of the reference relaxation (when a calculator is given)",
     )
 
@@ -286,8 +315,25 @@ class ToyRecipe(_Model):
     kind: Literal["toy-lj"] = Field("toy-lj", description="recipe kind")
     layers: int = Field(3, ge=3, description="atomic layers per slab (>= 3)")
     params: dict[str, float] = Field(
-        default_factory=dict, description="ToyPairCalculator parameters"
+        default_factory=dict,
+        description="ToyPairCalculator parameters ["
+        + ", ".join(f"{k}: {b.text()}" for k, b in TOY_PARAMS.items())
+        + "]",
     )
+
+    @field_validator("params")
+    @classmethod
+    def _params(cls, value: dict[str, float]) -> dict[str, float]:
+        for key, number in value.items():
+            if key not in TOY_PARAMS:
+                raise ValueError(
+                    f"unknown parameter {key!r}: expected one of {', '.join(TOY_PARAMS)}"
+                )
+            try:
+                TOY_PARAMS[key].check(number)
+            except ValueError as exc:
+                raise ValueError(f"{key}: {exc}") from None
+        return value
 
 
 StructureRecipe = Annotated[

@@ -1,6 +1,7 @@
-"""The one checked reader of every structure file a user gives (interface, slab, bulk, sheet).
+"""The one checked reader of every structure file a user gives (interface, slab, bulk, sheet,
+training set).
 
-:func:`read_structure` reads a file with ASE between two sets of checks, each refusal one
+:func:`read_structure` reads a file (:func:`read_structures` every frame of it) with ASE between two sets of checks, each refusal one
 :class:`~flatcontact.errors.InputError` naming the field, the file and the defect:
 
 Before parsing (nothing allocated from what the file claims):
@@ -82,23 +83,57 @@ def read_structure(
     InputError
         One line ``"<field>: <path>: <defect>"``.
     """
+    path, label = _checked_file(path, field, format)
+    atoms = _read(path, label, format, -1 if index is None else index)
+    if not isinstance(atoms, Atoms):
+        raise InputError(f"{label}: expected one structure, found {type(atoms).__name__}")
+    check_structure(atoms, label)
+    return atoms
+
+
+def read_structures(
+    path: str | os.PathLike[str], field: str = "", *, format: str | None = None
+) -> list[Atoms]:
+    """Every frame of a structure file (a training set), each checked as
+    :func:`read_structure` checks one; messages name ``"<path> frame <k>"`` (from 0).
+
+    Raises
+    ------
+    InputError
+        One line naming the file (and the frame) and the first defect; a file without
+        frames is one too.
+    """
+    path, label = _checked_file(path, field, format)
+    frames = _read(path, label, format, ":")
+    frames = [frames] if isinstance(frames, Atoms) else list(frames)
+    if not frames:
+        raise InputError(f"{label}: no frames")
+    for k, atoms in enumerate(frames):
+        check_structure(atoms, f"{label} frame {k}")
+    return frames
+
+
+def _checked_file(path, field: str, format: str | None) -> tuple[Path, str]:
+    """(path, label) of a file that exists and passed :func:`check_file`."""
     path = Path(path)
     label = f"{field}: {path}" if field else str(path)
     if not path.is_file():
         raise InputError(f"{label}: file not found")
     check_file(path, label, format)
+    return path, label
+
+
+def _read(path: Path, label: str, format: str | None, index):
+    """ASE's reader, its warnings silenced and any failure one line naming the file."""
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # ASE's warnings on odd files are not the user's
-            atoms = read(path, format=format, index=-1 if index is None else index)
+            return read(path, format=format, index=index)
     except Exception as exc:  # any reader error (or MemoryError) is the user's file to fix
+        said = " ".join(str(exc).split())[:200]
         raise InputError(
-            f"{label}: not a structure file ASE can read ({type(exc).__name__}: {exc})"
+            f"{label}: not a structure file ASE can read ({type(exc).__name__}: {said})"
         ) from None
-    if not isinstance(atoms, Atoms):
-        raise InputError(f"{label}: expected one structure, found {type(atoms).__name__}")
-    check_structure(atoms, label)
-    return atoms
 
 
 def check_file(path: Path, label: str, format: str | None = None) -> None:

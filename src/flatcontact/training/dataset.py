@@ -6,7 +6,10 @@ stress in eV/Å³, Voigt order (xx, yy, zz, yz, xz, xy), positive = tensile
 ``info["config_type"]`` (a group name used for weights, splits and reports).
 
 :func:`read_dataset` validates everything before any work starts and raises a
-one-line :class:`~flatcontact.errors.InputError` that names the file and frame.
+one-line :class:`~flatcontact.errors.InputError` that names the file and frame: first the
+checked structure reader (:func:`flatcontact.structures.structure_file.read_structures`:
+file size and claimed atom counts before parsing; atom count, finite positions and cell,
+cell shape and minimum distance per frame), then the labels (:func:`validate_frame`).
 """
 
 from __future__ import annotations
@@ -17,11 +20,12 @@ from pathlib import Path
 import numpy as np
 from ase import Atoms
 from ase.calculators.singlepoint import SinglePointCalculator
-from ase.io import read, write
+from ase.io import write
 from ase.neighborlist import neighbor_list
 
 from flatcontact.errors import InputError
 from flatcontact.fileio import atomic_path
+from flatcontact.structures.structure_file import read_structures
 
 #: Two atoms closer than this (Å) make a frame unphysical.
 MIN_DISTANCE_ANGSTROM = 0.6
@@ -98,14 +102,9 @@ def read_dataset(path: str | Path, elements: Sequence[str] | None = None) -> lis
     path = Path(path)
     if not path.is_file():
         raise InputError(f"{path}: dataset file not found")
-    try:
-        frames = read(path, index=":", format="extxyz")
-    except Exception as exc:  # ASE raises many types on malformed files
-        raise InputError(
-            f"{path}: not a readable extxyz file ({type(exc).__name__}: {exc})"
-        ) from None
-    if not frames:
-        raise InputError(f"{path}: no frames")
+    # the checked structure reader: size, claimed atom counts before parsing; atom count,
+    # finite positions and cell, cell shape, minimum distance of every frame after
+    frames = read_structures(path, format="extxyz")
     for k, atoms in enumerate(frames):
         validate_frame(atoms, f"{path} frame {k}", elements)
         atoms.info.setdefault("config_type", "default")

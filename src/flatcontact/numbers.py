@@ -1,5 +1,9 @@
 """The numeric domain of every float a user gives: finite, a normal double, within bounds.
 
+A foundation module outside ``config`` so that the data models the settings hold (the
+structure recipe, :mod:`flatcontact.structures.recipe`) can use it without importing the
+settings package that imports them.
+
 A float field of the settings is typed with :func:`physical`: ``radius_um: physical(1e-3,
 1e4, "µm")``. The value must be finite (no NaN or inf), a normal double (no subnormal such as
 ``1e-320``, whose reciprocal overflows) and inside closed bounds that no physical use reaches
@@ -84,3 +88,14 @@ def field_bounds(field: Any) -> Bounds | None:
         if isinstance(item, Bounds):
             return item
     return bounds_in(field.annotation)
+
+
+def state_bounds(model: Any) -> None:
+    """Append the bounds of every :func:`physical` field of the pydantic class ``model`` to
+    its description (``[0.5..20 Å]``), once: ``flatcontact config --show-default`` prints
+    them as the field's comment. Called by the settings' and the recipe's base classes from
+    ``__pydantic_init_subclass__``."""
+    for field in model.model_fields.values():
+        bounds = field_bounds(field)
+        if bounds is not None and bounds.text() not in (field.description or ""):
+            field.description = f"{field.description or ''} [{bounds.text()}]".strip()
