@@ -9,13 +9,22 @@ the old threshold in ``analyze.json``.
 
 from __future__ import annotations
 
+import contextlib
+import json
 import logging
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from flatcontact.errors import InputError
 from flatcontact.fileio import atomic_path, write_json_atomic, write_text_atomic
-from flatcontact.layout import ANALYZE_JSON, FRICTION_CSV, FRICTION_NC, analyze_figure
+from flatcontact.layout import (
+    ANALYZE_JSON,
+    FRICTION_CSV,
+    FRICTION_NC,
+    SCAN_JSON,
+    analyze_figure,
+)
 from flatcontact.stages._common import captured, renamed_errors, save
 
 #: Parameters of :func:`flatcontact.analysis.analyze.analyze_ispes` -> the settings path.
@@ -81,7 +90,7 @@ def run_analyze(
     from flatcontact.ispes.contract import open_ispes
 
     s = settings.analysis
-    with renamed_errors(SETTINGS_NAMES):
+    with renamed_errors(SETTINGS_NAMES), _folds_named(Path(inputs.ispes).parent / SCAN_JSON):
         ds = open_ispes(inputs.ispes)
         with captured(AnalysisWarning) as caught:
             analysis = analyze_ispes(
@@ -103,6 +112,33 @@ def run_analyze(
     if folder is not None:
         _write(result, folder, settings.report.svg)
     return result
+
+
+@contextlib.contextmanager
+def _folds_named(scan_json: Path):
+    """A load that is not monotonic where the scan recorded folds (``scan.json``
+    ``load_folds``, :mod:`flatcontact.ispes.grid_bracket`) is a fold of the material, not
+    noise: the one line says so and names the physical remedy besides the numerical one."""
+    try:
+        yield
+    except InputError as exc:
+        text = str(exc)
+        folds = []
+        if "not monotonic" in text:
+            try:
+                folds = json.loads(scan_json.read_text()).get("load_folds") or []
+            except (OSError, ValueError, AttributeError):
+                folds = []
+        if not folds:
+            raise
+        first = folds[0]
+        raise InputError(
+            f"{text}; the scan recorded {len(folds)} folding column(s) ({SCAN_JSON} "
+            f"load_folds; first: {first.get('column')}, p = {first.get('p_gpa', float('nan')):.3g} "
+            f"GPa at z = {first.get('z_angstrom', float('nan')):.4g} Å): a plane that slips or "
+            "opens under load folds p(z) — use scan.relax_mode: normal, or loads below the fold "
+            "(analysis.p_gpa, scan.p_range_gpa.hi_gpa)"
+        ) from None
 
 
 def _write(result: AnalyzeResult, folder: Path, svg: bool) -> None:
