@@ -73,11 +73,14 @@ def test_reference_rows_have_zero_difference_and_others_are_model_minus_referenc
 
 
 def test_the_same_model_twice_gives_the_same_numbers(committee):
-    """A deterministic scan and analysis: the committee member scanned twice agrees exactly."""
+    """The committee member scanned twice agrees to round-off. Not bit for bit: the engine
+    sends each atom at the image nearest the one LAMMPS holds, and a second scan in the same
+    process starts from the images the first left, so the last bits of the positions differ
+    (measured: ≤ 8.4e-9 MPa on τ of tens of MPa, 2e-10 relative)."""
     table, _ = committee
     again = table[table.model == "vashishta-again"]
     for q in ("tau_mpa", "sigma_mss_mpa", "shear_stiffness_gpa_per_nm"):
-        np.testing.assert_allclose(again[f"d_{q}"], 0.0, atol=1e-9)
+        np.testing.assert_allclose(again[f"d_{q}"], 0.0, atol=1e-7)
 
 
 def test_committee_spread_is_half_the_range_and_the_repeated_member_adds_nothing(committee):
@@ -86,10 +89,13 @@ def test_committee_spread_is_half_the_range_and_the_repeated_member_adds_nothing
 
     _, results = committee
     spread = committee_spread(results)
-    assert spread == committee_spread({k: results[k] for k in ("vashishta", "tersoff")})
+    # the repeated member equals the first to round-off (see the test above): it adds nothing
+    pair = committee_spread({k: results[k] for k in ("vashishta", "tersoff")})
+    assert spread.keys() == pair.keys()
+    assert all(spread[k] == pytest.approx(pair[k], rel=1e-8) for k in pair)  # measured 3e-9
     for key in LAW_COEFFICIENTS:
         a, b = (results[m]["laws"][key] for m in ("vashishta", "tersoff"))
-        assert spread[key] == pytest.approx(abs(a - b) / 2, rel=1e-12)
+        assert spread[key] == pytest.approx(abs(a - b) / 2, rel=1e-8)
     assert max(spread.values()) > 0  # two different silica models: a non-zero spread
 
 
