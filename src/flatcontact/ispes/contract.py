@@ -190,17 +190,17 @@ def validate_ispes(ds: xr.Dataset, source: str = "ISPES grid") -> xr.Dataset:
             raise InputError(
                 f"{source}: variable '{var}' must have dims {DIMS}, has {ds[var].dims}"
             )
-        if not _numeric(ds[var].dtype):
+        if not numeric_dtype(ds[var].dtype):
             raise InputError(f"{source}: variable '{var}' must hold numbers, holds {ds[var].dtype}")
     for name in (*DIMS, VAR_CONVERGED, VAR_FORCE_CALLS, VAR_MAPPED):
-        if name in ds.variables and not _numeric(ds[name].dtype, bool_ok=True):
+        if name in ds.variables and not numeric_dtype(ds[name].dtype, bool_ok=True):
             raise InputError(f"{source}: '{name}' must hold numbers, holds {ds[name].dtype}")
     for attr in REQUIRED_ATTRS:
         if attr not in ds.attrs:
             raise InputError(f"{source}: missing attribute '{attr}' (Å vectors a1, a2 and area Å²)")
-    a1 = _finite_attr(ds, "a1", source, "an in-plane vector of 2 numbers in Å")
-    a2 = _finite_attr(ds, "a2", source, "an in-plane vector of 2 numbers in Å")
-    stored_area = _finite_attr(ds, "area", source, "one number in Å²")
+    a1 = finite_attribute(ds, "a1", source, "an in-plane vector of 2 numbers in Å")
+    a2 = finite_attribute(ds, "a2", source, "an in-plane vector of 2 numbers in Å")
+    stored_area = finite_attribute(ds, "area", source, "one number in Å²")
     if a1.size < 2 or a2.size < 2:
         raise InputError(f"{source}: attributes a1, a2 must be in-plane 2-vectors in Å")
     if stored_area.size != 1:
@@ -235,14 +235,14 @@ def validate_ispes(ds: xr.Dataset, source: str = "ISPES grid") -> xr.Dataset:
     return ds
 
 
-def _numeric(dtype: Any, bool_ok: bool = False) -> bool:
+def numeric_dtype(dtype: Any, bool_ok: bool = False) -> bool:
     """Whether ``dtype`` holds real numbers (booleans only with ``bool_ok``)."""
     if np.issubdtype(dtype, np.bool_):
         return bool_ok
     return np.issubdtype(dtype, np.integer) or np.issubdtype(dtype, np.floating)
 
 
-def _finite_attr(ds: xr.Dataset, name: str, source: str, expected: str) -> np.ndarray:
+def finite_attribute(ds: xr.Dataset, name: str, source: str, expected: str) -> np.ndarray:
     """Attribute ``name`` as a flat float array; InputError unless it is finite numbers."""
     value = ds.attrs[name]
     try:

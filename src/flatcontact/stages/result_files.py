@@ -26,12 +26,12 @@ import os
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from flatcontact import limits
 from flatcontact.errors import InputError
+from flatcontact.ispes.contract import finite_attribute, numeric_dtype
 
 #: Largest results file read (bytes): the paper's study writes ~1 MB.
 MAX_BYTES = 2_000_000_000
@@ -76,11 +76,6 @@ def _refuse(path: Path, defect: str) -> InputError:
         f"{path}: {defect}; the file does not follow its contract: remove {path.parent} and "
         "rerun to recompute it"
     )
-
-
-def _numbers(values: Any) -> bool:
-    dtype = np.asarray(values).dtype
-    return np.issubdtype(dtype, np.integer) or np.issubdtype(dtype, np.floating)
 
 
 def open_result(path: str | os.PathLike[str], contract: ResultContract, loads=None):
@@ -133,7 +128,7 @@ def _check_sizes(ds, path: Path, contract: ResultContract) -> None:
 
 
 def _check_index(ds, path: Path, contract: ResultContract, loads) -> None:
-    if contract.index not in ds.coords or not _numbers(ds[contract.index].values):
+    if contract.index not in ds.coords or not numeric_dtype(ds[contract.index].values.dtype):
         raise _refuse(path, f"coordinate '{contract.index}' missing or not numbers")
     p = np.asarray(ds[contract.index].values, dtype=float)
     if p.size == 0 or not np.all(np.isfinite(p)):
@@ -155,7 +150,7 @@ def _check_variables(ds, path: Path, contract: ResultContract) -> None:
         if name not in ds.data_vars:
             raise _refuse(path, f"variable '{name}' missing")
         var = ds[name]
-        if var.dims[:1] != (contract.index,) or not _numbers(var.values):
+        if var.dims[:1] != (contract.index,) or not numeric_dtype(var.values.dtype):
             raise _refuse(path, f"variable '{name}' must be numbers along '{contract.index}'")
         if not np.all(np.isfinite(np.asarray(var.values, dtype=float))):
             raise _refuse(path, f"variable '{name}' holds NaN or inf")
@@ -168,12 +163,7 @@ def _check_attrs(ds, path: Path, contract: ResultContract) -> None:
     for name in contract.attrs:
         if name not in ds.attrs:
             raise _refuse(path, f"attribute '{name}' missing")
-        value = ds.attrs[name]
         try:
-            if isinstance(value, str | bytes):
-                raise ValueError(name)
-            array = np.asarray(value, dtype=float).ravel()
-        except (TypeError, ValueError):
-            raise _refuse(path, f"attribute '{name}' must be numbers, is text") from None
-        if array.size == 0 or not np.all(np.isfinite(array)):
-            raise _refuse(path, f"attribute '{name}' must be finite numbers")
+            finite_attribute(ds, name, str(path), "finite numbers")
+        except InputError as exc:
+            raise _refuse(path, str(exc).removeprefix(f"{path}: ")) from None
