@@ -31,6 +31,7 @@ from flatcontact.report.sections.analysis import analysis_section
 from flatcontact.report.sections.build import interface_material, interface_section
 from flatcontact.report.sections.comparison import own_results_section, paper_section
 from flatcontact.report.sections.contact import contact_section
+from flatcontact.report.sections.experiment import experiment_section
 from flatcontact.report.sections.gates import gates_section
 from flatcontact.report.sections.laws import laws_section
 from flatcontact.report.sections.scan import scan_section
@@ -84,6 +85,9 @@ def build_sections(
         sections.append(
             own_results_section(cfg, material, model, laws, scan, contact, table, family)
         )
+    experiment = experiment_section(contact, build)  # contact.experiment.compare
+    if experiment is not None:
+        sections.append(experiment)
     return [
         *sections,
         interface_section(cfg, build, f_build, interface, paper),
