@@ -128,3 +128,39 @@ def test_reference_rows_carry_their_own_laws():
     assert same["collapse_stress_mpa"] == pytest.approx(doc["run"]["collapse_stress_mpa"])
     assert double["tau0_mpa"] == 2 * LAWS["tau0_mpa"]
     assert double["collapse_stress_mpa"] > 1.5 * same["collapse_stress_mpa"]
+
+
+def test_the_report_section_states_the_lock_and_every_row():
+    """The section reads build.json's coincidence match (strain per slab) and tables the run,
+    each reference and each measurement, with the ratios from the document."""
+    from flatcontact.report.sections.experiment import experiment_section, lock_text
+
+    build = {
+        "recipe": {
+            "match": {
+                "kind": "coincidence",
+                "slab1_supercell": [[1, 0], [0, 1]],
+                "slab2_supercell": [[1, 0], [0, 1]],
+                "n_atoms": 15,
+                "slab1_strain_percent": [0.0, 0.0],
+                "slab2_strain_percent": [2.53, 2.53],
+            }
+        }
+    }
+    assert "slab 2 +2.53, +2.53 %" in lock_text(build)
+    assert "slab 1" not in lock_text(build).split("strain")[1]
+    assert lock_text({}) == "no coincidence lock (one material)"
+    run = ContactParameters(radius_um=5.0, contact_modulus_gpa=70.0, shear_modulus_gpa=60.0, **LAWS)
+    doc = compare_collapse("tip", run, 1.77, PAPER_EXPERIMENT_COLLAPSE_MPA, {"q": LAWS})
+    section = experiment_section({"experiment_comparison": doc}, build)
+    (table,) = section.tables
+    labels = [r[0] for r in table.rows]
+    assert labels == [
+        "tip (this run)",
+        "q",
+        "measured: graphene-passivated SiOx",
+        "measured: bare SiOx",
+    ]
+    assert table.rows[0][4] == f"{doc['run']['collapse_stress_mpa'] / 26.7:.3g}"
+    assert "+2.53" in section.paragraphs[0]
+    assert experiment_section({}, build) is None
