@@ -22,6 +22,13 @@ Sources
   :mod:`flatcontact.training.ispes_check`, ``flatcontact validate-potential``).
 - Lattice constants and density of α-quartz, experiment (Levien, Prewitt and Weidner,
   Am. Mineral. 65, 920 (1980)).
+- The paper's oscillatory-shear experiment (its Sec. "Experimental support", Fig. 6): a
+  diamond spherecone, R = 5 µm, at p0 = 1.77 GPa; the lateral stiffness collapses near
+  26.7 MPa on 4-layer graphene over SiOx and near 145 MPa on bare 300 nm SiOx (mean shear
+  stress: force amplitude over the Hertz area, read off the figure: "~").
+- Isotropic moduli of the experiment's bodies, the nanoindentation standard pair: diamond
+  E = 1141 GPa, ν = 0.07, fused silica E = 72 GPa, ν = 0.17 (Oliver and Pharr, J. Mater.
+  Res. 7, 1564 (1992)); the 300 nm thermal oxide is taken as fused silica.
 """
 
 from __future__ import annotations
@@ -50,6 +57,15 @@ PAPER_EXPERIMENT_P0_GPA = 1.77
 #: Peak Hertz pressures used when none are given (GPa): the paper's Fig. 4 (1 GPa) and
 #: experiment (1.77 GPa) loads, bracketed by a light and two heavier loads.
 DEFAULT_P0_GPA: tuple[float, ...] = (0.5, 1.0, 1.77, 2.0, 3.0)
+
+#: The experiment's measured collapse stresses (MPa, amplitude Q_max/(π a²), p0 =
+#: :data:`PAPER_EXPERIMENT_P0_GPA`): graphene-passivated and bare SiOx (Fig. 6 text).
+PAPER_EXPERIMENT_COLLAPSE_MPA = MappingProxyType(
+    {"graphene-passivated SiOx": 26.7, "bare SiOx": 145.0}
+)
+#: Young's modulus (GPa) and Poisson ratio of diamond and fused silica (Oliver and Pharr 1992).
+DIAMOND_ISOTROPIC = MappingProxyType({"youngs_modulus_gpa": 1141.0, "poisson_ratio": 0.07})
+FUSED_SILICA_ISOTROPIC = MappingProxyType({"youngs_modulus_gpa": 72.0, "poisson_ratio": 0.17})
 
 #: Non-retarded Hamaker constant of α-quartz across vacuum, Lifshitz theory (zJ; Bergström 1997).
 QUARTZ_HAMAKER_ZJ = 88.0

@@ -130,6 +130,13 @@ class ExperimentConfig(Section):
     stress_measure: Literal["amplitude", "rms"] = Field(
         "amplitude", description="stress of the data: amplitude Q_max/πa² or rms ⟨Q⟩/πa²"
     )
+    compare: Literal["passivated-tip"] | None = Field(
+        None,
+        description="the run models an interface of the paper's oscillatory-shear experiment "
+        "(passivated-tip: diamond tip on few-layer graphene over SiOx): the report sets the "
+        "run's collapse stress at experiment.p0_gpa against the measured collapses and the "
+        "quartz laws' (summary.json 'experiment_comparison'); null: no such table",
+    )
 
 
 class ContactConfig(Section):

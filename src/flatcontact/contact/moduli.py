@@ -28,6 +28,19 @@ from numpy.typing import ArrayLike, NDArray
 FloatArray = NDArray[np.float64]
 
 
+def contact_modulus(e1_pa: float, nu1: float, e2_pa: float, nu2: float) -> float:
+    """Hertz contact modulus E* of two isotropic bodies: 1/E* = (1−ν1²)/E1 + (1−ν2²)/E2
+    (Johnson 1985, Eq. 4.22; any one unit for both E, returned in it)."""
+    return 1.0 / ((1.0 - nu1**2) / e1_pa + (1.0 - nu2**2) / e2_pa)
+
+
+def paper_shear_modulus(e1_pa: float, nu1: float, e2_pa: float, nu2: float) -> float:
+    """The paper's G* (q0 = G*·u/(π a)) of two isotropic bodies from E and ν:
+    G_i = E_i/(2(1+ν_i)), G* = 4 G*_J (:func:`johnson_effective_shear_modulus`)."""
+    g1, g2 = e1_pa / (2.0 * (1.0 + nu1)), e2_pa / (2.0 * (1.0 + nu2))
+    return 4.0 * johnson_effective_shear_modulus(g1, nu1, g2, nu2)
+
+
 def johnson_effective_shear_modulus(g1_pa: float, nu1: float, g2_pa: float, nu2: float) -> float:
     """Johnson's G*_J from the shear moduli and Poisson ratios: 1/G*_J = (2−ν1)/G1 + (2−ν2)/G2."""
     return 1.0 / ((2.0 - nu1) / g1_pa + (2.0 - nu2) / g2_pa)

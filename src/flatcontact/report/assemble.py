@@ -31,6 +31,7 @@ from flatcontact.report.sections.analysis import analysis_section
 from flatcontact.report.sections.build import interface_material, interface_section
 from flatcontact.report.sections.comparison import own_results_section, paper_section
 from flatcontact.report.sections.contact import contact_section
+from flatcontact.report.sections.experiment import experiment_section
 from flatcontact.report.sections.gates import gates_section
 from flatcontact.report.sections.laws import laws_section
 from flatcontact.report.sections.scan import scan_section
@@ -57,7 +58,10 @@ def build_sections(
     ``stage_rows``: (stage, state, seconds, finished) of the summary table. The section
     next to the summary compares the run with the paper when its slabs are the paper's
     α-quartz (:func:`flatcontact.reference.is_paper_material`), else shows its results alone;
-    only then does any section show a value of the paper. A validity gate passed with
+    only then does any section show a value of the paper, except the experiment section
+    (:mod:`flatcontact.report.sections.experiment`), which a run asks for with
+    ``contact.experiment.compare`` and which sets its collapse stress against the paper's
+    measurements and quartz laws. A validity gate passed with
     ``contact.accept_untrusted`` (``summary.json["gates"]``) puts a box above everything
     (:mod:`flatcontact.report.sections.gates`). Stackings are named for the
     interface's family (:func:`flatcontact.report.stacking_names.stacking_family`).
@@ -84,6 +88,9 @@ def build_sections(
         sections.append(
             own_results_section(cfg, material, model, laws, scan, contact, table, family)
         )
+    experiment = experiment_section(contact, build)  # contact.experiment.compare
+    if experiment is not None:
+        sections.append(experiment)
     return [
         *sections,
         interface_section(cfg, build, f_build, interface, paper),

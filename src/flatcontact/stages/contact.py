@@ -43,7 +43,12 @@ from flatcontact.layout import (
     FIT_JSON,
     SUMMARY_JSON,
 )
-from flatcontact.reference import PAPER, PAPER_LAW_KEYS, is_paper_material
+from flatcontact.reference import (
+    PAPER,
+    PAPER_EXPERIMENT_COLLAPSE_MPA,
+    PAPER_LAW_KEYS,
+    is_paper_material,
+)
 from flatcontact.stages._common import rename, renamed_errors, save
 
 #: ContactParameters fields -> the settings path that sets them.
@@ -333,13 +338,56 @@ def check_contact(settings, params) -> None:
     # with k < 0 or μ < 0 the model is defined only where τ > 0 and σ >= 0 on the whole
     # contact (p0 < τ0/|k|, p0 <= σ0/|μ|)
     params.check_p0_gpa(c.p0_gpa, "contact.p0_gpa")
-    if c.experiment.csv:
+    if c.experiment.csv or c.experiment.compare:
         params.check_p0_gpa(c.experiment.p0_gpa, "contact.experiment.p0_gpa")
     if c.maugis_lambda is not None and not params.work_of_adhesion_j_m2 > 0:
         raise InputError(
             "contact.maugis_lambda: the Maugis–Dugdale radius needs a work of adhesion > 0 "
             "(contact.work_of_adhesion_j_m2, or the scan's work of separation)"
         )
+
+
+#: flatcontact's own α-quartz laws: ``flatcontact run`` on the built-in default (quick preset,
+#: ``make run``; bundled sio2-snap + Hamaker LJ, (0001) dense interface), its
+#: ``04-laws/laws.json`` (the same before and after issue 20, re-measured 2026-11-25; the check
+#: every branch keeps). Code, not a data file, so a change reruns the contact stage.
+QUARTZ_QUICK_LAWS = {
+    "label": "quartz, flatcontact quick preset (make run)",
+    "k_mpa_per_gpa": 14.370389,
+    "tau0_mpa": 30.503874,
+    "mu_mpa_per_gpa": 4.99966,
+    "sigma0_mpa": 7.014888,
+}
+
+
+def quartz_reference_laws() -> dict[str, dict[str, float]]:
+    """The quartz law sets the experiment comparison sets a run against: the paper's
+    (:data:`flatcontact.reference.PAPER`) and flatcontact's quick preset
+    (:data:`QUARTZ_QUICK_LAWS`)."""
+    return {
+        "quartz, the paper's laws (SNAP + TS-vdW LJ)": {k: PAPER[k] for k in PAPER_LAW_KEYS},
+        QUARTZ_QUICK_LAWS["label"]: {k: float(QUARTZ_QUICK_LAWS[k]) for k in PAPER_LAW_KEYS},
+    }
+
+
+def experiment_comparison(settings, params) -> dict:
+    """``summary.json["experiment_comparison"]`` for ``contact.experiment.compare``: the run's
+    collapse stress at ``contact.experiment.p0_gpa`` against the measured collapses
+    (:data:`flatcontact.reference.PAPER_EXPERIMENT_COLLAPSE_MPA`) and the quartz laws'
+    (:func:`flatcontact.contact.tip_comparison.compare_collapse`)."""
+    from flatcontact.contact.tip_comparison import compare_collapse
+
+    c = settings.contact
+    doc = compare_collapse(
+        settings.report.title or settings.structure.kind,
+        params,
+        c.experiment.p0_gpa,
+        PAPER_EXPERIMENT_COLLAPSE_MPA,
+        quartz_reference_laws(),
+        fraction=c.collapse_fraction,
+    )
+    doc["experiment"] = c.experiment.compare
+    return doc
 
 
 @dataclass
@@ -358,6 +406,7 @@ class ContactResult:
     intervals: dict | None = None  # contact_intervals: the laws' uncertainty carried through
     bands: tuple | None = None  # analyses at the lower and upper corner of the law box
     gates: dict | None = None  # the validity gates that fired and which were overridden
+    experiment_comparison: dict | None = None  # contact.experiment.compare
     files: list[Path] = field(default_factory=list)
 
     def cycle_rows(self) -> list[dict]:
@@ -389,6 +438,8 @@ class ContactResult:
         }
         if self.experiment is not None:
             doc["experiment"] = self.experiment
+        if self.experiment_comparison is not None:
+            doc["experiment_comparison"] = self.experiment_comparison
         if self.intervals is not None:
             doc["intervals"] = self.intervals
         if self.gates is not None:
@@ -459,6 +510,8 @@ def run_contact(
             measure=c.experiment.stress_measure,
         )
         result.experiment = comparison.to_json()
+    if c.experiment.compare:
+        result.experiment_comparison = experiment_comparison(settings, params)
     if c.cycle.enabled:
         from flatcontact.contact import cycle
 
