@@ -26,7 +26,6 @@ def test_defaults():
 @pytest.mark.parametrize(
     ("data", "field"),
     [
-        ({"twist_deg": 0.0}, "twist_deg"),
         ({"twist_deg": 75.0}, "twist_deg"),
         ({"twist_deg": float("nan")}, "twist_deg"),
         ({"max_atoms": 1}, "max_atoms"),
@@ -36,6 +35,8 @@ def test_defaults():
         ({"strain_percent": [1.0, 1.0]}, "strain_percent"),
         ({"strain_percent": [30.0]}, "strain_percent"),
         ({"strain_on": "slab1"}, "strain_on"),
+        ({"angle_tolerance_deg": 0.0}, "angle_tolerance_deg"),
+        ({"twist_deg": -1.0}, "twist_deg"),
         ({"twist": 1.1}, "twist"),
     ],
 )

@@ -216,9 +216,63 @@ def test_explicit_supercells_are_checked_naming_the_field():
 
 
 def test_ladder_refusals_name_the_field():
-    with pytest.raises(InputError, match=r"approximants\.twist_deg"):
-        approximant_sequence(GRAPHENE_ON_HBN, parse_approximants({"twist_deg": 1.1}))
+    with pytest.raises(InputError, match=r"approximants\.strain_percent=1: .* at 0 ± 0\.5°"):
+        approximant_sequence(  # aligned graphene/h-BN within 1 % needs n = 37: 5330 atoms
+            GRAPHENE_ON_HBN,
+            parse_approximants({"twist_deg": 0.0, "strain_percent": [1.0], "max_atoms": 2000}),
+        )
     with pytest.raises(InputError, match=r"approximants\.strain_percent=0\.01"):
         approximant_sequence(
             GRAPHENE_ON_HBN, parse_approximants({"strain_percent": [0.01], "max_atoms": 200})
         )
+
+
+def test_aligned_ladder_is_the_homothetic_n_on_n_minus_1_cell():
+    """Slab 2 held at 0° (tolerance 0.001°): the only coincidence cells are n×n graphene on
+    m×m h-BN; the smallest within 1.7 % has the least n with |n·a_g/((n−1)·a_hBN) − 1| ≤ 1.7 %
+    (found here by a plain loop)."""
+    n = next(n for n in range(2, 200) if abs(n * A_GRAPHENE / ((n - 1) * A_HBN) - 1) <= 0.017)
+    settings = parse_approximants(
+        {
+            "twist_deg": 0.0,
+            "angle_tolerance_deg": 0.001,
+            "strain_percent": [3.0, 1.7],
+            "max_atoms": 2 * n * n + 2 * (n - 1) ** 2,
+        }
+    )
+    first, aligned = approximant_sequence(GRAPHENE_ON_HBN, settings)
+    assert first.n_atoms == 4 and first.twist_deg == 0.0
+    assert aligned.n_atoms == 2 * n * n + 2 * (n - 1) ** 2  # 3482 for n = 30
+    assert aligned.cells_per_layer == n * n
+    expected = 100 * (n * A_GRAPHENE / ((n - 1) * A_HBN) - 1)
+    np.testing.assert_allclose(aligned.strain_percent_slab2, [expected, expected], atol=1e-5)
+    assert abs(aligned.angle_error_deg) < 1e-6
+
+
+def test_oriented_ladder_keeps_the_target_rotation_and_builds_exactly():
+    settings = parse_approximants(
+        {"twist_deg": 30.0, "strain_percent": [3.0, 1.0, 0.3], "max_atoms": 1000}
+    )
+    seq = approximant_sequence(GRAPHENE_ON_HBN, settings)
+    assert len(seq) == 3
+    worst = [max(map(abs, a.strain_percent_slab1 + a.strain_percent_slab2)) for a in seq]
+    assert all(b < a for a, b in itertools.pairwise(worst))
+    for a, bound in zip(seq, (3.0, 1.0, 0.3), strict=True):
+        assert worst[seq.index(a)] <= bound
+        assert abs(a.angle_error_deg) <= 0.5 + 1e-9
+        # the rotation modulo the hexagonal 60°: 30° ± 0.5°
+        assert abs((a.twist_deg - 30.0 + 30.0) % 60.0 - 30.0) <= 0.5 + 1e-9
+        atoms, report = _build(GRAPHENE_ON_HBN, a)
+        match = report["recipe"]["match"]
+        assert len(atoms) == a.n_atoms
+        assert match["slab2_rotation_deg"] == pytest.approx(a.twist_deg, abs=1e-5)
+        np.testing.assert_allclose(match["slab2_strain_percent"], a.strain_percent_slab2)
+
+
+def test_approximants_of_zero_twist_are_the_small_angle_family():
+    """Toward 0° the best approximant of each size is (n, n+1): the no-target sequence."""
+    big = {"max_atoms": 4000, "max_cells": 50}
+    toward_zero = approximant_sequence(GRAPHENE, parse_approximants({"twist_deg": 0.0, **big}))
+    family = approximant_sequence(GRAPHENE, parse_approximants(big))
+    assert [a.label for a in toward_zero] == [a.label for a in family]
+    assert [a.label for a in family][:3] == ["twist-1-2", "twist-2-3", "twist-3-4"]

@@ -38,11 +38,19 @@ LadderPercent = physical(1e-3, 20.0, "%")
 class ApproximantSettings(Section):
     """Commensurate approximant cells of an incommensurate contact (docs/incommensurate.md)."""
 
-    twist_deg: physical(0.01, 59.99, "deg") | None = Field(
+    twist_deg: physical(0.0, 60.0, "deg") | None = Field(
         None,
-        description="target twist of slab 2 against slab 1 (same hexagonal lattice), e.g. 1.1 "
-        "or 30: the commensurate (m, n) cells of decreasing angle error; none: the (n, n+1) "
-        "family 21.787°, 13.174°, 9.430°, ... (angle and size change together)",
+        description="target twist of slab 2 against slab 1, e.g. 1.1 or 30. Same hexagonal "
+        "lattice: the commensurate (m, n) cells of decreasing angle error; none: the (n, n+1) "
+        "family 21.787°, 13.174°, 9.430°, ... (angle and size change together). Two "
+        "materials: only coincidence cells that rotate slab 2 within angle_tolerance_deg of "
+        "it (modulo the lattice's rotation symmetry), e.g. 0 for an aligned pair; none: any "
+        "rotation",
+    )
+    angle_tolerance_deg: physical(0.001, 30.0, "deg") = Field(
+        0.5,
+        description="two materials with twist_deg: largest deviation of slab 2's rotation "
+        "from the target",
     )
     max_atoms: int = Field(
         2000, ge=2, le=100_000, description="largest interface (atoms) in the sequence"

@@ -30,6 +30,14 @@ Two materials (``slab2`` of another material, any ``rotate_deg``)
     ``ZSLGenerator``) for each strain bound of the decreasing ladder ``strain_percent``:
     the smallest cell (fewest atoms, then least strain) with every principal strain of both
     slabs within the bound (:func:`~flatcontact.structures.match.coincidence_match`).
+    Without ``twist_deg`` any rotation of slab 2 is accepted (the cells of the ladder may
+    differ in orientation); with it only cells whose rotation of slab 2 is within
+    ``angle_tolerance_deg`` of the target modulo the rotation symmetry of slab 2's lattice
+    (60° hexagonal, 90° square, else 180°), e.g. 0 for the aligned pair whose mismatch
+    alone makes it incommensurate; these come from a direct search over compact cells
+    (:func:`~flatcontact.structures.match.oriented_coincidence_match`: reduced vectors no
+    longer than √(2·A_max)), not from the ZSL enumeration. ``rotate_deg`` (a symmetry of slab 2's lattice) does
+    not change the lattice's orientation and enters ``twist_deg`` only as an offset.
     A bound the previous cell already meets gives that cell again and is skipped; a bound
     with no cell within ``max_atoms`` ends the ladder. The override names the supercells
     explicitly (``match.slab1_supercell``, ``match.slab2_supercell``), so it builds that
@@ -51,6 +59,8 @@ from flatcontact.structures.construct import slab_sources
 from flatcontact.structures.match import (
     atom_count,
     coincidence_match,
+    orientation_error_deg,
+    strain_and_rotation,
     twist_angle_deg,
     twist_match,
 )
@@ -180,11 +190,6 @@ def approximant_sequence(structure: Any, settings: ApproximantSettings) -> list[
     src2 = s2 or s1
     na1, na2 = len(s1.make(n1)), len(src2.make(n2))  # atoms per primitive cell of each slab
     if other and not np.allclose(s1.cell2, src2.cell2, atol=1e-6):
-        require(
-            settings.twist_deg is None,
-            f"{APPROXIMANTS}.twist_deg: the two materials have different lattices; their "
-            "approximants come from the strain ladder (approximants.strain_percent)",
-        )
         return _coincidence_sequence(recipe, s1.cell2, src2.cell2, na1, na2, settings)
     require(
         settings.strain_percent is None,
@@ -231,6 +236,8 @@ def _twist_sequence(recipe, cell2, na1: int, na2: int, settings) -> list[Approxi
 
 def _coincidence_sequence(recipe, a1, a2, na1: int, na2: int, settings) -> list[Approximant]:
     ladder = settings.strain_percent or list(DEFAULT_STRAIN_LADDER_PERCENT)
+    target = settings.twist_deg
+    orientation = None if target is None else (target, settings.angle_tolerance_deg)
     out: list[Approximant] = []
     for bound in ladder:
         try:
@@ -243,18 +250,25 @@ def _coincidence_sequence(recipe, a1, a2, na1: int, na2: int, settings) -> list[
                 max_atoms=settings.max_atoms,
                 strain_on=settings.strain_on,
                 field=f"{APPROXIMANTS}.strain_percent",
+                orientation_deg=orientation,
             )
         except InputError:
             if not out:
+                within = (
+                    ""
+                    if orientation is None
+                    else f" at {target:g} ± {settings.angle_tolerance_deg:g}° (twist_deg)"
+                )
                 raise InputError(
                     f"{APPROXIMANTS}.strain_percent={bound:g}: no coincidence cell of the two "
-                    f"lattices within {bound:g}% strain and {settings.max_atoms} atoms (raise "
-                    "approximants.max_atoms or start the ladder at a larger bound)"
+                    f"lattices within {bound:g}% strain and {settings.max_atoms} atoms{within} "
+                    "(raise approximants.max_atoms or start the ladder at a larger bound)"
                 ) from None
             break
         if out and _same_cell(match, out[-1]):
             continue
-        rotation = match.report(a1, a2, na1, na2)["slab2_rotation_deg"]
+        rotation = strain_and_rotation(match.deformation(2, a2))[1]
+        error = 0.0 if target is None else orientation_error_deg(rotation, target, a2)
         override = {
             "match": {
                 "max_strain_percent": bound,
@@ -273,7 +287,7 @@ def _coincidence_sequence(recipe, a1, a2, na1: int, na2: int, settings) -> list[
                 na1,
                 na2,
                 _wrapped(recipe.rotate_deg + rotation),
-                0.0,
+                error,
                 override,
             )
         )
