@@ -276,3 +276,10 @@ def test_approximants_of_zero_twist_are_the_small_angle_family():
     family = approximant_sequence(GRAPHENE, parse_approximants(big))
     assert [a.label for a in toward_zero] == [a.label for a in family]
     assert [a.label for a in family][:3] == ["twist-1-2", "twist-2-3", "twist-3-4"]
+
+
+def test_two_materials_of_one_lattice_are_refused_naming_slab2():
+    """Cu(111) against Cu(111) given as another material: one lattice, no twist possible."""
+    same = {"kind": "fcc111", "element": "Cu", "layers": 1, "slab2": {"element": "Cu", "layers": 1}}
+    with pytest.raises(InputError, match=r"structure\.slab2: .* same in-plane lattice"):
+        approximant_sequence(same, parse_approximants({}))

@@ -192,6 +192,11 @@ def approximant_sequence(structure: Any, settings: ApproximantSettings) -> list[
     if other and not np.allclose(s1.cell2, src2.cell2, atol=1e-6):
         return _coincidence_sequence(recipe, s1.cell2, src2.cell2, na1, na2, settings)
     require(
+        not other,
+        f"{SECTION}.slab2: {src2.material} has the same in-plane lattice as {s1.material}; a "
+        "twist needs one material in both slabs and there is no mismatch to strain away",
+    )
+    require(
         settings.strain_percent is None,
         f"{APPROXIMANTS}.strain_percent: both slabs have one lattice (no lattice mismatch to "
         "strain away); give approximants.twist_deg or leave it out for the (n, n+1) family",
