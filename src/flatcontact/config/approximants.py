@@ -12,7 +12,8 @@ increasing size converges to the incommensurate contact
   cells whose angle error to the target decreases with size; without it the (n, n + 1)
   family (21.787°, 13.174°, 9.430°, ... toward the small-angle, moiré, limit).
 * Two materials: the smallest coincidence cell within each strain bound of
-  ``strain_percent`` (decreasing), the strain put on slab 2 or shared (``strain_on``).
+  ``strain_percent`` (decreasing), the strain put on slab 2 or shared (``strain_on``); any
+  rotation of slab 2, or with ``twist_deg`` one within ``angle_tolerance_deg`` of it.
 
 The section changes no stage's numbers (no stage fingerprint reads it).
 """
