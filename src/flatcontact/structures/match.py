@@ -130,12 +130,16 @@ def coincidence_match(
     max_atoms: int,
     strain_on: str = "slab2",
     field: str = "slab2",
+    orientation_deg: tuple[float, float] | None = None,
 ) -> Match:
     """The smallest coincidence lattice of slabs with in-plane cells ``a1`` (below) and ``a2``.
 
     ``n1``, ``n2``: atoms per primitive in-plane cell of each slab (all its layers). The
     accepted match has every principal strain of both slabs ≤ ``max_strain`` (a fraction)
-    and at most ``max_atoms`` atoms. InputError naming ``field`` when none exists.
+    and at most ``max_atoms`` atoms; with ``orientation_deg`` = (target, tolerance) also
+    the rotation it puts on slab 2 within the tolerance of the target, modulo the rotation
+    symmetry of slab 2's lattice (:func:`oriented_coincidence_match`, a direct search in
+    place of the ZSL enumeration). InputError naming ``field`` when none exists.
     """
     from pymatgen.analysis.interfaces.zsl import ZSLGenerator
 
@@ -143,6 +147,25 @@ def coincidence_match(
         raise InputError(f"strain_on='{strain_on}': expected slab2 or both")
     a1 = np.asarray(a1, float)[:, :2]
     a2 = np.asarray(a2, float)[:, :2]
+    if orientation_deg is not None:
+        found = oriented_coincidence_match(
+            a1,
+            a2,
+            n1,
+            n2,
+            max_strain=max_strain,
+            max_atoms=max_atoms,
+            target_deg=orientation_deg[0],
+            tolerance_deg=orientation_deg[1],
+            strain_on=strain_on,
+        )
+        if found is None:
+            raise InputError(
+                f"{field}: no coincidence lattice with strain <= {100 * max_strain:g}% on each "
+                f"slab, <= {max_atoms} atoms and slab 2 rotated {orientation_deg[0]:g} ± "
+                f"{orientation_deg[1]:g}° (raise the strain or atom bound)"
+            )
+        return found
     area1, area2 = abs(np.linalg.det(a1)), abs(np.linalg.det(a2))
     density = n1 / area1 + n2 / area2
     max_area = max_atoms / density * (1.0 + max_strain) ** 2
@@ -170,12 +193,7 @@ def coincidence_match(
             p2 = integer_matrix(f, a2, field)
         except InputError:
             continue
-        if strain_on == "slab2":
-            cell = s
-        else:
-            rot, _ = _polar(np.linalg.solve(f, s).T)
-            cell = 0.5 * (s + f @ rot.T)
-        match = Match(p1, p2, cell, "coincidence")
+        match = Match(p1, p2, common_cell(s, f, strain_on), "coincidence")
         worst = max(
             max(abs(x) for x in strain_and_rotation(match.deformation(k, a))[0])
             for k, a in ((1, a1), (2, a2))
@@ -193,6 +211,161 @@ def coincidence_match(
             f"and <= {max_atoms} atoms (raise match.max_strain or match.max_atoms)"
         )
     return _without_lattice_rotation(best[1], a2, field)
+
+
+def rotation_symmetry_deg(cell2: np.ndarray) -> float:
+    """The smallest rotation (deg) that maps the 2D lattice ``cell2`` onto itself: 60
+    (hexagonal), 90 (square) or 180 (any lattice)."""
+    for angle in (60.0, 90.0):
+        if lattice_is_invariant(cell2, rotation(angle)):
+            return angle
+    return 180.0
+
+
+def orientation_error_deg(rotation_deg: float, target_deg: float, cell2: np.ndarray) -> float:
+    """``rotation_deg`` − ``target_deg`` reduced modulo the rotation symmetry of the lattice
+    ``cell2`` into [−s/2, s/2) (rotations that differ by a symmetry give the same lattice)."""
+    sym = rotation_symmetry_deg(cell2)
+    return float((rotation_deg - target_deg + 0.5 * sym) % sym - 0.5 * sym)
+
+
+def oriented_coincidence_match(
+    a1: np.ndarray,
+    a2: np.ndarray,
+    n1: int,
+    n2: int,
+    *,
+    max_strain: float,
+    max_atoms: int,
+    target_deg: float,
+    tolerance_deg: float,
+    strain_on: str = "slab2",
+) -> Match | None:
+    """The smallest compact coincidence cell that rotates slab 2 by ``target_deg`` ±
+    ``tolerance_deg`` (modulo its lattice's rotation symmetry), or None.
+
+    A direct search: every vector v of slab 1's lattice no longer than R = √(2·A_max)
+    (A_max: the area of ``max_atoms`` atoms, strained) is paired with the nearest vector u
+    of slab 2's lattice rotated by the target; v is a candidate when |v|/|u| − 1 is within
+    ``max_strain`` and the angle between them within the tolerance plus asin(max_strain).
+    Every right-handed Gauss-reduced pair of candidates (increasing area) is a cell; the
+    first areas whose principal strains (:func:`common_cell` with ``strain_on``) are all
+    within ``max_strain`` and whose rotation of slab 2 is within the tolerance give the
+    match (fewest atoms, then least strain, then least angle error). Cells with a reduced
+    vector longer than R (aspect ratio above about 2 at A_max) are not searched.
+    """
+    a1 = np.asarray(a1, float)[:, :2]
+    a2 = np.asarray(a2, float)[:, :2]
+    area1, area2 = abs(np.linalg.det(a1)), abs(np.linalg.det(a2))
+    density = n1 / area1 + n2 / area2
+    max_area = max_atoms / density * (1.0 + max_strain) ** 2
+    radius = float(np.sqrt(2.0 * max_area))
+    nmax = int(np.ceil(radius / np.linalg.svd(a1, compute_uv=False).min())) + 1
+    r = np.arange(-nmax, nmax + 1)
+    p = np.array(np.meshgrid(r, r, indexing="ij")).reshape(2, -1).T
+    v = p @ a1
+    length = np.linalg.norm(v, axis=1)
+    keep = (length > 1e-9) & (length <= radius)
+    p, v, length = p[keep], v[keep], length[keep]
+    b2 = a2 @ rotation(target_deg).T  # slab 2's lattice rotated by the target (rows)
+    w = np.round(v @ np.linalg.inv(b2)).astype(int)
+    u = w @ b2
+    ulen = np.linalg.norm(u, axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = length / ulen
+        cos = np.einsum("ij,ij->i", v, u) / (length * ulen)
+    angle = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+    slack = tolerance_deg + np.degrees(np.arcsin(min(max_strain, 1.0))) + 1e-9
+    ok = (ulen > 1e-9) & (np.abs(ratio - 1.0) <= max_strain + 1e-12) & (angle <= slack)
+    p, v, w, length = p[ok], v[ok], w[ok], length[ok]
+    if len(p) < 2:
+        return None
+    order = np.argsort(length, kind="stable")
+    p, v, w, length = p[order], v[order], w[order], length[order]
+    pairs = []
+    for i in range(len(v)):
+        cross = v[i, 0] * v[:, 1] - v[i, 1] * v[:, 0]
+        dot = v @ v[i]
+        j = np.nonzero(
+            (cross > 1e-9)
+            & (length >= length[i] - 1e-9)
+            & (np.abs(dot) <= 0.5 * length[i] ** 2 + 1e-9)
+            & (cross <= max_area * (1 + 1e-9))
+        )[0]
+        pairs += [(float(cross[k]), i, int(k)) for k in j]
+    pairs.sort()
+    best, best_area = None, None
+    for area, i, k in pairs:
+        if best_area is not None and area > best_area * (1.0 + 1e-6):
+            break
+        p1 = np.array([p[i], p[k]])
+        p2 = np.array([w[i], w[k]])
+        if round(np.linalg.det(p2)) <= 0:
+            continue
+        match = Match(p1, p2, common_cell(p1 @ a1, p2 @ a2, strain_on), "coincidence")
+        worst = max(
+            max(abs(x) for x in strain_and_rotation(match.deformation(which, a))[0])
+            for which, a in ((1, a1), (2, a2))
+        )
+        rot = strain_and_rotation(match.deformation(2, a2))[1]
+        error = abs(orientation_error_deg(rot, target_deg, a2))
+        n_atoms = atom_count(match, n1, n2)
+        if worst > max_strain + 1e-12 or error > tolerance_deg + 1e-9 or n_atoms > max_atoms:
+            continue
+        key = (n_atoms, round(worst, 9), round(error, 6))
+        if best is None or key < best[0]:
+            best, best_area = (key, match), area
+    return None if best is None else best[1]
+
+
+def common_cell(s: np.ndarray, f: np.ndarray, strain_on: str) -> np.ndarray:
+    """The common cell (2×2 rows, Å) of slab 1's supercell ``s`` and slab 2's ``f``:
+    ``s`` itself (``strain_on="slab2"``) or the mean of ``s`` and ``f`` rotated onto it by
+    the rotation of the polar decomposition (``"both"``)."""
+    if strain_on == "slab2":
+        return np.asarray(s, float).copy()
+    rot, _ = _polar(np.linalg.solve(f, s).T)
+    return 0.5 * (s + f @ rot.T)
+
+
+def explicit_match(
+    a1: np.ndarray,
+    a2: np.ndarray,
+    p1,
+    p2,
+    *,
+    max_strain: float,
+    strain_on: str = "slab2",
+    field: str = "match",
+) -> Match:
+    """The coincidence lattice of the given supercells P1, P2 (2×2 int, rows in each slab's
+    own basis): the cell :func:`coincidence_match` would make of them.
+
+    InputError naming ``field`` when a principal strain of either slab exceeds
+    ``max_strain`` (a fraction) or a supercell is degenerate or left-handed.
+    """
+    if strain_on not in ("slab2", "both"):
+        raise InputError(f"strain_on='{strain_on}': expected slab2 or both")
+    a1 = np.asarray(a1, float)[:, :2]
+    a2 = np.asarray(a2, float)[:, :2]
+    p1, p2 = np.asarray(p1, int), np.asarray(p2, int)
+    for which, p in (("slab1", p1), ("slab2", p2)):
+        if p.shape != (2, 2) or round(np.linalg.det(p)) <= 0:
+            raise InputError(
+                f"{field}.{which}_supercell={p.tolist()}: expected a 2×2 integer matrix of "
+                "positive determinant (right-handed supercell)"
+            )
+    s, f = p1 @ a1, p2 @ a2
+    match = Match(p1, p2, common_cell(s, f, strain_on), "coincidence")
+    for which, a in ((1, a1), (2, a2)):
+        strains, _ = strain_and_rotation(match.deformation(which, a))
+        worst = max(abs(x) for x in strains)
+        if worst > max_strain + 1e-9:
+            raise InputError(
+                f"{field}.slab{which}_supercell: the cell strains slab {which} by "
+                f"{100 * worst:.4g}% > max_strain_percent={100 * max_strain:g}"
+            )
+    return match
 
 
 def _without_lattice_rotation(match: Match, a2: np.ndarray, field: str) -> Match:
