@@ -375,3 +375,20 @@ def shift_space_group(
         ):
             unique.append(op)
     return ShiftGroup(tuple(unique), tol)
+
+
+def self_translations(
+    reference: Atoms, slab: int, tolerance_angstrom: float = DEFAULT_TOLERANCE_ANGSTROM
+) -> list[np.ndarray]:
+    """In-plane translations τ (3-vectors, Å, reduced to the cell) that map slab ``slab`` of
+    ``reference`` onto itself modulo the in-plane lattice, keeping species, held flags and
+    layers: the primitive lattice of that slab modulo the supercell (identity included).
+    The pure translations of the shift-space group are differences of slab 1's and slab 2's
+    (:mod:`flatcontact.ispes.shift_lattice`)."""
+    lattice = np.column_stack(in_plane_vectors(reference))
+    lab = _labels(reference)
+    layer = np.asarray(reference.arrays.get("layer", np.zeros(len(reference), int)))
+    mask = np.asarray(reference.arrays["slab"]) == slab
+    part = (reference.positions[mask], lab[mask], layer[mask])
+    found = _translations(*part, *part, np.eye(3), lattice, float(tolerance_angstrom))
+    return [t for t in found if abs(t[2]) <= tolerance_angstrom]
