@@ -124,7 +124,7 @@ def _crystal_source(
     return crystal_source(oriented, termination, material, record, f"{field}.termination")
 
 
-def _sources(recipe) -> tuple[Any, Any | None, int, int]:
+def slab_sources(recipe) -> tuple[Any, Any | None, int, int]:
     """(source of slab 1, source of slab 2 or None for the same material, layers 1, layers 2)."""
     if isinstance(recipe, SheetsRecipe):
         s1 = _sheet_source(recipe.sheet, recipe.stacking, recipe.interlayer_angstrom, SECTION)
@@ -242,7 +242,7 @@ def build_from_slab_file(recipe: SlabFileRecipe) -> tuple[Atoms, dict]:
 
 def build_generic(recipe) -> tuple[Atoms, dict]:
     """Interface of a ``sheets``, ``crystal`` or ``fcc111`` recipe (unrelaxed) and its report."""
-    s1, s2, n1, n2 = _sources(recipe)
+    s1, s2, n1, n2 = slab_sources(recipe)
     for which, n in ((1, n1), (2, n2)):
         require(
             n == 1 or n >= recipe.held_layers + 1,

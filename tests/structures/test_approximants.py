@@ -1,0 +1,137 @@
+"""Commensurate approximant sequences: closed-form twist cells, the strain ladder, exact builds."""
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+
+from flatcontact.config.approximants import parse_approximants
+from flatcontact.config.merge import merge_config
+from flatcontact.errors import InputError
+from flatcontact.structures.approximants import approximant_sequence, coprime_twists
+from flatcontact.structures.construct import build_interface
+from flatcontact.structures.sheets import builtin_sheet
+
+GRAPHENE = {"kind": "sheets", "sheet": "graphene", "layers": 1}
+
+
+def _build(structure, approximant):
+    """The interface of ``structure`` with the approximant's override merged the way a run
+    configuration merges a section (nested mappings key by key)."""
+    merged = merge_config({"structure": structure}, {"structure": approximant.structure_override})
+    return build_interface(merged["structure"])
+
+
+def _cross(u, v) -> float:
+    return float(u[0] * v[1] - u[1] * v[0])
+
+
+def _coincidence_cells(theta_deg: float, radius_cells: int = 40) -> int:
+    """Primitive cells of graphene's lattice L in the coincidence lattice L ∩ R(θ)L, by brute
+    force: the two shortest non-collinear vectors of L that R(θ)L also holds (a reduced
+    basis of the coincidence lattice) span its cell."""
+    a = builtin_sheet("graphene").cell.array[:2, :2]
+    t = np.radians(theta_deg)
+    rot = np.array([[np.cos(t), -np.sin(t)], [np.sin(t), np.cos(t)]])
+    inv_rotated = np.linalg.inv((rot @ a.T).T)
+    r = np.arange(-radius_cells, radius_cells + 1)
+    ij = np.array([(i, j) for i in r for j in r if (i, j) != (0, 0)], float)
+    v = ij @ a
+    frac = v @ inv_rotated
+    common = v[np.all(np.abs(frac - np.round(frac)) < 1e-6, axis=1)]
+    common = common[np.argsort(np.linalg.norm(common, axis=1))]
+    first = common[0]
+    second = next(w for w in common[1:] if abs(_cross(first, w)) > 1e-6)
+    return round(abs(_cross(first, second)) / abs(np.linalg.det(a)))
+
+
+def test_small_angle_family_is_the_closed_form_with_the_stated_atom_counts():
+    """No target: (1,2), (2,3), (3,4), ... with cos θ = (m²+4mn+n²)/(2(m²+mn+n²)) and
+    4(m²+mn+n²) atoms for a graphene bilayer (two atoms per cell per layer)."""
+    seq = approximant_sequence(GRAPHENE, parse_approximants({"max_atoms": 400}))
+    assert [a.label for a in seq] == [
+        "twist-1-2",
+        "twist-2-3",
+        "twist-3-4",
+        "twist-4-5",
+        "twist-5-6",
+    ]
+    expected = [(21.787, 28), (13.174, 76), (9.430, 148), (7.341, 244), (6.009, 364)]
+    for a, (theta, atoms) in zip(seq, expected, strict=True):
+        assert a.twist_deg == pytest.approx(theta, abs=5e-4)
+        assert a.n_atoms == atoms
+        assert a.angle_error_deg == 0.0
+        assert a.strain_percent_slab1 == a.strain_percent_slab2 == (0.0, 0.0)
+    for a in seq:
+        m, n = a.structure_override["twist"]
+        cos = (m * m + 4 * m * n + n * n) / (2 * (m * m + m * n + n * n))
+        assert math.degrees(math.acos(cos)) == pytest.approx(a.twist_deg, abs=1e-9)
+        # area: m²+mn+n² primitive cells of graphene, √3/2·a² each
+        cells = m * m + m * n + n * n
+        assert a.cells_per_layer == cells
+        assert a.area_angstrom2 == pytest.approx(cells * math.sqrt(3) / 2 * 2.46**2, rel=1e-9)
+    assert len(approximant_sequence(GRAPHENE, parse_approximants({"max_cells": 2}))) == 2
+
+
+@pytest.mark.parametrize("target", [30.0, 1.1, 7.0, 45.0])
+def test_angle_error_falls_strictly_with_size_and_no_smaller_cell_is_closer(target):
+    seq = approximant_sequence(
+        GRAPHENE, parse_approximants({"twist_deg": target, "max_atoms": 3000, "max_cells": 50})
+    )
+    assert len(seq) >= 3
+    sizes = [a.n_atoms for a in seq]
+    errors = [abs(a.angle_error_deg) for a in seq]
+    assert sizes == sorted(sizes) and len(set(sizes)) == len(sizes)
+    assert all(b < a for a, b in itertools.pairwise(errors))
+    for a in seq:
+        assert a.angle_error_deg == pytest.approx(a.twist_deg - target, abs=1e-12)
+    # the best approximant within the bound: no twist of the brute-force coincidence
+    # enumeration up to the largest cell is closer to the target than the last one
+    last = seq[-1]
+    for m, n in coprime_twists(last.cells_per_layer):
+        theta = math.degrees(math.acos((m * m + 4 * m * n + n * n) / (2 * (m * m + m * n + n * n))))
+        assert abs(theta - target) >= errors[-1] - 1e-9
+
+
+def test_cell_size_rule_of_coprime_twists_against_brute_force_coincidence():
+    """The cell built for coprime (m, n) is the coincidence cell when 3 ∤ m − n, three
+    times it when 3 | m − n (Shallcross et al. 2010)."""
+    for m, n in coprime_twists(60):
+        seq_cells = m * m + m * n + n * n
+        theta = math.degrees(math.acos((m * m + 4 * m * n + n * n) / (2 * (m * m + m * n + n * n))))
+        true = _coincidence_cells(theta)
+        assert seq_cells == (3 * true if (m - n) % 3 == 0 else true), (m, n)
+
+
+@pytest.mark.parametrize("target", [None, 30.0])
+def test_each_twist_override_builds_the_stated_cell(target):
+    settings = parse_approximants({"twist_deg": target, "max_atoms": 400, "max_cells": 4})
+    for a in approximant_sequence(GRAPHENE, settings):
+        atoms, report = _build(GRAPHENE, a)
+        record = report["recipe"]
+        assert len(atoms) == a.n_atoms
+        assert record["twist_angle_deg"] == pytest.approx(a.twist_deg, abs=1e-9)
+        assert record["match"]["kind"] == "twist"
+        assert abs(np.linalg.det(atoms.cell.array[:2, :2])) == pytest.approx(
+            a.area_angstrom2, rel=1e-9
+        )
+
+
+def test_twist_of_thicker_slabs_counts_every_layer():
+    structure = {"kind": "sheets", "sheet": "graphene", "layers": 2, "stacking": "AB"}
+    seq = approximant_sequence(structure, parse_approximants({"max_atoms": 400}))
+    assert [a.n_atoms for a in seq] == [56, 152, 296]  # 2 slabs × 2 layers × 2 atoms × cells
+    atoms, _ = _build(structure, seq[1])
+    assert len(atoms) == 152
+
+
+def test_bad_combinations_are_refused_naming_the_field():
+    with pytest.raises(InputError, match=r"approximants\.strain_percent"):
+        approximant_sequence(GRAPHENE, parse_approximants({"strain_percent": [1.0]}))
+    with pytest.raises(InputError, match=r"approximants\.max_atoms=20"):
+        approximant_sequence(GRAPHENE, parse_approximants({"max_atoms": 20}))
+    with pytest.raises(InputError, match=r"structure\.kind='toy-lj'"):
+        approximant_sequence({"kind": "toy-lj"}, parse_approximants({}))
+    square = {"kind": "fcc111", "element": "Cu"}  # hexagonal: accepted
+    assert approximant_sequence(square, parse_approximants({"max_atoms": 200}))[0].n_atoms == 84
