@@ -176,3 +176,23 @@ def test_in_plane_vectors_of_the_built_cell_are_the_supercell():
     a1, a2 = in_plane_vectors(atoms)
     assert np.linalg.norm(a1) == pytest.approx(2.46 * math.sqrt(7), rel=1e-6)
     assert np.linalg.norm(a2) == pytest.approx(2.46 * math.sqrt(7), rel=1e-6)
+
+
+def test_the_group_modulo_translations_restates_to_the_whole_group_on_the_shift_cell():
+    """(1, 2): the whole group is 12 point operations times the 49 translations; keeping one
+    operation per point operation loses nothing on the shift cell."""
+    atoms = _twisted(1, 2)
+    lat = shift_lattice_of(atoms)
+    whole = shift_space_group(atoms)
+    reduced = shift_space_group(atoms, modulo_translations=True)
+    assert whole.order == reduced.order * lat.index
+
+    def restated(group):
+        ops = [(np.array(o.matrix), np.array(o.translation)) for o in group.operations]
+        return {
+            (tuple(m.ravel()), tuple(np.round(t, 6) % 1.0))
+            for m, t in shift_cell_operations(lat, ops)
+        }
+
+    assert restated(whole) == restated(reduced)
+    assert len(restated(reduced)) == reduced.order
