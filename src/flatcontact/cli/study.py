@@ -107,7 +107,7 @@ def models_command(
 
 def _cell_progress(label: str, result: dict) -> None:
     if "error" in result:
-        console.print(f"  {label}: failed: {result['error']}", highlight=False)
+        console.print(f"  {label}: failed: {result['error']}", highlight=False, soft_wrap=True)
         return
     gates = ", ".join(result["gates"]["fired"]) or "none"
     console.print(
@@ -115,6 +115,7 @@ def _cell_progress(label: str, result: dict) -> None:
         f"tau0 {result['tau0_mpa']:.4g} MPa, corrugation {result['barrier_mev_per_a2']:.4g} "
         f"meV/A^2, gates fired: {gates}, {result['wall_s']:.1f} s",
         highlight=False,
+        soft_wrap=True,
     )
 
 
@@ -159,6 +160,7 @@ def approximants_command(
         f"{len(cells)} cell(s), base grid {cfg.scan.grid[0]}x{cfg.scan.grid[1]} per period of "
         f"the landscape, relax_mode {cfg.scan.relax_mode}:",
         highlight=False,
+        soft_wrap=True,
     )
     first = cells[0]["atom_calls_upper_bound"] if cells else 1
     for c in cells:
@@ -169,20 +171,24 @@ def approximants_command(
             f"grid {c['grid'][0]}x{c['grid'][1]}, <= {c['points_upper_bound']} points, "
             f"cost <= {c['atom_calls_upper_bound'] / first:.3g}x the first cell",
             highlight=False,
+            soft_wrap=True,
         )
     if list_only:
         return
     check_out_dir(out)
-    console.print(f"flatcontact study approximants: {config} -> {out}", highlight=False)
+    console.print(
+        f"flatcontact study approximants: {config} -> {out}", highlight=False, soft_wrap=True
+    )
     doc = run_approximants(cfg, out, on_done=_cell_progress)
     write_approximants(doc, out, _command_line())
     for key, name in (("tau0_mpa", "tau0"), ("barrier_mev_per_a2", "corrugation")):
-        console.print(_scaling_line(name, doc["scaling"][key]), highlight=False)
+        console.print(_scaling_line(name, doc["scaling"][key]), highlight=False, soft_wrap=True)
     c = doc["cost"]
     console.print(
         f"force calls: {c['force_calls_study']} (stored {c['force_calls_stored']}); "
         f"study: {(out / 'study.json').resolve()}",
         highlight=False,
+        soft_wrap=True,
     )
 
 
