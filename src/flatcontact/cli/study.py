@@ -113,7 +113,9 @@ def _cell_progress(label: str, result: dict) -> None:
     console.print(
         f"  {label}: scan {result['scan_action']}, {result['force_calls']} force calls, "
         f"tau0 {result['tau0_mpa']:.4g} MPa, corrugation {result['barrier_mev_per_a2']:.4g} "
-        f"meV/A^2, gates fired: {gates}, {result['wall_s']:.1f} s",
+        f"meV/A^2 (noise {result['noise_mev_per_a2']:.2g}"
+        f"{'' if result['resolved'] else ': NOT resolved'}), gates fired: {gates}, "
+        f"{result['wall_s']:.1f} s",
         highlight=False,
         soft_wrap=True,
     )

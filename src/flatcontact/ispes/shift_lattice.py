@@ -296,3 +296,38 @@ def to_shift_cell(ds, lattice: ShiftLattice):
         shift_lattice_index=int(lattice.index),
     )
     return xr.Dataset(variables, coords=coords, attrs=attrs)
+
+
+def translation_noise_ev_per_a2(
+    reference, calculator, lattice: ShiftLattice, samples: int = 4, seed: int = 1
+) -> float:
+    """The numerical noise floor of the energy landscape (eV/Å² of the supercell).
+
+    The stack at shift s and at s + b (b a shift-lattice vector) is the same structure, so
+    their energies are equal in exact arithmetic; the largest |E(s + b) − E(s)| over
+    ``samples`` random shifts s (``seed``) and b ∈ {b1, b2} is the round-off of the
+    engine's energy sum (different neighbour order for the same structure). A corrugation
+    not well above it is not resolved. Single-point energies at the reference thickness,
+    slab 2 placed rigidly: a relaxed scan is noisier (its force tolerance), so this is a
+    lower bound of a relaxed scan's noise.
+    """
+    from flatcontact.structures.interface_contract import in_plane_vectors, thickness
+    from flatcontact.structures.placement import place_slab2
+
+    a1, a2 = in_plane_vectors(reference)
+    area = float(abs(a1[0] * a2[1] - a1[1] * a2[0]))
+    z = thickness(reference)
+    rng = np.random.default_rng(seed)
+
+    def energy(s) -> float:
+        atoms = place_slab2(reference, float(s[0]), float(s[1]), z, spread_compression=False)
+        atoms.calc = calculator
+        return float(atoms.get_potential_energy())
+
+    worst = 0.0
+    for _ in range(samples):
+        s = rng.random(2)
+        e0 = energy(s)
+        for b in lattice.basis:
+            worst = max(worst, abs(energy(s + b) - e0))
+    return worst / area

@@ -5,7 +5,8 @@ the lowest load in meV/Å²) over the cells of ``study.json``; each panel draws 
 power law ``y = c·N^−α`` and, when fitted, ``y = y∞ + c·N^−α``, and states the exponent and
 the extrapolated limit with their intervals, or why a model was refused
 (:mod:`flatcontact.studies.scaling`). Values ≤ 0 cannot be drawn on a log axis: they are
-named in the panel, not dropped silently.
+named in the panel, not dropped silently; a cell whose corrugation is not resolved above the
+energy noise floor is drawn as an open triangle and left out of the fits.
 """
 
 from __future__ import annotations
@@ -46,8 +47,19 @@ def figure_approximants(doc: dict) -> Figure:
     for ax, (key, (title, label)) in zip(axes, PANELS.items(), strict=True):
         n = np.array([c["n_atoms"] for c in cells], float)
         y = np.array([c[key] for c in cells], float)
-        good = np.isfinite(y) & (y > 0)
+        resolved = np.array([bool(c.get("resolved", True)) for c in cells], bool)
+        drawable = np.isfinite(y) & (y > 0)
+        good = drawable & resolved
         ax.loglog(n[good], y[good], "o", color="C0", label="cells")
+        if np.any(drawable & ~resolved):
+            ax.loglog(
+                n[drawable & ~resolved],
+                y[drawable & ~resolved],
+                "v",
+                mfc="none",
+                color="C3",
+                label="unresolved (< 10× noise): noise",
+            )
         for c, ok in zip(cells, good, strict=True):
             if ok:
                 ax.annotate(
@@ -75,7 +87,7 @@ def figure_approximants(doc: dict) -> Figure:
                 yy = op["limit"] + op["prefactor"] * grid ** -op["exponent"]
                 keep = yy > 0
                 ax.loglog(grid[keep], yy[keep], "--", color="C2", lw=1, label="y∞ + c·N^−α")
-        bad = [c["label"] for c, ok in zip(cells, good, strict=True) if not ok]
+        bad = [c["label"] for c, ok in zip(cells, drawable, strict=True) if not ok]
         note = _fit_text(fit, label.split("(")[-1].rstrip(")"))
         if bad:
             note += f"\nnot drawn (≤ 0 or NaN): {', '.join(bad)}"

@@ -134,7 +134,8 @@ def write_study(doc: dict, cfg: RunConfig, out: str | Path, command: str) -> lis
 APPROXIMANTS_CSV = "approximants.csv"
 #: One row per cell of ``flatcontact study approximants`` (strains: the largest principal
 #: strain of each slab in %, absolute; k and μ in MPa/GPa; barrier: the ISPES corrugation
-#: at the lowest load; gates: the validity gates that fired, ``;``-separated).
+#: at the lowest load; noise: the energy noise floor; resolved: barrier >= 10 x noise; gates:
+#: the validity gates that fired, ``;``-separated).
 APPROXIMANTS_COLUMNS = (
     "label",
     "atoms",
@@ -149,6 +150,8 @@ APPROXIMANTS_COLUMNS = (
     "sigma0_mpa",
     "mu_mpa_per_gpa",
     "barrier_mev_per_a2",
+    "noise_mev_per_a2",
+    "resolved",
     "force_calls",
     "wall_s",
     "gates",
@@ -174,7 +177,7 @@ def approximants_csv_text(doc: dict) -> str:
                 c["shift_lattice_index"],
                 "x".join(str(g) for g in c["grid"]),
                 *(
-                    [""] * 5
+                    [""] * 7
                     if failed
                     else [
                         c["tau0_mpa"],
@@ -182,6 +185,8 @@ def approximants_csv_text(doc: dict) -> str:
                         c["sigma0_mpa"],
                         c["mu_mpa_per_gpa"],
                         c["barrier_mev_per_a2"],
+                        c["noise_mev_per_a2"],
+                        c["resolved"],
                     ]
                 ),
                 "" if failed else c["force_calls"],
