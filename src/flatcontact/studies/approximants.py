@@ -24,7 +24,9 @@ Per cell it returns the laws (τ0, k, σ0, μ of the analysis' energy form), the
 the constant-pressure ISPES at the lowest load (max − min, meV/Å²), the energy noise floor
 (the same structure at two shifts one shift-lattice vector apart,
 :func:`~flatcontact.ispes.shift_lattice.translation_noise_ev_per_a2`) and whether the
-corrugation is resolved (≥ :data:`RESOLVED_FACTOR` × the floor), the gates that fired, the
+corrugation is resolved (≥ :data:`RESOLVED_FACTOR` × the floor; a cell whose ISPES has no
+lateral range above that at any thickness is not analysed: its laws are NaN and its
+"barrier" is that range, an upper bound), the gates that fired, the
 scan's force calls and the wall time of the cell; the study fits the size scaling of τ0 and
 the corrugation on the resolved cells (:mod:`flatcontact.studies.scaling`).
 
@@ -141,6 +143,14 @@ def corrugation_mev_per_a2(friction_nc: Path) -> tuple[float, float]:
     return float(p[i]), float(np.nanmax(surface) - np.nanmin(surface))
 
 
+def lateral_range_mev_per_a2(shifted) -> float:
+    """The largest lateral range (max − min over the shifts) of the energy per area at any
+    thickness of a shift-cell ISPES (meV/Å²): an upper bound of its corrugation at constant
+    load, compared with the noise floor before any analysis."""
+    e = np.asarray(shifted["energy"].values, float) / float(shifted.attrs["area"])
+    return 1e3 * float(np.nanmax(np.nanmax(e, axis=(0, 1)) - np.nanmin(e, axis=(0, 1))))
+
+
 def _gates(cfg: RunConfig, root: Path, lattice) -> dict:
     """The validity gates on the shift-cell analysis: the scan's (in-slab slip, load folds),
     the laws' (negative slope), the landscape's (degenerate minima) and the broken-symmetry
@@ -233,26 +243,40 @@ def run_cell(config: dict, folder: str, planned: int) -> dict:
     shifted = to_shift_cell(ds, lattice)
     shifted.to_netcdf(cell / ISPES_NC, engine="h5netcdf")
     shutil.copy2(scan_folder / SCAN_JSON, cell / SCAN_JSON)
-    run_analyze(cfg, AnalyzeInputs(cell / ISPES_NC), cell / "analyze")
-    run_laws(cfg, LawsInputs.read(cell / "analyze" / FRICTION_CSV, cell / ISPES_NC), cell / "laws")
-    laws = json.loads((cell / "laws" / LAWS_JSON).read_text())
-    form = laws.get("energy_form") or cfg.analysis.energy_form
-    law = laws.get(form) if isinstance(laws.get(form), dict) else laws
-    p_low, barrier = corrugation_mev_per_a2(cell / "analyze" / FRICTION_NC)
-    gates = _gates(cfg, root, lattice)
     noise = 1e3 * translation_noise_ev_per_a2(
         reference, make_calculator(cfg.potential, reference), lattice
     )
+    lateral = lateral_range_mev_per_a2(shifted)
+    nan = math.nan
+    form, law, p_low, barrier, gates = cfg.analysis.energy_form, {}, nan, lateral, None
+    if lateral >= RESOLVED_FACTOR * noise:
+        run_analyze(cfg, AnalyzeInputs(cell / ISPES_NC), cell / "analyze")
+        run_laws(
+            cfg, LawsInputs.read(cell / "analyze" / FRICTION_CSV, cell / ISPES_NC), cell / "laws"
+        )
+        laws = json.loads((cell / "laws" / LAWS_JSON).read_text())
+        form = laws.get("energy_form") or cfg.analysis.energy_form
+        law = laws.get(form) if isinstance(laws.get(form), dict) else laws
+        p_low, barrier = corrugation_mev_per_a2(cell / "analyze" / FRICTION_NC)
+        gates = _gates(cfg, root, lattice)
+    else:  # noise only: the analysis of a noise landscape costs minutes and means nothing
+        gates = {
+            "fired": [],
+            "messages": [],
+            "not_checked": ["all: the landscape is not resolved above the noise floor"],
+        }
     calls = int(scan.get("force_calls_total") or 0)
     return {
         "folder": str(root),
         "energy_form": form,
-        "tau0_mpa": float(law["tau0_mpa"]),
-        "k_mpa_per_gpa": float(law["k_mpa_per_gpa"]),
-        "sigma0_mpa": float(law["sigma0_mpa"]),
-        "mu_mpa_per_gpa": float(law["mu_mpa_per_gpa"]),
-        "tau0_stderr_mpa": float(law.get("tau0_stderr_mpa", math.nan)),
+        "tau0_mpa": float(law.get("tau0_mpa", nan)),
+        "k_mpa_per_gpa": float(law.get("k_mpa_per_gpa", nan)),
+        "sigma0_mpa": float(law.get("sigma0_mpa", nan)),
+        "mu_mpa_per_gpa": float(law.get("mu_mpa_per_gpa", nan)),
+        "tau0_stderr_mpa": float(law.get("tau0_stderr_mpa", nan)),
         "barrier_mev_per_a2": barrier,
+        "lateral_range_mev_per_a2": lateral,
+        "analysed": bool(law),
         "barrier_at_p_gpa": p_low,
         "noise_mev_per_a2": noise,
         "resolved": bool(barrier >= RESOLVED_FACTOR * noise),
