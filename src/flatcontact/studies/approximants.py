@@ -297,6 +297,11 @@ def run_cell(config: dict, folder: str, planned: int) -> dict:
 
 def _run_cells(executor, jobs: list[tuple], on_done: Callable | None) -> dict:
     """Run ``jobs`` = [(label, config dict, folder, planned index)] through ``executor``."""
+    if executor.workers == 1 and len(jobs) > 1:  # a serial executor runs at submission:
+        out: dict = {}  # one cell at a time, so each is told as it ends
+        for job in jobs:
+            out.update(_run_cells(executor, [job], on_done))
+        return out
     handles = {executor.submit(run_cell, c, f, i): label for label, c, f, i in jobs}
     out: dict = {}
     pending = set(handles)
