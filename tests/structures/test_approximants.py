@@ -135,3 +135,90 @@ def test_bad_combinations_are_refused_naming_the_field():
         approximant_sequence({"kind": "toy-lj"}, parse_approximants({}))
     square = {"kind": "fcc111", "element": "Cu"}  # hexagonal: accepted
     assert approximant_sequence(square, parse_approximants({"max_atoms": 200}))[0].n_atoms == 84
+
+
+GRAPHENE_ON_HBN = {
+    "kind": "sheets",
+    "sheet": "graphene",
+    "stacking": "A",
+    "slab2": {"sheet": "h-BN", "stacking": "A"},
+}
+A_GRAPHENE, A_HBN = 2.46, 2.504
+
+
+@pytest.mark.parametrize("strain_on", ["slab2", "both"])
+def test_strain_ladder_cells_within_their_bounds_strain_falling_and_built_exactly(strain_on):
+    settings = parse_approximants(
+        {"strain_percent": [3.0, 2.5, 1.0, 0.3], "strain_on": strain_on, "max_atoms": 300}
+    )
+    seq = approximant_sequence(GRAPHENE_ON_HBN, settings)
+    # 2.5 % is met by the 3 % cell already (mismatch 1.76 %): skipped; 0.3 %: none <= 300 atoms
+    assert [a.label for a in seq] == ["zsl-3pct", "zsl-1pct"]
+    worst = [max(map(abs, a.strain_percent_slab1 + a.strain_percent_slab2)) for a in seq]
+    assert all(b < a for a, b in itertools.pairwise(worst))
+    for a, bound in zip(seq, (3.0, 1.0), strict=True):
+        assert a.kind == "coincidence" and a.angle_error_deg == 0.0
+        assert worst[seq.index(a)] <= bound
+        assert a.n_atoms <= 300
+        # independent: the isotropic strain is the ratio of the two supercells' vector lengths
+        m = a.structure_override["match"]
+        t1 = np.array(m["slab1_supercell"]) @ builtin_sheet("graphene").cell.array[:2, :2]
+        t2 = np.array(m["slab2_supercell"]) @ builtin_sheet("h-BN").cell.array[:2, :2]
+        ratio = np.linalg.norm(t1[0]) / np.linalg.norm(t2[0])
+        assert np.linalg.norm(t1[1]) / np.linalg.norm(t2[1]) == pytest.approx(ratio, rel=1e-6)
+        if strain_on == "slab2":
+            assert a.strain_percent_slab1 == (0.0, 0.0)
+            np.testing.assert_allclose(a.strain_percent_slab2, 100 * (ratio - 1), atol=1e-5)
+        else:  # the mean cell: opposite strains, (1 + e1)·ratio... = mean length
+            mean = 0.5 * (1.0 + 1.0 / ratio)
+            np.testing.assert_allclose(a.strain_percent_slab1, 100 * (mean - 1), atol=1e-5)
+            np.testing.assert_allclose(a.strain_percent_slab2, 100 * (mean * ratio - 1), atol=1e-5)
+        atoms, report = _build(GRAPHENE_ON_HBN, a)
+        match = report["recipe"]["match"]
+        assert len(atoms) == match["n_atoms"] == a.n_atoms
+        np.testing.assert_allclose(match["slab1_strain_percent"], a.strain_percent_slab1)
+        np.testing.assert_allclose(match["slab2_strain_percent"], a.strain_percent_slab2)
+        assert abs(np.linalg.det(atoms.cell.array[:2, :2])) == pytest.approx(
+            a.area_angstrom2, rel=1e-9
+        )
+    # the smallest cell is the 1×1 lock: h-BN compressed onto graphene (closed form)
+    if strain_on == "slab2":
+        np.testing.assert_allclose(
+            seq[0].strain_percent_slab2, 2 * [100 * (A_GRAPHENE / A_HBN - 1)], atol=1e-5
+        )
+
+
+def test_explicit_supercells_are_checked_naming_the_field():
+    base = {**GRAPHENE_ON_HBN, "match": {"max_atoms": 600}}
+    good = {"slab1_supercell": [[4, 6], [-2, 4]], "slab2_supercell": [[6, 3], [3, 6]]}
+    atoms, report = build_interface({**base, "match": {"max_atoms": 600, **good}})
+    assert len(atoms) == 110 and report["recipe"]["match"]["supercells"].startswith("given")
+    cases = [
+        ({"slab1_supercell": [[1, 0], [0, 1]]}, r"structure\.match: .*slab2_supercell"),
+        (
+            {"slab1_supercell": [[0, 1], [1, 0]], "slab2_supercell": [[1, 0], [0, 1]]},
+            r"structure\.match.*slab1_supercell.*positive determinant",
+        ),
+        (  # 1×1 on 1×1 strains h-BN by 1.76 % > 1 %
+            {
+                "slab1_supercell": [[1, 0], [0, 1]],
+                "slab2_supercell": [[1, 0], [0, 1]],
+                "max_strain_percent": 1.0,
+            },
+            r"structure\.match\.slab2_supercell: the cell strains slab 2 by 1\.7",
+        ),
+    ]
+    for match, pattern in cases:
+        with pytest.raises(InputError, match=pattern):
+            build_interface({**base, "match": {"max_atoms": 600, **match}})
+    with pytest.raises(InputError, match=r"structure\.match\.slab1_supercell: explicit"):
+        build_interface({**GRAPHENE, "match": good})
+
+
+def test_ladder_refusals_name_the_field():
+    with pytest.raises(InputError, match=r"approximants\.twist_deg"):
+        approximant_sequence(GRAPHENE_ON_HBN, parse_approximants({"twist_deg": 1.1}))
+    with pytest.raises(InputError, match=r"approximants\.strain_percent=0\.01"):
+        approximant_sequence(
+            GRAPHENE_ON_HBN, parse_approximants({"strain_percent": [0.01], "max_atoms": 200})
+        )

@@ -272,7 +272,7 @@ def _coincidence_sequence(recipe, a1, a2, na1: int, na2: int, settings) -> list[
                 a2,
                 na1,
                 na2,
-                recipe.rotate_deg + rotation,
+                _wrapped(recipe.rotate_deg + rotation),
                 0.0,
                 override,
             )
@@ -280,6 +280,12 @@ def _coincidence_sequence(recipe, a1, a2, na1: int, na2: int, settings) -> list[
         if len(out) == settings.max_cells:
             break
     return out
+
+
+def _wrapped(angle_deg: float) -> float:
+    """``angle_deg`` in (−180°, 180°]."""
+    out = -((-angle_deg + 180.0) % 360.0 - 180.0)
+    return 180.0 if out == -180.0 else out + 0.0
 
 
 def _same_cell(match, previous: Approximant) -> bool:

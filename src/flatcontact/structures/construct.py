@@ -31,6 +31,7 @@ from flatcontact.structures.match import (
     apply_supercell,
     atom_count,
     coincidence_match,
+    explicit_match,
     identity_match,
     twist_match,
 )
@@ -266,6 +267,14 @@ def build_generic(recipe) -> tuple[Atoms, dict]:
         raise InputError(
             f"{SECTION}.twist: a twist needs the same material in both slabs (no slab2)"
         )
+    explicit = bounds.slab1_supercell is not None
+    if explicit and (
+        recipe.twist is not None or not other or np.allclose(s1.cell2, s2.cell2, atol=1e-6)
+    ):
+        raise InputError(
+            f"{SECTION}.match.slab1_supercell: explicit supercells are for a coincidence lattice "
+            "of two materials of different lattices (slab2 another material, no twist)"
+        )
     continuation = s2 is None and recipe.twist is None and recipe.rotate_deg == 0 and not flip
     if continuation:
         match = identity_match(s1.cell2)
@@ -307,6 +316,16 @@ def build_generic(recipe) -> tuple[Atoms, dict]:
         match, theta = twist_match(s1.cell2, *recipe.twist, field=f"{SECTION}.twist")
         operations.append(f"twisted by {theta:.6f}° (commensurate (m, n) = {list(recipe.twist)})")
         record["twist_angle_deg"] = theta
+    elif other and not np.allclose(s1.cell2, s2.cell2, atol=1e-6) and explicit:
+        match = explicit_match(
+            s1.cell2,
+            s2.cell2,
+            bounds.slab1_supercell,
+            bounds.slab2_supercell,
+            max_strain=bounds.max_strain_percent / 100.0,
+            strain_on=bounds.strain_on,
+            field=f"{SECTION}.match",
+        )
     elif other and not np.allclose(s1.cell2, s2.cell2, atol=1e-6):
         match = coincidence_match(
             s1.cell2,
@@ -329,6 +348,8 @@ def build_generic(recipe) -> tuple[Atoms, dict]:
         "none (another material)" if other else "translated copy"
     )
     record["match"] = match.report(s1.cell2, src2.cell2, na1, na2)
+    if explicit:
+        record["match"]["supercells"] = "given (structure.match.slab1_supercell, slab2_supercell)"
     slab1 = apply_supercell(slab1, match.p1, match.cell)
     slab2 = apply_supercell(slab2, match.p2, match.cell)
     atoms = stack_pair(slab1, slab2, spacing, by=by)

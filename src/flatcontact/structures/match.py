@@ -170,12 +170,7 @@ def coincidence_match(
             p2 = integer_matrix(f, a2, field)
         except InputError:
             continue
-        if strain_on == "slab2":
-            cell = s
-        else:
-            rot, _ = _polar(np.linalg.solve(f, s).T)
-            cell = 0.5 * (s + f @ rot.T)
-        match = Match(p1, p2, cell, "coincidence")
+        match = Match(p1, p2, common_cell(s, f, strain_on), "coincidence")
         worst = max(
             max(abs(x) for x in strain_and_rotation(match.deformation(k, a))[0])
             for k, a in ((1, a1), (2, a2))
@@ -193,6 +188,56 @@ def coincidence_match(
             f"and <= {max_atoms} atoms (raise match.max_strain or match.max_atoms)"
         )
     return _without_lattice_rotation(best[1], a2, field)
+
+
+def common_cell(s: np.ndarray, f: np.ndarray, strain_on: str) -> np.ndarray:
+    """The common cell (2×2 rows, Å) of slab 1's supercell ``s`` and slab 2's ``f``:
+    ``s`` itself (``strain_on="slab2"``) or the mean of ``s`` and ``f`` rotated onto it by
+    the rotation of the polar decomposition (``"both"``)."""
+    if strain_on == "slab2":
+        return np.asarray(s, float).copy()
+    rot, _ = _polar(np.linalg.solve(f, s).T)
+    return 0.5 * (s + f @ rot.T)
+
+
+def explicit_match(
+    a1: np.ndarray,
+    a2: np.ndarray,
+    p1,
+    p2,
+    *,
+    max_strain: float,
+    strain_on: str = "slab2",
+    field: str = "match",
+) -> Match:
+    """The coincidence lattice of the given supercells P1, P2 (2×2 int, rows in each slab's
+    own basis): the cell :func:`coincidence_match` would make of them.
+
+    InputError naming ``field`` when a principal strain of either slab exceeds
+    ``max_strain`` (a fraction) or a supercell is degenerate or left-handed.
+    """
+    if strain_on not in ("slab2", "both"):
+        raise InputError(f"strain_on='{strain_on}': expected slab2 or both")
+    a1 = np.asarray(a1, float)[:, :2]
+    a2 = np.asarray(a2, float)[:, :2]
+    p1, p2 = np.asarray(p1, int), np.asarray(p2, int)
+    for which, p in (("slab1", p1), ("slab2", p2)):
+        if p.shape != (2, 2) or round(np.linalg.det(p)) <= 0:
+            raise InputError(
+                f"{field}.{which}_supercell={p.tolist()}: expected a 2×2 integer matrix of "
+                "positive determinant (right-handed supercell)"
+            )
+    s, f = p1 @ a1, p2 @ a2
+    match = Match(p1, p2, common_cell(s, f, strain_on), "coincidence")
+    for which, a in ((1, a1), (2, a2)):
+        strains, _ = strain_and_rotation(match.deformation(which, a))
+        worst = max(abs(x) for x in strains)
+        if worst > max_strain + 1e-9:
+            raise InputError(
+                f"{field}.slab{which}_supercell: the cell strains slab {which} by "
+                f"{100 * worst:.4g}% > max_strain_percent={100 * max_strain:g}"
+            )
+    return match
 
 
 def _without_lattice_rotation(match: Match, a2: np.ndarray, field: str) -> Match:

@@ -107,6 +107,35 @@ class MatchSettings(_Model):
         description="slab2: slab 1 keeps its lattice, slab 2 takes the strain; "
         "both: the common cell is the mean of the two",
     )
+    # the two supercells are left out of the dumped recipe while unset, so the fingerprints
+    # of existing runs are unchanged
+    slab1_supercell: tuple[tuple[int, int], tuple[int, int]] | None = Field(
+        None,
+        exclude_if=lambda value: value is None,
+        description="two materials: slab 1's supercell (2×2 integers, rows in its primitive "
+        "cell) in place of the smallest match, e.g. from flatcontact's approximant sequence; "
+        "with slab2_supercell",
+    )
+    slab2_supercell: tuple[tuple[int, int], tuple[int, int]] | None = Field(
+        None,
+        exclude_if=lambda value: value is None,
+        description="two materials: slab 2's supercell, with slab1_supercell",
+    )
+
+    @model_validator(mode="after")
+    def _supercells(self) -> MatchSettings:
+        given = (self.slab1_supercell is not None, self.slab2_supercell is not None)
+        if given[0] != given[1]:
+            missing = "slab2_supercell" if given[0] else "slab1_supercell"
+            raise ValueError(f"{missing}: required with the other slab's supercell")
+        for name in ("slab1_supercell", "slab2_supercell"):
+            p = getattr(self, name)
+            if p is not None and p[0][0] * p[1][1] - p[0][1] * p[1][0] <= 0:
+                raise ValueError(
+                    f"{name}: expected a positive determinant (a right-handed supercell), "
+                    f"got {[list(r) for r in p]}"
+                )
+        return self
 
 
 class _PairOptions(_Model):

@@ -34,6 +34,37 @@ COMMENSURATE_WARNING = (
     "τ and σ here overstate those of an incommensurate contact."
 )
 
+#: A commensurate lock that strains a slab by more than this (largest principal strain, %)
+#: is stated in the report: the strained lattice is not the material's.
+LOCK_STRAIN_NOTE_PERCENT = 0.5
+
+
+def lock_statement(build: dict) -> str | None:
+    """The note on a coincidence lock that strains a slab by more than
+    :data:`LOCK_STRAIN_NOTE_PERCENT` (``build.json``'s ``recipe.match``), or None."""
+    rec = build.get("recipe")
+    match = rec.get("match") if isinstance(rec, dict) else None
+    if not isinstance(match, dict) or match.get("kind") != "coincidence":
+        return None
+    parts = []
+    for i in (1, 2):
+        strains = [float(v) for v in match.get(f"slab{i}_strain_percent") or []]
+        if strains and max(abs(v) for v in strains) > LOCK_STRAIN_NOTE_PERCENT:
+            values = sorted({round(v, 3) for v in strains}, key=abs, reverse=True)
+            material = (rec.get(f"slab{i}") or {}).get("material")
+            parts.append(
+                f"{' and '.join(f'{v:+.3g}' for v in values)} % on slab {i}"
+                + (f" ({material})" if material else "")
+            )
+    if not parts:
+        return None
+    return (
+        f"Commensurate lock, strain {'; '.join(parts)}: the lattices are strained to coincide "
+        f"in a cell of {match.get('n_atoms', '?')} atoms, so the contact is neither "
+        "incommensurate nor made of the unstrained materials. The incommensurate contact is "
+        "the limit of `flatcontact study approximants` (docs/incommensurate.md)."
+    )
+
 
 def interface_material(atoms: Atoms) -> str:
     """The material of the run's interface (``info['material']`` of ``interface.extxyz``;
@@ -164,7 +195,8 @@ def interface_section(
     """Section 1: what the interface is (``build``: the build stage's ``build.json``,
     :func:`structure_paragraphs`), its atoms, thickness and relaxation, which layers the
     scan holds and how the others relax (``atoms``: ``interface.extxyz``;
-    ``cfg.scan.relax_mode``), the warning that a commensurate lock overstates τ (not for
+    ``cfg.scan.relax_mode``), the lock's strain when above :data:`LOCK_STRAIN_NOTE_PERCENT`
+    (:func:`lock_statement`) and the warning that a commensurate lock overstates τ (not for
     the paper's quartz, ``paper``) and Fig. 1 from ``folder``."""
     rel = build.get("interface_relaxation") or {}
     checks = build.get("interface_verification") or {}
@@ -191,7 +223,7 @@ def interface_section(
     return Section(
         "1. Interface",
         paragraphs=paragraphs,
-        notes=[] if paper else [COMMENSURATE_WARNING],
+        notes=[] if paper else [n for n in (lock_statement(build), COMMENSURATE_WARNING) if n],
         figures=[
             Figure(
                 folder / png(BUILD_FIGURE),
