@@ -58,7 +58,7 @@ def figure_approximants(doc: dict) -> Figure:
                 "v",
                 mfc="none",
                 color="C3",
-                label="unresolved (< 10× noise): noise",
+                label="unresolved (< 10× noise): upper bound",
             )
         for c, ok in zip(cells, good, strict=True):
             if ok:
