@@ -164,14 +164,14 @@ def approximants_command(
         highlight=False,
         soft_wrap=True,
     )
-    first = cells[0]["atom_calls_upper_bound"] if cells else 1
+    first = cells[0]["atom_points_planned"] if cells else 1
     for c in cells:
         console.print(
             f"  {c['label']}: {c['n_atoms']} atoms, twist {c['twist_deg']:.4f} deg "
             f"(error {c['angle_error_deg']:+.4f}), strain {c['strain_percent_slab1']:.3g} / "
             f"{c['strain_percent_slab2']:.3g} %, shift lattice index {c['shift_lattice_index']}, "
-            f"grid {c['grid'][0]}x{c['grid'][1]}, <= {c['points_upper_bound']} points, "
-            f"cost <= {c['atom_calls_upper_bound'] / first:.3g}x the first cell",
+            f"grid {c['grid'][0]}x{c['grid'][1]}, {c['points_planned']} points planned, "
+            f"cost ~ {c['atom_points_planned'] / first:.3g}x the first cell (atoms x points)",
             highlight=False,
             soft_wrap=True,
         )

@@ -64,7 +64,7 @@ SHIFT_CELL = "shift-cell"
 RESOLVED_FACTOR = 10.0
 
 
-def planned_index(approximant, structure: dict | None = None) -> int:
+def planned_index(approximant) -> int:
     """The shift-lattice index the cell will have (before it is built): ``N²`` for a
     commensurate twist of N cells per layer (``N²/3`` when m − n is a multiple of 3: the
     built cell is 3 coincidence cells), Λ_1 + Λ_2 of the match matrices for a coincidence
@@ -118,9 +118,10 @@ def plan(cfg: RunConfig) -> list[dict]:
                 "strain_percent_slab2": _max_abs(a.strain_percent_slab2),
                 "shift_lattice_index": index,
                 "grid": [n, n],
-                # the scan's points before the symmetry reduction: an upper bound
-                "points_upper_bound": n * n * n_z,
-                "atom_calls_upper_bound": n * n * n_z * a.n_atoms,
+                # grid points as planned (the load bracket may add thicknesses); a rigid-layers
+                # point costs one force call, a relaxed one ~10 (docs/incommensurate.md)
+                "points_planned": n * n * n_z,
+                "atom_points_planned": n * n * n_z * a.n_atoms,
                 "structure_override": a.structure_override,
                 "config": config,
             }
