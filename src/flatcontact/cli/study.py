@@ -1,4 +1,4 @@
-"""``flatcontact study convergence|models``: studies over many runs of one interface.
+"""``flatcontact study convergence|models|approximants``: studies over many runs of one interface.
 
 Thin: loads the run configuration, calls :mod:`flatcontact.studies` and prints one line per
 finished variant and where the study's files are (docs/studies.md).
@@ -103,6 +103,95 @@ def models_command(
         text = ", ".join(f"{k} {v:.3g}" for k, v in spread.items())
         console.print(f"spread ({form}): {text}", highlight=False)
     console.print(f"study: {(out / 'study.json').resolve()}", highlight=False)
+
+
+def _cell_progress(label: str, result: dict) -> None:
+    if "error" in result:
+        console.print(f"  {label}: failed: {result['error']}", highlight=False, soft_wrap=True)
+        return
+    gates = ", ".join(result["gates"]["fired"]) or "none"
+    console.print(
+        f"  {label}: scan {result['scan_action']}, {result['force_calls']} force calls, "
+        f"tau0 {result['tau0_mpa']:.4g} MPa, corrugation {result['barrier_mev_per_a2']:.4g} "
+        f"meV/A^2 (noise {result['noise_mev_per_a2']:.2g}"
+        f"{'' if result['resolved'] else ': NOT resolved'}), gates fired: {gates}, "
+        f"{result['wall_s']:.1f} s",
+        highlight=False,
+        soft_wrap=True,
+    )
+
+
+def _scaling_line(name: str, fit: dict) -> str:
+    parts = []
+    for key in ("power_law", "offset_power_law"):
+        f = fit[key]
+        if "refused" in f:
+            parts.append(f"{f['model']}: not fitted ({f['refused']})")
+        elif key == "power_law":
+            parts.append(
+                f"{f['model']}: alpha {f['exponent']:.3g} +- {f['exponent_half_width']:.2g}"
+            )
+        else:
+            parts.append(
+                f"{f['model']}: alpha {f['exponent']:.3g} +- {f['exponent_half_width']:.2g}, "
+                f"y_inf {f['limit']:.3g} +- {f['limit_half_width']:.2g}"
+            )
+    return f"{name}: " + "; ".join(parts)
+
+
+@study_app.command("approximants")
+def approximants_command(
+    config: Annotated[
+        Path,
+        typer.Argument(help="Run configuration (YAML): structure, model, scan, approximants:."),
+    ],
+    out: Annotated[Path, _OUT] = Path("flatcontact-study"),
+    list_only: Annotated[
+        bool,
+        typer.Option("--list", help="Print the cells, their grid and cost bound; run nothing."),
+    ] = False,
+) -> None:
+    """The ISPES study of each commensurate approximant cell: tau0 and corrugation vs size."""
+    from flatcontact.config.load import load_config
+    from flatcontact.studies.approximants import plan, run_approximants
+    from flatcontact.studies.output import write_approximants
+
+    cfg = load_config(config)
+    cells = plan(cfg)
+    console.print(
+        f"{len(cells)} cell(s), base grid {cfg.scan.grid[0]}x{cfg.scan.grid[1]} per period of "
+        f"the landscape, relax_mode {cfg.scan.relax_mode}:",
+        highlight=False,
+        soft_wrap=True,
+    )
+    first = cells[0]["atom_points_planned"] if cells else 1
+    for c in cells:
+        console.print(
+            f"  {c['label']}: {c['n_atoms']} atoms, twist {c['twist_deg']:.4f} deg "
+            f"(error {c['angle_error_deg']:+.4f}), strain {c['strain_percent_slab1']:.3g} / "
+            f"{c['strain_percent_slab2']:.3g} %, shift lattice index {c['shift_lattice_index']}, "
+            f"grid {c['grid'][0]}x{c['grid'][1]}, {c['points_planned']} points planned, "
+            f"cost ~ {c['atom_points_planned'] / first:.3g}x the first cell (atoms x points)",
+            highlight=False,
+            soft_wrap=True,
+        )
+    if list_only:
+        return
+    check_out_dir(out)
+    console.print(
+        f"flatcontact study approximants: {config} -> {out}", highlight=False, soft_wrap=True
+    )
+    doc = run_approximants(cfg, out, on_done=_cell_progress)
+    write_approximants(doc, out, _command_line())
+    for key, name in (("tau0_mpa", "tau0"), ("barrier_mev_per_a2", "corrugation")):
+        console.print(_scaling_line(name, doc["scaling"][key]), highlight=False, soft_wrap=True)
+    c = doc["cost"]
+    console.print(
+        f"force calls: {c['force_calls_study']} (stored {c['force_calls_stored']}); "
+        f"study: {(out / 'study.json').resolve()}",
+        highlight=False,
+        soft_wrap=True,
+    )
 
 
 @study_app.command("export-uncertainty")

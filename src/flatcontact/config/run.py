@@ -15,6 +15,7 @@ from pydantic import Field, field_validator, model_validator
 
 from flatcontact.config import migration
 from flatcontact.config.analysis import AnalysisConfig
+from flatcontact.config.approximants import ApproximantSettings
 from flatcontact.config.contact import ContactConfig
 from flatcontact.config.elastic import ElasticConfig
 from flatcontact.config.messages import show
@@ -86,6 +87,12 @@ class RunConfig(Section):
     refine: RefineConfig = Field(
         default_factory=RefineConfig,
         description="what 'flatcontact study convergence' refines and how far (no stage reads it)",
+    )
+    approximants: ApproximantSettings = Field(
+        default_factory=ApproximantSettings,
+        exclude_if=lambda value: value == ApproximantSettings(),
+        description="which approximant cells 'flatcontact study approximants' runs "
+        "(no stage reads it)",
     )
     report: ReportConfig = Field(
         default_factory=ReportConfig, description="the HTML report and figures (stage report)"

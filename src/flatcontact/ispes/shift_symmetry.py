@@ -290,6 +290,7 @@ def shift_space_group(
     tolerance_angstrom: float = DEFAULT_TOLERANCE_ANGSTROM,
     *,
     spread_compression: bool = True,
+    modulo_translations: bool = False,
 ) -> ShiftGroup:
     """The shift-space group of ``reference`` (see the module docstring), identity first.
 
@@ -301,6 +302,13 @@ def shift_space_group(
         Largest distance (Å) between a mapped atom and its image for an operation to count.
     spread_compression
         As the scan's placement of slab 2 (false in ``rigid`` mode).
+    modulo_translations
+        Keep one operation per point operation and slab swap (the first that checks): the
+        others differ from it by a pure translation of the group, the shift lattice
+        Λ_1 + Λ_2 of a coincidence cell (:mod:`flatcontact.ispes.shift_lattice`). A twist
+        cell of N primitive cells per layer has N² such translations, and checking every
+        pair costs N² stack checks per point operation (227 s for the 76-atom (2, 3) cell,
+        measured); on one period of the shift lattice they are all the identity.
 
     Returns
     -------
@@ -324,12 +332,14 @@ def shift_space_group(
         f[np.abs(f - 1.0) < 1e-9] = 0.0
         return (float(round(f[0], 12)) + 0.0, float(round(f[1], 12)) + 0.0)
 
-    def add(op: ShiftOperation, w: np.ndarray, tau_of_shift) -> None:
+    def add(op: ShiftOperation, w: np.ndarray, tau_of_shift) -> bool:
         key = (op.matrix, tuple(round(x * 1e6) % 1000000 for x in op.translation), op.swaps_slabs)
         if key in ops:
-            return
+            return True
         if _stack_maps(reference, w, op, tau_of_shift, tol, spread_compression):
             ops[key] = op
+            return True
+        return False
 
     for r in _point_operations(lattice):
         m_int = np.round(inv @ r @ lattice).astype(int)
@@ -345,7 +355,8 @@ def shift_space_group(
                         continue
                     m = tuple(tuple(int(v) for v in row) for row in m_int)
                     op = ShiftOperation(m, fractional(tau1 - tau2), False)
-                    add(op, w, lambda d, tau1=tau1: tau1)
+                    if add(op, w, lambda d, tau1=tau1: tau1) and modulo_translations:
+                        break
             else:
                 ta = _translations(*parts[1], *parts[2], w, lattice, tol)
                 tb = _translations(*parts[2], *parts[1], w, lattice, tol) if ta else []
@@ -360,7 +371,8 @@ def shift_space_group(
                         out[:2] -= r @ d
                         return out
 
-                    add(op, w, tau_of_shift)
+                    if add(op, w, tau_of_shift) and modulo_translations:
+                        break
     found = sorted(
         ops.values(),
         key=lambda o: (not o.is_identity, o.matrix, o.translation, o.swaps_slabs),
@@ -375,3 +387,20 @@ def shift_space_group(
         ):
             unique.append(op)
     return ShiftGroup(tuple(unique), tol)
+
+
+def self_translations(
+    reference: Atoms, slab: int, tolerance_angstrom: float = DEFAULT_TOLERANCE_ANGSTROM
+) -> list[np.ndarray]:
+    """In-plane translations τ (3-vectors, Å, reduced to the cell) that map slab ``slab`` of
+    ``reference`` onto itself modulo the in-plane lattice, keeping species, held flags and
+    layers: the primitive lattice of that slab modulo the supercell (identity included).
+    The pure translations of the shift-space group are differences of slab 1's and slab 2's
+    (:mod:`flatcontact.ispes.shift_lattice`)."""
+    lattice = np.column_stack(in_plane_vectors(reference))
+    lab = _labels(reference)
+    layer = np.asarray(reference.arrays.get("layer", np.zeros(len(reference), int)))
+    mask = np.asarray(reference.arrays["slab"]) == slab
+    part = (reference.positions[mask], lab[mask], layer[mask])
+    found = _translations(*part, *part, np.eye(3), lattice, float(tolerance_angstrom))
+    return [t for t in found if abs(t[2]) <= tolerance_angstrom]

@@ -129,3 +129,92 @@ def write_study(doc: dict, cfg: RunConfig, out: str | Path, command: str) -> lis
         fig = figure_study(doc, quantity)
         files += save_figure(fig, out / f"study_{quantity}", formats=("png",))
     return files
+
+
+APPROXIMANTS_CSV = "approximants.csv"
+#: One row per cell of ``flatcontact study approximants`` (strains: the largest principal
+#: strain of each slab in %, absolute; k and μ in MPa/GPa; barrier: the ISPES corrugation
+#: at the lowest load; noise: the energy noise floor; resolved: barrier >= 10 x noise; gates:
+#: the validity gates that fired, ``;``-separated).
+APPROXIMANTS_COLUMNS = (
+    "label",
+    "atoms",
+    "twist_deg",
+    "angle_error_deg",
+    "strain_percent_slab1",
+    "strain_percent_slab2",
+    "shift_lattice_index",
+    "grid",
+    "tau0_mpa",
+    "k_mpa_per_gpa",
+    "sigma0_mpa",
+    "mu_mpa_per_gpa",
+    "barrier_mev_per_a2",
+    "noise_mev_per_a2",
+    "resolved",
+    "force_calls",
+    "wall_s",
+    "gates",
+    "error",
+)
+
+
+def approximants_csv_text(doc: dict) -> str:
+    """``approximants.csv`` of an approximant study document (one row per cell)."""
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(APPROXIMANTS_COLUMNS)
+    for c in doc["cells"]:
+        failed = "error" in c
+        writer.writerow(
+            [
+                c["label"],
+                c["n_atoms"],
+                f"{c['twist_deg']:.6f}",
+                f"{c['angle_error_deg']:.6f}",
+                c["strain_percent_slab1"],
+                c["strain_percent_slab2"],
+                c["shift_lattice_index"],
+                "x".join(str(g) for g in c["grid"]),
+                *(
+                    [""] * 7
+                    if failed
+                    else [
+                        c["tau0_mpa"],
+                        c["k_mpa_per_gpa"],
+                        c["sigma0_mpa"],
+                        c["mu_mpa_per_gpa"],
+                        c["barrier_mev_per_a2"],
+                        c["noise_mev_per_a2"],
+                        c["resolved"],
+                    ]
+                ),
+                "" if failed else c["force_calls"],
+                "" if failed else f"{c['wall_s']:.1f}",
+                "" if failed else ";".join(c["gates"]["fired"]),
+                c.get("error", ""),
+            ]
+        )
+    return buf.getvalue()
+
+
+def write_approximants(doc: dict, out: str | Path, command: str) -> list[Path]:
+    """``study.json``, ``approximants.csv`` and ``approximants.png`` of an approximant study."""
+    from flatcontact.plots.approximants import figure_approximants
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    doc = {
+        **doc,
+        "provenance": {
+            "command": command,
+            "date": datetime.date.today().isoformat(),
+            "flatcontact_version": __version__,
+        },
+    }
+    files = [
+        write_json_atomic(out / STUDY_JSON, json.loads(json.dumps(doc, default=float))),
+        write_text_atomic(out / APPROXIMANTS_CSV, approximants_csv_text(doc)),
+    ]
+    files += save_figure(figure_approximants(doc), out / "approximants", formats=("png",))
+    return files

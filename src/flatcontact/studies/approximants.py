@@ -1,0 +1,378 @@
+"""``flatcontact study approximants``: the ISPES study of each commensurate approximant cell.
+
+The cells are :func:`flatcontact.structures.approximants.approximant_sequence` of the
+configuration's ``structure:`` and ``approximants:`` sections (commensurate twists toward a
+target angle or the (n, n+1) family; coincidence lattices of decreasing strain). Each cell is
+an ordinary run directory ``DIR/runs/<label>`` (the structure override merged in) run by
+:class:`flatcontact.pipeline.Pipeline` through build and scan, the cells side by side through
+the scan's executor (``scan.executor``/``scan.workers``; each cell's scan serial), so a rerun
+skips every finished stage.
+
+The grid (docs/incommensurate.md, "The approximant study"): the ISPES of a coincidence cell
+is periodic in the shift lattice Λ_1 + Λ_2 (:mod:`flatcontact.ispes.shift_lattice`), whose
+cell is ``index`` times smaller than the supercell (N² for an N-cell twist). Each cell is
+scanned on an ``n × n`` grid over its supercell with n the base grid (``scan.grid``, the
+density per period of the untwisted contact) raised to the next integer coprime to the
+index; that grid visits an ``n × n`` grid over ONE period of the landscape, so the scan
+costs the base grid's points, and :func:`~flatcontact.ispes.shift_lattice.to_shift_cell`
+re-indexes it onto that period (``runs/<label>/shift-cell/ispes.nc``). The analysis and the
+laws (the stages' own functions) and the validity gates run on that file
+(``shift-cell/analyze``, ``shift-cell/laws``); the loads are the configuration's
+(pressures are intensive: the same loads for every cell).
+
+Per cell it returns the laws (τ0, k, σ0, μ of the analysis' energy form), the corrugation of
+the constant-pressure ISPES at the lowest load (max − min, meV/Å²), the energy noise floor
+(the same structure at two shifts one shift-lattice vector apart,
+:func:`~flatcontact.ispes.shift_lattice.translation_noise_ev_per_a2`) and whether the
+corrugation is resolved (≥ :data:`RESOLVED_FACTOR` × the floor; a cell whose ISPES has no
+lateral range above that at any thickness is not analysed: its laws are NaN and its
+"barrier" is that range, an upper bound), the gates that fired, the
+scan's force calls and the wall time of the cell; the study fits the size scaling of τ0 and
+the corrugation on the resolved cells (:mod:`flatcontact.studies.scaling`).
+
+Symmetry: a cell whose shift lattice is finer than its supercell scans every grid point
+(``scan.symmetry.enabled: false``): the scan's shift-space group search checks every pair of
+the two slabs' translations, N² stack checks per point operation, which costs far more than
+the points it saves (227 s against 30 force calls for the 76-atom (2, 3) cell, measured).
+The gates use the group modulo those translations, restated on the shift cell.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from flatcontact.config.run import RunConfig
+from flatcontact.errors import InputError
+from flatcontact.ispes.executors import make_executor
+from flatcontact.ispes.shift_lattice import grid_size_for
+from flatcontact.layout import FRICTION_CSV, FRICTION_NC, INTERFACE, ISPES_NC, LAWS_JSON, SCAN_JSON
+from flatcontact.studies.scaling import fit_scaling
+from flatcontact.studies.variants import variant_config
+
+#: Folder of a cell's run directory that holds the ISPES on one shift-lattice period.
+SHIFT_CELL = "shift-cell"
+#: A cell's corrugation is resolved when it is at least this multiple of the energy noise
+#: floor (:func:`flatcontact.ispes.shift_lattice.translation_noise_ev_per_a2`); the scaling
+#: is fitted on resolved cells only.
+RESOLVED_FACTOR = 10.0
+
+
+def planned_index(approximant) -> int:
+    """The shift-lattice index the cell will have (before it is built): ``N²`` for a
+    commensurate twist of N cells per layer (``N²/3`` when m − n is a multiple of 3: the
+    built cell is 3 coincidence cells), Λ_1 + Λ_2 of the match matrices for a coincidence
+    cell (:func:`flatcontact.ispes.shift_lattice.shift_lattice`). The run checks it on the
+    built atoms (:func:`flatcontact.ispes.shift_lattice.shift_lattice_of`)."""
+    from flatcontact.ispes.shift_lattice import shift_lattice
+
+    override = approximant.structure_override
+    if "twist" in override:
+        m, n = override["twist"]
+        cells = m * m + m * n + n * n
+        return cells * cells // (3 if (m - n) % 3 == 0 else 1)
+    match = override.get("match", {})
+    if "slab1_supercell" in match:
+        return shift_lattice(match["slab1_supercell"], match["slab2_supercell"]).index
+    return 1
+
+
+def plan(cfg: RunConfig) -> list[dict]:
+    """The cells of the study: per approximant its record, the grid, the index and the
+    validated configuration (every cell checked before any work; one-line InputError)."""
+    from flatcontact.structures.approximants import approximant_sequence
+
+    cells = approximant_sequence(cfg.section("structure"), cfg.approximants)
+    base = max(cfg.scan.grid)
+    n_z = (
+        cfg.scan.p_range_gpa.n
+        if cfg.scan.p_range_gpa is not None
+        else len(cfg.scan.thickness_angstrom)
+    )
+    out = []
+    for a in cells:
+        index = planned_index(a)
+        n = grid_size_for(base, index)
+        scan = {"grid": [n, n]}
+        if index > 1:
+            # the scan's shift-space group checks every pair of the slabs' translations: N²
+            # stack checks per point operation (227 s for the 76-atom (2, 3) cell against
+            # 30 force calls of its rigid-layers scan, measured); every point is cheaper
+            scan["symmetry"] = {"enabled": False}
+        over = {"structure": a.structure_override, "scan": scan, "report": {"svg": False}}
+        config = variant_config(cfg, over, f"approximants ({a.label})").to_dict()
+        out.append(
+            {
+                "label": a.label,
+                "kind": a.kind,
+                "n_atoms": a.n_atoms,
+                "twist_deg": a.twist_deg,
+                "angle_error_deg": a.angle_error_deg,
+                "strain_percent_slab1": _max_abs(a.strain_percent_slab1),
+                "strain_percent_slab2": _max_abs(a.strain_percent_slab2),
+                "shift_lattice_index": index,
+                "grid": [n, n],
+                # grid points as planned (the load bracket may add thicknesses); a rigid-layers
+                # point costs one force call, a relaxed one ~10 (docs/incommensurate.md)
+                "points_planned": n * n * n_z,
+                "atom_points_planned": n * n * n_z * a.n_atoms,
+                "structure_override": a.structure_override,
+                "config": config,
+            }
+        )
+    return out
+
+
+def _max_abs(values) -> float:
+    return float(max((abs(v) for v in values), default=0.0))
+
+
+def corrugation_mev_per_a2(friction_nc: Path) -> tuple[float, float]:
+    """(lowest load GPa, max − min of its constant-pressure ISPES in meV/Å²) of ``friction.nc``."""
+    import xarray as xr
+
+    with xr.open_dataset(friction_nc, engine="h5netcdf") as ds:
+        p = np.asarray(ds["p_gpa"].values, float)
+        i = int(np.argmin(p))
+        surface = np.asarray(ds["energy_map"].values[i], float)
+    return float(p[i]), float(np.nanmax(surface) - np.nanmin(surface))
+
+
+def lateral_range_mev_per_a2(shifted) -> float:
+    """The largest lateral range (max − min over the shifts) of the energy per area at any
+    thickness of a shift-cell ISPES (meV/Å²): an upper bound of its corrugation at constant
+    load, compared with the noise floor before any analysis."""
+    e = np.asarray(shifted["energy"].values, float) / float(shifted.attrs["area"])
+    return 1e3 * float(np.nanmax(np.nanmax(e, axis=(0, 1)) - np.nanmin(e, axis=(0, 1))))
+
+
+def _gates(cfg: RunConfig, root: Path, lattice) -> dict:
+    """The validity gates on the shift-cell analysis: the scan's (in-slab slip, load folds),
+    the laws' (negative slope), the landscape's (degenerate minima) and the broken-symmetry
+    gate on the interface's whole shift-space group restated on the shift cell."""
+    from flatcontact.analysis import gates as gate_lib
+    from flatcontact.ispes.shift_lattice import shift_cell_operations
+    from flatcontact.ispes.shift_symmetry import shift_space_group
+    from flatcontact.stages.gates import GateInputs, evaluate_gates
+    from flatcontact.structures.interface_io import read_interface
+
+    cell = root / SHIFT_CELL
+    report = evaluate_gates(
+        GateInputs(
+            interface=None,
+            scan_json=cell / SCAN_JSON,
+            friction_nc=cell / "analyze" / FRICTION_NC,
+            laws_json=cell / "laws" / LAWS_JSON,
+        )
+    )
+    findings = list(report.findings)
+    group = shift_space_group(
+        read_interface(root / "01-build" / INTERFACE),
+        cfg.scan.symmetry.tolerance_angstrom,
+        spread_compression=cfg.scan.relax_mode != "rigid",
+        modulo_translations=True,
+    )
+    ops = shift_cell_operations(
+        lattice, [(np.array(op.matrix), np.array(op.translation)) for op in group.operations]
+    )
+    import xarray as xr
+
+    with xr.open_dataset(cell / "analyze" / FRICTION_NC, engine="h5netcdf") as fr:
+        broken = gate_lib.broken_symmetry(
+            np.asarray(fr["energy_map"].values, float),
+            [float(v) for v in fr["p_gpa"].values],
+            np.asarray(fr.attrs["a1"], float),
+            np.asarray(fr.attrs["a2"], float),
+            ops,
+        )
+    if broken is not None:
+        findings.append(broken)
+    return {
+        "fired": [f.gate for f in findings],
+        "messages": [f"{f.gate}: {f.message}" for f in findings],
+        "not_checked": [g for g in report.not_checked if g != "broken_symmetry"],
+        "shift_group_order_on_shift_cell": len(ops),
+    }
+
+
+def run_cell(config: dict, folder: str, planned: int) -> dict:
+    """Run one approximant cell (``config``: a validated configuration's ``to_dict()``) in
+    ``folder``: build and scan through the pipeline, then the ISPES on one shift-lattice
+    period, its analysis, laws and gates (module docstring). Module-level with plain
+    arguments so an executor can run cells side by side."""
+    from flatcontact.ispes.shift_lattice import (
+        shift_lattice_of,
+        to_shift_cell,
+        translation_noise_ev_per_a2,
+    )
+    from flatcontact.pipeline import Pipeline
+    from flatcontact.potentials.engines import make_calculator
+    from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
+    from flatcontact.stages.laws import LawsInputs, run_laws
+    from flatcontact.structures.interface_io import read_interface
+
+    cfg = RunConfig.model_validate(config)
+    cfg = cfg.model_copy(
+        update={"scan": cfg.scan.model_copy(update={"executor": "serial", "workers": 1})}
+    )
+    root = Path(folder)
+    t0 = time.perf_counter()
+    with Pipeline(cfg, root) as pipe:
+        pipe.build()
+        ds = pipe.scan()
+        scan = pipe.scan_summary()
+        action = pipe.results["scan"].action
+        scan_folder = pipe.folder("scan")
+        build_folder = pipe.folder("build")
+    reference = read_interface(build_folder / INTERFACE)
+    lattice = shift_lattice_of(reference, cfg.scan.symmetry.tolerance_angstrom)
+    if lattice.index != planned:
+        raise InputError(
+            f"approximants: the built cell's shift lattice has index {lattice.index}, the plan "
+            f"{planned}; the grid {cfg.scan.grid} was chosen for the plan"
+        )
+    cell = root / SHIFT_CELL
+    if cell.exists():
+        shutil.rmtree(cell)  # derived from the scan: rebuilt every time (seconds)
+    cell.mkdir(parents=True)
+    shifted = to_shift_cell(ds, lattice)
+    shifted.to_netcdf(cell / ISPES_NC, engine="h5netcdf")
+    shutil.copy2(scan_folder / SCAN_JSON, cell / SCAN_JSON)
+    noise = 1e3 * translation_noise_ev_per_a2(
+        reference, make_calculator(cfg.potential, reference), lattice
+    )
+    lateral = lateral_range_mev_per_a2(shifted)
+    nan = math.nan
+    form, law, p_low, barrier, gates = cfg.analysis.energy_form, {}, nan, lateral, None
+    if lateral >= RESOLVED_FACTOR * noise:
+        run_analyze(cfg, AnalyzeInputs(cell / ISPES_NC), cell / "analyze")
+        run_laws(
+            cfg, LawsInputs.read(cell / "analyze" / FRICTION_CSV, cell / ISPES_NC), cell / "laws"
+        )
+        laws = json.loads((cell / "laws" / LAWS_JSON).read_text())
+        form = laws.get("energy_form") or cfg.analysis.energy_form
+        law = laws.get(form) if isinstance(laws.get(form), dict) else laws
+        p_low, barrier = corrugation_mev_per_a2(cell / "analyze" / FRICTION_NC)
+        gates = _gates(cfg, root, lattice)
+    else:  # noise only: the analysis of a noise landscape costs minutes and means nothing
+        gates = {
+            "fired": [],
+            "messages": [],
+            "not_checked": ["all: the landscape is not resolved above the noise floor"],
+        }
+    calls = int(scan.get("force_calls_total") or 0)
+    return {
+        "folder": str(root),
+        "energy_form": form,
+        "tau0_mpa": float(law.get("tau0_mpa", nan)),
+        "k_mpa_per_gpa": float(law.get("k_mpa_per_gpa", nan)),
+        "sigma0_mpa": float(law.get("sigma0_mpa", nan)),
+        "mu_mpa_per_gpa": float(law.get("mu_mpa_per_gpa", nan)),
+        "tau0_stderr_mpa": float(law.get("tau0_stderr_mpa", nan)),
+        "barrier_mev_per_a2": barrier,
+        "lateral_range_mev_per_a2": lateral,
+        "analysed": bool(law),
+        "barrier_at_p_gpa": p_low,
+        "noise_mev_per_a2": noise,
+        "resolved": bool(barrier >= RESOLVED_FACTOR * noise),
+        "shift_lattice_index": lattice.index,
+        "shift_cell_a1_angstrom": np.asarray(shifted.attrs["a1"], float).tolist(),
+        "shift_cell_a2_angstrom": np.asarray(shifted.attrs["a2"], float).tolist(),
+        "gates": gates,
+        "work_of_separation_j_per_m2": float(
+            (scan.get("adhesion") or {}).get("work_of_separation_j_per_m2") or math.nan
+        ),
+        "force_calls": calls,
+        "force_calls_spent": 0 if action == "skipped" else calls,
+        "computed_points": scan.get("computed_points"),
+        "scan_action": action,
+        "wall_s": time.perf_counter() - t0,
+    }
+
+
+def _run_cells(executor, jobs: list[tuple], on_done: Callable | None) -> dict:
+    """Run ``jobs`` = [(label, config dict, folder, planned index)] through ``executor``."""
+    if executor.workers == 1 and len(jobs) > 1:  # a serial executor runs at submission:
+        out: dict = {}  # one cell at a time, so each is told as it ends
+        for job in jobs:
+            out.update(_run_cells(executor, [job], on_done))
+        return out
+    handles = {executor.submit(run_cell, c, f, i): label for label, c, f, i in jobs}
+    out: dict = {}
+    pending = set(handles)
+    while pending:
+        done, pending = executor.wait_first(pending)
+        for h in done:
+            try:
+                out[handles[h]] = executor.result(h)
+            except InputError as exc:  # one cell the builder, model or analysis refuses
+                out[handles[h]] = {"error": str(exc)}
+            if on_done is not None:
+                on_done(handles[h], out[handles[h]])
+    return out
+
+
+def run_approximants(
+    cfg: RunConfig, out: str | Path, on_done: Callable[[str, dict], None] | None = None
+) -> dict:
+    """Run every cell of :func:`plan` into ``out``; returns the ``study.json`` document.
+
+    ``on_done(label, result)`` is told when each cell finishes (the CLI prints a line). A
+    cell the builder, the model or the analysis refuses is that cell's ``error`` (the others
+    stand); the scaling is fitted on the cells that ran.
+    """
+    out = Path(out)
+    cells = plan(cfg)
+    executor = make_executor(
+        cfg.scan.executor, cfg.scan.workers, cfg.scan.dask_address, cfg.scan.jobqueue
+    )
+    jobs = [
+        (
+            c["label"],
+            c["config"],
+            str(out / "runs" / c["label"]),
+            c["shift_lattice_index"],
+        )
+        for c in cells
+    ]
+    try:
+        results = _run_cells(executor, jobs, on_done)
+    finally:
+        executor.close()
+    rows = []
+    for c in cells:
+        r = results[c["label"]]
+        entry = {k: v for k, v in c.items() if k != "config"}
+        rows.append({**entry, **r})
+    ok = [r for r in rows if "error" not in r]
+    fitted = [r for r in ok if r["resolved"]]
+    atoms = [r["n_atoms"] for r in fitted]
+    return {
+        "study": "approximants",
+        "approximants": cfg.section("approximants"),
+        "base_grid": list(cfg.scan.grid),
+        "relax_mode": cfg.scan.relax_mode,
+        "cells": rows,
+        "failed": {r["label"]: r["error"] for r in rows if "error" in r},
+        "scaling": {
+            "tau0_mpa": fit_scaling(atoms, [r["tau0_mpa"] for r in fitted]),
+            "barrier_mev_per_a2": fit_scaling(atoms, [r["barrier_mev_per_a2"] for r in fitted]),
+            "cells": [r["label"] for r in fitted],
+            "unresolved": [r["label"] for r in ok if not r["resolved"]],
+            "resolved_factor": RESOLVED_FACTOR,
+        },
+        "cost": {
+            "force_calls_study": sum(r["force_calls_spent"] for r in ok),
+            "force_calls_stored": sum(r["force_calls"] for r in ok),
+            "wall_s_cells": sum(r["wall_s"] for r in ok),
+            "cells": len(rows),
+            "executor": executor.name,
+            "workers": executor.workers,
+        },
+    }
