@@ -123,3 +123,38 @@ def test_the_study_examples_are_their_runs_with_an_approximant_ladder(path):
         assert study[key] == run[key], key
     for key in ("grid", "p_range_gpa"):
         assert study["scan"][key] == run["scan"][key]
+
+
+@pytest.mark.slow
+def test_the_h_diamond_study_leaves_the_lock_far_below_it(tmp_path, capsys):
+    """``flatcontact study approximants`` on the H-diamond/graphene companion, lock and 1 %
+    cell (~6 min on a loaded 2-core machine): the lock's collapse is the contact stage's for
+    the phase-1 laws within their spread (rigid-layers against normal: same τ0 within 1 %),
+    the 407-atom cell's corrugation is resolved above its noise floor and its collapse is
+    orders of magnitude below the lock's; the rows are printed and written."""
+    import json
+
+    import yaml
+    from tests.cli.cli_helpers import run_cli
+
+    doc = yaml.safe_load(
+        (EXAMPLES / "passivated-tip-h-diamond-graphene-approximants.yaml").read_text()
+    )
+    doc["structure"]["bulk"] = str(EXAMPLES / doc["structure"]["bulk"])
+    doc["approximants"]["max_cells"] = 2
+    config = tmp_path / "study.yaml"
+    config.write_text(yaml.safe_dump(doc))
+    code, out, err = run_cli(
+        ["study", "approximants", str(config), "--out", str(tmp_path / "s")], capsys
+    )
+    assert code in (0, None), err
+    rows = json.loads((tmp_path / "s" / "experiment_collapse.json").read_text())
+    lock, cell = rows["cells"]
+    assert (lock["label"], cell["label"]) == ("zsl-3pct", "zsl-1pct")
+    assert lock["tau0_mpa"] == pytest.approx(LOCK["tau0_mpa"], rel=0.01)
+    assert lock["collapse_stress_mpa"] == pytest.approx(
+        cell_collapse(_cell(), CFG)["collapse_stress_mpa"], rel=0.01
+    )
+    assert cell["resolved"] and cell["barrier_mev_per_a2"] > 10 * cell["noise_mev_per_a2"]
+    assert cell["collapse_stress_mpa"] < 1e-2 * lock["collapse_stress_mpa"]
+    assert "collapse stress at p0 = 1.77 GPa" in out and "zsl-1pct: 407 atoms" in out
