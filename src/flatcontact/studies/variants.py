@@ -125,14 +125,43 @@ def base_value(cfg: RunConfig, setting: str) -> float:
     return float(cfg.potential.lj.cutoff_angstrom)
 
 
+def without_foreign_uncertainty(cfg: RunConfig) -> RunConfig:
+    """``cfg`` without its ``uncertainty`` block when that was measured on another structure or model.
+
+    A variant of a study changes the structure (layers) or the model (cutoff, ``--models``) of a
+    base that may carry a measured block (the ``paper`` preset's quartz numbers): the block does
+    not apply to the variant, and the run would refuse it
+    (:func:`flatcontact.stages.measured_on.check_measured_on`). The study measures the variant's
+    τ and σ_MSS, which the block does not touch, so the variant runs without it. A block that
+    applies (the variants of the scan settings) is kept, so their stage fingerprints are those
+    of the base's own configuration.
+    """
+    from flatcontact.stages.measured_on import measured_on
+
+    recorded = cfg.uncertainty.measured_on
+    if not recorded:
+        return cfg
+    mine = measured_on(cfg)
+    if all(recorded[k] == mine[k] for k in recorded if k in mine):
+        return cfg
+    data = cfg.to_dict()
+    del data["uncertainty"]
+    return RunConfig.model_validate(data)
+
+
 def variant_config(cfg: RunConfig, overrides: dict, source: str) -> RunConfig:
-    """``cfg`` with ``overrides`` laid over it, validated (one-line InputError naming ``source``)."""
+    """``cfg`` with ``overrides`` laid over it, validated (one-line InputError naming ``source``).
+
+    An ``uncertainty`` block measured on another structure or model than the variant's is
+    dropped (:func:`without_foreign_uncertainty`).
+    """
     from flatcontact.config.messages import one_line
 
     try:
-        return RunConfig.model_validate(merge_config(cfg.to_dict(), overrides))
+        out = RunConfig.model_validate(merge_config(cfg.to_dict(), overrides))
     except ValidationError as exc:
         raise one_line(exc, source) from None
+    return without_foreign_uncertainty(out)
 
 
 def shares_build(setting: str) -> bool:
