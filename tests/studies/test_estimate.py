@@ -55,7 +55,7 @@ def test_the_rules_scale_points_calls_and_seconds_from_the_base():
     rounds = [[v["seconds"] for v in est["variants"] if v["level"] == k] for k in (1, 2)]
     wall = 34.0 + sum(max(sum(r) / 2, max(r)) for r in rounds)
     assert est["wall_seconds"] == pytest.approx(wall)
-    assert est["cpu_seconds"] == pytest.approx(34.0 + sum(sum(r) for r in rounds))
+    assert est["serial_seconds"] == pytest.approx(34.0 + sum(sum(r) for r in rounds))
     text = "\n".join(estimate_lines(est))
     assert "grid1 (grid 5x5): 150 points, ~75 computed, ~750 force calls" in text
     assert f"all 8 variants: ~{total} force calls" in text

@@ -133,8 +133,10 @@ def estimate_convergence(
     dict
         ``base`` (as measured), ``variants`` (one estimate each), ``force_calls_study``
         (every rung once, the base once), ``force_calls_from_scratch`` (each setting's
-        ladder with its own base), ``cpu_seconds`` and ``wall_seconds`` (rounds of
-        ``workers`` side by side, every setting using all its steps: an upper bound).
+        ladder with its own base), ``serial_seconds`` (every run one after another) and
+        ``wall_seconds`` (rounds of ``workers`` side by side, every setting using all its
+        steps: an upper bound). Seconds are the base's wall seconds scaled: they carry the
+        machine's load while the base ran.
     """
     variants = [_variant_estimate(cfg, v, base) for steps in ladder.values() for v in steps]
     base_seconds = sum(base["seconds"].values())
@@ -151,7 +153,7 @@ def estimate_convergence(
         "variants": variants,
         "force_calls_study": calls,
         "force_calls_from_scratch": scratch,
-        "cpu_seconds": base_seconds + sum(v["seconds"] for v in variants),
+        "serial_seconds": base_seconds + sum(v["seconds"] for v in variants),
         "wall_seconds": wall,
         "workers": workers,
     }
@@ -174,7 +176,7 @@ def estimate_lines(est: dict) -> list[str]:
     lines.append(
         f"  all {len(est['variants'])} variants: ~{est['force_calls_study']} force calls "
         f"(each setting from scratch: ~{est['force_calls_from_scratch']}), "
-        f"~{_duration(est['cpu_seconds'])} CPU, ~{_duration(est['wall_seconds'])} wall on "
+        f"~{_duration(est['serial_seconds'])} one after another, ~{_duration(est['wall_seconds'])} on "
         f"{est['workers']} worker(s) if no setting converges early"
     )
     return lines
