@@ -144,14 +144,16 @@ def _probe(
     by :func:`~flatcontact.ispes.probe.join_column`) and the ideal work of separation at the
     lowest rigid stacking (a chain of its own, independent of the thicknesses). Returns
     ``(resolved, notes, work)``: ``work`` the
-    :class:`~flatcontact.ispes.work_of_separation.WorkOfSeparation` computed on a worker,
-    or None (serial: :func:`adhesion_record` computes it).
+    :class:`~flatcontact.ispes.work_of_separation.WorkOfSeparation` (serial: computed here
+    after the probe, from the same single points of every stacking).
     """
     calc = worker_calculator(factory, reference)
     relax_one = functools.partial(relax_column_point, reference, calc, relax)
     rigid = rigid_stackings(reference, calc, grid)
     if executor is None or getattr(executor, "workers", 1) <= 1:
-        return (*probe_thicknesses(relax_one, reference, rigid, grid), None)
+        lowest = extreme_stackings(rigid.energy_ev, grid)[0]
+        extra, notes = probe_thicknesses(relax_one, reference, rigid, grid)
+        return extra, notes, ideal_work_of_separation(reference, factory, relax, lowest, calc=calc)
     context = ScanContext(reference, factory, relax)
     work = []
 
@@ -395,9 +397,12 @@ def run_scan(
         An executor object (:mod:`flatcontact.ispes.executors`); if None, one is built
         from ``executor_options`` (``make_executor`` keywords) after validation.
     progress
-        Called as ``progress(done, total)`` (points in the store, points of the grid) once
+        Called as ``progress(done, total)`` (grid points done, points of the grid) once
         the grid is known and after every stored point, like an observer attached to an ASE
-        dynamics; the CLI draws its progress bar from it.
+        dynamics; the CLI draws its progress bar from it. A reduced scan counts the grid
+        points a stored representative fills by symmetry and its verified points
+        (``total`` = grid points + verified points), one bar to 100 %; a fallback to the
+        full grid counts the grid's stored points from there.
     max_new_points
         Stop after computing this many new points (benchmarks); the store stays resumable.
     symmetry
@@ -499,8 +504,14 @@ def run_scan(
                         cached = recent.get(idx)
                         return cached if cached is not None else store.positions(idx)
 
-                    def run_points(parent, z=z):
-                        """Relax the points of the tree ``parent`` missing from the store."""
+                    def run_points(parent, z=z, weight=None, total=None):
+                        """Relax the points of the tree ``parent`` missing from the store.
+
+                        Progress counts ``weight[idx]`` (default 1) per stored point out of
+                        ``total`` (default: the tree's points): a representative of a reduced
+                        scan counts the grid points it fills, so one bar runs to the grid.
+                        """
+                        weight = weight or {}
 
                         def make_task(idx):
                             par = parent[idx]
@@ -529,8 +540,9 @@ def run_scan(
 
                         rank = {idx: k for k, idx in enumerate(parent)}
                         pending = {idx for idx in parent if idx not in store}
-                        total = len(parent)
-                        stored = total - len(pending)
+                        if total is None:
+                            total = len(parent)
+                        stored = sum(weight.get(idx, 1) for idx in parent if idx in store)
                         if progress is not None:
                             progress(stored, total)
                         in_flight: dict[Any, tuple] = {}
@@ -565,7 +577,7 @@ def run_scan(
                                 recent.put(idx, result.positions)
                                 queue.stored(idx)
                                 computed_calls.append(result.force_calls)
-                                stored += 1
+                                stored += weight.get(idx, 1)
                                 if progress is not None:
                                     progress(stored, total)
 
@@ -583,8 +595,14 @@ def run_scan(
                                 "verification": None,
                                 "computed_in_full": False,
                             }
+                            # progress over the grid: a representative fills its orbit,
+                            # a verified point counts one more
+                            fills = collections.Counter(reduction.representative.values())
+                            grid_points = int(np.prod(shape))
                             run_points(
-                                _tree_in_store_order(z, shape, root, order, reduction.computed)
+                                _tree_in_store_order(z, shape, root, order, reduction.computed),
+                                weight=fills,
+                                total=grid_points + symmetry.verify_points,
                             )
                             if all(rep in store for rep in reduction.computed):
                                 # chosen from the complete representatives only: a resumed
@@ -594,7 +612,9 @@ def run_scan(
                                 )
                                 symmetry_record.update(reduction.to_json())
                                 run_points(
-                                    _tree_in_store_order(z, shape, root, order, reduction.computed)
+                                    _tree_in_store_order(z, shape, root, order, reduction.computed),
+                                    weight=fills,
+                                    total=grid_points + len(reduction.verify),
                                 )
                             if all(idx in store for idx in reduction.computed):
                                 area = cell_area(*in_plane_vectors(reference))
