@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import argparse
 import heapq
+import itertools
 import json
 import os
 import tempfile
@@ -148,6 +149,15 @@ def record_scan(path: Path) -> dict:
         return out
 
     scan_mod.adhesion_record = adhesion_record
+    orig_extend = scan_mod._extend
+
+    def extend(*args, **kwargs):
+        added = orig_extend(*args, **kwargs)
+        if added:  # the next points are a new round of the grid
+            rec.setdefault("round_starts", []).append(len(rec["grid_points"]))
+        return added
+
+    scan_mod._extend = extend
     orig_work = scan_mod.ideal_work_of_separation
 
     def ideal_work(*args, **kwargs):
@@ -250,15 +260,29 @@ def simulate_tree(
 
 def grid_makespan(rec: dict, workers: int, start: float = 0.0, busy=()) -> float:
     """The grid on its measured warm-start tree (:func:`simulate_tree`), from ``start``, with
-    ``busy`` the times at which workers still running other chains become free."""
-    parent = {
-        tuple(p["index"]): (tuple(p["parent"]) if p["parent"] else None) for p in rec["grid_points"]
-    }
-    cost = {tuple(p["index"]): p["s"] for p in rec["grid_points"]}
+    ``busy`` the times at which workers still running other chains become free.
+
+    A thickness the grid's bracket check added after the scan (``scan._extend``) is a round
+    of its own: its points start once every point before is stored (``round_starts``, the
+    positions in the record where a round begins); a parent in an earlier round is stored.
+    """
+    points = rec["grid_points"]
+    bounds = [0, *rec.get("round_starts", []), len(points)]
     driver = sum(rec["store_s"]) / max(1, len(rec["store_s"]))
-    busy = sorted(busy)[:workers]
-    free_at = list(busy) + [start] * (workers - len(busy))
-    return simulate_tree(parent, cost, free_at, driver, start)
+    t = start
+    for lo, hi in itertools.pairwise(bounds):
+        here = {tuple(p["index"]) for p in points[lo:hi]}
+        parent = {
+            tuple(p["index"]): (
+                tuple(p["parent"]) if p["parent"] and tuple(p["parent"]) in here else None
+            )
+            for p in points[lo:hi]
+        }
+        cost = {tuple(p["index"]): p["s"] for p in points[lo:hi]}
+        late = sorted(b for b in busy if b > t)[:workers]
+        free_at = late + [t] * (workers - len(late))
+        t = simulate_tree(parent, cost, free_at, driver, t)
+    return t
 
 
 def parts(rec: dict) -> dict:
@@ -306,6 +330,15 @@ def model(rec: dict, schedule: str, workers: int) -> tuple[float, float]:
         t = chains_makespan(ordered, workers, q["rigid"])
     if schedule == "overlap":
         return _overlap_makespan(rec, workers, q) + serial, total
+    if schedule == "independent":
+        # what-if: every compressed point of a column its own chain (a cold start at its
+        # thickness), at the cost measured warm (an assumption: cold starts were not measured
+        # there), the stretchings as in ``new``
+        z_ref = rec["z_ref"] + 1e-9
+        ups = [c for c in probe_chains(rec, True)[: len({tuple(p["shift"]) for p in rec["probe"]})]]
+        downs = [[p["s"]] for p in rec["probe"] if p["z"] <= z_ref]
+        t = chains_makespan([*ups, [q["work"]], *downs], workers, q["rigid"])
+        return grid_makespan(rec, workers, t) + serial, total
     return grid_makespan(rec, workers, t) + serial, total
 
 
@@ -378,13 +411,27 @@ def report(rec: dict) -> str:
         "| schedule | " + " | ".join(f"{w} workers" for w in WORKERS) + " |",
         "|---|" + "---|" * len(WORKERS),
     ]
-    schedules = ("old", "new", "overlap") if "p" in rec["probe"][0] else ("old", "new")
+    schedules = ("old", "new", "independent")
+    if "p" in rec["probe"][0]:
+        schedules += ("overlap",)
     for schedule in schedules:
         cells = []
         for w in WORKERS:
             span, total = model(rec, schedule, w)
             cells.append(f"{total / (w * span):.1%} ({span:.1f} s)")
         lines.append(f"| {schedule} | " + " | ".join(cells) + " |")
+    q = parts(rec)
+    grid_work = q["grid"] + q["store"]
+    for w in (8, 16):
+        chains = probe_chains(rec, True)
+        n_up = len({tuple(p["shift"]) for p in rec["probe"]})
+        t_probe = chains_makespan([*chains[:n_up], [q["work"]], *chains[n_up:]], w, 0.0)
+        t_grid = grid_makespan(rec, w)
+        lines.append(
+            f"  new at {w} workers: rigid {q['rigid']:.2f} s + probe chains and W {t_probe:.2f} s "
+            f"+ grid {t_grid:.2f} s (alone {grid_work / (w * t_grid):.0%} efficient, rounds "
+            f"{len(rec.get('round_starts', [])) + 1}) + driver rest {q['rest']:.2f} s"
+        )
     return "\n".join(lines)
 
 
