@@ -133,15 +133,18 @@ def _totals(path: str) -> int:
 
 
 def _lammps_share(path: str) -> int:
-    """Inclusive instructions of ``lammps_command`` (LAMMPS's part) in a callgrind dump."""
+    """Inclusive instructions of LAMMPS's ``Input::one`` (what each ``lammps_command``
+    runs: LAMMPS's part of the scan) in a callgrind dump."""
     out = subprocess.run(
         ["callgrind_annotate", "--inclusive=yes", "--threshold=100", path],
         capture_output=True,
         text=True,
         check=True,
     ).stdout
-    found = re.search(r"^\s*([\d,]+) .*:lammps_command\b", out, re.M)
-    return int(found.group(1).replace(",", "")) if found else 0
+    found = re.search(r"^\s*([\d,]+) .*:LAMMPS_NS::Input::one\(", out, re.M)
+    if found is None:
+        raise RuntimeError(f"{path}: no LAMMPS_NS::Input::one in callgrind's annotation")
+    return int(found.group(1).replace(",", ""))
 
 
 def instructions(system: str, n: int, max_steps: int | None) -> dict:
