@@ -26,7 +26,8 @@ measures it two ways:
 The large REBO+KC cells relax a fixed number of force calls (``max_steps`` in
 :data:`CASES`: 0.6-2.7 s per call) and skip the instruction count (valgrind is ~50× slower).
 System names as arguments run those only (``cu quartz``), ``system:repeat`` one size
-(``graphene:20``); ``--repeats=N`` pairs (default 7), ``--no-instructions`` skips valgrind.
+(``graphene:20``); ``--repeats=N`` pairs (default 7), ``--no-instructions`` skips valgrind,
+``--table-only`` measures nothing.
 Every row measured is appended to ``benchmarks/optimiser_cost_measured.jsonl`` (with its
 date and load); the table has the newest row of each system and size, and ``--write-docs``
 replaces it between the markers in ``docs/performance.md``.
@@ -255,6 +256,8 @@ def main(argv: list[str]) -> None:
         if a.startswith("--repeats="):
             repeats = int(a.split("=", 1)[1])
     for system, n, cap, count in CASES:
+        if "--table-only" in argv:  # no measurement: the table of the stored rows
+            break
         if only and system not in only and f"{system}:{n}" not in only:
             continue
         count = None if count is False or "--no-instructions" in argv else count
