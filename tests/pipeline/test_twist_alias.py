@@ -104,9 +104,9 @@ def test_a_plain_run_of_the_1_2_twist_reads_the_real_period(tmp_path):
 @pytest.mark.slow
 def test_a_one_by_one_cell_keeps_its_cell(tmp_path):
     """The AB bilayer (index 1): the scan's grid and cell are the interface's, untouched."""
-    cfg = {k: v for k, v in TBG_12.items() if k != "contact"}
+    cfg = dict(TBG_12)
     cfg["structure"] = {"kind": "sheets", "sheet": "graphene", "layers": 1}
-    cfg["analysis"] = {"p_gpa": [0.0], "direction_deg": "auto"}
+    cfg["analysis"] = {"p_gpa": [0.0, 0.5], "direction_deg": "auto"}
     root = tmp_path / "ab"
     with Pipeline(build_config(cfg), root) as pipe:
         pipe.build()
