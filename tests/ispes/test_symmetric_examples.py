@@ -66,7 +66,9 @@ def test_reduced_scan_equals_the_full_scan(
     assert sym["verification"]["points"] == 2
     assert red.points_stored < full.points_stored / 3
     a, b = red.dataset, full.dataset
-    np.testing.assert_array_equal(a["thickness"].values, b["thickness"].values)
+    # the same thickness list to round-off: the engine's nearest-image cache carries over from
+    # the first scan of the process to the second (measured 2e-14 Å, not bit for bit)
+    np.testing.assert_allclose(a["thickness"].values, b["thickness"].values, rtol=0, atol=1e-9)
     assert bool(a["converged"].all()) and bool(b["converged"].all())
     area = float(a.attrs["area"])
     de = np.abs(a["energy"].values - b["energy"].values).max() / area * 1e3
