@@ -4,12 +4,14 @@
 ``python -m benchmarks.bench_parallel 1 2 4`` (any worker counts).
 
 The paper preset's interface is built once; then the whole scan of the paper preset (the
-probe of the thicknesses, serial in the driver, then 12 × 12 lateral points × the probed
-thicknesses) runs from scratch with 1 worker (the serial executor: every point in this
+probe of the thicknesses: its single points in the driver, its columns' chains and the work
+of separation on the workers; then 12 × 12 lateral points × the probed thicknesses) runs
+from scratch with 1 worker (the serial executor: every point in this
 process, no worker start) and with W local worker processes (``ProcessExecutor``: spawn,
 imports and LAMMPS setup overlapping the probe), as ``flatcontact run --preset paper`` does.
 Printed per run: wall time, the driver's CPU time, points per second, force calls, and the
-efficiency T1 / (W · T_W).
+efficiency T1 / (W · T_W). More workers than the machine has cores: the schedule model,
+``python -m benchmarks.schedule_model``.
 
 The machine's own ceiling is measured too: W independent processes each running LAMMPS's
 force loop on the same cell (no Python, no communication) against one alone. On a VM whose

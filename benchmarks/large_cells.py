@@ -52,14 +52,11 @@ def graphene_interface(n: int):
     return ref.repeat((n, n, 1))
 
 
-def one_point(system: str, n: int, threads: int) -> dict:
-    """Build, relax one point, report seconds, calls and memory."""
-    from flatcontact.ispes.geometry import thickness
-    from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point
+def case(system: str, n: int):
+    """(interface, interaction model, lateral shift as fractions of the big cell) of a system
+    (``cu``, ``graphene``, ``quartz``) repeated n×n: the point every benchmark here relaxes."""
     from flatcontact.potentials import InteractionModel
-    from flatcontact.potentials.calculator import LammpsInterfaceCalculator
 
-    rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     if system == "cu":
         ref = cu_interface(n)
         model = InteractionModel(preset="cu-eam")
@@ -72,6 +69,17 @@ def one_point(system: str, n: int, threads: int) -> dict:
         ref = quartz_interface(n)
         model = InteractionModel(intra="snap:sio2-snap")
         shift = (1 / (2 * n), 0.0)
+    return ref, model, shift
+
+
+def one_point(system: str, n: int, threads: int) -> dict:
+    """Build, relax one point, report seconds, calls and memory."""
+    from flatcontact.ispes.geometry import thickness
+    from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point
+    from flatcontact.potentials.calculator import LammpsInterfaceCalculator
+
+    rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    ref, model, shift = case(system, n)
     t0 = time.perf_counter()
     calc = LammpsInterfaceCalculator(model, ref)
     if threads > 1:  # rebuild the engine with OpenMP threads

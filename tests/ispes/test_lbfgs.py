@@ -12,7 +12,8 @@ from ase.optimize import LBFGS
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from flatcontact.ispes.lbfgs import TwoLoopMemory, lbfgs_relax
+from flatcontact.ispes.lbfgs import TwoLoopMemory, largest_atomic_norm, lbfgs_relax
+from flatcontact.ispes.relax import constraint_projector
 
 
 def ase_trajectory(atoms, fmax, steps, **kwargs):
@@ -87,6 +88,41 @@ def test_same_steps_as_ase_along_z_only():
     assert out.steps == nsteps
     assert max(np.abs(a - b).max() for a, b in zip(path_ase, path, strict=True)) < 1e-9
     assert np.array_equal(out.positions[:, :2], atoms.positions[:, :2])
+
+
+@pytest.mark.parametrize("mode", ["full", "normal"])
+def test_scan_projector_takes_ase_steps(mode):
+    """The scan's own projector (``constraint_projector``: 0/1 factors written into
+    lbfgs_relax's reused arrays) against ASE's FixAtoms (and FixCartesian in ``normal``)."""
+    atoms, held = cu_slab()
+    free = np.flatnonzero(~held)
+    constraints = [FixAtoms(mask=held)]
+    if mode == "normal":
+        constraints.append(FixCartesian(free, mask=(True, True, False)))
+    reference = atoms.copy()
+    reference.set_constraint(constraints)
+    reference.calc = EMT()
+    path_ase, nsteps = ase_trajectory(reference, 1e-4, 200)
+    project = constraint_projector(held, mode, [])
+    path, out = own_trajectory(atoms, EMT(), project, 1e-4, 200)
+    assert out.converged and out.steps == nsteps > 10
+    assert max(np.abs(a - b).max() for a, b in zip(path_ase, path, strict=True)) < 1e-9
+    assert np.array_equal(out.positions[held], atoms.positions[held])
+    if mode == "normal":
+        assert np.array_equal(out.positions[:, :2], atoms.positions[:, :2])
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), n=st.integers(1, 300), scale=st.floats(-9.0, 3.0))
+def test_largest_atomic_norm_is_ases(seed, n, scale):
+    """ASE's norm, np.sqrt((v**2).sum(axis=1).max()), to the last bit, with or without the
+    scratch array (which must not change the input)."""
+    v = np.random.default_rng(seed).normal(size=(n, 3)) * 10.0**scale
+    expected = float(np.sqrt((v**2).sum(axis=1).max()))
+    before = v.copy()
+    assert largest_atomic_norm(v) == expected
+    assert largest_atomic_norm(v, np.empty_like(v)) == expected
+    assert np.array_equal(v, before)
 
 
 class Quadratic(Calculator):

@@ -121,6 +121,14 @@ def test_executors_give_the_same_grid(tmp_path, toy_reference, toy_factory, thic
         )
         for a, b in zip(_values(serial.dataset), _values(other.dataset), strict=True):
             np.testing.assert_allclose(a, b, rtol=0, atol=1e-12)
+        # the probe's columns (two chains each on the workers) and the ideal work of
+        # separation (a worker's chain beside them) are the serial driver's
+        assert other.adhesion.keys() == serial.adhesion.keys()
+        for key, value in serial.adhesion.items():
+            if isinstance(value, float):
+                assert other.adhesion[key] == pytest.approx(value, rel=1e-12, abs=1e-12), key
+            else:
+                assert other.adhesion[key] == value, key
 
 
 def test_warm_start_orders_agree_within_tolerance(tmp_path, toy_reference, toy_factory):

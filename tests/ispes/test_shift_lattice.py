@@ -14,6 +14,7 @@ from flatcontact.ispes.contract import fractional_shifts, symmetry_attrs
 from flatcontact.ispes.shift_lattice import (
     grid_size_for,
     reindex,
+    scan_grid,
     shift_cell_operations,
     shift_lattice,
     shift_lattice_of,
@@ -117,6 +118,22 @@ def test_a_coprime_supercell_grid_visits_one_period_once():
     assert len(set(zip(ta.ravel(), tb.ravel(), strict=True))) == 36
     with pytest.raises(InputError, match=r"scan.grid \[7, 7\]: .*gcd\(n, 49\) = 1 \(n = 8\)"):
         reindex(lat, 7, 7)
+
+
+def test_the_scan_grid_keeps_a_one_by_one_cell_and_squares_a_coprime_grid_otherwise():
+    """Index 1: ``scan.grid`` as given (quartz, the AB bilayer); index 49: the square grid of
+    the larger side raised to coprime with 49, which visits one period once."""
+    assert scan_grid([6, 8], 1) == (6, 8)
+    assert scan_grid([6, 6], 49) == (6, 6)
+    assert scan_grid([7, 7], 49) == (8, 8)
+    assert scan_grid([6, 7], 49) == (8, 8)
+    assert scan_grid([5, 3], 3) == (5, 5)
+    match, _ = twist_match(HEX, 1, 2)
+    lat = shift_lattice(match.p1, match.p2, match.cell)
+    for grid in ([7, 7], [6, 9], [13, 2]):
+        n_a, n_b = scan_grid(grid, lat.index)
+        ta, tb = reindex(lat, n_a, n_b)
+        assert len(set(zip(ta.ravel(), tb.ravel(), strict=True))) == n_a * n_b
 
 
 def _synthetic_ispes(n: int, lattice, f) -> xr.Dataset:

@@ -229,3 +229,51 @@ def test_the_fallback_names_the_failing_points_and_why_the_whole_grid(tmp_path):
         assert str(tuple(c["point"])) in reason
     assert "unverified orbits" in reason
     assert red.points_stored == 72 and not red.dataset["mapped"].any()
+
+
+def test_quartz_two_fold_axis_is_kept_on_the_scan_grids():
+    """The quick preset's quartz interface: a slab-swapping two-fold axis whose half-cell
+    translation the atoms give 1.5e-7 off (7e-7 Å, far inside the 1e-3 Å structure
+    tolerance); on a 12 × 12 grid that is 1.8e-6 grid steps, which a fixed 1e-6 dropped."""
+    from flatcontact.config import load_config as preset_config
+    from flatcontact.stages.build import BuildInputs, run_build
+
+    reference = run_build(preset_config(preset_name="quick"), BuildInputs(), None).atoms
+    group = shift_space_group(reference)
+    assert group.order == 2 and group.operations[1].swaps_slabs
+    assert group.cell_lengths_angstrom == pytest.approx((4.916, 4.916), abs=1e-3)
+    for n in (6, 12, 24):
+        assert group.for_grid(n, n).order == 2
+
+
+def test_grid_tolerance_is_the_structure_tolerance():
+    """An operation whose image of the grid is off the nodes by less than the structure
+    tolerance (in Å along a1) maps the grid; by more, it does not."""
+    from flatcontact.ispes.shift_symmetry import ShiftGroup, ShiftOperation
+
+    identity = ShiftOperation(((1, 0), (0, 1)), (0.0, 0.0), False)
+    length, tol = 5.0, 1e-3
+    for off_angstrom, kept in ((0.5 * tol, True), (2.0 * tol, False)):
+        shifted = ShiftOperation(((1, 0), (0, 1)), (0.5 + off_angstrom / length, 0.0), False)
+        group = ShiftGroup((identity, shifted), tol, (length, length))
+        assert group.for_grid(12, 12).order == (2 if kept else 1)
+    # a node just below 1 is node 0 (periodic)
+    below = ShiftOperation(((1, 0), (0, 1)), (1.0 - 0.5 * tol / length, 0.0), False)
+    group = ShiftGroup((identity, below), tol, (length, length))
+    assert group.for_grid(12, 12).order == 2
+    np.testing.assert_array_equal(group.grid_images(12, 12)[1], group.grid_images(12, 12)[0])
+
+
+def test_progress_of_a_reduced_scan_counts_grid_points(tmp_path):
+    """One bar over the grid: a stored representative counts the points of its orbit, a
+    verified point one more; it never goes back and ends at grid points + verified points."""
+    calls = []
+    red = _reduced_toy_scan(tmp_path / "bar", progress=lambda d, t: calls.append((d, t)))
+    done = [d for d, _ in calls]
+    assert done == sorted(done)
+    n_verified = red.symmetry["verification"]["points"]
+    assert n_verified == 3
+    assert calls[-1] == (72 + n_verified, 72 + n_verified)
+    assert all(t == 72 + 3 for _, t in calls)  # verify_points 3, all of them chosen
+    # the representatives' phase ends with every grid point filled
+    assert (72, 75) in calls

@@ -6,7 +6,7 @@
   interpolant and finds one saddle class with C3 kept (its own report,
   :mod:`flatcontact.analysis.symmetry`), at the plain-LAMMPS γ_usf = 10.116 meV/Å²
   (/work/shared/NOTES.md) within 0.5 %; the full grid with the plain interpolant, the same
-  samples, shows the artefacts the symmetry removes (a second saddle class, C3 broken).
+  samples, shows the artefacts the symmetry removes (unequal saddles, C3 broken).
 """
 
 import numpy as np
@@ -66,7 +66,9 @@ def test_reduced_scan_equals_the_full_scan(
     assert sym["verification"]["points"] == 2
     assert red.points_stored < full.points_stored / 3
     a, b = red.dataset, full.dataset
-    np.testing.assert_array_equal(a["thickness"].values, b["thickness"].values)
+    # the same thickness list to round-off: the engine's nearest-image cache carries over from
+    # the first scan of the process to the second (measured 2e-14 Å, not bit for bit)
+    np.testing.assert_allclose(a["thickness"].values, b["thickness"].values, rtol=0, atol=1e-9)
     assert bool(a["converged"].all()) and bool(b["converged"].all())
     area = float(a.attrs["area"])
     de = np.abs(a["energy"].values - b["energy"].values).max() / area * 1e3
@@ -93,6 +95,12 @@ def test_symmetrised_analysis_of_cu111_6x6_has_one_saddle_class_and_keeps_c3(tmp
     assert energies[0] == pytest.approx(GAMMA_USF_MEV_PER_A2, rel=5e-3)
     assert 1e3 * pa.stackings.barrier == pytest.approx(GAMMA_USF_MEV_PER_A2, rel=5e-3)
 
-    plain, plain_classes, _ = at_zero_load(_scan("cu111-eam", tmp_path / "full", False))
-    assert len(plain_classes) == 2  # the square frequency set's artefact saddle
+    plain, plain_classes, plain_saddles = at_zero_load(_scan("cu111-eam", tmp_path / "full", False))
+    # the square frequency set's artefact: the three saddles are not equal (SP 10.135 against
+    # 10.165 meV/Å² twice) and the point-group report finds C3 broken; the kept operations,
+    # judged on the frequencies whose image stays in the set (as the broken-symmetry gate),
+    # see the samples' C3 and make them one class (they were two while a frequency mapped
+    # outside the set counted as a mismatch)
+    assert np.ptp([1e3 * p.energy for p in plain_saddles]) > 1e-2
     assert "C3" not in plain.symmetry.kept
+    assert len(plain_classes) == 1

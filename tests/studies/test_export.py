@@ -9,6 +9,7 @@ import json
 
 import pytest
 import yaml
+from tests.studies.toy import EPS_CROSS, toy_data, toy_model, write_yaml
 
 from flatcontact.analysis.uncertainty import LAW_COEFFICIENTS
 from flatcontact.config.load import build_config
@@ -19,33 +20,13 @@ from flatcontact.stages.measured_on import check_measured_on, measured_on
 from flatcontact.studies import convergence as convergence_module
 from flatcontact.studies.export import merge_studies, read_study
 
-TOY = {
-    "structure": {"kind": "toy-lj", "layers": 3},
-    "potential": {"calculator": {"target": "flatcontact.ispes.toy:toy_calculator"}},
-    "scan": {
-        "grid": [3, 3],
-        "p_range_gpa": {"lo_gpa": -0.2, "hi_gpa": 1.5, "n": 4},
-        "executor": "serial",
-    },
-    "analysis": {"p_gpa": [0.0, 0.5, 1.0]},
-    "contact": {"p0_gpa": [0.5, 1.0]},
-    "report": {"svg": False},
-}
-#: the toy's cross-interface LJ depth (flatcontact.ispes.toy): the second model doubles it
-EPS_CROSS = {"a": 0.01, "b": 0.02}
-
-
-def _write(path, data):
-    path.write_text(yaml.safe_dump(data, sort_keys=False))
-    return path
-
 
 def test_export_of_written_study_blocks_is_the_quartz_file_format(tmp_path):
     """Fast: two study documents with the blocks write_study puts in study.json (numbers
     made up), exported by the command; the file has the quartz data file's fields."""
     from flatcontact.studies.output import uncertainty_block
 
-    cfg = build_config(copy.deepcopy(TOY), None, "toy")
+    cfg = build_config(toy_data(), None, "toy")
     numbers = {k: 0.5 + i for i, k in enumerate(LAW_COEFFICIENTS)}
     conv = {
         "study": "convergence",
@@ -79,7 +60,7 @@ def test_export_of_written_study_blocks_is_the_quartz_file_format(tmp_path):
     assert exported["model_spread_internal"] == {k: float(f"{v:.3g}") for k, v in numbers.items()}
     assert exported["measured_on"] == measured_on(cfg)
     UncertaintyConfig.model_validate(exported)
-    check_measured_on(build_config({**copy.deepcopy(TOY), "uncertainty": exported}, None, "t"))
+    check_measured_on(build_config(toy_data(uncertainty=exported), None, "t"))
 
 
 @pytest.fixture(scope="module")
@@ -87,15 +68,13 @@ def studies(tmp_path_factory):
     """A one-step thickness refinement and a two-model study of the toy (4 runs, ~25 s each
     on the loaded 2-core machine)."""
     root = tmp_path_factory.mktemp("export")
-    conf = _write(
+    conf = write_yaml(
         root / "toy.yaml",
-        {**TOY, "refine": {"settings": ["thicknesses"], "max_steps": 1}},
+        toy_data(refine={"settings": ["thicknesses"], "max_steps": 1}),
     )
     models = []
     for label, eps in EPS_CROSS.items():
-        pot = copy.deepcopy(TOY["potential"])
-        pot["calculator"]["kwargs"] = {"eps_cross_ev": eps}
-        models.append(_write(root / f"toy-{label}.yaml", {"potential": pot}))
+        models.append(write_yaml(root / f"toy-{label}.yaml", {"potential": toy_model(eps)}))
     return root, conf, models
 
 
@@ -168,7 +147,7 @@ def test_export_writes_the_format_of_the_quartz_data_file(ran):
     mod = yaml.safe_load((root / "mod" / "uncertainty.yaml").read_text())["uncertainty"]
     assert exported["convergence_internal"] == conv["convergence_internal"]
     assert exported["model_spread_enthalpy"] == mod["model_spread_enthalpy"]
-    cfg = build_config({**TOY, "uncertainty": exported}, None, "toy")
+    cfg = build_config(toy_data(uncertainty=exported), None, "toy")
     assert exported["measured_on"] == measured_on(cfg)
     check_measured_on(cfg)
     assert [s["blocks"] for s in exported["provenance"]["studies"]] == [
@@ -208,9 +187,9 @@ def test_a_variant_that_fails_is_reported_as_its_settings_failure(tmp_path, monk
         return real(config, folder, share)
 
     monkeypatch.setattr(convergence_module, "run_variant", refusing)
-    conf = _write(
+    conf = write_yaml(
         tmp_path / "toy.yaml",
-        {**TOY, "refine": {"settings": ["thicknesses", "layers"], "max_steps": 1}},
+        toy_data(refine={"settings": ["thicknesses", "layers"], "max_steps": 1}),
     )
     code, out, err = _cli(["study", "convergence", conf, "--out", tmp_path / "s"])
     assert code == 0, err

@@ -4,13 +4,13 @@ calls), the intervals carried into laws.json and the refusal of a block measured
 
 from __future__ import annotations
 
-import copy
 import json
 import math
 
 import pytest
 import yaml
 from tests.hardening.helpers import run_cli
+from tests.studies.toy import TOY, toy_config, toy_data, toy_model, write_yaml
 
 from flatcontact.analysis.uncertainty import LAW_COEFFICIENTS
 from flatcontact.config.load import build_config
@@ -19,32 +19,13 @@ from flatcontact.stages.measured_on import check_measured_on, measured_on
 from flatcontact.studies.convergence import run_convergence
 from flatcontact.studies.output import write_study
 
-TOY = {
-    "structure": {"kind": "toy-lj", "layers": 3},
-    "calculator": {"target": "flatcontact.ispes.toy:toy_calculator"},
-    "scan": {
-        "grid": [3, 3],
-        "p_range_gpa": {"lo_gpa": -0.2, "hi_gpa": 1.5, "n": 4},
-        "executor": "serial",
-    },
-    "analysis": {"p_gpa": [0.0, 0.5, 1.0]},
-    "contact": {"p0_gpa": [0.5, 1.0]},
-    "report": {"svg": False},
-}
-
-
-def toy(**refine):
-    data = copy.deepcopy(TOY)
-    data["refine"] = refine
-    return build_config(data, None, "toy")
-
 
 @pytest.fixture(scope="module")
 def thickness_study(tmp_path_factory):
     """Thicknesses 4 -> 6 at a 3 % tolerance, and fmax halved: both converge (measured
     changes < 1 %); the base is shared by both settings."""
     out = tmp_path_factory.mktemp("conv")
-    cfg = toy(settings=["thicknesses", "fmax"], max_steps=2, tolerance_pct=3.0)
+    cfg = toy_config(settings=["thicknesses", "fmax"], max_steps=2, tolerance_pct=3.0)
     doc = run_convergence(cfg, out)
     write_study(doc, cfg, out, "test")
     return cfg, out, doc
@@ -105,7 +86,7 @@ def test_a_refinement_that_does_not_converge_within_its_budget_is_reported(tmp_p
     """The grid 3x3 -> 5x5 moves τ by tens of % (the toy's barrier is barely sampled): one
     step of budget, reported as not converged on the console and in study.json."""
     conf = tmp_path / "toy.yaml"
-    conf.write_text(yaml.safe_dump({**TOY, "refine": {"settings": ["grid"], "max_steps": 1}}))
+    write_yaml(conf, toy_data(refine={"settings": ["grid"], "max_steps": 1}))
     code, out, err = run_cli(["study", "convergence", conf, "--out", tmp_path / "s"], capsys)
     assert code == 0, err
     doc = json.loads((tmp_path / "s" / "study.json").read_text())
@@ -138,7 +119,7 @@ def test_laws_json_intervals_are_the_fit_and_the_study_in_quadrature(
     # the 3x3 toy breaks its symmetry by 36 % (validity gate, issue 20): the laws are what is
     # tested here, so the contact stage goes on with them
     contact = {**TOY["contact"], "accept_untrusted": ["broken_symmetry"]}
-    conf.write_text(yaml.safe_dump({**TOY, "contact": contact, "uncertainty": block}))
+    write_yaml(conf, toy_data(contact=contact, uncertainty=block))
     code, _, err = run_cli(["run", conf, "--out", tmp_path / "run"], capsys)
     assert code == 0, err
     laws = json.loads((tmp_path / "run" / "04-laws" / "laws.json").read_text())
@@ -163,10 +144,8 @@ def test_a_run_refuses_a_block_measured_on_another_structure_or_model(
 ):
     _cfg, out, _ = thickness_study
     block = yaml.safe_load((out / "uncertainty.yaml").read_text())["uncertainty"]
-    other = copy.deepcopy(TOY)
-    other["structure"]["layers"] = 4
-    conf = tmp_path / "other.yaml"
-    conf.write_text(yaml.safe_dump({**other, "uncertainty": block}))
+    other = toy_data(structure={**TOY["structure"], "layers": 4}, uncertainty=block)
+    conf = write_yaml(tmp_path / "other.yaml", other)
     code, _, err = run_cli(["run", conf, "--out", tmp_path / "run"], capsys)
     assert code == 2
     line = err.strip()
@@ -174,21 +153,18 @@ def test_a_run_refuses_a_block_measured_on_another_structure_or_model(
     assert "uncertainty.measured_on.structure_sha256" in line and "another structure" in line
     assert not any((tmp_path / "run").glob("0*-*"))
     # another model (the toy's LJ depth changed): refused naming the potential
-    model = copy.deepcopy(TOY)
-    model["calculator"]["kwargs"] = {"eps_cross_ev": 0.02}
+    model = toy_data(potential=toy_model(0.02), uncertainty=block)
     with pytest.raises(InputError, match="another potential"):
-        check_measured_on(build_config({**model, "uncertainty": block}, None, "m"))
+        check_measured_on(build_config(model, None, "m"))
     # the same interface and model (other scan settings) uses it
-    same = copy.deepcopy(TOY)
-    same["scan"]["grid"] = [4, 4]
-    check_measured_on(build_config({**same, "uncertainty": block}, None, "same"))
+    same = toy_data(scan={**TOY["scan"], "grid": [4, 4]}, uncertainty=block)
+    check_measured_on(build_config(same, None, "same"))
 
 
 def test_the_paper_preset_keeps_its_quartz_uncertainty_only_on_quartz():
     paper = build_config({}, "paper")
     assert paper.uncertainty.convergence_internal
-    toy_data = {**copy.deepcopy(TOY), "report": {"fig2_p_gpa": [0.5, 1.0]}}
-    other = build_config(toy_data, "paper")
+    other = build_config(toy_data(report={"fig2_p_gpa": [0.5, 1.0]}), "paper")
     assert other.uncertainty.convergence_internal == {} and other.uncertainty.source == ""
     coarser = build_config({"scan": {"grid": [8, 8]}}, "paper")
     assert coarser.uncertainty == paper.uncertainty

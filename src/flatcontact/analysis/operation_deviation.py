@@ -89,12 +89,16 @@ def operation_deviation(
     return _interpolant_deviation(surface, matrix, translation) / span
 
 
-def _interpolant_deviation(
+def coefficient_image_difference(
     surface: PeriodicSurface, matrix: np.ndarray, translation: np.ndarray
-) -> float:
-    """max |Σ_H (c'_H − c_H) e^{2πi H·s}| on the doubled grid, over the frequencies ``H``
-    that are the image ``MᵀG`` of a frequency ``G`` of the index set and in it themselves;
-    ``c'_H = c_G e^{2πi G·t}``."""
+) -> np.ndarray:
+    """``c' − c`` on the interpolant's frequencies, where ``c'`` are the coefficients of
+    ``e∘g``: at each frequency ``H = MᵀG`` that is the image of a frequency ``G`` of the index
+    set and in it itself, ``c'_H = c_G e^{2πi G·t}``; 0 elsewhere (a frequency mapped outside
+    the set, or one no frequency maps onto, carries no information about ``g``: module
+    docstring). Same shape as ``surface.coefficients``; shared by :func:`operation_deviation`
+    (the max norm on the doubled grid) and
+    :func:`flatcontact.analysis.stackings.kept_operations` (the L2 norm, Parseval)."""
     k, ll = surface.k, surface.l
     c = surface.coefficients
     index = {(int(a), int(b)): (i, j) for i, a in enumerate(k) for j, b in enumerate(ll)}
@@ -102,11 +106,21 @@ def _interpolant_deviation(
     t = np.asarray(translation, float)
     diff = np.zeros_like(c)
     for (a, b), (i, j) in index.items():
-        target = index.get(tuple(int(v) for v in np.array([a, b]) @ m))
+        target = index.get((int(a * m[0, 0] + b * m[1, 0]), int(a * m[0, 1] + b * m[1, 1])))
         if target is None:
             continue
         diff[target] += c[i, j] * np.exp(1j * TWO_PI * (a * t[0] + b * t[1]))
         diff[target] -= c[target]
+    return diff
+
+
+def _interpolant_deviation(
+    surface: PeriodicSurface, matrix: np.ndarray, translation: np.ndarray
+) -> float:
+    """max |Σ_H (c'_H − c_H) e^{2πi H·s}| on the doubled grid
+    (:func:`coefficient_image_difference`)."""
+    k, ll = surface.k, surface.l
+    diff = coefficient_image_difference(surface, matrix, translation)
     n_a, n_b = np.asarray(surface.values).shape
     ea = np.exp(1j * TWO_PI * np.outer(np.arange(2 * n_a) / (2 * n_a), k))
     eb = np.exp(1j * TWO_PI * np.outer(np.arange(2 * n_b) / (2 * n_b), ll))

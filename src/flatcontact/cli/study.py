@@ -46,16 +46,33 @@ def convergence_command(
         Path, typer.Argument(help="Run configuration (YAML) with a refine: section.")
     ],
     out: Annotated[Path, _OUT] = Path("flatcontact-study"),
+    estimate: Annotated[
+        bool,
+        typer.Option(
+            "--estimate",
+            help="Run (or reuse) only the base and print each variant's points, force calls "
+            "and time extrapolated from it; the study run later reuses the base.",
+        ),
+    ] = False,
 ) -> None:
     """Refine grid, thicknesses, layers, fmax, cutoff one at a time until τ and σ_MSS stop moving."""
     from flatcontact.config.load import load_config
     from flatcontact.studies.convergence import run_convergence
+    from flatcontact.studies.estimate import estimate_lines
     from flatcontact.studies.output import write_study
+
+    def _estimate(est: dict) -> None:
+        for line in estimate_lines(est):
+            console.print(line, highlight=False)
 
     cfg = load_config(config)
     check_out_dir(out)
     console.print(f"flatcontact study convergence: {config} -> {out}", highlight=False)
-    doc = run_convergence(cfg, out, on_done=_progress)
+    doc = run_convergence(
+        cfg, out, on_done=_progress, on_estimate=_estimate, estimate_only=estimate
+    )
+    if estimate:
+        return
     write_study(doc, cfg, out, _command_line())
     for s, st in doc["settings"].items():
         if st["state"] == "failed":

@@ -9,7 +9,10 @@ round, until the step moves every per-load τ and σ_MSS by less than ``toleranc
   into an explicit ``scan.thickness_angstrom``) times ``thickness_factor`` over the same range;
 * ``layers``: ``structure.layers`` + ``layers_step`` (recipes with a layer count);
 * ``fmax``: ``scan.fmax_ev_per_angstrom`` times ``fmax_factor`` (< 1);
-* ``cutoff``: the cross-interface LJ cutoff + ``cutoff_step_angstrom`` (``coupling: lj`` only).
+* ``cutoff``: the cross-interface cutoff + ``cutoff_step_angstrom``: the LJ's (``coupling:
+  lj``) or the cutoff argument of each tapered interlayer style (``coupling: interlayer``:
+  ``kolmogorov/crespi/full``, ``ilp/*``, ``coul/shield``; the taper takes the term to zero
+  smoothly at every rung, and the ladder only lengthens it).
 
 ``settings: auto`` takes every one of these that the recipe and model have
 (:func:`flatcontact.studies.variants.applicable_settings`). The section changes no stage's
@@ -53,5 +56,7 @@ class RefineConfig(Section):
     layers_step: int = Field(1, ge=1, le=20, description="layers per slab added per step")
     fmax_factor: physical(0.05, 0.9) = Field(0.5, description="force tolerance times this")
     cutoff_step_angstrom: physical(0.5, 50.0, "Å") = Field(
-        4.0, description="cross-interface LJ cutoff added per step"
+        4.0,
+        description="cross-interface cutoff added per step (the LJ's, or each tapered "
+        "interlayer style's: KC, ILP, coul/shield)",
     )

@@ -300,15 +300,23 @@ class TwoLoopMemory:
         return out
 
 
-def largest_atomic_norm(vectors: np.ndarray) -> float:
+def largest_atomic_norm(vectors: np.ndarray, scratch: np.ndarray | None = None) -> float:
     """max_i |v_i| over atoms of an (n, 3) array (ASE's force and step norm).
 
-    The squared norms in one pass without a temporary array (``einsum``), the square root of
-    their maximum only (the root is monotonic and correctly rounded: the same number).
+    The squares in one vectorised pass, x² + y² + z² summed into the first column in two
+    more (as ASE's ``(v**2).sum(axis=1)``), the square root of their maximum only (the root
+    is monotonic and correctly rounded: the same number). ``einsum("ij,ij->i")`` did it
+    without a temporary but loops over rows of three: ≈ 6× slower at 4,704 atoms.
+    ``scratch``: an (n, 3) array for the squares (:func:`lbfgs_relax` reuses one: on a large
+    cell a fresh array costs more than the arithmetic), else a new one.
     """
     if not len(vectors):
         return 0.0
-    return float(np.sqrt(np.einsum("ij,ij->i", vectors, vectors).max()))
+    sq = np.multiply(vectors, vectors, out=scratch)
+    norms = sq[:, 0]
+    np.add(norms, sq[:, 1], out=norms)
+    np.add(norms, sq[:, 2], out=norms)
+    return float(np.sqrt(norms.max()))
 
 
 def lbfgs_relax(
@@ -370,7 +378,8 @@ def lbfgs_relax(
         project_force = project_step = project
     f = project_force(forces)
     steps = 0
-    converged = largest_atomic_norm(f) < fmax
+    scratch = np.empty(shape)  # the squares of largest_atomic_norm
+    converged = largest_atomic_norm(f, scratch) < fmax
     if converged or max_steps < 1:
         return LbfgsOutcome(x, float(energy), forces, steps, calls, bool(converged))
     history = TwoLoopMemory(x.size, memory_for(x.size) if memory is None else memory, alpha)
@@ -390,7 +399,7 @@ def lbfgs_relax(
             history.push_stored(g, scale, out=direction)
         np.negative(dr, out=dr)
         scale = -damping
-        longest = largest_atomic_norm(dr)
+        longest = largest_atomic_norm(dr, scratch)
         if longest >= maxstep:
             dr *= maxstep / longest
             scale *= maxstep / longest
@@ -403,5 +412,5 @@ def lbfgs_relax(
         energy, forces = evaluate(x)
         calls += 1
         f = project_force(forces)
-        converged = largest_atomic_norm(f) < fmax
+        converged = largest_atomic_norm(f, scratch) < fmax
     return LbfgsOutcome(x, float(energy), forces, steps, calls, bool(converged))

@@ -148,6 +148,141 @@ _UP_OFFSETS = np.concatenate(
 )
 
 
+@dataclasses.dataclass(frozen=True)
+class ColumnChain:
+    """One chain of a probed column: relaxed points in the order relaxed, each warm-started
+    from the one before (the first cold). Thicknesses in Å, energies in eV, loads in GPa."""
+
+    thickness_angstrom: tuple[float, ...]
+    energy_ev: tuple[float, ...]
+    normal_stress_gpa: tuple[float, ...]
+    force_calls: tuple[int, ...]
+
+
+def compress_chain(
+    relax: Callable[[float, float, float, np.ndarray | None, float | None], tuple],
+    reference: Atoms,
+    shift: tuple[float, float],
+    p_hi_gpa: float,
+    dz_down_angstrom: float = 0.1,
+    max_down_steps: int = 80,
+) -> ColumnChain:
+    """The compression of a column: the reference thickness (cold start), then steps of
+    ``dz_down_angstrom`` down, each warm-started from the last, until the load reaches
+    ``p_hi_gpa`` (GPa). The first point is the column's load at the reference thickness."""
+    z_ref = thickness(reference)
+    a, b = shift
+    e, p, n, pos = relax(a, b, z_ref, None, None)
+    out = [(z_ref, e, p, n)]
+    start, start_z = pos, z_ref
+    k = 0
+    while p < p_hi_gpa:
+        k += 1
+        if k > max_down_steps:
+            raise InputError(
+                f"p-range-gpa: the load did not reach {p_hi_gpa} GPa within {max_down_steps * dz_down_angstrom:.3g} Å "
+                f"of compression (reached {p:.3g} GPa)"
+            )
+        z = z_ref - k * dz_down_angstrom
+        try:
+            e, p, n, pos = relax(a, b, z, start, start_z)
+        except InputError as exc:
+            raise InputError(
+                f"p-range-gpa: the slabs overlap before the load reaches {p_hi_gpa} GPa ({exc})"
+            ) from None
+        out.append((z, e, p, n))
+        start, start_z = pos, z
+    return ColumnChain(*(tuple(v) for v in zip(*out, strict=True)))
+
+
+def _stretch_stop(
+    p_min: float, p: float, stop_at_gpa: float | None, separated_gpa: float
+) -> tuple[bool, float]:
+    """The stretching's stop rule after a point of load ``p``: ``(stop, new p_min)``.
+
+    Past the tensile maximum (p above the smallest load so far, ``p_min``) a column with a
+    ``stop_at_gpa`` stops, as one at or below it does; a column without stops once the
+    slabs are separated (|p| < ``separated_gpa`` after a tension). Stopping is monotonic in
+    ``p_min``: a smaller ``p_min`` stops at the same point or earlier.
+    """
+    past_min = p > p_min
+    p_min = min(p_min, p)
+    if stop_at_gpa is not None and (p <= stop_at_gpa or past_min):
+        return True, p_min
+    return past_min and p_min < 0 and abs(p) < separated_gpa, p_min
+
+
+def stretch_chain(
+    relax: Callable[[float, float, float, np.ndarray | None, float | None], tuple],
+    reference: Atoms,
+    shift: tuple[float, float],
+    p_ref_gpa: float | None,
+    separated_gpa: float = 1e-4,
+    stop_at_gpa: float | None = None,
+) -> ColumnChain:
+    """The stretching of a column: the default offsets above the reference thickness, the
+    first cold, each next warm-started from the last, until :func:`_stretch_stop`.
+
+    ``p_ref_gpa`` is the load at the reference thickness (the compression's first point).
+    Without it (``None``: the two chains run at the same time) the rule starts from
+    ``p_min = +inf``, which stops at the same point or later
+    (:func:`_stretch_stop` is monotonic); :func:`join_column` cuts the chain where the rule
+    with the load at the reference stops, so the column equals the sequential one exactly.
+    """
+    z_ref = thickness(reference)
+    a, b = shift
+    out = []
+    start, start_z = None, None
+    p_min = np.inf if p_ref_gpa is None else p_ref_gpa
+    for dz in _UP_OFFSETS:
+        z = z_ref + float(dz)
+        e, p, n, pos = relax(a, b, z, start, start_z)
+        out.append((z, e, p, n))
+        start, start_z = pos, z
+        stop, p_min = _stretch_stop(p_min, p, stop_at_gpa, separated_gpa)
+        if stop:
+            break
+    return ColumnChain(*(tuple(v) for v in zip(*out, strict=True)))
+
+
+def join_column(
+    reference: Atoms,
+    shift: tuple[float, float],
+    compressed: ColumnChain,
+    stretched: ColumnChain,
+    separated_gpa: float = 1e-4,
+    stop_at_gpa: float | None = None,
+) -> ColumnProbe:
+    """The :class:`ColumnProbe` of a column from its two chains (ascending z).
+
+    The stretching is cut after the first point where :func:`_stretch_stop`, started from
+    the compression's load at the reference thickness, stops: the points a chain run
+    without that load relaxed beyond it are dropped (their warm starts came from the same
+    points, so the kept ones equal the sequential column's).
+    """
+    p_min = compressed.normal_stress_gpa[0]
+    keep = len(stretched.thickness_angstrom)
+    for k, p in enumerate(stretched.normal_stress_gpa):
+        stop, p_min = _stretch_stop(p_min, p, stop_at_gpa, separated_gpa)
+        if stop:
+            keep = k + 1
+            break
+    z = np.concatenate([compressed.thickness_angstrom, stretched.thickness_angstrom[:keep]])
+    e = np.concatenate([compressed.energy_ev, stretched.energy_ev[:keep]])
+    p = np.concatenate([compressed.normal_stress_gpa, stretched.normal_stress_gpa[:keep]])
+    calls = sum(compressed.force_calls) + sum(stretched.force_calls[:keep])
+    order = np.argsort(z, kind="stable")
+    a1, a2 = in_plane_vectors(reference)
+    return ColumnProbe(
+        shift=(float(shift[0]), float(shift[1])),
+        thickness_angstrom=z[order],
+        energy_ev=e[order],
+        normal_stress_gpa=p[order],
+        force_calls=int(calls),
+        area_angstrom2=cell_area(a1, a2),
+    )
+
+
 def probe_column(
     relax: Callable[[float, float, float, np.ndarray | None, float | None], tuple],
     reference: Atoms,
@@ -159,6 +294,10 @@ def probe_column(
     stop_at_gpa: float | None = None,
 ) -> ColumnProbe:
     """Relax a column at ``shift`` from compression up to separation.
+
+    Two chains of warm starts (:func:`compress_chain`, then :func:`stretch_chain`, which
+    starts cold above the reference thickness), one after the other; the scan driver runs
+    them on two workers at once and joins them with :func:`join_column` (the same column).
 
     Parameters
     ----------
@@ -175,57 +314,11 @@ def probe_column(
     separated_gpa
         Beyond the tensile maximum, stop once |p| is below this (GPa) — the slabs are
         separated — or at the last default offset (reference + 20 Å).
+    stop_at_gpa
+        Stop stretching once the load is at most this (GPa) or past the tensile maximum.
     """
-    z_ref = thickness(reference)
-    a, b = shift
-    records: dict[float, tuple[float, float]] = {}
-    calls = 0
-
-    e, p, n, pos = relax(a, b, z_ref, None, None)
-    records[z_ref] = (e, p)
-    calls += n
-    start, start_z = pos, z_ref
-    # compress
-    k = 0
-    while p < p_hi_gpa:
-        k += 1
-        if k > max_down_steps:
-            raise InputError(
-                f"p-range-gpa: the load did not reach {p_hi_gpa} GPa within {max_down_steps * dz_down_angstrom:.3g} Å "
-                f"of compression (reached {p:.3g} GPa)"
-            )
-        z = z_ref - k * dz_down_angstrom
-        try:
-            e, p, n, pos = relax(a, b, z, start, start_z)
-        except InputError as exc:
-            raise InputError(
-                f"p-range-gpa: the slabs overlap before the load reaches {p_hi_gpa} GPa ({exc})"
-            ) from None
-        records[z] = (e, p)
-        calls += n
-        start, start_z = pos, z
-    # stretch to separation
-    start, start_z = None, None
-    p_min = records[z_ref][1]
-    for dz in _UP_OFFSETS:
-        z = z_ref + float(dz)
-        e, p, n, pos = relax(a, b, z, start, start_z)
-        records[z] = (e, p)
-        calls += n
-        start, start_z = pos, z
-        past_min = p > p_min
-        p_min = min(p_min, p)
-        if stop_at_gpa is not None and (p <= stop_at_gpa or past_min):
-            break
-        if past_min and p_min < 0 and abs(p) < separated_gpa:
-            break
-    zs = np.array(sorted(records))
-    a1, a2 = in_plane_vectors(reference)
-    return ColumnProbe(
-        shift=(float(a), float(b)),
-        thickness_angstrom=zs,
-        energy_ev=np.array([records[z][0] for z in zs]),
-        normal_stress_gpa=np.array([records[z][1] for z in zs]),
-        force_calls=calls,
-        area_angstrom2=cell_area(a1, a2),
+    down = compress_chain(relax, reference, shift, p_hi_gpa, dz_down_angstrom, max_down_steps)
+    up = stretch_chain(
+        relax, reference, shift, down.normal_stress_gpa[0], separated_gpa, stop_at_gpa
     )
+    return join_column(reference, shift, down, up, separated_gpa, stop_at_gpa)

@@ -39,7 +39,13 @@ from flatcontact.ispes.geometry import in_plane_vectors, thickness, validate_int
 from flatcontact.ispes.grid import GridSpec, check_thicknesses
 from flatcontact.ispes.grid_bracket import MAX_EXTENSIONS, bracket_targets_gpa, check_grid
 from flatcontact.ispes.order import PREFERENCES, search_tree
-from flatcontact.ispes.probe import extreme_stackings, probe_column, rigid_stackings
+from flatcontact.ispes.probe import (
+    compress_chain,
+    extreme_stackings,
+    join_column,
+    rigid_stackings,
+    stretch_chain,
+)
 from flatcontact.ispes.reduction import (
     SymmetrySettings,
     choose_verify,
@@ -126,27 +132,52 @@ def _probe(
     grid: GridSpec,
     relax: RelaxSettings,
     executor: Any = None,
-) -> tuple[dict, list[str]]:
+) -> tuple[dict, list[str], Any]:
     """Resolve the thicknesses of a pressure-range grid
-    (:func:`flatcontact.ispes.thicknesses.probe_thicknesses`).
+    (:func:`flatcontact.ispes.thicknesses.probe_thicknesses`) and, with more than one
+    worker, the ideal work of separation beside them.
 
-    The single points of every stacking run here; the probed columns, independent chains,
-    run on the executor's workers when it has more than one (they are the serial part of a
-    scan: 4 % of the paper preset's serial time, which by Amdahl's law alone capped two
-    workers at 96 %).
+    The single points of every stacking run here. With more than one worker the rest runs
+    on the workers as independent chains of relaxations, at once: each probed column's
+    compression and stretching (:func:`flatcontact.ispes.probe.compress_chain`,
+    :func:`~flatcontact.ispes.probe.stretch_chain`, joined exactly as the sequential column
+    by :func:`~flatcontact.ispes.probe.join_column`) and the ideal work of separation at the
+    lowest rigid stacking (a chain of its own, independent of the thicknesses). Returns
+    ``(resolved, notes, work)``: ``work`` the
+    :class:`~flatcontact.ispes.work_of_separation.WorkOfSeparation` (serial: computed here
+    after the probe, from the same single points of every stacking).
     """
     calc = worker_calculator(factory, reference)
     relax_one = functools.partial(relax_column_point, reference, calc, relax)
     rigid = rigid_stackings(reference, calc, grid)
-    probe_columns = None
-    if executor is not None and getattr(executor, "workers", 1) > 1:
-        context = ScanContext(reference, factory, relax)
+    if executor is None or getattr(executor, "workers", 1) <= 1:
+        lowest = extreme_stackings(rigid.energy_ev, grid)[0]
+        extra, notes = probe_thicknesses(relax_one, reference, rigid, grid)
+        return extra, notes, ideal_work_of_separation(reference, factory, relax, lowest, calc=calc)
+    context = ScanContext(reference, factory, relax)
+    work = []
 
-        def probe_columns(specs):
-            handles = [executor.submit(probe_column_task, context, *spec) for spec in specs]
-            return [executor.result(h) for h in handles]
+    def probe_columns(specs):
+        # the stretchings, the work of separation, then the compressions (on quartz the
+        # compressions are the long chains, 19-21 points of ~30 force calls; past its first
+        # point a stretching costs ~1 call per point: benchmarks/schedule_model.py)
+        up = [executor.submit(probe_chain_task, context, "stretch", *spec) for spec in specs]
+        lowest = extreme_stackings(rigid.energy_ev, grid)[0]
+        work.append(executor.submit(work_of_separation_task, context, lowest))
+        down = [executor.submit(probe_chain_task, context, "compress", *spec) for spec in specs]
+        return [
+            join_column(
+                reference,
+                shift,
+                executor.result(d),
+                executor.result(u),
+                stop_at_gpa=stop,
+            )
+            for (shift, _, stop), d, u in zip(specs, down, up, strict=True)
+        ]
 
-    return probe_thicknesses(relax_one, reference, rigid, grid, probe_columns)
+    extra, notes = probe_thicknesses(relax_one, reference, rigid, grid, probe_columns)
+    return extra, notes, executor.result(work[0]) if work else None
 
 
 def adhesion_record(
@@ -155,25 +186,28 @@ def adhesion_record(
     grid: GridSpec,
     relax: RelaxSettings,
     pull_off: dict | None = None,
+    work: Any = None,
 ) -> dict:
     """The ``adhesion`` entry of a scan: the ideal work of separation and the probe's pull-off.
 
     W (``work_of_separation_j_per_m2``) is that of the lowest rigid energy among the grid's
     lateral shifts (:func:`flatcontact.ispes.work_of_separation.ideal_work_of_separation`),
-    whatever the thicknesses; ``pull_off`` is the probe's record
+    whatever the thicknesses; ``work``, if given, is that W already computed (on a worker,
+    :func:`_probe`). ``pull_off`` is the probe's record
     (:class:`flatcontact.ispes.separation.Adhesion`, absent for given thicknesses). A
     record of an older scan whose ``work_of_separation_*`` keys were the pull-off's is
     renamed to ``pull_off_*``.
     """
-    calc = worker_calculator(factory, reference)
-    shift = extreme_stackings(rigid_stackings(reference, calc, grid).energy_ev, grid)[0]
     pulled = {}
     for key, value in (pull_off or {}).items():
         if key.startswith("work_of_separation"):
             key = key.replace("work_of_separation", "pull_off_work", 1)
         pulled[key] = value
-    w = ideal_work_of_separation(reference, factory, relax, shift, calc=calc)
-    return {**pulled, **w.record()}
+    if work is None:
+        calc = worker_calculator(factory, reference)
+        shift = extreme_stackings(rigid_stackings(reference, calc, grid).energy_ev, grid)[0]
+        work = ideal_work_of_separation(reference, factory, relax, shift, calc=calc)
+    return {**pulled, **work.record()}
 
 
 def _tree_in_store_order(
@@ -307,12 +341,25 @@ def relax_column_point(reference, calc, relax, a, b, z, start, start_z) -> tuple
     return r.energy_ev, r.normal_stress_gpa, r.force_calls, r.positions
 
 
-def probe_column_task(context: ScanContext, shift, p_hi_gpa, stop_at_gpa):
-    """Worker entry point: one probed column (:func:`flatcontact.ispes.probe.probe_column`)
-    with this worker's cached calculator."""
+def probe_chain_task(context: ScanContext, kind: str, shift, p_hi_gpa, stop_at_gpa):
+    """Worker entry point: one chain of a probed column with this worker's cached
+    calculator: ``kind`` ``"compress"`` (:func:`flatcontact.ispes.probe.compress_chain`) or
+    ``"stretch"`` (:func:`flatcontact.ispes.probe.stretch_chain`, without the load at the
+    reference thickness: :func:`flatcontact.ispes.probe.join_column` cuts it)."""
     calc = worker_calculator(context.factory, context.reference)
     relax_one = functools.partial(relax_column_point, context.reference, calc, context.settings)
-    return probe_column(relax_one, context.reference, shift, p_hi_gpa, stop_at_gpa=stop_at_gpa)
+    if kind == "compress":
+        return compress_chain(relax_one, context.reference, shift, p_hi_gpa)
+    return stretch_chain(relax_one, context.reference, shift, None, stop_at_gpa=stop_at_gpa)
+
+
+def work_of_separation_task(context: ScanContext, shift):
+    """Worker entry point: the ideal work of separation at ``shift``
+    (:func:`flatcontact.ispes.work_of_separation.ideal_work_of_separation`)."""
+    calc = worker_calculator(context.factory, context.reference)
+    return ideal_work_of_separation(
+        context.reference, context.factory, context.settings, shift, calc=calc
+    )
 
 
 def run_scan(
@@ -351,9 +398,12 @@ def run_scan(
         An executor object (:mod:`flatcontact.ispes.executors`); if None, one is built
         from ``executor_options`` (``make_executor`` keywords) after validation.
     progress
-        Called as ``progress(done, total)`` (points in the store, points of the grid) once
+        Called as ``progress(done, total)`` (grid points done, points of the grid) once
         the grid is known and after every stored point, like an observer attached to an ASE
-        dynamics; the CLI draws its progress bar from it.
+        dynamics; the CLI draws its progress bar from it. A reduced scan counts the grid
+        points a stored representative fills by symmetry and its verified points
+        (``total`` = grid points + verified points), one bar to 100 %; a fallback to the
+        full grid counts the grid's stored points from there.
     max_new_points
         Stop after computing this many new points (benchmarks); the store stays resumable.
     symmetry
@@ -407,13 +457,14 @@ def run_scan(
                         "a2": a2.tolist(),
                         "potential_label": factory.label,
                     }
+                    work = None
                     if grid.thickness_angstrom is not None:
                         resolved["thickness_angstrom"] = list(grid.thickness_angstrom)
                     else:
-                        extra, notes = _probe(reference, factory, grid, relax, executor)
+                        extra, notes, work = _probe(reference, factory, grid, relax, executor)
                         resolved.update(extra)
                     resolved["adhesion"] = adhesion_record(
-                        reference, factory, grid, relax, resolved.get("adhesion")
+                        reference, factory, grid, relax, resolved.get("adhesion"), work
                     )
                     store.set_resolved(resolved)
                 resolved = store.resolved
@@ -454,8 +505,14 @@ def run_scan(
                         cached = recent.get(idx)
                         return cached if cached is not None else store.positions(idx)
 
-                    def run_points(parent, z=z):
-                        """Relax the points of the tree ``parent`` missing from the store."""
+                    def run_points(parent, z=z, weight=None, total=None):
+                        """Relax the points of the tree ``parent`` missing from the store.
+
+                        Progress counts ``weight[idx]`` (default 1) per stored point out of
+                        ``total`` (default: the tree's points): a representative of a reduced
+                        scan counts the grid points it fills, so one bar runs to the grid.
+                        """
+                        weight = weight or {}
 
                         def make_task(idx):
                             par = parent[idx]
@@ -484,8 +541,9 @@ def run_scan(
 
                         rank = {idx: k for k, idx in enumerate(parent)}
                         pending = {idx for idx in parent if idx not in store}
-                        total = len(parent)
-                        stored = total - len(pending)
+                        if total is None:
+                            total = len(parent)
+                        stored = sum(weight.get(idx, 1) for idx in parent if idx in store)
                         if progress is not None:
                             progress(stored, total)
                         in_flight: dict[Any, tuple] = {}
@@ -520,7 +578,7 @@ def run_scan(
                                 recent.put(idx, result.positions)
                                 queue.stored(idx)
                                 computed_calls.append(result.force_calls)
-                                stored += 1
+                                stored += weight.get(idx, 1)
                                 if progress is not None:
                                     progress(stored, total)
 
@@ -538,8 +596,14 @@ def run_scan(
                                 "verification": None,
                                 "computed_in_full": False,
                             }
+                            # progress over the grid: a representative fills its orbit,
+                            # a verified point counts one more
+                            fills = collections.Counter(reduction.representative.values())
+                            grid_points = int(np.prod(shape))
                             run_points(
-                                _tree_in_store_order(z, shape, root, order, reduction.computed)
+                                _tree_in_store_order(z, shape, root, order, reduction.computed),
+                                weight=fills,
+                                total=grid_points + symmetry.verify_points,
                             )
                             if all(rep in store for rep in reduction.computed):
                                 # chosen from the complete representatives only: a resumed
@@ -549,7 +613,9 @@ def run_scan(
                                 )
                                 symmetry_record.update(reduction.to_json())
                                 run_points(
-                                    _tree_in_store_order(z, shape, root, order, reduction.computed)
+                                    _tree_in_store_order(z, shape, root, order, reduction.computed),
+                                    weight=fills,
+                                    total=grid_points + len(reduction.verify),
                                 )
                             if all(idx in store for idx in reduction.computed):
                                 area = cell_area(*in_plane_vectors(reference))

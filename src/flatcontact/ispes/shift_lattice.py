@@ -192,6 +192,21 @@ def grid_size_for(base: int, index: int) -> int:
     return n
 
 
+def scan_grid(grid: tuple[int, int] | list[int], index: int) -> tuple[int, int]:
+    """The lateral grid a scan over the supercell uses for a shift lattice of ``index``.
+
+    ``grid`` (``scan.grid``) is the density per period of the landscape. Index 1 (a 1×1
+    cell, quartz, the AB bilayer): ``grid`` unchanged. Index > 1: the square ``n × n`` with
+    ``n`` = :func:`grid_size_for` (the larger of ``grid``, the index), which visits an
+    ``n × n`` grid over one period at the base grid's cost; :func:`to_shift_cell` re-indexes
+    it. Used by the scan stage and ``flatcontact study approximants`` (one choice)."""
+    n_a, n_b = (int(v) for v in grid)
+    if int(index) == 1:
+        return n_a, n_b
+    n = grid_size_for(max(n_a, n_b), index)
+    return n, n
+
+
 def reindex(lattice: ShiftLattice, n_a: int, n_b: int) -> tuple[np.ndarray, np.ndarray]:
     """Target indices ``(ia', ib')`` (each ``n_a × n_b``) of every supercell grid point.
 

@@ -83,21 +83,37 @@ class ShiftGroup:
 
     operations: tuple[ShiftOperation, ...]
     tolerance_angstrom: float
+    #: |a1|, |a2| (Å) of the interface the group was found on; None: unknown
+    cell_lengths_angstrom: tuple[float, float] | None = None
 
     @property
     def order(self) -> int:
         return len(self.operations)
 
     def for_grid(self, n_a: int, n_b: int) -> ShiftGroup:
-        """The subgroup whose operations map the ``n_a × n_b`` grid of shifts onto itself."""
+        """The subgroup whose operations map the ``n_a × n_b`` grid of shifts onto itself.
+
+        An image counts as a grid point when it lies within the structure tolerance of one:
+        ``tolerance_angstrom / |a_i|`` in fractions of a_i (× n_i in grid steps), the
+        precision to which the operation's translation is known from the atoms (a quartz
+        two-fold axis found 1.5e-7 off a half-cell translation is kept). Without the cell
+        lengths, 1e-6 grid steps.
+        """
         ia, ib = np.meshgrid(np.arange(n_a), np.arange(n_b), indexing="ij")
         s = np.stack([ia.ravel() / n_a, ib.ravel() / n_b], -1)
+        n = np.array([n_a, n_b], dtype=float)
+        if self.cell_lengths_angstrom is None:
+            atol = np.full(2, 1e-6)
+        else:
+            atol = n * self.tolerance_angstrom / np.asarray(self.cell_lengths_angstrom, float)
+        atol = np.minimum(atol, 0.25)  # an image a quarter step off is not on the grid
         kept = []
         for op in self.operations:
-            g = op.apply(s) * (n_a, n_b)
-            if np.allclose(g, np.round(g), atol=1e-6):
+            g = op.apply(s) * n
+            # the nearest grid index, periodic: an image just below 1 is index 0
+            if np.all(np.abs(g - np.round(g)) <= atol):
                 kept.append(op)
-        return ShiftGroup(tuple(kept), self.tolerance_angstrom)
+        return ShiftGroup(tuple(kept), self.tolerance_angstrom, self.cell_lengths_angstrom)
 
     def grid_images(self, n_a: int, n_b: int) -> np.ndarray:
         """Index images ``out[k, ia, ib] = (ja, jb)`` of every grid point under operation k.
@@ -386,7 +402,8 @@ def shift_space_group(
             for u in unique
         ):
             unique.append(op)
-    return ShiftGroup(tuple(unique), tol)
+    lengths = (float(np.linalg.norm(lattice[:, 0])), float(np.linalg.norm(lattice[:, 1])))
+    return ShiftGroup(tuple(unique), tol, lengths)
 
 
 def self_translations(

@@ -40,6 +40,46 @@ def base_style(name: str) -> str:
     return head if head and tail in ACCELERATOR_SUFFIXES else name
 
 
+#: Pair styles whose first argument is their global cutoff (Å): the registry-dependent interlayer
+#: potentials and h-BN's shielded Coulomb term (LAMMPS ``pair_style kolmogorov/crespi/full``,
+#: ``ilp/graphene/hbn``, ``ilp/tmd``, ``saip/metal``, ``coul/shield``: ``cutoff tap_flag``).
+#: With ``tap_flag`` 1 the whole pair term is multiplied by the taper
+#: Tap(x) = 20x⁷ − 70x⁶ + 84x⁵ − 35x⁴ + 1, x = r/r_c (Leven et al. 2016; the LAMMPS ``ilp/graphene/hbn`` documentation), so energy and
+#: force go to zero smoothly at r_c and the cutoff is part of the fitted model (16 Å for
+#: ``CH_taper.KC`` and ``BNCH.ILP``).
+CUTOFF_FIRST_STYLES = frozenset(
+    {"kolmogorov/crespi/full", "ilp/graphene/hbn", "ilp/tmd", "saip/metal", "coul/shield"}
+)
+
+
+def style_cutoff_angstrom(pair_style: str) -> float | None:
+    """The global cutoff (Å) of ``pair_style`` if its style takes one first, else None.
+
+    ``"kolmogorov/crespi/full 16.0 1"`` → 16.0; ``"rebo"`` → None.
+    """
+    words = pair_style.split()
+    if base_style(words[0]) not in CUTOFF_FIRST_STYLES or len(words) < 2:
+        return None
+    try:
+        return float(words[1])
+    except ValueError:
+        return None
+
+
+def with_cutoff(pair_style: str, cutoff_angstrom: float) -> str:
+    """``pair_style`` with its global cutoff replaced (the other arguments, the taper flag, kept).
+
+    Raises
+    ------
+    InputError
+        The style takes no cutoff as its first argument (:data:`CUTOFF_FIRST_STYLES`).
+    """
+    if style_cutoff_angstrom(pair_style) is None:
+        raise InputError(f"pair_style {pair_style!r}: has no cutoff argument to set")
+    words = pair_style.split()
+    return " ".join([words[0], f"{cutoff_angstrom:g}", *words[2:]])
+
+
 def is_file_token(token: str) -> bool:
     """A ``pair_coeff`` token names a file when it has a '.' or '/' and is not a number."""
     try:

@@ -83,16 +83,26 @@ def shift_group_operations(inputs: GateInputs) -> list[tuple[np.ndarray, np.ndar
     """The interface's shift-space group as plain ``(M, t)`` (fractional basis, a slab swap's
     sign inside ``M``), found on ``inputs.interface`` the way the scan finds it
     (:func:`flatcontact.ispes.shift_symmetry.shift_space_group`), every operation, not only
-    those that map the grid onto itself."""
+    those that map the grid onto itself.
+
+    A coincidence or twist cell (shift-lattice index > 1) has its landscape stated on one
+    period of the shift lattice (:mod:`flatcontact.stages.scan`): the group is found modulo
+    its pure translations and restated on that period
+    (:func:`flatcontact.ispes.shift_lattice.shift_cell_operations`)."""
+    from flatcontact.ispes.shift_lattice import shift_cell_operations, shift_lattice_of
     from flatcontact.ispes.shift_symmetry import shift_space_group
     from flatcontact.structures.interface_io import read_interface
 
+    reference = read_interface(inputs.interface)
+    lattice = shift_lattice_of(reference, inputs.symmetry_tolerance_angstrom)
     group = shift_space_group(
-        read_interface(inputs.interface),
+        reference,
         inputs.symmetry_tolerance_angstrom,
         spread_compression=inputs.spread_compression,
+        modulo_translations=lattice.index > 1,
     )
-    return [(np.array(op.matrix, int), np.array(op.translation, float)) for op in group.operations]
+    ops = [(np.array(op.matrix, int), np.array(op.translation, float)) for op in group.operations]
+    return ops if lattice.index == 1 else shift_cell_operations(lattice, ops)
 
 
 def _landscape_gates(inputs: GateInputs, ds, not_checked: list[str]) -> list:

@@ -2,10 +2,22 @@
 
 Files: ``points.db`` (the resumable point store), ``ispes.nc`` (the ISPES contract),
 ``scan.json`` (:meth:`ScanStageResult.to_json`) and ``fig_scan_columns.png`` (+ ``.svg``).
+
+Coincidence and twist cells (issue 23): the energy repeats on the shift lattice Λ_1 + Λ_2,
+``index`` times finer than the interface cell (N² for an N-cell twist,
+:mod:`flatcontact.ispes.shift_lattice`). The stage finds it on the atoms before the scan,
+scans the grid :func:`~flatcontact.ispes.shift_lattice.scan_grid` (n × n over the
+supercell, n coprime to the index: the points of an n × n grid over ONE period) and writes
+``ispes.nc`` re-indexed onto that period
+(:func:`~flatcontact.ispes.shift_lattice.to_shift_cell`), so the analysis, the laws and the
+contact stage read the real period; a grid over the supercell read as one period would be
+aliased (τ0 of the (1, 2) twisted bilayer 7× too small). ``scan.json`` ``shift_lattice``
+states the cell the analysis reads; index 1 (a 1×1 cell) changes nothing.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 from collections.abc import Callable
@@ -43,6 +55,7 @@ class ScanStageResult:
     warnings: list[str] = field(default_factory=list)
     files: list[Path] = field(default_factory=list)
     layer_slip: dict | None = None  # flatcontact.ispes.slip.SlipTable.to_json()
+    shift_lattice: dict | None = None  # the cell ispes.nc is stated on (module docstring)
 
     @property
     def dataset(self):
@@ -74,15 +87,18 @@ class ScanStageResult:
             "warnings": list(self.warnings),
             "load_folds": list(getattr(r, "load_folds", [])),
             "layer_slip": self.layer_slip,
+            "shift_lattice": self.shift_lattice,
         }
 
 
-def grid_spec(scan) -> GridSpec:
-    """The scan grid of the ``scan`` settings (:class:`flatcontact.ispes.grid.GridSpec`)."""
+def grid_spec(scan, lateral: tuple[int, int] | None = None) -> GridSpec:
+    """The scan grid of the ``scan`` settings (:class:`flatcontact.ispes.grid.GridSpec`);
+    ``lateral`` replaces ``scan.grid`` (the grid chosen for a shift lattice, :func:`run_scan`)."""
     r = scan.p_range_gpa
+    n_a, n_b = lateral if lateral is not None else scan.grid
     return GridSpec(
-        scan.grid[0],
-        scan.grid[1],
+        n_a,
+        n_b,
         thickness_angstrom=tuple(scan.thickness_angstrom) if scan.thickness_angstrom else None,
         p_range_gpa=(r.lo_gpa, r.hi_gpa, r.n) if r else None,
         bracket_all_stackings=scan.bracket_all_stackings,
@@ -189,10 +205,18 @@ def run_scan(
             "relaxed ones of the scan's model"
         )
         log.warning("scan: %s", warnings[-1])
+    lattice, lateral, record = _shift_lattice_grid(s, reference)
+    if lateral != tuple(s.grid):
+        warnings.append(
+            f"scan.grid {list(s.grid)}: the landscape repeats on a shift lattice of index "
+            f"{lattice.index}; scanned {lateral[0]} x {lateral[1]} over the interface cell "
+            "(coprime to the index), re-indexed onto one period"
+        )
+        log.warning("scan: %s", warnings[-1])
     scan = ispes_scan.run_scan(
         reference,
         factory,
-        grid_spec(s),
+        grid_spec(s, lateral),
         folder,
         relax_settings(s),
         order=s.order,
@@ -201,12 +225,24 @@ def run_scan(
         symmetry=symmetry_settings(s),
         bracket_loads_gpa=list(settings.analysis.p_gpa),
     )
+    if lattice.index > 1:
+        from flatcontact.ispes.contract import write_ispes
+        from flatcontact.ispes.shift_lattice import to_shift_cell
+
+        scan = dataclasses.replace(scan, dataset=to_shift_cell(scan.dataset, lattice))
+        write_ispes(scan.dataset, scan.ispes_path)
+        record.update(
+            a1_angstrom=np.asarray(scan.dataset.attrs["a1"], float).tolist(),
+            a2_angstrom=np.asarray(scan.dataset.attrs["a2"], float).tolist(),
+            area_angstrom2=float(scan.dataset.attrs["area"]),
+        )
     separated = _no_repulsive_branch(scan.dataset)
     if separated is not None:
         warnings.append(separated)
     for note in scan.notes:
         log.warning("scan: %s", note)
     result = ScanStageResult(scan, warnings, [scan.store_path, scan.ispes_path])
+    result.shift_lattice = record
     if "layer" in reference.arrays and "slab" in reference.arrays:
         from flatcontact.ispes.slip import slip_table, store_points
 
@@ -216,3 +252,35 @@ def run_scan(
         figure_scan_columns(scan.dataset, scan.adhesion), folder, SCAN_FIGURE, settings.report.svg
     )
     return result
+
+
+def _shift_lattice_grid(scan, reference) -> tuple[Any, tuple[int, int], dict]:
+    """The interface's shift lattice, the lateral grid to scan and the ``scan.json``
+    ``shift_lattice`` record (module docstring), checked before any point is relaxed.
+
+    Raises
+    ------
+    InputError
+        One line naming ``scan.grid`` and the index when the grid cannot be re-indexed onto
+        one period (:func:`flatcontact.ispes.shift_lattice.reindex`): never an aliased grid.
+    """
+    from flatcontact.ispes.shift_lattice import reindex, scan_grid, shift_lattice_of
+    from flatcontact.structures.interface_contract import in_plane_vectors
+
+    lattice = shift_lattice_of(reference, scan.symmetry.tolerance_angstrom)
+    lateral = scan_grid(scan.grid, lattice.index)
+    if lattice.index > 1:
+        reindex(lattice, *lateral)
+    a1, a2 = in_plane_vectors(reference)
+    area = float(abs(a1[0] * a2[1] - a1[1] * a2[0]))
+    record = {
+        "index": int(lattice.index),
+        "cell": "shift_lattice" if lattice.index > 1 else "interface",
+        "grid_requested": [int(v) for v in scan.grid],
+        "grid": list(lateral),
+        "a1_angstrom": np.asarray(a1, float).tolist(),
+        "a2_angstrom": np.asarray(a2, float).tolist(),
+        "area_angstrom2": area,
+        "interface_area_angstrom2": area,
+    }
+    return lattice, lateral, record

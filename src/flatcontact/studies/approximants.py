@@ -11,12 +11,13 @@ skips every finished stage.
 The grid (docs/incommensurate.md, "The approximant study"): the ISPES of a coincidence cell
 is periodic in the shift lattice Λ_1 + Λ_2 (:mod:`flatcontact.ispes.shift_lattice`), whose
 cell is ``index`` times smaller than the supercell (N² for an N-cell twist). Each cell is
-scanned on an ``n × n`` grid over its supercell with n the base grid (``scan.grid``, the
-density per period of the untwisted contact) raised to the next integer coprime to the
-index; that grid visits an ``n × n`` grid over ONE period of the landscape, so the scan
-costs the base grid's points, and :func:`~flatcontact.ispes.shift_lattice.to_shift_cell`
-re-indexes it onto that period (``runs/<label>/shift-cell/ispes.nc``). The analysis and the
-laws (the stages' own functions) and the validity gates run on that file
+scanned by the ordinary scan stage (:mod:`flatcontact.stages.scan`), which picks the grid
+(:func:`~flatcontact.ispes.shift_lattice.scan_grid`: the base grid ``scan.grid``, the
+density per period of the untwisted contact, raised to the next integer coprime to the
+index; :func:`plan` states it with the same function) and writes its ``ispes.nc``
+re-indexed onto ONE period of the landscape; the study copies it to
+``runs/<label>/shift-cell/ispes.nc``. The analysis and the laws (the stages' own functions)
+and the validity gates (:func:`flatcontact.stages.gates.evaluate_gates`) run on that file
 (``shift-cell/analyze``, ``shift-cell/laws``); the loads are the configuration's
 (pressures are intensive: the same loads for every cell).
 
@@ -51,7 +52,7 @@ import numpy as np
 from flatcontact.config.run import RunConfig
 from flatcontact.errors import InputError
 from flatcontact.ispes.executors import make_executor
-from flatcontact.ispes.shift_lattice import grid_size_for
+from flatcontact.ispes.shift_lattice import scan_grid
 from flatcontact.layout import FRICTION_CSV, FRICTION_NC, INTERFACE, ISPES_NC, LAWS_JSON, SCAN_JSON
 from flatcontact.studies.scaling import fit_scaling
 from flatcontact.studies.variants import variant_config
@@ -89,7 +90,6 @@ def plan(cfg: RunConfig) -> list[dict]:
     from flatcontact.structures.approximants import approximant_sequence
 
     cells = approximant_sequence(cfg.section("structure"), cfg.approximants)
-    base = max(cfg.scan.grid)
     n_z = (
         cfg.scan.p_range_gpa.n
         if cfg.scan.p_range_gpa is not None
@@ -98,8 +98,8 @@ def plan(cfg: RunConfig) -> list[dict]:
     out = []
     for a in cells:
         index = planned_index(a)
-        n = grid_size_for(base, index)
-        scan = {"grid": [n, n]}
+        n_a, n_b = scan_grid(cfg.scan.grid, index)
+        scan = {"grid": [n_a, n_b]}
         if index > 1:
             # the scan's shift-space group checks every pair of the slabs' translations: N²
             # stack checks per point operation (227 s for the 76-atom (2, 3) cell against
@@ -117,11 +117,11 @@ def plan(cfg: RunConfig) -> list[dict]:
                 "strain_percent_slab1": _max_abs(a.strain_percent_slab1),
                 "strain_percent_slab2": _max_abs(a.strain_percent_slab2),
                 "shift_lattice_index": index,
-                "grid": [n, n],
+                "grid": [n_a, n_b],
                 # grid points as planned (the load bracket may add thicknesses); a rigid-layers
                 # point costs one force call, a relaxed one ~10 (docs/incommensurate.md)
-                "points_planned": n * n * n_z,
-                "atom_points_planned": n * n * n_z * a.n_atoms,
+                "points_planned": n_a * n_b * n_z,
+                "atom_points_planned": n_a * n_b * n_z * a.n_atoms,
                 "structure_override": a.structure_override,
                 "config": config,
             }
@@ -152,52 +152,28 @@ def lateral_range_mev_per_a2(shifted) -> float:
     return 1e3 * float(np.nanmax(np.nanmax(e, axis=(0, 1)) - np.nanmin(e, axis=(0, 1))))
 
 
-def _gates(cfg: RunConfig, root: Path, lattice) -> dict:
-    """The validity gates on the shift-cell analysis: the scan's (in-slab slip, load folds),
-    the laws' (negative slope), the landscape's (degenerate minima) and the broken-symmetry
-    gate on the interface's whole shift-space group restated on the shift cell."""
-    from flatcontact.analysis import gates as gate_lib
-    from flatcontact.ispes.shift_lattice import shift_cell_operations
-    from flatcontact.ispes.shift_symmetry import shift_space_group
-    from flatcontact.stages.gates import GateInputs, evaluate_gates
-    from flatcontact.structures.interface_io import read_interface
+def _gates(cfg: RunConfig, root: Path) -> dict:
+    """The validity gates of the ordinary run (:func:`flatcontact.stages.gates.evaluate_gates`)
+    on the shift-cell analysis: the scan's (in-slab slip, load folds), the laws' (negative
+    slope), the landscape's (degenerate minima) and the broken-symmetry gate on the
+    interface's shift-space group restated on the shift cell."""
+    from flatcontact.stages.gates import GateInputs, evaluate_gates, shift_group_operations
 
     cell = root / SHIFT_CELL
-    report = evaluate_gates(
-        GateInputs(
-            interface=None,
-            scan_json=cell / SCAN_JSON,
-            friction_nc=cell / "analyze" / FRICTION_NC,
-            laws_json=cell / "laws" / LAWS_JSON,
-        )
-    )
-    findings = list(report.findings)
-    group = shift_space_group(
-        read_interface(root / "01-build" / INTERFACE),
-        cfg.scan.symmetry.tolerance_angstrom,
+    inputs = GateInputs(
+        interface=root / "01-build" / INTERFACE,
+        scan_json=cell / SCAN_JSON,
+        friction_nc=cell / "analyze" / FRICTION_NC,
+        laws_json=cell / "laws" / LAWS_JSON,
+        symmetry_tolerance_angstrom=cfg.scan.symmetry.tolerance_angstrom,
         spread_compression=cfg.scan.relax_mode != "rigid",
-        modulo_translations=True,
     )
-    ops = shift_cell_operations(
-        lattice, [(np.array(op.matrix), np.array(op.translation)) for op in group.operations]
-    )
-    import xarray as xr
-
-    with xr.open_dataset(cell / "analyze" / FRICTION_NC, engine="h5netcdf") as fr:
-        broken = gate_lib.broken_symmetry(
-            np.asarray(fr["energy_map"].values, float),
-            [float(v) for v in fr["p_gpa"].values],
-            np.asarray(fr.attrs["a1"], float),
-            np.asarray(fr.attrs["a2"], float),
-            ops,
-        )
-    if broken is not None:
-        findings.append(broken)
+    report = evaluate_gates(inputs)
     return {
-        "fired": [f.gate for f in findings],
-        "messages": [f"{f.gate}: {f.message}" for f in findings],
-        "not_checked": [g for g in report.not_checked if g != "broken_symmetry"],
-        "shift_group_order_on_shift_cell": len(ops),
+        "fired": [f.gate for f in report.findings],
+        "messages": [f"{f.gate}: {f.message}" for f in report.findings],
+        "not_checked": list(report.not_checked),
+        "shift_group_order_on_shift_cell": len(shift_group_operations(inputs)),
     }
 
 
@@ -206,11 +182,7 @@ def run_cell(config: dict, folder: str, planned: int) -> dict:
     ``folder``: build and scan through the pipeline, then the ISPES on one shift-lattice
     period, its analysis, laws and gates (module docstring). Module-level with plain
     arguments so an executor can run cells side by side."""
-    from flatcontact.ispes.shift_lattice import (
-        shift_lattice_of,
-        to_shift_cell,
-        translation_noise_ev_per_a2,
-    )
+    from flatcontact.ispes.shift_lattice import shift_lattice_of, translation_noise_ev_per_a2
     from flatcontact.pipeline import Pipeline
     from flatcontact.potentials.engines import make_calculator
     from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
@@ -232,17 +204,18 @@ def run_cell(config: dict, folder: str, planned: int) -> dict:
         build_folder = pipe.folder("build")
     reference = read_interface(build_folder / INTERFACE)
     lattice = shift_lattice_of(reference, cfg.scan.symmetry.tolerance_angstrom)
-    if lattice.index != planned:
+    if lattice.index != planned or scan["shift_lattice"]["index"] != planned:
         raise InputError(
-            f"approximants: the built cell's shift lattice has index {lattice.index}, the plan "
-            f"{planned}; the grid {cfg.scan.grid} was chosen for the plan"
+            f"approximants: the built cell's shift lattice has index {lattice.index} (the scan "
+            f"{scan['shift_lattice']['index']}), the plan {planned}; the grid {cfg.scan.grid} "
+            "was chosen for the plan"
         )
     cell = root / SHIFT_CELL
     if cell.exists():
         shutil.rmtree(cell)  # derived from the scan: rebuilt every time (seconds)
     cell.mkdir(parents=True)
-    shifted = to_shift_cell(ds, lattice)
-    shifted.to_netcdf(cell / ISPES_NC, engine="h5netcdf")
+    shifted = ds  # the scan stage's ispes.nc: already on one shift-lattice period
+    shutil.copy2(scan_folder / ISPES_NC, cell / ISPES_NC)
     shutil.copy2(scan_folder / SCAN_JSON, cell / SCAN_JSON)
     noise = 1e3 * translation_noise_ev_per_a2(
         reference, make_calculator(cfg.potential, reference), lattice
@@ -259,7 +232,7 @@ def run_cell(config: dict, folder: str, planned: int) -> dict:
         form = laws.get("energy_form") or cfg.analysis.energy_form
         law = laws.get(form) if isinstance(laws.get(form), dict) else laws
         p_low, barrier = corrugation_mev_per_a2(cell / "analyze" / FRICTION_NC)
-        gates = _gates(cfg, root, lattice)
+        gates = _gates(cfg, root)
     else:  # noise only: the analysis of a noise landscape costs minutes and means nothing
         gates = {
             "fired": [],

@@ -24,6 +24,7 @@ from flatcontact.config.run import RunConfig
 from flatcontact.errors import InputError
 from flatcontact.ispes.executors import make_executor
 from flatcontact.studies.compare import largest_change, law_changes
+from flatcontact.studies.estimate import base_measurements, estimate_convergence
 from flatcontact.studies.runner import run_variant
 from flatcontact.studies.variants import (
     base_value,
@@ -54,11 +55,19 @@ def _run_round(executor, jobs: list[tuple], on_done: Callable | None) -> dict:
 
 
 def run_convergence(
-    cfg: RunConfig, out: str | Path, on_done: Callable[[str, dict], None] | None = None
+    cfg: RunConfig,
+    out: str | Path,
+    on_done: Callable[[str, dict], None] | None = None,
+    on_estimate: Callable[[dict], None] | None = None,
+    estimate_only: bool = False,
 ) -> dict:
     """Run the convergence study of ``cfg`` into ``out``; returns the ``study.json`` document.
 
-    ``on_done(name, result)`` is told when each variant finishes (the CLI prints a line).
+    ``on_done(name, result)`` is told when each variant finishes (the CLI prints a line);
+    ``on_estimate(estimate)`` once the base has run, with the cost of every rung extrapolated
+    from it (:func:`flatcontact.studies.estimate.estimate_convergence`). With
+    ``estimate_only`` the study stops there and returns ``{"study": "estimate", **estimate}``
+    (the base run stays, shared with the study that follows).
     """
     out = Path(out)
     settings, skipped = chosen_settings(cfg)
@@ -77,6 +86,13 @@ def run_convergence(
     )
     try:
         results = _run_round(executor, [("base", cfg.to_dict(), str(base_dir), None)], on_done)
+        if "error" in results["base"]:
+            raise InputError(f"the base configuration failed: {results['base']['error']}")
+        estimate = estimate_convergence(cfg, ladder, base_measurements(base_dir), executor.workers)
+        if on_estimate is not None:
+            on_estimate(estimate)
+        if estimate_only:
+            return {"study": "estimate", **estimate}
         status = {s: {"state": "open", "steps": 0} for s in settings}
         previous = {s: "base" for s in settings}
         for level in range(1, r.max_steps + 1):
@@ -172,6 +188,7 @@ def run_convergence(
         "delta": {
             f: {k: (0.0 if math.isnan(v) else v) for k, v in d.items()} for f, d in delta.items()
         },
+        "estimate": estimate,
         "cost": {
             "force_calls_study": spent,
             "force_calls_stored": stored,

@@ -25,6 +25,7 @@ from flatcontact.errors import InputError
 from flatcontact.ispes.executors import make_executor
 from flatcontact.potentials.presets import PRESETS
 from flatcontact.studies.convergence import FORMS, _run_round
+from flatcontact.studies.variants import without_foreign_uncertainty
 
 
 def model_section(spec: str) -> tuple[str, dict]:
@@ -59,10 +60,10 @@ def run_models(cfg: RunConfig, models: list[str], out: str | Path, on_done=None)
     for label, section in entries:
         data = {**cfg.to_dict(), "potential": section}
         try:
-            RunConfig.model_validate(data)
+            variant = without_foreign_uncertainty(RunConfig.model_validate(data))
         except ValidationError as exc:
             raise one_line(exc, f"--models {label}") from None
-        jobs.append((label, data, str(out / "runs" / _slug(label)), None))
+        jobs.append((label, variant.to_dict(), str(out / "runs" / _slug(label)), None))
     executor = make_executor(
         cfg.scan.executor, cfg.scan.workers, cfg.scan.dask_address, cfg.scan.jobqueue
     )

@@ -18,6 +18,7 @@ from flatcontact.config.merge import merge_config
 from flatcontact.config.refine import REFINABLE
 from flatcontact.config.run import RunConfig
 from flatcontact.errors import InputError
+from flatcontact.potentials.styles import CUTOFF_FIRST_STYLES, style_cutoff_angstrom, with_cutoff
 
 #: Recipe kinds whose ``layers`` field is a slab thickness a study may refine (``slab`` and
 #: ``file`` read their layers from the structure file).
@@ -45,12 +46,57 @@ def applicable_settings(cfg: RunConfig) -> dict[str, str]:
         out["layers"] = f"structure.kind {cfg.structure.kind} has no layer count to refine"
     if cfg.scan.relax_mode == "rigid":
         out["fmax"] = "scan.relax_mode rigid relaxes nothing"
-    if cfg.potential.calculator is not None or cfg.potential.coupling != "lj":
+    if cfg.potential.calculator is not None or (
+        cfg.potential.coupling != "lj" and not interlayer_cutoffs(cfg)
+    ):
         out["cutoff"] = (
             f"the cross-interface coupling ({cfg.potential.coupling}) has no cutoff setting "
-            "of its own (only coupling: lj has potential.lj.cutoff_angstrom)"
+            "of its own (coupling: lj has potential.lj.cutoff_angstrom, coupling: interlayer "
+            f"a cutoff argument of {', '.join(sorted(CUTOFF_FIRST_STYLES))})"
         )
     return out
+
+
+def _interlayer_styles(cfg: RunConfig) -> list[dict]:
+    """The ``potential.interlayer`` styles of ``cfg`` as plain data (one or a list)."""
+    data = cfg.to_dict()["potential"].get("interlayer")
+    if data is None:
+        return []
+    return [data] if isinstance(data, dict) else list(data)
+
+
+def interlayer_cutoffs(cfg: RunConfig) -> list[float]:
+    """The global cutoffs (Å) of the interlayer styles that take one (``coupling: interlayer``)."""
+    if cfg.potential.coupling != "interlayer":
+        return []
+    cuts = (style_cutoff_angstrom(s["pair_style"]) for s in _interlayer_styles(cfg))
+    return [c for c in cuts if c is not None]
+
+
+def _cutoff_step(cfg: RunConfig, level: int) -> tuple[dict, float, str]:
+    """Overrides, x value and label of the cross-interface cutoff refined ``level`` times.
+
+    ``coupling: lj``: the LJ cutoff + level · step (the energy is shifted to zero there).
+    ``coupling: interlayer``: every interlayer style with a cutoff argument (KC, ILP,
+    coul/shield) gets its own cutoff + level · step, its taper flag kept: the taper takes the
+    term smoothly to zero at the new cutoff, so every step is a continuous potential; the
+    ladder only lengthens the cutoff from the model's own (the fitted 16 Å of the presets),
+    it never cuts into the range the model was fitted with.
+    """
+    add = level * cfg.refine.cutoff_step_angstrom
+    if cfg.potential.coupling == "lj":
+        rc = cfg.potential.lj.cutoff_angstrom + add
+        return {"potential": {"lj": {"cutoff_angstrom": rc}}}, rc, f"LJ cutoff {rc:g} Å"
+    styles = []
+    for s in _interlayer_styles(cfg):
+        rc = style_cutoff_angstrom(s["pair_style"])
+        styles.append(
+            s if rc is None else {**s, "pair_style": with_cutoff(s["pair_style"], rc + add)}
+        )
+    rc = interlayer_cutoffs(cfg)[0] + add
+    potential = cfg.to_dict()["potential"]  # whole: an interlayer entry replaces the model
+    interlayer = styles[0] if isinstance(potential["interlayer"], dict) else styles
+    return {"potential": {**potential, "interlayer": interlayer}}, rc, f"interlayer cutoff {rc:g} Å"
 
 
 def chosen_settings(cfg: RunConfig) -> tuple[list[str], dict[str, str]]:
@@ -101,9 +147,7 @@ def step(cfg: RunConfig, setting: str, level: int) -> Variant:
         over = {"scan": {"fmax_ev_per_angstrom": fmax}}
         value, label = fmax, f"fmax {fmax:.3g} eV/Å"
     elif setting == "cutoff":
-        rc = cfg.potential.lj.cutoff_angstrom + level * r.cutoff_step_angstrom
-        over = {"potential": {"lj": {"cutoff_angstrom": rc}}}
-        value, label = rc, f"LJ cutoff {rc:g} Å"
+        over, value, label = _cutoff_step(cfg, level)
     else:
         raise InputError(
             f"refine.settings: expected some of {', '.join(REFINABLE)}, got {setting!r}"
@@ -122,17 +166,48 @@ def base_value(cfg: RunConfig, setting: str) -> float:
         return float(cfg.structure.layers)
     if setting == "fmax":
         return float(scan.fmax_ev_per_angstrom)
+    if cfg.potential.coupling == "interlayer" and interlayer_cutoffs(cfg):
+        return interlayer_cutoffs(cfg)[0]
     return float(cfg.potential.lj.cutoff_angstrom)
 
 
+def without_foreign_uncertainty(cfg: RunConfig) -> RunConfig:
+    """``cfg`` without its ``uncertainty`` block when that was measured on another structure or model.
+
+    A variant of a study changes the structure (layers) or the model (cutoff, ``--models``) of a
+    base that may carry a measured block (the ``paper`` preset's quartz numbers): the block does
+    not apply to the variant, and the run would refuse it
+    (:func:`flatcontact.stages.measured_on.check_measured_on`). The study measures the variant's
+    τ and σ_MSS, which the block does not touch, so the variant runs without it. A block that
+    applies (the variants of the scan settings) is kept, so their stage fingerprints are those
+    of the base's own configuration.
+    """
+    from flatcontact.stages.measured_on import measured_on
+
+    recorded = cfg.uncertainty.measured_on
+    if not recorded:
+        return cfg
+    mine = measured_on(cfg)
+    if all(recorded[k] == mine[k] for k in recorded if k in mine):
+        return cfg
+    data = cfg.to_dict()
+    del data["uncertainty"]
+    return RunConfig.model_validate(data)
+
+
 def variant_config(cfg: RunConfig, overrides: dict, source: str) -> RunConfig:
-    """``cfg`` with ``overrides`` laid over it, validated (one-line InputError naming ``source``)."""
+    """``cfg`` with ``overrides`` laid over it, validated (one-line InputError naming ``source``).
+
+    An ``uncertainty`` block measured on another structure or model than the variant's is
+    dropped (:func:`without_foreign_uncertainty`).
+    """
     from flatcontact.config.messages import one_line
 
     try:
-        return RunConfig.model_validate(merge_config(cfg.to_dict(), overrides))
+        out = RunConfig.model_validate(merge_config(cfg.to_dict(), overrides))
     except ValidationError as exc:
         raise one_line(exc, source) from None
+    return without_foreign_uncertainty(out)
 
 
 def shares_build(setting: str) -> bool:

@@ -1,0 +1,192 @@
+"""What a convergence study will cost, extrapolated from its base run, before the variants run.
+
+``flatcontact study convergence CONFIG --estimate`` runs (or reuses) the base, the run every
+setting shares, and prints per variant of every ladder: the points of its scan (lateral grid
+points × thicknesses), the irreducible points it computes, its force calls and its time, so a
+user knows whether the study fits the machine before spending it. The study itself prints
+the same table after its base round and stores it in ``study.json`` (``estimate``) beside
+what was spent.
+
+Extrapolation from the base (``b``) to a variant (``v``), the rules stated per setting:
+
+* points = ``grid_x · grid_y · thicknesses``; the thicknesses are the base scan's own list
+  (the requested ones plus those the probe column added to reach P = 0, at the requested
+  spacing), and a thickness step samples the same z range at the refined spacing,
+  ``T_v = 1 + (T_b − 1)(R_v − 1)/(R_b − 1)`` (R: requested thicknesses). The probe may add
+  a few more or fewer thicknesses for another grid or spacing: on the toy the points came out
+  within 10 % (tests/studies/test_estimate.py);
+* computed points (the irreducible registries the scan relaxes) scale with the points:
+  ``C_v = C_b · points_v / points_b`` (the interface's symmetry fraction is kept);
+* force calls = the base's force calls per computed point × ``C_v``. For ``fmax`` and
+  ``cutoff`` steps this is a lower bound (a tighter tolerance takes more optimiser steps;
+  nothing relaxes in ``rigid``/``rigid-layers`` scans, where it is exact);
+* scan seconds = the base's scan seconds per force call × force calls, times
+  ``layers_v / layers_b`` for a layers step (cost per call ∝ atoms for the short-ranged
+  potentials used here); build, analyze and laws take the base's seconds (a layers or cutoff
+  variant rebuilds: the base's build seconds are counted for it, others share the base's).
+
+Wall time: each round runs its variants side by side on ``workers`` processes, so a round
+takes ``max(Σ seconds / workers, max seconds)``; the total assumes every setting uses all
+``max_steps`` steps (an upper bound: a converged setting stops).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+from flatcontact.config.run import RunConfig
+from flatcontact.layout import SCAN_JSON, STAGES
+from flatcontact.rundir import RECORD_NAME
+from flatcontact.studies.variants import Variant, base_value, shares_build
+
+#: The stages a variant runs (the study's runner stops after laws).
+STUDY_STAGES = ("build", "scan", "analyze", "laws")
+
+
+def base_measurements(base_dir: str | Path) -> dict:
+    """What the finished base run measured: points, force calls and seconds per stage.
+
+    Returns
+    -------
+    dict
+        ``grid`` [nx, ny], ``thicknesses`` (the scan's own list, probe additions included),
+        ``points_total``, ``points_computed``, ``force_calls``, ``seconds`` (stage -> s).
+    """
+    root = Path(base_dir)
+    folder = {s: root / f"{STAGES[s]:02d}-{s}" for s in STUDY_STAGES}
+    scan = json.loads((folder["scan"] / SCAN_JSON).read_text())
+    seconds = {}
+    for s in STUDY_STAGES:
+        record = json.loads((folder[s] / RECORD_NAME).read_text())
+        seconds[s] = float(record.get("seconds") or 0.0)
+    inputs = json.loads((folder["scan"] / RECORD_NAME).read_text())["inputs"]["scan"]
+    return {
+        "grid": [int(g) for g in inputs["grid"]],
+        "thicknesses": len(scan["thickness_angstrom"]),
+        "points_total": int(scan["points_total"]),
+        "points_computed": int(scan.get("points_computed") or scan["points_total"]),
+        "force_calls": int(scan["force_calls_total"]),
+        "seconds": seconds,
+    }
+
+
+def _requested_thicknesses(cfg: RunConfig) -> int:
+    scan = cfg.scan
+    return scan.p_range_gpa.n if scan.p_range_gpa is not None else len(scan.thickness_angstrom)
+
+
+def _variant_estimate(cfg: RunConfig, v: Variant, base: dict) -> dict:
+    grid = list(base["grid"])
+    thick = base["thicknesses"]
+    if v.setting == "grid":
+        grid = [int(g) for g in v.overrides["scan"]["grid"]]
+    elif v.setting == "thicknesses":
+        requested = _requested_thicknesses(cfg)
+        thick = round(1 + (thick - 1) * (v.value - 1) / max(requested - 1, 1))
+    points = grid[0] * grid[1] * thick
+    computed = base["points_computed"] * points / base["points_total"]
+    calls_per_point = base["force_calls"] / max(base["points_computed"], 1)
+    calls = calls_per_point * computed
+    per_call = base["seconds"]["scan"] / max(base["force_calls"], 1)
+    scan_s = per_call * calls
+    if v.setting == "layers":
+        scan_s *= v.value / base_value(cfg, "layers")
+    build_s = 0.0 if shares_build(v.setting) else base["seconds"]["build"]
+    seconds = build_s + scan_s + base["seconds"]["analyze"] + base["seconds"]["laws"]
+    return {
+        "name": v.name,
+        "setting": v.setting,
+        "level": v.level,
+        "label": v.label,
+        "grid": grid,
+        "thicknesses": thick,
+        "points": points,
+        "points_computed": round(computed),
+        "force_calls": round(calls),
+        "seconds": seconds,
+        "lower_bound": v.setting in ("fmax", "cutoff")
+        and cfg.scan.relax_mode not in ("rigid", "rigid-layers"),
+    }
+
+
+def estimate_convergence(
+    cfg: RunConfig, ladder: dict[str, list[Variant]], base: dict, workers: int
+) -> dict:
+    """The cost of every rung of ``ladder`` extrapolated from the measured ``base``.
+
+    Parameters
+    ----------
+    cfg
+        The study's base configuration.
+    ladder
+        Setting -> its variants, level 1 … ``max_steps`` (:func:`flatcontact.studies.
+        variants.step`).
+    base
+        :func:`base_measurements` of the finished base run.
+    workers
+        Variants run side by side (the study's executor).
+
+    Returns
+    -------
+    dict
+        ``base`` (as measured), ``variants`` (one estimate each), ``force_calls_study``
+        (every rung once, the base once), ``force_calls_from_scratch`` (each setting's
+        ladder with its own base), ``serial_seconds`` (every run one after another) and
+        ``wall_seconds`` (rounds of ``workers`` side by side, every setting using all its
+        steps: an upper bound). Seconds are the base's wall seconds scaled: they carry the
+        machine's load while the base ran.
+    """
+    variants = [_variant_estimate(cfg, v, base) for steps in ladder.values() for v in steps]
+    base_seconds = sum(base["seconds"].values())
+    calls = base["force_calls"] + sum(v["force_calls"] for v in variants)
+    scratch = calls + base["force_calls"] * max(len(ladder) - 1, 0)
+    wall = base_seconds
+    levels = max((len(s) for s in ladder.values()), default=0)
+    for level in range(1, levels + 1):
+        round_s = [v["seconds"] for v in variants if v["level"] == level]
+        if round_s:
+            wall += max(sum(round_s) / max(workers, 1), max(round_s))
+    return {
+        "base": base,
+        "variants": variants,
+        "force_calls_study": calls,
+        "force_calls_from_scratch": scratch,
+        "serial_seconds": base_seconds + sum(v["seconds"] for v in variants),
+        "wall_seconds": wall,
+        "workers": workers,
+    }
+
+
+def estimate_lines(est: dict) -> list[str]:
+    """The estimate as console lines: one per variant, then the totals."""
+    b = est["base"]
+    lines = [
+        f"estimate from the base ({b['grid'][0]}x{b['grid'][1]}, {b['thicknesses']} thicknesses: "
+        f"{b['points_total']} points, {b['points_computed']} computed, {b['force_calls']} force "
+        f"calls, {sum(b['seconds'].values()):.0f} s):"
+    ]
+    for v in est["variants"]:
+        bound = " (lower bound)" if v["lower_bound"] else ""
+        lines.append(
+            f"  {v['name']} ({v['label']}): {v['points']} points, ~{v['points_computed']} "
+            f"computed, ~{v['force_calls']} force calls{bound}, ~{_duration(v['seconds'])}"
+        )
+    lines.append(
+        f"  all {len(est['variants'])} variants: ~{est['force_calls_study']} force calls "
+        f"(each setting from scratch: ~{est['force_calls_from_scratch']}), "
+        f"~{_duration(est['serial_seconds'])} one after another, ~{_duration(est['wall_seconds'])} on "
+        f"{est['workers']} worker(s) if no setting converges early"
+    )
+    return lines
+
+
+def _duration(seconds: float) -> str:
+    if not math.isfinite(seconds):
+        return "?"
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    if seconds < 7200:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"

@@ -1,0 +1,118 @@
+"""An ordinary run of a commensurate twist cell reads its ISPES on the real period (issue 23).
+
+The energy of the (1, 2) twisted bilayer (28 atoms) repeats on a shift lattice 7 × 7 times
+finer than its cell (:mod:`flatcontact.ispes.shift_lattice`). A 6 × 6 grid over the cell is
+the 6 × 6 points of ONE period in another order; read as one period of the cell it gives a
+τ0 seven times too small (0.200 MPa, docs/incommensurate.md). The scan stage re-indexes it
+onto the period, so the plain pipeline gives the study's 1.402 MPa; a 1×1 cell (the AB
+bilayer) keeps its cell.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from flatcontact.analysis.analyze import analyze_ispes
+from flatcontact.config import build_config
+from flatcontact.ispes.contract import open_ispes
+from flatcontact.ispes.shift_lattice import reindex, shift_lattice_of
+from flatcontact.pipeline import Pipeline
+from flatcontact.structures.interface_contract import in_plane_vectors
+from flatcontact.structures.interface_io import read_interface
+
+TBG_12 = {
+    "structure": {"kind": "sheets", "sheet": "graphene", "layers": 1, "twist": [1, 2]},
+    "potential": {"preset": "graphene-rebo-kc"},
+    "scan": {
+        "grid": [6, 6],
+        "p_range_gpa": {"lo_gpa": 0.0, "hi_gpa": 2.0, "n": 4},
+        "relax_mode": "rigid-layers",
+        "executor": "serial",
+    },
+    "analysis": {"p_gpa": [0.0, 0.5, 1.0, 1.5], "direction_deg": "auto"},
+    "contact": {"p0_gpa": [0.5, 1.0], "contact_modulus_gpa": 30, "shear_modulus_gpa": 10},
+    "report": {"svg": False},
+}
+
+
+def _on_the_supercell(ds, lattice):
+    """The scan's points put back where the scan computed them: a grid over the supercell,
+    read as if it were one period (what the analysis read before issue 23 was fixed)."""
+    ta, tb = reindex(lattice, ds.sizes["shift_a"], ds.sizes["shift_b"])
+    out = ds.copy(deep=True)
+    for name, var in ds.data_vars.items():
+        if var.dims[:2] == ("shift_a", "shift_b"):
+            values = np.asarray(var.values)[ta, tb]
+            if name == "energy":
+                values = values * lattice.index
+            out[name] = (var.dims, values, dict(var.attrs))
+    for key in ("symmetry_order", "symmetry_matrices", "symmetry_translations"):
+        out.attrs.pop(key, None)
+    out.attrs.update(
+        a1=ds.attrs["supercell_a1"], a2=ds.attrs["supercell_a2"], area=ds.attrs["supercell_area"]
+    )
+    return out
+
+
+@pytest.mark.slow
+def test_a_plain_run_of_the_1_2_twist_reads_the_real_period(tmp_path):
+    """build → scan → analyze → laws → contact of the (1, 2) cell, rigid-layers REBO + KC.
+
+    The stored landscape is one period: its vectors are the supercell's divided by
+    N = m² + mn + n² = 7 (computed here from the built cell), ``scan.json`` says so, the
+    laws give the study's τ0 = 1.402 MPa (docs/incommensurate.md) and no gate fires. The
+    same values put back on the supercell grid give τ 7× smaller (the 0.200 MPa artefact:
+    the same values over a 7× longer distance). Measured: τ0 1.40225 MPa, ~70 s (shared
+    machine)."""
+    root = tmp_path / "tbg12"
+    with Pipeline(build_config(TBG_12), root) as pipe:
+        pipe.run()
+        laws = pipe.laws()
+        scan = pipe.scan_summary()
+        ds = pipe.scan()
+    reference = read_interface(root / "01-build" / "interface.extxyz")
+    a1, a2 = in_plane_vectors(reference)
+    cells = 1 * 1 + 1 * 2 + 2 * 2
+    np.testing.assert_allclose(np.asarray(ds.attrs["a1"])[:2], np.asarray(a1)[:2] / cells)
+    np.testing.assert_allclose(np.asarray(ds.attrs["a2"])[:2], np.asarray(a2)[:2] / cells)
+    assert int(ds.attrs["shift_lattice_index"]) == cells**2
+    record = scan["shift_lattice"]
+    assert record["index"] == 49 and record["cell"] == "shift_lattice"
+    assert record["grid"] == [6, 6] and math.isclose(
+        record["area_angstrom2"] * 49, record["interface_area_angstrom2"], rel_tol=1e-9
+    )
+    assert laws["tau0_mpa"] == pytest.approx(1.402, abs=0.005)
+    summary = json.loads((root / "06-contact" / "summary.json").read_text())
+    assert summary["gates"]["fired"] == []
+    assert "broken_symmetry" not in summary["gates"]["not_checked"]
+
+    aliased = analyze_ispes(
+        _on_the_supercell(open_ispes(root / "02-scan" / "ispes.nc"), shift_lattice_of(reference)),
+        [0.0],
+        direction_deg="auto",
+        threshold_gpa=None,
+    )
+    tau_aliased = aliased.pressures[0].friction.tau_mpa
+    assert tau_aliased == pytest.approx(0.200, abs=0.01)
+    assert laws["internal"]["loads"][0]["tau_mpa"] / tau_aliased == pytest.approx(7.0, rel=0.02)
+
+
+@pytest.mark.slow
+def test_a_one_by_one_cell_keeps_its_cell(tmp_path):
+    """The AB bilayer (index 1): the scan's grid and cell are the interface's, untouched."""
+    cfg = dict(TBG_12)
+    cfg["structure"] = {"kind": "sheets", "sheet": "graphene", "layers": 1}
+    cfg["analysis"] = {"p_gpa": [0.0, 0.5], "direction_deg": "auto"}
+    root = tmp_path / "ab"
+    with Pipeline(build_config(cfg), root) as pipe:
+        pipe.build()
+        ds = pipe.scan()
+        scan = pipe.scan_summary()
+    a1, _ = in_plane_vectors(read_interface(root / "01-build" / "interface.extxyz"))
+    assert scan["shift_lattice"]["index"] == 1 and scan["shift_lattice"]["cell"] == "interface"
+    assert "shift_lattice_index" not in ds.attrs
+    np.testing.assert_allclose(np.asarray(ds.attrs["a1"])[:2], np.asarray(a1)[:2])
