@@ -156,6 +156,39 @@ def _scaling_line(name: str, fit: dict) -> str:
     return f"{name}: " + "; ".join(parts)
 
 
+def _print_experiment_collapse(cfg, doc: dict, out: Path) -> None:
+    """Each cell's collapse stress at the experiment's conditions (``contact.experiment``):
+    printed and written to ``experiment_collapse.json``."""
+    from flatcontact.fileio import write_json_atomic
+    from flatcontact.studies.approximant_collapse import (
+        EXPERIMENT_COLLAPSE_JSON,
+        approximant_collapse,
+    )
+
+    rows = approximant_collapse(doc, cfg)
+    write_json_atomic(out / EXPERIMENT_COLLAPSE_JSON, rows)
+    console.print(
+        f"collapse stress at p0 = {rows['p0_gpa']:g} GPa (R {rows['radius_um']:g} um, E* "
+        f"{rows['contact_modulus_gpa']:g}, G* {rows['shear_modulus_gpa']:g} GPa; measured "
+        + ", ".join(f"{k} {v:g}" for k, v in rows["measured_mpa"].items())
+        + " MPa):",
+        highlight=False,
+        soft_wrap=True,
+    )
+    for r in rows["cells"]:
+        if r["collapse_stress_mpa"] is None:
+            value = "-"
+        else:
+            ratios = ", ".join(f"/{k} {v:.3g}" for k, v in r["ratio_to_measured"].items())
+            value = f"{r['collapse_stress_mpa']:.4g} MPa ({ratios})"
+        console.print(
+            f"  {r['label']}: {r['n_atoms']} atoms, tau0 {r['tau0_mpa']:.4g} MPa, collapse "
+            f"{value}" + (f"; {r['reason']}" if r["reason"] else ""),
+            highlight=False,
+            soft_wrap=True,
+        )
+
+
 @study_app.command("approximants")
 def approximants_command(
     config: Annotated[
@@ -202,6 +235,8 @@ def approximants_command(
     write_approximants(doc, out, _command_line())
     for key, name in (("tau0_mpa", "tau0"), ("barrier_mev_per_a2", "corrugation")):
         console.print(_scaling_line(name, doc["scaling"][key]), highlight=False, soft_wrap=True)
+    if cfg.contact.experiment.compare is not None:
+        _print_experiment_collapse(cfg, doc, out)
     c = doc["cost"]
     console.print(
         f"force calls: {c['force_calls_study']} (stored {c['force_calls_stored']}); "
