@@ -213,3 +213,24 @@ def test_the_group_modulo_translations_restates_to_the_whole_group_on_the_shift_
 
     assert restated(whole) == restated(reduced)
     assert len(restated(reduced)) == reduced.order
+
+
+def test_a_cell_that_repeats_only_nearly_is_refused_before_the_scan():
+    """A build relaxation of a coincidence cell modulates the sheets by 0.05–0.1 Å: the exact
+    shift lattice is then the supercell (index 1), the landscape still repeats 49 times in it,
+    and a 6×6 grid over the supercell would alias it (τ0 7× too small on the (1, 2) twist).
+    The scan stage refuses, in one line, before any point is relaxed; the exact cell passes."""
+    from types import SimpleNamespace
+
+    from flatcontact.stages.scan import _shift_lattice_grid
+
+    scan = SimpleNamespace(grid=[6, 6], symmetry=SimpleNamespace(tolerance_angstrom=1e-3))
+    atoms = _twisted(1, 2)
+    lattice, lateral, record = _shift_lattice_grid(scan, atoms)
+    assert lattice.index == 49 and record["cell"] == "shift_lattice"
+    wobbly = atoms.copy()
+    rng = np.random.default_rng(7)
+    wobbly.positions[:, :2] += rng.uniform(-0.05, 0.05, (len(atoms), 2))
+    with pytest.raises(InputError, match=r"^structure: slab \d of the built cell repeats 7 times .* but 1 times .*index 1\)") as err:
+        _shift_lattice_grid(scan, wobbly)
+    assert "\n" not in str(err.value)

@@ -254,6 +254,12 @@ def run_scan(
     return result
 
 
+#: Displacement (Å) within which a relaxed cell still repeats on a finer shift lattice: a build
+#: relaxation of a coincidence cell modulates the sheets by 0.05–0.1 Å (H-diamond(111) on
+#: graphene, measured), far below the 1.4 Å between unlike positions of a honeycomb.
+NEAR_PERIOD_TOLERANCE_ANGSTROM = 0.25
+
+
 def _shift_lattice_grid(scan, reference) -> tuple[Any, tuple[int, int], dict]:
     """The interface's shift lattice, the lateral grid to scan and the ``scan.json``
     ``shift_lattice`` record (module docstring), checked before any point is relaxed.
@@ -265,9 +271,24 @@ def _shift_lattice_grid(scan, reference) -> tuple[Any, tuple[int, int], dict]:
         one period (:func:`flatcontact.ispes.shift_lattice.reindex`): never an aliased grid.
     """
     from flatcontact.ispes.shift_lattice import reindex, scan_grid, shift_lattice_of
+    from flatcontact.ispes.shift_symmetry import self_translations
     from flatcontact.structures.interface_contract import in_plane_vectors
 
     lattice = shift_lattice_of(reference, scan.symmetry.tolerance_angstrom)
+    tol = scan.symmetry.tolerance_angstrom
+    for slab in (1, 2):
+        exact = len(self_translations(reference, slab, tol))
+        near = len(self_translations(reference, slab, NEAR_PERIOD_TOLERANCE_ANGSTROM))
+        if near > exact:
+            raise InputError(
+                f"structure: slab {slab} of the built cell repeats {near} times in the "
+                f"supercell to within {NEAR_PERIOD_TOLERANCE_ANGSTROM} Å but {exact} times to "
+                f"scan.symmetry.tolerance_angstrom = {tol} Å (shift lattice index "
+                f"{lattice.index}), as after a build relaxation of a twist or coincidence cell; "
+                "a grid over the supercell would alias that landscape: build the cell unrelaxed "
+                "(a large structure.fmax_ev_per_angstrom, as "
+                "examples/passivated-tip-h-diamond-graphene-approximants.yaml does)"
+            )
     lateral = scan_grid(scan.grid, lattice.index)
     if lattice.index > 1:
         reindex(lattice, *lateral)
