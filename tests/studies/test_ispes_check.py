@@ -92,10 +92,12 @@ def test_committee_spread_is_half_the_range_and_the_repeated_member_adds_nothing
     # the repeated member equals the first to round-off (see the test above): it adds nothing
     pair = committee_spread({k: results[k] for k in ("vashishta", "tersoff")})
     assert spread.keys() == pair.keys()
-    assert all(spread[k] == pytest.approx(pair[k], rel=1e-8) for k in pair)  # measured 3e-9
+    # round-off of the laws (≤ 1e-9 relative) on a spread that is a small difference of them
+    # (μ: 0.0198 of 1.06): 1e-9 MPa absolute, measured; 1e-7 allowed
+    assert all(spread[k] == pytest.approx(pair[k], rel=1e-8, abs=1e-7) for k in pair)
     for key in LAW_COEFFICIENTS:
         a, b = (results[m]["laws"][key] for m in ("vashishta", "tersoff"))
-        assert spread[key] == pytest.approx(abs(a - b) / 2, rel=1e-8)
+        assert spread[key] == pytest.approx(abs(a - b) / 2, rel=1e-8, abs=1e-7)
     assert max(spread.values()) > 0  # two different silica models: a non-zero spread
 
 

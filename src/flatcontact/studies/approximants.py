@@ -54,6 +54,7 @@ from flatcontact.errors import InputError
 from flatcontact.ispes.executors import make_executor
 from flatcontact.ispes.shift_lattice import scan_grid
 from flatcontact.layout import FRICTION_CSV, FRICTION_NC, INTERFACE, ISPES_NC, LAWS_JSON, SCAN_JSON
+from flatcontact.studies.runner import run_jobs
 from flatcontact.studies.scaling import fit_scaling
 from flatcontact.studies.variants import variant_config
 
@@ -269,28 +270,6 @@ def run_cell(config: dict, folder: str, planned: int) -> dict:
     }
 
 
-def _run_cells(executor, jobs: list[tuple], on_done: Callable | None) -> dict:
-    """Run ``jobs`` = [(label, config dict, folder, planned index)] through ``executor``."""
-    if executor.workers == 1 and len(jobs) > 1:  # a serial executor runs at submission:
-        out: dict = {}  # one cell at a time, so each is told as it ends
-        for job in jobs:
-            out.update(_run_cells(executor, [job], on_done))
-        return out
-    handles = {executor.submit(run_cell, c, f, i): label for label, c, f, i in jobs}
-    out: dict = {}
-    pending = set(handles)
-    while pending:
-        done, pending = executor.wait_first(pending)
-        for h in done:
-            try:
-                out[handles[h]] = executor.result(h)
-            except InputError as exc:  # one cell the builder, model or analysis refuses
-                out[handles[h]] = {"error": str(exc)}
-            if on_done is not None:
-                on_done(handles[h], out[handles[h]])
-    return out
-
-
 def run_approximants(
     cfg: RunConfig, out: str | Path, on_done: Callable[[str, dict], None] | None = None
 ) -> dict:
@@ -315,7 +294,7 @@ def run_approximants(
         for c in cells
     ]
     try:
-        results = _run_cells(executor, jobs, on_done)
+        results = run_jobs(executor, run_cell, jobs, on_done)
     finally:
         executor.close()
     rows = []

@@ -25,7 +25,7 @@ from flatcontact.errors import InputError
 from flatcontact.ispes.executors import make_executor
 from flatcontact.studies.compare import largest_change, law_changes
 from flatcontact.studies.estimate import base_measurements, estimate_convergence
-from flatcontact.studies.runner import run_variant
+from flatcontact.studies.runner import run_jobs, run_variant
 from flatcontact.studies.variants import (
     base_value,
     chosen_settings,
@@ -35,23 +35,6 @@ from flatcontact.studies.variants import (
 )
 
 FORMS = ("internal", "enthalpy")
-
-
-def _run_round(executor, jobs: list[tuple], on_done: Callable | None) -> dict:
-    """Run ``jobs`` = [(key, config dict, folder, share_from)] through ``executor``."""
-    handles = {executor.submit(run_variant, c, f, s): key for key, c, f, s in jobs}
-    out: dict = {}
-    pending = set(handles)
-    while pending:
-        done, pending = executor.wait_first(pending)
-        for h in done:
-            try:
-                out[handles[h]] = executor.result(h)
-            except InputError as exc:  # one variant the model or builder refuses: reported
-                out[handles[h]] = {"error": str(exc)}
-            if on_done is not None:
-                on_done(handles[h], out[handles[h]])
-    return out
 
 
 def run_convergence(
@@ -85,7 +68,9 @@ def run_convergence(
         cfg.scan.executor, cfg.scan.workers, cfg.scan.dask_address, cfg.scan.jobqueue
     )
     try:
-        results = _run_round(executor, [("base", cfg.to_dict(), str(base_dir), None)], on_done)
+        results = run_jobs(
+            executor, run_variant, [("base", cfg.to_dict(), str(base_dir), None)], on_done
+        )
         if "error" in results["base"]:
             raise InputError(f"the base configuration failed: {results['base']['error']}")
         estimate = estimate_convergence(cfg, ladder, base_measurements(base_dir), executor.workers)
@@ -104,7 +89,7 @@ def run_convergence(
                 v = ladder[s][level - 1]
                 share = str(base_dir) if shares_build(s) else None
                 jobs.append((v.name, configs[v.name], str(runs_dir / v.name), share))
-            results.update(_run_round(executor, jobs, on_done))
+            results.update(run_jobs(executor, run_variant, jobs, on_done))
             for s in open_:
                 v = ladder[s][level - 1]
                 status[s]["steps"] = level

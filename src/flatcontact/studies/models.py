@@ -24,7 +24,8 @@ from flatcontact.config.run import RunConfig
 from flatcontact.errors import InputError
 from flatcontact.ispes.executors import make_executor
 from flatcontact.potentials.presets import PRESETS
-from flatcontact.studies.convergence import FORMS, _run_round
+from flatcontact.studies.convergence import FORMS
+from flatcontact.studies.runner import run_jobs, run_variant
 from flatcontact.studies.variants import without_foreign_uncertainty
 
 
@@ -68,7 +69,7 @@ def run_models(cfg: RunConfig, models: list[str], out: str | Path, on_done=None)
         cfg.scan.executor, cfg.scan.workers, cfg.scan.dask_address, cfg.scan.jobqueue
     )
     try:
-        results = _run_round(executor, jobs, on_done)
+        results = run_jobs(executor, run_variant, jobs, on_done)
     finally:
         executor.close()
     variants = [

@@ -18,11 +18,13 @@ from __future__ import annotations
 import math
 import shutil
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import pandas as pd
 
 from flatcontact.config.run import RunConfig
+from flatcontact.errors import InputError
 from flatcontact.layout import FRICTION_CSV, RUN_MARKER, STAGES
 from flatcontact.pipeline import Pipeline
 
@@ -90,3 +92,31 @@ def run_variant(config: dict, folder: str, share_build_from: str | None = None) 
         "scan_action": action,
         "seconds": time.perf_counter() - t0,
     }
+
+
+def run_jobs(executor, task: Callable, jobs: list[tuple], on_done: Callable | None = None) -> dict:
+    """Run ``jobs`` = [(key, *arguments of task)] through ``executor``; ``{key: result}``.
+
+    A job that ``task`` refuses (:class:`~flatcontact.errors.InputError`: a variant or cell the
+    builder, model or analysis refuses) gives ``{"error": message}`` and the others go on.
+    ``on_done(key, result)`` is told as each job ends; a serial executor runs a job when it is
+    submitted, so there the jobs are submitted one at a time and each is told as it ends.
+    """
+    if executor.workers == 1 and len(jobs) > 1:
+        out: dict = {}
+        for job in jobs:
+            out.update(run_jobs(executor, task, [job], on_done))
+        return out
+    handles = {executor.submit(task, *args): key for key, *args in jobs}
+    out = {}
+    pending = set(handles)
+    while pending:
+        done, pending = executor.wait_first(pending)
+        for h in done:
+            try:
+                out[handles[h]] = executor.result(h)
+            except InputError as exc:
+                out[handles[h]] = {"error": str(exc)}
+            if on_done is not None:
+                on_done(handles[h], out[handles[h]])
+    return out
