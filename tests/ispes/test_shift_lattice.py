@@ -226,11 +226,14 @@ def test_a_cell_that_repeats_only_nearly_is_refused_before_the_scan():
 
     scan = SimpleNamespace(grid=[6, 6], symmetry=SimpleNamespace(tolerance_angstrom=1e-3))
     atoms = _twisted(1, 2)
-    lattice, lateral, record = _shift_lattice_grid(scan, atoms)
+    lattice, _, record = _shift_lattice_grid(scan, atoms)
     assert lattice.index == 49 and record["cell"] == "shift_lattice"
     wobbly = atoms.copy()
     rng = np.random.default_rng(7)
     wobbly.positions[:, :2] += rng.uniform(-0.05, 0.05, (len(atoms), 2))
-    with pytest.raises(InputError, match=r"^structure: slab \d of the built cell repeats 7 times .* but 1 times .*index 1\)") as err:
+    with pytest.raises(
+        InputError,
+        match=r"^structure: slab \d of the built cell repeats 7 times .* but 1 times .*index 1\)",
+    ) as err:
         _shift_lattice_grid(scan, wobbly)
     assert "\n" not in str(err.value)
