@@ -67,3 +67,43 @@ def test_lock_statement_names_every_slab_above_the_threshold_and_nothing_below()
     assert 0 < worst < LOCK_STRAIN_NOTE_PERCENT and lock_statement(fine) is None
     _, twisted = build_interface({"kind": "sheets", "sheet": "graphene", "twist": [1, 2]})
     assert twisted["recipe"]["match"]["kind"] == "twist" and lock_statement(twisted) is None
+
+
+def _registries(atoms, shared) -> int:
+    """Distinct registries of slab 2's primitive cells on slab 1's lattice: positions of slab
+    2's atoms modulo slab 1's primitive cell (from the cell and ``slab1_supercell``, rounded to
+    1e-3), over the atoms per primitive cell of slab 2 (2 for graphene), counted on the atoms."""
+    import numpy as np
+
+    match = shared["recipe"].get("match") or {"slab1_supercell": [[1, 0], [0, 1]]}
+    primitive = np.linalg.solve(np.asarray(match["slab1_supercell"], float), atoms.cell[:2, :2])
+    top = atoms[atoms.positions[:, 2] > atoms.positions[:, 2].mean()]
+    frac = np.linalg.solve(primitive.T, top.positions[:, :2].T).T
+    keys = {tuple(np.round(f, 3) % 1.0) for f in np.round(frac % 1.0, 3)}
+    return len(keys) // 2
+
+
+@pytest.mark.parametrize(("twist", "cells"), [((1, 2), 7), ((2, 3), 19)])
+def test_a_twist_cell_is_not_called_a_lock_in_one_registry(twist, cells, tmp_path):
+    """A commensurate twist puts slab 2's atoms in N = m² + mn + n² registries of slab 1's
+    lattice (counted here on the built atoms): the report says so instead of the 1×1 lock's
+    "every atom climbs the same barrier", and the AB bilayer keeps that warning."""
+    from flatcontact.report.sections.build import COMMENSURATE_WARNING, approximant_note
+    from flatcontact.report.sections.experiment import lock_text
+
+    m, n = twist
+    assert cells == m * m + m * n + n * n
+    atoms, shared = build_interface(
+        {"kind": "sheets", "sheet": "graphene", "stacking": "A", "twist": list(twist)}
+    )
+    assert _registries(atoms, shared) == cells
+    note = approximant_note(shared)
+    assert f"twist of {cells} primitive cells" in note and f"{cells} different registries" in note
+    assert "commensurate twist θ = " in lock_text(shared) and "no strain" in lock_text(shared)
+    cfg = load_config(EXAMPLES / "passivated-tip-graphene-ab.yaml")
+    notes = " ".join(interface_section(cfg, shared, tmp_path).notes)
+    assert "different registries" in notes and "climbs the same barrier" not in notes
+    ab_atoms, ab = build_interface({"kind": "sheets", "sheet": "graphene", "stacking": "AB"})
+    assert _registries(ab_atoms, ab) == 1
+    assert approximant_note(ab) is None
+    assert interface_section(cfg, ab, tmp_path).notes == [COMMENSURATE_WARNING]

@@ -74,6 +74,27 @@ def test_too_few_cells_or_a_non_positive_value_is_refused_with_its_reason():
     )
 
 
+def test_a_power_law_through_values_that_go_up_and_down_is_refused_with_its_numbers():
+    """τ0 of twisted h-BN (ILP, rigid layers, measured with this study over 28, 76, 148
+    atoms) rises then falls: no c·N^−α does that. The fit is refused, keeping the least-squares
+    exponent (checked against scipy's linregress); the same points in falling order are fitted."""
+    from scipy import stats
+
+    n = np.array([28.0, 76.0, 148.0])
+    up_down = np.array([0.00618, 0.0204, 0.00149])
+    reg = stats.linregress(np.log(n), np.log(up_down))
+    fit = fit_power_law(n, up_down)
+    assert "go up and down" in fit["refused"] and "prefactor" not in fit
+    assert fit["exponent"] == pytest.approx(-reg.slope, rel=1e-9)
+    assert fit["exponent_half_width"] == pytest.approx(stats.t.ppf(0.975, 1) * reg.stderr)
+    falling = np.sort(up_down)[::-1]
+    kept = fit_power_law(n, falling)
+    assert "refused" not in kept
+    assert kept["exponent"] == pytest.approx(-stats.linregress(np.log(n), np.log(falling)).slope)
+    # the order is by atom count, not by the order the cells are given in
+    assert "refused" not in fit_power_law(n[::-1], falling[::-1])
+
+
 # ------------------------------------------------------------------ plan and files
 def test_the_plan_of_twisted_bilayer_graphene_keeps_the_base_grid_per_period():
     cells = plan(build_config(TBG))

@@ -34,6 +34,34 @@ COMMENSURATE_WARNING = (
     "τ and σ here overstate those of an incommensurate contact."
 )
 
+
+def approximant_note(build: dict) -> str | None:
+    """The note on an approximant cell (``build.json``'s ``recipe.match``: a twist, or a
+    coincidence cell of more than one primitive cell of slab 1), which replaces
+    :data:`COMMENSURATE_WARNING`: its atoms are not in one registry, and its τ is the interior
+    corrugation of the locked cell (docs/incommensurate.md). None for a 1×1 or untwisted cell."""
+    rec = build.get("recipe")
+    match = rec.get("match") if isinstance(rec, dict) else None
+    if not isinstance(match, dict) or match.get("kind") not in ("twist", "coincidence"):
+        return None
+    supercell = match.get("slab1_supercell")
+    if supercell is None:
+        return None
+    cells = round(abs(float(np.linalg.det(np.asarray(supercell, dtype=float)))))
+    if cells <= 1:
+        return None
+    what = "commensurate twist" if match["kind"] == "twist" else "coincidence cell"
+    return (
+        f"The scan's cell is a {what} of {cells} primitive cells of slab 1 per layer: its atoms "
+        f"sit in {cells} different registries, so most of the registry dependence cancels "
+        "inside the cell, and τ and σ here are the interior corrugation of an infinite contact "
+        "locked at this angle and strain (scanned on one period of its shift lattice, finer than "
+        "the cell). The incommensurate contact is the limit of larger cells (`flatcontact study "
+        "approximants`); the rim, edges and defects of a real finite contact are in no periodic "
+        "cell (docs/incommensurate.md)."
+    )
+
+
 #: A commensurate lock that strains a slab by more than this (largest principal strain, %)
 #: is stated in the report: the strained lattice is not the material's.
 LOCK_STRAIN_NOTE_PERCENT = 0.5
@@ -196,8 +224,9 @@ def interface_section(
     :func:`structure_paragraphs`), its atoms, thickness and relaxation, which layers the
     scan holds and how the others relax (``atoms``: ``interface.extxyz``;
     ``cfg.scan.relax_mode``), the lock's strain when above :data:`LOCK_STRAIN_NOTE_PERCENT`
-    (:func:`lock_statement`) and the warning that a commensurate lock overstates τ (not for
-    the paper's quartz, ``paper``) and Fig. 1 from ``folder``."""
+    (:func:`lock_statement`) and the warning that a commensurate lock overstates τ, or for an
+    approximant cell what its τ is (:func:`approximant_note`; neither for the paper's quartz,
+    ``paper``) and Fig. 1 from ``folder``."""
     rel = build.get("interface_relaxation") or {}
     checks = build.get("interface_verification") or {}
     verified = bool(checks) and all(v.get("dense") for v in checks.values())
@@ -223,7 +252,16 @@ def interface_section(
     return Section(
         "1. Interface",
         paragraphs=paragraphs,
-        notes=[] if paper else [n for n in (lock_statement(build), COMMENSURATE_WARNING) if n],
+        notes=[]
+        if paper
+        else [
+            n
+            for n in (
+                lock_statement(build),
+                approximant_note(build) or COMMENSURATE_WARNING,
+            )
+            if n
+        ],
         figures=[
             Figure(
                 folder / png(BUILD_FIGURE),

@@ -34,6 +34,12 @@ def lock_text(build: dict | None) -> str:
     if not isinstance(rec, dict):
         return "no coincidence lock (one material)"
     match = rec.get("match") or {}
+    if match.get("kind") == "twist":
+        return (
+            f"commensurate twist θ = {float(rec.get('twist_angle_deg', float('nan'))):.4f}°, "
+            f"{match.get('n_atoms', '?')} atoms, no strain (an approximant of the twisted "
+            "contact, not a lock in one registry)"
+        )
     if match.get("kind") != "coincidence":
         return "commensurate by construction (no coincidence match)"
     strains = [
