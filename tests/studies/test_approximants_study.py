@@ -244,3 +244,41 @@ def test_tau_of_twisted_bilayer_graphene_falls_with_the_cell_size(tmp_path):
     # the first cell is clean; the (2, 3) landscape is only ~20x its noise floor, so gates
     # on its minima and slopes may fire (measured: degenerate_minima, negative_slope)
     assert cells[0]["gates"]["fired"] == [], cells[0]["gates"]
+
+
+def test_a_cell_whose_gates_fired_leaves_the_fit_and_is_named():
+    """A number the tool distrusts does not flow silently into the scaling fit: a resolved cell
+    whose laws are gated (degenerate_minima) leaves the τ0 fit but not the corrugation fit (that
+    gate distrusts the laws, not the landscape); broken_symmetry distrusts both; an accepted gate
+    (contact.accept_untrusted) counts as not fired; the console line names what was left out."""
+    from flatcontact.cli.study import _scaling_line
+    from flatcontact.studies.approximants import scaling_block
+
+    def cell(label, n, tau0, fired=()):
+        return {
+            "label": label,
+            "n_atoms": n,
+            "tau0_mpa": tau0,
+            "barrier_mev_per_a2": tau0 / 100,
+            "resolved": True,
+            "gates": {"fired": list(fired)},
+        }
+
+    cells = [
+        cell("a", 28, 1.0),
+        cell("b", 76, 0.3),
+        cell("c", 148, 0.1, ["degenerate_minima"]),
+        cell("d", 244, 0.05, ["broken_symmetry"]),
+    ]
+    doc = scaling_block(cells, set())
+    assert doc["tau0_mpa"]["cells"] == ["a", "b"]
+    assert doc["tau0_mpa"]["gated"] == {"c": ["degenerate_minima"], "d": ["broken_symmetry"]}
+    assert "refused" in doc["tau0_mpa"]["power_law"]  # 2 cells left: no fit
+    assert doc["barrier_mev_per_a2"]["cells"] == ["a", "b", "c"]
+    assert doc["barrier_mev_per_a2"]["gated"] == {"d": ["broken_symmetry"]}
+    assert "refused" not in doc["barrier_mev_per_a2"]["power_law"]
+    line = _scaling_line("tau0", doc["tau0_mpa"])
+    assert "left out (gates fired): c (degenerate_minima), d (broken_symmetry)" in line
+    accepted = scaling_block(cells, {"degenerate_minima", "broken_symmetry"})
+    assert accepted["tau0_mpa"]["cells"] == ["a", "b", "c", "d"]
+    assert not accepted["tau0_mpa"]["gated"]

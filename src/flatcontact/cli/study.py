@@ -153,6 +153,12 @@ def _scaling_line(name: str, fit: dict) -> str:
                 f"{f['model']}: alpha {f['exponent']:.3g} +- {f['exponent_half_width']:.2g}, "
                 f"y_inf {f['limit']:.3g} +- {f['limit_half_width']:.2g}"
             )
+    gated = fit.get("gated") or {}
+    if gated:
+        parts.append(
+            "left out (gates fired): "
+            + ", ".join(f"{label} ({', '.join(g)})" for label, g in gated.items())
+        )
     return f"{name}: " + "; ".join(parts)
 
 

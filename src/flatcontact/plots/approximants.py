@@ -91,6 +91,8 @@ def figure_approximants(doc: dict) -> Figure:
         note = _fit_text(fit, label.split("(")[-1].rstrip(")"))
         if bad:
             note += f"\nnot drawn (≤ 0 or NaN): {', '.join(bad)}"
+        if fit.get("gated"):
+            note += "\nleft out of the fit (gates fired): " + ", ".join(fit["gated"])
         ax.text(0.02, 0.02, note, transform=ax.transAxes, fontsize=6.5, va="bottom")
         ax.set_xlabel("atoms in the cell")
         ax.set_ylabel(label)

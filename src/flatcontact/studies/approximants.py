@@ -270,6 +270,45 @@ def run_cell(config: dict, folder: str, planned: int) -> dict:
     }
 
 
+#: The gates that distrust the landscape itself (its corrugation); the others (a load fold, a
+#: falling law, degenerate minima) distrust the laws read from it (τ0).
+LANDSCAPE_GATES = frozenset({"in_slab_slip", "broken_symmetry"})
+
+
+def _distrusted(row: dict, accepted: set, only: frozenset | None = None) -> list[str]:
+    """The gates that fired on a cell and were not accepted (``contact.accept_untrusted``),
+    restricted to ``only``: a cell they name leaves the scaling fit (never silently: the study's
+    ``scaling.<quantity>.gated`` lists it with its gates)."""
+    fired = [g for g in (row.get("gates") or {}).get("fired", []) if g not in accepted]
+    return [g for g in fired if only is None or g in only]
+
+
+def scaling_block(cells: list[dict], accepted: set) -> dict:
+    """``study.json["scaling"]``: the size-scaling fits of τ0 and of the corrugation.
+
+    A fit takes the cells that are resolved above the noise floor and on which no gate that
+    distrusts that quantity fired (:func:`_distrusted`; gates in ``accepted``, the
+    configuration's ``contact.accept_untrusted``, count as not fired). The cells left out
+    for their gates are listed under ``gated`` with the gates, so the console line and the
+    figure name them.
+    """
+    resolved = [r for r in cells if r["resolved"]]
+    out: dict = {}
+    for key, only in (("tau0_mpa", None), ("barrier_mev_per_a2", LANDSCAPE_GATES)):
+        kept = [r for r in resolved if not _distrusted(r, accepted, only)]
+        out[key] = {
+            **fit_scaling([r["n_atoms"] for r in kept], [r[key] for r in kept]),
+            "cells": [r["label"] for r in kept],
+            "gated": {
+                r["label"]: _distrusted(r, accepted, only) for r in resolved if r not in kept
+            },
+        }
+    out["cells"] = [r["label"] for r in resolved]
+    out["unresolved"] = [r["label"] for r in cells if not r["resolved"]]
+    out["resolved_factor"] = RESOLVED_FACTOR
+    return out
+
+
 def run_approximants(
     cfg: RunConfig, out: str | Path, on_done: Callable[[str, dict], None] | None = None
 ) -> dict:
@@ -303,8 +342,6 @@ def run_approximants(
         entry = {k: v for k, v in c.items() if k != "config"}
         rows.append({**entry, **r})
     ok = [r for r in rows if "error" not in r]
-    fitted = [r for r in ok if r["resolved"]]
-    atoms = [r["n_atoms"] for r in fitted]
     return {
         "study": "approximants",
         "approximants": cfg.section("approximants"),
@@ -312,13 +349,7 @@ def run_approximants(
         "relax_mode": cfg.scan.relax_mode,
         "cells": rows,
         "failed": {r["label"]: r["error"] for r in rows if "error" in r},
-        "scaling": {
-            "tau0_mpa": fit_scaling(atoms, [r["tau0_mpa"] for r in fitted]),
-            "barrier_mev_per_a2": fit_scaling(atoms, [r["barrier_mev_per_a2"] for r in fitted]),
-            "cells": [r["label"] for r in fitted],
-            "unresolved": [r["label"] for r in ok if not r["resolved"]],
-            "resolved_factor": RESOLVED_FACTOR,
-        },
+        "scaling": scaling_block(ok, set(cfg.contact.accept_untrusted)),
         "cost": {
             "force_calls_study": sum(r["force_calls_spent"] for r in ok),
             "force_calls_stored": sum(r["force_calls"] for r in ok),
