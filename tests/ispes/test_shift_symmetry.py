@@ -97,7 +97,7 @@ def _toy_factory():
     )
 
 
-def _scan(tmp_path, name, symmetry, mode="normal"):
+def _scan(tmp_path, name, symmetry, mode="normal", **kwargs):
     ref = toy_interface_3()
     z0 = thickness(ref)
     return run_scan(
@@ -108,6 +108,7 @@ def _scan(tmp_path, name, symmetry, mode="normal"):
         RelaxSettings(mode=mode),
         executor=SerialExecutor(),
         symmetry=symmetry,
+        **kwargs,
     )
 
 
@@ -150,18 +151,7 @@ def test_a_relaxation_that_breaks_the_symmetry_is_computed_in_full(tmp_path):
 
 
 def _reduced_toy_scan(out, **kwargs):
-    ref = toy_interface_3()
-    z0 = thickness(ref)
-    return run_scan(
-        ref,
-        _toy_factory(),
-        GridSpec(6, 6, thickness_angstrom=(z0 - 0.2, z0 + 0.3)),
-        out,
-        RelaxSettings(mode="normal"),
-        executor=SerialExecutor(),
-        symmetry=SymmetrySettings(verify_points=3),
-        **kwargs,
-    )
+    return _scan(out.parent, out.name, SymmetrySettings(verify_points=3), **kwargs)
 
 
 @pytest.mark.parametrize("phase", ["representatives", "verified points"])
