@@ -104,30 +104,12 @@ def test_halving_the_thickness_spacing_of_a_toy_scan_moves_tau_and_sigma_below_o
     import io
 
     import pandas as pd
+    from tests.studies.toy import toy_scan
 
     from flatcontact.analysis.analyze import analyze_ispes
     from flatcontact.analysis.outputs import friction_csv_text
-    from flatcontact.ispes.grid import GridSpec
-    from flatcontact.ispes.relax import RelaxSettings
-    from flatcontact.ispes.scan import run_scan
-    from flatcontact.potentials.engines import calculator_factory
-    from flatcontact.potentials.model import InteractionModel
-    from flatcontact.structures.interface_contract import thickness
-    from flatcontact.structures.toy import toy_interface
 
-    ref = toy_interface(layers=3)
-    z = thickness(ref) + np.linspace(-0.3, 1.5, 13)
-    factory = calculator_factory(
-        InteractionModel(calculator={"target": "flatcontact.ispes.toy:toy_calculator"})
-    )
-    ds = run_scan(
-        ref,
-        factory,
-        GridSpec(4, 4, thickness_angstrom=tuple(z)),
-        tmp_path,
-        RelaxSettings(1e-4),
-        executor_options={"kind": "serial"},
-    ).dataset
+    ds = toy_scan(tmp_path, grid=4, n_thicknesses=13, fmax_ev_per_angstrom=1e-4).dataset
     loads = [0.25, 0.5, 0.75, 1.0]
 
     def table(grid):

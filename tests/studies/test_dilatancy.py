@@ -13,28 +13,10 @@ LOADS = [0.0, 0.25, 0.5]
 
 @pytest.fixture(scope="module")
 def scan(tmp_path_factory):
-    from flatcontact.ispes.grid import GridSpec
-    from flatcontact.ispes.relax import RelaxSettings
-    from flatcontact.ispes.scan import run_scan
-    from flatcontact.potentials.engines import calculator_factory
-    from flatcontact.potentials.model import InteractionModel
-    from flatcontact.structures.interface_contract import thickness
-    from flatcontact.structures.toy import toy_interface
+    from tests.studies.toy import toy_scan
 
     out = tmp_path_factory.mktemp("dilatancy")
-    ref = toy_interface(layers=3)
-    z = thickness(ref) + np.linspace(-0.3, 1.5, 7)
-    factory = calculator_factory(
-        InteractionModel(calculator={"target": "flatcontact.ispes.toy:toy_calculator"})
-    )
-    res = run_scan(
-        ref,
-        factory,
-        GridSpec(3, 3, thickness_angstrom=tuple(z)),
-        out,
-        RelaxSettings(1e-3),
-        executor_options={"kind": "serial"},
-    )
+    res = toy_scan(out, grid=3, n_thicknesses=7, fmax_ev_per_angstrom=1e-3)
     res.dataset.to_netcdf(out / "ispes.nc", engine="h5netcdf")
     return out
 

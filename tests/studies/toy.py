@@ -53,3 +53,30 @@ def write_yaml(path: Path, data: dict) -> Path:
     """Write ``data`` as YAML to ``path``; returns ``path``."""
     path.write_text(yaml.safe_dump(data, sort_keys=False))
     return path
+
+
+def toy_scan(out: Path, grid: int, n_thicknesses: int, fmax_ev_per_angstrom: float):
+    """A serial scan of the 3-layer toy LJ interface on a ``grid`` × ``grid`` lateral grid and
+    ``n_thicknesses`` thicknesses from 0.3 Å below to 1.5 Å above its reference, into ``out``
+    (the :func:`flatcontact.ispes.scan.run_scan` result)."""
+    import numpy as np
+
+    from flatcontact.ispes.grid import GridSpec
+    from flatcontact.ispes.relax import RelaxSettings
+    from flatcontact.ispes.scan import run_scan
+    from flatcontact.potentials.engines import calculator_factory
+    from flatcontact.potentials.model import InteractionModel
+    from flatcontact.structures.interface_contract import thickness
+    from flatcontact.structures.toy import toy_interface
+
+    ref = toy_interface(layers=3)
+    z = thickness(ref) + np.linspace(-0.3, 1.5, n_thicknesses)
+    factory = calculator_factory(InteractionModel(calculator=TOY["potential"]["calculator"]))
+    return run_scan(
+        ref,
+        factory,
+        GridSpec(grid, grid, thickness_angstrom=tuple(z)),
+        out,
+        RelaxSettings(fmax_ev_per_angstrom),
+        executor_options={"kind": "serial"},
+    )
