@@ -127,6 +127,38 @@ class PeriodicSurface:
         self.l = ll
 
     # ------------------------------------------------------------------ symmetry
+    def zone_folded(self) -> PeriodicSurface:
+        """The same samples with every frequency moved to its shortest alias (:func:`_fold_to_zone`).
+
+        The grid's own square frequency set ``|k| <= N_a/2``, ``|l| <= N_b/2`` is not closed
+        under the rotations of a hexagonal lattice: on a grid whose samples are exactly
+        three-fold symmetric, its interpolant is not (the corner terms rotate onto frequencies
+        outside the set). Folded to the Cartesian-shortest aliases (ties share the
+        coefficient equally), the frequency set is closed under every lattice operation that
+        maps the grid onto itself, so samples that keep an operation give an interpolant that
+        keeps it to round-off. The samples are reproduced exactly; only the interpolation
+        between them changes.
+        """
+        ks, ls = np.meshgrid(self.k, self.l, indexing="ij")
+        g = np.stack([ks.ravel(), ls.ravel()], -1)
+        c = self.coefficients.ravel()
+        keep = c != 0
+        if not np.any(keep):
+            return self
+        g, c = _fold_to_zone(g[keep], c[keep], self.values.shape, self.inverse)
+        gi = np.round(g).astype(int)
+        kmax, lmax = int(np.max(np.abs(gi[:, 0]))), int(np.max(np.abs(gi[:, 1])))
+        coef = np.zeros((2 * kmax + 1, 2 * lmax + 1), complex)
+        np.add.at(coef, (gi[:, 0] + kmax, gi[:, 1] + lmax), c)
+        out = object.__new__(PeriodicSurface)
+        out.lattice, out.inverse = self.lattice, self.inverse
+        out.a1, out.a2 = self.a1, self.a2
+        out.values = self.values
+        out.coefficients = coef
+        out.k = np.arange(-kmax, kmax + 1, dtype=float)
+        out.l = np.arange(-lmax, lmax + 1, dtype=float)
+        return out
+
     def symmetrised(self, operations: list[tuple[np.ndarray, np.ndarray]]) -> PeriodicSurface:
         """The group average ``(1/|G|) Σ_g e(M_g s + t_g)`` of this interpolant.
 
@@ -148,11 +180,12 @@ class PeriodicSurface:
         """
         if len(operations) <= 1:
             return self
-        ks, ls = np.meshgrid(self.k, self.l, indexing="ij")
+        folded = self.zone_folded()
+        ks, ls = np.meshgrid(folded.k, folded.l, indexing="ij")
         g = np.stack([ks.ravel(), ls.ravel()], -1)
-        c = self.coefficients.ravel()
+        c = folded.coefficients.ravel()
         keep = c != 0
-        g, c = _fold_to_zone(g[keep], c[keep], self.values.shape, self.inverse)
+        g, c = g[keep], c[keep]
         mapped = [
             (g @ np.asarray(m, float), c * np.exp(1j * TWO_PI * (g @ np.asarray(t, float))))
             for m, t in operations
