@@ -10,12 +10,15 @@ from hypothesis import strategies as st
 
 from flatcontact import units
 from flatcontact.analysis import synthetic as syn
-from flatcontact.analysis.constant_pressure import constant_pressure, invert_columns
+from flatcontact.analysis.constant_pressure import branch_run, constant_pressure, invert_columns
 from flatcontact.analysis.diagnostics import (
+    LoadFoldWarning,
     StressEnergyMismatchWarning,
     UnconvergedPointsWarning,
 )
 from flatcontact.errors import InputError
+from flatcontact.ispes.probe import ColumnProbe
+from flatcontact.ispes.thicknesses import repulsive_branch
 
 A1, A2 = syn.hexagonal_cell()
 MODEL = syn.SyntheticInterface(
@@ -120,16 +123,18 @@ def test_pressure_outside_the_data_names_column_and_range():
 def test_bad_columns_are_refused():
     z = np.linspace(24.2, 26.5, 12)
     ds = MODEL.grid(3, 3, z)
-    bumpy = ds.copy(deep=True)
+    bumpy = ds.copy(deep=True)  # one bad stress next to the loads asked: a fold there
     bumpy["normal_stress"][1, 2, 3] = bumpy.normal_stress[1, 2, 1] + 1.0
-    with pytest.raises(InputError, match=r"normal_stress is not monotonic on the repulsive.*z = "):
+    with pytest.raises(InputError, match=r"P = 0.5 GPa is at or above a fold of .*normal_stress"):
         constant_pressure(bumpy, [0.5], load_source="stress")
-    constant_pressure(bumpy, [0.5], load_source="energy")  # the energy source never reads p
+    # the energy source reads the stored stress where it folds, too (and at the spline's ends)
+    with pytest.raises(InputError, match=r"P = 0.5 GPa is at or above a fold of .*normal_stress"):
+        constant_pressure(bumpy, [0.5], load_source="energy")
     dented = ds.copy(deep=True)  # a concave kink in U(z): -dU/dz turns, then falls again
     dented["energy"][1, 2, 4] = dented.energy[1, 2, 4] - 0.2
     with pytest.raises(
         InputError,
-        match=r"-\(1/A\) dU/dz is not monotonic on the repulsive branch.*z = .*tighten "
+        match=r"P = 0.5 GPa is at or above a fold of .*-\(1/A\) dU/dz.*tighten "
         r"scan.fmax_ev_per_angstrom or use analysis.load_source: stress",
     ):
         constant_pressure(dented, [0.5], load_source="energy")
@@ -197,3 +202,60 @@ def test_single_column_inversion_property(depth, alpha, p_frac, load_source):
     assert res.thickness_angstrom[0, 0] == pytest.approx(-np.log(ustar) / alpha, abs=tol_z)
     exact = depth * (ustar**2 - 2 * ustar)
     assert res.energy_ev_per_a2[0, 0] == pytest.approx(exact, abs=tol_e * np.max(np.abs(e)))
+
+
+def _folded(n_z: int, column: tuple[int, int] = (1, 2), nodes: int = 3):
+    """The model's grid with a fold on one column's compressed side: its first ``nodes`` samples
+    are the model's own energy and stress 0.35 Å further out (a plane that slipped under load:
+    a consistent state on another branch, its load below the next node's)."""
+    z = np.linspace(24.2, 26.5, n_z)
+    ds = MODEL.grid(6, 6, z)
+    i, j = column
+    other = MODEL.grid(6, 6, z + 0.35)
+    ds["energy"][i, j, :nodes] = other.energy.values[i, j, :nodes]
+    ds["normal_stress"][i, j, :nodes] = other.normal_stress.values[i, j, :nodes]
+    return ds
+
+
+@pytest.mark.parametrize("load_source", ["stress", "energy"])
+def test_a_fold_above_the_loads_is_read_past_on_its_own_nodes(load_source):
+    """Loads below a fold are read on the branch that carries P = 0, splined on the nodes past
+    the fold only: the closed form to the accuracy of the same grid without the fold (a spline
+    through the fold would bend the segments next to it), with a LoadFoldWarning; a load the
+    compressed side also reaches is refused in one line."""
+    ds = _folded(36)
+    p_ok = np.array([-0.5, 0.0, 0.5, 1.0, 2.0])
+    stress = ds.normal_stress[1, 2].values
+    s = int(np.flatnonzero(np.diff(stress) >= 0)[0]) + 1
+    assert s == 3 and np.min(stress[:s]) > p_ok.max() and stress[s + 1] > p_ok.max()
+    with pytest.warns(LoadFoldWarning, match=r"folds on the compressed side"):
+        res = constant_pressure(ds, p_ok, load_source=load_source)
+    clean = constant_pressure(
+        MODEL.grid(6, 6, np.linspace(24.2, 26.5, 36)), p_ok, load_source=load_source
+    )
+    sfrac = _frac_grid(res)
+    for i, p in enumerate(p_ok):
+        pev = p / units.EV_PER_A3_TO_GPA
+        ref = MODEL.landscape(sfrac, pev) + MODEL.energy_offset_ev / MODEL.area
+        err_clean = np.max(np.abs(clean.energy_ev_per_a2[i] - ref))
+        err = np.abs(res.energy_ev_per_a2[i] - ref)
+        assert err[1, 2] < max(10 * err_clean, 1e-7), (p, err[1, 2], err_clean)
+        z_ref = MODEL.thickness_at(sfrac, pev)
+        assert abs(res.thickness_angstrom[i][1, 2] - z_ref[1, 2]) < 1e-3
+    with pytest.raises(InputError, match=r"at or above a fold of .*shift_a=0.1667, shift_b=0.3333"):
+        constant_pressure(ds, [float(np.min(stress[:s])) + 0.1], load_source=load_source)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.floats(-3.0, 6.0, allow_nan=False), min_size=3, max_size=14, unique=True))
+def test_the_analysis_branch_is_the_scans(values):
+    """The analysis reads the branch the scan chose its thicknesses on: the same nodes."""
+    p = np.asarray(values)
+    probe = ColumnProbe((0.0, 0.0), np.arange(p.size) * 0.1 + 20.0, np.zeros(p.size), p, 0, 1.0)
+    s, e = branch_run(p)
+    try:
+        _, pb, _ = repulsive_branch(probe)
+    except InputError:
+        assert e - s < 1
+        return
+    np.testing.assert_array_equal(pb, p[s : e + 1])

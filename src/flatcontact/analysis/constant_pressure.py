@@ -11,6 +11,11 @@ Eq. for ``Ũ(p)|_{X,Y}``). Here:
   smallest thickness up to the sample of lowest ``p`` (the maximum tension). On
   this branch ``p`` must decrease strictly with ``z``; it is the mechanically
   stable branch under a fixed load, since ``d²(U + P A z)/dz² = -A dp/dz > 0``.
+  Where ``p`` rises with ``z`` on the compressed side (a *fold*: a plane slips or
+  opens under load), the branch is the falling run that carries ``P = 0`` (the
+  scan's rule, :func:`branch_run`), splined on its own nodes; loads that the
+  compressed side also reaches, or that fall in the segment next to the fold, are
+  refused in one line; lower loads are read with a :class:`LoadFoldWarning`.
   Beyond the maximum tension lies the *adhesive tail* (``p`` rises back towards
   0): ``p(z)`` is not invertible there, it is reported and never used;
 - a ``P`` outside ``[p_min, p_max]`` of a column's branch is an error naming the
@@ -38,7 +43,11 @@ import xarray as xr
 from scipy.interpolate import CubicSpline, make_interp_spline
 
 from flatcontact import units
-from flatcontact.analysis.diagnostics import StressEnergyMismatchWarning, UnconvergedPointsWarning
+from flatcontact.analysis.diagnostics import (
+    LoadFoldWarning,
+    StressEnergyMismatchWarning,
+    UnconvergedPointsWarning,
+)
 from flatcontact.analysis.noise import LoadNoise, load_noise
 from flatcontact.errors import InputError
 from flatcontact.ispes import contract
@@ -93,9 +102,11 @@ def invert_columns(
         Names of the columns for error messages.
     load_source
         ``"energy"``: the load is ``p(z) = -(1/A) dU/dz`` of the cubic spline of
-        ``U(z)``, clamped at the first and last thickness by the stored stress (the only
-        place the stored stress enters); ``"stress"``: the stored ``normal_stress``, splined. Either way
-        the repulsive branch runs up to the node of lowest ``p``.
+        ``U(z)``, clamped at the first and last thickness by the stored stress;
+        ``"stress"``: the stored ``normal_stress``, splined. Either way the repulsive branch
+        runs up to the node of lowest ``p``, and where the stored stress (the load measured
+        at each node) folds, the columns are split there first (:func:`branch_run`) and
+        splined past the fold only.
 
     Raises
     ------
@@ -117,6 +128,20 @@ def invert_columns(
         )
     if not np.all(np.diff(z) > 0):
         raise InputError("thickness: values must be strictly increasing")
+    # a fold of the stored load (the stress measured at each node) splits the columns first,
+    # before any spline runs through it; the energy-derived load's own folds follow below
+    stored_start = np.array([branch_run(p[j])[0] for j in range(n_col)])
+    if np.any(stored_start > 0):
+        _above_a_fold(targets, p, stored_start, z, labels, "normal_stress", "")
+        _warn_fold(labels, p, stored_start, z, "normal_stress")
+        base = None
+        if np.any(stored_start == 0):
+            keep = stored_start == 0
+            base = (
+                keep,
+                invert_columns(z, e[keep], p[keep], targets, _pick(labels, keep), load_source),
+            )
+        return _past_the_folds(base, stored_start, z, e, p, targets, labels, load_source)
     if load_source == "energy":
         # clamped at the two end nodes by the stored stress (dU/dz = -A p): the energies
         # alone cannot fix a spline's end slopes, and not-a-knot ends put p wrong by tenths
@@ -129,7 +154,7 @@ def invert_columns(
         inv = _invert_energy(z, spline_e, targets, labels)
     else:
         inv = _invert_stress(z, p, spline_e, targets, labels)
-    zstar, estar, p_lo, p_hi, z_end, slope = inv
+    zstar, estar, p_lo, p_hi, z_end, slope, start = inv
 
     # diagnostics: tail and stress/energy consistency on the branch nodes
     last = z_end < z[-1]
@@ -147,7 +172,7 @@ def invert_columns(
         spread = np.sum(np.where(inner, dedz - quintic, 0.0) ** 2, axis=1)
     else:
         spread = np.full(n_col, np.nan)
-    return ColumnInversion(
+    result = ColumnInversion(
         thickness_angstrom=zstar,
         energy_ev_per_a2=estar,
         branch_p_range_ev_per_a3=np.column_stack([p_lo, p_hi]),
@@ -157,6 +182,73 @@ def invert_columns(
         mismatch_sq_sum=np.sum(np.where(inner, diff, 0.0) ** 2, axis=1),
         derivative_spread_sq_sum=spread,
         n_branch_nodes=np.sum(inner, axis=1),
+    )
+    if np.any(start > 0):
+        return _past_the_folds(
+            (np.ones(n_col, bool), result), start, z, e, p, targets, labels, load_source
+        )
+    return result
+
+
+#: The fields of :class:`ColumnInversion` shaped ``(n_p, n_col)`` (the others lead with ``n_col``).
+_PER_LOAD_FIELDS = ("thickness_angstrom", "energy_ev_per_a2", "slope_ev_per_a4")
+
+
+def _pick(labels: list[str], mask: np.ndarray) -> list[str]:
+    return [lab for lab, c in zip(labels, mask, strict=True) if c]
+
+
+def _past_the_folds(base, start, z, e, p, targets, labels, load_source) -> ColumnInversion:
+    """The columns inverted again on the nodes past their fold (``start > 0``) only, so the
+    splines of the branch that carries P = 0 do not run through the fold (a cubic spline
+    couples every node; the fold's jump would bend the segments next to it), laid over
+    ``base`` = ``(mask, result for those columns)`` or None."""
+    n_col = start.size
+    parts = [] if base is None else [base]
+    for s in np.unique(start[start > 0]):
+        s, cols = int(s), start == s
+        if z.size - s < MIN_THICKNESS_POINTS:
+            j = int(np.flatnonzero(cols)[0])
+            raise InputError(
+                f"{labels[j]}: {z.size - s} thickness values past its fold at z = {z[s]:.4g} Å; "
+                f"at least {MIN_THICKNESS_POINTS} are needed for the splines of the branch that "
+                "carries P = 0: extend the scan in thickness or hold the slabs' inner planes "
+                "laterally (scan.relax_mode: normal)"
+            )
+        try:
+            sub = invert_columns(
+                z[s:], e[cols, s:], p[cols, s:], targets, _pick(labels, cols), load_source
+            )
+        except InputError as exc:
+            raise InputError(f"past the fold at z = {z[s]:.4g} Å: {exc}") from None
+        parts.append((cols, sub))
+    fields = {}
+    for name in ColumnInversion.__dataclass_fields__:
+        first = np.asarray(getattr(parts[0][1], name))
+        shape = (targets.size, n_col) if name in _PER_LOAD_FIELDS else (n_col, *first.shape[1:])
+        full = np.empty(shape, first.dtype)
+        for cols, part in parts:
+            if name in _PER_LOAD_FIELDS:
+                full[:, cols] = np.asarray(getattr(part, name))
+            else:
+                full[cols] = np.asarray(getattr(part, name))
+        fields[name] = full
+    return ColumnInversion(**fields)
+
+
+def _warn_fold(labels, p_nodes, start, z, what) -> None:
+    folded = np.flatnonzero(start > 0)
+    j = int(folded[0])
+    more = f" and {folded.size - 1} more column(s)" if folded.size > 1 else ""
+    gpa = units.EV_PER_A3_TO_GPA
+    warnings.warn(
+        f"{labels[j]}{more}: {what} folds on the compressed side (p = "
+        f"{p_nodes[j, start[j] - 1] * gpa:.4g} GPa at z = {z[start[j] - 1]:.4g} Å rises to "
+        f"{p_nodes[j, start[j]] * gpa:.4g} GPa at z = {z[start[j]]:.4g} Å); every load asked lies "
+        "below the fold and is read on the branch that carries P = 0, splined without the "
+        "nodes before it",
+        LoadFoldWarning,
+        stacklevel=4,
     )
 
 
@@ -172,6 +264,28 @@ def _out_of_range(targets, p_lo, p_hi, z, z_end, labels) -> None:
         )
 
 
+def _above_a_fold(targets, p_nodes, start, z, labels, what, remedy) -> None:
+    """InputError unless every load asked lies below each folded column's ceiling.
+
+    The ceiling is the lowest of the nodes before the fold ``s`` and of node ``s + 1``: at or
+    above ``min(p[:s])`` a load is also reached on the compressed side (two thicknesses), and
+    the segment ``s .. s + 1`` next to the jump is not read (its first node is the fold's own
+    sample, whatever made it: a plane that slipped or a bad value; the fold may also be noise
+    of the load: ``remedy``)."""
+    for j in np.flatnonzero(start > 0):
+        s = int(start[j])
+        ceiling = float(min(np.min(p_nodes[j, :s]), p_nodes[j, s + 1]))
+        if np.max(targets) >= ceiling:
+            gpa = units.EV_PER_A3_TO_GPA
+            raise InputError(
+                f"P = {np.max(targets) * gpa:.4g} GPa is at or above a fold of {labels[j]}: "
+                f"{what} = {p_nodes[j, s - 1] * gpa:.4g} GPa at z = {z[s - 1]:.4g} Å rises to "
+                f"{p_nodes[j, s] * gpa:.4g} GPa at z = {z[s]:.4g} Å; loads from "
+                f"{ceiling * gpa:.4g} GPa up are not read past it (reached on both sides of "
+                "it, or next to it): choose loads below that (analysis.p_gpa)" + remedy
+            )
+
+
 #: The remedy named when the energy-derived load is not monotonic: its error is second
 #: order in the relaxation residuals but grows with the number of soft modes (thick,
 #: compliant slabs), so a tighter force tolerance or the first-order stored load fixes it.
@@ -181,29 +295,51 @@ _ENERGY_LOAD_HINT = (
 )
 
 
+def branch_run(p: np.ndarray) -> tuple[int, int]:
+    """``(s, e)``: the nodes ``s .. e`` of one column's load ``p`` (falling with ``z``) that carry P = 0.
+
+    The scan's rule (:func:`flatcontact.ispes.thicknesses.repulsive_branch`, the same split;
+    a test holds the two equal): the nodes up to the global tensile maximum ``m``
+    (``argmin p``) are split where ``p`` rises with ``z``; the branch is the first falling run
+    that reaches ``p <= 0`` (the last run if none does). ``s > 0`` is a fold on the compressed
+    side: loads above ``p[s]`` are on another branch. ``e - s < 1`` leaves no segment.
+    """
+    m = int(np.argmin(p))
+    rises = np.flatnonzero(np.diff(p[: m + 1]) >= 0)
+    starts = np.concatenate([[0], rises + 1])
+    ends = np.concatenate([rises, [m]])
+    k = next((i for i, e in enumerate(ends) if p[e] <= 0), len(ends) - 1)
+    return int(starts[k]), int(ends[k])
+
+
 def _branch(z, p, labels, what, remedy=""):
-    """Index ``m`` of the lowest node of ``p`` per column; InputError unless p falls up to it
-    (``remedy`` is appended to the message of a load that is not monotonic)."""
-    n_z = p.shape[1]
-    m = np.argmin(p, axis=1)
-    idx = np.arange(n_z - 1)
-    rising = (np.diff(p, axis=1) >= 0) & (idx[None, :] < m[:, None])
-    if np.any(m == 0):
-        j = int(np.flatnonzero(m == 0)[0])
+    """``(s, e)`` per column: the branch that carries P = 0 runs from node ``s`` to node ``e``
+    (:func:`branch_run`); InputError if the load rises from the first node, or if the branch
+    has no segment (``p`` rises where it crosses 0; ``remedy`` appended)."""
+    n_col = p.shape[0]
+    start = np.zeros(n_col, int)
+    end = np.zeros(n_col, int)
+    for j in range(n_col):
+        start[j], end[j] = branch_run(p[j])
+    m_all = np.argmin(p, axis=1)
+    if np.any(m_all == 0):
+        j = int(np.flatnonzero(m_all == 0)[0])
         raise InputError(
             f"{labels[j]}: {what} rises with thickness from the first point "
             f"(p = {p[j, 0] * units.EV_PER_A3_TO_GPA:.4g} GPa at z = {z[0]:.4g} Å); "
             "no repulsive branch to invert"
         )
-    if np.any(rising):
-        j, k = (int(v) for v in np.argwhere(rising)[0])
+    bad = end - start < 1
+    if np.any(bad):
+        j = int(np.flatnonzero(bad)[0])
+        k = max(int(start[j]) - 1, 0)
         raise InputError(
             f"{labels[j]}: {what} is not monotonic on the repulsive branch: "
             f"p = {p[j, k] * units.EV_PER_A3_TO_GPA:.4g} GPa at z = {z[k]:.4g} Å, "
             f"{p[j, k + 1] * units.EV_PER_A3_TO_GPA:.4g} GPa at z = {z[k + 1]:.4g} Å "
             "(expected p to decrease with thickness up to the maximum tension)" + remedy
         )
-    return m
+    return start, end
 
 
 def _invert(z, p_nodes, coef_p, spline_e, targets, labels, what, remedy=""):
@@ -216,14 +352,19 @@ def _invert(z, p_nodes, coef_p, spline_e, targets, labels, what, remedy=""):
     Returns ``(z*, U(z*)/A, p_lo, p_hi, z_m, dp/dz at z*)``.
     """
     n_col, n_z = p_nodes.shape
-    m = _branch(z, p_nodes, labels, what, remedy)
-    p_lo = p_nodes[np.arange(n_col), m]
-    p_hi = p_nodes[:, 0]
+    start, m = _branch(z, p_nodes, labels, what, remedy)
+    cols1 = np.arange(n_col)
+    p_lo = p_nodes[cols1, m]
+    p_hi = p_nodes[cols1, start]
+    _above_a_fold(targets, p_nodes, start, z, labels, what, remedy)
     _out_of_range(targets, p_lo, p_hi, z, z[m], labels)
-    # segment k with p_k >= P >= p_{k+1}, k < m  (p strictly decreasing there)
-    on_branch = np.arange(n_z)[None, None, :] <= m[None, :, None]
+    if np.any(start > 0):
+        _warn_fold(labels, p_nodes, start, z, what)
+    # segment k with p_k >= P >= p_{k+1}, start <= k < m  (p strictly decreasing there)
+    idx = np.arange(n_z)[None, None, :]
+    on_branch = (idx >= start[None, :, None]) & (idx <= m[None, :, None])
     count = np.sum((p_nodes[None, :, :] >= targets[:, None, None]) & on_branch, axis=2)
-    k = np.clip(count - 1, 0, np.maximum(m - 1, 0)[None, :])  # (n_p, n_col)
+    k = np.clip(start[None, :] + count - 1, start[None, :], np.maximum(m - 1, start)[None, :])
     cols = np.broadcast_to(np.arange(n_col), k.shape)
     coef = coef_p[:, k, cols]  # (4, n_p, n_col), polynomial in (zz - z_k)
     lo = np.zeros(k.shape)
@@ -239,7 +380,7 @@ def _invert(z, p_nodes, coef_p, spline_e, targets, labels, what, remedy=""):
     ce = spline_e.c[:, k, cols]
     e_star = ((ce[0] * dz + ce[1]) * dz + ce[2]) * dz + ce[3]
     slope = (3 * coef[0] * dz + 2 * coef[1]) * dz + coef[2]
-    return z[k] + dz, e_star, p_lo, p_hi, z[m], slope
+    return z[k] + dz, e_star, p_lo, p_hi, z[m], slope, start
 
 
 def _invert_stress(z, p, spline_e, targets, labels):

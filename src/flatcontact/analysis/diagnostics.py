@@ -35,3 +35,9 @@ class DegenerateMinimaWarning(AnalysisWarning):
     """The landscape has inequivalent minima within the noise of the global one, and τ differs
     between them: the slider's τ depends on which of them it sits in (see
     :mod:`flatcontact.analysis.starts`)."""
+
+
+class LoadFoldWarning(AnalysisWarning):
+    """A column's load rises with thickness on the compressed side (a fold: a plane slips or
+    opens under load, or the energy-derived load is noisy there). Every load asked lies below
+    the fold, on the branch that carries P = 0; the nodes above it are not used."""
