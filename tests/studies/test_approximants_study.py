@@ -109,6 +109,23 @@ def test_the_plan_of_twisted_bilayer_graphene_keeps_the_base_grid_per_period():
     assert cells[0]["twist_deg"] == pytest.approx(21.786789, abs=1e-5)
 
 
+@pytest.mark.parametrize(
+    ("mode", "enabled", "expected"),
+    [
+        ("rigid-layers", "auto", "auto"),  # reduced like any interface
+        ("normal", "auto", False),  # the verification's tolerance is the whole corrugation
+        ("normal", True, True),  # an explicit setting is kept
+        ("full", "auto", "auto"),  # auto scans full relaxations in full already
+    ],
+)
+def test_the_plan_reduces_rigid_twist_cells_and_scans_relaxed_ones_in_full(mode, enabled, expected):
+    cfg = {**TBG, "scan": {**TBG["scan"], "relax_mode": mode, "symmetry": {"enabled": enabled}}}
+    cells = plan(build_config(cfg))
+    assert all(c["shift_lattice_index"] > 1 for c in cells)
+    for c in cells:
+        assert c["config"]["scan"]["symmetry"]["enabled"] == expected
+
+
 def _fake_doc() -> dict:
     cells = []
     for i, (n, tau, barrier) in enumerate(((28, 1.4, 0.05), (76, 0.2, 0.004), (148, 0.03, 3e-4))):
