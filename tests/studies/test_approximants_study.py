@@ -105,8 +105,25 @@ def test_the_plan_of_twisted_bilayer_graphene_keeps_the_base_grid_per_period():
         assert math.gcd(c["grid"][0], c["shift_lattice_index"]) == 1
         assert c["grid"] == [6, 6]
         assert c["config"]["structure"]["twist"] == c["structure_override"]["twist"]
-        assert c["config"]["scan"]["symmetry"]["enabled"] is False
+        assert c["config"]["scan"]["symmetry"]["enabled"] == "auto"  # reduced like any cell
     assert cells[0]["twist_deg"] == pytest.approx(21.786789, abs=1e-5)
+
+
+@pytest.mark.parametrize(
+    ("mode", "enabled", "expected"),
+    [
+        ("rigid-layers", "auto", "auto"),  # reduced like any interface
+        ("normal", "auto", False),  # the verification's tolerance is the whole corrugation
+        ("normal", True, True),  # an explicit setting is kept
+        ("full", "auto", "auto"),  # auto scans full relaxations in full already
+    ],
+)
+def test_the_plan_reduces_rigid_twist_cells_and_scans_relaxed_ones_in_full(mode, enabled, expected):
+    cfg = {**TBG, "scan": {**TBG["scan"], "relax_mode": mode, "symmetry": {"enabled": enabled}}}
+    cells = plan(build_config(cfg))
+    assert all(c["shift_lattice_index"] > 1 for c in cells)
+    for c in cells:
+        assert c["config"]["scan"]["symmetry"]["enabled"] == expected
 
 
 def _fake_doc() -> dict:

@@ -491,10 +491,13 @@ def run_scan(
                     full_tree = _tree_in_store_order(z, shape, root, order)
                     reduction = None
                     if symmetry.enabled:
+                        # modulo the pure translations, lifted onto the grid: a twist
+                        # cell's N² translations are never enumerated against each other
                         group = shift_space_group(
                             reference,
                             symmetry.tolerance_angstrom,
                             spread_compression=relax.mode != "rigid",
+                            modulo_translations=True,
                         ).for_grid(grid.n_a, grid.n_b)
                         reduction = plan_reduction(group, shape, list(full_tree))
 

@@ -32,6 +32,7 @@ the Euclidean operation, must coincide with the stack at ``g·s`` to
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from itertools import product
 
@@ -85,9 +86,14 @@ class ShiftGroup:
     tolerance_angstrom: float
     #: |a1|, |a2| (Å) of the interface the group was found on; None: unknown
     cell_lengths_angstrom: tuple[float, float] | None = None
+    #: the group's pure translations (fractional, in [0, 1), (0, 0) first) when
+    #: ``operations`` lists one operation per coset of them (``modulo_translations``);
+    #: None: ``operations`` is the whole group
+    translations: tuple[tuple[float, float], ...] | None = None
 
     @property
     def order(self) -> int:
+        """The number of operations listed (cosets of the translations when they are kept apart)."""
         return len(self.operations)
 
     def for_grid(self, n_a: int, n_b: int) -> ShiftGroup:
@@ -98,6 +104,11 @@ class ShiftGroup:
         precision to which the operation's translation is known from the atoms (a quartz
         two-fold axis found 1.5e-7 off a half-cell translation is kept). Without the cell
         lengths, 1e-6 grid steps.
+
+        A group listed modulo its pure translations (:attr:`translations`) is lifted: every
+        ``(M, t + λ)``, λ a translation, that maps the grid onto itself is kept, which is
+        exactly the subgroup the whole group would give (for a twist cell on a grid coprime
+        to the shift-lattice index, one element per coset, :mod:`flatcontact.ispes.shift_lattice`).
         """
         ia, ib = np.meshgrid(np.arange(n_a), np.arange(n_b), indexing="ij")
         s = np.stack([ia.ravel() / n_a, ib.ravel() / n_b], -1)
@@ -108,12 +119,31 @@ class ShiftGroup:
             atol = n * self.tolerance_angstrom / np.asarray(self.cell_lengths_angstrom, float)
         atol = np.minimum(atol, 0.25)  # an image a quarter step off is not on the grid
         kept = []
-        for op in self.operations:
+        for op in self._lifted_to(n, atol):
             g = op.apply(s) * n
             # the nearest grid index, periodic: an image just below 1 is index 0
             if np.all(np.abs(g - np.round(g)) <= atol):
                 kept.append(op)
         return ShiftGroup(tuple(kept), self.tolerance_angstrom, self.cell_lengths_angstrom)
+
+    def _lifted_to(self, n: np.ndarray, atol: np.ndarray) -> list[ShiftOperation]:
+        """The operations ``(M, t + λ)`` whose translation lies on the grid of ``n`` steps
+        (λ every pure translation); the operations themselves without :attr:`translations`.
+
+        ``M s + t`` maps the grid ``s ∈ Z²/n`` onto itself exactly when ``t`` is on it, so
+        only the translations need testing: ``order × index`` checks, vectorised."""
+        if self.translations is None:
+            return list(self.operations)
+        lam = np.asarray(self.translations, float).reshape(-1, 2)
+        out = []
+        for op in self.operations:
+            t = np.asarray(op.translation, float) + lam
+            t -= np.floor(t + 1e-9)
+            g = t * n
+            on = np.all(np.abs(g - np.round(g)) <= atol, axis=1)
+            for k in np.flatnonzero(on):
+                out.append(dataclasses.replace(op, translation=_fraction_tuple(t[k])))
+        return out
 
     def grid_images(self, n_a: int, n_b: int) -> np.ndarray:
         """Index images ``out[k, ia, ib] = (ja, jb)`` of every grid point under operation k.
@@ -146,6 +176,7 @@ class ShiftGroup:
         return out
 
     def as_dict(self) -> dict:
+        """``order``, ``tolerance_angstrom`` and ``operations`` (as listed)."""
         return {
             "order": self.order,
             "tolerance_angstrom": self.tolerance_angstrom,
@@ -206,11 +237,9 @@ class _Matcher:
 
 def _keeps_layers(perm: np.ndarray, src_layer: np.ndarray, dst_layer: np.ndarray) -> bool:
     """Whether the atom map sends every layer of the source onto one layer of the target."""
-    pairs = {}
-    for a, b in zip(src_layer.tolist(), dst_layer[perm].tolist(), strict=True):
-        if pairs.setdefault(a, b) != b:
-            return False
-    return len(set(pairs.values())) == len(pairs)
+    pairs = np.unique(np.stack([src_layer, dst_layer[perm]], axis=1), axis=0)
+    # a function (each source layer once) that is one-to-one (each target layer once)
+    return len(np.unique(pairs[:, 0])) == len(pairs) == len(np.unique(pairs[:, 1]))
 
 
 def _translations(
@@ -223,8 +252,17 @@ def _translations(
     w: np.ndarray,
     lattice: np.ndarray,
     tol: float,
+    dst_translations: list[np.ndarray] | None = None,
 ) -> list[np.ndarray]:
-    """Every τ (3-vector, Å, in-plane part reduced to the cell) with ``W src + τ ≡ dst``."""
+    """Every τ (3-vector, Å, in-plane part reduced to the cell) with ``W src + τ ≡ dst``.
+
+    With ``dst_translations`` (the translations mapping ``dst`` onto itself, e.g.
+    :func:`self_translations`): one τ only, or none. Every other τ differs from it by one of
+    them (``W src + τ ≡ dst ≡ W src + τ'`` makes ``τ' − τ`` map ``dst`` onto itself), and
+    candidates are tried once per class of target atoms modulo them, the atoms of the
+    slab's primitive content: a handful of matches whatever the supercell, where every
+    target atom of the anchor's species is a candidate without them.
+    """
     if len(src) != len(dst) or not np.array_equal(np.sort(src_lab), np.sort(dst_lab)):
         return []
     matcher = _Matcher(dst, dst_lab, lattice)
@@ -234,7 +272,17 @@ def _translations(
     moved = src @ w.T
     found: list[np.ndarray] = []
     inv = np.linalg.inv(lattice)
-    for j in np.flatnonzero(dst_lab == anchor_label):
+    candidates = np.flatnonzero(dst_lab == anchor_label)
+    covered = np.zeros(len(dst), bool)
+    shifts = None if dst_translations is None else np.asarray(dst_translations, float)
+    for j in candidates:
+        if covered[j]:
+            continue
+        if shifts is not None:
+            # the class of j: its images under dst's own translations (each gives a τ that
+            # differs by one of them, so j stands for all)
+            images = matcher.match(dst[j] + shifts, np.full(len(shifts), anchor_label), tol)
+            covered[j if images is None else images] = True
         tau = dst[j] - moved[anchor]
         f = inv @ tau[:2]
         tau[:2] = lattice @ (f - np.floor(f + 1e-9))
@@ -243,6 +291,8 @@ def _translations(
             continue
         if not any(_same_translation(tau, t, lattice, tol) for t in found):
             found.append(tau)
+        if shifts is not None:
+            break
     return found
 
 
@@ -310,6 +360,18 @@ def shift_space_group(
 ) -> ShiftGroup:
     """The shift-space group of ``reference`` (see the module docstring), identity first.
 
+    The search works modulo the slabs' own lattices. Each slab's translations ``T_i`` (the
+    in-plane translations mapping it onto itself, :func:`self_translations`) are found once;
+    their differences ``τ₁ − τ₂`` are the group's pure translations, the shift lattice
+    Λ_1 + Λ_2 (:mod:`flatcontact.ispes.shift_lattice`; one translation, zero, for a 1×1 cell).
+    For each point operation and slab swap one space translation per slab is then enough
+    (the others differ from it by ``T_i``) and is found among one candidate per atom of the
+    slab's primitive content, by a KD-tree match of the whole slab; each such operation is
+    checked on the stack at two generic shifts. Cost: ``|T_i|`` slab matches once, then a few
+    per point operation, where trying every pair of ``T_1 × T_2`` costs ``N²`` stack checks
+    per point operation for a twist cell of N primitive cells per layer (227 s for the
+    76-atom (2, 3) cell; benchmarks/bench_symcell.py).
+
     Parameters
     ----------
     reference
@@ -319,17 +381,17 @@ def shift_space_group(
     spread_compression
         As the scan's placement of slab 2 (false in ``rigid`` mode).
     modulo_translations
-        Keep one operation per point operation and slab swap (the first that checks): the
-        others differ from it by a pure translation of the group, the shift lattice
-        Λ_1 + Λ_2 of a coincidence cell (:mod:`flatcontact.ispes.shift_lattice`). A twist
-        cell of N primitive cells per layer has N² such translations, and checking every
-        pair costs N² stack checks per point operation (227 s for the 76-atom (2, 3) cell,
-        measured); on one period of the shift lattice they are all the identity.
+        List one operation per coset of the pure translations (point operation and slab
+        swap) and keep the translations apart in :attr:`ShiftGroup.translations`;
+        :meth:`ShiftGroup.for_grid` lifts them onto a grid (the scan's use), and on one
+        period of the shift lattice they are all the identity (the gates' use). False: the
+        whole group, every coset times every translation (``order × index`` operations;
+        588 for the (1, 2) twist cell).
 
     Returns
     -------
     ShiftGroup
-        Operations ``s ↦ M s + t`` sorted with the identity first, then by (swaps, M, t).
+        Operations ``s ↦ M s + t`` sorted with the identity first, then by (M, t, swaps).
     """
     tol = float(tolerance_angstrom)
     lattice = np.column_stack(in_plane_vectors(reference))
@@ -338,72 +400,176 @@ def shift_space_group(
     lab = _labels(reference)
     layer = np.asarray(reference.arrays.get("layer", np.zeros(len(reference), int)))
     slab = np.asarray(reference.arrays["slab"])
-    one, two = slab == 1, slab == 2
-    parts = {k: (pos[m], lab[m], layer[m]) for k, m in ((1, one), (2, two))}
-    ops: dict[tuple, ShiftOperation] = {}
+    parts = {k: (pos[slab == k], lab[slab == k], layer[slab == k]) for k in (1, 2)}
+    own = {k: _self_translations(*parts[k], lattice, tol) for k in (1, 2)}
+    pure = _pure_translations(own[1], own[2], inv)
+    ops: list[ShiftOperation] = []
 
     def fractional(v: np.ndarray) -> tuple[float, float]:
-        f = inv @ np.asarray(v, float)[:2]
-        f = f - np.floor(f + 1e-9)
-        f[np.abs(f - 1.0) < 1e-9] = 0.0
-        return (float(round(f[0], 12)) + 0.0, float(round(f[1], 12)) + 0.0)
+        return _fraction_tuple(inv @ np.asarray(v, float)[:2])
 
-    def add(op: ShiftOperation, w: np.ndarray, tau_of_shift) -> bool:
-        key = (op.matrix, tuple(round(x * 1e6) % 1000000 for x in op.translation), op.swaps_slabs)
-        if key in ops:
-            return True
-        if _stack_maps(reference, w, op, tau_of_shift, tol, spread_compression):
-            ops[key] = op
-            return True
-        return False
+    def known(op: ShiftOperation) -> bool:
+        # the same coset of the pure translations (a slab swap that acts on shifts like an
+        # operation without one is the same shift-space operation)
+        return any(
+            u.matrix == op.matrix
+            and _in_translations(np.subtract(u.translation, op.translation), pure)
+            for u in ops
+        )
 
-    for r in _point_operations(lattice):
+    def add(op: ShiftOperation, w: np.ndarray, tau_of_shift) -> None:
+        if not known(op) and _stack_maps(reference, w, op, tau_of_shift, tol, spread_compression):
+            ops.append(op)
+
+    # the operations without a slab swap first: one with a swap that acts on shifts like
+    # one of them is kept as the one without
+    for sigma, r in product((1, -1), _point_operations(lattice)):
         m_int = np.round(inv @ r @ lattice).astype(int)
-        for sigma in (1, -1):
-            w = np.eye(3)
-            w[:2, :2] = r
-            w[2, 2] = sigma
-            if sigma == 1:
-                t1 = _translations(*parts[1], *parts[1], w, lattice, tol)
-                t2 = _translations(*parts[2], *parts[2], w, lattice, tol) if t1 else []
-                for tau1, tau2 in product(t1, t2):
-                    if abs(tau1[2]) > tol or abs(tau2[2]) > tol:
-                        continue
-                    m = tuple(tuple(int(v) for v in row) for row in m_int)
-                    op = ShiftOperation(m, fractional(tau1 - tau2), False)
-                    if add(op, w, lambda d, tau1=tau1: tau1) and modulo_translations:
-                        break
-            else:
-                ta = _translations(*parts[1], *parts[2], w, lattice, tol)
-                tb = _translations(*parts[2], *parts[1], w, lattice, tol) if ta else []
-                for tau_a, tau_b in product(ta, tb):
-                    if abs(tau_a[2] - tau_b[2]) > tol:
-                        continue
-                    m = tuple(tuple(int(-v) for v in row) for row in m_int)
-                    op = ShiftOperation(m, fractional(tau_b - tau_a), True)
+        w = np.eye(3)
+        w[:2, :2] = r
+        w[2, 2] = sigma
+        if sigma == 1:
+            t1 = _translations(*parts[1], *parts[1], w, lattice, tol, own[1])
+            t2 = _translations(*parts[2], *parts[2], w, lattice, tol, own[2]) if t1 else []
+            if not t2 or abs(t1[0][2]) > tol or abs(t2[0][2]) > tol:
+                continue
+            tau1, tau2 = t1[0], t2[0]
+            m = tuple(tuple(int(v) for v in row) for row in m_int)
+            add(ShiftOperation(m, fractional(tau1 - tau2), False), w, lambda d, t=tau1: t)
+        else:
+            ta = _translations(*parts[1], *parts[2], w, lattice, tol, own[2])
+            tb = _translations(*parts[2], *parts[1], w, lattice, tol, own[1]) if ta else []
+            if not tb or abs(ta[0][2] - tb[0][2]) > tol:
+                continue
+            tau_a, tau_b = ta[0], tb[0]
+            m = tuple(tuple(int(-v) for v in row) for row in m_int)
 
-                    def tau_of_shift(d, tau_b=tau_b, r=r):
-                        out = tau_b.copy()
-                        out[:2] -= r @ d
-                        return out
+            def tau_of_shift(d, tau_b=tau_b, r=r):
+                out = tau_b.copy()
+                out[:2] -= r @ d
+                return out
 
-                    if add(op, w, tau_of_shift) and modulo_translations:
-                        break
-    found = sorted(
-        ops.values(),
-        key=lambda o: (not o.is_identity, o.matrix, o.translation, o.swaps_slabs),
-    )
-    # an operation that swaps the slabs and acts on shifts like one that does not is the same
-    # shift-space operation: keep one
-    unique: list[ShiftOperation] = []
-    for op in found:
-        if not any(
-            u.matrix == op.matrix and np.allclose(u.translation, op.translation, atol=1e-9)
-            for u in unique
-        ):
-            unique.append(op)
+            add(ShiftOperation(m, fractional(tau_b - tau_a), True), w, tau_of_shift)
     lengths = (float(np.linalg.norm(lattice[:, 0])), float(np.linalg.norm(lattice[:, 1])))
-    return ShiftGroup(tuple(unique), tol, lengths)
+    if modulo_translations:
+        return ShiftGroup(_sorted(ops), tol, lengths, translations=pure)
+    whole = []
+    for op in ops:
+        t = np.asarray(op.translation) + np.asarray(pure)
+        whole += [dataclasses.replace(op, translation=_fraction_tuple(v)) for v in t]
+    return ShiftGroup(_sorted(whole), tol, lengths)
+
+
+def _sorted(ops: list[ShiftOperation]) -> tuple[ShiftOperation, ...]:
+    """Identity first, then by (M, t, swaps)."""
+    return tuple(
+        sorted(ops, key=lambda o: (not o.is_identity, o.matrix, o.translation, o.swaps_slabs))
+    )
+
+
+def _fraction_tuple(f: np.ndarray) -> tuple[float, float]:
+    """Fractions reduced into [0, 1) and rounded to 1e-12 (a stable key)."""
+    f = np.asarray(f, float) - np.floor(np.asarray(f, float) + 1e-9)
+    f[np.abs(f - 1.0) < 1e-9] = 0.0
+    return (float(round(f[0], 12)) + 0.0, float(round(f[1], 12)) + 0.0)
+
+
+def _pure_translations(
+    own1: list[np.ndarray], own2: list[np.ndarray], inv: np.ndarray
+) -> tuple[tuple[float, float], ...]:
+    """The pure translations ``τ₁ − τ₂`` of the group (fractional, (0, 0) first, distinct)."""
+    a = np.array([inv @ t[:2] for t in own1])
+    b = np.array([inv @ t[:2] for t in own2])
+    diff = (a[:, None, :] - b[None, :, :]).reshape(-1, 2)
+    diff -= np.floor(diff + 1e-9)
+    diff[np.abs(diff - 1.0) < 1e-9] = 0.0
+    keys = np.round(diff * 1e6).astype(np.int64) % 1000000
+    _, first = np.unique(keys, axis=0, return_index=True)
+    out = np.round(diff[first], 12) + 0.0  # as _fraction_tuple, vectorised
+    out[out >= 1.0] = 0.0
+    out = out[np.lexsort((out[:, 1], out[:, 0]))]
+    return tuple((float(a), float(b)) for a, b in out)
+
+
+def _in_translations(d: np.ndarray, pure: tuple[tuple[float, float], ...]) -> bool:
+    """Whether the fractional difference ``d`` is one of the pure translations (mod 1)."""
+    e = np.asarray(pure) - np.asarray(d, float)
+    e -= np.round(e)
+    return bool(np.any(np.all(np.abs(e) < 1e-6, axis=1)))
+
+
+#: Atoms per slab on which every candidate self-translation is screened before a full match.
+_SCREEN_ATOMS = 12
+
+
+def _self_translations(
+    pos: np.ndarray, lab: np.ndarray, layer: np.ndarray, lattice: np.ndarray, tol: float
+) -> list[np.ndarray]:
+    """The in-plane translations mapping one slab onto itself (identity first), 3-vectors with
+    zero z, the in-plane part reduced to the cell.
+
+    They form a group T (the slab's primitive lattice modulo the cell), so not every one
+    needs a full match: each candidate (an atom of the anchor's species minus the anchor) is
+    screened on :data:`_SCREEN_ATOMS` atoms spread over the slab (one vectorised KD-tree
+    query), and the survivors are taken in turn: one already in the group generated by the
+    fully matched ones is a member (a sum of symmetries is one); another is matched on the
+    whole slab (species, held flags, layers) and, if it maps, joins the generators. Full
+    matches: the generators (two for a 2-D lattice) and any survivor of the screen that is
+    not a symmetry, instead of one per atom of the anchor's species.
+    """
+    inv = np.linalg.inv(lattice)
+    labels, counts = np.unique(lab, return_counts=True)
+    anchor_label = labels[np.argmin(counts)]
+    anchor = int(np.flatnonzero(lab == anchor_label)[0])
+    candidates = np.flatnonzero(lab == anchor_label)
+    frac = (pos[candidates, :2] - pos[anchor, :2]) @ inv.T
+    frac -= np.floor(frac + 1e-9)
+    same_height = np.abs(pos[candidates, 2] - pos[anchor, 2]) <= tol
+    frac = frac[same_height]
+    matcher = _Matcher(pos, lab, lattice)
+    # screen: a few atoms spread over the slab (every k-th), each candidate at once
+    sample = np.unique(np.linspace(0, len(pos) - 1, min(_SCREEN_ATOMS, len(pos))).astype(int))
+    keep = np.ones(len(frac), bool)
+    for i in sample:
+        moved = pos[i] + np.column_stack([frac @ lattice.T, np.zeros(len(frac))])
+        p = matcher._wrap(moved)
+        tree, _ = matcher.trees[int(lab[i])]
+        d, _ = tree.query(p, k=1, distance_upper_bound=tol)
+        keep &= np.isfinite(d)
+    group = np.zeros((1, 2))  # the group generated by the matched translations (fractions)
+
+    def member(f: np.ndarray) -> bool:
+        e = group - f
+        e -= np.round(e)
+        return bool(np.any(np.all(np.abs(e @ lattice.T) < tol, axis=1)))
+
+    for f in frac[keep]:
+        if member(f):
+            continue
+        tau = np.array([*(lattice @ f), 0.0])
+        perm = matcher.match(pos + tau, lab, tol)
+        if perm is None or not _keeps_layers(perm, layer, layer):
+            continue
+        group = _generated(group, f, tol, lattice, len(frac))
+    return [np.array([*(lattice @ f), 0.0]) for f in group]
+
+
+def _generated(
+    group: np.ndarray, f: np.ndarray, tol: float, lattice: np.ndarray, bound: int
+) -> np.ndarray:
+    """The finite group (fractions mod 1) generated by ``group`` and the translation ``f``:
+    ``group + k f`` for k up to the order of ``f`` modulo ``group`` (at most ``bound``)."""
+    out = [group]
+    step = np.asarray(f, float)
+    for _ in range(bound):
+        e = group - step
+        e -= np.round(e)
+        if np.any(np.all(np.abs(e @ lattice.T) < tol, axis=1)):
+            break
+        shifted = group + step
+        out.append(shifted - np.floor(shifted + 1e-9))
+        step = step + f
+    return np.concatenate(out)
 
 
 def self_translations(
@@ -418,6 +584,6 @@ def self_translations(
     lab = _labels(reference)
     layer = np.asarray(reference.arrays.get("layer", np.zeros(len(reference), int)))
     mask = np.asarray(reference.arrays["slab"]) == slab
-    part = (reference.positions[mask], lab[mask], layer[mask])
-    found = _translations(*part, *part, np.eye(3), lattice, float(tolerance_angstrom))
-    return [t for t in found if abs(t[2]) <= tolerance_angstrom]
+    return _self_translations(
+        reference.positions[mask], lab[mask], layer[mask], lattice, float(tolerance_angstrom)
+    )
