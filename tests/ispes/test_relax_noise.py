@@ -94,3 +94,37 @@ def test_a_scan_that_relaxes_nothing_has_no_relaxation_floor(toy):
     held = reference.copy()
     held.arrays["held"] = np.ones(len(held), bool)
     assert not relaxes_something(held, RelaxSettings(0.01, mode="full"))
+
+
+@pytest.mark.slow
+def test_relaxed_twisted_graphene_has_a_tolerance_floor_far_above_its_round_off():
+    """The (1, 2) twist of two 2-sheet graphene slabs, REBO + KC, ``normal``: the relaxation
+    floor at the quick preset's 0.01 eV/Å is orders of magnitude above the engine's round-off
+    (the rigid floor) and falls with the tolerance. Measured (shared machine): 7.9e-4, 1.4e-4,
+    9.4e-5 meV/Å² at 0.01, 0.002, 5e-4 eV/Å, rigid 3e-12; ~20 s per tolerance."""
+    from flatcontact.config.load import build_config
+    from flatcontact.potentials.engines import make_calculator
+    from flatcontact.structures.construct import build_interface
+
+    cfg = build_config(
+        {
+            "structure": {"kind": "sheets", "sheet": "graphene", "layers": 2, "twist": [1, 2]},
+            "potential": {"preset": "graphene-rebo-kc"},
+            "elastic": {"enabled": True},
+        }
+    )
+    atoms, _ = build_interface(cfg.section("structure"))
+    calc = make_calculator(cfg.potential, atoms)
+    lattice = shift_lattice_of(atoms)
+    assert lattice.index == 49
+    z = thickness(atoms)
+    rigid = translation_noise_ev_per_a2(atoms, calc, lattice)
+    loose, tight = (
+        relaxation_noise(
+            atoms, calc, lattice, RelaxSettings(f, mode="normal"), [z - 0.3, z, z + 0.3]
+        )
+        for f in (0.01, 0.0005)
+    )
+    assert loose.unconverged == tight.unconverged == 0
+    assert loose.ev_per_a2 > 3 * tight.ev_per_a2 > 0, (loose, tight)
+    assert tight.ev_per_a2 > 1e3 * rigid, (tight, rigid)
