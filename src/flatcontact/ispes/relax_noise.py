@@ -21,6 +21,12 @@ energies over the samples, divided by the supercell area (eV/Å²): the scatter 
 of one structure at fixed thickness, round-off included. It is a floor for the energy per
 area at fixed thickness; the constant-load landscape also carries the load's error
 (:mod:`flatcontact.analysis.noise`), which this does not add.
+
+It is the scatter a relaxation *may* leave at that tolerance, from a start that is not already
+at the minimum. A scan's warm start from a neighbour on a nearly flat landscape can begin much
+closer and stop much closer (measured, docs/incommensurate.md: the rigid-layers H-diamond(111)
+/graphene cells' whole lateral range is 5–10× below this floor), but nothing in the scan
+shows that it did; the floor is the tolerance's guarantee, not the scan's luck.
 """
 
 from __future__ import annotations
