@@ -166,9 +166,10 @@ def tolerance_advice(barrier_mev_per_a2: float, noise_mev_per_a2: float, relaxed
     that multiple of the rigid (round-off) floor: a tighter ``scan.fmax_ev_per_angstrom``
     could resolve it, a rerun at the same tolerance cannot. The tolerance it names is
     necessary, not sufficient: the floor brought to 1/:data:`RESOLVED_FACTOR` of the
-    corrugation bound, with the floor taken ∝ fmax² (near a minimum the energy left is
-    ½ Fᵀ H⁻¹ F; measured in docs/incommensurate.md), and the true relaxed corrugation may be
-    smaller than the bound.
+    corrugation bound, with the floor taken ∝ fmax² (the scaling of the harmonic bound: near a
+    minimum the energy left is ½ Fᵀ H⁻¹ F), an estimate only: on relaxed twisted graphene the
+    measured floor fell more slowly from 0.01 to 5e-4 eV/Å and far faster below
+    (docs/incommensurate.md); and the true relaxed corrugation may be smaller than the bound.
     """
     if relaxed is None:
         return ""
