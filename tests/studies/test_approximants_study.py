@@ -145,6 +145,9 @@ def _fake_doc() -> dict:
                 "mu_mpa_per_gpa": 0.006,
                 "barrier_mev_per_a2": barrier,
                 "noise_mev_per_a2": 1e-8,
+                "relax_noise_mev_per_a2": math.nan,
+                "floor_mev_per_a2": 1e-8,
+                "relax_noise": None,
                 "resolved": True,
                 "force_calls": 144,
                 "wall_s": 20.0,
@@ -191,6 +194,61 @@ def test_the_csv_has_one_row_per_cell_with_the_documented_columns(tmp_path):
     files = write_approximants(doc, tmp_path, "flatcontact study approximants x.yaml")
     assert {f.name for f in files} == {"study.json", "approximants.csv", "approximants.png"}
     assert json.loads((tmp_path / "study.json").read_text())["provenance"]["command"]
+
+
+def _relaxed_doc() -> dict:
+    """The fake study as a relaxed one: the first cell's relaxation floor is measured (with its
+    cost), the second's is above its corrugation (unresolved, with the advice line), the third
+    relaxes nothing (nan)."""
+    from flatcontact.ispes.relax_noise import RelaxationNoise
+    from flatcontact.studies.approximants import tolerance_advice
+
+    doc = _fake_doc()
+    for cell, relax in zip(doc["cells"][:2], (2.5e-7, 1e-3), strict=True):
+        measured = RelaxationNoise(relax * 1e-3, 0.01, "normal", 12, 340, 0, 0.02)
+        cell.update(
+            relax_noise_mev_per_a2=relax,
+            floor_mev_per_a2=max(relax, cell["noise_mev_per_a2"]),
+            relax_noise=measured.to_json(),
+            resolved=cell["barrier_mev_per_a2"] >= RESOLVED_FACTOR * relax,
+            tolerance_advice=tolerance_advice(
+                cell["barrier_mev_per_a2"], cell["noise_mev_per_a2"], measured
+            ),
+        )
+    return {**doc, "relax_mode": "normal"}
+
+
+def test_the_relaxation_floor_round_trips_through_the_csv_and_study_json(tmp_path):
+    doc = _relaxed_doc()
+    write_approximants(doc, tmp_path, "flatcontact study approximants x.yaml")
+    rows = list(csv.DictReader(io.StringIO((tmp_path / "approximants.csv").read_text())))
+    back = json.loads((tmp_path / "study.json").read_text())["cells"]
+    for cell, row, stored in zip(doc["cells"][:3], rows, back, strict=False):
+        for key in ("noise_mev_per_a2", "relax_noise_mev_per_a2", "floor_mev_per_a2"):
+            assert float(row[key]) == pytest.approx(cell[key], nan_ok=True, rel=0), key
+            assert float(stored[key]) == pytest.approx(cell[key], nan_ok=True, rel=0), key
+        assert row["resolved"] == str(cell["resolved"])
+        assert stored["relax_noise"] == cell["relax_noise"]
+    assert [r["resolved"] for r in rows[:3]] == ["True", "False", "True"]
+    assert back[0]["relax_noise"]["mev_per_a2"] == pytest.approx(2.5e-7, rel=1e-12)
+    assert back[0]["relax_noise"]["force_calls"] == 340
+    assert rows[3]["relax_noise_mev_per_a2"] == rows[3]["floor_mev_per_a2"] == ""
+
+
+def test_the_advice_names_the_tolerance_that_could_resolve_a_relaxed_cell():
+    """Corrugation bound B below 10x the relaxation floor X at fmax f (and above 10x the
+    round-off): the floor ∝ fmax² reaches B/10 at f·sqrt(B/(10 X)); nothing to say when the
+    cell is resolved, when the round-off alone hides it, or when nothing relaxes."""
+    from flatcontact.ispes.relax_noise import RelaxationNoise
+    from flatcontact.studies.approximants import tolerance_advice
+
+    measured = RelaxationNoise(1e-7, 0.01, "normal", 12, 300, 0, 0.02)  # 1e-4 meV/Å²
+    line = tolerance_advice(2e-4, 2e-8, measured)
+    assert "scan.fmax_ev_per_angstrom <= ~0.004" in line  # 0.01·sqrt(2e-4/1e-3) = 0.0045
+    assert "relaxation floor 0.0001" in line and "\n" not in line
+    assert tolerance_advice(2e-3, 2e-8, measured) == ""  # resolved: 2e-3 >= 10 x 1e-4
+    assert tolerance_advice(1e-7, 2e-8, measured) == ""  # below 10x the round-off too
+    assert tolerance_advice(2e-4, 2e-8, None) == ""
 
 
 def test_the_figure_states_the_fit_or_why_there_is_none():

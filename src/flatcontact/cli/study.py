@@ -6,6 +6,7 @@ finished variant and where the study's files are (docs/studies.md).
 
 from __future__ import annotations
 
+import math
 import shlex
 import sys
 from pathlib import Path
@@ -127,10 +128,12 @@ def _cell_progress(label: str, result: dict) -> None:
         console.print(f"  {label}: failed: {result['error']}", highlight=False, soft_wrap=True)
         return
     gates = ", ".join(result["gates"]["fired"]) or "none"
+    relaxed = result["relax_noise_mev_per_a2"]
+    floor = "" if math.isnan(relaxed) else f", relaxation floor {relaxed:.2g}"
     console.print(
         f"  {label}: scan {result['scan_action']}, {result['force_calls']} force calls, "
         f"tau0 {result['tau0_mpa']:.4g} MPa, corrugation {result['barrier_mev_per_a2']:.4g} "
-        f"meV/A^2 (noise {result['noise_mev_per_a2']:.2g}"
+        f"meV/A^2 (noise {result['noise_mev_per_a2']:.2g}{floor}"
         f"{'' if result['resolved'] else ': NOT resolved'}), gates fired: {gates}, "
         f"{result['wall_s']:.1f} s",
         highlight=False,
@@ -241,11 +244,19 @@ def approximants_command(
     write_approximants(doc, out, _command_line())
     for key, name in (("tau0_mpa", "tau0"), ("barrier_mev_per_a2", "corrugation")):
         console.print(_scaling_line(name, doc["scaling"][key]), highlight=False, soft_wrap=True)
+    if doc["tolerance_advice"]:
+        console.print(
+            "force tolerance: "
+            + "; ".join(f"{label}: {text}" for label, text in doc["tolerance_advice"].items()),
+            highlight=False,
+            soft_wrap=True,
+        )
     if cfg.contact.experiment.compare is not None:
         _print_experiment_collapse(cfg, doc, out)
     c = doc["cost"]
     console.print(
-        f"force calls: {c['force_calls_study']} (stored {c['force_calls_stored']}); "
+        f"force calls: {c['force_calls_study']} (stored {c['force_calls_stored']}; "
+        f"relaxation floors {c['force_calls_floor']}); "
         f"study: {(out / 'study.json').resolve()}",
         highlight=False,
         soft_wrap=True,

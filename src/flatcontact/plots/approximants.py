@@ -6,7 +6,8 @@ power law ``y = c·N^−α`` and, when fitted, ``y = y∞ + c·N^−α``, and st
 the extrapolated limit with their intervals, or why a model was refused
 (:mod:`flatcontact.studies.scaling`). Values ≤ 0 cannot be drawn on a log axis: they are
 named in the panel, not dropped silently; a cell whose corrugation is not resolved above the
-energy noise floor is drawn as an open triangle and left out of the fits.
+noise floor (the round-off, or for a relaxed scan the relaxation floor when it is larger) is
+drawn as an open triangle and left out of the fits.
 """
 
 from __future__ import annotations
@@ -58,7 +59,7 @@ def figure_approximants(doc: dict) -> Figure:
                 "v",
                 mfc="none",
                 color="C3",
-                label="unresolved (< 10× noise): upper bound",
+                label="unresolved (< 10× noise floor): upper bound",
             )
         for c, ok in zip(cells, good, strict=True):
             if ok:

@@ -53,6 +53,7 @@ def cell_collapse(cell: dict, cfg: RunConfig) -> dict:
         **{key: cell.get(key, math.nan) for key in LAW_KEYS},
         "barrier_mev_per_a2": cell.get("barrier_mev_per_a2", math.nan),
         "noise_mev_per_a2": cell.get("noise_mev_per_a2", math.nan),
+        "floor_mev_per_a2": cell.get("floor_mev_per_a2", cell.get("noise_mev_per_a2", math.nan)),
         "resolved": bool(cell.get("resolved")),
         "gates_fired": list(gates),
         "collapse_stress_mpa": None,
@@ -65,7 +66,7 @@ def cell_collapse(cell: dict, cfg: RunConfig) -> dict:
     if not row["resolved"]:
         row["reason"] = (
             f"not resolved: corrugation {row['barrier_mev_per_a2']:.3g} meV/A^2 is below "
-            f"10x the noise floor {row['noise_mev_per_a2']:.3g}; no laws (an upper bound only)"
+            f"10x the noise floor {row['floor_mev_per_a2']:.3g}; no laws (an upper bound only)"
         )
         return row
     laws = {key: float(cell[key]) for key in LAW_KEYS}

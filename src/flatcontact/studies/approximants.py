@@ -22,9 +22,12 @@ and the validity gates (:func:`flatcontact.stages.gates.evaluate_gates`) run on 
 (pressures are intensive: the same loads for every cell).
 
 Per cell it returns the laws (τ0, k, σ0, μ of the analysis' energy form), the corrugation of
-the constant-pressure ISPES at the lowest load (max − min, meV/Å²), the energy noise floor
-(the same structure at two shifts one shift-lattice vector apart,
-:func:`~flatcontact.ispes.shift_lattice.translation_noise_ev_per_a2`) and whether the
+the constant-pressure ISPES at the lowest load (max − min, meV/Å²), the energy noise floors
+(the round-off: the same structure at two shifts one shift-lattice vector apart,
+:func:`~flatcontact.ispes.shift_lattice.translation_noise_ev_per_a2`; for a scan that
+relaxes anything, also the relaxation's: the same structure relaxed three times from
+perturbed starts with the scan's tolerance, :func:`~flatcontact.ispes.relax_noise.relaxation_noise`;
+the floor is the larger) and whether the
 corrugation is resolved (≥ :data:`RESOLVED_FACTOR` × the floor; a cell whose ISPES has no
 lateral range above that at any thickness is not analysed: its laws are NaN and its
 "barrier" is that range, an upper bound), the gates that fired, the
@@ -68,8 +71,9 @@ from flatcontact.studies.variants import variant_config
 #: Folder of a cell's run directory that holds the ISPES on one shift-lattice period.
 SHIFT_CELL = "shift-cell"
 #: A cell's corrugation is resolved when it is at least this multiple of the energy noise
-#: floor (:func:`flatcontact.ispes.shift_lattice.translation_noise_ev_per_a2`); the scaling
-#: is fitted on resolved cells only.
+#: floor (the larger of :func:`flatcontact.ispes.shift_lattice.translation_noise_ev_per_a2`
+#: and, for a relaxed scan, :func:`flatcontact.ispes.relax_noise.relaxation_noise`); the
+#: scaling is fitted on resolved cells only.
 RESOLVED_FACTOR = 10.0
 
 
@@ -165,6 +169,38 @@ def lateral_range_mev_per_a2(shifted) -> float:
     return 1e3 * float(np.nanmax(np.nanmax(e, axis=(0, 1)) - np.nanmin(e, axis=(0, 1))))
 
 
+def tolerance_advice(barrier_mev_per_a2: float, noise_mev_per_a2: float, relaxed) -> str:
+    """One line when a relaxed cell is unresolved because of its force tolerance, else "".
+
+    ``relaxed`` is the cell's :class:`~flatcontact.ispes.relax_noise.RelaxationNoise` (None:
+    nothing relaxes). The line is written when the corrugation (an upper bound when the cell
+    was not analysed) is below :data:`RESOLVED_FACTOR` × the relaxation floor but not below
+    that multiple of the rigid (round-off) floor: a tighter ``scan.fmax_ev_per_angstrom``
+    could resolve it, a rerun at the same tolerance cannot. The tolerance it names is
+    necessary, not sufficient: the floor brought to 1/:data:`RESOLVED_FACTOR` of the
+    corrugation bound, with the floor taken ∝ fmax² (the scaling of the harmonic bound: near a
+    minimum the energy left is ½ Fᵀ H⁻¹ F), an estimate only: on relaxed twisted graphene the
+    measured floor fell more slowly from 0.01 to 5e-4 eV/Å and far faster below
+    (docs/incommensurate.md); and the true relaxed corrugation may be smaller than the bound.
+    """
+    if relaxed is None:
+        return ""
+    relax_noise = 1e3 * relaxed.ev_per_a2
+    bound = RESOLVED_FACTOR * relax_noise
+    if not (
+        barrier_mev_per_a2 < bound and barrier_mev_per_a2 >= RESOLVED_FACTOR * noise_mev_per_a2
+    ):
+        return ""
+    fmax = relaxed.fmax_ev_per_a
+    needed = fmax * math.sqrt(barrier_mev_per_a2 / bound)
+    return (
+        f"corrugation <= {barrier_mev_per_a2:.2g} meV/A^2 is below {RESOLVED_FACTOR:g}x the "
+        f"relaxation floor {relax_noise:.2g} at scan.fmax_ev_per_angstrom {fmax:g} "
+        f"({relaxed.mode}); resolving it needs scan.fmax_ev_per_angstrom <= ~{needed:.1g} "
+        "(floor ~ fmax^2) or a rigid-layers scan"
+    )
+
+
 def _gates(cfg: RunConfig, root: Path) -> dict:
     """The validity gates of the ordinary run (:func:`flatcontact.stages.gates.evaluate_gates`)
     on the shift-cell analysis: the scan's (in-slab slip, load folds), the laws' (negative
@@ -195,11 +231,13 @@ def run_cell(config: dict, folder: str, planned: int) -> dict:
     ``folder``: build and scan through the pipeline, then the ISPES on one shift-lattice
     period, its analysis, laws and gates (module docstring). Module-level with plain
     arguments so an executor can run cells side by side."""
+    from flatcontact.ispes.relax_noise import relaxation_noise, relaxes_something
     from flatcontact.ispes.shift_lattice import shift_lattice_of, translation_noise_ev_per_a2
     from flatcontact.pipeline import Pipeline
     from flatcontact.potentials.engines import make_calculator
     from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
     from flatcontact.stages.laws import LawsInputs, run_laws
+    from flatcontact.stages.scan import relax_settings
     from flatcontact.structures.interface_io import read_interface
 
     cfg = RunConfig.model_validate(config)
@@ -230,13 +268,19 @@ def run_cell(config: dict, folder: str, planned: int) -> dict:
     shifted = ds  # the scan stage's ispes.nc: already on one shift-lattice period
     shutil.copy2(scan_folder / ISPES_NC, cell / ISPES_NC)
     shutil.copy2(scan_folder / SCAN_JSON, cell / SCAN_JSON)
-    noise = 1e3 * translation_noise_ev_per_a2(
-        reference, make_calculator(cfg.potential, reference), lattice
-    )
+    calculator = make_calculator(cfg.potential, reference)
+    noise = 1e3 * translation_noise_ev_per_a2(reference, calculator, lattice)
+    relax, relaxed = relax_settings(cfg.scan), None
+    if relaxes_something(reference, relax):
+        relaxed = relaxation_noise(
+            reference, calculator, lattice, relax, np.asarray(shifted["thickness"].values)
+        )
+    relax_noise = math.nan if relaxed is None else 1e3 * relaxed.ev_per_a2
+    floor = max(noise, 0.0 if relaxed is None else relax_noise)
     lateral = lateral_range_mev_per_a2(shifted)
     nan = math.nan
     form, law, p_low, barrier, gates = cfg.analysis.energy_form, {}, nan, lateral, None
-    if lateral >= RESOLVED_FACTOR * noise:
+    if lateral >= RESOLVED_FACTOR * floor:
         run_analyze(cfg, AnalyzeInputs(cell / ISPES_NC), cell / "analyze")
         run_laws(
             cfg, LawsInputs.read(cell / "analyze" / FRICTION_CSV, cell / ISPES_NC), cell / "laws"
@@ -266,7 +310,11 @@ def run_cell(config: dict, folder: str, planned: int) -> dict:
         "analysed": bool(law),
         "barrier_at_p_gpa": p_low,
         "noise_mev_per_a2": noise,
-        "resolved": bool(barrier >= RESOLVED_FACTOR * noise),
+        "relax_noise_mev_per_a2": relax_noise,
+        "floor_mev_per_a2": floor,
+        "relax_noise": None if relaxed is None else relaxed.to_json(),
+        "resolved": bool(barrier >= RESOLVED_FACTOR * floor),
+        "tolerance_advice": tolerance_advice(barrier, noise, relaxed),
         "shift_lattice_index": lattice.index,
         "shift_cell_a1_angstrom": np.asarray(shifted.attrs["a1"], float).tolist(),
         "shift_cell_a2_angstrom": np.asarray(shifted.attrs["a2"], float).tolist(),
@@ -354,6 +402,7 @@ def run_approximants(
         entry = {k: v for k, v in c.items() if k != "config"}
         rows.append({**entry, **r})
     ok = [r for r in rows if "error" not in r]
+    advice = {r["label"]: r["tolerance_advice"] for r in ok if r.get("tolerance_advice")}
     return {
         "study": "approximants",
         "approximants": cfg.section("approximants"),
@@ -362,9 +411,11 @@ def run_approximants(
         "cells": rows,
         "failed": {r["label"]: r["error"] for r in rows if "error" in r},
         "scaling": scaling_block(ok, set(cfg.contact.accept_untrusted)),
+        "tolerance_advice": advice,
         "cost": {
             "force_calls_study": sum(r["force_calls_spent"] for r in ok),
             "force_calls_stored": sum(r["force_calls"] for r in ok),
+            "force_calls_floor": sum((r["relax_noise"] or {}).get("force_calls", 0) for r in ok),
             "wall_s_cells": sum(r["wall_s"] for r in ok),
             "cells": len(rows),
             "executor": executor.name,

@@ -134,8 +134,11 @@ def write_study(doc: dict, cfg: RunConfig, out: str | Path, command: str) -> lis
 APPROXIMANTS_CSV = "approximants.csv"
 #: One row per cell of ``flatcontact study approximants`` (strains: the largest principal
 #: strain of each slab in %, absolute; k and μ in MPa/GPa; barrier: the ISPES corrugation
-#: at the lowest load; noise: the energy noise floor; resolved: barrier >= 10 x noise; gates:
-#: the validity gates that fired, ``;``-separated).
+#: at the lowest load; noise: the engine's round-off floor of single-point energies;
+#: relax_noise: the relaxation's floor, round-off and force tolerance
+#: (:mod:`flatcontact.ispes.relax_noise`; empty/nan when the scan relaxes nothing); floor: the
+#: larger of the two; resolved: barrier >= 10 x floor; gates: the validity gates that fired,
+#: ``;``-separated).
 APPROXIMANTS_COLUMNS = (
     "label",
     "atoms",
@@ -151,6 +154,8 @@ APPROXIMANTS_COLUMNS = (
     "mu_mpa_per_gpa",
     "barrier_mev_per_a2",
     "noise_mev_per_a2",
+    "relax_noise_mev_per_a2",
+    "floor_mev_per_a2",
     "resolved",
     "force_calls",
     "wall_s",
@@ -177,7 +182,7 @@ def approximants_csv_text(doc: dict) -> str:
                 c["shift_lattice_index"],
                 "x".join(str(g) for g in c["grid"]),
                 *(
-                    [""] * 7
+                    [""] * 9
                     if failed
                     else [
                         c["tau0_mpa"],
@@ -186,6 +191,8 @@ def approximants_csv_text(doc: dict) -> str:
                         c["mu_mpa_per_gpa"],
                         c["barrier_mev_per_a2"],
                         c["noise_mev_per_a2"],
+                        c["relax_noise_mev_per_a2"],
+                        c["floor_mev_per_a2"],
                         c["resolved"],
                     ]
                 ),
