@@ -116,6 +116,8 @@ def models_command(
     console.print(f"flatcontact study models: {config} -> {out}", highlight=False)
     doc = run_models(cfg, models, out, on_done=_progress)
     write_study(doc, cfg, out, _command_line())
+    for label, why in doc["failed"].items():
+        console.print(f"{label}: failed, not in the spread: {why}", highlight=False)
     for form, spread in doc["spread"].items():
         text = ", ".join(f"{k} {v:.3g}" for k, v in spread.items())
         console.print(f"spread ({form}): {text}", highlight=False)

@@ -93,7 +93,10 @@ def uncertainty_block(doc: dict, cfg: RunConfig, command: str) -> dict:
             f"model_spread_{f}": {k: _sig3(v) for k, v in d.items()}
             for f, d in doc["spread"].items()
         }
-        what = f"half the max - min range of each law coefficient over {', '.join(doc['models'])}"
+        spread_over = [v.get("model", v["name"]) for v in doc["variants"]]
+        what = f"half the max - min range of each law coefficient over {', '.join(spread_over)}"
+        if doc.get("failed"):
+            what += f" (failed, not in the spread: {', '.join(doc['failed'])})"
     return {
         **parts,
         "coverage": 1.0,
