@@ -78,6 +78,11 @@ def convergence_command(
         if st["state"] == "failed":
             console.print(f"{s}: failed at step {st['steps']}: {st['error']}", highlight=False)
             continue
+        if st["state"] == "not refined":
+            console.print(
+                f"{s}: not refined at step {st['steps']}: {st['reason']}", highlight=False
+            )
+            continue
         ch = st.get("last_change", {})
         console.print(
             f"{s}: {st['state']} after {st['steps']} step(s); last step moved "
