@@ -82,10 +82,17 @@ def uncertainty_block(doc: dict, cfg: RunConfig, command: str) -> dict:
         parts = {
             f"convergence_{f}": {k: _sig3(v) for k, v in d.items()} for f, d in doc["delta"].items()
         }
+        states = {s: st.get("state", "") for s, st in doc["settings"].items()}
+        used = [s for s, state in states.items() if state not in ("failed", "not refined")]
+        open_ = [f"{s} ({state})" for s, state in states.items() if state != "converged"]
         what = (
             f"largest change of each law coefficient over the last refinement step of "
-            f"{', '.join(doc['settings']) or 'no setting'} (tolerance {doc['tolerance_pct']:g} %; "
-            + ("all converged" if doc["converged"] else "NOT all converged: see study.json")
+            f"{', '.join(used) or 'no setting'} (tolerance {doc['tolerance_pct']:g} %; "
+            + (
+                "all converged"
+                if doc["converged"]
+                else f"NOT converged: {', '.join(open_)}; see study.json"
+            )
             + ")"
         )
     else:
