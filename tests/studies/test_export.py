@@ -240,3 +240,24 @@ def test_the_blocks_source_names_each_setting_that_did_not_converge():
     doc["settings"] = {"grid": {"state": "converged"}}
     doc["converged"] = True
     assert "of grid (tolerance 3 %; all converged)" in uncertainty_block(doc, cfg, "t")["source"]
+
+
+def test_the_cost_line_compares_stored_force_calls_with_the_ladders_from_scratch():
+    """Ni(111) after --estimate: the study printed 'force calls: 2461 (each setting from
+    scratch: 4485)', this invocation's calls (the base, run by --estimate, left out) against
+    ladders that count the base once per setting. The line compares the stored calls (what
+    the study cost) with the ladders from scratch, and says what this invocation computed."""
+    from flatcontact.studies.output import cost_line
+
+    base, variants = 506, [912, 484, 545, 520]
+    stored = base + sum(variants)
+    cost = {
+        "force_calls_study": sum(variants),
+        "force_calls_stored": stored,
+        "force_calls_from_scratch": stored + 3 * base,
+        "variants": 5,
+    }
+    line = cost_line(cost)
+    assert line.startswith(f"force calls: {stored} in 5 runs against {stored + 3 * base} ")
+    assert f"{sum(variants)} computed by this invocation" in line
+    assert "invocation" not in cost_line({**cost, "force_calls_study": stored})

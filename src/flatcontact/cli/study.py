@@ -59,7 +59,7 @@ def convergence_command(
     from flatcontact.config.load import load_config
     from flatcontact.studies.convergence import run_convergence
     from flatcontact.studies.estimate import estimate_lines
-    from flatcontact.studies.output import write_study
+    from flatcontact.studies.output import cost_line, write_study
 
     def _estimate(est: dict) -> None:
         for line in estimate_lines(est):
@@ -91,11 +91,8 @@ def convergence_command(
         )
     for s, why in doc["skipped_settings"].items():
         console.print(f"{s}: not refined ({why})", highlight=False)
-    c = doc["cost"]
     console.print(
-        f"force calls: {c['force_calls_study']} (each setting from scratch: "
-        f"{c['force_calls_from_scratch']}); study: {(out / 'study.json').resolve()}",
-        highlight=False,
+        f"{cost_line(doc['cost'])}; study: {(out / 'study.json').resolve()}", highlight=False
     )
 
 

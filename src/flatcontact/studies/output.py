@@ -120,6 +120,19 @@ def uncertainty_block(doc: dict, cfg: RunConfig, command: str) -> dict:
     }
 
 
+def cost_line(cost: dict) -> str:
+    """The console line of a convergence study's force calls: stored by its runs (what the
+    study cost, whichever invocation ran them) against each setting's ladder from scratch,
+    and how many of them this invocation computed (a rerun or a study after ``--estimate``
+    reuses the rest)."""
+    stored, now = cost["force_calls_stored"], cost["force_calls_study"]
+    reused = "" if now == stored else f"; {now} computed by this invocation, the rest reused"
+    return (
+        f"force calls: {stored} in {cost['variants']} runs against "
+        f"{cost['force_calls_from_scratch']} for each setting's ladder from scratch{reused}"
+    )
+
+
 def write_study(doc: dict, cfg: RunConfig, out: str | Path, command: str) -> list[Path]:
     """Write the study's files into ``out``; returns their paths."""
     out = Path(out)
