@@ -7,30 +7,13 @@ scan."""
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
+from tests.studies.columns import chosen as _chosen
+from tests.studies.columns import column as _column
 
 from flatcontact.config.load import build_config
-from flatcontact.ispes.probe import ColumnProbe
-from flatcontact.ispes.thicknesses import (
-    MIN_THICKNESS_SPACING_ANGSTROM,
-    thicknesses_spanning_columns,
-)
+from flatcontact.ispes.thicknesses import MIN_THICKNESS_SPACING_ANGSTROM
 from flatcontact.studies.compare import median_spacing_angstrom, thickness_step_refines
-
-
-def _column(z0: float, p0_gpa: float, a_per_angstrom: float, shift=(0.0, 0.0)) -> ColumnProbe:
-    """A probed column whose load is the Morse-like p(z) = p0 (e^{-2a(z-z0)} - e^{-a(z-z0)}):
-    P = 0 at z0, stiffness p0·a GPa/Å there, tensile maximum -p0/4 at z0 + ln 2 / a."""
-    z = np.arange(13.8, 16.0, 0.01)
-    d = z - z0
-    p = p0_gpa * (np.exp(-2 * a_per_angstrom * d) - np.exp(-a_per_angstrom * d))
-    return ColumnProbe(shift, z, np.zeros_like(z), p, 0, 7.0)
-
-
-def _chosen(probes, hi_gpa, n):
-    z = thicknesses_spanning_columns(probes, 0.0, hi_gpa, n).thickness_angstrom
-    return {"thickness_angstrom": z.tolist()}
 
 
 def test_a_larger_n_can_coarsen_a_stiff_interface_and_the_step_says_so():
