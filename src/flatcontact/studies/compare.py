@@ -87,5 +87,6 @@ def thickness_step_refines(
         f"{len(fine['thickness_angstrom'])} thicknesses) against {a:.4g} Å for {coarse_name} "
         f"({len(coarse['thickness_angstrom'])}); the spacing is set by the bracket of the "
         f"extreme stackings and the minimum spacing {MIN_THICKNESS_SPACING_ANGSTROM} Å, not by "
-        "scan.p_range_gpa.n; give scan.thickness_angstrom to refine it"
+        "scan.p_range_gpa.n; a finer scan.thickness_angstrom list needs energies converged "
+        "for their derivative at its spacing (a tighter scan.fmax_ev_per_angstrom)"
     )
