@@ -59,6 +59,9 @@ def test_the_rules_scale_points_calls_and_seconds_from_the_base():
     assert est["serial_seconds"] == pytest.approx(34.0 + sum(sum(r) for r in rounds))
     text = "\n".join(estimate_lines(est))
     assert "grid1 (grid 5x5): 150 points, ~75 computed, ~750 force calls" in text
+    # a thickness rung names the scan's thicknesses beside the requested count (the base's
+    # 6 include the probe's; "6 thicknesses" alone read as fewer than Ni(111)'s base of 18)
+    assert "thicknesses1 (6 thicknesses; ~9 scanned): 81 points" in text
     assert f"all 8 variants: ~{total} force calls" in text
 
 

@@ -190,8 +190,9 @@ def estimate_lines(est: dict) -> list[str]:
     ]
     for v in est["variants"]:
         bound = " (lower bound)" if v["lower_bound"] else ""
+        scanned = f"; ~{v['thicknesses']} scanned" if v["setting"] == "thicknesses" else ""
         lines.append(
-            f"  {v['name']} ({v['label']}): {v['points']} points, ~{v['points_computed']} "
+            f"  {v['name']} ({v['label']}{scanned}): {v['points']} points, ~{v['points_computed']} "
             f"computed, ~{v['force_calls']} force calls{bound}, ~{_duration(v['seconds'])}"
         )
     lines.append(
