@@ -29,7 +29,7 @@ def _block() -> dict:
     }
 
 
-@pytest.mark.parametrize("form", ["export json", "study yaml"])
+@pytest.mark.parametrize("form", ["export json", "study yaml", "study json", "study directory"])
 def test_a_file_named_by_uncertainty_is_the_block_it_holds(tmp_path, form):
     """The file, relative to the config file, gives the same configuration as the block
     pasted inline; its measured_on is checked as the inline one's."""
@@ -38,10 +38,14 @@ def test_a_file_named_by_uncertainty_is_the_block_it_holds(tmp_path, form):
     if form == "export json":
         (tmp_path / "studies" / "u.json").write_text(json.dumps(block))
         name = "studies/u.json"
+    elif form == "study json":  # study.json holds the block beside the study's results
+        doc = {"study": "convergence", "variants": [], "uncertainty": block}
+        (tmp_path / "studies" / "study.json").write_text(json.dumps(doc))
+        name = "studies/study.json"
     else:
         text = "# measured by flatcontact study\n" + yaml.safe_dump({"uncertainty": block})
         (tmp_path / "studies" / "uncertainty.yaml").write_text(text)
-        name = "studies/uncertainty.yaml"
+        name = "studies/uncertainty.yaml" if form == "study yaml" else "studies"
     (tmp_path / "run").mkdir()
     by_file = load_config(
         write_yaml(tmp_path / "run" / "a.yaml", toy_data(uncertainty=f"../{name}"))

@@ -152,20 +152,23 @@ def recipe_files(recipe: Any) -> list[tuple[str, str]]:
 def _uncertainty_file(name: str, config: Path) -> dict:
     """The ``uncertainty`` block in the file ``name`` (relative to the config file ``config``).
 
-    The file is what ``flatcontact study export-uncertainty`` writes (JSON) or a study's
-    ``uncertainty.yaml`` (the block under an ``uncertainty:`` key); either is read as YAML.
+    The file is what ``flatcontact study export-uncertainty`` writes (JSON), or a study's
+    ``uncertainty.yaml`` or ``study.json`` (the block under an ``uncertainty`` key), or a
+    study directory (its ``uncertainty.yaml``); each is read as YAML.
     A missing, unreadable or non-mapping file is one InputError line naming the field.
     """
     target = Path(_resolved(name, config.parent))
     field = f"{config}: uncertainty"
+    if target.is_dir():  # a study directory: its uncertainty.yaml
+        target = target / "uncertainty.yaml"
     if not target.is_file():
         raise InputError(
             f"{field}: file {target} not found (expected a file written by "
-            "'flatcontact study export-uncertainty' or a study's uncertainty.yaml)"
+            "'flatcontact study export-uncertainty', a study directory or its uncertainty.yaml)"
         )
     block = parse_yaml(read_text_file(target, "uncertainty file", MAX_CONFIG_BYTES), str(target))
-    if isinstance(block, dict) and set(block) == {"uncertainty"}:
-        block = block["uncertainty"]
+    if isinstance(block, dict) and isinstance(block.get("uncertainty"), dict):
+        block = block["uncertainty"]  # a study's uncertainty.yaml or study.json
     if not isinstance(block, dict):
         raise InputError(f"{field}: {target} holds no uncertainty block (expected a mapping)")
     return block
