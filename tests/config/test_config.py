@@ -109,6 +109,13 @@ def test_file_overlays_preset_and_resolves_paths(tmp_path):
         # input files named by the config exist
         ("contact: {experiment: {csv: nothere.csv}}\n", "c.yaml: contact.experiment.csv: file "),
         ("structure: {kind: file, file: no.extxyz}\n", "c.yaml: structure.file: file "),
+        # a union's member type is not part of the path (it printed
+        # "refine.settings.list[literal['grid','thicknesses',...]].0")
+        (
+            "refine: {settings: [bogus]}\n",
+            "c.yaml: refine.settings.0: expected 'grid', 'thicknesses', 'layers', 'fmax' or "
+            "'cutoff', got \"bogus\"",
+        ),
     ],
 )
 def test_bad_config_is_one_line_naming_the_path(tmp_path, text, message):

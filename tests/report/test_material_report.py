@@ -275,3 +275,59 @@ def test_the_quartz_report_still_compares_with_the_paper(tmp_path):
 def test_stacking_names_per_family(family, expected):
     energies = {"BA": 0.0, "AB": 1.22, "SP": 1.415, "AA": 5.6}
     assert display_names(energies, family) == expected
+
+
+def _results_row(html: str, label: str) -> str:
+    """The cell of the 'Results for' table's row ``label`` (the first table that has it)."""
+    m = re.search(re.escape(label) + r"</td><td>([^<]*)</td>", html)
+    assert m is not None, label
+    return m.group(1)
+
+
+def test_results_table_gives_the_study_intervals_beside_the_fit_error(tmp_path):
+    """A run with a study's uncertainty block (Ni(111) as a new user ran it: the table showed
+    k = -1.73 ± 0.93, the fit alone, where laws.json's interval with convergence and model
+    spread is [-7.45, 3.98], and Q_peak/πa² with no interval): each law row carries the
+    interval of laws.json (law_intervals over the fit, convergence and model parts combined
+    by law_half_widths) and Q_peak/πa² the contact stage's interval; without a study's parts
+    the rows are the fit's ± alone."""
+    from flatcontact.analysis.uncertainty import law_components, law_half_widths, law_intervals
+
+    cfg = _cu_config(layers=4)
+    atoms, report = build_interface(cfg.structure)
+    laws = _laws(-0.9, 3770.0, -0.51, 1099.0)
+    conv = {"k_mpa_per_gpa": 3.64, "tau0_mpa": 131.0, "mu_mpa_per_gpa": 1.25, "sigma0_mpa": 2.1}
+    models = {"k_mpa_per_gpa": 4.31, "tau0_mpa": 52.0, "mu_mpa_per_gpa": 1.52, "sigma0_mpa": 209}
+    hw = law_half_widths(laws, convergence=conv, model=models)
+    laws["intervals"] = law_intervals(
+        laws, hw, law_components(laws, convergence=conv, model=models)
+    )
+    folders = _stage_folders(
+        tmp_path, atoms, {**report, "interface_relaxation": None}, laws, CU_STACKINGS
+    )
+    summary = json.loads((folders["contact"] / SUMMARY_JSON).read_text())
+    q = {"value": 2206.0, "low": 2080.0, "high": 2330.0}
+    summary["intervals"] = {
+        "half_widths": hw,
+        "results": [
+            {
+                "p0_gpa": 1.0,
+                "effective_shear_strength_mpa": q,
+                "collapse_stress_mpa": q,
+                "knee_stress_amplitude_mpa": q,
+            }
+        ],
+    }
+    (folders["contact"] / SUMMARY_JSON).write_text(json.dumps(summary))
+    html = render_html("Ni", build_sections(cfg, folders, []))
+    for key, label in (("k_mpa_per_gpa", "k (MPa/GPa)"), ("sigma0_mpa", "σ0 (MPa)")):
+        iv = laws["intervals"][key]
+        cell = _results_row(html, label)
+        assert cell.endswith(f"; [{iv['low']:.3g}, {iv['high']:.3g}]"), cell
+    cell = _results_row(html, "effective shear strength Q_peak/πa² at p0 = 1 GPa (MPa)")
+    assert cell == "2206 [2080, 2330]"
+    # the same run without a study's parts: the fit's ± alone, as before
+    (tmp_path / "plain").mkdir()
+    plain = _cu_report(tmp_path / "plain")
+    assert _results_row(plain, "k (MPa/GPa)") == "-0.9 ± 0.3"
+    assert _results_row(plain, "effective shear strength Q_peak/πa² at p0 = 1 GPa (MPa)") == "2206"

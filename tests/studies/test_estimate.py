@@ -7,6 +7,7 @@ import json
 
 import pytest
 from tests.hardening.helpers import run_cli
+from tests.studies.columns import chosen, column
 from tests.studies.toy import toy_config, toy_data, write_yaml
 
 from flatcontact.studies.convergence import run_convergence
@@ -58,6 +59,9 @@ def test_the_rules_scale_points_calls_and_seconds_from_the_base():
     assert est["serial_seconds"] == pytest.approx(34.0 + sum(sum(r) for r in rounds))
     text = "\n".join(estimate_lines(est))
     assert "grid1 (grid 5x5): 150 points, ~75 computed, ~750 force calls" in text
+    # a thickness rung names the scan's thicknesses beside the requested count (the base's
+    # 6 include the probe's; "6 thicknesses" alone read as fewer than Ni(111)'s base of 18)
+    assert "thicknesses1 (6 thicknesses; ~9 scanned): 81 points" in text
     assert f"all 8 variants: ~{total} force calls" in text
 
 
@@ -95,3 +99,22 @@ def test_estimate_runs_only_the_base_and_predicts_what_the_study_spends(tmp_path
         )
         assert est["points"] == pytest.approx(got[0], rel=0.15), est["name"]
         assert est["force_calls"] == pytest.approx(got[1], rel=0.5), est["name"]
+
+
+def test_a_thickness_rung_below_the_minimum_spacing_is_estimated_as_the_scan_merges_it():
+    """A stiff interface (the Morse-like columns of tests/studies/columns.py: 25 GPa/Å, a
+    repulsive stacking 0.3 Å out): the scan's own chooser gives the base's thicknesses for
+    n = 4 and the rungs' for n = 6 and 9; the estimate from the base's count and range is
+    within 15 % of each (Ni(111): the rule without the merge said 29 for 16 scanned)."""
+    stiff = [column(14.2, 12.5, 2.0), column(14.5, 12.5, 2.0, (2 / 3, 1 / 3))]
+    z = {n: chosen(stiff, 2.0, n)["thickness_angstrom"] for n in (4, 6, 9)}
+    cfg = toy_config(settings=["thicknesses"], max_steps=2)  # p_range_gpa n = 4
+    base = {
+        **BASE,
+        "thicknesses": len(z[4]),
+        "thickness_range_angstrom": max(z[4]) - min(z[4]),
+    }
+    ladder = {"thicknesses": [step(cfg, "thicknesses", i) for i in (1, 2)]}
+    est = {v["name"]: v for v in estimate_convergence(cfg, ladder, base, 1)["variants"]}
+    for name, n in (("thicknesses1", 6), ("thicknesses2", 9)):
+        assert est[name]["thicknesses"] == pytest.approx(len(z[n]), rel=0.15), name

@@ -208,3 +208,56 @@ def test_a_variant_that_fails_is_reported_as_its_settings_failure(tmp_path, monk
         a = by["base"]["laws"]["internal"][key]
         b = by["thicknesses1"]["laws"]["internal"][key]
         assert doc["delta"]["internal"][key] == pytest.approx(abs(b - a))
+
+
+def test_the_blocks_source_names_each_setting_that_did_not_converge():
+    """The source line of a convergence study's block names every setting that is not
+    converged with its state, and the refinement steps δ_conv was taken over are only those of
+    the settings that neither failed nor did not refine (it said 'NOT all converged: see
+    study.json' and listed every setting)."""
+    from flatcontact.studies.output import uncertainty_block
+
+    cfg = build_config(toy_data(), None, "toy")
+    numbers = {k: 1.0 for k in LAW_COEFFICIENTS}
+    doc = {
+        "study": "convergence",
+        "delta": {"internal": numbers, "enthalpy": numbers},
+        "settings": {
+            "grid": {"state": "converged"},
+            "thicknesses": {"state": "not refined"},
+            "layers": {"state": "failed"},
+            "fmax": {"state": "not converged"},
+        },
+        "tolerance_pct": 3.0,
+        "converged": False,
+        "variants": [{"name": "base"}],
+    }
+    source = uncertainty_block(doc, cfg, "t")["source"]
+    assert "last refinement step of grid, fmax (" in source
+    assert (
+        "NOT converged: thicknesses (not refined), layers (failed), fmax (not converged)" in source
+    )
+    doc["settings"] = {"grid": {"state": "converged"}}
+    doc["converged"] = True
+    assert "of grid (tolerance 3 %; all converged)" in uncertainty_block(doc, cfg, "t")["source"]
+
+
+def test_the_cost_line_compares_stored_force_calls_with_the_ladders_from_scratch():
+    """Ni(111) after --estimate: the study printed 'force calls: 2461 (each setting from
+    scratch: 4485)', this invocation's calls (the base, run by --estimate, left out) against
+    ladders that count the base once per setting. The line compares the stored calls (what
+    the study cost) with the ladders from scratch, and says what this invocation computed."""
+    from flatcontact.studies.output import cost_line
+
+    base, variants = 506, [912, 484, 545, 520]
+    stored = base + sum(variants)
+    cost = {
+        "force_calls_study": sum(variants),
+        "force_calls_stored": stored,
+        "force_calls_from_scratch": stored + 3 * base,
+        "variants": 5,
+    }
+    line = cost_line(cost)
+    assert line.startswith(f"force calls: {stored} in 5 runs against {stored + 3 * base} ")
+    assert f"{sum(variants)} computed by this invocation" in line
+    assert "invocation" not in cost_line({**cost, "force_calls_study": stored})

@@ -96,7 +96,7 @@ def test_a_refinement_that_does_not_converge_within_its_budget_is_reported(tmp_p
     assert doc["converged"] is False
     assert "grid: not converged after 1 step(s)" in " ".join(out.split())
     block = yaml.safe_load((tmp_path / "s" / "uncertainty.yaml").read_text())["uncertainty"]
-    assert "NOT all converged" in block["source"]
+    assert "NOT converged: grid (not converged)" in block["source"]
     for f in (
         "study_tau_mpa.png",
         "study_sigma_mss_mpa.png",

@@ -60,7 +60,7 @@ def convergence_command(
     from flatcontact.config.load import load_config
     from flatcontact.studies.convergence import run_convergence
     from flatcontact.studies.estimate import estimate_lines
-    from flatcontact.studies.output import write_study
+    from flatcontact.studies.output import cost_line, write_study
 
     def _estimate(est: dict) -> None:
         for line in estimate_lines(est):
@@ -79,6 +79,11 @@ def convergence_command(
         if st["state"] == "failed":
             console.print(f"{s}: failed at step {st['steps']}: {st['error']}", highlight=False)
             continue
+        if st["state"] == "not refined":
+            console.print(
+                f"{s}: not refined at step {st['steps']}: {st['reason']}", highlight=False
+            )
+            continue
         ch = st.get("last_change", {})
         console.print(
             f"{s}: {st['state']} after {st['steps']} step(s); last step moved "
@@ -87,11 +92,8 @@ def convergence_command(
         )
     for s, why in doc["skipped_settings"].items():
         console.print(f"{s}: not refined ({why})", highlight=False)
-    c = doc["cost"]
     console.print(
-        f"force calls: {c['force_calls_study']} (each setting from scratch: "
-        f"{c['force_calls_from_scratch']}); study: {(out / 'study.json').resolve()}",
-        highlight=False,
+        f"{cost_line(doc['cost'])}; study: {(out / 'study.json').resolve()}", highlight=False
     )
 
 
@@ -117,6 +119,8 @@ def models_command(
     console.print(f"flatcontact study models: {config} -> {out}", highlight=False)
     doc = run_models(cfg, models, out, on_done=_progress)
     write_study(doc, cfg, out, _command_line())
+    for label, why in doc["failed"].items():
+        console.print(f"{label}: failed, not in the spread: {why}", highlight=False)
     for form, spread in doc["spread"].items():
         text = ", ".join(f"{k} {v:.3g}" for k, v in spread.items())
         console.print(f"spread ({form}): {text}", highlight=False)

@@ -78,7 +78,9 @@ def load_config(path: str | Path | None = None, preset_name: str | None = None) 
     """Read and validate a run configuration (YAML); ``None`` gives the preset alone.
 
     Relative paths inside the file (``structure.file``, ``contact.experiment.csv``) are
-    resolved against the file's directory. Every problem is one :class:`InputError` line
+    resolved against the file's directory; ``uncertainty`` may name a file holding the block
+    (what ``flatcontact study export-uncertainty`` writes, or a study's ``uncertainty.yaml``),
+    read in its place. Every problem is one :class:`InputError` line
     naming the file and the field path: a file that is missing, a directory, unreadable,
     larger than :data:`~flatcontact.config.yaml_io.MAX_CONFIG_BYTES`, not UTF-8, not YAML,
     nested deeper than :data:`~flatcontact.config.yaml_io.MAX_CONFIG_DEPTH` or with a key
@@ -94,6 +96,8 @@ def load_config(path: str | Path | None = None, preset_name: str | None = None) 
     if not isinstance(data, dict):
         raise InputError(f"{path}: expected a mapping of sections, got {type(data).__name__}")
     data = migration.contact_keys(data, str(path))
+    if isinstance(data.get("uncertainty"), str):
+        data["uncertainty"] = _uncertainty_file(data["uncertainty"], path)
     for dotted in FILE_FIELDS:
         holder, key = _holder(data, dotted)
         if isinstance(holder, dict) and isinstance(holder.get(key), str):
@@ -143,6 +147,31 @@ def recipe_files(recipe: Any) -> list[tuple[str, str]]:
         if isinstance(obj, str) and obj not in BUILTIN_SHEET_NAMES:
             out.append((dotted, obj))
     return out
+
+
+def _uncertainty_file(name: str, config: Path) -> dict:
+    """The ``uncertainty`` block in the file ``name`` (relative to the config file ``config``).
+
+    The file is what ``flatcontact study export-uncertainty`` writes (JSON), or a study's
+    ``uncertainty.yaml`` or ``study.json`` (the block under an ``uncertainty`` key), or a
+    study directory (its ``uncertainty.yaml``); each is read as YAML.
+    A missing, unreadable or non-mapping file is one InputError line naming the field.
+    """
+    target = Path(_resolved(name, config.parent))
+    field = f"{config}: uncertainty"
+    if target.is_dir():  # a study directory: its uncertainty.yaml
+        target = target / "uncertainty.yaml"
+    if not target.is_file():
+        raise InputError(
+            f"{field}: file {target} not found (expected a file written by "
+            "'flatcontact study export-uncertainty', a study directory or its uncertainty.yaml)"
+        )
+    block = parse_yaml(read_text_file(target, "uncertainty file", MAX_CONFIG_BYTES), str(target))
+    if isinstance(block, dict) and isinstance(block.get("uncertainty"), dict):
+        block = block["uncertainty"]  # a study's uncertainty.yaml or study.json
+    if not isinstance(block, dict):
+        raise InputError(f"{field}: {target} holds no uncertainty block (expected a mapping)")
+    return block
 
 
 def _holder(data: dict, dotted: str) -> tuple[Any, str]:

@@ -53,11 +53,13 @@ _MESSAGES = {
 def one_line(exc: ValidationError, source: str) -> InputError:
     """The first pydantic error as ``<source>: <dotted.path>: expected ..., got <value>``."""
     first = exc.errors()[0]
-    # union members (direction_deg: float | 'auto') name their type in the path: drop them
+    # union members (direction_deg: float | 'auto'; refine.settings: 'auto' | list[...]) name
+    # their type in the path: drop them
     loc = [
         str(p)
         for p in first.get("loc", ())
-        if not str(p).startswith(("function-", "literal[")) and str(p) not in ("float", "int")
+        if not str(p).startswith(("function-", "literal[", "list[", "tuple[", "dict["))
+        and str(p) not in ("float", "int", "str", "bool")
     ]
     where = ".".join(loc)
     kind = first.get("type", "")

@@ -3,6 +3,7 @@ errors, and the stages' warnings one box per kind."""
 
 from __future__ import annotations
 
+import math
 import re
 from typing import Any
 
@@ -27,10 +28,22 @@ def fmt(value: Any, digits: int = 4) -> str:
 
 
 def pm(value: float | None, err: float | None) -> str:
-    """``value ± err`` (3 and 2 significant digits; ``value`` alone without ``err``; 'n/a')."""
+    """``value ± err`` (3 and 2 significant digits; ``value`` alone without ``err``; 'n/a').
+
+    A value whose third significant digit is coarser than the error's second is written to
+    the error's decimal place instead, so the digits the error resolves are not rounded away
+    (τ0 of Ni(111): ``5876.02 ± 0.87``, not ``5.88e+03 ± 0.87``).
+    """
     if value is None:
         return "n/a"
-    return f"{value:.3g} ± {err:.2g}" if err is not None else f"{value:.3g}"
+    if err is None:
+        return f"{value:.3g}"
+    if value != 0 and err > 0 and math.isfinite(value) and math.isfinite(err):
+        value_step = 10.0 ** (math.floor(math.log10(abs(value))) - 2)
+        decimals = 1 - math.floor(math.log10(err))  # the error's second significant digit
+        if value_step > 10.0**-decimals * (1 + 1e-12) and decimals >= 0:
+            return f"{value:.{decimals}f} ± {err:.{decimals}f}"
+    return f"{value:.3g} ± {err:.2g}"
 
 
 #: A stage warning ``"Category: <source> at P = <p> GPa<detail>: <message>"``.

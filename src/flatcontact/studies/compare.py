@@ -4,13 +4,22 @@ A refinement step converges when it moves every per-load τ and σ_MSS by less t
 tolerance: ``|x_fine − x_coarse| < tol_pct/100 · max(|x_fine|, |x_coarse|, floor_mpa)``
 (the floor keeps a value near zero from failing on round-off). A load that one variant
 reaches and the other does not (NaN in one of them) is a change without bound.
+
+A step of the thicknesses setting refines only if the scanned thicknesses come out closer
+together (:func:`thickness_step_refines`): the scan chooses them from ``p_range_gpa.n`` and
+then adds thicknesses to bracket the extreme stackings and drops those closer than the
+minimum spacing (:mod:`flatcontact.ispes.thicknesses`), so a larger ``n`` can give a coarser
+list (Ni(111), Foiles EAM: n 4 → 6 took the median spacing from 0.024 to 0.031 Å).
 """
 
 from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from flatcontact.analysis.uncertainty import LAW_COEFFICIENTS
+from flatcontact.ispes.thicknesses import MIN_THICKNESS_SPACING_ANGSTROM
 
 QUANTITIES = ("tau_mpa", "sigma_mss_mpa")
 
@@ -51,3 +60,33 @@ def law_changes(coarse: dict, fine: dict, form: str) -> dict[str, float]:
         va, vb = a.get(key), b.get(key)
         out[key] = abs(float(vb) - float(va)) if va is not None and vb is not None else math.nan
     return out
+
+
+def median_spacing_angstrom(thickness_angstrom) -> float:
+    """The median distance (Å) between neighbouring scanned thicknesses (NaN for fewer than two)."""
+    z = np.unique(np.asarray(thickness_angstrom, dtype=float))
+    return float(np.median(np.diff(z))) if z.size >= 2 else math.nan
+
+
+def thickness_step_refines(
+    coarse: dict, fine: dict, fine_name: str, coarse_name: str
+) -> str | None:
+    """``None`` when ``fine``'s scan samples z more finely than ``coarse``'s, else why not (one line).
+
+    Finer = a smaller median spacing of the scans' thicknesses (``thickness_angstrom`` of
+    :func:`flatcontact.studies.runner.run_variant`), to 1e-9 Å. A step that leaves the spacing
+    as it is or widens it measures nothing about the spacing: its change is no evidence of
+    convergence.
+    """
+    a = median_spacing_angstrom(coarse["thickness_angstrom"])
+    b = median_spacing_angstrom(fine["thickness_angstrom"])
+    if b < a - 1e-9:
+        return None
+    return (
+        f"{fine_name} did not refine the thicknesses: its scan's are {b:.4g} Å apart (median, "
+        f"{len(fine['thickness_angstrom'])} thicknesses) against {a:.4g} Å for {coarse_name} "
+        f"({len(coarse['thickness_angstrom'])}); the spacing is set by the bracket of the "
+        f"extreme stackings and the minimum spacing {MIN_THICKNESS_SPACING_ANGSTROM} Å, not by "
+        "scan.p_range_gpa.n; a finer scan.thickness_angstrom list needs energies converged "
+        "for their derivative at its spacing (a tighter scan.fmax_ev_per_angstrom)"
+    )

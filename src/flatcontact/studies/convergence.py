@@ -6,11 +6,15 @@ level ``i`` of every setting still open (:func:`flatcontact.studies.variants.ste
 each round a setting whose step moved every per-load τ and σ_MSS by less than
 ``refine.tolerance_pct`` (:func:`flatcontact.studies.compare.largest_change`) is
 ``converged`` at its previous level; one still moving after ``refine.max_steps`` steps is
-``not converged`` within the budget, and the study says so (``study.json``, the console).
+``not converged`` within the budget, and the study says so (``study.json``, the console). A
+thicknesses step whose scan is not more finely spaced than the previous one
+(:func:`flatcontact.studies.compare.thickness_step_refines`) is ``not refined``, with the
+reason: its change says nothing about convergence and stays out of δ_conv.
 
 The uncertainty it measures, per energy form and law coefficient c, is
 ``δ_conv(c) = max over settings of |Δc|`` at each setting's last step (the change one more
-refinement makes), the rule of docs/convergence.md.
+refinement makes), the rule of docs/convergence.md, over the settings neither failed nor
+not refined.
 """
 
 from __future__ import annotations
@@ -23,7 +27,7 @@ from flatcontact.analysis.uncertainty import LAW_COEFFICIENTS
 from flatcontact.config.run import RunConfig
 from flatcontact.errors import InputError
 from flatcontact.ispes.executors import make_executor
-from flatcontact.studies.compare import largest_change, law_changes
+from flatcontact.studies.compare import largest_change, law_changes, thickness_step_refines
 from flatcontact.studies.estimate import base_measurements, estimate_convergence
 from flatcontact.studies.runner import run_jobs, run_variant
 from flatcontact.studies.variants import (
@@ -103,7 +107,16 @@ def run_convergence(
                 status[s]["steps"] = level
                 status[s]["last_change"] = change
                 status[s]["last_step"] = [previous[s], v.name]
-                if change["max_pct"] < r.tolerance_pct:
+                why = (
+                    thickness_step_refines(
+                        results[previous[s]], results[v.name], v.name, previous[s]
+                    )
+                    if s == "thicknesses"
+                    else None
+                )
+                if why is not None:
+                    status[s].update(state="not refined", reason=why)
+                elif change["max_pct"] < r.tolerance_pct:
                     status[s]["state"] = "converged"
                     status[s]["converged_at"] = previous[s]
                 elif level == r.max_steps:
@@ -147,7 +160,7 @@ def run_convergence(
                         results[status[s]["last_step"][0]], results[status[s]["last_step"][1]], form
                     )[key]
                     for s in settings
-                    if status[s]["state"] != "failed"
+                    if status[s]["state"] not in ("failed", "not refined")
                 ),
                 default=0.0,
             )

@@ -14,7 +14,12 @@ Extrapolation from the base (``b``) to a variant (``v``), the rules stated per s
   spacing), and a thickness step samples the same z range at the refined spacing,
   ``T_v = 1 + (T_b − 1)(R_v − 1)/(R_b − 1)`` (R: requested thicknesses). The probe may add
   a few more or fewer thicknesses for another grid or spacing: on the toy the points came out
-  within 10 % (tests/studies/test_estimate.py);
+  within 10 % (tests/studies/test_estimate.py). A refined spacing ``h_v = h_b (R_b − 1)/(R_v
+  − 1)`` (``h_b`` the base's mean spacing) below the scan's minimum spacing
+  (:data:`flatcontact.ispes.thicknesses.MIN_THICKNESS_SPACING_ANGSTROM`) is widened as the
+  scan's merge widens it, to the first multiple of ``h_v`` at or above the minimum, and
+  ``T_v = 1 + range_b / h_v`` (Ni(111), Foiles EAM, n 4 → 6: 15 estimated, 16 scanned; the
+  rule without the merge said 29);
 * computed points (the irreducible registries the scan relaxes) scale with the points:
   ``C_v = C_b · points_v / points_b`` (the interface's symmetry fraction is kept);
 * force calls = the base's force calls per computed point × ``C_v``. For ``fmax`` and
@@ -37,6 +42,7 @@ import math
 from pathlib import Path
 
 from flatcontact.config.run import RunConfig
+from flatcontact.ispes.thicknesses import MIN_THICKNESS_SPACING_ANGSTROM
 from flatcontact.layout import SCAN_JSON, STAGES
 from flatcontact.rundir import RECORD_NAME
 from flatcontact.studies.variants import Variant, base_value, shares_build
@@ -52,6 +58,7 @@ def base_measurements(base_dir: str | Path) -> dict:
     -------
     dict
         ``grid`` [nx, ny], ``thicknesses`` (the scan's own list, probe additions included),
+        ``thickness_range_angstrom`` (its largest minus its smallest),
         ``points_total``, ``points_computed``, ``force_calls``, ``seconds`` (stage -> s).
     """
     root = Path(base_dir)
@@ -65,6 +72,9 @@ def base_measurements(base_dir: str | Path) -> dict:
     return {
         "grid": [int(g) for g in inputs["grid"]],
         "thicknesses": len(scan["thickness_angstrom"]),
+        "thickness_range_angstrom": float(
+            max(scan["thickness_angstrom"]) - min(scan["thickness_angstrom"])
+        ),
         "points_total": int(scan["points_total"]),
         "points_computed": int(scan.get("points_computed") or scan["points_total"]),
         "force_calls": int(scan["force_calls_total"]),
@@ -84,7 +94,18 @@ def _variant_estimate(cfg: RunConfig, v: Variant, base: dict) -> dict:
         grid = [int(g) for g in v.overrides["scan"]["grid"]]
     elif v.setting == "thicknesses":
         requested = _requested_thicknesses(cfg)
-        thick = round(1 + (thick - 1) * (v.value - 1) / max(requested - 1, 1))
+        ratio = (requested - 1) / max(v.value - 1, 1)  # spacing of the rung / the base's
+        span = base.get("thickness_range_angstrom")
+        h = span / (thick - 1) * ratio if span and thick > 1 else None
+        if (
+            h is not None
+            and cfg.scan.p_range_gpa is not None
+            and h < MIN_THICKNESS_SPACING_ANGSTROM
+        ):
+            h *= math.ceil(MIN_THICKNESS_SPACING_ANGSTROM / h - 1e-9)  # the scan's merge
+            thick = round(1 + span / h)
+        else:
+            thick = round(1 + (thick - 1) / ratio)
     points = grid[0] * grid[1] * thick
     computed = base["points_computed"] * points / base["points_total"]
     calls_per_point = base["force_calls"] / max(base["points_computed"], 1)
@@ -169,8 +190,9 @@ def estimate_lines(est: dict) -> list[str]:
     ]
     for v in est["variants"]:
         bound = " (lower bound)" if v["lower_bound"] else ""
+        scanned = f"; ~{v['thicknesses']} scanned" if v["setting"] == "thicknesses" else ""
         lines.append(
-            f"  {v['name']} ({v['label']}): {v['points']} points, ~{v['points_computed']} "
+            f"  {v['name']} ({v['label']}{scanned}): {v['points']} points, ~{v['points_computed']} "
             f"computed, ~{v['force_calls']} force calls{bound}, ~{_duration(v['seconds'])}"
         )
     lines.append(

@@ -24,6 +24,7 @@ from flatcontact.config.run import RunConfig
 from flatcontact.errors import InputError
 from flatcontact.ispes.executors import make_executor
 from flatcontact.potentials.presets import PRESETS
+from flatcontact.stages.preflight import check_inputs
 from flatcontact.studies.convergence import FORMS
 from flatcontact.studies.runner import run_jobs, run_variant
 from flatcontact.studies.variants import without_foreign_uncertainty
@@ -64,6 +65,7 @@ def run_models(cfg: RunConfig, models: list[str], out: str | Path, on_done=None)
             variant = without_foreign_uncertainty(RunConfig.model_validate(data))
         except ValidationError as exc:
             raise one_line(exc, f"--models {label}") from None
+        check_inputs(variant, f"--models {label}")
         jobs.append((label, variant.to_dict(), str(out / "runs" / _slug(label)), None))
     executor = make_executor(
         cfg.scan.executor, cfg.scan.workers, cfg.scan.dask_address, cfg.scan.jobqueue
@@ -72,6 +74,7 @@ def run_models(cfg: RunConfig, models: list[str], out: str | Path, on_done=None)
         results = run_jobs(executor, run_variant, jobs, on_done)
     finally:
         executor.close()
+    failed = {label: results[label]["error"] for label in labels if "error" in results[label]}
     variants = [
         {
             "name": label,
@@ -83,7 +86,13 @@ def run_models(cfg: RunConfig, models: list[str], out: str | Path, on_done=None)
             **results[label],
         }
         for i, label in enumerate(labels)
+        if label not in failed
     ]
+    if len(variants) < 2:
+        why = "; ".join(f"{k}: {v}" for k, v in failed.items())
+        raise InputError(
+            f"--models: {len(variants)} of {len(labels)} models ran, a spread needs two ({why})"
+        )
     spread = {
         form: model_spread({v["name"]: v["laws"].get(form, {}) for v in variants}) for form in FORMS
     }
@@ -98,6 +107,7 @@ def run_models(cfg: RunConfig, models: list[str], out: str | Path, on_done=None)
     return {
         "study": "models",
         "models": models,
+        "failed": failed,
         "variants": variants,
         "spread": spread,
         "per_load_spread": per_load,

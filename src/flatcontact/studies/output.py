@@ -82,10 +82,17 @@ def uncertainty_block(doc: dict, cfg: RunConfig, command: str) -> dict:
         parts = {
             f"convergence_{f}": {k: _sig3(v) for k, v in d.items()} for f, d in doc["delta"].items()
         }
+        states = {s: st.get("state", "") for s, st in doc["settings"].items()}
+        used = [s for s, state in states.items() if state not in ("failed", "not refined")]
+        open_ = [f"{s} ({state})" for s, state in states.items() if state != "converged"]
         what = (
             f"largest change of each law coefficient over the last refinement step of "
-            f"{', '.join(doc['settings']) or 'no setting'} (tolerance {doc['tolerance_pct']:g} %; "
-            + ("all converged" if doc["converged"] else "NOT all converged: see study.json")
+            f"{', '.join(used) or 'no setting'} (tolerance {doc['tolerance_pct']:g} %; "
+            + (
+                "all converged"
+                if doc["converged"]
+                else f"NOT converged: {', '.join(open_)}; see study.json"
+            )
             + ")"
         )
     else:
@@ -93,7 +100,10 @@ def uncertainty_block(doc: dict, cfg: RunConfig, command: str) -> dict:
             f"model_spread_{f}": {k: _sig3(v) for k, v in d.items()}
             for f, d in doc["spread"].items()
         }
-        what = f"half the max - min range of each law coefficient over {', '.join(doc['models'])}"
+        spread_over = [v.get("model", v["name"]) for v in doc["variants"]]
+        what = f"half the max - min range of each law coefficient over {', '.join(spread_over)}"
+        if doc.get("failed"):
+            what += f" (failed, not in the spread: {', '.join(doc['failed'])})"
     return {
         **parts,
         "coverage": 1.0,
@@ -108,6 +118,19 @@ def uncertainty_block(doc: dict, cfg: RunConfig, command: str) -> dict:
             "rounding": "three significant figures",
         },
     }
+
+
+def cost_line(cost: dict) -> str:
+    """The console line of a convergence study's force calls: stored by its runs (what the
+    study cost, whichever invocation ran them) against each setting's ladder from scratch,
+    and how many of them this invocation computed (a rerun or a study after ``--estimate``
+    reuses the rest)."""
+    stored, now = cost["force_calls_stored"], cost["force_calls_study"]
+    reused = "" if now == stored else f"; {now} computed by this invocation, the rest reused"
+    return (
+        f"force calls: {stored} in {cost['variants']} runs against "
+        f"{cost['force_calls_from_scratch']} for each setting's ladder from scratch{reused}"
+    )
 
 
 def write_study(doc: dict, cfg: RunConfig, out: str | Path, command: str) -> list[Path]:

@@ -49,7 +49,8 @@ def run_variant(config: dict, folder: str, share_build_from: str | None = None) 
     dict
         ``loads`` (``p_gpa``, ``tau_mpa``, ``sigma_mss_mpa``; NaN where the load is not
         reached), ``laws`` (energy form -> coefficients and standard errors),
-        ``work_of_separation_j_per_m2``, ``force_calls`` (stored by the scan),
+        ``work_of_separation_j_per_m2``, ``thickness_angstrom`` (the scan's, Å),
+        ``force_calls`` (stored by the scan),
         ``force_calls_spent`` (0 when the scan stage was skipped), ``scan_action``,
         ``seconds``.
     """
@@ -87,6 +88,7 @@ def run_variant(config: dict, folder: str, share_build_from: str | None = None) 
         },
         "energy_form": laws.get("energy_form"),
         "work_of_separation_j_per_m2": float(w) if w is not None else math.nan,
+        "thickness_angstrom": [float(z) for z in scan.get("thickness_angstrom") or []],
         "force_calls": calls,
         "force_calls_spent": 0 if action == "skipped" else calls,
         "scan_action": action,

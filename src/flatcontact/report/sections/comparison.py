@@ -112,22 +112,25 @@ def own_results_section(
     :mod:`flatcontact.report.stacking_names`) and contact results of a material other than
     the paper's: no comparison with the paper's α-quartz numbers, which are not about this
     material."""
+    studied = _carries_study(laws)
     rows = [
-        ("k (MPa/GPa)", pm(laws.get("k_mpa_per_gpa"), laws.get("k_stderr_mpa_per_gpa"))),
-        ("τ0 (MPa)", pm(laws.get("tau0_mpa"), laws.get("tau0_stderr_mpa"))),
-        ("μ (MPa/GPa)", pm(laws.get("mu_mpa_per_gpa"), laws.get("mu_stderr_mpa_per_gpa"))),
-        ("σ0 (MPa)", pm(laws.get("sigma0_mpa"), laws.get("sigma0_stderr_mpa"))),
+        (label, pm(laws.get(key), laws.get(err_key)) + _law_interval(laws, key, studied))
+        for key, err_key, label in LAW_COEFFICIENTS
+    ]
+    rows.append(
         (
             "work of separation W (J/m²)",
             fmt((scan.get("adhesion") or {}).get("work_of_separation_j_per_m2")),
-        ),
-    ]
-    for r in contact["results"]:
+        )
+    )
+    intervals = (contact.get("intervals") or {}).get("results") or []
+    for i, r in enumerate(contact["results"]):
+        cell = fmt(r["effective_shear_strength_mpa"])
+        if studied and i < len(intervals):
+            q = intervals[i]["effective_shear_strength_mpa"]
+            cell += f" [{q['low']:.4g}, {q['high']:.4g}]"
         rows.append(
-            (
-                f"effective shear strength Q_peak/πa² at p0 = {r['p0_gpa']:g} GPa (MPa)",
-                fmt(r["effective_shear_strength_mpa"]),
-            )
+            (f"effective shear strength Q_peak/πa² at p0 = {r['p0_gpa']:g} GPa (MPa)", cell)
         )
     moduli = contact.get("provenance", {}).get("moduli", "config")
     params = contact.get("parameters", {})
@@ -142,16 +145,44 @@ def own_results_section(
                 "minimum-energy-path barrier",
             )
         )
+    paragraphs = [
+        f"Material: {material}; interaction model: {model}. Load laws τ = k·P + τ0 and "
+        f"σ = μ·P + σ0 fitted on P ≤ {cfg.analysis.threshold_gpa:g} GPa."
+    ]
+    if studied:
+        paragraphs.append(
+            "± is the fit's standard error; [low, high] the interval with the measured "
+            "convergence and model spread of the uncertainty block (section 4, "
+            "laws.json intervals; Q_peak/πa² over the box of those intervals)."
+        )
     return Section(
         f"Results for {material}",
         paragraphs=[
-            f"Material: {material}; interaction model: {model}. Load laws τ = k·P + τ0 and "
-            f"σ = μ·P + σ0 fitted on P ≤ {cfg.analysis.threshold_gpa:g} GPa.",
+            *paragraphs,
             f"Contact moduli E* = {fmt(params.get('contact_modulus_gpa'))} GPa, G* = "
             f"{fmt(params.get('shear_modulus_gpa'))} GPa ({moduli}).",
         ],
         tables=tables,
     )
+
+
+def _carries_study(laws: dict) -> bool:
+    """Do ``laws.json``'s intervals carry a study's parts (a nonzero convergence or model
+    spread beside the fit)? Then the fit's standard error alone understates them."""
+    for iv in (laws.get("intervals") or {}).values():
+        parts = iv.get("components") or {}
+        if any(v for k, v in parts.items() if k != "fit"):
+            return True
+    return False
+
+
+def _law_interval(laws: dict, key: str, studied: bool) -> str:
+    """``"; [low, high]"``: the coefficient's interval of ``laws.json`` when it carries a
+    study's parts (else nothing: the ± standard error is the whole interval)."""
+    iv = (laws.get("intervals") or {}).get(key)
+    if not studied or not iv or iv.get("low") is None:
+        return ""
+    return f"; [{iv['low']:.3g}, {iv['high']:.3g}]"
 
 
 def _intra(cfg) -> str | None:
