@@ -82,13 +82,15 @@ class VirtualExecutor:
     submitted before it (FIFO), and lasts its CPU seconds (``cache[key] = (result, error,
     seconds)``). The driver's clock advances by the driver's own CPU between executor calls
     (live task computations excluded) and, in ``wait_first``/``result``, to the end of the
-    task waited for. ``log`` lists ``(event, key, driver clock, start, end)``.
+    task waited for (``driver_cpu`` False: the driver takes no time, a deterministic
+    schedule). ``log`` lists ``(event, key, driver clock, start, end)``.
     """
 
     name = "virtual"
 
-    def __init__(self, workers: int, cache: dict | None = None):
+    def __init__(self, workers: int, cache: dict | None = None, driver_cpu: bool = True):
         self.workers = int(workers)
+        self.driver_cpu = driver_cpu
         self.cache = {} if cache is None else cache
         self.clock = 0.0
         self._free = [0.0] * self.workers
@@ -100,7 +102,8 @@ class VirtualExecutor:
 
     def _tick(self) -> None:
         now = time.process_time()
-        self.clock += now - self._mark
+        if self.driver_cpu:
+            self.clock += now - self._mark
         self._mark = now
 
     def submit(self, fn, *args) -> Handle:
