@@ -50,7 +50,7 @@ def task_key(fn: Any, args: tuple) -> tuple:
     if name == "run_task":
         task = rest[0]
         return (name, tuple(task.index), task.start_index and tuple(task.start_index))
-    if name == "rigid_rows_task":
+    if name in ("rigid_rows_task", "overlap_check_task"):
         return (name, tuple(rest[1]))
     if name == "warm_worker":
         return (name,)
@@ -166,6 +166,31 @@ def paper_inputs():
     )
 
 
+def warm_up() -> None:
+    """A toy scan first, so that no replayed run pays the process's first-use costs (imports,
+    the netCDF writer, the database driver: seconds under load, docs/performance.md)."""
+    from flatcontact.ispes.grid import GridSpec
+    from flatcontact.ispes.relax import RelaxSettings
+    from flatcontact.ispes.scan import run_scan
+    from flatcontact.potentials.engines import calculator_factory
+    from flatcontact.potentials.model import InteractionModel
+    from flatcontact.structures.toy import toy_interface
+
+    factory = calculator_factory(
+        InteractionModel(calculator={"target": "flatcontact.ispes.toy:toy_calculator"})
+    )
+    grid = GridSpec(3, 3, p_range_gpa=(-0.05, 1.0, 4))
+    with tempfile.TemporaryDirectory() as tmp:
+        run_scan(
+            toy_interface(layers=3),
+            factory,
+            grid,
+            Path(tmp) / "toy",
+            RelaxSettings(fmax_ev_per_a=1e-3),
+            executor=VirtualExecutor(4),
+        )
+
+
 def replay(inputs, workers: int, cache: dict) -> dict:
     """One scan on ``workers`` virtual workers; its makespan, work and what it did."""
     from flatcontact.ispes.scan import run_scan
@@ -242,6 +267,7 @@ def main(argv: list[str] | None = None) -> None:
         with gzip.open(args.source, "rb") as fh:
             cache = pickle.load(fh)["cache"]
     inputs = paper_inputs()
+    warm_up()
     runs = []
     for w in args.workers:
         t0 = time.perf_counter()
