@@ -212,13 +212,13 @@ def _probe_many(
 
     1. The rigid single points, a block of rows of the lateral grid per worker
        (:func:`rigid_rows_task`).
-    2. At once: each probed column's stretching (one chain), the ideal work of separation
-       at the lowest rigid stacking (one chain, left running beside the grid: a
-       :class:`PendingWork`), and the compressions as segments of
-       :data:`~flatcontact.ispes.probe.COMPRESS_SEGMENT_STEPS` steps
+    2. At once: each probed column's stretching (one chain), the compressions as segments
+       of :data:`~flatcontact.ispes.probe.COMPRESS_SEGMENT_STEPS` steps
        (:func:`probe_segment_task`), as many as there are free workers
        (:func:`~flatcontact.ispes.probe.next_segments`), one more whenever a probe chain
-       finishes, until each column's segments reach HI.
+       finishes, until each column's segments reach HI; then the ideal work of separation at
+       the lowest rigid stacking (one chain, left running beside the grid: a
+       :class:`PendingWork`).
     3. The columns joined (:meth:`~flatcontact.ispes.probe.CompressionSegments.join`,
        :func:`~flatcontact.ispes.probe.join_column`) and the thicknesses chosen as in
        sequence. Segments started beyond a column's end are left to finish unused.
@@ -237,8 +237,6 @@ def _probe_many(
 
     def probe_columns(specs):
         up = [executor.submit(probe_chain_task, context, "stretch", *spec) for spec in specs]
-        lowest = extreme_stackings(rigid.energy_ev, grid)[0]
-        work.append(PendingWork(executor.submit(work_of_separation_task, context, lowest)))
         plans = [CompressionSegments(p_hi) for _, p_hi, _ in specs]
         in_flight: dict[Any, tuple[int, int]] = {}
 
@@ -247,7 +245,10 @@ def _probe_many(
                 shift, p_hi, _ = specs[c]
                 in_flight[executor.submit(probe_segment_task, context, shift, p_hi, j)] = (c, j)
 
-        start(max(len(specs), workers - len(specs) - 1))
+        start(max(len(specs), workers - len(specs)))
+        # the work of separation after the first segments (FIFO): it gates nothing
+        lowest = extreme_stackings(rigid.energy_ev, grid)[0]
+        work.append(PendingWork(executor.submit(work_of_separation_task, context, lowest)))
         waiting = set(up)
         while any(plan.join() is None for plan in plans):
             done, _ = executor.wait_first(set(in_flight) | waiting)
@@ -685,6 +686,8 @@ def run_scan(
                             )
 
                         rank = {idx: k for k, idx in enumerate(parent)}
+                        if getattr(executor, "workers", 1) >= MANY_WORKERS:
+                            rank = deepest_first(parent, rank)
                         pending = {idx for idx in parent if idx not in store}
                         if total is None:
                             total = len(parent)
@@ -828,6 +831,30 @@ def run_scan(
     if interrupted:
         raise ScanInterrupted(result)
     return result
+
+
+def deepest_first(parent: dict, rank: dict) -> dict:
+    """Ranks for :class:`ReadyQueue` that put, of the ready points, the one with the longest
+    chain of descendants below it first (ties: the tree's visiting order ``rank``).
+
+    With many workers the warm-start tree's long branches then start early and the grid's
+    last points leave fewer workers idle (the paper preset at 16 workers: 0.15 s of a 15.7 s
+    round, ``benchmarks/schedule_model.py``). Each point keeps its warm-start parent, so the
+    numbers do not change; only the order in which points are computed does.
+    """
+    children: dict = {}
+    for idx, par in parent.items():
+        children.setdefault(par, []).append(idx)
+    order, stack = [], list(children.get(None, []))
+    while stack:  # parents before children
+        idx = stack.pop()
+        order.append(idx)
+        stack.extend(children.get(idx, []))
+    height: dict = {}
+    for idx in reversed(order):
+        height[idx] = 1 + max((height[c] for c in children.get(idx, [])), default=0)
+    ranked = sorted(parent, key=lambda idx: (-height.get(idx, 1), rank[idx]))
+    return {idx: k for k, idx in enumerate(ranked)}
 
 
 class ReadyQueue:
