@@ -258,7 +258,9 @@ def table(runs: list[dict]) -> str:
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(prog="python -m benchmarks.schedule_replay")
-    parser.add_argument("--record", type=Path, default=Path("schedule_replay_record.pkl.gz"))
+    parser.add_argument(
+        "--record", type=Path, default=None, help="write the tasks (with any new ones) here"
+    )
     parser.add_argument("--from", dest="source", type=Path, default=None)
     parser.add_argument("--workers", type=int, nargs="*", default=list(WORKERS))
     args = parser.parse_args(argv)
@@ -280,7 +282,7 @@ def main(argv: list[str] | None = None) -> None:
             f"load {os.getloadavg()[0]:.1f})",
             flush=True,
         )
-        if not args.source:
+        if args.record:
             with gzip.open(args.record, "wb") as fh:
                 pickle.dump(
                     {
