@@ -83,14 +83,22 @@ class VirtualExecutor:
     seconds)``). The driver's clock advances by the driver's own CPU between executor calls
     (live task computations excluded) and, in ``wait_first``/``result``, to the end of the
     task waited for (``driver_cpu`` False: the driver takes no time, a deterministic
-    schedule). ``log`` lists ``(event, key, driver clock, start, end)``.
+    schedule; ``driver_scale``: the driver's CPU times this, for a driver measured at
+    another load than the tasks). ``log`` lists ``(event, key, driver clock, start, end)``.
     """
 
     name = "virtual"
 
-    def __init__(self, workers: int, cache: dict | None = None, driver_cpu: bool = True):
+    def __init__(
+        self,
+        workers: int,
+        cache: dict | None = None,
+        driver_cpu: bool = True,
+        driver_scale: float = 1.0,
+    ):
         self.workers = int(workers)
         self.driver_cpu = driver_cpu
+        self.driver_scale = float(driver_scale)
         self.cache = {} if cache is None else cache
         self.clock = 0.0
         self._free = [0.0] * self.workers
@@ -103,7 +111,7 @@ class VirtualExecutor:
     def _tick(self) -> None:
         now = time.process_time()
         if self.driver_cpu:
-            self.clock += now - self._mark
+            self.clock += self.driver_scale * (now - self._mark)
         self._mark = now
 
     def submit(self, fn, *args) -> Handle:
@@ -191,12 +199,12 @@ def warm_up() -> None:
         )
 
 
-def replay(inputs, workers: int, cache: dict) -> dict:
+def replay(inputs, workers: int, cache: dict, driver_scale: float = 1.0) -> dict:
     """One scan on ``workers`` virtual workers; its makespan, work and what it did."""
     from flatcontact.ispes.scan import run_scan
 
     reference, factory, grid, relax, order = inputs
-    ex = VirtualExecutor(workers, cache)
+    ex = VirtualExecutor(workers, cache, driver_scale=driver_scale)
     with tempfile.TemporaryDirectory() as tmp:
         r = run_scan(reference, factory, grid, Path(tmp) / "scan", relax, order, executor=ex)
     ex._tick()
@@ -263,6 +271,12 @@ def main(argv: list[str] | None = None) -> None:
     )
     parser.add_argument("--from", dest="source", type=Path, default=None)
     parser.add_argument("--workers", type=int, nargs="*", default=list(WORKERS))
+    parser.add_argument(
+        "--driver-scale",
+        type=float,
+        default=1.0,
+        help="the driver's measured CPU times this (the tasks were recorded at another load)",
+    )
     args = parser.parse_args(argv)
     cache = {}
     if args.source:
@@ -273,7 +287,7 @@ def main(argv: list[str] | None = None) -> None:
     runs = []
     for w in args.workers:
         t0 = time.perf_counter()
-        run = replay(inputs, w, cache)
+        run = replay(inputs, w, cache, args.driver_scale)
         runs.append(run)
         print(
             f"{w} workers: T {run['makespan_s']:.2f} s, tasks {run['task_s']:.1f} s CPU "
