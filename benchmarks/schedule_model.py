@@ -1,5 +1,9 @@
 """Modelled parallel efficiency of the whole paper-preset scan at 1 … 16 workers (issue 22).
 
+This analytic model describes the schedule of a scan with 1-3 workers (and of every scan
+before the many-worker probe); a scan with ``flatcontact.ispes.scan.MANY_WORKERS`` or more
+workers is replayed, with its own driver, by ``benchmarks/schedule_replay.py``.
+
 ``python -m benchmarks.schedule_model`` runs the paper preset's scan once, serially, and
 records every relaxation it makes: the probe's single points of every stacking, each probed
 column's points (shift, thickness, cold or warm start, force calls, CPU seconds), the ideal

@@ -107,14 +107,27 @@ def check_thicknesses(
     rigid slabs); this runs it for every lateral shift at every thickness, before any
     relaxation.
     """
+    items = [(float(z), row) for z in thicknesses for row in range(grid.n_a)]
+    check_rows(reference, grid, items, spread_compression=spread_compression)
+
+
+def check_rows(
+    reference: Atoms,
+    grid: GridSpec,
+    items: Sequence[tuple[float, int]],
+    *,
+    spread_compression: bool = True,
+) -> None:
+    """:func:`check_thicknesses` for the ``(z, i_a)`` pairs in ``items``: every shift
+    ``shift_b`` of row ``i_a`` at thickness z (Å), in that order (the scan with many
+    workers splits the check into blocks of pairs on its workers)."""
     sa, sb = grid.shifts()
-    for z in thicknesses:
-        for a in sa:
-            for b in sb:
-                place_slab2(
-                    reference,
-                    float(a),
-                    float(b),
-                    float(z),
-                    spread_compression=spread_compression,
-                )
+    for z, row in items:
+        for b in sb:
+            place_slab2(
+                reference,
+                float(sa[row]),
+                float(b),
+                float(z),
+                spread_compression=spread_compression,
+            )

@@ -73,11 +73,21 @@ def rigid_stackings(reference: Atoms, calc, grid: GridSpec) -> RigidStackings:
     The load is the net z-force on slab 2 per area
     (:func:`flatcontact.ispes.relax.normal_stress_gpa`, the scan's own definition).
     """
+    energy, load = rigid_rows(reference, calc, grid, range(grid.n_a))
+    return RigidStackings(energy, load)
+
+
+def rigid_rows(reference: Atoms, calc, grid: GridSpec, rows) -> tuple[np.ndarray, np.ndarray]:
+    """The rigid energies (eV) and loads (GPa) of :func:`rigid_stackings` for the shifts
+    ``shift_a`` of the indices ``rows`` only: arrays of shape ``(len(rows), n_b)`` (the
+    scan with many workers evaluates the rows on its workers)."""
     z_ref = thickness(reference)
     sa, sb = grid.shifts()
-    energy = np.full(grid.shape_lateral, np.nan)
-    load = np.full(grid.shape_lateral, np.nan)
-    for i, a in enumerate(sa):
+    rows = list(rows)
+    energy = np.full((len(rows), grid.n_b), np.nan)
+    load = np.full((len(rows), grid.n_b), np.nan)
+    for i, row in enumerate(rows):
+        a = sa[row]
         for j, b in enumerate(sb):
             try:
                 atoms = place_slab2(reference, float(a), float(b), z_ref)
@@ -87,7 +97,7 @@ def rigid_stackings(reference: Atoms, calc, grid: GridSpec) -> RigidStackings:
             energy[i, j] = atoms.get_potential_energy()
             load[i, j] = normal_stress_gpa(atoms, atoms.get_forces(apply_constraint=False))
             atoms.calc = None
-    return RigidStackings(energy, load)
+    return energy, load
 
 
 def _first_extreme(values: np.ndarray, grid: GridSpec, highest: bool) -> tuple[float, float]:
@@ -157,6 +167,9 @@ class ColumnChain:
     energy_ev: tuple[float, ...]
     normal_stress_gpa: tuple[float, ...]
     force_calls: tuple[int, ...]
+    #: a compression segment (:func:`compress_segment`) that ended where the slabs overlap:
+    #: the message; None otherwise
+    overlap: str | None = None
 
 
 def compress_chain(
@@ -179,20 +192,166 @@ def compress_chain(
     while p < p_hi_gpa:
         k += 1
         if k > max_down_steps:
-            raise InputError(
-                f"p-range-gpa: the load did not reach {p_hi_gpa} GPa within {max_down_steps * dz_down_angstrom:.3g} Å "
-                f"of compression (reached {p:.3g} GPa)"
-            )
+            raise InputError(_too_far_message(p_hi_gpa, max_down_steps, dz_down_angstrom, p))
         z = z_ref - k * dz_down_angstrom
         try:
             e, p, n, pos = relax(a, b, z, start, start_z)
         except InputError as exc:
-            raise InputError(
-                f"p-range-gpa: the slabs overlap before the load reaches {p_hi_gpa} GPa ({exc})"
-            ) from None
+            raise InputError(_overlap_message(p_hi_gpa, exc)) from None
         out.append((z, e, p, n))
         start, start_z = pos, z
     return ColumnChain(*(tuple(v) for v in zip(*out, strict=True)))
+
+
+#: Thickness steps of one segment when a column's compression runs as several chains
+#: (:func:`compress_segment`, :class:`CompressionSegments`: the scan does it with many
+#: workers). Each segment starts cold at its first thickness, which costs more than a warm
+#: step (quartz, paper preset: 65-90 force calls cold against ~30 warm per 0.1 Å step), so
+#: shorter segments shorten the longest chain but add work.
+COMPRESS_SEGMENT_STEPS = 3
+
+
+def _overlap_message(p_hi_gpa: float, exc: Exception) -> str:
+    return f"p-range-gpa: the slabs overlap before the load reaches {p_hi_gpa} GPa ({exc})"
+
+
+def _too_far_message(p_hi_gpa: float, max_down_steps: int, dz: float, p: float) -> str:
+    return (
+        f"p-range-gpa: the load did not reach {p_hi_gpa} GPa within {max_down_steps * dz:.3g} Å "
+        f"of compression (reached {p:.3g} GPa)"
+    )
+
+
+def compress_segment(
+    relax: Callable[[float, float, float, np.ndarray | None, float | None], tuple],
+    reference: Atoms,
+    shift: tuple[float, float],
+    p_hi_gpa: float,
+    first_step: int,
+    n_steps: int = COMPRESS_SEGMENT_STEPS,
+    dz_down_angstrom: float = 0.1,
+    max_down_steps: int = 80,
+) -> ColumnChain:
+    """Steps ``first_step`` … ``first_step + n_steps - 1`` of a column's compression
+    (z = z_ref − k·``dz_down_angstrom``, at most ``max_down_steps``), the first started
+    cold, each next warm-started from the last, ending after the first whose load reaches
+    ``p_hi_gpa`` (GPa). Slabs that overlap end the segment with the message in ``overlap``
+    (raised by :meth:`CompressionSegments.join` only if the column needs that thickness),
+    except at the reference thickness (step 0), which raises as :func:`compress_chain` does.
+
+    Segment 0 with ``n_steps`` > ``max_down_steps`` is :func:`compress_chain` itself; a
+    later segment differs from the sequential column only through its cold start (a
+    relaxation from another start, equal within the force tolerance).
+    """
+    z_ref = thickness(reference)
+    a, b = shift
+    out = []
+    start, start_z = None, None
+    overlap = None
+    for k in range(first_step, min(first_step + n_steps, max_down_steps + 1)):
+        z = z_ref - k * dz_down_angstrom
+        try:
+            e, p, n, pos = relax(a, b, z, start, start_z)
+        except InputError as exc:
+            if k == 0:
+                raise
+            overlap = _overlap_message(p_hi_gpa, exc)
+            break
+        out.append((z, e, p, n))
+        start, start_z = pos, z
+        if p >= p_hi_gpa:
+            break
+    fields = tuple(tuple(v) for v in zip(*out, strict=True)) if out else ((), (), (), ())
+    return ColumnChain(*fields, overlap=overlap)
+
+
+class CompressionSegments:
+    """A column's compression run as segments of ``n_steps`` thickness steps
+    (:func:`compress_segment`), each a chain of its own, and joined in order.
+
+    The schedule a driver follows (the scan with many workers, and
+    ``benchmarks/schedule_model.py``, which replays it): :meth:`launch` names the next
+    segment to start, as long as no finished segment has reached ``p_hi_gpa`` (or the slabs'
+    overlap) and the steps are not exhausted; :meth:`add` takes a finished segment;
+    :meth:`join` is the compression once every segment up to the first that reaches the
+    load is in. Which segments were started beyond it depends on timing; the result does not.
+    """
+
+    def __init__(
+        self,
+        p_hi_gpa: float,
+        n_steps: int = COMPRESS_SEGMENT_STEPS,
+        dz_down_angstrom: float = 0.1,
+        max_down_steps: int = 80,
+    ):
+        if n_steps < 1:
+            raise InputError(f"n_steps: expected at least one step per segment, got {n_steps}")
+        self.p_hi_gpa = float(p_hi_gpa)
+        self.n_steps = int(n_steps)
+        self.dz = float(dz_down_angstrom)
+        self.max_down_steps = int(max_down_steps)
+        self.segments: dict[int, ColumnChain] = {}
+        self.launched = 0
+
+    def _ends(self, chain: ColumnChain) -> bool:
+        return chain.overlap is not None or any(p >= self.p_hi_gpa for p in chain.normal_stress_gpa)
+
+    def wants_more(self) -> bool:
+        """Whether a further segment may be needed: none finished has ended the column and
+        the next one starts within ``max_down_steps``."""
+        if any(self._ends(c) for c in self.segments.values()):
+            return False
+        return self.launched * self.n_steps <= self.max_down_steps
+
+    def launch(self) -> int:
+        """The index of the next segment to start (steps ``index * n_steps`` on)."""
+        self.launched += 1
+        return self.launched - 1
+
+    def add(self, index: int, chain: ColumnChain) -> None:
+        self.segments[index] = chain
+
+    def join(self) -> ColumnChain | None:
+        """The compression (as :func:`compress_chain` returns it), or None while a segment
+        it needs is missing. Raises the sequential chain's InputError when the slabs overlap
+        before the load is reached or the load is not reached within ``max_down_steps``."""
+        out: list[tuple] = []
+        j = 0
+        while j * self.n_steps <= self.max_down_steps:
+            chain = self.segments.get(j)
+            if chain is None:
+                return None
+            for point in zip(
+                chain.thickness_angstrom,
+                chain.energy_ev,
+                chain.normal_stress_gpa,
+                chain.force_calls,
+                strict=True,
+            ):
+                out.append(point)
+                if point[2] >= self.p_hi_gpa:
+                    return ColumnChain(*(tuple(v) for v in zip(*out, strict=True)))
+            if chain.overlap is not None:
+                raise InputError(chain.overlap)
+            j += 1
+        raise InputError(
+            _too_far_message(self.p_hi_gpa, self.max_down_steps, self.dz, float(out[-1][2]))
+        )
+
+
+def next_segments(plans: list[CompressionSegments], slots: int) -> list[tuple[int, int]]:
+    """The compression segments to start in ``slots`` free worker slots, as ``(column,
+    segment)``: each to the column that wants more (:meth:`CompressionSegments.wants_more`)
+    and has started the fewest, ties to the first column. The scan calls it with the free
+    workers when the probe starts and with one slot whenever a probe chain finishes."""
+    out = []
+    for _ in range(slots):
+        wanting = [c for c, plan in enumerate(plans) if plan.wants_more()]
+        if not wanting:
+            break
+        c = min(wanting, key=lambda c: (plans[c].launched, c))
+        out.append((c, plans[c].launch()))
+    return out
 
 
 def _stretch_stop(

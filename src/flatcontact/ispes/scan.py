@@ -36,13 +36,18 @@ from flatcontact.ispes.contract import (
     cell_area,
 )
 from flatcontact.ispes.geometry import in_plane_vectors, thickness, validate_interface
-from flatcontact.ispes.grid import GridSpec, check_thicknesses
+from flatcontact.ispes.grid import GridSpec, check_rows, check_thicknesses
 from flatcontact.ispes.grid_bracket import MAX_EXTENSIONS, bracket_targets_gpa, check_grid
 from flatcontact.ispes.order import PREFERENCES, search_tree
 from flatcontact.ispes.probe import (
+    CompressionSegments,
+    RigidStackings,
     compress_chain,
+    compress_segment,
     extreme_stackings,
     join_column,
+    next_segments,
+    rigid_rows,
     rigid_stackings,
     stretch_chain,
 )
@@ -126,6 +131,23 @@ def scan_settings(
     return out
 
 
+#: From this many workers on, the probe runs as many short chains (:func:`_probe_many`):
+#: the rigid single points on the workers, each column's compression in segments started
+#: cold (:class:`~flatcontact.ispes.probe.CompressionSegments`), the ideal work of
+#: separation beside the grid. Below, the columns are relaxed exactly as in sequence (a
+#: 1-2 worker run keeps its numbers); a segment's cold start moves the probe's loads, and
+#: the thicknesses with them, within the force tolerance.
+MANY_WORKERS = 4
+
+
+class PendingWork:
+    """The ideal work of separation still running on a worker (:func:`_probe_many`): the
+    scan stores it once the grid is done (``handle``: the executor's)."""
+
+    def __init__(self, handle: Any):
+        self.handle = handle
+
+
 def _probe(
     reference: Atoms,
     factory: Any,
@@ -147,10 +169,13 @@ def _probe(
     :class:`~flatcontact.ispes.work_of_separation.WorkOfSeparation` (serial: computed here
     after the probe, from the same single points of every stacking).
     """
+    workers = 1 if executor is None else getattr(executor, "workers", 1)
+    if workers >= MANY_WORKERS:
+        return _probe_many(reference, factory, grid, relax, executor)
     calc = worker_calculator(factory, reference)
     relax_one = functools.partial(relax_column_point, reference, calc, relax)
     rigid = rigid_stackings(reference, calc, grid)
-    if executor is None or getattr(executor, "workers", 1) <= 1:
+    if workers <= 1:
         lowest = extreme_stackings(rigid.energy_ev, grid)[0]
         extra, notes = probe_thicknesses(relax_one, reference, rigid, grid)
         return extra, notes, ideal_work_of_separation(reference, factory, relax, lowest, calc=calc)
@@ -180,6 +205,80 @@ def _probe(
     return extra, notes, executor.result(work[0]) if work else None
 
 
+def _probe_many(
+    reference: Atoms, factory: Any, grid: GridSpec, relax: RelaxSettings, executor: Any
+) -> tuple[dict, list[str], PendingWork]:
+    """:func:`_probe` with many workers: nothing relaxes in the driver.
+
+    1. The rigid single points, a block of rows of the lateral grid per worker
+       (:func:`rigid_rows_task`).
+    2. At once: each probed column's stretching (one chain), the compressions as segments
+       of :data:`~flatcontact.ispes.probe.COMPRESS_SEGMENT_STEPS` steps
+       (:func:`probe_segment_task`), as many as there are free workers
+       (:func:`~flatcontact.ispes.probe.next_segments`), one more whenever a probe chain
+       finishes, until each column's segments reach HI; then the ideal work of separation at
+       the lowest rigid stacking (one chain, left running beside the grid: a
+       :class:`PendingWork`).
+    3. The columns joined (:meth:`~flatcontact.ispes.probe.CompressionSegments.join`,
+       :func:`~flatcontact.ispes.probe.join_column`) and the thicknesses chosen as in
+       sequence. Segments started beyond a column's end are left to finish unused.
+
+    ``benchmarks/schedule_model.py`` replays this order.
+    """
+    context = ScanContext(reference, factory, relax)
+    workers = executor.workers
+    blocks = [b for b in np.array_split(np.arange(grid.n_a), min(workers, grid.n_a)) if b.size]
+    handles = [executor.submit(rigid_rows_task, context, grid, b.tolist()) for b in blocks]
+    parts = [executor.result(h) for h in handles]
+    rigid = RigidStackings(
+        np.concatenate([e for e, _ in parts]), np.concatenate([p for _, p in parts])
+    )
+    work = []
+
+    def probe_columns(specs):
+        up = [executor.submit(probe_chain_task, context, "stretch", *spec) for spec in specs]
+        plans = [CompressionSegments(p_hi) for _, p_hi, _ in specs]
+        in_flight: dict[Any, tuple[int, int]] = {}
+
+        def start(slots):
+            for c, j in next_segments(plans, slots):
+                shift, p_hi, _ = specs[c]
+                in_flight[executor.submit(probe_segment_task, context, shift, p_hi, j)] = (c, j)
+
+        start(max(len(specs), workers - len(specs)))
+        # the work of separation after the first segments (FIFO): it gates nothing
+        lowest = extreme_stackings(rigid.energy_ev, grid)[0]
+        work.append(PendingWork(executor.submit(work_of_separation_task, context, lowest)))
+        waiting = set(up)
+        while any(plan.join() is None for plan in plans):
+            done, _ = executor.wait_first(set(in_flight) | waiting)
+            for handle in done:
+                if handle in waiting:
+                    waiting.discard(handle)
+                else:
+                    c, j = in_flight.pop(handle)
+                    plans[c].add(j, executor.result(handle))
+                start(1)
+        return [
+            join_column(reference, shift, plan.join(), executor.result(u), stop_at_gpa=stop)
+            for (shift, _, stop), plan, u in zip(specs, plans, up, strict=True)
+        ]
+
+    extra, notes = probe_thicknesses(None, reference, rigid, grid, probe_columns)
+    return extra, notes, work[0]
+
+
+def pull_off_record(pull_off: dict | None) -> dict:
+    """The probe's pull-off record (:class:`flatcontact.ispes.separation.Adhesion`), the
+    ``work_of_separation_*`` keys of an older scan renamed to ``pull_off_*``."""
+    pulled = {}
+    for key, value in (pull_off or {}).items():
+        if key.startswith("work_of_separation"):
+            key = key.replace("work_of_separation", "pull_off_work", 1)
+        pulled[key] = value
+    return pulled
+
+
 def adhesion_record(
     reference: Atoms,
     factory: Any,
@@ -198,11 +297,7 @@ def adhesion_record(
     record of an older scan whose ``work_of_separation_*`` keys were the pull-off's is
     renamed to ``pull_off_*``.
     """
-    pulled = {}
-    for key, value in (pull_off or {}).items():
-        if key.startswith("work_of_separation"):
-            key = key.replace("work_of_separation", "pull_off_work", 1)
-        pulled[key] = value
+    pulled = pull_off_record(pull_off)
     if work is None:
         calc = worker_calculator(factory, reference)
         shift = extreme_stackings(rigid_stackings(reference, calc, grid).energy_ev, grid)[0]
@@ -353,6 +448,49 @@ def probe_chain_task(context: ScanContext, kind: str, shift, p_hi_gpa, stop_at_g
     return stretch_chain(relax_one, context.reference, shift, None, stop_at_gpa=stop_at_gpa)
 
 
+def _check_overlaps(executor: Any, context: ScanContext, grid: GridSpec, z: list[float]) -> None:
+    """The overlap check of every lateral shift at the thicknesses ``z`` before they are
+    scanned (:func:`flatcontact.ispes.grid.check_thicknesses`: one InputError naming the
+    first overlap). With :data:`MANY_WORKERS` or more workers the ``(z, row)`` pairs are
+    split into a block per worker (:func:`overlap_check_task`; at the paper preset's
+    3,168 points the check is seconds of the driver's time); else in the driver."""
+    spread = context.settings.mode != "rigid"
+    workers = getattr(executor, "workers", 1)
+    if workers < MANY_WORKERS:
+        check_thicknesses(context.reference, grid, z, spread_compression=spread)
+        return
+    items = [(v, row) for v in z for row in range(grid.n_a)]
+    blocks = [b for b in np.array_split(np.arange(len(items)), workers) if b.size]
+    handles = [
+        executor.submit(overlap_check_task, context, grid, [items[k] for k in b]) for b in blocks
+    ]
+    for handle in handles:  # in order: the first overlap in the grid's order is named
+        executor.result(handle)
+
+
+def overlap_check_task(context: ScanContext, grid: GridSpec, items: list[tuple[float, int]]):
+    """Worker entry point: :func:`flatcontact.ispes.grid.check_rows` of ``items``."""
+    check_rows(context.reference, grid, items, spread_compression=context.settings.mode != "rigid")
+
+
+def probe_segment_task(context: ScanContext, shift, p_hi_gpa, index: int):
+    """Worker entry point: segment ``index`` of a probed column's compression
+    (:func:`flatcontact.ispes.probe.compress_segment`) with this worker's cached calculator."""
+    calc = worker_calculator(context.factory, context.reference)
+    relax_one = functools.partial(relax_column_point, context.reference, calc, context.settings)
+    segments = CompressionSegments(p_hi_gpa)
+    return compress_segment(
+        relax_one, context.reference, shift, p_hi_gpa, index * segments.n_steps, segments.n_steps
+    )
+
+
+def rigid_rows_task(context: ScanContext, grid: GridSpec, rows: list[int]):
+    """Worker entry point: the rigid single points of the lateral rows ``rows``
+    (:func:`flatcontact.ispes.probe.rigid_rows`)."""
+    calc = worker_calculator(context.factory, context.reference)
+    return rigid_rows(context.reference, calc, grid, rows)
+
+
 def work_of_separation_task(context: ScanContext, shift):
     """Worker entry point: the ideal work of separation at ``shift``
     (:func:`flatcontact.ispes.work_of_separation.ideal_work_of_separation`)."""
@@ -449,6 +587,7 @@ def run_scan(
             notes: list[str] = []
             interrupted = False
             computed_calls: list[int] = []
+            pending_work = None
             try:
                 if store.resolved is None:
                     a1, a2 = in_plane_vectors(reference)
@@ -463,12 +602,18 @@ def run_scan(
                     else:
                         extra, notes, work = _probe(reference, factory, grid, relax, executor)
                         resolved.update(extra)
-                    resolved["adhesion"] = adhesion_record(
-                        reference, factory, grid, relax, resolved.get("adhesion"), work
-                    )
+                    if isinstance(work, PendingWork):  # stored once the grid is done
+                        pending_work = work
+                        resolved["adhesion"] = pull_off_record(resolved.get("adhesion"))
+                    else:
+                        resolved["adhesion"] = adhesion_record(
+                            reference, factory, grid, relax, resolved.get("adhesion"), work
+                        )
                     store.set_resolved(resolved)
                 resolved = store.resolved
-                if "work_of_separation_shift_a" not in (resolved.get("adhesion") or {}):
+                if pending_work is None and "work_of_separation_shift_a" not in (
+                    resolved.get("adhesion") or {}
+                ):
                     # a store resolved before the ideal W existed: its W was the pull-off's
                     resolved = {
                         **resolved,
@@ -479,13 +624,14 @@ def run_scan(
                 sa, sb = grid.shifts()
                 context = ScanContext(reference, factory, relax)
                 recent = PositionsCache()
+                checked: set[float] = set()  # thicknesses whose overlap check passed
                 while True:
                     notes = list(resolved.get("notes", notes))
                     z = np.asarray(resolved["thickness_angstrom"], dtype=float)
                     if grid.thickness_angstrom is None:
-                        check_thicknesses(
-                            reference, grid, z, spread_compression=relax.mode != "rigid"
-                        )
+                        new_z = [float(v) for v in z if float(v) not in checked]
+                        _check_overlaps(executor, context, grid, new_z)
+                        checked.update(new_z)
                     shape = (grid.n_a, grid.n_b, z.size)
                     root = (0, 0, int(np.argmin(np.abs(z - thickness(reference)))))
                     full_tree = _tree_in_store_order(z, shape, root, order)
@@ -543,6 +689,8 @@ def run_scan(
                             )
 
                         rank = {idx: k for k, idx in enumerate(parent)}
+                        if getattr(executor, "workers", 1) >= MANY_WORKERS:
+                            rank = deepest_first(parent, rank)
                         pending = {idx for idx in parent if idx not in store}
                         if total is None:
                             total = len(parent)
@@ -646,6 +794,13 @@ def run_scan(
                     ):
                         break
                     resolved = store.resolved
+                if pending_work is not None and not interrupted:
+                    # the ideal work of separation ran beside the grid (a resumed scan
+                    # whose store lacks it computes it in the driver, above)
+                    w = executor.result(pending_work.handle)
+                    adhesion = {**(store.resolved.get("adhesion") or {}), **w.record()}
+                    store.set_resolved({**store.resolved, "adhesion": adhesion})
+                    resolved = store.resolved
                 kept = list(store.resolved.get("notes", []))
                 notes = kept + [n for n in notes if n not in kept]
             finally:
@@ -679,6 +834,30 @@ def run_scan(
     if interrupted:
         raise ScanInterrupted(result)
     return result
+
+
+def deepest_first(parent: dict, rank: dict) -> dict:
+    """Ranks for :class:`ReadyQueue` that put, of the ready points, the one with the longest
+    chain of descendants below it first (ties: the tree's visiting order ``rank``).
+
+    With many workers the warm-start tree's long branches then start early and the grid's
+    last points leave fewer workers idle (the paper preset at 16 workers: 0.15 s of a 15.7 s
+    round, ``benchmarks/schedule_model.py``). Each point keeps its warm-start parent, so the
+    numbers do not change; only the order in which points are computed does.
+    """
+    children: dict = {}
+    for idx, par in parent.items():
+        children.setdefault(par, []).append(idx)
+    order, stack = [], list(children.get(None, []))
+    while stack:  # parents before children
+        idx = stack.pop()
+        order.append(idx)
+        stack.extend(children.get(idx, []))
+    height: dict = {}
+    for idx in reversed(order):
+        height[idx] = 1 + max((height[c] for c in children.get(idx, [])), default=0)
+    ranked = sorted(parent, key=lambda idx: (-height.get(idx, 1), rank[idx]))
+    return {idx: k for k, idx in enumerate(ranked)}
 
 
 class ReadyQueue:

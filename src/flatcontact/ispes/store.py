@@ -385,20 +385,26 @@ class PointStore:
         order = np.argsort(z)
         rank = np.empty_like(order)
         rank[order] = np.arange(z.size)
+        # the variables' own arrays, looked up once (an xarray lookup per point and variable
+        # was 0.16 s of the driver's time per assembly at the paper preset's 3,312 points)
+        energy = ds[contract.VAR_ENERGY].values
+        stress = ds[contract.VAR_STRESS].values
+        converged = ds[contract.VAR_CONVERGED].values
+        calls = ds[contract.VAR_FORCE_CALLS].values
         for (ia, ib, iz), rec in self._done.items():
             k = int(rank[iz])
-            ds[contract.VAR_ENERGY].values[ia, ib, k] = rec["energy_ev"]
-            ds[contract.VAR_STRESS].values[ia, ib, k] = rec["normal_stress_gpa"]
-            ds[contract.VAR_CONVERGED].values[ia, ib, k] = rec["converged"]
-            ds[contract.VAR_FORCE_CALLS].values[ia, ib, k] = rec["force_calls"]
-        mapped = np.zeros(ds[contract.VAR_ENERGY].shape, dtype=bool)
+            energy[ia, ib, k] = rec["energy_ev"]
+            stress[ia, ib, k] = rec["normal_stress_gpa"]
+            converged[ia, ib, k] = rec["converged"]
+            calls[ia, ib, k] = rec["force_calls"]
+        mapped = np.zeros(energy.shape, dtype=bool)
         for (ia, ib, iz), rep in (mapping or {}).items():
             if (ia, ib, iz) in self._done or tuple(rep) not in self._done:
                 continue
             rec, k = self._done[tuple(rep)], int(rank[iz])
-            ds[contract.VAR_ENERGY].values[ia, ib, k] = rec["energy_ev"]
-            ds[contract.VAR_STRESS].values[ia, ib, k] = rec["normal_stress_gpa"]
-            ds[contract.VAR_CONVERGED].values[ia, ib, k] = rec["converged"]
+            energy[ia, ib, k] = rec["energy_ev"]
+            stress[ia, ib, k] = rec["normal_stress_gpa"]
+            converged[ia, ib, k] = rec["converged"]
             mapped[ia, ib, k] = True
         ds[contract.VAR_MAPPED] = (contract.DIMS, mapped)
         ds.attrs["points_done"] = len(self._done) + int(mapped.sum())
