@@ -282,3 +282,51 @@ def test_a_cell_whose_gates_fired_leaves_the_fit_and_is_named():
     accepted = scaling_block(cells, {"degenerate_minima", "broken_symmetry"})
     assert accepted["tau0_mpa"]["cells"] == ["a", "b", "c", "d"]
     assert not accepted["tau0_mpa"]["gated"]
+
+
+# ------------------------------------------------------------------ contact moduli
+#: Twisted h-BN as a new user writes it: no moduli source (no contact.*_modulus_gpa, no
+#: elastic stage), the study's loads.
+HBN = {
+    **TBG,
+    "structure": {"kind": "sheets", "sheet": "h-BN", "layers": 1},
+    "potential": {"preset": "hbn-tersoff-ilp"},
+    "elastic": {"enabled": False},
+    "approximants": {"max_cells": 2},
+}
+EXPERIMENT = {"experiment": {"compare": "passivated-tip", "p0_gpa": 1.77}}
+
+
+def test_without_the_experiment_comparison_no_moduli_are_needed(tmp_path):
+    """The study runs build and scan only: a configuration without contact moduli plans, and
+    each cell's own pipeline (its preflight: build unrelaxed, model set up) accepts it."""
+    from flatcontact.config.run import RunConfig
+    from flatcontact.pipeline import Pipeline
+
+    cells = plan(build_config(HBN))
+    assert [c["label"] for c in cells] == ["twist-1-2", "twist-2-3"]
+    with Pipeline(RunConfig.model_validate(cells[0]["config"]), tmp_path / "cell"):
+        pass
+
+
+def test_the_experiment_comparison_without_moduli_is_refused_before_any_work(tmp_path, capsys):
+    """With contact.experiment.compare each cell's laws go through the contact model: without
+    E*, G* it would take the quartz defaults. Refused in one line naming both fields, before a
+    cell is built; elastic.enabled does not count (the study runs no elastic stage); both
+    moduli given are accepted."""
+    for extra in ({}, {"elastic": {"enabled": True}}):
+        with pytest.raises(InputError) as info:
+            plan(build_config({**HBN, **extra, "contact": EXPERIMENT}))
+        text = str(info.value)
+        assert "\n" not in text
+        assert text.startswith("contact.contact_modulus_gpa/shear_modulus_gpa:")
+        assert "contact.experiment.compare" in text and "structure.kind=sheets" in text
+    given = {**EXPERIMENT, "contact_modulus_gpa": 30.0, "shear_modulus_gpa": 20.0}
+    assert len(plan(build_config({**HBN, "contact": given}))) == 2
+    cfg = tmp_path / "hbn.yaml"
+    cfg.write_text(json.dumps({**HBN, "contact": EXPERIMENT}))
+    line = one_error_line(
+        *run_cli(["study", "approximants", str(cfg), "--out", str(tmp_path / "s")], capsys)[::2]
+    )
+    assert "contact.experiment.compare" in line
+    assert not (tmp_path / "s").exists()

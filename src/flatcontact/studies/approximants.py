@@ -87,9 +87,13 @@ def planned_index(approximant) -> int:
 
 def plan(cfg: RunConfig) -> list[dict]:
     """The cells of the study: per approximant its record, the grid, the index and the
-    validated configuration (every cell checked before any work; one-line InputError)."""
+    validated configuration (every cell checked before any work; one-line InputError). The
+    contact moduli are required only with ``contact.experiment.compare``
+    (:func:`flatcontact.studies.approximant_collapse.check_experiment_moduli`)."""
     from flatcontact.structures.approximants import approximant_sequence
+    from flatcontact.studies.approximant_collapse import check_experiment_moduli
 
+    check_experiment_moduli(cfg)
     cells = approximant_sequence(cfg.section("structure"), cfg.approximants)
     n_z = (
         cfg.scan.p_range_gpa.n
