@@ -14,12 +14,13 @@ seconds of this process, in which LAMMPS runs). The cell's cost, in seconds of o
   holding one: the median force calls per point of its ``scan.json``), else assumed
   (:data:`ASSUMED_CALLS_PER_POINT`, stated on the console as assumed);
 * ``overhead_per_point``: the scan's work per point beyond the force calls (placement,
-  bookkeeping, the point store); measured on a finished cell when there is one (its scan
-  seconds less its force calls at the timed cost, per point), else
-  :data:`POINT_OVERHEAD_S`;
-* ``fixed_per_cell``: build check, noise floor, analysis with figures, laws and gates;
-  measured on the finished cell when the study's ``study.json`` has it (its wall time less
-  its scan), else :data:`CELL_FIXED_S`.
+  bookkeeping, the point store), :data:`POINT_OVERHEAD_S`;
+* ``fixed_per_cell``: build, noise floor, analysis with figures, laws and gates,
+  :data:`CELL_FIXED_S`.
+
+Every term is CPU seconds (what a free core spends); a finished cell's stage records hold
+wall seconds, which carry the machine's load, so only its force calls per point (a count)
+calibrate the estimate.
 
 The wall time on the study's executor: the cells run side by side on ``workers`` processes,
 each cell's scan serial, so the study takes at least ``max(Σ seconds / workers, max
@@ -28,14 +29,15 @@ is said to need a Dask cluster (docs/cluster.md; ``scan.dask_address`` or
 ``scan.jobqueue``); a single cell above it gains nothing from more workers (its scan is
 serial in the study) and is said so.
 
-All times are measured on the machine at hand under its current load: the estimate is as
-good as that load is representative.
+When the machine's load average exceeds its cores the console says by how much the wall time
+may stretch (load / cores).
 """
 
 from __future__ import annotations
 
 import json
 import math
+import os
 import statistics
 import time
 from pathlib import Path
@@ -52,14 +54,14 @@ from flatcontact.rundir import RECORD_NAME
 #: rounded up; ``normal`` a median of 12 and 15 on twisted 2+2-sheet graphene
 #: (docs/incommensurate.md); ``full`` relaxes at least as much as ``normal`` (a lower bound).
 ASSUMED_CALLS_PER_POINT = {"rigid-layers": 4.0, "normal": 15.0, "full": 15.0}
-#: Seconds per grid point beyond its force calls when no finished cell measured it: the
-#: rigid twisted graphene scans (1, 2) to (3, 4) spent 0.040–0.058 s per point beyond their
-#: timed force calls (6.1–9.4 s for 144 points, loaded 2-core machine).
-POINT_OVERHEAD_S = 0.05
-#: Seconds per cell outside its scan when no finished cell measured it: 20–25 s for the
-#: resolved (1, 2) and (2, 3) twisted graphene cells with their scans stored (1 s for an
-#: unresolved cell, which is not analysed; loaded 2-core machine), rounded up.
-CELL_FIXED_S = 30.0
+#: CPU seconds per grid point beyond its force calls: the rigid twisted graphene scans
+#: (1, 2), (2, 3), (3, 4) spent 2.8, 2.9, 3.8 CPU s on 144 points, of which 0.3, 0.6, 1.0 s
+#: were force calls (timed): 0.016–0.019 s per point, rounded up.
+POINT_OVERHEAD_S = 0.02
+#: CPU seconds per cell outside its scan: build 1.3–2.0 s, then noise floor, analysis,
+#: laws and gates 6.1 and 7.5 s for the resolved (1, 2) and (2, 3) cells (0.35 s for the
+#: unresolved (3, 4), which is not analysed); rounded up.
+CELL_FIXED_S = 10.0
 #: A study longer than this on the local workers is said to need Dask: more than a night.
 DASK_THRESHOLD_S = 8 * 3600.0
 #: Force calls timed per cell after the warm-up call.
@@ -109,7 +111,8 @@ def time_force_call(cell_config: dict) -> dict:
 
 def measured_cell(folder: str | Path) -> dict | None:
     """What a finished cell's scan measured (``DIR/runs/<label>``), or None if it has none:
-    ``points``, ``force_calls``, ``median_calls_per_point`` and ``scan_s`` (wall)."""
+    ``points``, ``force_calls``, ``median_calls_per_point`` and ``scan_s`` (wall, for the
+    record: it carries the machine's load)."""
     scan_dir = Path(folder) / f"{STAGES['scan']:02d}-scan"
     try:
         scan = json.loads((scan_dir / SCAN_JSON).read_text())
@@ -127,20 +130,6 @@ def measured_cell(folder: str | Path) -> dict | None:
         "median_calls_per_point": float(scan.get("median_force_calls_per_point") or calls / points),
         "scan_s": float(seconds),
     }
-
-
-def _fixed_seconds(out: Path, label: str, scan_s: float) -> float | None:
-    """A finished cell's seconds outside its scan, from the study's ``study.json`` (its
-    ``wall_s`` counts the scan only when the scan ran in that call), or None."""
-    try:
-        doc = json.loads((out / "study.json").read_text())
-    except (OSError, ValueError):
-        return None
-    for cell in doc.get("cells", []):
-        if cell.get("label") == label and "wall_s" in cell:
-            ran = cell.get("scan_action") != "skipped"
-            return max(float(cell["wall_s"]) - (scan_s if ran else 0.0), 0.0)
-    return None
 
 
 def executor_workers(cfg: RunConfig) -> tuple[str, int | None]:
@@ -166,7 +155,7 @@ def estimate_cost(cfg: RunConfig, cells: list[dict], out: str | Path | None = No
         The plan.
     out
         The study folder; a finished cell in ``out/runs/<label>`` calibrates the force calls
-        per point and the overhead per point (the smallest finished cell).
+        per point (the smallest finished cell).
 
     Returns
     -------
@@ -185,14 +174,7 @@ def estimate_cost(cfg: RunConfig, cells: list[dict], out: str | Path | None = No
         for c in sorted(cells, key=lambda c: c["n_atoms"]):
             m = measured_cell(Path(out) / "runs" / c["label"])
             if m is not None:
-                t = timed[c["label"]]
-                overhead = (m["scan_s"] - m["force_calls"] * t["wall_s"]) / m["points"]
-                calibration = {
-                    "label": c["label"],
-                    **m,
-                    "overhead_per_point_s": max(overhead, 0.0),
-                    "fixed_s": _fixed_seconds(Path(out), c["label"], m["scan_s"]),
-                }
+                calibration = {"label": c["label"], **m}
                 break
     rows = []
     for c in cells:
@@ -204,12 +186,7 @@ def estimate_cost(cfg: RunConfig, cells: list[dict], out: str | Path | None = No
             source = f"measured on {calibration['label']}"
         else:
             per_point, source = ASSUMED_CALLS_PER_POINT[mode], f"assumed for {mode}"
-        overhead = (
-            calibration["overhead_per_point_s"] if calibration is not None else POINT_OVERHEAD_S
-        )
-        fixed = CELL_FIXED_S
-        if calibration is not None and calibration["fixed_s"] is not None:
-            fixed = calibration["fixed_s"]
+        overhead, fixed = POINT_OVERHEAD_S, CELL_FIXED_S
         points = int(c["points_planned"])
         calls = per_point * points
         seconds = calls * t["cpu_s"] + points * overhead + fixed
@@ -243,6 +220,8 @@ def estimate_cost(cfg: RunConfig, cells: list[dict], out: str | Path | None = No
         "dask_threshold_s": DASK_THRESHOLD_S,
         "needs_dask": bool(local > DASK_THRESHOLD_S),
         "calibration": calibration,
+        "load_average": os.getloadavg()[0],
+        "cores": default_workers(),
     }
 
 
@@ -259,9 +238,9 @@ def cost_lines(est: dict) -> list[str]:
         )
     cal = est["calibration"]
     basis = (
-        f"calibrated on the finished cell {cal['label']}"
+        f"force calls per point measured on the finished cell {cal['label']}"
         if cal
-        else "overheads as measured on rigid twisted graphene (no finished cell in --out)"
+        else "no finished cell in --out"
     )
     if est["wall_seconds"] is None:
         where = f"on the Dask cluster: ~max({duration(est['cpu_seconds'])} / its workers, "
@@ -273,8 +252,14 @@ def cost_lines(est: dict) -> list[str]:
         )
     lines.append(
         f"cost: ~{duration(est['cpu_seconds'])} CPU (one core, all cells one after another), "
-        f"{where}; {basis}; times on this machine under its present load"
+        f"{where}; {basis}"
     )
+    slowdown = est["load_average"] / max(est["cores"], 1)
+    if slowdown > 1:
+        lines.append(
+            f"  the machine is loaded now (load average {est['load_average']:.1f} on "
+            f"{est['cores']} core(s)): expect up to ~{slowdown:.1f}x that wall time"
+        )
     threshold = duration(est["dask_threshold_s"])
     if est["needs_dask"]:
         verdict = (
