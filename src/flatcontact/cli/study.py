@@ -213,11 +213,13 @@ def approximants_command(
 ) -> None:
     """The ISPES study of each commensurate approximant cell: tau0 and corrugation vs size."""
     from flatcontact.config.load import load_config
-    from flatcontact.studies.approximants import plan, run_approximants
+    from flatcontact.studies.approximants import model_caveats, plan, run_approximants
     from flatcontact.studies.output import write_approximants
 
     cfg = load_config(config)
     cells = plan(cfg)
+    for caveat in model_caveats(cfg):
+        console.print(f"caveat: {caveat}", highlight=False, soft_wrap=True)
     console.print(
         f"{len(cells)} cell(s), base grid {cfg.scan.grid[0]}x{cfg.scan.grid[1]} per period of "
         f"the landscape, relax_mode {cfg.scan.relax_mode}:",

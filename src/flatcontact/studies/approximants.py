@@ -134,6 +134,42 @@ def plan(cfg: RunConfig) -> list[dict]:
     return out
 
 
+def model_caveats(cfg: RunConfig) -> list[str]:
+    """What the interaction model itself puts under the corrugation of large cells.
+
+    A Coulomb term across the interface cut off at a finite radius (``coul/shield 16.0 1`` of
+    the h-BN ILP presets, any ``coul/*`` interlayer style but a long-range one): summed to
+    infinity, its registry dependence between two neutral charge lattices falls as
+    e^(−|G| d) with the common reciprocal vectors |G| ∝ √N; truncated, it keeps a part that
+    falls as a power of |G| and moves with the cutoff. Measured on rigid twisted h-BN: from
+    the second cell on it is the whole corrugation (docs/incommensurate.md, "a new user's
+    run"). One line per such style, naming it; none for other models.
+    """
+    from flatcontact.potentials.styles import style_cutoff_angstrom
+
+    data = cfg.to_dict()["potential"]
+    if data.get("coupling") != "interlayer":
+        return []
+    styles = data.get("interlayer") or []
+    styles = [styles] if isinstance(styles, dict) else styles
+    out = []
+    for style in styles:
+        pair_style = str(style.get("pair_style", ""))
+        name = pair_style.split()[0] if pair_style.split() else ""
+        if "coul" not in name or "long" in name:
+            continue
+        cutoff = style_cutoff_angstrom(pair_style)
+        at = f"{cutoff:g} A" if cutoff is not None else "its cutoff"
+        out.append(
+            f"potential.interlayer {pair_style!r}: a Coulomb term cut off at {at} across the "
+            "interface; its registry dependence does not vanish with the cell size (the "
+            "exact sum's does): on rigid twisted h-BN it is the whole corrugation from the "
+            "second cell on (docs/incommensurate.md); compare with a longer cutoff before "
+            "reading the larger cells"
+        )
+    return out
+
+
 def _max_abs(values) -> float:
     return float(max((abs(v) for v in values), default=0.0))
 
@@ -353,6 +389,7 @@ def run_approximants(
         "relax_mode": cfg.scan.relax_mode,
         "cells": rows,
         "failed": {r["label"]: r["error"] for r in rows if "error" in r},
+        "caveats": model_caveats(cfg),
         "scaling": scaling_block(ok, set(cfg.contact.accept_untrusted)),
         "cost": {
             "force_calls_study": sum(r["force_calls_spent"] for r in ok),
