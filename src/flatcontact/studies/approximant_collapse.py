@@ -26,12 +26,10 @@ from flatcontact.config.run import RunConfig
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.contact.tip_comparison import LAW_KEYS, compare_collapse
 from flatcontact.errors import InputError
+from flatcontact.layout import EXPERIMENT_COLLAPSE_JSON  # noqa: F401 (the file these rows go to)
 from flatcontact.reference import PAPER_EXPERIMENT_COLLAPSE_MPA, is_paper_material
 from flatcontact.stages.build import structure_elements
 from flatcontact.stages.contact import quartz_reference_laws
-
-#: File of the study folder that holds the rows (``flatcontact study approximants``).
-EXPERIMENT_COLLAPSE_JSON = "experiment_collapse.json"
 
 
 def check_experiment_moduli(cfg: RunConfig) -> None:
