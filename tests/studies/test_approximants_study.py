@@ -340,6 +340,13 @@ def test_a_cut_off_coulomb_term_across_the_interface_is_stated(tmp_path, capsys)
     from flatcontact.studies.approximants import model_caveats
 
     assert model_caveats(build_config(TBG)) == []
+    # graphene on h-BN: the same coul/shield style, but the graphene sheet has no charge
+    gr_hbn = {
+        **HBN,
+        "structure": {"kind": "sheets", "sheet": "graphene", "slab2": {"sheet": "h-BN"}},
+        "potential": {"preset": "graphene-hbn-ilp"},
+    }
+    assert model_caveats(build_config(gr_hbn)) == []
     (caveat,) = model_caveats(build_config(HBN))
     assert caveat.startswith("potential.interlayer 'coul/shield 16.0 1': a Coulomb term cut off")
     assert "16 A" in caveat

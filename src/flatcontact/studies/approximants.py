@@ -143,13 +143,23 @@ def model_caveats(cfg: RunConfig) -> list[str]:
     e^(−|G| d) with the common reciprocal vectors |G| ∝ √N; truncated, it keeps a part that
     falls as a power of |G| and moves with the cutoff. Measured on rigid twisted h-BN: from
     the second cell on it is the whole corrugation (docs/incommensurate.md, "a new user's
-    run"). One line per such style, naming it; none for other models.
+    run"). One line per such style, naming it, when both slabs of the interface (built
+    unrelaxed, milliseconds) carry charges (graphene/h-BN: the neutral sheet sees no
+    Coulomb term); none for other models.
     """
     from flatcontact.potentials.styles import style_cutoff_angstrom
+    from flatcontact.structures.construct import build_interface
 
     data = cfg.to_dict()["potential"]
-    if data.get("coupling") != "interlayer":
+    charges = data.get("charges") or {}
+    if data.get("coupling") != "interlayer" or not charges:
         return []
+    atoms, _ = build_interface(cfg.structure)
+    symbols = np.asarray(atoms.get_chemical_symbols())
+    slab = np.asarray(atoms.arrays["slab"])
+    for i in (1, 2):
+        if not any(abs(float(charges.get(e, 0.0))) > 0 for e in set(symbols[slab == i])):
+            return []
     styles = data.get("interlayer") or []
     styles = [styles] if isinstance(styles, dict) else styles
     out = []
