@@ -97,3 +97,11 @@ FIG6_FIT = "fig6_fit"
 
 # ---- report
 REPORT_HTML = "report.html"
+
+
+# ---- studies (``flatcontact study ... --out DIR``)
+#: A study's whole record (``studies/output.py``).
+STUDY_JSON = "study.json"
+#: The approximant study's collapse stress per cell at the experiment's conditions
+#: (``studies/approximant_collapse.py``; with ``contact.experiment.compare``).
+EXPERIMENT_COLLAPSE_JSON = "experiment_collapse.json"

@@ -78,6 +78,7 @@ from flatcontact.layout import (
     SUMMARY_JSON,
     VERSIONS_JSON,
 )
+from flatcontact.report.sections.approximant_study import approximant_study_digest
 from flatcontact.rundir import (
     RunDirectory,
     RunLock,
@@ -536,6 +537,8 @@ class Pipeline:
         inputs = {"report": cfg.section("report"), **{k: v.fingerprint for k, v in ups.items()}}
         if cfg.elastic.enabled:  # the report tables the elastic stage's Cij
             inputs["elastic"] = self._upstream("elastic").fingerprint
+        if cfg.report.approximant_study is not None:  # the report tables that study's files
+            inputs["approximant_study"] = approximant_study_digest(cfg.report.approximant_study)
         folders = {name: self.folder(name) for name in STAGES}
         versions = json.loads((self.root / VERSIONS_JSON).read_text())
 

@@ -380,3 +380,45 @@ def test_without_equivalent_minima_the_results_are_those_of_the_old_rule():
         assert len(a.starts) == len(b.starts)
         assert a.stackings.euler_ok and np.isfinite(a.stackings.barrier)
     assert new.direction_deg == 90.0 and new.direction_rule == "given"
+
+
+def test_a_shift_lattice_landscape_names_its_points_by_kind_not_as_bilayer_stackings():
+    """The ISPES of a twisted or coincidence cell on one period of its shift lattice
+    (``shift_lattice_index`` > 1, as the scan stage writes it) is hexagonal with one maximum,
+    like a bilayer's, but its minima are no AB/BA stacking: friction.csv names them by kind
+    and rank (min1, saddle1, max1). The same grid without the attribute (or index 1) keeps
+    AB/BA/SP/AA. The energies are those of the closed form either way."""
+    import csv
+    import io
+
+    from flatcontact.analysis.outputs import friction_csv_text
+
+    v = 1e-4
+    mev = 1e3
+    a1, a2 = syn.hexagonal_cell(0.93)  # the (1, 2) twist's shift-lattice period
+    model = syn.SyntheticInterface(a1, a2, syn.three_cosine(a1, a2), corrugation_ev_per_a2=v)
+    base = model.grid(9, 9, np.linspace(24.3, 25.6, 12))
+    names = {}
+    for index in (None, 1, 49):
+        ds = base.copy()
+        if index is not None:
+            ds.attrs["shift_lattice_index"] = index
+        res = analyze_ispes(ds, [0.5, 1.0], direction_deg="auto", energy_zero="each")
+        rows = list(csv.DictReader(io.StringIO(friction_csv_text(res))))
+        for row in rows:
+            named = {
+                k: float(e)
+                for k, e in (
+                    item.split("=") for item in row["stacking_energies_mev_per_a2"].split(";")
+                )
+            }
+            names.setdefault(index, set()).update(named)
+            names.setdefault((index, "start"), set()).add(row["start_stacking"])
+            if index == 49:
+                # AB and BA are one class (three-cosine landscape): one minimum name
+                assert named["max1"] - named["min1"] == pytest.approx(4.5 * v * mev, rel=1e-6)
+                assert named["saddle1"] - named["min1"] == pytest.approx(0.5 * v * mev, rel=1e-6)
+    assert names[None] == names[1] == {"AA", "AB", "BA", "SP"}
+    assert names[(None, "start")] <= {"AB", "BA"}
+    assert names[49] == {"min1", "saddle1", "max1"}
+    assert names[(49, "start")] == {"min1"}

@@ -357,3 +357,139 @@ def test_a_cell_whose_gates_fired_leaves_the_fit_and_is_named():
     accepted = scaling_block(cells, {"degenerate_minima", "broken_symmetry"})
     assert accepted["tau0_mpa"]["cells"] == ["a", "b", "c", "d"]
     assert not accepted["tau0_mpa"]["gated"]
+
+
+# ------------------------------------------------------------------ contact moduli
+#: Twisted h-BN as a new user writes it: no moduli source (no contact.*_modulus_gpa, no
+#: elastic stage), the study's loads.
+HBN = {
+    **TBG,
+    "structure": {"kind": "sheets", "sheet": "h-BN", "layers": 1},
+    "potential": {"preset": "hbn-tersoff-ilp"},
+    "elastic": {"enabled": False},
+    "approximants": {"max_cells": 2},
+}
+EXPERIMENT = {"experiment": {"compare": "passivated-tip", "p0_gpa": 1.77}}
+
+
+def test_without_the_experiment_comparison_no_moduli_are_needed(tmp_path):
+    """The study runs build and scan only: a configuration without contact moduli plans, and
+    each cell's own pipeline (its preflight: build unrelaxed, model set up) accepts it."""
+    from flatcontact.config.run import RunConfig
+    from flatcontact.pipeline import Pipeline
+
+    cells = plan(build_config(HBN))
+    assert [c["label"] for c in cells] == ["twist-1-2", "twist-2-3"]
+    with Pipeline(RunConfig.model_validate(cells[0]["config"]), tmp_path / "cell"):
+        pass
+
+
+def test_the_experiment_comparison_without_moduli_is_refused_before_any_work(tmp_path, capsys):
+    """With contact.experiment.compare each cell's laws go through the contact model: without
+    E*, G* it would take the quartz defaults. Refused in one line naming both fields, before a
+    cell is built; elastic.enabled does not count (the study runs no elastic stage); both
+    moduli given are accepted."""
+    for extra in ({}, {"elastic": {"enabled": True}}):
+        with pytest.raises(InputError) as info:
+            plan(build_config({**HBN, **extra, "contact": EXPERIMENT}))
+        text = str(info.value)
+        assert "\n" not in text
+        assert text.startswith("contact.contact_modulus_gpa/shear_modulus_gpa:")
+        assert "contact.experiment.compare" in text and "structure.kind=sheets" in text
+    given = {**EXPERIMENT, "contact_modulus_gpa": 30.0, "shear_modulus_gpa": 20.0}
+    assert len(plan(build_config({**HBN, "contact": given}))) == 2
+    cfg = tmp_path / "hbn.yaml"
+    cfg.write_text(json.dumps({**HBN, "contact": EXPERIMENT}))
+    line = one_error_line(
+        *run_cli(["study", "approximants", str(cfg), "--out", str(tmp_path / "s")], capsys)[::2]
+    )
+    assert "contact.experiment.compare" in line
+    assert not (tmp_path / "s").exists()
+
+
+def test_a_cut_off_coulomb_term_across_the_interface_is_stated(tmp_path, capsys):
+    """The h-BN ILP preset carries coul/shield cut off at 16 A across the interface, whose
+    registry dependence (not the ILP's) is the whole corrugation of rigid twisted h-BN from
+    the second cell on (docs/incommensurate.md): the study says so, naming the style; REBO +
+    KC graphene has no such term and gets no caveat."""
+    from flatcontact.studies.approximants import model_caveats
+
+    assert model_caveats(build_config(TBG)) == []
+    # graphene on h-BN: the same coul/shield style, but the graphene sheet has no charge
+    gr_hbn = {
+        **HBN,
+        "structure": {"kind": "sheets", "sheet": "graphene", "slab2": {"sheet": "h-BN"}},
+        "potential": {"preset": "graphene-hbn-ilp"},
+    }
+    assert model_caveats(build_config(gr_hbn)) == []
+    (caveat,) = model_caveats(build_config(HBN))
+    assert caveat.startswith("potential.interlayer 'coul/shield 16.0 1': a Coulomb term cut off")
+    assert "16 A" in caveat
+    cfg = tmp_path / "hbn.yaml"
+    cfg.write_text(json.dumps(HBN))
+    code, out, _ = run_cli(["study", "approximants", str(cfg), "--list"], capsys)
+    assert code in (0, None)
+    assert "caveat: potential.interlayer 'coul/shield 16.0 1'" in out
+
+
+def _lateral_range_mev_per_a2(cell_config: dict, interlayer: list, charges: dict | None):
+    """Max − min of the energy per supercell area of a rigid cell over a 4 × 4 grid on one
+    shift-lattice period at the reference thickness, with ``interlayer`` across (Tersoff in
+    each sheet): slab 2 placed rigidly, one energy per shift."""
+    from flatcontact.config.run import RunConfig
+    from flatcontact.ispes.shift_lattice import shift_lattice_of
+    from flatcontact.potentials.engines import make_calculator
+    from flatcontact.structures.construct import build_interface
+    from flatcontact.structures.interface_contract import in_plane_vectors, thickness
+    from flatcontact.structures.placement import place_slab2
+
+    data = dict(cell_config)
+    data["potential"] = {
+        "intra": [{"pair_style": "tersoff", "pair_coeff": ["BNC.tersoff"], "elements": ["B", "N"]}],
+        "intra_scope": "layer",
+        "coupling": "interlayer",
+        "interlayer": interlayer,
+        **({"charges": charges} if charges else {}),
+    }
+    cfg = RunConfig.model_validate(data)
+    ref, _ = build_interface(cfg.structure)
+    basis = shift_lattice_of(ref, 1e-3).basis
+    a1, a2 = in_plane_vectors(ref)
+    area = abs(a1[0] * a2[1] - a1[1] * a2[0])
+    calc = make_calculator(cfg.potential, ref)
+    energies = []
+    for i, j in itertools.product(range(4), range(4)):
+        s = i / 4 * basis[0] + j / 4 * basis[1]
+        atoms = place_slab2(ref, float(s[0]), float(s[1]), thickness(ref), spread_compression=False)
+        atoms.calc = calc
+        energies.append(atoms.get_potential_energy())
+    return 1e3 * (max(energies) - min(energies)) / area
+
+
+def test_the_twisted_hbn_corrugation_beyond_the_first_cell_is_the_coulomb_cutoff():
+    """The measurement behind the caveat (docs/incommensurate.md), on the rigid (2, 3) cell
+    (76 atoms): the ILP alone has a lateral range > 1000x below the shielded Coulomb term at
+    the preset's 16 A cutoff, and the Coulomb term's range falls > 10x when its cutoff goes to
+    48 A (the infinite sum's is ~e^(-|G| d), nothing): the cutoff, not the ILP, the B/N
+    sublattice or the Tersoff round-off, sets the corrugation. Measured 4.8e-9, 2.5e-5,
+    1.7e-7 meV/A^2 on a 6 x 6 grid."""
+    cell = plan(build_config(HBN))[1]
+    assert cell["label"] == "twist-2-3"
+    ilp = [
+        {
+            "pair_style": "ilp/graphene/hbn 16.0 1",
+            "pair_coeff": ["BNCH.ILP"],
+            "elements": ["B", "N"],
+        }
+    ]
+    pairs = {"B-B": "0.70", "B-N": "0.69498201415576216335", "N-N": "0.69"}
+    charges = {"B": 0.42, "N": -0.42}
+
+    def coul(cut):
+        return [{"pair_style": f"coul/shield {cut} 1", "pair_coeff_pairs": pairs}]
+
+    ilp_only = _lateral_range_mev_per_a2(cell["config"], ilp, None)
+    coul_16 = _lateral_range_mev_per_a2(cell["config"], coul(16.0), charges)
+    coul_48 = _lateral_range_mev_per_a2(cell["config"], coul(48.0), charges)
+    assert coul_16 > 1000 * ilp_only, (coul_16, ilp_only)
+    assert coul_48 < coul_16 / 10, (coul_48, coul_16)

@@ -62,6 +62,9 @@ from flatcontact.ispes import contract
 ENERGY_ZEROS = ("lowest-p", "each", "none")
 #: Lateral points per axis: a periodic interpolant needs the first harmonic (k = -1, 0, 1).
 MIN_LATERAL_POINTS = 3
+#: Attribute of a grid re-indexed onto one shift-lattice period and its index
+#: (:func:`flatcontact.ispes.shift_lattice.to_shift_cell`; absent or 1: an ordinary cell).
+SHIFT_LATTICE_INDEX_ATTR = "shift_lattice_index"
 
 
 @dataclass(frozen=True)
@@ -198,6 +201,10 @@ def analyze_ispes(
         Find, classify and name the stationary points of each load's landscape and the
         minimum-energy-path barrier (:mod:`.stackings`); their symmetry classes make
         equivalent minima starts (:mod:`.starts`).
+        A grid re-indexed onto one period of a twisted or coincidence cell's shift lattice
+        (attribute ``shift_lattice_index`` > 1, :func:`flatcontact.ispes.shift_lattice.
+        to_shift_cell`) has its points named by kind and rank (``min1``, ``saddle1``,
+        ``max1``), not AB/BA/SP/AA: its minima are not bilayer stackings.
     symmetrise
         Average each load's interpolant over the shift-space group the grid stores
         (``symmetry_*`` attributes of the scan, :func:`flatcontact.ispes.contract.symmetry_operations`;
@@ -271,7 +278,8 @@ def analyze_ispes(
     stackings: list[Stackings | None] = [None] * p.size
     if with_stackings:
         clock = time.perf_counter()
-        stackings = [analyze_stackings(surf) for surf in surfaces]
+        site_names = int(ds.attrs.get(SHIFT_LATTICE_INDEX_ATTR, 1)) <= 1
+        stackings = [analyze_stackings(surf, site_names=site_names) for surf in surfaces]
         timings["stackings"] = time.perf_counter() - clock
     direction_rule = "given"
     if auto:

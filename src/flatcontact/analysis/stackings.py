@@ -28,7 +28,12 @@ For any 2-D lattice, from the exact periodic interpolant (:mod:`.periodic`):
    ``SITE_TOLERANCE`` × the lattice constant. Every other class is named by kind
    and energy rank, ``min1``, ``saddle1``, ``max1``, ... (lowest first). This is
    the bilayer convention of graphene/h-BN derived from the lattice alone, not
-   from any material.
+   from any material. With ``site_names=False`` every point gets the kind-and-rank
+   name: the landscape of a twisted or coincidence cell on its shift lattice
+   (``shift_lattice_index`` > 1, :mod:`flatcontact.ispes.shift_lattice`) is hexagonal
+   with one maximum too, but its minima are no AB or BA stacking (no atom of one
+   slab sits over a hollow of the other across the cell); they are the lowest-energy
+   registry of the cell, ``min1``.
 4. **Minimum-energy-path barrier.** Index-1 saddles connect minima (steepest
    descent from each saddle along ± its unstable direction, then Newton). On
    this periodic graph (minima, with the lattice offsets of the saddles' ends)
@@ -351,10 +356,16 @@ def _classes(surface: PeriodicSurface, found: list[tuple], ops: list[SpaceOperat
 # ---------------------------------------------------------------------------- names
 
 
-def _names(surface: PeriodicSurface, found: list[tuple], classes: list[int], lattice: str):
+def _names(
+    surface: PeriodicSurface,
+    found: list[tuple],
+    classes: list[int],
+    lattice: str,
+    site_names: bool = True,
+):
     names: list[str | None] = [None] * len(found)
     maxima = [i for i, f in enumerate(found) if f[4] == "maximum"]
-    if lattice == "hexagonal" and len(maxima) == 1:
+    if site_names and lattice == "hexagonal" and len(maxima) == 1:
         a = surface.a1
         b = surface.a2 if float(np.dot(surface.a1, surface.a2)) > 0 else surface.a1 + surface.a2
         aa = found[maxima[0]][1]
@@ -400,8 +411,13 @@ def _names(surface: PeriodicSurface, found: list[tuple], classes: list[int], lat
 # ---------------------------------------------------------------------------- entry point
 
 
-def analyze_stackings(surface: PeriodicSurface, tolerance: float = SYMMETRY_TOLERANCE) -> Stackings:
-    """Stationary points, symmetry classes, names and MEP barrier of ``surface`` (module doc)."""
+def analyze_stackings(
+    surface: PeriodicSurface, tolerance: float = SYMMETRY_TOLERANCE, site_names: bool = True
+) -> Stackings:
+    """Stationary points, symmetry classes, names and MEP barrier of ``surface`` (module doc).
+
+    ``site_names``: name the hexagonal sites AA, AB, BA, SP (module doc, step 3); ``False``
+    (a twisted or coincidence cell's shift-lattice landscape): kind and rank only."""
     found = stationary_points(surface)
     minima = [i for i, f in enumerate(found) if f[4] == "minimum"]
     if not minima:  # cannot happen for a periodic function; keep the interface total
@@ -413,7 +429,7 @@ def analyze_stackings(surface: PeriodicSurface, tolerance: float = SYMMETRY_TOLE
     ops = kept_operations(surface, [found[i][1] for i in minima], tolerance)
     classes = _classes(surface, found, ops)
     lattice = lattice_kind(surface.a1, surface.a2)
-    names = _names(surface, found, classes, lattice)
+    names = _names(surface, found, classes, lattice, site_names)
     start = minima[0]
     euler_ok = _euler_ok(found)
     first, history = barrier_graph(surface, found, start, classes)

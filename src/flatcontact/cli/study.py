@@ -211,16 +211,22 @@ def approximants_command(
     out: Annotated[Path, _OUT] = Path("flatcontact-study"),
     list_only: Annotated[
         bool,
-        typer.Option("--list", help="Print the cells, their grid and cost bound; run nothing."),
+        typer.Option(
+            "--list",
+            help="Print the cells, their grid and their cost in seconds (one force call timed "
+            "per cell; calibrated on a finished cell in --out if there is one); run no scan.",
+        ),
     ] = False,
 ) -> None:
     """The ISPES study of each commensurate approximant cell: tau0 and corrugation vs size."""
     from flatcontact.config.load import load_config
-    from flatcontact.studies.approximants import plan, run_approximants
+    from flatcontact.studies.approximants import model_caveats, plan, run_approximants
     from flatcontact.studies.output import write_approximants
 
     cfg = load_config(config)
     cells = plan(cfg)
+    for caveat in model_caveats(cfg):
+        console.print(f"caveat: {caveat}", highlight=False, soft_wrap=True)
     console.print(
         f"{len(cells)} cell(s), base grid {cfg.scan.grid[0]}x{cfg.scan.grid[1]} per period of "
         f"the landscape, relax_mode {cfg.scan.relax_mode}:",
@@ -239,6 +245,10 @@ def approximants_command(
             soft_wrap=True,
         )
     if list_only:
+        from flatcontact.studies.approximant_cost import cost_lines, estimate_cost
+
+        for line in cost_lines(estimate_cost(cfg, cells, out if out.is_dir() else None)):
+            console.print(line, highlight=False, soft_wrap=True)
         return
     check_out_dir(out)
     console.print(

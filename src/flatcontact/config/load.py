@@ -28,7 +28,7 @@ from flatcontact.structures.recipe import FILE_FIELDS as RECIPE_FILE_FIELDS
 #: (:data:`flatcontact.structures.sheets.BUILTIN_SHEETS`; a test keeps them equal).
 BUILTIN_SHEET_NAMES = ("graphene", "h-BN", "MoS2")
 #: Fields naming an input file (relative to the config file); they must exist.
-FILE_FIELDS = ("contact.experiment.csv",)
+FILE_FIELDS = ("contact.experiment.csv", "report.approximant_study")
 #: Fields naming a list of input files (each relative to the config file).
 FILE_LIST_FIELDS = ("contact.fit.csv",)
 

@@ -18,3 +18,10 @@ class ReportConfig(Section):
         "middle and highest",
     )
     svg: bool = Field(True, description="also write SVG figures next to the PNGs")
+    approximant_study: str | None = Field(
+        None,
+        description="study.json of a 'flatcontact study approximants --out DIR' of this "
+        "interface (relative to the config file): the report tables its cells toward the "
+        "incommensurate contact (and their collapse stresses, DIR/experiment_collapse.json) "
+        "beside this run's commensurate cell; null: no such table",
+    )

@@ -28,6 +28,10 @@ from flatcontact.layout import (
 from flatcontact.reference import is_paper_material
 from flatcontact.report.html import Section
 from flatcontact.report.sections.analysis import analysis_section
+from flatcontact.report.sections.approximant_study import (
+    approximant_study_section,
+    read_approximant_study,
+)
 from flatcontact.report.sections.build import interface_material, interface_section
 from flatcontact.report.sections.comparison import own_results_section, paper_section
 from flatcontact.report.sections.contact import contact_section
@@ -91,6 +95,9 @@ def build_sections(
     experiment = experiment_section(contact, build)  # contact.experiment.compare
     if experiment is not None:
         sections.append(experiment)
+    study = cfg.report.approximant_study  # the sequence toward the incommensurate contact
+    if study is not None:
+        sections.append(approximant_study_section(read_approximant_study(study), study, build))
     return [
         *sections,
         interface_section(cfg, build, f_build, interface, paper),

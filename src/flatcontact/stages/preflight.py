@@ -21,6 +21,7 @@ from flatcontact.errors import InputError
 from flatcontact.ispes.executors import check_scheduler_address
 from flatcontact.potentials.engines import calculator_factory
 from flatcontact.potentials.loader import load_callable
+from flatcontact.report.sections.approximant_study import read_approximant_study
 from flatcontact.stages import _calculator
 from flatcontact.stages.build import structure_elements
 from flatcontact.stages.contact import check_fit_settings, check_moduli_source
@@ -57,6 +58,8 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
             raise InputError(f"{source}: contact.experiment.csv: {exc}") from None
     if cfg.contact.fit.csv:
         check_fit_settings(cfg)
+    if cfg.report.approximant_study is not None:
+        read_approximant_study(cfg.report.approximant_study, f"{source}: report.approximant_study")
     calc = cfg.potential.calculator
     if calc is not None and cfg.scan.optimizer == "lammps-cg":
         raise InputError(

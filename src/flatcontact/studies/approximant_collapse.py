@@ -26,11 +26,44 @@ from flatcontact.config.run import RunConfig
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.contact.tip_comparison import LAW_KEYS, compare_collapse
 from flatcontact.errors import InputError
-from flatcontact.reference import PAPER_EXPERIMENT_COLLAPSE_MPA
+from flatcontact.layout import EXPERIMENT_COLLAPSE_JSON  # noqa: F401 (the file these rows go to)
+from flatcontact.reference import PAPER_EXPERIMENT_COLLAPSE_MPA, is_paper_material
+from flatcontact.stages.build import structure_elements
 from flatcontact.stages.contact import quartz_reference_laws
 
-#: File of the study folder that holds the rows (``flatcontact study approximants``).
-EXPERIMENT_COLLAPSE_JSON = "experiment_collapse.json"
+
+def check_experiment_moduli(cfg: RunConfig) -> None:
+    """Refuse, before any cell runs, a study that compares with the experiment without E*, G*.
+
+    The study runs build and scan only: without ``contact.experiment.compare`` it needs no
+    contact moduli at all (no contact model runs). With it, each cell's laws go through the
+    contact model with ``contact.contact_modulus_gpa`` and ``contact.shear_modulus_gpa``, so
+    both must be given, unless the slabs are the paper's α-quartz (whose E*, G* the defaults
+    are). ``elastic.enabled`` does not give them here: the study runs no elastic stage.
+
+    Raises
+    ------
+    InputError
+        One line naming the two fields and why they are needed.
+    """
+    c = cfg.contact
+    if c.experiment.compare is None:
+        return
+    if {"contact_modulus_gpa", "shear_modulus_gpa"} <= c.model_fields_set:
+        return
+    elements = structure_elements(cfg.structure)
+    if is_paper_material(cfg, elements):
+        return
+    what = f"structure.kind={cfg.structure.kind}"
+    if elements is not None:
+        what += f" ({'-'.join(sorted(elements))})"
+    raise InputError(
+        f"contact.contact_modulus_gpa/shear_modulus_gpa: contact.experiment.compare is set, so "
+        f"the approximant study puts each cell's laws through the contact model, and {what} is "
+        "not the paper's alpha-quartz whose E* and G* are the defaults; give both moduli (GPa) "
+        "(the study runs no elastic stage: elastic.enabled does not give them) or unset "
+        "contact.experiment.compare"
+    )
 
 
 def cell_collapse(cell: dict, cfg: RunConfig) -> dict:

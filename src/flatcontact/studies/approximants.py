@@ -108,9 +108,13 @@ def symmetry_override(cfg: RunConfig, index: int) -> dict:
 
 def plan(cfg: RunConfig) -> list[dict]:
     """The cells of the study: per approximant its record, the grid, the index and the
-    validated configuration (every cell checked before any work; one-line InputError)."""
+    validated configuration (every cell checked before any work; one-line InputError). The
+    contact moduli are required only with ``contact.experiment.compare``
+    (:func:`flatcontact.studies.approximant_collapse.check_experiment_moduli`)."""
     from flatcontact.structures.approximants import approximant_sequence
+    from flatcontact.studies.approximant_collapse import check_experiment_moduli
 
+    check_experiment_moduli(cfg)
     cells = approximant_sequence(cfg.section("structure"), cfg.approximants)
     n_z = (
         cfg.scan.p_range_gpa.n
@@ -142,6 +146,52 @@ def plan(cfg: RunConfig) -> list[dict]:
                 "structure_override": a.structure_override,
                 "config": config,
             }
+        )
+    return out
+
+
+def model_caveats(cfg: RunConfig) -> list[str]:
+    """What the interaction model itself puts under the corrugation of large cells.
+
+    A Coulomb term across the interface cut off at a finite radius (``coul/shield 16.0 1`` of
+    the h-BN ILP presets, any ``coul/*`` interlayer style but a long-range one): summed to
+    infinity, its registry dependence between two neutral charge lattices falls as
+    e^(−|G| d) with the common reciprocal vectors |G| ∝ √N; truncated, it keeps a part that
+    falls as a power of |G| and moves with the cutoff. Measured on rigid twisted h-BN: from
+    the second cell on it is the whole corrugation (docs/incommensurate.md, "a new user's
+    run"). One line per such style, naming it, when both slabs of the interface (built
+    unrelaxed, milliseconds) carry charges (graphene/h-BN: the neutral sheet sees no
+    Coulomb term); none for other models.
+    """
+    from flatcontact.potentials.styles import style_cutoff_angstrom
+    from flatcontact.structures.construct import build_interface
+
+    data = cfg.to_dict()["potential"]
+    charges = data.get("charges") or {}
+    if data.get("coupling") != "interlayer" or not charges:
+        return []
+    atoms, _ = build_interface(cfg.structure)
+    symbols = np.asarray(atoms.get_chemical_symbols())
+    slab = np.asarray(atoms.arrays["slab"])
+    for i in (1, 2):
+        if not any(abs(float(charges.get(e, 0.0))) > 0 for e in set(symbols[slab == i])):
+            return []
+    styles = data.get("interlayer") or []
+    styles = [styles] if isinstance(styles, dict) else styles
+    out = []
+    for style in styles:
+        pair_style = str(style.get("pair_style", ""))
+        name = pair_style.split()[0] if pair_style.split() else ""
+        if "coul" not in name or "long" in name:
+            continue
+        cutoff = style_cutoff_angstrom(pair_style)
+        at = f"{cutoff:g} A" if cutoff is not None else "its cutoff"
+        out.append(
+            f"potential.interlayer {pair_style!r}: a Coulomb term cut off at {at} across the "
+            "interface; its registry dependence does not vanish with the cell size (the "
+            "exact sum's does): on rigid twisted h-BN it is the whole corrugation from the "
+            "second cell on (docs/incommensurate.md); compare with a longer cutoff before "
+            "reading the larger cells"
         )
     return out
 
@@ -410,6 +460,7 @@ def run_approximants(
         "relax_mode": cfg.scan.relax_mode,
         "cells": rows,
         "failed": {r["label"]: r["error"] for r in rows if "error" in r},
+        "caveats": model_caveats(cfg),
         "scaling": scaling_block(ok, set(cfg.contact.accept_untrusted)),
         "tolerance_advice": advice,
         "cost": {

@@ -24,11 +24,11 @@ import yaml
 from flatcontact import __version__
 from flatcontact.config.run import RunConfig
 from flatcontact.fileio import write_json_atomic, write_text_atomic
+from flatcontact.layout import STUDY_JSON
 from flatcontact.plots import save_figure
 from flatcontact.plots.study import QUANTITY_LABELS, figure_study
 from flatcontact.stages.measured_on import measured_on
 
-STUDY_JSON = "study.json"
 STUDY_CSV = "study.csv"
 UNCERTAINTY_YAML = "uncertainty.yaml"
 CSV_COLUMNS = (
