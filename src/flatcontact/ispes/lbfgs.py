@@ -381,8 +381,10 @@ def lbfgs_relax(
     evaluate
         ``evaluate(positions) -> (energy_ev, forces)``, positions and forces (n, 3) in Å
         and eV/Å; called exactly once per visited structure. The positions array is reused
-        two steps later: ``evaluate`` must copy what it keeps (the forces it returns are
-        not modified).
+        two steps later: ``evaluate`` must copy what it keeps. The forces it returns are
+        read (never modified) before the next call only, so they may be the engine's own
+        array (:meth:`~flatcontact.potentials.lammps_engine.LammpsEngine.compute` with
+        ``copy=False``); the outcome keeps a copy of the last.
     positions
         Start (n, 3), Å; not modified.
     project
@@ -420,7 +422,7 @@ def lbfgs_relax(
     scratch = np.empty(shape)  # the squares of largest_atomic_norm
     converged = largest_atomic_norm(f, scratch) < fmax
     if converged or max_steps < 1:
-        return LbfgsOutcome(x, float(energy), forces, steps, calls, bool(converged))
+        return LbfgsOutcome(x, float(energy), np.array(forces), steps, calls, bool(converged))
     history = TwoLoopMemory(x.size, memory_for(x.size) if memory is None else memory, alpha)
     x_prev = np.empty_like(x)
     g, g_prev = history.gradients  # the memory's own rows: -H g in one product
@@ -451,4 +453,4 @@ def lbfgs_relax(
         calls += 1
         f = project_force(forces)
         converged = largest_atomic_norm(f, scratch) < fmax
-    return LbfgsOutcome(x, float(energy), forces, steps, calls, bool(converged))
+    return LbfgsOutcome(x, float(energy), np.array(forces), steps, calls, bool(converged))

@@ -365,7 +365,8 @@ def point_evaluator(calc, atoms: Atoms):
     Calculators of :mod:`flatcontact.potentials` give their engine directly
     (``calc.position_evaluator``: built once for this structure, one evaluation per call,
     counted in ``calc.force_calls``); any other ASE calculator is asked through a
-    constraint-free copy of ``atoms`` (``calculate`` once per new structure).
+    constraint-free copy of ``atoms`` (``calculate`` once per new structure). The forces
+    returned are valid until the next call (they may be the engine's own array).
     """
     direct = getattr(calc, "position_evaluator", None)
     if direct is not None:

@@ -96,6 +96,12 @@ class LammpsBox:
         self.lz = float(cell[2, 2])
         self._lattice = (self.lx, self.ly, self.lz if self.pbc[2] else 0.0, self.xy, 0.0, 0.0)
 
+    @property
+    def same_frame(self) -> bool:
+        """Vectors (forces) need no conversion: a slab cell with a1 along x (LAMMPS's frame
+        is the caller's)."""
+        return not self.bulk and self._aligned
+
     def commands(self, type_elements: Sequence[str], atom_style: str = "atomic") -> list[str]:
         """``units`` … ``create_box`` and ``mass`` commands for types 1..len(type_elements)."""
         if self.bulk:
