@@ -233,7 +233,9 @@ class TwoLoopMemory:
         order = self._slots()
         with_s = self._pairs(k) @ s  # s_j·s, y_j·s interleaved
         with_y = self._pairs(k) @ y
-        self._store(with_s[1::2][order], with_y[0::2][order], with_y[1::2][order], *self._own_products())
+        self._store(
+            with_s[1::2][order], with_y[0::2][order], with_y[1::2][order], *self._own_products()
+        )
 
     def push(self, s: np.ndarray, y: np.ndarray, g: np.ndarray, step: float) -> np.ndarray:
         """Store the pair (s, y) and return H·g, as ``add(s, y)`` then
