@@ -64,7 +64,6 @@ the measurements behind it are in its docstring and ``docs/performance.md``.
 from __future__ import annotations
 
 import dataclasses
-import functools
 import inspect
 from collections.abc import Callable
 
@@ -392,9 +391,9 @@ def lbfgs_relax(
     project
         The constraint projector P: (n, 3) -> (n, 3), linear, applied to the forces and to
         every step (held atoms get zero, constrained directions are removed); returns a
-        new array, or, if it takes an ``out`` argument, writes into ``out`` (two arrays
-        reused for forces and steps, zero at first: ``out`` must keep those zeros where P
-        keeps nothing) and returns it.
+        new array, or, if it takes an ``out`` argument, writes every component of ``out``
+        (the memory's gradient row for the forces, the step itself for the step: ``out``
+        may be ``v``) and returns it.
     fmax
         Converged when the largest per-atom norm of P(F) is below ``fmax`` (eV/Å).
     max_steps
@@ -411,28 +410,33 @@ def lbfgs_relax(
     """
     x = np.array(positions, dtype=float)
     shape = x.shape
+    # the memory first: its gradient rows take -P(F) straight away (np.zeros: pages untouched
+    # until used, nothing spent on a start that is already converged)
+    history = TwoLoopMemory(x.size, memory_for(x.size) if memory is None else memory, alpha)
+    g, g_prev = history.gradients  # -H g then takes one product (TwoLoopMemory._apply)
+    in_place = "out" in inspect.signature(project).parameters
+
+    def gradient(forces: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """-P(F) into the gradient row ``out``; as (n, 3) (its norm is P(F)'s)."""
+        if in_place:
+            project(forces, out=out.reshape(shape))
+            np.negative(out, out=out)
+        else:
+            np.negative(project(forces).ravel(), out=out)
+        return out.reshape(shape)
+
     energy, forces = evaluate(x)
     calls = 1
-    if "out" in inspect.signature(project).parameters:  # projects into reused zeroed arrays
-        f_buf, step_buf = np.zeros(shape), np.zeros(shape)
-        project_force = functools.partial(project, out=f_buf)
-        project_step = functools.partial(project, out=step_buf)
-    else:
-        project_force = project_step = project
-    f = project_force(forces)
     steps = 0
     scratch = np.empty(shape)  # the squares of largest_atomic_norm
-    converged = largest_atomic_norm(f, scratch) < fmax
+    converged = largest_atomic_norm(gradient(forces, g), scratch) < fmax
     if converged or max_steps < 1:
         return LbfgsOutcome(x, float(energy), np.array(forces), steps, calls, bool(converged))
-    history = TwoLoopMemory(x.size, memory_for(x.size) if memory is None else memory, alpha)
     x_prev = np.empty_like(x)
-    g, g_prev = history.gradients  # the memory's own rows: -H g in one product
     direction = np.empty(x.size)
     dr = direction.reshape(shape)  # the step -H g: a view of the direction's buffer
     scale = 1.0  # s = scale · P(H g_prev): the factor of the last step
     while not converged and steps < max_steps:
-        np.negative(f.ravel(), out=g)
         if steps == 0:
             history.inverse_hessian_times(g, out=direction, factor=-1.0)
         else:
@@ -448,11 +452,10 @@ def lbfgs_relax(
         if damping != 1.0:
             dr *= damping
         x, x_prev = x_prev, x
-        np.add(x_prev, project_step(dr), out=x)
+        np.add(x_prev, project(dr, out=dr) if in_place else project(dr), out=x)
         g, g_prev = g_prev, g
         steps += 1
         energy, forces = evaluate(x)
         calls += 1
-        f = project_force(forces)
-        converged = largest_atomic_norm(f, scratch) < fmax
+        converged = largest_atomic_norm(gradient(forces, g), scratch) < fmax
     return LbfgsOutcome(x, float(energy), np.array(forces), steps, calls, bool(converged))
