@@ -39,7 +39,7 @@ Two passes per step
 -------------------
 On a large cell the cost is reading the 2k stored vectors of length n from memory: at 4,704
 Cu atoms (k = 21, 4.7 MB) callgrind's cache simulation puts 65 % of the scan's misses of a
-1 MB cache in these reads, 8.8 MB per call, where LAMMPS's own call misses 2.9 MB
+1 MiB cache in these reads, 8.8 MB per call, where LAMMPS's own call misses 3.1 MB
 (``docs/performance.md``, "Fourth round"). The memory keeps S Yᵀ and Y Yᵀ (k×k), so
 Y z0 = (Y g - (Y Yᵀ) a)/α needs no pass, and H g = g/α + Yᵀ(-a/α) + Sᵀc is one pass. The new
 pair's products with the stored ones need none either (:meth:`TwoLoopMemory.push`):
