@@ -23,11 +23,19 @@ measures it two ways:
   (valgrind is ~50× slower). Instructions do not see memory stalls (the L-BFGS algebra is
   bandwidth-bound on large cells), so both columns are given.
 
+- **Cache misses** (``--cache-sim``: the same callgrind run with ``--cache-sim=yes`` and this
+  machine's per-core caches, 32 KiB 8-way L1d and 1 MiB 8-way L2, 64 B lines): the bytes
+  per call that miss the simulated L2 (read and write misses × 64 B), for the scan, LAMMPS's
+  share of it and LAMMPS alone. Instructions do not show memory traffic; this does (it
+  does not model the shared 32 MiB L3, whose hit rate depends on the other processes).
+
 The large REBO+KC cells relax a fixed number of force calls (``max_steps`` in
 :data:`CASES`: 0.6-2.7 s per call) and skip the instruction count (valgrind is ~50× slower).
 System names as arguments run those only (``cu quartz``), ``system:repeat`` one size
 (``graphene:20``); ``--repeats=N`` pairs (default 7), ``--no-instructions`` skips valgrind,
-``--table-only`` measures nothing.
+``--table-only`` measures nothing, ``--counts-only`` runs the callgrind count alone and
+adds it to the newest stored row of that system and size (the timed pairs taken in a quiet
+window with ``--no-instructions``, the load-independent counts afterwards).
 Every row measured is appended to ``benchmarks/optimiser_cost_measured.jsonl`` (with its
 date and load); the table has the newest row of each system and size, and ``--write-docs``
 replaces it between the markers in ``docs/performance.md``.
@@ -65,6 +73,10 @@ WARMUP_STEPS = 2
 MEASURED = Path(__file__).with_name("optimiser_cost_measured.jsonl")
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "performance.md"
 BEGIN, END = "<!-- optimiser_cost:begin -->", "<!-- optimiser_cost:end -->"
+#: callgrind's cache simulation: this machine's per-core L1 (32 KiB, 8-way) and L2 (1 MiB,
+#: 8-way) as the simulated first and last level, 64 B lines
+CACHE_SIM = ("--cache-sim=yes", "--I1=32768,8,64", "--D1=32768,8,64", "--LL=1048576,8,64")
+LINE_BYTES = 64
 MARK_SOURCE = """#include <valgrind/callgrind.h>
 void fc_start(void) { CALLGRIND_START_INSTRUMENTATION; }
 void fc_dump(const char *s) { CALLGRIND_DUMP_STATS_AT(s); }
@@ -137,28 +149,43 @@ def _marker_library(folder: str) -> str | None:
     return lib if built.returncode == 0 else None
 
 
-def _totals(path: str) -> int:
-    return int(re.search(r"^totals: (\d+)", Path(path).read_text(), re.M).group(1))
+def _totals(path: str) -> dict[str, int]:
+    """The event totals of a callgrind dump: {"Ir": …} (and "DLmr", "DLmw" with the cache
+    simulation)."""
+    text = Path(path).read_text()
+    names = re.search(r"^events: (.+)$", text, re.M).group(1).split()
+    values = re.search(r"^totals: (.+)$", text, re.M).group(1).split()
+    return dict(zip(names, map(int, values), strict=True))
 
 
-def _lammps_share(path: str) -> int:
-    """Inclusive instructions of LAMMPS's ``Input::one`` (what each ``lammps_command``
-    runs: LAMMPS's part of the scan) in a callgrind dump."""
+def _lammps_share(path: str) -> dict[str, int]:
+    """Inclusive events of LAMMPS's ``Input::one`` (what each ``lammps_command`` runs:
+    LAMMPS's part of the scan) in a callgrind dump, as :func:`_totals`."""
+    names = list(_totals(path))
     out = subprocess.run(
         ["callgrind_annotate", "--inclusive=yes", "--threshold=100", path],
         capture_output=True,
         text=True,
         check=True,
     ).stdout
-    found = re.search(r"^\s*([\d,]+) .*:LAMMPS_NS::Input::one\(", out, re.M)
+    found = re.search(r"^\s*([\d,. ()%]+?)\s+\S*:LAMMPS_NS::Input::one\(", out, re.M)
     if found is None:
         raise RuntimeError(f"{path}: no LAMMPS_NS::Input::one in callgrind's annotation")
-    return int(found.group(1).replace(",", ""))
+    counts = re.sub(r"\([^)]*\)", " ", found.group(1)).split()  # drop the percentages
+    return {
+        k: 0 if v == "." else int(v.replace(",", "")) for k, v in zip(names, counts, strict=True)
+    }
 
 
-def instructions(system: str, n: int, max_steps: int | None) -> dict:
+def _miss_mb(events: dict[str, int], calls: int) -> float:
+    """MB per call that missed the simulated last level (read and write misses)."""
+    return (events["DLmr"] + events["DLmw"]) * LINE_BYTES / calls / 1e6
+
+
+def instructions(system: str, n: int, max_steps: int | None, cache: bool = False) -> dict:
     """Instructions per force call of the scan (LAMMPS's part and ours) and of LAMMPS alone:
-    one pair under callgrind in a fresh process."""
+    one pair under callgrind in a fresh process; ``cache``: with the cache simulation
+    (:data:`CACHE_SIM`), and the MB per call that missed it."""
     with tempfile.TemporaryDirectory() as tmp:
         lib = _marker_library(tmp)
         if lib is None:
@@ -168,6 +195,7 @@ def instructions(system: str, n: int, max_steps: int | None) -> dict:
         subprocess.run(
             [
                 *("valgrind", "--tool=callgrind", "--instr-atstart=no"),
+                *(CACHE_SIM if cache else ()),
                 *(f"--callgrind-out-file={out}", sys.executable),
                 *("-m", "benchmarks.optimiser_cost", "--one", *args),
             ],
@@ -184,22 +212,32 @@ def instructions(system: str, n: int, max_steps: int | None) -> dict:
         calls = row["force_calls"]  # of the counted relaxation
         scan, alone = _totals(dumps["scan"]), _totals(dumps["alone"])
         lammps = _lammps_share(dumps["scan"])
-    return {
+    out = {
         "instr_calls": calls,
-        "scan_minstr": scan / calls / 1e6,
-        "alone_minstr": alone / calls / 1e6,
-        "lammps_in_scan_minstr": lammps / calls / 1e6,
-        "instr_ratio": scan / alone,
+        "scan_minstr": scan["Ir"] / calls / 1e6,
+        "alone_minstr": alone["Ir"] / calls / 1e6,
+        "lammps_in_scan_minstr": lammps["Ir"] / calls / 1e6,
+        "instr_ratio": scan["Ir"] / alone["Ir"],
     }
+    if cache:
+        out.update(
+            scan_miss_mb=_miss_mb(scan, calls),
+            lammps_in_scan_miss_mb=_miss_mb(lammps, calls),
+            alone_miss_mb=_miss_mb(alone, calls),
+        )
+    return out
 
 
 def _env() -> dict:
     return dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
 
 
-def run_case(system: str, n: int, max_steps: int | None, count: int | None, repeats: int) -> dict:
+def run_case(
+    system: str, n: int, max_steps: int | None, count: int | None, repeats: int, cache: bool
+) -> dict:
     """One row: the timed pairs in a fresh process, then (``count`` not None) the instruction
-    count, of a relaxation capped at ``count`` steps if ``count`` > 0."""
+    count, of a relaxation capped at ``count`` steps if ``count`` > 0 (``cache``: with the
+    cache simulation)."""
     rest = (str(repeats), str(max_steps or 0), "")
     out = subprocess.run(
         [sys.executable, "-m", "benchmarks.optimiser_cost", "--one", system, str(n), *rest],
@@ -210,7 +248,7 @@ def run_case(system: str, n: int, max_steps: int | None, count: int | None, repe
     )
     row = json.loads(out.stdout.strip().splitlines()[-1])
     if count is not None:
-        row.update(instructions(system, n, count or max_steps))
+        row.update(instructions(system, n, count or max_steps, cache))
     return row
 
 
@@ -218,8 +256,9 @@ def table(rows: list[dict]) -> str:
     lines = [
         "| system | atoms | L-BFGS memory | force calls | scan CPU ms/call | LAMMPS alone "
         "ms/call (energy too) | ratio: median [range] of pairs | M instructions/call: scan "
-        "(LAMMPS; ours), alone | instruction ratio |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "(LAMMPS; ours), alone | instruction ratio | MB/call past a 1 MiB cache: scan "
+        "(LAMMPS), alone |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         lo, hi = r["ratio_range"]
@@ -234,11 +273,36 @@ def table(rows: list[dict]) -> str:
             )
         else:
             instr = "— | —"
+        if "scan_miss_mb" in r:
+            instr += (
+                f" | {r['scan_miss_mb']:.2f} ({r['lammps_in_scan_miss_mb']:.2f}), "
+                f"{r['alone_miss_mb']:.2f}"
+            )
+        else:
+            instr += " | —"
         lines.append(
             f"| {r['system']} | {r['atoms']:,} | {r['memory']} | {calls} | {r['scan_ms']:.2f} | "
             f"{r['alone_ms']:.2f} | {r['ratio']:.2f} [{lo:.2f}–{hi:.2f}] ×{r['repeats']} | {instr} |"
         )
     return "\n".join(lines)
+
+
+def _add_counts(system: str, n: int, counts: dict) -> None:
+    """Put ``counts`` (of :func:`instructions`) into the newest stored row of ``system`` at
+    lateral repeat ``n`` (the row's own counts, if any, are replaced)."""
+    from benchmarks.large_cells import case
+
+    atoms = len(case(system, n)[0])
+    lines = MEASURED.read_text().splitlines()
+    for k in range(len(lines) - 1, -1, -1):
+        row = json.loads(lines[k])
+        if (row["system"], row["atoms"]) == (system, atoms):
+            row.update(counts, counts_date=time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()))
+            lines[k] = json.dumps(row)
+            MEASURED.write_text("\n".join(lines) + "\n")
+            print(json.dumps(row), flush=True)
+            return
+    sys.exit(f"error: no stored row of {system} with {atoms} atoms to add the counts to")
 
 
 def main(argv: list[str]) -> None:
@@ -255,13 +319,18 @@ def main(argv: list[str]) -> None:
     for a in argv:
         if a.startswith("--repeats="):
             repeats = int(a.split("=", 1)[1])
+    cache = "--cache-sim" in argv
     for system, n, cap, count in CASES:
         if "--table-only" in argv:  # no measurement: the table of the stored rows
             break
         if only and system not in only and f"{system}:{n}" not in only:
             continue
+        if "--counts-only" in argv:
+            if count is not False:
+                _add_counts(system, n, instructions(system, n, count or cap, cache))
+            continue
         count = None if count is False or "--no-instructions" in argv else count
-        r = run_case(system, n, cap, count, repeats)
+        r = run_case(system, n, cap, count, repeats, cache)
         r["date"] = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
         with MEASURED.open("a") as fh:
             fh.write(json.dumps(r) + "\n")

@@ -260,6 +260,43 @@ def test_push_equals_the_loops_on_random_histories(seed, n, memory, steps, held)
         x, g = x_new, g_new
 
 
+@settings(max_examples=30, deadline=None)
+@given(
+    seed=st.integers(0, 2**31 - 1),
+    n=st.integers(3, 60),
+    memory=st.integers(1, 8),
+    steps=st.integers(1, 20),
+)
+def test_gradient_rows_path_equals_the_loops(seed, n, memory, steps):
+    """lbfgs_relax's path: g kept in the memory's own gradient rows (alternating), the pair
+    written into its slot, -H g from one product over the gradient row and the slots
+    (``factor=-1``), equals minus the loops to 1e-12 at every step, the ring wrapping."""
+    rng = np.random.default_rng(seed)
+    q, _ = np.linalg.qr(rng.normal(size=(n, n)))
+    k = q @ np.diag(rng.uniform(0.5, 60.0, n)) @ q.T
+    mem = TwoLoopMemory(n, memory=memory, alpha=70.0)
+    g, g_prev = mem.gradients
+    x = rng.normal(size=n)
+    g[...] = k @ x
+    step = np.empty(n)
+    mem.inverse_hessian_times(g, out=step, factor=-1.0)
+    np.testing.assert_array_equal(step, -(g * (1.0 / 70.0)))  # H0 = I/α, as ASE multiplies
+    pairs = []
+    for _ in range(steps):
+        t = rng.uniform(0.1, 1.0)
+        x_new = x + t * step
+        g, g_prev = g_prev, g
+        g[...] = k @ x_new + 1e-3 * rng.normal(size=n)
+        s, y = mem.next_pair()
+        np.subtract(x_new, x, out=s)
+        np.subtract(g, g_prev, out=y)
+        pairs = [*pairs, (s.copy(), y.copy())][-memory:]
+        mem.push_stored(g, -t, out=step, factor=-1.0)
+        want = -explicit_loops(pairs, g, 70.0)
+        assert np.abs(step - want).max() <= 1e-12 * np.abs(want).max()
+        x = x_new
+
+
 def test_memory_rule():
     """ASE's 100 pairs up to 1,000 atoms (every preset and example: their iterates stay);
     beyond, the stored coordinates m·n stay within the budget, never below the floor."""

@@ -150,3 +150,25 @@ def test_positions_keep_lammps_images_so_no_spurious_rebuild():
         np.testing.assert_allclose(moved[1], want[1], rtol=0, atol=1e-9)
     finally:
         engine.close()
+
+
+def test_uncopied_forces_are_lammps_array_and_fresh_values(close_interface):
+    """``compute(copy=False)`` (the scan's L-BFGS): on a slab cell with a1 along x the forces
+    are LAMMPS's own array, read-only, and equal to a fresh setup's along the path (rebuilds
+    and re-wraps included); with the default copy they are the same numbers in a new array."""
+    model = InteractionModel(intra="vashishta")
+    atoms = close_interface
+    setup = compile_setup(model, atoms)
+    engine = LammpsEngine(setup, atoms.cell.array, atoms.pbc)
+    try:
+        assert engine.box.same_frame
+        engine.compute(atoms.positions)
+        for k, pos in enumerate(_path(atoms, 3)):
+            energy, forces = engine.compute(pos, copy=k % 2 == 1)
+            own = np.shares_memory(forces, engine._views()[2])
+            assert own == (k % 2 == 0) and forces.flags.writeable == (k % 2 == 1)
+            want = _fresh(setup, atoms.cell.array, atoms.pbc, pos, False)
+            assert energy == pytest.approx(want[0], rel=1e-11, abs=1e-9)
+            np.testing.assert_allclose(forces, want[1], rtol=0, atol=1e-9)
+    finally:
+        engine.close()

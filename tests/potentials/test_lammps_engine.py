@@ -128,3 +128,25 @@ def test_element_mismatch_is_one_line_input_error(close_interface):
     with pytest.raises(InputError, match="Ge") as info:
         make_calculator(InteractionModel(intra="vashishta"), atoms)
     assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("angle", [2.7e-34, 1e-17, -1e-16])
+def test_a1_along_x_to_round_off_is_the_unrotated_frame(close_interface, angle):
+    """A cell whose a1 leaves x by round-off only (2.7e-34 rad in the built Cu(111) cells) is
+    LAMMPS's own frame exactly (no rotation per call: ``same_frame``); its energy and forces
+    are the unrotated cell's, and rotating by 1e-6 rad is still a rotation."""
+    from flatcontact.potentials.lammps_box import LammpsBox
+
+    spec = InteractionModel(intra="vashishta")
+    e0, f0, _ = _energy_forces(spec, close_interface)
+    cell = close_interface.cell.array.copy()
+    cell[0, 1] = angle * cell[0, 0]
+    tilted = close_interface.copy()
+    tilted.set_cell(cell, scale_atoms=False)
+    box = LammpsBox(cell, tilted.pbc)
+    assert box.same_frame and np.array_equal(box.q, np.eye(2))
+    e1, f1, _ = _energy_forces(spec, tilted)
+    assert e1 == pytest.approx(e0, rel=1e-14)
+    np.testing.assert_allclose(f1, f0, rtol=0, atol=1e-12)
+    cell[0, 1] = 1e-6 * cell[0, 0]
+    assert not LammpsBox(cell, tilted.pbc).same_frame

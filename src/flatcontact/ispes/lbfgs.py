@@ -35,18 +35,24 @@ so each system is one k×k matrix-vector product where a general LU solve cost O
 (≈ 0.2 ms per step at k = 100, on any cell). Only the sums are associated differently from
 the loops (round-off: ``tests/ispes/test_lbfgs.py`` compares with the loops to 1e-12).
 
-Four matrix-vector products per step
-------------------------------------
-On a large cell the cost is reading the 2k stored vectors of length n (memory bandwidth:
-≈ 0.5 ms per 100×14,112 matrix on one core; a matrix product with a few right-hand sides
-is no cheaper in OpenBLAS, which packs the matrix). The memory keeps S Yᵀ and Y Yᵀ (k×k),
-so Y z0 = (Y g - (Y Yᵀ) a)/α needs no pass, and H g = g/α + Yᵀ(-a/α) + Sᵀc is one pass over
-S and Y. The new pair's products with the stored ones need none either (:meth:`TwoLoopMemory.push`):
+Two passes per step
+-------------------
+On a large cell the cost is reading the 2k stored vectors of length n from memory: at 4,704
+Cu atoms (k = 21, 4.7 MB) callgrind's cache simulation puts 65 % of the scan's misses of a
+1 MiB cache in these reads, 8.8 MB per call, where LAMMPS's own call misses 3.1 MB
+(``docs/performance.md``, "Fourth round"). The memory keeps S Yᵀ and Y Yᵀ (k×k), so
+Y z0 = (Y g - (Y Yᵀ) a)/α needs no pass, and H g = g/α + Yᵀ(-a/α) + Sᵀc is one pass. The new
+pair's products with the stored ones need none either (:meth:`TwoLoopMemory.push`):
 S y = S g - S g_prev and Y y = Y g - Y g_prev from the saved products of the last step, and
 Y s = t Y (H g_prev) because the step is s = t P(H g_prev) for the orthogonal projector P
-whose range holds every stored vector (t the step's scale). A step is then S g, Y g and the
-combination: four matrix-vector products where the loops took six (the two loops' four and
-two for the new pair), equal to the loops to round-off (``tests/ispes/test_lbfgs.py``).
+whose range holds every stored vector (t the step's scale). The pairs live interleaved in
+one block (s_j, y_j adjacent), with the two gradient rows in front: S g and Y g are one
+matrix-vector product over the slots in use, the new pair's s·y and y·y one over its two
+rows, and -H g = -(g/α + Yᵀ(-a/α) + Sᵀc) one product over the gradient row and the slots
+(no separate pass for g/α, the sum or the sign). Two passes over the stored vectors per
+step, where the loops took six, equal to the loops to round-off
+(``tests/ispes/test_lbfgs.py``); fewer cannot do, as S g needs the new gradient and the
+step needs S g.
 
 The memory
 ----------
@@ -58,7 +64,6 @@ the measurements behind it are in its docstring and ``docs/performance.md``.
 from __future__ import annotations
 
 import dataclasses
-import functools
 import inspect
 from collections.abc import Callable
 
@@ -112,12 +117,15 @@ class LbfgsOutcome:
 class TwoLoopMemory:
     """The L-BFGS memory (s, y, ρ) in a ring buffer, and H·g by two triangular products.
 
-    The long vectors live in two preallocated (memory, n) arrays S and Y (ring order);
-    beside them, in chronological order, the memory keeps the k×k products S Yᵀ (s_i·y_j),
-    Y Yᵀ (y_i·y_j) and the inverse R⁻¹ of R = triu(S Yᵀ) (module docstring, "The recursion
-    as triangular products"), and from the last direction d = H g the k-vectors S g, Y g and
-    Y d. A step of :func:`lbfgs_relax` (:meth:`push_stored`) then reads S and Y twice, in
-    four matrix-vector products (module docstring, "Four matrix-vector products per step").
+    The long vectors live in one preallocated (2 + 2·memory, n) array ``block``: two rows
+    for the caller's gradients (:attr:`gradients`), then the pairs interleaved, s of slot j
+    in row 2 + 2j and y in the row after it (ring order), so the slots in use are one
+    contiguous matrix and, with the gradient, so is the combination H g. Beside them, in
+    chronological order, the memory keeps the k×k products S Yᵀ (s_i·y_j), Y Yᵀ (y_i·y_j)
+    and the inverse R⁻¹ of R = triu(S Yᵀ) (module docstring, "The recursion as triangular
+    products"), and from the last direction d = H g the k-vectors S g, Y g and Y d. A step of
+    :func:`lbfgs_relax` (:meth:`push_stored`) then reads the stored vectors twice, in two
+    matrix-vector products (module docstring, "Two passes per step").
 
     Parameters
     ----------
@@ -134,8 +142,11 @@ class TwoLoopMemory:
             raise ValueError(f"memory: expected at least one stored pair, got {memory}")
         self.memory = m = int(memory)
         self.h0 = 1.0 / float(alpha)
-        self.s = np.zeros((m, n))  # ring order: pair number p lives in slot p % memory
-        self.y = np.zeros((m, n))
+        self.block = np.zeros((2 + 2 * m, n))
+        #: two rows the caller may keep g and g_prev in: H g then takes no pass of its own
+        self.gradients = self.block[:2]
+        self.s = self.block[2::2]  # views: s of slot j is s[j], y of slot j is y[j]
+        self.y = self.block[3::2]
         # chronological (oldest first), the top-left size × size block in use
         self.rho = np.zeros(m)
         self.sy = np.zeros((m, m))  # sy[i, j] = s_i · y_j
@@ -144,8 +155,7 @@ class TwoLoopMemory:
         self.count = 0  # pairs stored so far (all time)
         # s_i·g, y_i·g and y_i·d (chronological) of the last direction d = H g; None before it
         self._last: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
-        self._weights = np.zeros((2, m))
-        self._tmp = np.empty(n)
+        self._weights = np.zeros(2 + 2 * m)
 
     @property
     def size(self) -> int:
@@ -158,11 +168,23 @@ class TwoLoopMemory:
         k = min(count, self.memory)
         return np.arange(count - k, count) % self.memory
 
+    def _pairs(self, used: int) -> np.ndarray:
+        """The rows of the first ``used`` slots, s and y interleaved: one (2·used, n) matrix."""
+        return self.block[2 : 2 + 2 * used]
+
     def next_pair(self) -> tuple[np.ndarray, np.ndarray]:
         """Views (s, y) of the slot the next pair goes to, for :meth:`push_stored` (the
         caller writes the pair there: no copy). The slot may hold the oldest pair still."""
         slot = self.count % self.memory
         return self.s[slot], self.y[slot]
+
+    def _own_products(self) -> tuple[float, float]:
+        """s·y and y·y of the pair in :meth:`next_pair`'s slot: one product of its two
+        adjacent rows with y."""
+        slot = self.count % self.memory
+        rows = self.block[2 + 2 * slot : 4 + 2 * slot]
+        sy, yy = rows @ rows[1]
+        return float(sy), float(yy)
 
     def _store(self, ys: np.ndarray, sy: np.ndarray, yy: np.ndarray, own_sy: float, own_yy: float):
         """Append the pair just written to :meth:`next_pair` to the chronological k×k products
@@ -194,8 +216,8 @@ class TwoLoopMemory:
     def add(self, s: np.ndarray, y: np.ndarray) -> None:
         """Store the pair (s, y) with ρ = 1/(y·s), as ASE does (no curvature test).
 
-        Every product is computed afresh (three matrix-vector products); :meth:`push` is the
-        step's cheaper path.
+        Every product is computed afresh (a pass over the stored vectors); :meth:`push` is
+        the step's cheaper path.
         """
         s_new, y_new = self.next_pair()
         s_new[...] = s
@@ -208,12 +230,10 @@ class TwoLoopMemory:
         s, y = self.next_pair()
         k = self.size
         order = self._slots()
+        with_s = self._pairs(k) @ s  # s_j·s, y_j·s interleaved
+        with_y = self._pairs(k) @ y
         self._store(
-            (self.y[:k] @ s)[order],
-            (self.s[:k] @ y)[order],
-            (self.y[:k] @ y)[order],
-            float(np.dot(s, y)),
-            float(np.dot(y, y)),
+            with_s[1::2][order], with_y[0::2][order], with_y[1::2][order], *self._own_products()
         )
 
     def push(self, s: np.ndarray, y: np.ndarray, g: np.ndarray, step: float) -> np.ndarray:
@@ -225,60 +245,75 @@ class TwoLoopMemory:
         y_new[...] = y
         return self.push_stored(g, step)
 
-    def push_stored(self, g: np.ndarray, step: float, out: np.ndarray | None = None) -> np.ndarray:
-        """Store the pair already written to :meth:`next_pair` and return H·g.
+    def push_stored(
+        self, g: np.ndarray, step: float, out: np.ndarray | None = None, factor: float = 1.0
+    ) -> np.ndarray:
+        """Store the pair already written to :meth:`next_pair` and return ``factor``·H·g.
 
-        Valid for the L-BFGS step only: the last call returned d = H g_prev, y = g - g_prev,
-        and s = ``step``·P(d) for an orthogonal projector P whose range holds every stored
-        vector and g (so y_i·s = ``step`` (Y d)_i). The products with the new pair then follow
-        from the saved k-vectors: S y = S g - S g_prev, Y y = Y g - Y g_prev, Y s = step·Y d;
-        S g and Y g over the slots in use (the new pair's included: s·g and y·g come with
-        them, a slot being overwritten gives a product that is dropped with its pair) and
-        the new pair's s·y, y·y are the only long products. Without a previous direction it
-        falls back to the products computed afresh (:meth:`add`). ``out``: where H·g goes
-        (length n), else a new array.
+        Valid for the L-BFGS step only: the last call returned d = H g_prev (times its
+        factor), y = g - g_prev, and s = ``step``·P(d) for an orthogonal projector P whose
+        range holds every stored vector and g (so y_i·s = ``step`` (Y d)_i). The products
+        with the new pair then follow from the saved k-vectors: S y = S g - S g_prev,
+        Y y = Y g - Y g_prev, Y s = step·Y d; S g and Y g over the slots in use (the new
+        pair's included: s·g and y·g come with them, a slot being overwritten gives a
+        product that is dropped with its pair) are one pass over the stored vectors, and
+        the new pair's s·y, y·y the only other long products. Without a previous direction
+        it falls back to the products computed afresh (:meth:`add`). ``out``: where the
+        result goes (length n), else a new array.
         """
         if self._last is None:
             self._add_stored()
-            return self.inverse_hessian_times(g, out)
-        s_new, y_new = self.next_pair()
+            return self.inverse_hessian_times(g, out, factor)
         k = self.size
         sg_prev, yg_prev, yd_prev = self._last
         used = min(self.count + 1, self.memory)  # slots in use with the new pair
-        sg_slot = self.s[:used] @ g
-        yg_slot = self.y[:used] @ g
+        products = self._pairs(used) @ g  # s_j·g, y_j·g interleaved, slot order
+        sg_slot, yg_slot = products[0::2], products[1::2]
         old = self._slots()  # the k pairs held before (their slots; one may now hold the new)
         self._store(
             step * yd_prev[:k],
             sg_slot[old] - sg_prev[:k],
             yg_slot[old] - yg_prev[:k],
-            float(np.dot(s_new, y_new)),
-            float(np.dot(y_new, y_new)),
+            *self._own_products(),
         )
         order = self._slots()
-        sg, yg = sg_slot[order], yg_slot[order]
-        return self._apply(g, sg, yg, out)
+        return self._apply(g, sg_slot[order], yg_slot[order], out, factor)
 
-    def inverse_hessian_times(self, g: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
-        """H·g of the L-BFGS two-loop recursion (module docstring), in ``out`` or a new array."""
+    def inverse_hessian_times(
+        self, g: np.ndarray, out: np.ndarray | None = None, factor: float = 1.0
+    ) -> np.ndarray:
+        """``factor``·H·g of the L-BFGS two-loop recursion (module docstring), in ``out`` or a
+        new array."""
         order = self._slots()
-        return self._apply(g, self.s[order] @ g, self.y[order] @ g, out)
+        products = self._pairs(self.size) @ g
+        return self._apply(g, products[0::2][order], products[1::2][order], out, factor)
+
+    def _gradient_row(self, g: np.ndarray) -> int | None:
+        """0 or 1 if ``g`` is that row of :attr:`gradients` (the same memory), else None."""
+        if g.ndim != 1 or g.strides != self.block.strides[1:] or len(g) != self.block.shape[1]:
+            return None
+        for row in (0, 1):
+            if g.ctypes.data == self.block[row].ctypes.data:
+                return row
+        return None
 
     def _apply(
-        self, g: np.ndarray, sg: np.ndarray, yg: np.ndarray, out: np.ndarray | None
+        self, g: np.ndarray, sg: np.ndarray, yg: np.ndarray, out: np.ndarray | None, factor: float
     ) -> np.ndarray:
-        """H·g from the chronological products sg[i] = s_i·g, yg[i] = y_i·g.
+        """``factor``·H·g from the chronological products sg[i] = s_i·g, yg[i] = y_i·g.
 
         The long vectors are used in place (ring order); only k-vectors and k×k matrices
         are chronological, so a wrapped memory on a large cell copies nothing of size n.
-        Saves S g, Y g and Y·(H g) for the next :meth:`push_stored`.
+        H g = g/α + Yᵀ(-a/α) + Sᵀc is one matrix-vector product over the slots in use, and
+        the gradient too when ``g`` is a row of :attr:`gradients` (else one more pass adds
+        g/α). Saves S g, Y g and Y·(H g) for the next :meth:`push_stored`.
         """
         k = self.size
         if out is None:
             out = np.empty_like(g)
         if k == 0:
             self._last = (sg, yg, np.zeros(0))
-            return np.multiply(g, self.h0, out=out)
+            return np.multiply(g, factor * self.h0, out=out)
         r_inv = self.r_inv[:k, :k]
         # first loop: R a = S g
         a = r_inv @ sg
@@ -286,15 +321,20 @@ class TwoLoopMemory:
         y_z0 = (yg - self.yy[:k, :k] @ a) * self.h0
         # second loop: Rᵀ c = diag(R) a - Y z0, i.e. c = R⁻ᵀ (a/ρ - Y z0)
         c = (a / self.rho[:k] - y_z0) @ r_inv
-        # H g = z0 + Sᵀc = g/α + Yᵀ(-a/α) + Sᵀc: the second pass over the stored vectors
+        # the second pass over the stored vectors: weights c on s, -a/α on y (times factor)
         order = self._slots()
         used = min(self.count, self.memory)
-        weights = self._weights[:, :used]
-        weights[0, order] = c
-        weights[1, order] = -self.h0 * a
-        np.dot(weights[0], self.s[:used], out=out)
-        out += np.dot(weights[1], self.y[:used], out=self._tmp)
-        out += np.multiply(g, self.h0, out=self._tmp)
+        weights = self._weights[: 2 + 2 * used]
+        weights[:2] = 0.0
+        weights[2 + 2 * order] = factor * c
+        weights[3 + 2 * order] = -factor * self.h0 * a
+        row = self._gradient_row(g)
+        if row is not None:  # g/α in the same product
+            weights[row] = factor * self.h0
+            np.dot(weights, self.block[: 2 + 2 * used], out=out)
+        else:
+            np.dot(weights[2:], self._pairs(used), out=out)
+            out += np.multiply(g, factor * self.h0)
         # Y (H g) = Y z0 + (Y Sᵀ) c, for the next pair's products y_i·s
         self._last = (sg, yg, y_z0 + c @ self.sy[:k, :k])
         return out
@@ -342,16 +382,18 @@ def lbfgs_relax(
     evaluate
         ``evaluate(positions) -> (energy_ev, forces)``, positions and forces (n, 3) in Å
         and eV/Å; called exactly once per visited structure. The positions array is reused
-        two steps later: ``evaluate`` must copy what it keeps (the forces it returns are
-        not modified).
+        two steps later: ``evaluate`` must copy what it keeps. The forces it returns are
+        read (never modified) before the next call only, so they may be the engine's own
+        array (:meth:`~flatcontact.potentials.lammps_engine.LammpsEngine.compute` with
+        ``copy=False``); the outcome keeps a copy of the last.
     positions
         Start (n, 3), Å; not modified.
     project
         The constraint projector P: (n, 3) -> (n, 3), linear, applied to the forces and to
         every step (held atoms get zero, constrained directions are removed); returns a
-        new array, or, if it takes an ``out`` argument, writes into ``out`` (two arrays
-        reused for forces and steps, zero at first: ``out`` must keep those zeros where P
-        keeps nothing) and returns it.
+        new array, or, if it takes an ``out`` argument, writes every component of ``out``
+        (the memory's gradient row for the forces, the step itself for the step: ``out``
+        may be ``v``) and returns it.
     fmax
         Converged when the largest per-atom norm of P(F) is below ``fmax`` (eV/Å).
     max_steps
@@ -368,36 +410,40 @@ def lbfgs_relax(
     """
     x = np.array(positions, dtype=float)
     shape = x.shape
+    # the memory first: its gradient rows take -P(F) straight away (np.zeros: pages untouched
+    # until used, nothing spent on a start that is already converged)
+    history = TwoLoopMemory(x.size, memory_for(x.size) if memory is None else memory, alpha)
+    g, g_prev = history.gradients  # -H g then takes one product (TwoLoopMemory._apply)
+    in_place = "out" in inspect.signature(project).parameters
+
+    def gradient(forces: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """-P(F) into the gradient row ``out``; as (n, 3) (its norm is P(F)'s)."""
+        if in_place:
+            project(forces, out=out.reshape(shape))
+            np.negative(out, out=out)
+        else:
+            np.negative(project(forces).ravel(), out=out)
+        return out.reshape(shape)
+
     energy, forces = evaluate(x)
     calls = 1
-    if "out" in inspect.signature(project).parameters:  # projects into reused zeroed arrays
-        f_buf, step_buf = np.zeros(shape), np.zeros(shape)
-        project_force = functools.partial(project, out=f_buf)
-        project_step = functools.partial(project, out=step_buf)
-    else:
-        project_force = project_step = project
-    f = project_force(forces)
     steps = 0
     scratch = np.empty(shape)  # the squares of largest_atomic_norm
-    converged = largest_atomic_norm(f, scratch) < fmax
+    converged = largest_atomic_norm(gradient(forces, g), scratch) < fmax
     if converged or max_steps < 1:
-        return LbfgsOutcome(x, float(energy), forces, steps, calls, bool(converged))
-    history = TwoLoopMemory(x.size, memory_for(x.size) if memory is None else memory, alpha)
+        return LbfgsOutcome(x, float(energy), np.array(forces), steps, calls, bool(converged))
     x_prev = np.empty_like(x)
-    g, g_prev = np.empty(x.size), np.empty(x.size)
     direction = np.empty(x.size)
-    dr = direction.reshape(shape)  # the step: a view of the direction's buffer
+    dr = direction.reshape(shape)  # the step -H g: a view of the direction's buffer
     scale = 1.0  # s = scale · P(H g_prev): the factor of the last step
     while not converged and steps < max_steps:
-        np.negative(f.ravel(), out=g)
         if steps == 0:
-            history.inverse_hessian_times(g, out=direction)
+            history.inverse_hessian_times(g, out=direction, factor=-1.0)
         else:
             s, y = history.next_pair()
             np.subtract(x.ravel(), x_prev.ravel(), out=s)
             np.subtract(g, g_prev, out=y)
-            history.push_stored(g, scale, out=direction)
-        np.negative(dr, out=dr)
+            history.push_stored(g, scale, out=direction, factor=-1.0)
         scale = -damping
         longest = largest_atomic_norm(dr, scratch)
         if longest >= maxstep:
@@ -406,11 +452,10 @@ def lbfgs_relax(
         if damping != 1.0:
             dr *= damping
         x, x_prev = x_prev, x
-        np.add(x_prev, project_step(dr), out=x)
+        np.add(x_prev, project(dr, out=dr) if in_place else project(dr), out=x)
         g, g_prev = g_prev, g
         steps += 1
         energy, forces = evaluate(x)
         calls += 1
-        f = project_force(forces)
-        converged = largest_atomic_norm(f, scratch) < fmax
-    return LbfgsOutcome(x, float(energy), forces, steps, calls, bool(converged))
+        converged = largest_atomic_norm(gradient(forces, g), scratch) < fmax
+    return LbfgsOutcome(x, float(energy), np.array(forces), steps, calls, bool(converged))

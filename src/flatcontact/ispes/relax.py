@@ -327,7 +327,8 @@ def constraint_projector(fixed: np.ndarray, mode: str, groups: list[np.ndarray])
     forces ASE's ``FixAtoms``, ``FixCartesian`` and
     :class:`~flatcontact.ispes.rigid_layers.RigidLayersAlongZ` return, and the
     steps their ``adjust_positions`` allow. ``full`` and ``normal`` also take ``out=``: an
-    array, zero where nothing is kept, written in place (:func:`lbfgs_relax`'s buffers).
+    array whose every component is written (it may be ``v`` itself: :func:`lbfgs_relax`
+    projects into the memory's gradient row and the step in place).
     """
     held = np.asarray(fixed, dtype=bool)
     if mode == "rigid-layers":
@@ -350,7 +351,7 @@ def constraint_projector(fixed: np.ndarray, mode: str, groups: list[np.ndarray])
     def project(v: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         if out is None:
             return np.where(keep, v, 0.0)
-        # ``out`` (reused by lbfgs_relax): v times the 0/1 factors, one vectorised pass (the
+        # ``out`` (lbfgs_relax's gradient row, or v itself): v times the 0/1 factors, one vectorised pass (the
         # same numbers as the masked copy, the removed components ±0.0; np.copyto with a
         # broadcast ``where`` mask cost ≈ 50 instructions per component: 0.3 ms per call
         # at 4,704 atoms)
@@ -365,7 +366,8 @@ def point_evaluator(calc, atoms: Atoms):
     Calculators of :mod:`flatcontact.potentials` give their engine directly
     (``calc.position_evaluator``: built once for this structure, one evaluation per call,
     counted in ``calc.force_calls``); any other ASE calculator is asked through a
-    constraint-free copy of ``atoms`` (``calculate`` once per new structure).
+    constraint-free copy of ``atoms`` (``calculate`` once per new structure). The forces
+    returned are valid until the next call (they may be the engine's own array).
     """
     direct = getattr(calc, "position_evaluator", None)
     if direct is not None:

@@ -134,7 +134,8 @@ class InterfaceCalculator(Calculator):
         here; each call is then one evaluation with nothing else around it (no ASE results
         cache, no change check), counted in ``force_calls``. The positions must belong to
         ``atoms``'s structure (same atoms, cell, pbc). ASE's cached results are dropped, so
-        a later ``get_forces`` recomputes.
+        a later ``get_forces`` recomputes. The forces returned may be the engine's own
+        array (read-only): valid until the next call, copy what is kept.
         """
         self._engine_for(atoms)
         self.reset()
@@ -174,9 +175,11 @@ class LammpsInterfaceCalculator(InterfaceCalculator):
         return self.engine.compute(atoms.positions, stress=self.bulk and all(atoms.pbc))
 
     def _positions_evaluator(self, atoms: Atoms):
+        # forces not copied where LAMMPS's array is already in the caller's frame and order
+        # (read-only, valid until the next call: position_evaluator's contract)
         stress = self.bulk and all(atoms.pbc)
         compute = self.engine.compute
-        return lambda positions: compute(positions, stress=stress)
+        return lambda positions: compute(positions, stress=stress, copy=False)
 
     def minimize_positions(
         self, atoms: Atoms, held: np.ndarray, fmax: float, max_iterations: int

@@ -50,10 +50,18 @@ def tensor_to_voigt(t: np.ndarray) -> np.ndarray:
 
 
 def _inplane_frame(cell: np.ndarray) -> tuple[np.ndarray, float, float, float]:
-    """Orthogonal Q (2×2) with Q·a1 = (|a1|, 0), (Q·a2)_y > 0; and (lx, ly, xy) reduced tilt."""
+    """Orthogonal Q (2×2) with Q·a1 = (|a1|, 0), (Q·a2)_y > 0; and (lx, ly, xy) reduced tilt.
+
+    An a1 along ±x to round-off (|a1_y| within four ulps of |a1|: e.g. 1e-33 Å left by a
+    cell's construction) is taken as exactly along it: Q is then ±I or a reflection, exactly,
+    and the usual cell (a1 along +x) needs no rotation per call (``LammpsBox.same_frame``).
+    The rotation dropped is below the round-off of applying it.
+    """
     a1, a2 = cell[0, :2], cell[1, :2]
     lx = float(np.hypot(*a1))
     e1 = a1 / lx
+    if abs(e1[1]) <= 4 * np.finfo(float).eps:
+        e1 = np.array([np.copysign(1.0, e1[0]), 0.0])
     e2 = np.array([-e1[1], e1[0]])
     q = np.array([e1, e2])
     b2 = q @ a2
@@ -95,6 +103,12 @@ class LammpsBox:
         self._aligned = bool(np.array_equal(self.q, np.eye(2)))
         self.lz = float(cell[2, 2])
         self._lattice = (self.lx, self.ly, self.lz if self.pbc[2] else 0.0, self.xy, 0.0, 0.0)
+
+    @property
+    def same_frame(self) -> bool:
+        """Vectors (forces) need no conversion: a slab cell with a1 along x (LAMMPS's frame
+        is the caller's)."""
+        return not self.bulk and self._aligned
 
     def commands(self, type_elements: Sequence[str], atom_style: str = "atomic") -> list[str]:
         """``units`` … ``create_box`` and ``mass`` commands for types 1..len(type_elements)."""

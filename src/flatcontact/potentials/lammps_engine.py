@@ -131,7 +131,7 @@ class LammpsEngine:
                 raise
             raise InputError(f"LAMMPS could not set up the potential {label}: {exc}") from None
 
-    def _views(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _views(self, check_ids: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(rows, x, f): numpy views of LAMMPS's own ``x`` and ``f`` arrays and the rows of the
         caller's atoms in them, made once and remade only when LAMMPS moved its arrays
         (``_identity``: the rows are 0 … n-1).
@@ -144,7 +144,9 @@ class LammpsEngine:
         call the data addresses of ``id``, ``x`` and ``f`` are read through the C library
         (three calls of ``lammps_extract_atom``, microseconds) and the ids compared with the
         cached ones. The numpy wrapper (``lmp.numpy.extract_atom``), which costs tens of
-        microseconds per array, runs only when something changed.
+        microseconds per array, runs only when something changed. ``check_ids=False`` compares
+        the addresses only (:meth:`compute` before placing the positions: the ids were
+        compared after the last run, and nothing but a run moves atoms between rows).
         """
         lmp = self.lmp
         if self._extract is None:
@@ -158,8 +160,9 @@ class LammpsEngine:
             _first_row(self._extract(handle, b"f")),
         )
         cached = self._cached_views
-        if cached is not None and cached[0] == addresses and np.array_equal(cached[1], cached[2]):
-            return cached[3]
+        if cached is not None and cached[0] == addresses:
+            if not check_ids or np.array_equal(cached[1], cached[2]):
+                return cached[3]
         ids = lmp.numpy.extract_atom("id", nelem=self.n)
         if ids is None or len(ids) != self.n:  # pragma: no cover - a guard
             raise RuntimeError("LAMMPS does not own every atom in this process")
@@ -174,17 +177,20 @@ class LammpsEngine:
             self._cached_views = (addresses, ids, np.array(ids), views)
         return views
 
-    def compute(self, positions: np.ndarray, stress: bool = False):
+    def compute(self, positions: np.ndarray, stress: bool = False, copy: bool = True):
         """Energy (eV) and forces (eV/Å, caller's frame) at ``positions`` (Å).
 
         With ``stress=True`` (3D-periodic cells only) also the stress (eV/Å³, ASE Voigt order
         and sign): ``(energy, forces, stress)``. After the first call the positions go
         straight into LAMMPS's array at the images nearest its own
         (:meth:`~flatcontact.potentials.lammps_box.LammpsBox.place`); the forces come back
-        in one copy.
+        in one copy. ``copy=False``: where LAMMPS's frame and rows are the caller's (a slab
+        cell in the x-y frame, atoms in order: every scan cell built here), the forces are
+        LAMMPS's own array, read-only and valid until the next call (the scan's L-BFGS reads
+        them once: one pass less per call).
         """
         lmp = self.lmp
-        rows, x, _ = self._views()
+        rows, x, _ = self._views(check_ids=False)
         if self._ready:  # one force evaluation behind the neighbour check, no setup
             if self._identity:
                 self.box.place(positions, x, self._offsets)
@@ -202,7 +208,11 @@ class LammpsEngine:
             self._ready = True
         energy = float(lmp.get_thermo("pe"))
         rows, _, f = self._views()
-        forces = self.box.vectors_to_caller(f if self._identity else f[rows])
+        if not copy and self._identity and self.box.same_frame:
+            forces = f.view()
+            forces.flags.writeable = False
+        else:
+            forces = self.box.vectors_to_caller(f if self._identity else f[rows])
         if not stress:
             return energy, forces
         p = [self.lmp.get_thermo(k) for k in ("pxx", "pyy", "pzz", "pyz", "pxz", "pxy")]
