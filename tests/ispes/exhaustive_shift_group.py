@@ -4,8 +4,10 @@ large-cell work), kept as the reference the fast search is tested against.
 For every point operation R of the lattice and slab swap σ: every translation τ₁ that maps
 slab 1 onto itself under W = diag(R, σ) (every target atom of the anchor's species tried), every
 τ₂ for slab 2, and every pair (τ₁, τ₂) checked on the stack at two generic shifts. It shares
-the atom matcher and the stack check with :mod:`flatcontact.ispes.shift_symmetry`, not the
-search: no translation is inferred from another. Cost: N² stack checks per point operation
+the atom matcher, the per-slab translation search in its exhaustive mode (``_translations``
+without the slab's own translations) and the stack check with
+:mod:`flatcontact.ispes.shift_symmetry`, not the group search: no translation is inferred
+from another. Cost: N² stack checks per point operation
 for a twist cell of N primitive cells per layer (4 s for the (1, 2) cell, 100–230 s for
 (2, 3)): tests use it on small cells only.
 """
@@ -18,34 +20,18 @@ import numpy as np
 
 from flatcontact.ispes.shift_symmetry import (
     ShiftOperation,
-    _keeps_layers,
     _labels,
-    _Matcher,
     _point_operations,
     _stack_maps,
+    _translations,
 )
 from flatcontact.structures.interface_contract import in_plane_vectors
 
 
 def _every_translation(src, src_lab, src_layer, dst, dst_lab, dst_layer, w, lattice, tol):
-    """Every τ with ``W src + τ ≡ dst``: every target atom of the anchor's species tried."""
-    if len(src) != len(dst) or not np.array_equal(np.sort(src_lab), np.sort(dst_lab)):
-        return []
-    matcher = _Matcher(dst, dst_lab, lattice)
-    labels, counts = np.unique(src_lab, return_counts=True)
-    anchor_label = labels[np.argmin(counts)]
-    anchor = int(np.flatnonzero(src_lab == anchor_label)[0])
-    moved = src @ w.T
-    inv = np.linalg.inv(lattice)
-    found = []
-    for j in np.flatnonzero(dst_lab == anchor_label):
-        tau = dst[j] - moved[anchor]
-        f = inv @ tau[:2]
-        tau[:2] = lattice @ (f - np.floor(f + 1e-9))
-        perm = matcher.match(moved + tau, src_lab, tol)
-        if perm is not None and _keeps_layers(perm, src_layer, dst_layer):
-            found.append(tau)
-    return found
+    """Every τ with ``W src + τ ≡ dst``: the package's matcher without the slab's own
+    translations (every target atom of the anchor's species tried), as the old search did."""
+    return _translations(src, src_lab, src_layer, dst, dst_lab, dst_layer, w, lattice, tol)
 
 
 def exhaustive_group(reference, tol: float = 1e-3, spread_compression: bool = True) -> set:

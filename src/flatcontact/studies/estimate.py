@@ -45,6 +45,7 @@ from flatcontact.config.run import RunConfig
 from flatcontact.ispes.thicknesses import MIN_THICKNESS_SPACING_ANGSTROM
 from flatcontact.layout import SCAN_JSON, STAGES
 from flatcontact.rundir import RECORD_NAME
+from flatcontact.studies.approximant_cost import duration
 from flatcontact.studies.variants import Variant, base_value, shares_build
 
 #: The stages a variant runs (the study's runner stops after laws).
@@ -193,22 +194,12 @@ def estimate_lines(est: dict) -> list[str]:
         scanned = f"; ~{v['thicknesses']} scanned" if v["setting"] == "thicknesses" else ""
         lines.append(
             f"  {v['name']} ({v['label']}{scanned}): {v['points']} points, ~{v['points_computed']} "
-            f"computed, ~{v['force_calls']} force calls{bound}, ~{_duration(v['seconds'])}"
+            f"computed, ~{v['force_calls']} force calls{bound}, ~{duration(v['seconds'])}"
         )
     lines.append(
         f"  all {len(est['variants'])} variants: ~{est['force_calls_study']} force calls "
         f"(each setting from scratch: ~{est['force_calls_from_scratch']}), "
-        f"~{_duration(est['serial_seconds'])} one after another, ~{_duration(est['wall_seconds'])} on "
+        f"~{duration(est['serial_seconds'])} one after another, ~{duration(est['wall_seconds'])} on "
         f"{est['workers']} worker(s) if no setting converges early"
     )
     return lines
-
-
-def _duration(seconds: float) -> str:
-    if not math.isfinite(seconds):
-        return "?"
-    if seconds < 120:
-        return f"{seconds:.0f} s"
-    if seconds < 7200:
-        return f"{seconds / 60:.0f} min"
-    return f"{seconds / 3600:.1f} h"
