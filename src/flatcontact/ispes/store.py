@@ -48,12 +48,12 @@ import os
 import sqlite3
 import time
 import types
+import uuid
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 from ase import Atoms
-from ase.calculators.singlepoint import SinglePointCalculator
 
 from flatcontact.errors import InputError
 from flatcontact.fileio import refuse_link
@@ -164,6 +164,8 @@ class PointStore:
 
         self.commit_interval_s = float(commit_interval_s)
         self._last_commit = time.monotonic()
+        self._checked_keys = False
+        self._uncommitted = 0
 
         self.path = Path(path)
         self.settings = json.loads(json.dumps(settings))
@@ -240,6 +242,21 @@ class PointStore:
         if self._db.connection is not None:
             self._db.connection.commit()
         self._last_commit = time.monotonic()
+        self._uncommitted = 0
+
+    def flush(self) -> None:
+        """Commit the points written since the last commit, if any (one transaction).
+
+        The scan calls it before it blocks waiting for a result, so that with
+        ``commit_interval_s > 0`` a point is never left uncommitted while the driver
+        waits: the results that arrive together are one transaction."""
+        if self._uncommitted:
+            self._commit()
+
+    @property
+    def uncommitted(self) -> int:
+        """Points written but not yet committed."""
+        return self._uncommitted
 
     def close(self) -> None:
         """Commit, close the database connection and release the driver lock."""
@@ -302,20 +319,46 @@ class PointStore:
         """Relaxed positions (Å) of a finished point."""
         return self._db.get(id=self._done[tuple(index)]["id"]).positions.copy()
 
+    def _row(self, result: PointResult, kvp: dict):
+        """The ASE row of one point, built directly (what ``ase.db`` would make of
+        ``Atoms(numbers, positions, cell, pbc)`` with a ``SinglePointCalculator(energy=...)``).
+
+        Building an ``Atoms`` and a calculator only for ``ase.db`` to take them apart again
+        (``atoms2dict``: a state check comparing the atoms with ``allclose``, a formula per
+        key) was two thirds of the driver's cost per stored point; the row holds the same
+        columns (``tests/ispes/test_store_rows.py`` compares them with ASE's own).
+        """
+        from ase.db.core import now
+        from ase.db.row import AtomsRow
+
+        reference = self.reference
+        dct = {
+            "numbers": reference.numbers,
+            "positions": np.asarray(result.positions, dtype=float),
+            "unique_id": uuid.uuid4().hex,
+            "calculator": "unknown",  # SinglePointCalculator.name
+            "calculator_parameters": {},
+            "energy": float(result.energy_ev),
+            "key_value_pairs": kvp,
+        }
+        if reference.pbc.any():
+            dct["pbc"] = reference.pbc
+        if reference.cell.any():
+            dct["cell"] = reference.cell.array
+        row = AtomsRow(dct)
+        row.ctime = now()
+        row.user = os.getenv("USER")
+        return row
+
     def write(self, result: PointResult) -> None:
         """Store one finished point (committed within ``commit_interval_s``, and at close).
 
         A point already stored is ignored."""
+        import ase.db.core
+
         index = tuple(result.index)
         if index in self._done:
             return
-        atoms = Atoms(
-            numbers=self.reference.numbers,
-            positions=result.positions,
-            cell=self.reference.cell,
-            pbc=self.reference.pbc,
-        )
-        atoms.calc = SinglePointCalculator(atoms, energy=result.energy_ev)
         kvp = {
             "i_a": index[0],
             "i_b": index[1],
@@ -332,7 +375,12 @@ class PointStore:
             "seconds": result.seconds,
             "start": ",".join(str(i) for i in result.start_index) if result.start_index else "",
         }
-        row_id = self._db.write(atoms, key_value_pairs=kvp)
+        if not self._checked_keys:  # ase.db's key check, once: the keys and types never change
+            ase.db.core.check(kvp)
+            self._checked_keys = True
+        # the database's own row writer, without Database.write's per-row key check
+        row_id = self._db._write(self._row(result, kvp), dict(kvp), {}, None)
+        self._uncommitted += 1
         if time.monotonic() - self._last_commit >= self.commit_interval_s:
             self._commit()  # everything written so far, in order
         # the record from what was just written (SQLite stores these doubles and integers
