@@ -140,7 +140,8 @@ def scan_settings(
 MANY_WORKERS = 4
 
 #: The grid's stored points are committed at most this often (s) while results keep
-#: arriving, and always before the driver waits for the next result and at the end:
+#: arriving, and always before the driver waits for the next result (or, with the serial
+#: executor, relaxes the next point itself) and at the end:
 #: a ``kill -9`` loses at most the points stored in the last ``COMMIT_INTERVAL_S`` of the
 #: driver's uninterrupted storing (and the points in flight); SIGINT and a normal end lose
 #: none (the store commits when it closes). One commit per point was 0.3 ms of the
@@ -723,6 +724,7 @@ def run_scan(
                         in_flight: dict[Any, tuple] = {}
                         cap = 2 * max(1, getattr(executor, "workers", 1))
                         queue = ReadyQueue(parent, rank, store, pending)
+                        inline = getattr(executor, "name", None) == "serial"
                         while pending or in_flight:
                             if (
                                 max_new_points is not None
@@ -739,6 +741,8 @@ def run_scan(
                                 )
                             ):
                                 idx = queue.pop()
+                                if inline:
+                                    store.flush()  # the submit relaxes the point in the driver
                                 handle = executor.submit(run_task, context, make_task(idx))
                                 in_flight[handle] = idx
                                 pending.discard(idx)
@@ -757,6 +761,7 @@ def run_scan(
                                 stored += weight.get(idx, 1)
                                 if progress is not None:
                                     progress(stored, total)
+                        store.flush()  # before the assembly and the checks that follow
 
                     symmetry_record, mapping = None, None
                     try:

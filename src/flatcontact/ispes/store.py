@@ -45,7 +45,9 @@ import fcntl
 import hashlib
 import json
 import os
+import signal
 import sqlite3
+import threading
 import time
 import types
 import uuid
@@ -132,6 +134,10 @@ def discard_store(path: str | os.PathLike[str], remove_parent: bool = False) -> 
 
 def _one_line(exc: BaseException) -> str:
     return " ".join(f"{exc.__class__.__name__}: {exc}".split())
+
+
+class StoreTerminated(KeyboardInterrupt):
+    """SIGTERM while a store is open: unwinds like Ctrl-C, so the store commits and closes."""
 
 
 class PointStore:
@@ -237,6 +243,29 @@ class PointStore:
         self._db.connection.commit()
         self._db.connection.execute("PRAGMA journal_mode=WAL")
         self._db.connection.execute("PRAGMA synchronous=NORMAL")
+        self._catch_sigterm()
+
+    def _catch_sigterm(self) -> None:
+        """While open, SIGTERM raises :class:`StoreTerminated` in the driver (as SIGINT raises
+        KeyboardInterrupt), so that the points written but not yet committed are committed
+        when the store closes; only where SIGTERM would otherwise kill the process at once
+        (the main thread, the default action). A process forked from the driver gets the
+        default action back."""
+        self._old_sigterm = None
+        if threading.current_thread() is not threading.main_thread():
+            return
+        if signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL:
+            return
+        pid = os.getpid()
+
+        def terminated(signum, frame):
+            if os.getpid() != pid:  # a forked child: die as it would have
+                signal.signal(signal.SIGTERM, signal.SIG_DFL)
+                os.kill(os.getpid(), signal.SIGTERM)
+                return
+            raise StoreTerminated(f"SIGTERM; the points stored so far are kept in {self.path}")
+
+        self._old_sigterm = signal.signal(signal.SIGTERM, terminated)
 
     def _commit(self) -> None:
         if self._db.connection is not None:
@@ -266,6 +295,9 @@ class PointStore:
         if self._driver_lock is not None:
             self._driver_lock.close()
             self._driver_lock = None
+        if getattr(self, "_old_sigterm", None) is not None:
+            signal.signal(signal.SIGTERM, self._old_sigterm)
+            self._old_sigterm = None
 
     def __enter__(self) -> PointStore:
         return self
