@@ -12,15 +12,18 @@ a1, a2, the potential label, the probe column and adhesion if the thicknesses we
 chosen from a pressure range). A store whose settings differ from the current ones is
 refused with a line naming the first difference.
 
-Crash safety: only the driver process writes, on one connection; each finished point is
-committed at once (``commit_interval_s = 0``, the default) into SQLite's write-ahead log with
-``synchronous=NORMAL``: a commit is a write, not an fsync (an fsync per point cost 2-16 ms on
-a shared disk), and it survives the death of the process however it dies; only an
-operating-system crash or power loss can lose the last commits. A kill at any moment leaves
-every committed point intact and loses at most the points in flight; a point is never
-committed before the point it was warm-started from, so a resumed grid equals an
-uninterrupted one. (``commit_interval_s > 0`` batches commits; a kill then also loses the
-points finished since the last commit.) ASE's own lock file is disabled: after a
+Crash safety: only the driver process writes, on one connection, into SQLite's write-ahead
+log with ``synchronous=NORMAL``: a commit is a write, not an fsync (an fsync per point cost
+2-16 ms on a shared disk), and it survives the death of the process however it dies; only an
+operating-system crash or power loss can lose the last commits. With ``commit_interval_s = 0``
+(the default) each point is committed at once; the scan opens its store with
+``scan.COMMIT_INTERVAL_S`` (0.5 s) and calls :meth:`PointStore.flush` before the driver waits
+for a result, so the results that arrive together are one transaction and a ``kill -9`` loses
+at most the points stored in the last 0.5 s of uninterrupted storing, besides the points in
+flight. Ctrl-C, SIGTERM (raised as :class:`StoreTerminated` while a store is open) and a
+normal end commit everything when the store closes. A point is never committed before the
+point it was warm-started from (one connection, rows in order), so a resumed grid equals an
+uninterrupted one. ASE's own lock file is disabled: after a
 ``kill -9`` inside a write it would stay behind and block every later run forever.
 Instead the driver holds an advisory ``flock`` on ``points.db.driver`` for as long as
 the store is open; the kernel releases it when the process dies, however it dies, and
