@@ -67,6 +67,12 @@ class Handle:
     start: float
     end: float
     seq: int
+    executor: Any = None
+
+    def done(self) -> bool:
+        """Finished by the driver's clock now (as ``Future.done``: the next wait won't block)."""
+        self.executor._tick()
+        return self.end <= self.executor.clock
 
     def __hash__(self) -> int:
         return self.seq
@@ -133,7 +139,7 @@ class VirtualExecutor:
         heapq.heappush(self._free, start + seconds)
         self.busy_s += seconds
         self._seq += 1
-        handle = Handle(key, result, error, start, start + seconds, self._seq)
+        handle = Handle(key, result, error, start, start + seconds, self._seq, self)
         self.log.append(("submit", key, self.clock, start, start + seconds))
         return handle
 

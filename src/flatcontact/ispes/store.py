@@ -12,15 +12,18 @@ a1, a2, the potential label, the probe column and adhesion if the thicknesses we
 chosen from a pressure range). A store whose settings differ from the current ones is
 refused with a line naming the first difference.
 
-Crash safety: only the driver process writes, on one connection; each finished point is
-committed at once (``commit_interval_s = 0``, the default) into SQLite's write-ahead log with
-``synchronous=NORMAL``: a commit is a write, not an fsync (an fsync per point cost 2-16 ms on
-a shared disk), and it survives the death of the process however it dies; only an
-operating-system crash or power loss can lose the last commits. A kill at any moment leaves
-every committed point intact and loses at most the points in flight; a point is never
-committed before the point it was warm-started from, so a resumed grid equals an
-uninterrupted one. (``commit_interval_s > 0`` batches commits; a kill then also loses the
-points finished since the last commit.) ASE's own lock file is disabled: after a
+Crash safety: only the driver process writes, on one connection, into SQLite's write-ahead
+log with ``synchronous=NORMAL``: a commit is a write, not an fsync (an fsync per point cost
+2-16 ms on a shared disk), and it survives the death of the process however it dies; only an
+operating-system crash or power loss can lose the last commits. With ``commit_interval_s = 0``
+(the default) each point is committed at once; the scan opens its store with
+``scan.COMMIT_INTERVAL_S`` (0.5 s) and calls :meth:`PointStore.flush` before the driver waits
+for a result, so the results that arrive together are one transaction and a ``kill -9`` loses
+at most the points stored in the last 0.5 s of uninterrupted storing, besides the points in
+flight. Ctrl-C, SIGTERM (raised as :class:`StoreTerminated` while a store is open) and a
+normal end commit everything when the store closes. A point is never committed before the
+point it was warm-started from (one connection, rows in order), so a resumed grid equals an
+uninterrupted one. ASE's own lock file is disabled: after a
 ``kill -9`` inside a write it would stay behind and block every later run forever.
 Instead the driver holds an advisory ``flock`` on ``points.db.driver`` for as long as
 the store is open; the kernel releases it when the process dies, however it dies, and
@@ -45,15 +48,17 @@ import fcntl
 import hashlib
 import json
 import os
+import signal
 import sqlite3
+import threading
 import time
 import types
+import uuid
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 from ase import Atoms
-from ase.calculators.singlepoint import SinglePointCalculator
 
 from flatcontact.errors import InputError
 from flatcontact.fileio import refuse_link
@@ -134,6 +139,10 @@ def _one_line(exc: BaseException) -> str:
     return " ".join(f"{exc.__class__.__name__}: {exc}".split())
 
 
+class StoreTerminated(KeyboardInterrupt):
+    """SIGTERM while a store is open: unwinds like Ctrl-C, so the store commits and closes."""
+
+
 class PointStore:
     """A ``points.db`` opened for one set of settings (the driver's single writer).
 
@@ -164,6 +173,8 @@ class PointStore:
 
         self.commit_interval_s = float(commit_interval_s)
         self._last_commit = time.monotonic()
+        self._checked_keys = False
+        self._uncommitted = 0
 
         self.path = Path(path)
         self.settings = json.loads(json.dumps(settings))
@@ -230,16 +241,58 @@ class PointStore:
         # one connection for the store's lifetime, one commit per point: ASE otherwise opens
         # a connection and commits (an fsync each) several times inside every write
         self._db.__enter__()
+        # ase.db looks the database's external tables up (a query) for every row written as
+        # a row; the store creates none, so the list read once at opening stays exact
+        external = list(self._db._get_external_table_names())
+        self._db._get_external_table_names = lambda db_con=None: list(external)
         # write-ahead log without an fsync per commit: a commit survives the death of the
         # process (kill -9), only an operating-system crash can lose the last ones
         self._db.connection.commit()
         self._db.connection.execute("PRAGMA journal_mode=WAL")
         self._db.connection.execute("PRAGMA synchronous=NORMAL")
+        self._catch_sigterm()
+
+    def _catch_sigterm(self) -> None:
+        """While open, SIGTERM raises :class:`StoreTerminated` in the driver (as SIGINT raises
+        KeyboardInterrupt), so that the points written but not yet committed are committed
+        when the store closes; only where SIGTERM would otherwise kill the process at once
+        (the main thread, the default action). A process forked from the driver gets the
+        default action back."""
+        self._old_sigterm = None
+        if threading.current_thread() is not threading.main_thread():
+            return
+        if signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL:
+            return
+        pid = os.getpid()
+
+        def terminated(signum, frame):
+            if os.getpid() != pid:  # a forked child: die as it would have
+                signal.signal(signal.SIGTERM, signal.SIG_DFL)
+                os.kill(os.getpid(), signal.SIGTERM)
+                return
+            raise StoreTerminated(f"SIGTERM; the points stored so far are kept in {self.path}")
+
+        self._old_sigterm = signal.signal(signal.SIGTERM, terminated)
 
     def _commit(self) -> None:
         if self._db.connection is not None:
             self._db.connection.commit()
         self._last_commit = time.monotonic()
+        self._uncommitted = 0
+
+    def flush(self) -> None:
+        """Commit the points written since the last commit, if any (one transaction).
+
+        The scan calls it before it blocks waiting for a result, so that with
+        ``commit_interval_s > 0`` a point is never left uncommitted while the driver
+        waits: the results that arrive together are one transaction."""
+        if self._uncommitted:
+            self._commit()
+
+    @property
+    def uncommitted(self) -> int:
+        """Points written but not yet committed."""
+        return self._uncommitted
 
     def close(self) -> None:
         """Commit, close the database connection and release the driver lock."""
@@ -249,6 +302,9 @@ class PointStore:
         if self._driver_lock is not None:
             self._driver_lock.close()
             self._driver_lock = None
+        if getattr(self, "_old_sigterm", None) is not None:
+            signal.signal(signal.SIGTERM, self._old_sigterm)
+            self._old_sigterm = None
 
     def __enter__(self) -> PointStore:
         return self
@@ -302,20 +358,46 @@ class PointStore:
         """Relaxed positions (Å) of a finished point."""
         return self._db.get(id=self._done[tuple(index)]["id"]).positions.copy()
 
+    def _row(self, result: PointResult, kvp: dict):
+        """The ASE row of one point, built directly (what ``ase.db`` would make of
+        ``Atoms(numbers, positions, cell, pbc)`` with a ``SinglePointCalculator(energy=...)``).
+
+        Building an ``Atoms`` and a calculator only for ``ase.db`` to take them apart again
+        (``atoms2dict``: a state check comparing the atoms with ``allclose``, a formula per
+        key) was two thirds of the driver's cost per stored point; the row holds the same
+        columns (``tests/ispes/test_store_rows.py`` compares them with ASE's own).
+        """
+        from ase.db.core import now
+        from ase.db.row import AtomsRow
+
+        reference = self.reference
+        dct = {
+            "numbers": reference.numbers,
+            "positions": np.asarray(result.positions, dtype=float),
+            "unique_id": uuid.uuid4().hex,
+            "calculator": "unknown",  # SinglePointCalculator.name
+            "calculator_parameters": {},
+            "energy": float(result.energy_ev),
+            "key_value_pairs": kvp,
+        }
+        if reference.pbc.any():
+            dct["pbc"] = reference.pbc
+        if reference.cell.any():
+            dct["cell"] = reference.cell.array
+        row = AtomsRow(dct)
+        row.ctime = now()
+        row.user = os.getenv("USER")
+        return row
+
     def write(self, result: PointResult) -> None:
         """Store one finished point (committed within ``commit_interval_s``, and at close).
 
         A point already stored is ignored."""
+        import ase.db.core
+
         index = tuple(result.index)
         if index in self._done:
             return
-        atoms = Atoms(
-            numbers=self.reference.numbers,
-            positions=result.positions,
-            cell=self.reference.cell,
-            pbc=self.reference.pbc,
-        )
-        atoms.calc = SinglePointCalculator(atoms, energy=result.energy_ev)
         kvp = {
             "i_a": index[0],
             "i_b": index[1],
@@ -332,7 +414,14 @@ class PointStore:
             "seconds": result.seconds,
             "start": ",".join(str(i) for i in result.start_index) if result.start_index else "",
         }
-        row_id = self._db.write(atoms, key_value_pairs=kvp)
+        if not self._checked_keys:  # ase.db's key check, once: the keys and types never change
+            ase.db.core.check(kvp)
+            self._checked_keys = True
+        # the database's own row writer; the key-value pairs travel in the row (ase.db's
+        # rule for a row written without pairs: it keeps its own), so that ase.db's key
+        # check, a formula parse per key (a quarter of the write), runs once, above
+        row_id = self._db._write(self._row(result, kvp), {}, {}, None)
+        self._uncommitted += 1
         if time.monotonic() - self._last_commit >= self.commit_interval_s:
             self._commit()  # everything written so far, in order
         # the record from what was just written (SQLite stores these doubles and integers

@@ -1,0 +1,248 @@
+"""The driver's store rows: built directly, batched into one transaction, committed on SIGTERM.
+
+``PointStore.write`` builds the ASE row itself (no ``Atoms`` + ``SinglePointCalculator`` for
+``ase.db`` to take apart) and commits at most every ``commit_interval_s``; the rows must be
+the ones ASE itself writes from the atoms, the batched store must hold the same rows as the
+unbatched one, and a kill loses only what was not yet committed.
+"""
+
+import signal
+import sqlite3
+import subprocess
+import sys
+import textwrap
+
+import ase.db
+import numpy as np
+import pytest
+from ase import Atoms
+from ase.calculators.singlepoint import SinglePointCalculator
+
+from flatcontact.ispes.relax import PointResult
+from flatcontact.ispes.store import PointStore
+from flatcontact.structures.toy import toy_interface
+
+COLUMNS = (
+    "numbers", "positions", "cell", "pbc", "energy", "calculator",
+    "calculator_parameters", "key_value_pairs",
+)  # fmt: skip
+
+
+def _result(ref, k, n=12):
+    return PointResult(
+        index=(k % n, k // n, 0),
+        shift_a=(k % n) / n,
+        shift_b=(k // n) / n,
+        thickness=10.0 + 0.1 * k,
+        energy_ev=-1.0 - k / 7,
+        normal_stress_gpa=0.5 - k / 9,
+        reaction_stress_gpa=0.01 * k,
+        force_calls=10 + k,
+        steps=9 + k,
+        converged=k % 5 != 3,
+        max_force_ev_per_a=1e-4 * k,
+        seconds=0.1 * k,
+        positions=ref.positions + 1e-3 * k,
+        start_index=((k - 1) % n, (k - 1) // n, 0) if k else None,
+    )
+
+
+def _ase_rows(path):
+    """Every row's columns as ASE reads them, by grid index."""
+    out = {}
+    for row in ase.db.connect(str(path)).select():
+        out[(row.i_a, row.i_b, row.i_z)] = {key: row.get(key) for key in COLUMNS}
+    return out
+
+
+def _assert_same_rows(a, b):
+    assert a.keys() == b.keys()
+    for index in a:
+        for key in COLUMNS:
+            x, y = a[index][key], b[index][key]
+            if isinstance(x, np.ndarray):
+                np.testing.assert_array_equal(x, y, err_msg=f"{index} {key}")
+            else:
+                assert x == y, (index, key)
+
+
+def test_rows_are_the_ones_ase_writes_from_the_atoms(tmp_path):
+    """Independent: the same points written by ase.db from Atoms + SinglePointCalculator."""
+    ref = toy_interface(layers=3)
+    with PointStore(tmp_path / "points.db", {"test": "rows"}, ref) as store:
+        for k in range(30):
+            store.write(_result(ref, k))
+    plain = ase.db.connect(str(tmp_path / "plain.db"))
+    for k in range(30):
+        r = _result(ref, k)
+        atoms = Atoms(numbers=ref.numbers, positions=r.positions, cell=ref.cell, pbc=ref.pbc)
+        atoms.calc = SinglePointCalculator(atoms, energy=r.energy_ev)
+        kvp = {
+            "i_a": r.index[0], "i_b": r.index[1], "i_z": r.index[2],
+            "shift_a": r.shift_a, "shift_b": r.shift_b, "thickness": r.thickness,
+            "normal_stress_gpa": r.normal_stress_gpa,
+            "reaction_stress_gpa": r.reaction_stress_gpa, "force_calls": r.force_calls,
+            "steps": r.steps, "converged": bool(r.converged),
+            "max_force_ev_per_a": r.max_force_ev_per_a, "seconds": r.seconds,
+            "start": ",".join(map(str, r.start_index)) if r.start_index else "",
+        }  # fmt: skip
+        plain.write(atoms, key_value_pairs=kvp)
+    ours, theirs = _ase_rows(tmp_path / "points.db"), _ase_rows(tmp_path / "plain.db")
+    _assert_same_rows(ours, theirs)
+    # the key tables too: ase.db's queries by key find the same rows
+    db = ase.db.connect(str(tmp_path / "points.db"))
+    assert db.count("i_a=3,converged=True") == plain.count("i_a=3,converged=True") > 0
+    assert db.count("thickness>11.5") == plain.count("thickness>11.5") > 0
+    assert db.get(i_a=4, i_b=1).toatoms() == plain.get(i_a=4, i_b=1).toatoms()
+
+
+def _commits(store):
+    statements = []
+    store._db.connection.set_trace_callback(statements.append)
+    return statements
+
+
+def test_batched_store_holds_the_rows_of_the_unbatched_one(tmp_path):
+    ref = toy_interface(layers=3)
+    counts = {}
+    for name, interval in (("each", 0.0), ("batched", 3600.0)):
+        with PointStore(tmp_path / f"{name}.db", {"t": 1}, ref, commit_interval_s=interval) as s:
+            statements = _commits(s)
+            for k in range(40):
+                s.write(_result(ref, k))
+                if k % 10 == 9:
+                    s.flush()  # results that arrived together: one transaction
+            counts[name] = sum(1 for x in statements if x.strip().upper() == "COMMIT")
+            s.flush()
+            assert s.uncommitted == 0
+        with PointStore(tmp_path / f"{name}.db", {"t": 1}, ref) as s:
+            assert len(s) == 40
+    assert counts == {"each": 40, "batched": 4}
+    _assert_same_rows(_ase_rows(tmp_path / "each.db"), _ase_rows(tmp_path / "batched.db"))
+
+
+WRITER = textwrap.dedent(
+    """
+    import sys, time
+    from flatcontact.ispes.store import PointStore
+    from flatcontact.structures.toy import toy_interface
+    sys.path.insert(0, sys.argv[2])
+    from test_store_rows import _result
+
+    ref = toy_interface(layers=3)
+    with PointStore(sys.argv[1], {"test": "kill"}, ref, commit_interval_s=3600) as store:
+        for k in range(25):
+            store.write(_result(ref, k))
+        store.flush()
+        for k in range(25, 30):
+            store.write(_result(ref, k))
+        print("written", store.uncommitted, flush=True)
+        time.sleep(600)
+    """
+)
+
+
+@pytest.mark.parametrize(
+    "signum, kept", [(signal.SIGKILL, 25), (signal.SIGTERM, 30), (signal.SIGINT, 30)]
+)
+def test_a_kill_loses_only_the_uncommitted_points(tmp_path, signum, kept):
+    """SIGKILL loses the points written since the last commit (here 5, deliberately never
+    committed); SIGTERM and SIGINT unwind, and the store commits them as it closes."""
+    db = tmp_path / "points.db"
+    here = str(__import__("pathlib").Path(__file__).parent)
+    proc = subprocess.Popen(
+        [sys.executable, "-c", WRITER, str(db), here],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    )
+    try:
+        assert proc.stdout.readline().split() == ["written", "5"]
+    finally:
+        proc.send_signal(signum)
+        proc.wait(timeout=60)
+    with sqlite3.connect(db) as con:
+        assert con.execute("select count(*) from systems").fetchone()[0] == kept
+    ref = toy_interface(layers=3)
+    with PointStore(db, {"test": "kill"}, ref) as store:
+        assert sorted(store.done()) == sorted(_result(ref, k).index for k in range(kept))
+        np.testing.assert_array_equal(store.positions((0, 2, 0)), ref.positions + 0.024)
+
+
+KILLED_SCAN = textwrap.dedent(
+    """
+    import sys
+    from flatcontact.potentials.engines import calculator_factory
+    from flatcontact.potentials.model import InteractionModel
+    from flatcontact.ispes.executors import ProcessExecutor
+    from flatcontact.ispes.geometry import thickness
+    from flatcontact.ispes.grid import GridSpec
+    from flatcontact.ispes.relax import RelaxSettings
+    from flatcontact.ispes.scan import run_scan
+    from flatcontact.structures.toy import toy_interface
+
+    ref = toy_interface(layers=3)
+    z0 = thickness(ref)
+    toy = InteractionModel(calculator={"target": "flatcontact.ispes.toy:toy_calculator"})
+    pool = ProcessExecutor(2)
+    try:
+        run_scan(ref, calculator_factory(toy),
+                 GridSpec(6, 6, thickness_angstrom=(z0 - 0.25, z0 + 0.3)), sys.argv[1],
+                 RelaxSettings(fmax_ev_per_a=1e-4, optimizer="FIRE"), executor=pool,
+                 progress=lambda done, total: print(done, flush=True))
+    finally:
+        pool.close(cancel=True)
+    """
+)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("signum", [signal.SIGKILL, signal.SIGTERM])
+def test_scan_killed_mid_grid_on_workers_resumes_to_the_uninterrupted_grid(
+    tmp_path, toy_reference, toy_factory, signum
+):
+    """Batched commits on two worker processes: a scan killed mid-grid (SIGKILL: the
+    uncommitted points are lost and recomputed; SIGTERM: none is lost) resumes to the grid
+    of an uninterrupted serial scan, value for value."""
+    import os
+
+    from flatcontact.ispes.contract import open_ispes
+    from flatcontact.ispes.executors import SerialExecutor
+    from flatcontact.ispes.geometry import thickness
+    from flatcontact.ispes.grid import GridSpec
+    from flatcontact.ispes.relax import RelaxSettings
+    from flatcontact.ispes.scan import run_scan
+
+    out = tmp_path / "killed"
+    proc = subprocess.Popen(
+        [sys.executable, "-c", KILLED_SCAN, str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+        env={**os.environ, "OMP_NUM_THREADS": "1"},
+    )
+    try:
+        stored = 0
+        for line in proc.stdout:
+            stored = int(line)
+            if stored >= 20:
+                break
+    finally:
+        proc.send_signal(signum)
+        proc.wait(timeout=120)
+    with sqlite3.connect(out / "points.db") as con:
+        kept = con.execute("select count(*) from systems").fetchone()[0]
+    assert 0 < kept < 72, "the scan was not killed mid-grid"
+    if signum == signal.SIGTERM:
+        assert kept >= stored, "SIGTERM lost stored points"
+    settings = RelaxSettings(fmax_ev_per_a=1e-4, optimizer="FIRE")
+    z0 = thickness(toy_reference)
+    grid = GridSpec(6, 6, thickness_angstrom=(z0 - 0.25, z0 + 0.3))
+    resumed = run_scan(toy_reference, toy_factory, grid, out, settings, executor=SerialExecutor())
+    assert resumed.points_computed == 72 - kept
+    run_scan(
+        toy_reference, toy_factory, grid, tmp_path / "whole", settings, executor=SerialExecutor()
+    )
+    a, b = open_ispes(out / "ispes.nc"), open_ispes(tmp_path / "whole" / "ispes.nc")
+    for name in ("energy", "normal_stress", "converged"):
+        np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
