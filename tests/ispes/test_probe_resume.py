@@ -14,10 +14,11 @@ from flatcontact.ispes import relax as relax_module
 from flatcontact.ispes.contract import open_ispes
 from flatcontact.ispes.executors import SerialExecutor
 from flatcontact.ispes.grid import GridSpec
-from flatcontact.ispes.probe_units import PROBE_JSON, ProbeUnitsReused
+from flatcontact.ispes.probe_units import ProbeUnitsRepaired, ProbeUnitsReused
 from flatcontact.ispes.relax import RelaxSettings
 from flatcontact.ispes.scan import MANY_WORKERS, run_scan
 from flatcontact.ispes.store import discard_store
+from flatcontact.layout import PROBE_JSON
 from flatcontact.structures.toy import ToyPairCalculator
 
 SETTINGS = RelaxSettings(fmax_ev_per_a=1e-4, optimizer="FIRE")
@@ -207,3 +208,33 @@ def test_a_probe_record_that_is_not_one_is_refused_in_one_line(
     (out / PROBE_JSON).write_text("{not json")
     with pytest.raises(InputError, match=r"probe\.json: not a readable probe record"):
         run_scan(toy_reference, toy_factory, GRID, out, SETTINGS, executor=SerialExecutor())
+
+
+def test_a_unit_that_fails_validation_is_recomputed_with_one_warning(
+    tmp_path, toy_reference, toy_factory
+):
+    """A chain whose energies were damaged (NaN) and a row cut short are dropped and
+    recomputed (one warning each); the scan equals the undamaged one."""
+    out = tmp_path / "scan"
+    run_scan(toy_reference, toy_factory, GRID, out, SETTINGS, executor=SerialExecutor())
+    record = json.loads((out / PROBE_JSON).read_text())
+    keys = list(record["units"])
+    chain = next(k for k in keys if k.startswith('["compress"'))
+    record["units"][chain]["energy_ev"][0] = None
+    record["units"][keys[0]]["normal_stress_gpa"] = record["units"][keys[0]]["normal_stress_gpa"][
+        :1
+    ]
+    (out / PROBE_JSON).write_text(json.dumps(record))
+    discard_store(out / "points.db")
+    with pytest.warns(ProbeUnitsRepaired) as record:
+        run_scan(toy_reference, toy_factory, GRID, out, SETTINGS, executor=SerialExecutor())
+    repaired = [str(w.message) for w in record if w.category is ProbeUnitsRepaired]
+    assert len(repaired) == 2
+    assert "unreadable" in repaired[0]  # a row of 1 value for 3 shifts
+    assert "a chain holds a value that is not finite" in repaired[1]
+    reused = [w for w in record if w.category is ProbeUnitsReused]
+    assert _reused(reused) == {"rigid": 2, "compress": 1, "stretch": 2, "work": 1}
+    run_scan(
+        toy_reference, toy_factory, GRID, tmp_path / "ref", SETTINGS, executor=SerialExecutor()
+    )
+    _same_ispes(tmp_path / "ref" / "ispes.nc", out / "ispes.nc")

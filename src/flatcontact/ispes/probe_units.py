@@ -44,7 +44,6 @@ from flatcontact.fileio import refuse_link, write_json_atomic
 from flatcontact.ispes.probe import ColumnChain
 from flatcontact.ispes.work_of_separation import WorkOfSeparation
 
-PROBE_JSON = "probe.json"
 FORMAT = "flatcontact.probe/1"
 #: the unit kinds, in the order the progress line names them
 KINDS = ("rigid", "compress", "segment", "stretch", "work")
@@ -52,6 +51,10 @@ KINDS = ("rigid", "compress", "segment", "stretch", "work")
 
 class ProbeUnitsReused(UserWarning):
     """A resumed scan reused finished probe units from ``probe.json`` (the count per kind)."""
+
+
+class ProbeUnitsRepaired(UserWarning):
+    """Units of a ``probe.json`` failed validation and are recomputed."""
 
 
 def probe_settings(scan_settings: dict) -> dict:
@@ -108,6 +111,31 @@ def _decode(kind: str, record: dict) -> Any:
     )
 
 
+def _defect(kind: str, value: Any) -> str | None:
+    """What is wrong with a decoded unit, or None: chains of equal lengths with finite
+    thicknesses, energies and loads and non-negative call counts; a row's energy and load
+    both finite or both NaN (overlap); a work of separation with finite numbers."""
+    if kind == "rigid":
+        e, p = value
+        if e.shape != p.shape or np.any(np.isfinite(e) != np.isfinite(p)):
+            return "energy and load of a row differ in length or overlap"
+        return None
+    if kind == "work":
+        numbers = [v for v in dataclasses.astuple(value) if not isinstance(v, bool)]
+        numbers = np.asarray([x for v in numbers for x in np.atleast_1d(v)], dtype=float)
+        return None if np.all(np.isfinite(numbers)) else "a number of W is not finite"
+    fields = (value.thickness_angstrom, value.energy_ev, value.normal_stress_gpa)
+    if len({len(f) for f in (*fields, value.force_calls)}) != 1:
+        return "a chain's fields differ in length"
+    if not np.all(np.isfinite(np.asarray(fields, dtype=float))):
+        return "a chain holds a value that is not finite"
+    if any(n < 0 for n in value.force_calls):
+        return "a chain holds a negative force-call count"
+    if value.overlap is not None and not isinstance(value.overlap, str):
+        return "a chain's overlap is not text"
+    return None
+
+
 def unit_key(kind: str, *inputs: Any) -> str:
     """The key of a unit: its kind and inputs as compact JSON (floats with ``repr`` digits)."""
     if kind not in KINDS:
@@ -145,6 +173,8 @@ class ProbeUnits:
         self.units: dict[str, dict] = {}
         #: units reused by this run, per kind
         self.reused: Counter = Counter()
+        #: units of the file that failed validation (dropped, recomputed), the first defect
+        self.dropped: list[str] = []
         if self.path.exists() or self.path.is_symlink():
             refuse_link(self.path, "probe record")
             try:
@@ -164,11 +194,26 @@ class ProbeUnits:
 
     def get(self, kind: str, *inputs: Any) -> Any:
         """The finished unit ``kind`` with these inputs, or None (counted in :attr:`reused`)."""
-        record = self.units.get(unit_key(kind, *inputs))
+        key = unit_key(kind, *inputs)
+        record = self.units.get(key)
         if record is None:
             return None
+        try:
+            value = _decode(kind, record)
+            defect = _defect(kind, value)
+        except (KeyError, TypeError, ValueError, AttributeError) as exc:
+            defect = f"unreadable ({exc.__class__.__name__}: {exc})"
+        if defect is not None:
+            del self.units[key]
+            self.dropped.append(f"{key}: {defect}")
+            warnings.warn(
+                f"{self.path}: a probe unit failed validation and is recomputed ({key}: {defect})",
+                ProbeUnitsRepaired,
+                stacklevel=2,
+            )
+            return None
         self.reused[kind] += 1
-        return _decode(kind, record)
+        return value
 
     def put(self, kind: str, inputs: tuple, value: Any) -> Any:
         """Record a finished unit (the file rewritten atomically) and return ``value``."""

@@ -50,7 +50,7 @@ from flatcontact.ispes.probe import (
     rigid_rows,
     stretch_chain,
 )
-from flatcontact.ispes.probe_units import PROBE_JSON, ProbeUnits, probe_settings
+from flatcontact.ispes.probe_units import ProbeUnits, probe_settings
 from flatcontact.ispes.reduction import (
     SymmetrySettings,
     choose_verify,
@@ -71,7 +71,7 @@ from flatcontact.ispes.shift_symmetry import shift_space_group
 from flatcontact.ispes.store import PointStore, discard_store, interface_hash
 from flatcontact.ispes.thicknesses import probe_thicknesses
 from flatcontact.ispes.work_of_separation import ideal_work_of_separation
-from flatcontact.layout import ISPES_NC, POINTS_DB
+from flatcontact.layout import ISPES_NC, POINTS_DB, PROBE_JSON
 
 
 @dataclasses.dataclass
