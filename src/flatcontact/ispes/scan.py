@@ -741,7 +741,9 @@ def run_scan(
     grid
         The lateral grid and thicknesses or pressure range.
     out_dir
-        Receives ``points.db`` and ``ispes.nc``.
+        Receives ``points.db``, ``probe.json`` (the probe's finished units: a scan
+        interrupted in its probe resumes it, :mod:`flatcontact.ispes.probe_units`) and
+        ``ispes.nc``.
     relax
         Relaxation settings (tolerance, optimiser, step cap).
     order
