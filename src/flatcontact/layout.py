@@ -59,6 +59,8 @@ BUILD_FIGURE = "fig1_interface"
 # ---- scan
 #: The scan's resumable point store.
 POINTS_DB = "points.db"
+#: The probe's finished units (:mod:`flatcontact.ispes.probe_units`), beside the store.
+PROBE_JSON = "probe.json"
 #: The ISPES contract (:mod:`flatcontact.ispes.contract`).
 ISPES_NC = "ispes.nc"
 SCAN_JSON = "scan.json"

@@ -48,9 +48,9 @@ from flatcontact.ispes.probe import (
     join_column,
     next_segments,
     rigid_rows,
-    rigid_stackings,
     stretch_chain,
 )
+from flatcontact.ispes.probe_units import ProbeUnits, probe_settings
 from flatcontact.ispes.reduction import (
     SymmetrySettings,
     choose_verify,
@@ -71,7 +71,7 @@ from flatcontact.ispes.shift_symmetry import shift_space_group
 from flatcontact.ispes.store import PointStore, discard_store, interface_hash
 from flatcontact.ispes.thicknesses import probe_thicknesses
 from flatcontact.ispes.work_of_separation import ideal_work_of_separation
-from flatcontact.layout import ISPES_NC, POINTS_DB
+from flatcontact.layout import ISPES_NC, POINTS_DB, PROBE_JSON
 
 
 @dataclasses.dataclass
@@ -163,10 +163,67 @@ def _any_done(handles) -> bool:
 
 class PendingWork:
     """The ideal work of separation still running on a worker (:func:`_probe_many`): the
-    scan stores it once the grid is done (``handle``: the executor's)."""
+    scan stores it once the grid is done (``handle``: the executor's, or a :class:`Known`
+    unit of ``probe.json``)."""
 
-    def __init__(self, handle: Any):
+    def __init__(self, handle: Any, units: ProbeUnits | None = None, shift: Any = None):
         self.handle = handle
+        self.units = units
+        self.shift = shift
+
+    def result(self, executor: Any) -> Any:
+        """The work of separation, recorded in ``probe.json`` (:func:`unit_result`)."""
+        return unit_result(executor, self.units, "work", (*self.shift,), self.handle)
+
+
+class Known:
+    """A probe unit read back from ``probe.json``, in place of an executor's handle."""
+
+    def __init__(self, value: Any):
+        self.value = value
+
+
+def unit_submit(executor: Any, units: ProbeUnits | None, kind: str, inputs: tuple, fn, *args):
+    """The finished unit ``kind`` with ``inputs`` from ``probe.json`` (a :class:`Known`) or
+    ``fn(*args)`` submitted to the executor (its handle)."""
+    value = None if units is None else units.get(kind, *inputs)
+    return Known(value) if value is not None else executor.submit(fn, *args)
+
+
+def unit_result(executor: Any, units: ProbeUnits | None, kind: str, inputs: tuple, handle):
+    """The value of a :func:`unit_submit` handle; a computed unit is recorded at once."""
+    if isinstance(handle, Known):
+        return handle.value
+    value = executor.result(handle)
+    return value if units is None else units.put(kind, inputs, value)
+
+
+def _cached(units: ProbeUnits | None, kind: str, inputs: tuple, compute) -> Any:
+    return compute() if units is None else units.cached(kind, inputs, compute)
+
+
+def _rigid_serial(
+    reference: Atoms, calc, grid: GridSpec, units: ProbeUnits | None
+) -> RigidStackings:
+    """:func:`flatcontact.ispes.probe.rigid_stackings`, one ``probe.json`` unit per row."""
+    sa, sb = grid.shifts()
+    parts = [
+        _cached(
+            units,
+            "rigid",
+            _rigid_inputs(sa, sb, row),
+            lambda row=row: rigid_rows(reference, calc, grid, [row]),
+        )
+        for row in range(grid.n_a)
+    ]
+    return RigidStackings(
+        np.concatenate([e for e, _ in parts]), np.concatenate([p for _, p in parts])
+    )
+
+
+def _rigid_inputs(sa, sb, row: int) -> tuple:
+    """The key inputs of the rigid unit of lateral row ``row``: its shift_a, every shift_b."""
+    return (float(sa[row]), [float(b) for b in sb])
 
 
 def _probe(
@@ -175,6 +232,7 @@ def _probe(
     grid: GridSpec,
     relax: RelaxSettings,
     executor: Any = None,
+    units: ProbeUnits | None = None,
 ) -> tuple[dict, list[str], Any]:
     """Resolve the thicknesses of a pressure-range grid
     (:func:`flatcontact.ispes.thicknesses.probe_thicknesses`) and, with more than one
@@ -189,17 +247,53 @@ def _probe(
     ``(resolved, notes, work)``: ``work`` the
     :class:`~flatcontact.ispes.work_of_separation.WorkOfSeparation` (serial: computed here
     after the probe, from the same single points of every stacking).
+
+    ``units`` (``probe.json``, :mod:`flatcontact.ispes.probe_units`) records every finished
+    unit (a row of single points, a chain, a segment, the work of separation) as the driver
+    gets it, and gives back those a resumed probe finished before: the same values, so the
+    same thicknesses.
     """
     workers = 1 if executor is None else getattr(executor, "workers", 1)
     if workers >= MANY_WORKERS:
-        return _probe_many(reference, factory, grid, relax, executor)
+        return _probe_many(reference, factory, grid, relax, executor, units)
     calc = worker_calculator(factory, reference)
     relax_one = functools.partial(relax_column_point, reference, calc, relax)
-    rigid = rigid_stackings(reference, calc, grid)
+    rigid = _rigid_serial(reference, calc, grid, units)
+    lowest = extreme_stackings(rigid.energy_ev, grid)[0]
     if workers <= 1:
-        lowest = extreme_stackings(rigid.energy_ev, grid)[0]
-        extra, notes = probe_thicknesses(relax_one, reference, rigid, grid)
-        return extra, notes, ideal_work_of_separation(reference, factory, relax, lowest, calc=calc)
+
+        def probe_columns_here(specs):
+            # probe_column's two chains, one after the other, each a unit of probe.json
+            out = []
+            for shift, p_hi, stop in specs:
+                down = _cached(
+                    units,
+                    "compress",
+                    (*shift, p_hi),
+                    lambda shift=shift, p_hi=p_hi: compress_chain(
+                        relax_one, reference, shift, p_hi
+                    ),
+                )
+                p_ref = down.normal_stress_gpa[0]
+                up = _cached(
+                    units,
+                    "stretch",
+                    (*shift, p_ref, stop),
+                    lambda shift=shift, p_ref=p_ref, stop=stop: stretch_chain(
+                        relax_one, reference, shift, p_ref, stop_at_gpa=stop
+                    ),
+                )
+                out.append(join_column(reference, shift, down, up, stop_at_gpa=stop))
+            return out
+
+        extra, notes = probe_thicknesses(relax_one, reference, rigid, grid, probe_columns_here)
+        work = _cached(
+            units,
+            "work",
+            (*lowest,),
+            lambda: ideal_work_of_separation(reference, factory, relax, lowest, calc=calc),
+        )
+        return extra, notes, work
     context = ScanContext(reference, factory, relax)
     work = []
 
@@ -207,27 +301,64 @@ def _probe(
         # the stretchings, the work of separation, then the compressions (on quartz the
         # compressions are the long chains, 19-21 points of ~30 force calls; past its first
         # point a stretching costs ~1 call per point: benchmarks/schedule_model.py)
-        up = [executor.submit(probe_chain_task, context, "stretch", *spec) for spec in specs]
-        lowest = extreme_stackings(rigid.energy_ev, grid)[0]
-        work.append(executor.submit(work_of_separation_task, context, lowest))
-        down = [executor.submit(probe_chain_task, context, "compress", *spec) for spec in specs]
+        up = [
+            unit_submit(
+                executor,
+                units,
+                "stretch",
+                (*shift, None, stop),
+                probe_chain_task,
+                context,
+                "stretch",
+                shift,
+                p_hi,
+                stop,
+            )
+            for shift, p_hi, stop in specs
+        ]
+        work.append(
+            unit_submit(
+                executor, units, "work", (*lowest,), work_of_separation_task, context, lowest
+            )
+        )
+        down = [
+            unit_submit(
+                executor,
+                units,
+                "compress",
+                (*shift, p_hi),
+                probe_chain_task,
+                context,
+                "compress",
+                shift,
+                p_hi,
+                stop,
+            )
+            for shift, p_hi, stop in specs
+        ]
         return [
             join_column(
                 reference,
                 shift,
-                executor.result(d),
-                executor.result(u),
+                unit_result(executor, units, "compress", (*shift, p_hi), d),
+                unit_result(executor, units, "stretch", (*shift, None, stop), u),
                 stop_at_gpa=stop,
             )
-            for (shift, _, stop), d, u in zip(specs, down, up, strict=True)
+            for (shift, p_hi, stop), d, u in zip(specs, down, up, strict=True)
         ]
 
     extra, notes = probe_thicknesses(relax_one, reference, rigid, grid, probe_columns)
-    return extra, notes, executor.result(work[0]) if work else None
+    w = unit_result(executor, units, "work", (*lowest,), work[0]) if work else None
+    return extra, notes, w
 
 
 def _probe_many(
-    reference: Atoms, factory: Any, grid: GridSpec, relax: RelaxSettings, executor: Any
+    reference: Atoms,
+    factory: Any,
+    grid: GridSpec,
+    relax: RelaxSettings,
+    executor: Any,
+    units: ProbeUnits | None = None,
 ) -> tuple[dict, list[str], PendingWork]:
     """:func:`_probe` with many workers: nothing relaxes in the driver.
 
@@ -244,45 +375,122 @@ def _probe_many(
        :func:`~flatcontact.ispes.probe.join_column`) and the thicknesses chosen as in
        sequence. Segments started beyond a column's end are left to finish unused.
 
-    ``benchmarks/schedule_model.py`` replays this order.
+    ``benchmarks/schedule_model.py`` replays this order. Units finished before (``units``,
+    ``probe.json``) are not submitted: a row block holds only the rows still missing, a
+    finished segment is added to its column at once without taking a worker.
     """
     context = ScanContext(reference, factory, relax)
     workers = executor.workers
-    blocks = [b for b in np.array_split(np.arange(grid.n_a), min(workers, grid.n_a)) if b.size]
+    sa, sb = grid.shifts()
+    rows: dict[int, tuple] = {}
+    if units is not None:
+        for row in range(grid.n_a):
+            known = units.get("rigid", *_rigid_inputs(sa, sb, row))
+            if known is not None:
+                rows[row] = known
+    missing = np.array([row for row in range(grid.n_a) if row not in rows], dtype=int)
+    blocks = [b for b in np.array_split(missing, min(workers, max(missing.size, 1))) if b.size]
     handles = [executor.submit(rigid_rows_task, context, grid, b.tolist()) for b in blocks]
-    parts = [executor.result(h) for h in handles]
+    for block, handle in zip(blocks, handles, strict=True):
+        energy, load = executor.result(handle)
+        for k, row in enumerate(block.tolist()):
+            part = (energy[k : k + 1], load[k : k + 1])
+            rows[row] = (
+                part if units is None else units.put("rigid", _rigid_inputs(sa, sb, row), part)
+            )
+    parts = [rows[row] for row in range(grid.n_a)]
     rigid = RigidStackings(
         np.concatenate([e for e, _ in parts]), np.concatenate([p for _, p in parts])
     )
     work = []
 
     def probe_columns(specs):
-        up = [executor.submit(probe_chain_task, context, "stretch", *spec) for spec in specs]
+        up = [
+            unit_submit(
+                executor,
+                units,
+                "stretch",
+                (*shift, None, stop),
+                probe_chain_task,
+                context,
+                "stretch",
+                shift,
+                p_hi,
+                stop,
+            )
+            for shift, p_hi, stop in specs
+        ]
         plans = [CompressionSegments(p_hi) for _, p_hi, _ in specs]
         in_flight: dict[Any, tuple[int, int]] = {}
 
+        def segment_inputs(c, j):
+            shift, p_hi, _ = specs[c]
+            return (*shift, p_hi, j, plans[c].n_steps)
+
         def start(slots):
-            for c, j in next_segments(plans, slots):
+            while slots > 0:
+                picked = next_segments(plans, 1)
+                if not picked:
+                    break
+                c, j = picked[0]
                 shift, p_hi, _ = specs[c]
-                in_flight[executor.submit(probe_segment_task, context, shift, p_hi, j)] = (c, j)
+                handle = unit_submit(
+                    executor,
+                    units,
+                    "segment",
+                    segment_inputs(c, j),
+                    probe_segment_task,
+                    context,
+                    shift,
+                    p_hi,
+                    j,
+                )
+                if isinstance(handle, Known):  # finished before: no worker taken
+                    plans[c].add(j, handle.value)
+                    continue
+                in_flight[handle] = (c, j)
+                slots -= 1
 
         start(max(len(specs), workers - len(specs)))
         # the work of separation after the first segments (FIFO): it gates nothing
         lowest = extreme_stackings(rigid.energy_ev, grid)[0]
-        work.append(PendingWork(executor.submit(work_of_separation_task, context, lowest)))
-        waiting = set(up)
+        work.append(
+            PendingWork(
+                unit_submit(
+                    executor, units, "work", (*lowest,), work_of_separation_task, context, lowest
+                ),
+                units,
+                lowest,
+            )
+        )
+        waiting = {u: c for c, u in enumerate(up) if not isinstance(u, Known)}
+        stretched: dict[int, Any] = {}
         while any(plan.join() is None for plan in plans):
-            done, _ = executor.wait_first(set(in_flight) | waiting)
+            done, _ = executor.wait_first(set(in_flight) | set(waiting))
             for handle in done:
                 if handle in waiting:
-                    waiting.discard(handle)
+                    c = waiting.pop(handle)
+                    shift, _, stop = specs[c]
+                    stretched[c] = unit_result(
+                        executor, units, "stretch", (*shift, None, stop), handle
+                    )
                 else:
                     c, j = in_flight.pop(handle)
-                    plans[c].add(j, executor.result(handle))
+                    plans[c].add(
+                        j, unit_result(executor, units, "segment", segment_inputs(c, j), handle)
+                    )
                 start(1)
         return [
-            join_column(reference, shift, plan.join(), executor.result(u), stop_at_gpa=stop)
-            for (shift, _, stop), plan, u in zip(specs, plans, up, strict=True)
+            join_column(
+                reference,
+                shift,
+                plan.join(),
+                stretched[c]
+                if c in stretched
+                else unit_result(executor, units, "stretch", (*shift, None, stop), u),
+                stop_at_gpa=stop,
+            )
+            for c, ((shift, _, stop), plan, u) in enumerate(zip(specs, plans, up, strict=True))
         ]
 
     extra, notes = probe_thicknesses(None, reference, rigid, grid, probe_columns)
@@ -307,6 +515,7 @@ def adhesion_record(
     relax: RelaxSettings,
     pull_off: dict | None = None,
     work: Any = None,
+    units: ProbeUnits | None = None,
 ) -> dict:
     """The ``adhesion`` entry of a scan: the ideal work of separation and the probe's pull-off.
 
@@ -316,13 +525,19 @@ def adhesion_record(
     :func:`_probe`). ``pull_off`` is the probe's record
     (:class:`flatcontact.ispes.separation.Adhesion`, absent for given thicknesses). A
     record of an older scan whose ``work_of_separation_*`` keys were the pull-off's is
-    renamed to ``pull_off_*``.
+    renamed to ``pull_off_*``. ``units`` (``probe.json``) gives back the single points and
+    the W a resumed scan finished before and records those it computes.
     """
     pulled = pull_off_record(pull_off)
     if work is None:
         calc = worker_calculator(factory, reference)
-        shift = extreme_stackings(rigid_stackings(reference, calc, grid).energy_ev, grid)[0]
-        work = ideal_work_of_separation(reference, factory, relax, shift, calc=calc)
+        shift = extreme_stackings(_rigid_serial(reference, calc, grid, units).energy_ev, grid)[0]
+        work = _cached(
+            units,
+            "work",
+            (*shift,),
+            lambda: ideal_work_of_separation(reference, factory, relax, shift, calc=calc),
+        )
     return {**pulled, **work.record()}
 
 
@@ -547,7 +762,9 @@ def run_scan(
     grid
         The lateral grid and thicknesses or pressure range.
     out_dir
-        Receives ``points.db`` and ``ispes.nc``.
+        Receives ``points.db``, ``probe.json`` (the probe's finished units: a scan
+        interrupted in its probe resumes it, :mod:`flatcontact.ispes.probe_units`) and
+        ``ispes.nc``.
     relax
         Relaxation settings (tolerance, optimiser, step cap).
     order
@@ -612,6 +829,8 @@ def run_scan(
             interrupted = False
             computed_calls: list[int] = []
             pending_work = None
+            # the probe's finished units, beside the store (a resumed probe reuses them)
+            units = ProbeUnits(out_dir / PROBE_JSON, probe_settings(store.settings))
             try:
                 if store.resolved is None:
                     a1, a2 = in_plane_vectors(reference)
@@ -624,15 +843,18 @@ def run_scan(
                     if grid.thickness_angstrom is not None:
                         resolved["thickness_angstrom"] = list(grid.thickness_angstrom)
                     else:
-                        extra, notes, work = _probe(reference, factory, grid, relax, executor)
+                        extra, notes, work = _probe(
+                            reference, factory, grid, relax, executor, units
+                        )
                         resolved.update(extra)
                     if isinstance(work, PendingWork):  # stored once the grid is done
                         pending_work = work
                         resolved["adhesion"] = pull_off_record(resolved.get("adhesion"))
                     else:
                         resolved["adhesion"] = adhesion_record(
-                            reference, factory, grid, relax, resolved.get("adhesion"), work
+                            reference, factory, grid, relax, resolved.get("adhesion"), work, units
                         )
+                    units.announce()
                     store.set_resolved(resolved)
                 resolved = store.resolved
                 if pending_work is None and "work_of_separation_shift_a" not in (
@@ -642,7 +864,7 @@ def run_scan(
                     resolved = {
                         **resolved,
                         "adhesion": adhesion_record(
-                            reference, factory, grid, relax, resolved.get("adhesion")
+                            reference, factory, grid, relax, resolved.get("adhesion"), units=units
                         ),
                     }
                 sa, sb = grid.shifts()
@@ -827,7 +1049,7 @@ def run_scan(
                 if pending_work is not None and not interrupted:
                     # the ideal work of separation ran beside the grid (a resumed scan
                     # whose store lacks it computes it in the driver, above)
-                    w = executor.result(pending_work.handle)
+                    w = pending_work.result(executor)
                     adhesion = {**(store.resolved.get("adhesion") or {}), **w.record()}
                     store.set_resolved({**store.resolved, "adhesion": adhesion})
                     resolved = store.resolved

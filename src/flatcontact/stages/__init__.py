@@ -17,7 +17,7 @@ once. ``flatcontact <stage>`` (:mod:`flatcontact.cli`) and ``flatcontact run``
 stage      function                               files
 =========  =====================================  ==========================================
 build      :func:`.build.run_build`               interface.extxyz, build.json, fig1_interface
-scan       :func:`.scan.run_scan`                 points.db, ispes.nc, scan.json, fig_scan_columns
+scan       :func:`.scan.run_scan`                 points.db, probe.json, ispes.nc, scan.json, fig_scan_columns
 analyze    :func:`.analyze.run_analyze`           friction.csv, friction.nc, analyze.json, fig2_p*
 laws       :func:`.laws.run_laws`                 laws.json, fig3_laws
 elastic    :func:`.elastic.run_elastic`           elastic.json

@@ -1,6 +1,7 @@
 """Stage 2, scan: the ISPES grid of the interface (resumable, parallel).
 
-Files: ``points.db`` (the resumable point store), ``ispes.nc`` (the ISPES contract),
+Files: ``points.db`` (the resumable point store), ``probe.json`` (the probe's finished
+units, :mod:`flatcontact.ispes.probe_units`), ``ispes.nc`` (the ISPES contract),
 ``scan.json`` (:meth:`ScanStageResult.to_json`) and ``fig_scan_columns.png`` (+ ``.svg``).
 
 Coincidence and twist cells (issue 23): the energy repeats on the shift lattice Λ_1 + Λ_2,
