@@ -273,6 +273,7 @@ def test_out_of_disk_in_the_scan_store_is_one_line_and_the_rerun_resumes(
     config, run = copy
     (run / "02-scan" / "ispes.nc").unlink()
     (run / "02-scan" / "points.db").unlink()  # the scan recomputes its points
+    (run / "02-scan" / "probe.json").unlink()  # and its probe (a reused probe says so in a line)
     calls = {"n": 0}
     real_write = PointStore.write
 
