@@ -226,6 +226,26 @@ def _rigid_inputs(sa, sb, row: int) -> tuple:
     return (float(sa[row]), [float(b) for b in sb])
 
 
+def _submit_stretchings(executor, units, context, specs) -> list:
+    """One stretching chain per probed column ``(shift, p_hi, stop)``, each a probe unit
+    (reused from ``probe.json`` when it finished before)."""
+    return [
+        unit_submit(
+            executor,
+            units,
+            "stretch",
+            (*shift, None, stop),
+            probe_chain_task,
+            context,
+            "stretch",
+            shift,
+            p_hi,
+            stop,
+        )
+        for shift, p_hi, stop in specs
+    ]
+
+
 def _probe(
     reference: Atoms,
     factory: Any,
@@ -301,21 +321,7 @@ def _probe(
         # the stretchings, the work of separation, then the compressions (on quartz the
         # compressions are the long chains, 19-21 points of ~30 force calls; past its first
         # point a stretching costs ~1 call per point: benchmarks/schedule_model.py)
-        up = [
-            unit_submit(
-                executor,
-                units,
-                "stretch",
-                (*shift, None, stop),
-                probe_chain_task,
-                context,
-                "stretch",
-                shift,
-                p_hi,
-                stop,
-            )
-            for shift, p_hi, stop in specs
-        ]
+        up = _submit_stretchings(executor, units, context, specs)
         work.append(
             unit_submit(
                 executor, units, "work", (*lowest,), work_of_separation_task, context, lowest
@@ -405,21 +411,7 @@ def _probe_many(
     work = []
 
     def probe_columns(specs):
-        up = [
-            unit_submit(
-                executor,
-                units,
-                "stretch",
-                (*shift, None, stop),
-                probe_chain_task,
-                context,
-                "stretch",
-                shift,
-                p_hi,
-                stop,
-            )
-            for shift, p_hi, stop in specs
-        ]
+        up = _submit_stretchings(executor, units, context, specs)
         plans = [CompressionSegments(p_hi) for _, p_hi, _ in specs]
         in_flight: dict[Any, tuple[int, int]] = {}
 
