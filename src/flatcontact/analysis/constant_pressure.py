@@ -13,7 +13,7 @@ Eq. for ``Ũ(p)|_{X,Y}``). Here:
   stable branch under a fixed load, since ``d²(U + P A z)/dz² = -A dp/dz > 0``.
   Where ``p`` rises with ``z`` on the compressed side (a *fold*: a plane slips or
   opens under load), the branch is the falling run that carries ``P = 0`` (the
-  scan's rule, :func:`branch_run`), splined on its own nodes; loads that the
+  scan's rule, :func:`~flatcontact.ispes.contract.branch_run`), splined on its own nodes; loads that the
   compressed side also reaches, or that fall in the segment next to the fold, are
   refused in one line; lower loads are read with a :class:`LoadFoldWarning`.
   Beyond the maximum tension lies the *adhesive tail* (``p`` rises back towards
@@ -105,7 +105,7 @@ def invert_columns(
         ``U(z)``, clamped at the first and last thickness by the stored stress;
         ``"stress"``: the stored ``normal_stress``, splined. Either way the repulsive branch
         runs up to the node of lowest ``p``; where that load folds on the compressed side,
-        the column is splined past the fold only (:func:`branch_run`).
+        the column is splined past the fold only (:func:`~flatcontact.ispes.contract.branch_run`).
 
     Raises
     ------
@@ -133,7 +133,7 @@ def invert_columns(
     # 12x12 quartz grid's stress rose between neighbours in 72 columns, its energy load in 1)
     stored_start = np.zeros(n_col, int)
     if load_source == "stress":
-        stored_start = np.array([branch_run(p[j])[0] for j in range(n_col)])
+        stored_start, _ = _branch(z, p, labels, "normal_stress")
     if np.any(stored_start > 0):
         _above_a_fold(targets, p, stored_start, z, labels, "normal_stress", "")
         _warn_fold(labels, p, stored_start, z, "normal_stress")
@@ -298,32 +298,16 @@ _ENERGY_LOAD_HINT = (
 )
 
 
-def branch_run(p: np.ndarray) -> tuple[int, int]:
-    """``(s, e)``: the nodes ``s .. e`` of one column's load ``p`` (falling with ``z``) that carry P = 0.
-
-    The scan's rule (:func:`flatcontact.ispes.thicknesses.repulsive_branch`, the same split;
-    a test holds the two equal): the nodes up to the global tensile maximum ``m``
-    (``argmin p``) are split where ``p`` rises with ``z``; the branch is the first falling run
-    that reaches ``p <= 0`` (the last run if none does). ``s > 0`` is a fold on the compressed
-    side: loads above ``p[s]`` are on another branch. ``e - s < 1`` leaves no segment.
-    """
-    m = int(np.argmin(p))
-    rises = np.flatnonzero(np.diff(p[: m + 1]) >= 0)
-    starts = np.concatenate([[0], rises + 1])
-    ends = np.concatenate([rises, [m]])
-    k = next((i for i, e in enumerate(ends) if p[e] <= 0), len(ends) - 1)
-    return int(starts[k]), int(ends[k])
-
-
 def _branch(z, p, labels, what, remedy=""):
     """``(s, e)`` per column: the branch that carries P = 0 runs from node ``s`` to node ``e``
-    (:func:`branch_run`); InputError if the load rises from the first node, or if the branch
-    has no segment (``p`` rises where it crosses 0; ``remedy`` appended)."""
+    (:func:`~flatcontact.ispes.contract.branch_run`, the scan's rule); InputError if the load
+    rises from the first node, or if the branch has no segment (``p`` rises where it crosses
+    0; ``remedy`` appended)."""
     n_col = p.shape[0]
     start = np.zeros(n_col, int)
     end = np.zeros(n_col, int)
     for j in range(n_col):
-        start[j], end[j] = branch_run(p[j])
+        start[j], end[j] = contract.branch_run(p[j])
     m_all = np.argmin(p, axis=1)
     if np.any(m_all == 0):
         j = int(np.flatnonzero(m_all == 0)[0])
@@ -352,7 +336,8 @@ def _invert(z, p_nodes, coef_p, spline_e, targets, labels, what, remedy=""):
     maximum tension); on it the nodes must decrease strictly. ``z*`` lies in the
     segment whose end nodes bracket ``P`` and is found there by bisection of the
     piecewise polynomial ``coef_p`` (shape ``(4, n_z - 1, n_col)``, in ``z - z_k``).
-    Returns ``(z*, U(z*)/A, p_lo, p_hi, z_m, dp/dz at z*)``.
+    Returns ``(z*, U(z*)/A, p_lo, p_hi, z_m, dp/dz at z*, s)`` (``s``: each column's first
+    branch node, > 0 past a fold).
     """
     n_col, n_z = p_nodes.shape
     start, m = _branch(z, p_nodes, labels, what, remedy)

@@ -119,6 +119,25 @@ def symmetry_operations(ds: xr.Dataset) -> list[tuple[np.ndarray, np.ndarray]]:
     return [(ms[k], t[2 * k : 2 * k + 2]) for k in range(n)]
 
 
+def branch_run(p: np.ndarray) -> tuple[int, int]:
+    """``(s, e)``: the nodes ``s .. e`` of one column's load ``p`` (ascending ``z``) that carry P = 0.
+
+    The one rule by which the scan chooses thicknesses
+    (:func:`flatcontact.ispes.thicknesses.repulsive_branch`) and the analysis reads loads
+    (:func:`flatcontact.analysis.constant_pressure.invert_columns`): the nodes up to the
+    global tensile maximum ``m`` (``argmin p``) are split where ``p`` rises with ``z``; the
+    branch is the first falling run that reaches ``p <= 0`` (the last run if none does).
+    ``s > 0`` is a fold on the compressed side: loads above ``p[s]`` are on another branch.
+    ``e - s < 1`` leaves no segment to read.
+    """
+    m = int(np.argmin(p))
+    rises = np.flatnonzero(np.diff(p[: m + 1]) >= 0)
+    starts = np.concatenate([[0], rises + 1])
+    ends = np.concatenate([rises, [m]])
+    k = next((i for i, e in enumerate(ends) if p[e] <= 0), len(ends) - 1)
+    return int(starts[k]), int(ends[k])
+
+
 def cell_area(a1: np.ndarray, a2: np.ndarray) -> float:
     """Area |a1 × a2| (Å²) of the in-plane cell spanned by two 2-vectors."""
     a1 = np.asarray(a1, dtype=float)

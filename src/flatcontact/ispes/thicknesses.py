@@ -18,6 +18,7 @@ import numpy as np
 from ase import Atoms
 
 from flatcontact.errors import InputError
+from flatcontact.ispes.contract import branch_run
 from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.probe import ColumnProbe, RigidStackings, probe_column, probed_stackings
 from flatcontact.ispes.separation import adhesion
@@ -95,12 +96,7 @@ def repulsive_branch(
     sample leaves nothing to read: one-line InputError naming the column, z and p.
     """
     z, p = probe.thickness_angstrom, probe.normal_stress_gpa
-    m = int(np.argmin(p))
-    rises = np.flatnonzero(np.diff(p[: m + 1]) >= 0)
-    starts = np.concatenate([[0], rises + 1])
-    ends = np.concatenate([rises, [m]])
-    k = next((i for i, e in enumerate(ends) if p[e] <= 0), len(ends) - 1)
-    s, e = int(starts[k]), int(ends[k])
+    s, e = branch_run(p)
     fold = None
     if s > 0:
         fold = LoadFold(column_name(probe, role), z[s], p[s], z[s - 1], p[s - 1])
