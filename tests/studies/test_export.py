@@ -210,6 +210,59 @@ def test_a_variant_that_fails_is_reported_as_its_settings_failure(tmp_path, monk
         assert doc["delta"]["internal"][key] == pytest.approx(abs(b - a))
 
 
+@pytest.mark.slow
+def test_a_setting_whose_finer_step_fails_keeps_its_measured_step_in_delta(tmp_path, monkeypatch):
+    """The quartz thicknesses ladder: 19 → 29 thicknesses moved τ by more than the tolerance,
+    29 → 43 was refused by the analysis. The refused step must not erase the measured one:
+    δ_conv is the change of the last analysable step (it was dropped, understating the
+    interval), the setting stays ``failed`` with the refused step named."""
+    real = convergence_module.run_variant
+
+    def refusing(config, folder, share=None):
+        if folder.endswith("thicknesses2"):
+            raise InputError("the load folds (constructed)")
+        return real(config, folder, share)
+
+    monkeypatch.setattr(convergence_module, "run_variant", refusing)
+    conf = write_yaml(
+        tmp_path / "toy.yaml",
+        toy_data(refine={"settings": ["thicknesses"], "max_steps": 2, "tolerance_pct": 0.01}),
+    )
+    code, out, err = _cli(["study", "convergence", conf, "--out", tmp_path / "s"])
+    assert code == 0, err
+    doc = json.loads((tmp_path / "s" / "study.json").read_text())
+    st = doc["settings"]["thicknesses"]
+    assert st["state"] == "failed"
+    assert st["last_step"] == ["base", "thicknesses1"]
+    assert st["failed_step"] == ["thicknesses1", "thicknesses2"]
+    by = {v["name"]: v for v in doc["variants"]}
+    assert set(by) == {"base", "thicknesses1"}
+    moved = 0.0
+    for key in LAW_COEFFICIENTS:
+        a = by["base"]["laws"]["internal"][key]
+        b = by["thicknesses1"]["laws"]["internal"][key]
+        assert doc["delta"]["internal"][key] == pytest.approx(abs(b - a))
+        moved = max(moved, abs(b - a))
+    assert moved > 0.0  # the step moved the laws: the test would see it dropped
+    source = yaml.safe_load((tmp_path / "s" / "uncertainty.yaml").read_text())["uncertainty"][
+        "source"
+    ]
+    assert "thicknesses (step thicknesses1; the next failed)" in source
+    assert "NOT converged: thicknesses (failed)" in source
+    assert "thicknesses: failed at step 2" in " ".join(out.split())
+
+
+def test_counts_in_delta_states():
+    """Which settings' last step enters δ_conv, by state (studies.compare.counts_in_delta)."""
+    from flatcontact.studies.compare import counts_in_delta
+
+    assert counts_in_delta({"state": "converged", "last_change": {}})
+    assert counts_in_delta({"state": "not converged", "last_change": {}})
+    assert not counts_in_delta({"state": "not refined", "last_change": {}})
+    assert not counts_in_delta({"state": "failed"})  # failed at its first step
+    assert counts_in_delta({"state": "failed", "last_change": {}, "last_step": ["a", "b"]})
+
+
 def test_the_blocks_source_names_each_setting_that_did_not_converge():
     """The source line of a convergence study's block names every setting that is not
     converged with its state, and the refinement steps δ_conv was taken over are only those of

@@ -77,7 +77,14 @@ def convergence_command(
     write_study(doc, cfg, out, _command_line())
     for s, st in doc["settings"].items():
         if st["state"] == "failed":
-            console.print(f"{s}: failed at step {st['steps']}: {st['error']}", highlight=False)
+            kept = (
+                f" (step {' -> '.join(st['last_step'])} stays in the uncertainty)"
+                if "last_change" in st
+                else ""
+            )
+            console.print(
+                f"{s}: failed at step {st['steps']}: {st['error']}{kept}", highlight=False
+            )
             continue
         if st["state"] == "not refined":
             console.print(

@@ -90,3 +90,20 @@ def thickness_step_refines(
         "scan.p_range_gpa.n; a finer scan.thickness_angstrom list needs energies converged "
         "for their derivative at its spacing (a tighter scan.fmax_ev_per_angstrom)"
     )
+
+
+def counts_in_delta(state: dict) -> bool:
+    """Whether a setting's last step enters δ_conv.
+
+    Converged and not-converged settings count with their last step; a ``not refined``
+    thicknesses step never does (its change is no evidence). A ``failed`` setting counts with
+    its last *analysable* step when it had one (``last_step``, e.g. thicknesses 19 → 29 when
+    29 → 43 was refused): that step's change is a measured lower bound of what refinement
+    moves, and dropping it would understate the interval. A setting failed at its first step
+    has no measured change and does not count.
+    """
+    if state["state"] == "not refined":
+        return False
+    if state["state"] == "failed":
+        return "last_change" in state
+    return True

@@ -14,7 +14,8 @@ reason: its change says nothing about convergence and stays out of δ_conv.
 The uncertainty it measures, per energy form and law coefficient c, is
 ``δ_conv(c) = max over settings of |Δc|`` at each setting's last step (the change one more
 refinement makes), the rule of docs/convergence.md, over the settings neither failed nor
-not refined.
+not refined; a setting whose finer step failed counts with its last analysable step
+(:func:`counts_in_delta`).
 """
 
 from __future__ import annotations
@@ -27,7 +28,12 @@ from flatcontact.analysis.uncertainty import LAW_COEFFICIENTS
 from flatcontact.config.run import RunConfig
 from flatcontact.errors import InputError
 from flatcontact.ispes.executors import make_executor
-from flatcontact.studies.compare import largest_change, law_changes, thickness_step_refines
+from flatcontact.studies.compare import (
+    counts_in_delta,
+    largest_change,
+    law_changes,
+    thickness_step_refines,
+)
 from flatcontact.studies.estimate import base_measurements, estimate_convergence
 from flatcontact.studies.runner import run_jobs, run_variant
 from flatcontact.studies.variants import (
@@ -99,7 +105,11 @@ def run_convergence(
                 status[s]["steps"] = level
                 if "error" in results[v.name] or "error" in results[previous[s]]:
                     failed = results[v.name].get("error") or results[previous[s]].get("error")
-                    status[s].update(state="failed", error=failed, last_step=[previous[s], v.name])
+                    # an earlier analysable step (in last_step/last_change) stays this
+                    # setting's measured change: a refused finer step does not erase it
+                    status[s].update(
+                        state="failed", error=failed, failed_step=[previous[s], v.name]
+                    )
                     continue
                 change = largest_change(
                     results[previous[s]], results[v.name], r.tolerance_floor_mpa
@@ -160,7 +170,7 @@ def run_convergence(
                         results[status[s]["last_step"][0]], results[status[s]["last_step"][1]], form
                     )[key]
                     for s in settings
-                    if status[s]["state"] not in ("failed", "not refined")
+                    if counts_in_delta(status[s])
                 ),
                 default=0.0,
             )

@@ -28,6 +28,7 @@ from flatcontact.layout import STUDY_JSON
 from flatcontact.plots import save_figure
 from flatcontact.plots.study import QUANTITY_LABELS, figure_study
 from flatcontact.stages.measured_on import measured_on
+from flatcontact.studies.compare import counts_in_delta
 
 STUDY_CSV = "study.csv"
 UNCERTAINTY_YAML = "uncertainty.yaml"
@@ -83,7 +84,12 @@ def uncertainty_block(doc: dict, cfg: RunConfig, command: str) -> dict:
             f"convergence_{f}": {k: _sig3(v) for k, v in d.items()} for f, d in doc["delta"].items()
         }
         states = {s: st.get("state", "") for s, st in doc["settings"].items()}
-        used = [s for s, state in states.items() if state not in ("failed", "not refined")]
+        used = [
+            s
+            + (f" (step {st['last_step'][1]}; the next failed)" if st["state"] == "failed" else "")
+            for s, st in doc["settings"].items()
+            if counts_in_delta(st)
+        ]
         open_ = [f"{s} ({state})" for s, state in states.items() if state != "converged"]
         what = (
             f"largest change of each law coefficient over the last refinement step of "
