@@ -267,6 +267,19 @@ def _gates(cfg: RunConfig, root: Path) -> dict:
     }
 
 
+def write_energy_floor(path: Path, floor_mev_per_a2: float) -> None:
+    """Store a cell's measured noise floor (meV/Å²) in its shift-cell ``ispes.nc`` (the
+    contract's ``energy_floor_mev_per_a2``): the analysis takes it as the smallest degeneracy
+    tolerance of its minima (:func:`flatcontact.analysis.starts.degeneracy_tolerance_ev_per_a2`),
+    so minima closer than the floor count as indistinguishable and the ``degenerate_minima``
+    gate compares them as such."""
+    from flatcontact.ispes.contract import ENERGY_FLOOR_ATTR, open_ispes, write_ispes
+
+    ds = open_ispes(path)
+    ds.attrs[ENERGY_FLOOR_ATTR] = float(floor_mev_per_a2)
+    write_ispes(ds, path)
+
+
 def run_cell(config: dict, folder: str, planned: int) -> dict:
     """Run one approximant cell (``config``: a validated configuration's ``to_dict()``) in
     ``folder``: build and scan through the pipeline, then the ISPES on one shift-lattice
@@ -318,6 +331,7 @@ def run_cell(config: dict, folder: str, planned: int) -> dict:
         )
     relax_noise = math.nan if relaxed is None else 1e3 * relaxed.ev_per_a2
     floor = max(noise, 0.0 if relaxed is None else relax_noise)
+    write_energy_floor(cell / ISPES_NC, floor)
     lateral = lateral_range_mev_per_a2(shifted)
     nan = math.nan
     form, law, p_low, barrier, gates = cfg.analysis.energy_form, {}, nan, lateral, None
