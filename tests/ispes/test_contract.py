@@ -98,3 +98,16 @@ def test_a_file_without_mapped_points_or_group_reads_as_every_point_relaxed(tmp_
     with pytest.raises(InputError, match=r"new\.nc: symmetry attributes"):
         broken = new.assign_attrs(symmetry_translations=np.zeros(4))
         contract.open_ispes(contract.write_ispes(broken, tmp_path / "new.nc"))
+
+
+def test_the_measured_energy_floor_round_trips_and_a_bad_one_is_refused(tmp_path):
+    a1, a2 = _hex_vectors()
+    ds = contract.empty_grid(3, 3, [8.0, 9.0], a1, a2, potential="test")
+    assert np.isnan(contract.energy_floor_mev_per_a2(ds))  # not measured
+    ds.attrs[contract.ENERGY_FLOOR_ATTR] = 2.7e-4
+    back = contract.open_ispes(contract.write_ispes(ds, tmp_path / "ispes.nc"))
+    assert contract.energy_floor_mev_per_a2(back) == 2.7e-4
+    for bad in (-1e-4, "small", [1e-4, 2e-4]):
+        ds.attrs[contract.ENERGY_FLOOR_ATTR] = bad
+        with pytest.raises(InputError, match="energy_floor_mev_per_a2"):
+            contract.energy_floor_mev_per_a2(ds, "ispes.nc")

@@ -110,8 +110,10 @@ def test_the_study_rows_carry_the_quartz_laws_and_need_the_experiment():
 @pytest.mark.parametrize("path", STUDIES, ids=lambda p: p.stem)
 def test_the_study_examples_are_their_runs_with_an_approximant_ladder(path):
     """Each companion differs from its run example only by the approximants: section, the
-    rigid-layers mode, the executor, the title and the build relaxation (none: an ideal
-    reference keeps the shift lattice): same interface, model, loads, contact."""
+    rigid-layers mode, the scan's force tolerance (0.0005 eV/Å: the larger cells' corrugations
+    lie below the relaxation floor at the runs' 0.005), the executor, the title and the build
+    relaxation (none: an ideal reference keeps the shift lattice): same interface, model, loads,
+    contact."""
     run = load_config(path.with_name(path.name.replace("-approximants", ""))).to_dict()
     study = load_config(path).to_dict()
     assert study["approximants"]["max_atoms"] >= 559 and study["scan"]["relax_mode"] == (
@@ -123,6 +125,9 @@ def test_the_study_examples_are_their_runs_with_an_approximant_ladder(path):
         assert study[key] == run[key], key
     for key in ("grid", "p_range_gpa"):
         assert study["scan"][key] == run["scan"][key]
+    assert study["scan"]["fmax_ev_per_angstrom"] == pytest.approx(
+        0.1 * run["scan"]["fmax_ev_per_angstrom"]
+    )
 
 
 @pytest.mark.slow

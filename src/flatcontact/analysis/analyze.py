@@ -252,6 +252,8 @@ def analyze_ispes(
         ds, p, form=form, allow_missing=allow_missing, source=source, load_source=load_source
     )
     floor = cp.noise.barrier_threshold_ev_per_a2
+    # the grid's measured noise floor (approximant cells), NaN when the grid carries none
+    measured_floor = contract.energy_floor_mev_per_a2(ds, source) / units.EV_PER_A2_TO_MEV_PER_A2
     timings["constant_pressure"] = time.perf_counter() - clock
 
     a1, a2 = cp.a1, cp.a2
@@ -289,7 +291,7 @@ def analyze_ispes(
     previous_xy = None
     for i, pk in enumerate(p):
         surf = surfaces[i]
-        tol = degeneracy_tolerance_ev_per_a2(float(floor[i]))
+        tol = degeneracy_tolerance_ev_per_a2(float(floor[i]), measured_floor)
         starts, k = paths_from_near_degenerate_minima(
             surf,
             direction_deg,

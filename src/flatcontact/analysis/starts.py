@@ -17,10 +17,15 @@ Rule (deterministic, independent of round-off, the same at every load):
    interpolant (:meth:`.PeriodicSurface.local_minima`; robust to a constant
    added to the landscape, so the global minimum is always among them);
 2. minima within the **degeneracy tolerance** ``δ = max(2 ε(P),``
-   ``DEGENERACY_FLOOR_MEV_PER_A2)`` of the lowest are *near-degenerate*
+   ``DEGENERACY_FLOOR_MEV_PER_A2, F)`` of the lowest are *near-degenerate*
    (``ε(P)`` the energy noise of the load, :mod:`.noise`; the same ``2 ε``
-   below which a dip is not a minimum in σ_MSS). The data cannot tell which
-   of them is the ground state. With the landscape's symmetry classes
+   below which a dip is not a minimum in σ_MSS; ``F`` the grid's measured
+   energy noise floor where it carries one, the ISPES attribute
+   ``energy_floor_mev_per_a2``: the approximant study writes the larger of the
+   round-off and the relaxation floor of each cell, 2.7e-4 to 4.7e-4 meV/Å² on
+   the rigid-layers H-diamond(111)/graphene cells at fmax 0.005 eV/Å, above the
+   fixed window; a plain run measures no floor and uses ``max(2 ε, floor)``).
+   The data cannot tell which of them is the ground state. With the landscape's symmetry classes
    (:mod:`.stackings`), every minimum **symmetry-equivalent** to a
    near-degenerate one (mapped onto it by an operation the landscape keeps
    within 2 %, and within 2 % of the landscape's range in energy) is a start
@@ -79,7 +84,7 @@ TAU_SPREAD_RTOL = 1.0e-3
 #: The rule, as stored with the outputs.
 TAU_START_RULE = (
     "tau from the global minimum; if other inequivalent minima lie within the degeneracy "
-    "tolerance max(2 eps, floor) of it, or minima are symmetry-equivalent to it (landscape "
+    "tolerance max(2 eps, floor, the grid's measured noise floor) of it, or minima are symmetry-equivalent to it (landscape "
     "symmetry within 2%), the largest tau over those starts (equal tau: the start nearest the "
     "previous load's, then the lower minimum)"
 )
@@ -108,11 +113,20 @@ class StartOutcome:
         return self.above_lowest_ev_per_a2 * units.EV_PER_A2_TO_MEV_PER_A2
 
 
-def degeneracy_tolerance_ev_per_a2(barrier_threshold_ev_per_a2: float) -> float:
-    """δ = max(2 ε(P), floor) in eV/Å²; ``barrier_threshold_ev_per_a2`` is 2 ε (0 or NaN if unknown)."""
+def degeneracy_tolerance_ev_per_a2(
+    barrier_threshold_ev_per_a2: float, measured_floor_ev_per_a2: float = float("nan")
+) -> float:
+    """δ = max(2 ε(P), floor, F) in eV/Å² (module rule, step 2).
+
+    ``barrier_threshold_ev_per_a2`` is 2 ε (0 or NaN if unknown); ``measured_floor_ev_per_a2``
+    the grid's measured energy noise floor F (NaN if none was measured: then δ = max(2 ε,
+    floor)). Minima closer than F are not distinguishable, whatever the fixed window says.
+    """
     floor = DEGENERACY_FLOOR_MEV_PER_A2 / units.EV_PER_A2_TO_MEV_PER_A2
     thr = float(barrier_threshold_ev_per_a2)
-    return max(thr, floor) if np.isfinite(thr) else floor
+    measured = float(measured_floor_ev_per_a2)
+    values = [floor] + [v for v in (thr, measured) if np.isfinite(v)]
+    return max(values)
 
 
 def near_degenerate_minima(

@@ -91,7 +91,18 @@ class SymmetryConfig(Section):
         1e-2,
         description="largest accepted energy difference of a verified point (meV/Å²; two full "
         "scans of Cu(111) at fmax 0.005 eV/Å differ by up to 9e-4); above it "
-        "the relaxation breaks the symmetry and every point is computed",
+        "the relaxation breaks the symmetry and every point is computed. On a flat landscape "
+        "the smaller energy_tolerance_fraction of its range at the point's thickness applies "
+        "(never below the energy's round-off)",
+    )
+    energy_tolerance_fraction: physical(1e-6, 1.0, "") = Field(
+        0.05,
+        # left out of the dumped config while default, so existing run fingerprints are unchanged
+        exclude_if=lambda value: value == 0.05,
+        description="largest accepted energy difference of a verified point as a fraction of "
+        "the range (max - min) of the computed energies at its thickness, when smaller than "
+        "energy_tolerance_mev_per_a2 (half the broken_symmetry gate's 10 %: a twist cell's "
+        "whole corrugation can be below 0.01 meV/Å²)",
     )
     stress_tolerance_gpa: physical(1e-9, 10.0, "GPa") = Field(
         0.5,

@@ -23,6 +23,11 @@ attrs
     ``symmetry_order`` n, ``symmetry_matrices`` (4n integers: M row by row per operation) and
     ``symmetry_translations`` (2n fractions t), each operation mapping the fractional shift
     ``s`` to ``M s + t`` (mod 1) with E(M s + t) = E(s) (:func:`symmetry_operations`).
+    ``energy_floor_mev_per_a2`` (optional, one number): the energy noise floor of the grid
+    at fixed thickness, per area (meV/Å²), where it was measured (the approximant study's
+    cells: the larger of the round-off and the relaxation floor,
+    :mod:`flatcontact.ispes.relax_noise`); absent means not measured
+    (:func:`energy_floor_mev_per_a2`).
 
 Points not computed yet are NaN with ``converged = False``.
 
@@ -117,6 +122,23 @@ def symmetry_operations(ds: xr.Dataset) -> list[tuple[np.ndarray, np.ndarray]]:
     if not np.all(np.abs(np.abs(np.round(np.linalg.det(ms)))) == 1):
         raise InputError("symmetry attributes: every matrix must have determinant ±1")
     return [(ms[k], t[2 * k : 2 * k + 2]) for k in range(n)]
+
+
+#: Attribute of a grid's measured energy noise floor (meV/Å²; optional, module docstring).
+ENERGY_FLOOR_ATTR = "energy_floor_mev_per_a2"
+
+
+def energy_floor_mev_per_a2(ds: xr.Dataset, source: str = "ISPES grid") -> float:
+    """The grid's measured energy noise floor (meV/Å², ``energy_floor_mev_per_a2``), NaN when
+    it carries none; InputError unless a stored one is a finite number >= 0."""
+    if ENERGY_FLOOR_ATTR not in ds.attrs:
+        return float("nan")
+    value = finite_attribute(ds, ENERGY_FLOOR_ATTR, source, "one number >= 0 (meV/Å²)")
+    if value.size != 1 or value[0] < 0:
+        raise InputError(
+            f"{source}: attribute '{ENERGY_FLOOR_ATTR}' must be one number >= 0 (meV/Å²)"
+        )
+    return float(value[0])
 
 
 def branch_run(p: np.ndarray) -> tuple[int, int]:

@@ -1014,7 +1014,7 @@ def run_scan(
                                 )
                             if all(idx in store for idx in reduction.computed):
                                 area = cell_area(*in_plane_vectors(reference))
-                                check = verification(reduction, store.done(), area)
+                                check = verification(reduction, store.done(), area, symmetry)
                                 symmetry_record["verification"] = check
                                 if symmetry_broken(check, symmetry):
                                     reason = fallback_reason(check, symmetry, reduction.group.order)

@@ -116,6 +116,7 @@ def symmetry_settings(scan) -> SymmetrySettings:
         y.tolerance_angstrom,
         y.energy_tolerance_mev_per_a2,
         y.stress_tolerance_gpa,
+        y.energy_tolerance_fraction,
     )
 
 

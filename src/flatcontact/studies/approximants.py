@@ -27,25 +27,26 @@ the constant-pressure ISPES at the lowest load (max − min, meV/Å²), the ener
 :func:`~flatcontact.ispes.shift_lattice.translation_noise_ev_per_a2`; for a scan that
 relaxes anything, also the relaxation's: the same structure relaxed three times from
 perturbed starts with the scan's tolerance, :func:`~flatcontact.ispes.relax_noise.relaxation_noise`;
-the floor is the larger) and whether the
+the floor is the larger, written into the cell's shift-cell ``ispes.nc`` before its analysis,
+which takes it as the smallest degeneracy tolerance of its minima: :func:`write_energy_floor`)
+and whether the
 corrugation is resolved (≥ :data:`RESOLVED_FACTOR` × the floor; a cell whose ISPES has no
 lateral range above that at any thickness is not analysed: its laws are NaN and its
 "barrier" is that range, an upper bound), the gates that fired, the
 scan's force calls and the wall time of the cell; the study fits the size scaling of τ0 and
 the corrugation on the resolved cells (:mod:`flatcontact.studies.scaling`).
 
-Symmetry: the cells of a rigid study (``rigid-layers``, ``rigid``) are scanned reduced like
-any interface under ``scan.symmetry.enabled: auto``: the scan's group is found modulo the
+Symmetry: every cell is scanned as the scan stage scans any interface under
+``scan.symmetry`` (``auto``: reduced unless ``full``): the scan's group is found modulo the
 shift-lattice translations and lifted onto the grid
 (:func:`~flatcontact.ispes.shift_symmetry.shift_space_group`, ``modulo_translations``;
 0.2–0.3 s for the (1, 2) to (3, 4) cells, 0.7 s for (7, 8), where the old search of every
-pair of the slabs' translations took 227 s for the (2, 3) cell). A relaxed study
-(``normal``) of cells finer than their supercell scans every point under ``auto``
-(:func:`symmetry_override`): the verification's absolute tolerance (0.01 meV/Å² by default)
-is the whole corrugation of a twist cell, so a reduced scan would fill the grid with a
-symmetry the relaxation breaks (98 % on the (2, 3) cell, measured) and leave the
-broken-symmetry gate nothing to see. The gates use the group modulo the translations,
-restated on the shift cell.
+pair of the slabs' translations took 227 s for the (2, 3) cell), and the verified points are
+checked against a tolerance relative to the cell's own energy range
+(:func:`flatcontact.ispes.reduction.energy_tolerances`), so a relaxed cell whose landscape
+breaks the group by a sizeable fraction of its corrugation is computed in full and the
+broken-symmetry gate sees it (a relaxed study under ``auto`` no longer needs a special case).
+The gates use the group modulo the translations, restated on the shift cell.
 """
 
 from __future__ import annotations
@@ -96,16 +97,6 @@ def planned_index(approximant) -> int:
     return 1
 
 
-def symmetry_override(cfg: RunConfig, index: int) -> dict:
-    """``{"symmetry": {"enabled": False}}`` for a relaxed (``normal``) scan of a cell whose
-    shift lattice is finer than its supercell under ``scan.symmetry.enabled: auto`` (module
-    docstring: the verification's tolerance is the cell's whole corrugation), else ``{}``:
-    the configuration's own setting (``auto`` already scans ``full`` in full)."""
-    if index > 1 and cfg.scan.symmetry.enabled == "auto" and cfg.scan.relax_mode == "normal":
-        return {"symmetry": {"enabled": False}}
-    return {}
-
-
 def plan(cfg: RunConfig) -> list[dict]:
     """The cells of the study: per approximant its record, the grid, the index and the
     validated configuration (every cell checked before any work; one-line InputError). The
@@ -125,7 +116,7 @@ def plan(cfg: RunConfig) -> list[dict]:
     for a in cells:
         index = planned_index(a)
         n_a, n_b = scan_grid(cfg.scan.grid, index)
-        scan = {"grid": [n_a, n_b], **symmetry_override(cfg, index)}
+        scan = {"grid": [n_a, n_b]}
         over = {"structure": a.structure_override, "scan": scan, "report": {"svg": False}}
         config = variant_config(cfg, over, f"approximants ({a.label})").to_dict()
         out.append(
@@ -276,6 +267,19 @@ def _gates(cfg: RunConfig, root: Path) -> dict:
     }
 
 
+def write_energy_floor(path: Path, floor_mev_per_a2: float) -> None:
+    """Store a cell's measured noise floor (meV/Å²) in its shift-cell ``ispes.nc`` (the
+    contract's ``energy_floor_mev_per_a2``): the analysis takes it as the smallest degeneracy
+    tolerance of its minima (:func:`flatcontact.analysis.starts.degeneracy_tolerance_ev_per_a2`),
+    so minima closer than the floor count as indistinguishable and the ``degenerate_minima``
+    gate compares them as such."""
+    from flatcontact.ispes.contract import ENERGY_FLOOR_ATTR, open_ispes, write_ispes
+
+    ds = open_ispes(path)
+    ds.attrs[ENERGY_FLOOR_ATTR] = float(floor_mev_per_a2)
+    write_ispes(ds, path)
+
+
 def run_cell(config: dict, folder: str, planned: int) -> dict:
     """Run one approximant cell (``config``: a validated configuration's ``to_dict()``) in
     ``folder``: build and scan through the pipeline, then the ISPES on one shift-lattice
@@ -327,6 +331,7 @@ def run_cell(config: dict, folder: str, planned: int) -> dict:
         )
     relax_noise = math.nan if relaxed is None else 1e3 * relaxed.ev_per_a2
     floor = max(noise, 0.0 if relaxed is None else relax_noise)
+    write_energy_floor(cell / ISPES_NC, floor)
     lateral = lateral_range_mev_per_a2(shifted)
     nan = math.nan
     form, law, p_low, barrier, gates = cfg.analysis.energy_form, {}, nan, lateral, None
