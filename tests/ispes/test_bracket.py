@@ -102,7 +102,8 @@ def test_a_compressive_fold_is_named_and_the_loads_beyond_it_refused():
     }
     line = fold.message()
     assert "\n" not in line and "z = 10.2" in line and "0.8 GPa" in line and "1.5 GPa" in line
-    assert "relax_mode: normal" in line and any(line == note for note in c.notes)
+    assert "relax_mode: normal" in line and "scan.fmax_ev_per_angstrom" in line
+    assert any(line == note for note in c.notes)
     assert c.hi_gpa == 1.5
     zz = c.thickness_angstrom  # all on the tensile side of the fold
     assert zz.min() >= 10.3 - 1e-12 and np.interp(zz.max(), z[3:9], p[3:9]) <= 1e-12

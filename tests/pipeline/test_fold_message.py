@@ -1,5 +1,5 @@
-"""A load that is not monotonic where the scan recorded folds is named as a fold of the
-material (``scan.json`` ``load_folds``) with the physical remedy, in one line."""
+"""A load that is not monotonic where the scan recorded folds is named as a recorded
+fold (``scan.json`` ``load_folds``) with both causes and their remedies, in one line."""
 
 from __future__ import annotations
 
@@ -25,7 +25,7 @@ def test_a_recorded_fold_is_named_with_its_column_and_the_physical_remedy(tmp_pa
     text = str(info.value)
     assert text.startswith(NOT_MONOTONIC) and "\n" not in text
     assert "2 folding column(s)" in text and "z = 13.46 Å" in text
-    assert "scan.relax_mode: normal" in text
+    assert "scan.relax_mode: normal" in text and "scan.fmax_ev_per_angstrom" in text
 
 
 @pytest.mark.parametrize("record", [None, {}, {"load_folds": []}, "not json"])

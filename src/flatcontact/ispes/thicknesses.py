@@ -33,6 +33,19 @@ from flatcontact.ispes.separation import adhesion
 #: (:func:`merge_close_thicknesses`), so the bracket never shrinks.
 MIN_THICKNESS_SPACING_ANGSTROM = 0.02
 
+#: The two causes of a fold on the compressed side and their remedies, as the notes and the
+#: analysis stage name them. A plane that slips changes the stack (``scan.json`` ``layer_slip``
+#: lists in-slab slip above 0.25 Å); without one, the fold is the relaxation's: points that
+#: stopped at ``scan.fmax_ev_per_angstrom`` short of their minimum, an error that grows along a
+#: warm-started column (12-layer α-quartz at 0.005 eV/Å: 0.7-6.5 meV per point, a fold of
+#: 0.44 GPa of -(1/A) dU/dz that is gone at 0.0005 eV/Å; docs/convergence.md, "Slab layers at
+#: high load"; tests/ispes/test_fold_relaxation.py).
+FOLD_REMEDY = (
+    "if a plane slips (scan.json layer_slip), hold the slabs' inner planes laterally "
+    "(scan.relax_mode: normal); if none does, the relaxation stopped short of its minimum: "
+    "tighten scan.fmax_ev_per_angstrom"
+)
+
 
 @dataclasses.dataclass(frozen=True)
 class LoadFold:
@@ -68,8 +81,7 @@ class LoadFold:
             f"p-range-gpa: the {self.column} folds: p = {self.below_p_gpa:.4g} GPa at z = "
             f"{self.below_z_angstrom:.4g} Å rises to {self.p_gpa:.4g} GPa at z = "
             f"{self.z_angstrom:.4g} Å; loads above {self.p_gpa:.4g} GPa are not on one branch "
-            f"with P = 0 and are refused ({refused} GPa); hold the slabs' inner planes "
-            "laterally (scan.relax_mode: normal) if a plane slips, or lower "
+            f"with P = 0 and are refused ({refused} GPa); {FOLD_REMEDY}; or lower "
             f"scan.p_range_gpa.hi_gpa to at most {self.p_gpa:.3g} GPa"
         )
 

@@ -117,8 +117,9 @@ def run_analyze(
 @contextlib.contextmanager
 def _folds_named(scan_json: Path):
     """A load that is not monotonic where the scan recorded folds (``scan.json``
-    ``load_folds``, :mod:`flatcontact.ispes.grid_bracket`) is a fold of the material, not
-    noise: the one line says so and names the physical remedy besides the numerical one."""
+    ``load_folds``, :mod:`flatcontact.ispes.grid_bracket`) is named as that fold, with its two
+    causes and their remedies (:data:`flatcontact.ispes.thicknesses.FOLD_REMEDY`: a plane that
+    slips, or a relaxation stopped short of its minimum) besides the loads below it."""
     try:
         yield
     except InputError as exc:
@@ -131,13 +132,15 @@ def _folds_named(scan_json: Path):
                 folds = []
         if not folds:
             raise
+        # imported here: the CLI imports this module before numpy and ASE may load
+        from flatcontact.ispes.thicknesses import FOLD_REMEDY
+
         first = folds[0]
         raise InputError(
             f"{text}; the scan recorded {len(folds)} folding column(s) ({SCAN_JSON} "
             f"load_folds; first: {first.get('column')}, p = {first.get('p_gpa', float('nan')):.3g} "
-            f"GPa at z = {first.get('z_angstrom', float('nan')):.4g} Å): a plane that slips or "
-            "opens under load folds p(z) — use scan.relax_mode: normal, or loads below the fold "
-            "(analysis.p_gpa, scan.p_range_gpa.hi_gpa)"
+            f"GPa at z = {first.get('z_angstrom', float('nan')):.4g} Å): {FOLD_REMEDY}; or "
+            "use loads below the fold (analysis.p_gpa, scan.p_range_gpa.hi_gpa)"
         ) from None
 
 
