@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import copy
 import json
+import math
 
 import pytest
 import yaml
@@ -261,6 +262,51 @@ def test_counts_in_delta_states():
     assert not counts_in_delta({"state": "not refined", "last_change": {}})
     assert not counts_in_delta({"state": "failed"})  # failed at its first step
     assert counts_in_delta({"state": "failed", "last_change": {}, "last_step": ["a", "b"]})
+
+
+def test_noise_ratio_is_the_median_of_the_per_load_noise_ratios():
+    """studies.compare.noise_ratio: fine over coarse energy noise, median over common loads;
+    loads missing in one variant, NaN or zero coarse noise are left out."""
+    from flatcontact.studies.compare import NOISIER_FACTOR, noise_ratio
+
+    def loads(noise):
+        return {
+            "loads": [
+                {"p_gpa": p, "energy_noise_mev_per_a2": n}
+                for p, n in zip((0.0, 1.0, 2.0, 3.0), noise, strict=True)
+            ]
+        }
+
+    # the quartz 9 -> 12 layer step at fmax 0.005 (friction.csv at 1, 2, 3 GPa): ~5x
+    coarse = loads([4.53, 0.00993, 0.0151, 0.0199])
+    fine = loads([0.000755, 0.0496, 0.0795, 0.105])
+    # four ratios (one < 1 at 0 GPa, where the 9-layer noise estimate is large): the middle two
+    assert noise_ratio(coarse, fine) == pytest.approx((0.0496 / 0.00993 + 0.0795 / 0.0151) / 2)
+    assert noise_ratio(coarse, fine) >= NOISIER_FACTOR
+    assert noise_ratio(fine, coarse) < 1.0
+    gaps = loads([math.nan, 0.0, 0.01, 0.02])
+    assert noise_ratio(gaps, loads([1.0, 1.0, 0.02, 0.02])) == pytest.approx(1.5)
+    assert math.isnan(noise_ratio(loads([math.nan] * 4), fine))
+
+
+def test_the_blocks_source_says_which_step_was_noisier():
+    from flatcontact.studies.output import uncertainty_block
+
+    cfg = build_config(toy_data(), None, "toy")
+    numbers = {k: 1.0 for k in LAW_COEFFICIENTS}
+    doc = {
+        "study": "convergence",
+        "delta": {"internal": numbers, "enthalpy": numbers},
+        "settings": {
+            "grid": {"state": "converged", "last_change": {}},
+            "layers": {"state": "not converged", "last_change": {}, "noisier": 5.27},
+        },
+        "tolerance_pct": 3.0,
+        "converged": False,
+        "variants": [{"name": "base"}],
+    }
+    source = uncertainty_block(doc, cfg, "t")["source"]
+    assert "layers (its finer variant 5.27x noisier: may be relaxation error)" in source
 
 
 def test_the_blocks_source_names_each_setting_that_did_not_converge():

@@ -97,6 +97,14 @@ def convergence_command(
             f"{ch.get('quantity')} at {ch.get('p_gpa')} GPa by {ch.get('max_pct', 0):.3g} %",
             highlight=False,
         )
+        if st.get("noisier"):
+            console.print(
+                f"{s}: the last step's finer variant is {st['noisier']:g}x noisier "
+                "(energy_noise_mev_per_a2, median over the loads): its change may be "
+                "relaxation error, not the setting; refine it with a tighter "
+                "scan.fmax_ev_per_angstrom",
+                highlight=False,
+            )
     for s, why in doc["skipped_settings"].items():
         console.print(f"{s}: not refined ({why})", highlight=False)
     console.print(

@@ -107,3 +107,32 @@ def counts_in_delta(state: dict) -> bool:
     if state["state"] == "failed":
         return "last_change" in state
     return True
+
+
+#: A finer variant whose landscape is this many times noisier than the coarser one's
+#: (median over the loads of the analysis's ``energy_noise_mev_per_a2``) is flagged.
+NOISIER_FACTOR = 2.0
+
+
+def noise_ratio(coarse: dict, fine: dict) -> float:
+    """Median over the loads both list of ``fine``'s energy noise over ``coarse``'s (NaN if none).
+
+    The noise is the analysis's own per-load estimate of the landscape's relaxation noise
+    (``energy_noise_mev_per_a2`` of friction.csv). A refinement that makes it grow — more
+    free atoms relaxed to the same force tolerance: the energy a relaxation stopped at force
+    F leaves above its minimum grows like N·F²/k — changes τ by relaxation error, not by the
+    setting. Measured on quartz (docs/convergence.md, "Slab layers at high load"): 9 → 12
+    layers at fmax 0.005 eV/Å made the noise 5× larger and the step's internal-form τ change
+    at 3 GPa mostly relaxation error.
+    """
+    by_p = {round(r["p_gpa"], 9): r for r in coarse["loads"]}
+    ratios = []
+    for row in fine["loads"]:
+        other = by_p.get(round(row["p_gpa"], 9))
+        if other is None:
+            continue
+        a = other.get("energy_noise_mev_per_a2", math.nan)
+        b = row.get("energy_noise_mev_per_a2", math.nan)
+        if math.isfinite(a) and math.isfinite(b) and a > 0:
+            ratios.append(b / a)
+    return float(np.median(ratios)) if ratios else math.nan

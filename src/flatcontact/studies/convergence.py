@@ -15,7 +15,10 @@ The uncertainty it measures, per energy form and law coefficient c, is
 ``δ_conv(c) = max over settings of |Δc|`` at each setting's last step (the change one more
 refinement makes), the rule of docs/convergence.md, over the settings neither failed nor
 not refined; a setting whose finer step failed counts with its last analysable step
-(:func:`counts_in_delta`).
+(:func:`counts_in_delta`). A step whose finer variant's landscape is ``NOISIER_FACTOR`` times
+noisier than the coarser one's (:func:`flatcontact.studies.compare.noise_ratio`) is flagged
+``noisier`` (its change may be relaxation error: refine with a tighter force tolerance); it
+still counts in δ_conv.
 """
 
 from __future__ import annotations
@@ -29,9 +32,11 @@ from flatcontact.config.run import RunConfig
 from flatcontact.errors import InputError
 from flatcontact.ispes.executors import make_executor
 from flatcontact.studies.compare import (
+    NOISIER_FACTOR,
     counts_in_delta,
     largest_change,
     law_changes,
+    noise_ratio,
     thickness_step_refines,
 )
 from flatcontact.studies.estimate import base_measurements, estimate_convergence
@@ -117,6 +122,12 @@ def run_convergence(
                 status[s]["steps"] = level
                 status[s]["last_change"] = change
                 status[s]["last_step"] = [previous[s], v.name]
+                ratio = noise_ratio(results[previous[s]], results[v.name])
+                if ratio >= NOISIER_FACTOR:
+                    # counted all the same (an over-estimate, not an erasure), but said
+                    status[s]["noisier"] = round(ratio, 2)
+                else:
+                    status[s].pop("noisier", None)
                 why = (
                     thickness_step_refines(
                         results[previous[s]], results[v.name], v.name, previous[s]

@@ -87,6 +87,11 @@ def uncertainty_block(doc: dict, cfg: RunConfig, command: str) -> dict:
         used = [
             s
             + (f" (step {st['last_step'][1]}; the next failed)" if st["state"] == "failed" else "")
+            + (
+                f" (its finer variant {st['noisier']:g}x noisier: may be relaxation error)"
+                if st.get("noisier")
+                else ""
+            )
             for s, st in doc["settings"].items()
             if counts_in_delta(st)
         ]

@@ -48,7 +48,8 @@ def run_variant(config: dict, folder: str, share_build_from: str | None = None) 
     -------
     dict
         ``loads`` (``p_gpa``, ``tau_mpa``, ``sigma_mss_mpa``; NaN where the load is not
-        reached), ``laws`` (energy form -> coefficients and standard errors),
+        reached; ``energy_noise_mev_per_a2``, the analysis's own estimate of the landscape's
+        relaxation noise at that load), ``laws`` (energy form -> coefficients and standard errors),
         ``work_of_separation_j_per_m2``, ``thickness_angstrom`` (the scan's, Å),
         ``force_calls`` (stored by the scan),
         ``force_calls_spent`` (0 when the scan stage was skipped), ``scan_action``,
@@ -72,6 +73,7 @@ def run_variant(config: dict, folder: str, share_build_from: str | None = None) 
             "p_gpa": float(row["p_gpa"]),
             "tau_mpa": float(row["tau_mpa"]),
             "sigma_mss_mpa": float(row["sigma_mss_mpa"]),
+            "energy_noise_mev_per_a2": float(row.get("energy_noise_mev_per_a2", math.nan)),
         }
         for _, row in table.iterrows()
     ]
