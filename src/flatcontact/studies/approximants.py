@@ -234,10 +234,14 @@ def tolerance_advice(barrier_mev_per_a2: float, noise_mev_per_a2: float, relaxed
         return ""
     fmax = relaxed.fmax_ev_per_a
     needed = fmax * math.sqrt(barrier_mev_per_a2 / bound)
+    # two significant figures, rounded down: never the tolerance the cell already ran at
+    # (0.000486 at fmax 0.0005 printed as 0.0005 with one figure)
+    scale = 10.0 ** (math.floor(math.log10(needed)) - 1)
+    needed = math.floor(needed / scale) * scale
     return (
         f"corrugation <= {barrier_mev_per_a2:.2g} meV/A^2 is below {RESOLVED_FACTOR:g}x the "
         f"relaxation floor {relax_noise:.2g} at scan.fmax_ev_per_angstrom {fmax:g} "
-        f"({relaxed.mode}); resolving it needs scan.fmax_ev_per_angstrom <= ~{needed:.1g} "
+        f"({relaxed.mode}); resolving it needs scan.fmax_ev_per_angstrom <= ~{needed:.2g} "
         "(floor ~ fmax^2) or a rigid-layers scan"
     )
 
