@@ -102,9 +102,9 @@ def counts_in_delta(state: dict) -> bool:
     moves, and dropping it would understate the interval. A setting failed at its first step
     has no measured change and does not count.
     """
-    if state["state"] == "not refined":
+    if state.get("state") == "not refined":
         return False
-    if state["state"] == "failed":
+    if state.get("state") == "failed":
         return "last_change" in state
     return True
 

@@ -86,7 +86,11 @@ def uncertainty_block(doc: dict, cfg: RunConfig, command: str) -> dict:
         states = {s: st.get("state", "") for s, st in doc["settings"].items()}
         used = [
             s
-            + (f" (step {st['last_step'][1]}; the next failed)" if st["state"] == "failed" else "")
+            + (
+                f" (step {st['last_step'][1]}; the next failed)"
+                if st.get("state") == "failed"
+                else ""
+            )
             + (
                 f" (its finer variant {st['noisier']:g}x noisier: may be relaxation error)"
                 if st.get("noisier")
