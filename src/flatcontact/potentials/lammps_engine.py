@@ -22,6 +22,16 @@ as soon as an atom has moved more than half the 1 Å skin), exactly the step LAM
 fresh ``run 0`` to round-off (``tests/potentials/test_engine_fast_path.py``); measured per
 call in ``benchmarks/bench_scan.py`` and ``docs/performance.md``.
 
+What LAMMPS tallies: every run ends by resetting its list of the computes that keep
+invocation times (``Modify::post_run`` sets ``n_timeflag = -1``), and without a new ``init``
+(``pre no``) the next run's thermo setup then schedules *every* such compute on the run's
+last step (``addstep_compute`` falls back to ``addstep_compute_all``). So each ``run 1``
+tallies the energy and the global virial whatever the thermo style asks for: the energy
+the scan reads (≈ 12 % of a Cu EAM call, ``docs/performance.md``, "Fifth round"), the
+virial nothing reads on a slab cell, which therefore deletes the pressure compute
+(``uncompute thermo_press``). Skipping the energy on intermediate calls would need the
+energy compute deleted and re-created around them, each a full ``init`` (``run 0``).
+
 Threads: ``threads=N`` (> 1) loads LAMMPS's OPENMP package (``package omp N`` and the
 ``omp`` suffix, used by the styles that have an ``/omp`` variant); see
 ``docs/performance.md`` for where it pays.
@@ -115,7 +125,8 @@ class LammpsEngine:
                 charges=setup.charges,
             )
             self.lmp.commands_list(list(setup.commands))
-            # pressures only for periodic cells (the virial costs time in every run)
+            # pressures only for periodic cells: a slab cell deletes LAMMPS's pressure compute,
+            # else its virial is tallied in every run all the same (module docstring)
             thermo = "pe pxx pyy pzz pyz pxz pxy" if self.box.bulk else "pe"
             self.lmp.commands_list(
                 [
@@ -123,6 +134,7 @@ class LammpsEngine:
                     "neigh_modify every 1 delay 0 check yes",
                     f"thermo_style custom {thermo}",
                     "thermo_modify norm no",
+                    *(() if self.box.bulk else ("uncompute thermo_press",)),
                 ]
             )
         except Exception as exc:
