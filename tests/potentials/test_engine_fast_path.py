@@ -172,3 +172,29 @@ def test_uncopied_forces_are_lammps_array_and_fresh_values(close_interface):
             np.testing.assert_allclose(forces, want[1], rtol=0, atol=1e-9)
     finally:
         engine.close()
+
+
+def test_reallocated_lammps_arrays_are_followed(close_interface):
+    """LAMMPS reallocates ``x`` and ``f`` when the local + ghost atoms outgrow them (here a
+    ghost cutoff of 60 Å between two calls multiplies the ghosts: ``atom->nmax`` grows): the
+    engine's next call writes into and reads from the new arrays (one int, ``nmax``, tells it),
+    and its energy and forces are a fresh setup's."""
+    model = InteractionModel(intra="vashishta")
+    atoms = close_interface
+    setup = compile_setup(model, atoms)
+    engine = LammpsEngine(setup, atoms.cell.array, atoms.pbc)
+    try:
+        engine.compute(atoms.positions)
+        nmax = engine._nmax.value
+        x_before = engine._views()[1].ctypes.data
+        engine.lmp.commands_list(["comm_modify cutoff 60.0", "run 0 post no"])
+        assert engine._nmax.value > nmax  # the reallocation this test is about
+        assert engine.lmp.numpy.extract_atom("x").ctypes.data != x_before
+        for pos in _path(atoms, 5):
+            energy, forces = engine.compute(pos, copy=False)
+            want = _fresh(setup, atoms.cell.array, atoms.pbc, pos, False)
+            assert energy == pytest.approx(want[0], rel=1e-11, abs=1e-9)
+            np.testing.assert_allclose(forces, want[1], rtol=0, atol=1e-9)
+            _check_views(engine)
+    finally:
+        engine.close()

