@@ -175,19 +175,25 @@ def test_export_refuses_studies_of_other_interfaces_or_the_same_block_twice(ran,
     assert "no uncertainty block" in err and not (tmp_path / "u.json").exists()
 
 
+def _refuse_variant(monkeypatch, variant: str, message: str) -> None:
+    """Make the study's run of ``variant`` raise the one-line InputError a refusing builder
+    or analysis raises; every other variant runs for real."""
+    real = convergence_module.run_variant
+
+    def refusing(config, folder, share=None):
+        if folder.endswith(variant):
+            raise InputError(message)
+        return real(config, folder, share)
+
+    monkeypatch.setattr(convergence_module, "run_variant", refusing)
+
+
 @pytest.mark.slow
 def test_a_variant_that_fails_is_reported_as_its_settings_failure(tmp_path, monkeypatch):
     """A constructed failure: the layers step's run raises the one-line InputError a refusing
     builder raises. The study goes on, study.json and the console name the failure, and the
     other setting's verdict and δ_conv stand."""
-    real = convergence_module.run_variant
-
-    def refusing(config, folder, share=None):
-        if folder.endswith("layers1"):
-            raise InputError("probe column: p(z) is not monotonic (constructed)")
-        return real(config, folder, share)
-
-    monkeypatch.setattr(convergence_module, "run_variant", refusing)
+    _refuse_variant(monkeypatch, "layers1", "probe column: p(z) is not monotonic (constructed)")
     conf = write_yaml(
         tmp_path / "toy.yaml",
         toy_data(refine={"settings": ["thicknesses", "layers"], "max_steps": 1}),
@@ -217,14 +223,7 @@ def test_a_setting_whose_finer_step_fails_keeps_its_measured_step_in_delta(tmp_p
     29 → 43 was refused by the analysis. The refused step must not erase the measured one:
     δ_conv is the change of the last analysable step (it was dropped, understating the
     interval), the setting stays ``failed`` with the refused step named."""
-    real = convergence_module.run_variant
-
-    def refusing(config, folder, share=None):
-        if folder.endswith("thicknesses2"):
-            raise InputError("the load folds (constructed)")
-        return real(config, folder, share)
-
-    monkeypatch.setattr(convergence_module, "run_variant", refusing)
+    _refuse_variant(monkeypatch, "thicknesses2", "the load folds (constructed)")
     conf = write_yaml(
         tmp_path / "toy.yaml",
         toy_data(refine={"settings": ["thicknesses"], "max_steps": 2, "tolerance_pct": 0.01}),
