@@ -78,6 +78,21 @@ def test_lj_only_engine_matches_numpy_lj(close_interface):
     assert np.allclose(f, f_np, atol=1e-10)
 
 
+@pytest.mark.parametrize("cutoff_angstrom", [26.0, 30.0])
+def test_a_long_lj_cutoff_fits_lammps_neighbour_lists(close_interface, cutoff_angstrom):
+    """The quartz study's cutoff step to 26 Å overflowed LAMMPS's default per-atom neighbour
+    capacity ("Neighbor list overflow, boost neigh_modify one"): the setup sizes it from the
+    cutoff. Checked against the numpy LJ written independently of LAMMPS."""
+    spec = InteractionModel(intra="none", lj={"cutoff_angstrom": cutoff_angstrom})
+    e, f, _ = _energy_forces(spec, close_interface)
+    table = spec.lj.table(["O", "Si"], ["O", "Si"])
+    e_np, f_np = lj_cross_energy_forces(
+        close_interface, close_interface.arrays["slab"], table, cutoff_angstrom
+    )
+    assert e == pytest.approx(e_np, rel=1e-10, abs=1e-12)
+    assert np.allclose(f, f_np, atol=1e-10)
+
+
 @pytest.mark.parametrize("reflect", [False, True])
 def test_frame_invariance_rotation_reflection_and_cell_choice(close_interface, reflect):
     spec = InteractionModel(intra="vashishta")
@@ -150,3 +165,19 @@ def test_a1_along_x_to_round_off_is_the_unrotated_frame(close_interface, angle):
     np.testing.assert_allclose(f1, f0, rtol=0, atol=1e-12)
     cell[0, 1] = 1e-6 * cell[0, 0]
     assert not LammpsBox(cell, tilted.pbc).same_frame
+
+
+def test_the_paper_slab_builds_with_the_studys_26_angstrom_cutoff(tmp_path):
+    """The quartz convergence study's cutoff step 22 -> 26 Å died in the build stage (the
+    dense slab's relaxation: "Neighbor list overflow, boost neigh_modify one", LAMMPS's default
+    capacity of 2000 neighbours per atom); the capacity now follows the cutoff
+    (lammps_setup.neighbour_capacity)."""
+    from flatcontact.config import build_config
+    from flatcontact.pipeline import Pipeline
+    from flatcontact.potentials.lammps_setup import LAMMPS_DEFAULT_NEIGHBOURS, neighbour_capacity
+
+    assert neighbour_capacity(18.0) > LAMMPS_DEFAULT_NEIGHBOURS  # a bound, set from 18 Å on
+    cfg = build_config({"potential": {"lj": {"cutoff_angstrom": 26.0}}}, "paper")
+    with Pipeline(cfg, tmp_path / "run") as pipe:
+        pipe.build()
+    assert (tmp_path / "run" / "01-build" / "interface.extxyz").is_file()

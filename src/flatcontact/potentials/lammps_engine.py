@@ -51,6 +51,10 @@ from flatcontact.errors import InputError
 from flatcontact.potentials.lammps_box import create_box
 from flatcontact.potentials.lammps_runtime import new_lammps
 
+#: LAMMPS's neighbour skin (Å): lists hold pairs within cutoff + skin and are rebuilt when an
+#: atom has moved half of it.
+NEIGHBOR_SKIN_ANGSTROM = 1.0
+
 
 @dataclass(frozen=True)
 class LammpsSetup:
@@ -130,7 +134,7 @@ class LammpsEngine:
             thermo = "pe pxx pyy pzz pyz pxz pxy" if self.box.bulk else "pe"
             self.lmp.commands_list(
                 [
-                    "neighbor 1.0 bin",
+                    f"neighbor {NEIGHBOR_SKIN_ANGSTROM:g} bin",
                     "neigh_modify every 1 delay 0 check yes",
                     f"thermo_style custom {thermo}",
                     "thermo_modify norm no",

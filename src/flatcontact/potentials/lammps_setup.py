@@ -18,12 +18,35 @@ A single instance and no coupling is written as a plain ``pair_style`` (no hybri
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from flatcontact.errors import InputError
-from flatcontact.potentials.lammps_engine import LammpsSetup
+from flatcontact.potentials.lammps_engine import NEIGHBOR_SKIN_ANGSTROM, LammpsSetup
 from flatcontact.potentials.lj import LJPair, pair_key
 from flatcontact.potentials.model import slab_ids
+
+#: Largest atom number density of a solid that sizes the neighbour capacity (atoms/Å³;
+#: diamond 0.176, α-quartz 0.080, Cu 0.085).
+MAX_ATOM_DENSITY_PER_A3 = 0.2
+#: LAMMPS's default ``neigh_modify one`` (neighbours one atom may have).
+LAMMPS_DEFAULT_NEIGHBOURS = 2000
+#: The capacity the interlayer potentials (16 Å cutoffs) were measured to need.
+INTERLAYER_NEIGHBOURS = 20000
+
+
+def neighbour_capacity(cutoff_angstrom: float) -> int:
+    """Neighbours one atom can have within ``cutoff_angstrom`` + the skin in the densest solid.
+
+    ``ceil(4/3 π (r_c + skin)³ ρ_max)`` with ρ_max = :data:`MAX_ATOM_DENSITY_PER_A3` and the
+    engine's skin (:data:`flatcontact.potentials.lammps_engine.NEIGHBOR_SKIN_ANGSTROM`): a
+    bound on LAMMPS's per-atom list length (``neigh_modify one``), which caps memory only.
+    The paper preset's LJ at 18 Å fits the default 2000 on quartz; 26 Å overflowed it in the
+    quartz convergence study's cutoff step (needs 16,490 here).
+    """
+    r = cutoff_angstrom + NEIGHBOR_SKIN_ANGSTROM
+    return math.ceil(4.0 / 3.0 * math.pi * r**3 * MAX_ATOM_DENSITY_PER_A3)
 
 
 def layer_ids(atoms, fallback_planes: bool = False) -> np.ndarray:
@@ -216,8 +239,14 @@ def compile_setup(model, atoms, bulk: bool = False) -> LammpsSetup:
             for tj in range(ti, ntypes + 1)
             if (ti, tj) not in covered
         ]
-    if interlayer:  # 16 Å interlayer cutoffs in small periodic cells: long neighbour lists
-        commands.append("neigh_modify one 20000 page 400000")
+    # 16 Å interlayer cutoffs in small periodic cells, or a long cross-interface LJ: more
+    # neighbours per atom than LAMMPS's default capacity (2000; "Neighbor list overflow")
+    one = max(
+        INTERLAYER_NEIGHBOURS if interlayer else 0,
+        neighbour_capacity(cutoff) if lj_table is not None else 0,
+    )
+    if one > LAMMPS_DEFAULT_NEIGHBOURS:
+        commands.append(f"neigh_modify one {one} page {20 * one}")
     return LammpsSetup(
         types=tuple(types),
         type_elements=tuple(type_elements),
