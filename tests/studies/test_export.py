@@ -263,6 +263,33 @@ def test_counts_in_delta_states():
     assert counts_in_delta({"state": "failed", "last_change": {}, "last_step": ["a", "b"]})
 
 
+def test_a_variant_that_crashes_is_its_own_failure_not_the_studys():
+    """studies.runner.run_jobs: an engine error in one job (LAMMPS raises a plain Exception)
+    is that job's result; the other jobs' results stand; an InputError keeps its message."""
+    from flatcontact.ispes.executors import make_executor
+    from flatcontact.studies.runner import run_jobs
+
+    def task(x):
+        if x == 1:
+            raise Exception("ERROR on proc 0: Neighbor list overflow, boost neigh_modify one\nmore")
+        if x == 2:
+            raise InputError("refused (constructed)")
+        return {"value": 10 * x}
+
+    told = []
+    executor = make_executor("serial", 1, None, None)
+    out = run_jobs(
+        executor, task, [("a", 0), ("b", 1), ("c", 2), ("d", 3)], lambda k, r: told.append(k)
+    )
+    assert out["a"] == {"value": 0} and out["d"] == {"value": 30}
+    assert out["b"] == {
+        "error": "Exception: ERROR on proc 0: Neighbor list overflow, boost neigh_modify one",
+        "unexpected": True,
+    }
+    assert out["c"] == {"error": "refused (constructed)"}
+    assert told == ["a", "b", "c", "d"]
+
+
 def test_noise_ratio_is_the_median_of_the_per_load_noise_ratios():
     """studies.compare.noise_ratio: fine over coarse energy noise, median over common loads;
     loads missing in one variant, NaN or zero coarse noise are left out."""

@@ -102,7 +102,11 @@ def run_jobs(executor, task: Callable, jobs: list[tuple], on_done: Callable | No
     """Run ``jobs`` = [(key, *arguments of task)] through ``executor``; ``{key: result}``.
 
     A job that ``task`` refuses (:class:`~flatcontact.errors.InputError`: a variant or cell the
-    builder, model or analysis refuses) gives ``{"error": message}`` and the others go on.
+    builder, model or analysis refuses) gives ``{"error": message}`` and the others go on; a
+    job that fails otherwise (an engine error, a defect) gives ``{"error": "Type: first
+    line", "unexpected": True}``: one variant must not take hours of the others' results
+    down with it (the quartz study's 26 Å cutoff variant did, with LAMMPS's neighbour list
+    overflow). ``KeyboardInterrupt`` still stops the study.
     ``on_done(key, result)`` is told as each job ends; a serial executor runs a job when it is
     submitted, so there the jobs are submitted one at a time and each is told as it ends.
     """
@@ -121,6 +125,12 @@ def run_jobs(executor, task: Callable, jobs: list[tuple], on_done: Callable | No
                 out[handles[h]] = executor.result(h)
             except InputError as exc:
                 out[handles[h]] = {"error": str(exc)}
+            except Exception as exc:
+                # an engine error (LAMMPS: "Neighbor list overflow") or a defect in one
+                # variant: the others' results stand and the study is written; the
+                # variant's own run.log has the traceback
+                first = (str(exc).strip().splitlines() or [""])[0]
+                out[handles[h]] = {"error": f"{type(exc).__name__}: {first}", "unexpected": True}
             if on_done is not None:
                 on_done(handles[h], out[handles[h]])
     return out
