@@ -252,6 +252,31 @@ def test_a_setting_whose_finer_step_fails_keeps_its_measured_step_in_delta(tmp_p
     assert "thicknesses: failed at step 2" in " ".join(out.split())
 
 
+@pytest.mark.slow
+def test_delta_is_the_bases_error_the_whole_ladders_movement(tmp_path):
+    """A two-step grid ladder that does not converge: δ_conv is |c(grid2) − c(base)|, the
+    error of a run at the base settings (where the block is applied), not the last step's
+    |c(grid2) − c(grid1)| (the finest level's error)."""
+    conf = write_yaml(
+        tmp_path / "toy.yaml",
+        toy_data(refine={"settings": ["grid"], "max_steps": 2, "tolerance_pct": 0.01}),
+    )
+    code, _out, err = _cli(["study", "convergence", conf, "--out", tmp_path / "s"])
+    assert code == 0, err
+    doc = json.loads((tmp_path / "s" / "study.json").read_text())
+    st = doc["settings"]["grid"]
+    assert st["steps"] == 2 and st["last_step"] == ["grid1", "grid2"]
+    assert st["measured_step"] == ["base", "grid2"]
+    laws = {v["name"]: v["laws"]["internal"] for v in doc["variants"]}
+    differs = False
+    for key in LAW_COEFFICIENTS:
+        whole = abs(laws["grid2"][key] - laws["base"][key])
+        last = abs(laws["grid2"][key] - laws["grid1"][key])
+        assert doc["delta"]["internal"][key] == pytest.approx(whole)
+        differs |= not math.isclose(whole, last, rel_tol=1e-6, abs_tol=1e-12)
+    assert differs  # otherwise the test could not tell the rules apart
+
+
 def test_counts_in_delta_states():
     """Which settings' last step enters δ_conv, by state (studies.compare.counts_in_delta)."""
     from flatcontact.studies.compare import counts_in_delta
@@ -332,7 +357,9 @@ def test_the_blocks_source_says_which_step_was_noisier():
         "variants": [{"name": "base"}],
     }
     source = uncertainty_block(doc, cfg, "t")["source"]
-    assert "layers (its finer variant 5.27x noisier: may be relaxation error)" in source
+    assert (
+        "layers (its finest variant 5.27x noisier than the base: may be relaxation error)" in source
+    )
 
 
 def test_the_blocks_source_names_each_setting_that_did_not_converge():
@@ -358,7 +385,7 @@ def test_the_blocks_source_names_each_setting_that_did_not_converge():
         "variants": [{"name": "base"}],
     }
     source = uncertainty_block(doc, cfg, "t")["source"]
-    assert "last refinement step of grid, fmax (" in source
+    assert "the finest analysable level of grid, fmax (" in source
     assert (
         "NOT converged: thicknesses (not refined), layers (failed), fmax (not converged)" in source
     )

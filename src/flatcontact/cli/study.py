@@ -99,7 +99,7 @@ def convergence_command(
         )
         if st.get("noisier"):
             console.print(
-                f"{s}: the last step's finer variant is {st['noisier']:g}x noisier "
+                f"{s}: its finest variant is {st['noisier']:g}x noisier than the base "
                 "(energy_noise_mev_per_a2, median over the loads): its change may be "
                 "relaxation error, not the setting; refine it with a tighter "
                 "scan.fmax_ev_per_angstrom",

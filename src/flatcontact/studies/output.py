@@ -92,7 +92,7 @@ def uncertainty_block(doc: dict, cfg: RunConfig, command: str) -> dict:
                 else ""
             )
             + (
-                f" (its finer variant {st['noisier']:g}x noisier: may be relaxation error)"
+                f" (its finest variant {st['noisier']:g}x noisier than the base: may be relaxation error)"
                 if st.get("noisier")
                 else ""
             )
@@ -101,7 +101,7 @@ def uncertainty_block(doc: dict, cfg: RunConfig, command: str) -> dict:
         ]
         open_ = [f"{s} ({state})" for s, state in states.items() if state != "converged"]
         what = (
-            f"largest change of each law coefficient over the last refinement step of "
+            f"largest change of each law coefficient from the base to the finest analysable level of "
             f"{', '.join(used) or 'no setting'} (tolerance {doc['tolerance_pct']:g} %; "
             + (
                 "all converged"
