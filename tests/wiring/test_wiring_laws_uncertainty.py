@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -66,6 +67,9 @@ def stages(tmp_path_factory):
     run_laws(cfg, inputs, root / "laws")
     laws = json.loads((root / "laws" / LAWS_JSON).read_text())
     return cfg, laws, root
+
+
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_laws_json_has_both_forms_with_their_exact_slopes(stages):
@@ -225,15 +229,21 @@ def test_zero_input_error_gives_zero_width(capsys):
 def test_paper_preset_carries_the_measured_uncertainty():
     cfg = build_config({}, "paper")
     assert cfg.uncertainty.convergence_internal == MEASURED_LAW_UNCERTAINTY["convergence_internal"]
-    # docs/teachers.md "Carried into the laws": internal τ0 ± 10.3 MPa for the 9-layer paper
-    # preset, from its fit s.e. 5.332 MPa (results/paper_layers9.json), the convergence
-    # and the model spread, in quadrature
+    # docs/convergence.md "Measured law uncertainty of the paper preset": internal τ0 ± 48.0
+    # MPa for the paper preset, from its fit s.e. (the convergence study's base run, stored
+    # in docs/measured/quartz-study), the convergence and the model spread, in quadrature
+    study = json.loads(
+        (ROOT / "docs" / "measured" / "quartz-study" / "convergence" / "study.json").read_text()
+    )
+    base = next(v for v in study["variants"] if v["name"] == "base")
+    se = base["laws"]["internal"]["tau0_stderr_mpa"]
+    assert se == pytest.approx(5.332, abs=5e-4)  # the paper preset's own fit (docs/teachers.md)
     h = math.sqrt(
-        5.332**2
+        se**2
         + cfg.uncertainty.convergence_internal["tau0_mpa"] ** 2
         + cfg.uncertainty.model_spread_internal["tau0_mpa"] ** 2
     )
-    assert h == pytest.approx(10.3, abs=0.05)
+    assert f"τ0 25.2 ± {h:.1f}" in (ROOT / "docs" / "convergence.md").read_text()
     assert build_config({}).uncertainty.convergence_internal == {}
 
 
