@@ -188,6 +188,18 @@ def _refuse_variant(monkeypatch, variant: str, message: str) -> None:
     monkeypatch.setattr(convergence_module, "run_variant", refusing)
 
 
+def _two_step_study(tmp_path, setting: str) -> tuple[dict, str]:
+    """The toy's convergence study of one ``setting``, two steps at a 0.01 % tolerance (so the
+    second step runs); its study.json and the console text."""
+    conf = write_yaml(
+        tmp_path / "toy.yaml",
+        toy_data(refine={"settings": [setting], "max_steps": 2, "tolerance_pct": 0.01}),
+    )
+    code, out, err = _cli(["study", "convergence", conf, "--out", tmp_path / "s"])
+    assert code == 0, err
+    return json.loads((tmp_path / "s" / "study.json").read_text()), out
+
+
 @pytest.mark.slow
 def test_a_variant_that_fails_is_reported_as_its_settings_failure(tmp_path, monkeypatch):
     """A constructed failure: the layers step's run raises the one-line InputError a refusing
@@ -224,13 +236,7 @@ def test_a_setting_whose_finer_step_fails_keeps_its_measured_step_in_delta(tmp_p
     δ_conv is the change of the last analysable step (it was dropped, understating the
     interval), the setting stays ``failed`` with the refused step named."""
     _refuse_variant(monkeypatch, "thicknesses2", "the load folds (constructed)")
-    conf = write_yaml(
-        tmp_path / "toy.yaml",
-        toy_data(refine={"settings": ["thicknesses"], "max_steps": 2, "tolerance_pct": 0.01}),
-    )
-    code, out, err = _cli(["study", "convergence", conf, "--out", tmp_path / "s"])
-    assert code == 0, err
-    doc = json.loads((tmp_path / "s" / "study.json").read_text())
+    doc, out = _two_step_study(tmp_path, "thicknesses")
     st = doc["settings"]["thicknesses"]
     assert st["state"] == "failed"
     assert st["last_step"] == ["base", "thicknesses1"]
@@ -257,13 +263,7 @@ def test_delta_is_the_bases_error_the_whole_ladders_movement(tmp_path):
     """A two-step grid ladder that does not converge: δ_conv is |c(grid2) − c(base)|, the
     error of a run at the base settings (where the block is applied), not the last step's
     |c(grid2) − c(grid1)| (the finest level's error)."""
-    conf = write_yaml(
-        tmp_path / "toy.yaml",
-        toy_data(refine={"settings": ["grid"], "max_steps": 2, "tolerance_pct": 0.01}),
-    )
-    code, _out, err = _cli(["study", "convergence", conf, "--out", tmp_path / "s"])
-    assert code == 0, err
-    doc = json.loads((tmp_path / "s" / "study.json").read_text())
+    doc, _out = _two_step_study(tmp_path, "grid")
     st = doc["settings"]["grid"]
     assert st["steps"] == 2 and st["last_step"] == ["grid1", "grid2"]
     assert st["measured_step"] == ["base", "grid2"]
