@@ -340,23 +340,30 @@ def test_noise_ratio_is_the_median_of_the_per_load_noise_ratios():
     assert math.isnan(noise_ratio(loads([math.nan] * 4), fine))
 
 
-def test_the_blocks_source_says_which_step_was_noisier():
-    from flatcontact.studies.output import uncertainty_block
-
-    cfg = build_config(toy_data(), None, "toy")
+def _convergence_doc(settings: dict) -> dict:
+    """A convergence study document with made-up numbers and the given ``settings`` (not all
+    converged), as write_study passes it to uncertainty_block."""
     numbers = {k: 1.0 for k in LAW_COEFFICIENTS}
-    doc = {
+    return {
         "study": "convergence",
         "delta": {"internal": numbers, "enthalpy": numbers},
-        "settings": {
-            "grid": {"state": "converged", "last_change": {}},
-            "layers": {"state": "not converged", "last_change": {}, "noisier": 5.27},
-        },
+        "settings": settings,
         "tolerance_pct": 3.0,
         "converged": False,
         "variants": [{"name": "base"}],
     }
-    source = uncertainty_block(doc, cfg, "t")["source"]
+
+
+def test_the_blocks_source_says_which_step_was_noisier():
+    from flatcontact.studies.output import uncertainty_block
+
+    doc = _convergence_doc(
+        {
+            "grid": {"state": "converged", "last_change": {}},
+            "layers": {"state": "not converged", "last_change": {}, "noisier": 5.27},
+        }
+    )
+    source = uncertainty_block(doc, build_config(toy_data(), None, "toy"), "t")["source"]
     assert (
         "layers (its finest variant 5.27x noisier than the base: may be relaxation error)" in source
     )
@@ -370,20 +377,14 @@ def test_the_blocks_source_names_each_setting_that_did_not_converge():
     from flatcontact.studies.output import uncertainty_block
 
     cfg = build_config(toy_data(), None, "toy")
-    numbers = {k: 1.0 for k in LAW_COEFFICIENTS}
-    doc = {
-        "study": "convergence",
-        "delta": {"internal": numbers, "enthalpy": numbers},
-        "settings": {
+    doc = _convergence_doc(
+        {
             "grid": {"state": "converged"},
             "thicknesses": {"state": "not refined"},
             "layers": {"state": "failed"},
             "fmax": {"state": "not converged"},
-        },
-        "tolerance_pct": 3.0,
-        "converged": False,
-        "variants": [{"name": "base"}],
-    }
+        }
+    )
     source = uncertainty_block(doc, cfg, "t")["source"]
     assert "the finest analysable level of grid, fmax (" in source
     assert (

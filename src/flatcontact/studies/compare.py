@@ -33,18 +33,24 @@ def relative_change_pct(a: float, b: float, floor: float) -> float:
     return 100.0 * abs(b - a) / max(abs(a), abs(b), floor, 1e-300)
 
 
+def paired_loads(coarse: dict, fine: dict):
+    """``(coarse row, fine row)`` for each load both variants list (matched to 1e-9 GPa), in
+    ``fine``'s order."""
+    by_p = {round(r["p_gpa"], 9): r for r in coarse["loads"]}
+    for row in fine["loads"]:
+        other = by_p.get(round(row["p_gpa"], 9))
+        if other is not None:
+            yield other, row
+
+
 def largest_change(coarse: dict, fine: dict, floor_mpa: float) -> dict:
     """The largest per-load relative change (%) of τ and σ_MSS from ``coarse`` to ``fine``.
 
     Returns ``{"max_pct", "quantity", "p_gpa"}`` (the load and quantity where it is largest)
     over the loads both variants list.
     """
-    by_p = {round(r["p_gpa"], 9): r for r in coarse["loads"]}
     worst = {"max_pct": 0.0, "quantity": None, "p_gpa": None}
-    for row in fine["loads"]:
-        other = by_p.get(round(row["p_gpa"], 9))
-        if other is None:
-            continue
+    for other, row in paired_loads(coarse, fine):
         for q in QUANTITIES:
             pct = relative_change_pct(other[q], row[q], floor_mpa)
             if pct > worst["max_pct"] or worst["quantity"] is None:
@@ -93,14 +99,13 @@ def thickness_step_refines(
 
 
 def counts_in_delta(state: dict) -> bool:
-    """Whether a setting's last step enters δ_conv.
+    """Whether a setting's ladder enters δ_conv (its ``measured_step``, base → finest level).
 
-    Converged and not-converged settings count with their last step; a ``not refined``
-    thicknesses step never does (its change is no evidence). A ``failed`` setting counts with
-    its last *analysable* step when it had one (``last_step``, e.g. thicknesses 19 → 29 when
-    29 → 43 was refused): that step's change is a measured lower bound of what refinement
-    moves, and dropping it would understate the interval. A setting failed at its first step
-    has no measured change and does not count.
+    Converged and not-converged settings count; a ``not refined`` thicknesses step never does
+    (its change is no evidence). A ``failed`` setting counts with its last *analysable* level
+    when it had one (e.g. thicknesses 19 → 29 when 29 → 43 was refused): that change is a
+    measured lower bound of what refinement moves, and dropping it would understate the
+    interval. A setting failed at its first step has no measured change and does not count.
     """
     if state.get("state") == "not refined":
         return False
@@ -125,12 +130,8 @@ def noise_ratio(coarse: dict, fine: dict) -> float:
     layers at fmax 0.005 eV/Å made the noise 5× larger and the step's internal-form τ change
     at 3 GPa mostly relaxation error.
     """
-    by_p = {round(r["p_gpa"], 9): r for r in coarse["loads"]}
     ratios = []
-    for row in fine["loads"]:
-        other = by_p.get(round(row["p_gpa"], 9))
-        if other is None:
-            continue
+    for other, row in paired_loads(coarse, fine):
         a = other.get("energy_noise_mev_per_a2", math.nan)
         b = row.get("energy_noise_mev_per_a2", math.nan)
         if math.isfinite(a) and math.isfinite(b) and a > 0:

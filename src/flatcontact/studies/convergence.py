@@ -124,7 +124,6 @@ def run_convergence(
                 change = largest_change(
                     results[previous[s]], results[v.name], r.tolerance_floor_mpa
                 )
-                status[s]["steps"] = level
                 status[s]["last_change"] = change
                 status[s]["last_step"] = [previous[s], v.name]
                 # the base's error is what the block carries: the total movement of the
