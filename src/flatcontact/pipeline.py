@@ -78,7 +78,6 @@ from flatcontact.layout import (
     SUMMARY_JSON,
     VERSIONS_JSON,
 )
-from flatcontact.report.sections.approximant_study import approximant_study_digest
 from flatcontact.rundir import (
     RunDirectory,
     RunLock,
@@ -100,7 +99,7 @@ from flatcontact.stages.elastic import ElasticInputs, run_elastic
 from flatcontact.stages.gates import GateInputs, check_gates, evaluate_gates
 from flatcontact.stages.laws import LawsInputs, run_laws
 from flatcontact.stages.preflight import check_inputs
-from flatcontact.stages.report import ReportInputs, run_report
+from flatcontact.stages.report import ReportInputs, approximant_study_digest, run_report
 from flatcontact.stages.result_files import CONTACT, FRICTION, open_result
 from flatcontact.stages.scan import ScanInputs, run_scan
 from flatcontact.structures.interface_io import read_interface
