@@ -367,8 +367,7 @@ class Pipeline:
         """
         cfg = self.config
         build = self._upstream("build")
-        scan_inputs = {k: v for k, v in cfg.section("scan").items() if k not in EXECUTION_ONLY}
-        inputs = {"scan": scan_inputs, "model": self._model_inputs(), "build": build.fingerprint}
+        inputs = {**self._scan_inputs(), "build": build.fingerprint}
 
         def work(folder: Path) -> None:
             stage_inputs = ScanInputs(build.folder / INTERFACE)
@@ -381,6 +380,19 @@ class Pipeline:
 
         result = self._run("scan", inputs, work)
         return open_ispes(result.folder / ISPES_NC)
+
+    def _scan_inputs(self) -> dict:
+        """What the scan stage reads besides the build: its section (less the execution-only
+        keys), the model and, for a pressure-range grid, the load bracket its columns must
+        reach (``ispes.grid_bracket.bracket_targets_gpa``: the lowest and highest load of
+        ``analysis.p_gpa``), so a load added beyond the scanned range re-brackets the scan."""
+        cfg = self.config
+        scan_inputs = {k: v for k, v in cfg.section("scan").items() if k not in EXECUTION_ONLY}
+        inputs = {"scan": scan_inputs, "model": self._model_inputs()}
+        if cfg.scan.p_range_gpa is not None:
+            loads = [float(p) for p in cfg.analysis.p_gpa]
+            inputs["bracket_loads_gpa"] = [min(loads), max(loads)] if loads else None
+        return inputs
 
     def scan_summary(self) -> dict:
         """``02-scan/scan.json``: counts, force calls, thicknesses, adhesion (work of separation)."""
