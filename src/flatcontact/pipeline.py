@@ -90,6 +90,7 @@ from flatcontact.stages import _calculator
 from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
 from flatcontact.stages.build import BuildInputs, run_build
 from flatcontact.stages.contact import (
+    QUARTZ_QUICK_LAWS_FILE,
     ContactInputs,
     check_contact,
     contact_parameters,
@@ -530,6 +531,8 @@ class Pipeline:
             inputs["gates"] = stage_inputs.gates  # the recorded verdict (a clean run: no key)
         if cfg.contact.experiment.csv:
             inputs["experiment_sha256"] = file_sha256(cfg.contact.experiment.csv)
+        if cfg.contact.experiment.compare:  # the comparison quotes the quick preset's laws
+            inputs["quartz_quick_laws_sha256"] = file_sha256(QUARTZ_QUICK_LAWS_FILE)
         if cfg.contact.fit.csv:
             inputs["fit_sha256"] = [file_sha256(f) for f in cfg.contact.fit.csv]
 
