@@ -65,7 +65,7 @@ LAYERS: tuple[tuple[str, frozenset[str]], ...] = (
     # runs of the stages: one run (pipeline) and studies over many runs (studies import the
     # pipeline; the CLI, above, imports both)
     ("runs", frozenset({"pipeline", "studies"})),
-    ("front doors", frozenset({"cli", "__main__"})),
+    ("front doors", frozenset({"cli", "__main__", "notebook"})),
 )
 
 #: Which other cores each physics core may import: a core package, or one module of it
