@@ -24,7 +24,7 @@ from flatcontact.structures.build import build_quartz_interface
 from flatcontact.structures.cell2d import lattice_is_invariant, standard_slab
 from flatcontact.structures.crystal import crystal_slab, file_record, orient, read_bulk
 from flatcontact.structures.dense import relax
-from flatcontact.structures.interface_contract import thickness
+from flatcontact.structures.interface_contract import CONTINUATION, thickness
 from flatcontact.structures.interface_io import read_interface
 from flatcontact.structures.lattice import LatticeChoice
 from flatcontact.structures.layers import slab_layers
@@ -365,7 +365,7 @@ def build_generic(recipe, lattice: LatticeChoice | None = None) -> tuple[Atoms, 
             layer, z = np.asarray(stack.arrays["layer"]), stack.positions[:, 2]
             natural = float(z[layer == n1 + 1].min() - z[layer == n1].max())
         atoms = split_stack(stack, n1, spacing - natural)
-        record["slab2_operation"] = "continuation of slab 1's stacking"
+        record["slab2_operation"] = CONTINUATION
         record["match"] = match.report(
             s1.cell2, s1.cell2, n1 * s1.atoms_per_layer, n2 * s1.atoms_per_layer
         )
