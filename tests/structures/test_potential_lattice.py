@@ -133,6 +133,10 @@ def test_the_al_slab_is_built_at_the_zhou_eam_lattice(tmp_path):
     assert slab["in_plane_mismatch_percent"] == pytest.approx([expected] * 2, abs=5e-3)
     assert slab["lateral_stress_gpa_at_file_lattice"] < -1.0  # compressed at 4.05 Å
     assert result.warnings == []
+    from flatcontact.report.sections.build import file_lattice_note, lattice_paragraph
+
+    assert "structure.lattice = potential" in lattice_paragraph(result.to_json())
+    assert file_lattice_note(result.to_json()) is None
 
 
 def test_lattice_file_keeps_the_cif_and_states_the_mismatch(tmp_path):
@@ -148,6 +152,20 @@ def test_lattice_file_keeps_the_cif_and_states_the_mismatch(tmp_path):
     al.calc = bulk_calculator(load_config(tmp_path / "al.yaml").potential, al)
     pressure_gpa = -float(np.trace(al.get_stress(voigt=False))) / 3 * 160.21766208
     assert slab["lateral_stress_gpa_at_file_lattice"] == pytest.approx(-pressure_gpa, rel=1e-3)
+    # the report states the mismatch and the stress, and boxes the strained slabs
+    from flatcontact.report.sections.build import file_lattice_note, lattice_paragraph
+
+    build = result.to_json()
+    stress = f"{slab['lateral_stress_gpa_at_file_lattice']:.3g} GPa"
+    paragraph = lattice_paragraph(build)
+    assert "structure.lattice = file" in paragraph
+    assert "the model's lattice 4.0816/4.0816/4.0816 Å, the file's 4.0500/4.0500/4.0500 Å" in (
+        paragraph
+    )
+    assert "-0.775, -0.775, -0.775 % per lattice vector" in paragraph and stress in paragraph
+    note = file_lattice_note(build)
+    assert note.startswith("Not the model's lattice: slab 1 -0.775, -0.775 % in-plane")
+    assert stress in note
 
 
 def test_a_file_lattice_beyond_the_threshold_is_refused_in_one_line(tmp_path):
