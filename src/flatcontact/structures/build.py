@@ -313,9 +313,11 @@ def build_quartz_interface(
     choice, fit = quartz_lattice(spec, lattice)
     choice.check("structure.lattice")
     report["lattice"] = choice.record()
-    cell = fit.potential_cell if choice.use_potential else fit.file_cell
-    a_used = float(np.linalg.norm(cell[0]))
-    c_used = float(np.linalg.norm(cell[2]))
+    # the file's lattice is the experimental one exactly (no rescaling: bit-identical slabs)
+    a_used, c_used = QUARTZ_A_ANGSTROM, QUARTZ_C_ANGSTROM
+    if choice.use_potential:
+        a_used = float(np.linalg.norm(fit.potential_cell[0]))
+        c_used = float(np.linalg.norm(fit.potential_cell[2]))
     use_shipped = source == "shipped" or (
         source == "auto" and SHIPPED_DENSE_SLAB.is_file() and shipped_reaches(layers)
     )
@@ -329,7 +331,8 @@ def build_quartz_interface(
                 k: v for k, v in provenance.items() if k not in ("search", "verification")
             },
         }
-        slab = _in_plane_scaled(slab, a_used)
+        if choice.use_potential:
+            slab = _in_plane_scaled(slab, a_used)
         if layers > SHIPPED_LAYERS:
             slab, report["start"]["thickening"], bulk = thicken_shipped_slab(
                 slab, layers, spec, fmax_ev_per_angstrom
