@@ -140,7 +140,9 @@ class LatticeFit:
             "file_cell_angstrom": np.round(self.file_cell, 6).tolist(),
             "potential_cell_angstrom": np.round(self.potential_cell, 6).tolist(),
             "file_vs_potential_percent": [round(v, 4) for v in self.mismatch_percent()],
-            "lateral_stress_gpa_at_file_lattice": round(self.lateral_stress_gpa, 4),
+            "lateral_stress_gpa_at_file_lattice": (
+                round(self.lateral_stress_gpa, 4) if np.isfinite(self.lateral_stress_gpa) else None
+            ),
             "relaxation_converged": self.converged,
             **self.extra,
         }
@@ -218,7 +220,10 @@ def check_file_lattice(records: dict[str, dict], field: str = "structure.lattice
     """
     for name, rec in records.items():
         worst = max((abs(v) for v in rec.get("in_plane_mismatch_percent", [])), default=0.0)
-        if worst > MAX_FILE_MISMATCH_PERCENT:
+        if (
+            worst > MAX_FILE_MISMATCH_PERCENT
+            and rec.get("lateral_stress_gpa_at_file_lattice") is not None
+        ):
             raise InputError(
                 f"{field}=file: {name} ({rec.get('material', '?')}) is strained "
                 f"{worst:.3g} % in-plane against the potential's own lattice (file "
@@ -258,15 +263,43 @@ class LatticeChoice:
     def bulk(self, key, atoms: Atoms, material: str, miller=None) -> LatticeFit:
         """:func:`bulk_lattice` of ``atoms`` with the run's model (once per ``key``)."""
         if key not in self._fits:
-            self._fits[key] = bulk_lattice(atoms, self.calculator_for(atoms), material, miller)
+            self._fits[key] = self._fit(
+                lambda: bulk_lattice(atoms, self.calculator_for(atoms), material, miller),
+                atoms,
+                material,
+                "bulk",
+            )
         return self._fits[key]
 
     def sheet(self, key, sheet: Atoms, material: str, interlayer_angstrom: float) -> LatticeFit:
         """:func:`sheet_lattice` of ``sheet`` with the run's model (once per ``key``)."""
         if key not in self._fits:
-            boxed_calc = self.calculator_for(sheet)
-            self._fits[key] = sheet_lattice(sheet, boxed_calc, material, interlayer_angstrom)
+            self._fits[key] = self._fit(
+                lambda: sheet_lattice(
+                    sheet, self.calculator_for(sheet), material, interlayer_angstrom
+                ),
+                sheet,
+                material,
+                "sheet",
+            )
         return self._fits[key]
+
+    @staticmethod
+    def _fit(compute, atoms: Atoms, material: str, kind: str) -> LatticeFit:
+        """``compute()``, or, when the model's engine cannot compute the material alone (a
+        LAMMPS hybrid whose sub-style has no atom of it, e.g. h-BN's ``coul/shield`` on a
+        graphene sheet), the file's lattice recorded as not computed. A one-line
+        :class:`InputError` (an element the model lacks) propagates."""
+        try:
+            return compute()
+        except InputError:
+            raise
+        except Exception as exc:  # the engine's own error, kept as the reason
+            reason = next((ln.strip() for ln in str(exc).splitlines() if ln.strip()), repr(exc))
+            cell = np.asarray(atoms.cell.array, float).copy()
+            return LatticeFit(
+                material, kind, cell, cell, False, float("nan"), {"not_computed": reason}
+            )
 
     def note(self, slab: str, fit: LatticeFit, file_cell2, potential_cell2) -> dict:
         """Record slab ``slab``'s lattice: ``fit`` and the in-plane strain the file's puts on it."""
@@ -288,6 +321,12 @@ class LatticeChoice:
         may not describe this crystal (the slab is still built at the potential's)."""
         out = []
         for name, rec in self.slabs.items():
+            if "not_computed" in rec:
+                out.append(
+                    f"{name} ({rec['material']}): the model cannot compute this material alone "
+                    f"({rec['not_computed']}); its slabs are at the file's lattice, unchecked"
+                )
+                continue
             worst = max(abs(v) for v in rec["in_plane_mismatch_percent"])
             if self.use_potential and worst > MAX_FILE_MISMATCH_PERCENT:
                 out.append(

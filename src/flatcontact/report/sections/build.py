@@ -237,6 +237,13 @@ def lattice_paragraph(build: dict) -> str | None:
     used = lat.get("source")
     parts = []
     for name, rec in lat["slabs"].items():
+        if "not_computed" in rec:
+            parts.append(
+                f"{name.replace('slab', 'slab ')} ({rec.get('material', '?')}): the model cannot "
+                f"compute this material alone ({rec['not_computed']}), so it is kept at the "
+                "file's lattice, unchecked"
+            )
+            continue
         pot = "/".join(f"{v:.4f}" for v in rec["potential_lengths_angstrom"])
         fil = "/".join(f"{v:.4f}" for v in rec["file_lengths_angstrom"])
         parts.append(
