@@ -341,7 +341,7 @@ class Pipeline:
         """
         cfg = self.config
         # the file by name and content (file_sha256), not by where it is
-        structure = portable(cfg.section("structure"), "file")
+        structure = portable(cfg.structure_section(), "file")
         if cfg.structure.kind == "quartz-dense":
             structure.setdefault("file", None)  # the fingerprint of runs made before recipes
         inputs = {"structure": structure, "model": self._model_inputs()}
