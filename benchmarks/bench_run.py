@@ -33,6 +33,37 @@ def sizes(root: Path) -> tuple[int, list[tuple[str, int]]]:
     return sum(n for _, n in files), files[:LARGEST]
 
 
+class ScanClock:
+    """The scan stage's phases from the outside (ispes/scan.py is not instrumented): its start
+    and end (the pipeline's events) and the first and last ``progress(done, total)`` call;
+    the first comes when the grid is dispatched, after the serial work in front of it."""
+
+    def __init__(self) -> None:
+        self.marks: dict[str, float] = {}
+
+    def event(self, ev) -> None:
+        if ev.name == "scan" and ev.kind in ("start", "end"):
+            self.marks[ev.kind] = time.perf_counter()
+
+    def progress(self, done: int, total: int) -> None:
+        now = time.perf_counter()
+        self.marks.setdefault("first_progress", now)
+        self.marks["last_progress"] = now
+
+    def phases(self) -> dict[str, float]:
+        """Seconds before the grid (probe, ideal work of separation, symmetry detection,
+        worker start-up), on the grid (points and the symmetry verification), after it
+        (``ispes.nc``, ``scan.json``, the figure)."""
+        m = self.marks
+        if not {"start", "end", "first_progress", "last_progress"} <= set(m):
+            return {}
+        return {
+            "before_grid_s": round(m["first_progress"] - m["start"], 2),
+            "grid_s": round(m["last_progress"] - m["first_progress"], 2),
+            "after_grid_s": round(m["end"] - m["last_progress"], 2),
+        }
+
+
 def measure(preset: str) -> dict:
     """Run the default twice in a temporary directory; the ``"run"`` block of the record."""
     from flatcontact.config import load_config
@@ -41,10 +72,11 @@ def measure(preset: str) -> dict:
 
     cfg = load_config(preset_name=preset)
     block = {"preset": preset, **record.machine()}
+    clock = ScanClock()
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp) / "run"
         start = time.perf_counter()
-        with Pipeline(cfg, root) as pipe:
+        with Pipeline(cfg, root, on_event=clock.event, scan_progress=clock.progress) as pipe:
             pipe.run()
             first = dict(pipe.results)
         block["total_s"] = round(time.perf_counter() - start, 2)
@@ -63,6 +95,7 @@ def measure(preset: str) -> dict:
         "thicknesses": len(scan["thickness_angstrom"]),
         "stages_s": {n: round(r.seconds, 2) for n, r in first.items() if r.action == "ran"},
         "stage_actions": {n: r.action for n, r in first.items()},
+        "scan_phases_s": clock.phases(),
         "rerun_s": round(rerun, 2),
         "rerun_actions": actions,
         "run_dir_bytes": total,
@@ -115,6 +148,14 @@ def table(block: dict, baseline: dict) -> list[str]:
         f"{block['scan']['median_force_calls_per_point']} per point",
         f"  rerun with nothing changed: {block['rerun_s']:.2f} s, actions {block['rerun_actions']}",
     ]
+    if block.get("scan_phases_s"):
+        ph = block["scan_phases_s"]
+        lines.insert(
+            -1,
+            f"  scan phases: {ph['before_grid_s']:.2f} s before the grid (probe, ideal work of "
+            f"separation, symmetry, worker start-up), {ph['grid_s']:.2f} s on the grid, "
+            f"{ph['after_grid_s']:.2f} s after it",
+        )
     return lines
 
 
