@@ -70,6 +70,7 @@ from flatcontact.layout import (
     INTERFACE,
     ISPES_NC,
     LAWS_JSON,
+    OTHER_FORM_JSON,
     REPORT_HTML,
     RUN_LOG,
     RUN_MARKER,
@@ -437,15 +438,14 @@ class Pipeline:
         """
         cfg = self.config
         analyze = self._upstream("analyze")
-        scan = self._upstream("scan")
         inputs = {"threshold_gpa": cfg.analysis.threshold_gpa, "analyze": analyze.fingerprint}
-        # the other energy form comes from the scan's ISPES (analyze's fingerprint covers it
-        # and the analysis settings); the laws' intervals from the uncertainty section
+        # both energy forms come from the analyze stage's files (its fingerprint covers them:
+        # the scan's, the analysis settings, its code); the intervals from the uncertainty section
         inputs["uncertainty"] = cfg.section("uncertainty")
 
         def work(folder: Path) -> None:
-            ispes = scan.folder / ISPES_NC
-            run_laws(cfg, LawsInputs.read(analyze.folder / FRICTION_CSV, ispes), folder)
+            tables = analyze.folder
+            run_laws(cfg, LawsInputs.read(tables / FRICTION_CSV, tables / OTHER_FORM_JSON), folder)
 
         self._run("laws", inputs, work)
         return self._json("laws", LAWS_JSON)

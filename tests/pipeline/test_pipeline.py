@@ -70,7 +70,13 @@ def test_every_stage_ran_and_wrote_its_files(tiny_run):
     expected = {
         "01-build": ["interface.extxyz", "build.json", "fig1_interface.png"],
         "02-scan": ["points.db", "ispes.nc", "scan.json", "fig_scan_columns.png"],
-        "03-analyze": ["friction.csv", "friction.nc", "analyze.json", "fig2_p1gpa.png"],
+        "03-analyze": [
+            "friction.csv",
+            "friction.nc",
+            "analyze.json",
+            "other_form.json",
+            "fig2_p1gpa.png",
+        ],
         "04-laws": ["laws.json", "fig3_laws.png"],
         "06-contact": [
             "contact.nc",
