@@ -48,6 +48,7 @@ from flatcontact.config.run import RunConfig
 from flatcontact.ispes.executors import default_workers
 from flatcontact.layout import SCAN_JSON, STAGES
 from flatcontact.rundir import RECORD_NAME
+from flatcontact.studies.study_dir import RUNS, folder_name
 
 #: Force calls per grid point when no finished cell measured them and something relaxes:
 #: ``rigid-layers`` 3.6 measured on the H-diamond(111)/graphene lock (examples/README.md),
@@ -172,7 +173,7 @@ def estimate_cost(cfg: RunConfig, cells: list[dict], out: str | Path | None = No
     calibration = None
     if out is not None:
         for c in sorted(cells, key=lambda c: c["n_atoms"]):
-            m = measured_cell(Path(out) / "runs" / c["label"])
+            m = measured_cell(Path(out) / RUNS / folder_name(c["label"]))
             if m is not None:
                 calibration = {"label": c["label"], **m}
                 break

@@ -46,6 +46,7 @@ from flatcontact.studies.compare import (
 )
 from flatcontact.studies.estimate import base_measurements, estimate_convergence
 from flatcontact.studies.runner import run_jobs, run_variant
+from flatcontact.studies.study_dir import RUNS, refuse_study_links
 from flatcontact.studies.variants import (
     base_value,
     chosen_settings,
@@ -82,7 +83,8 @@ def run_convergence(
         for steps in ladder.values()
         for v in steps
     }
-    runs_dir = out / "runs"
+    refuse_study_links(out)
+    runs_dir = out / RUNS
     base_dir = runs_dir / "base"
     executor = make_executor(
         cfg.scan.executor, cfg.scan.workers, cfg.scan.dask_address, cfg.scan.jobqueue
