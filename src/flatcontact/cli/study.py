@@ -312,9 +312,14 @@ def export_uncertainty_command(
     ] = None,
 ) -> None:
     """One uncertainty file (the paper preset's data-file format) from the studies' blocks."""
+    from flatcontact.errors import InputError
     from flatcontact.fileio import write_json_atomic
     from flatcontact.studies.export import export_uncertainty
 
+    if out.is_dir() or (out.exists() and not out.is_file()):
+        raise InputError(
+            f"--out {str(out)!r}: exists and is not a regular file; name the JSON file to write"
+        )
     doc = export_uncertainty(studies, source, _command_line())
     check_out_dir(out.parent, "--out")
     write_json_atomic(out, doc)

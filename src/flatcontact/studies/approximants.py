@@ -51,7 +51,6 @@ The gates use the group modulo the translations, restated on the shift cell.
 
 from __future__ import annotations
 
-import json
 import math
 import shutil
 import time
@@ -66,6 +65,7 @@ from flatcontact.fileio import refuse_link
 from flatcontact.ispes.executors import make_executor
 from flatcontact.ispes.shift_lattice import scan_grid
 from flatcontact.layout import FRICTION_CSV, FRICTION_NC, INTERFACE, ISPES_NC, LAWS_JSON, SCAN_JSON
+from flatcontact.result_json import read_result_json
 from flatcontact.studies.runner import run_jobs
 from flatcontact.studies.scaling import fit_scaling
 from flatcontact.studies.study_dir import RUNS, folder_name, refuse_study_links
@@ -347,7 +347,7 @@ def run_cell(config: dict, folder: str, planned: int) -> dict:
         run_laws(
             cfg, LawsInputs.read(cell / "analyze" / FRICTION_CSV, cell / ISPES_NC), cell / "laws"
         )
-        laws = json.loads((cell / "laws" / LAWS_JSON).read_text())
+        laws = read_result_json(cell / "laws" / LAWS_JSON, energy_form=cfg.analysis.energy_form)
         form = laws.get("energy_form") or cfg.analysis.energy_form
         law = laws.get(form) if isinstance(laws.get(form), dict) else laws
         p_low, barrier = corrugation_mev_per_a2(cell / "analyze" / FRICTION_NC)

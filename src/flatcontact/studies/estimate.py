@@ -49,6 +49,7 @@ from pathlib import Path
 from flatcontact.config.run import RunConfig
 from flatcontact.ispes.thicknesses import MIN_THICKNESS_SPACING_ANGSTROM
 from flatcontact.layout import SCAN_JSON, STAGES
+from flatcontact.result_json import read_result_json
 from flatcontact.rundir import RECORD_NAME
 from flatcontact.studies.approximant_cost import duration, time_force_call
 from flatcontact.studies.variants import Variant, base_value, shares_build
@@ -69,7 +70,7 @@ def base_measurements(base_dir: str | Path) -> dict:
     """
     root = Path(base_dir)
     folder = {s: root / f"{STAGES[s]:02d}-{s}" for s in STUDY_STAGES}
-    scan = json.loads((folder["scan"] / SCAN_JSON).read_text())
+    scan = read_result_json(folder["scan"] / SCAN_JSON)
     seconds = {}
     for s in STUDY_STAGES:
         record = json.loads((folder[s] / RECORD_NAME).read_text())
