@@ -54,10 +54,24 @@ KINDS: dict[str, tuple[Callable[[Any], bool], str]] = {
     "count": (lambda v: isinstance(v, int) and not isinstance(v, bool) and v >= 0, "a count"),
     "text": (lambda v: isinstance(v, str), "text"),
     "mapping": (lambda v: isinstance(v, dict), "a mapping"),
+    "mapping?": (lambda v: v is None or isinstance(v, dict), "a mapping or null"),
     "list": (lambda v: isinstance(v, list), "a list"),
     "numbers": (
         lambda v: isinstance(v, list) and bool(v) and all(_finite(x) for x in v),
         "a non-empty list of finite numbers",
+    ),
+    "numbers?": (
+        lambda v: v is None or (isinstance(v, list) and all(_finite(x) for x in v)),
+        "a list of finite numbers or null",
+    ),
+    "strains": (
+        lambda v: v is None or _finite(v) or (isinstance(v, list) and all(_finite(x) for x in v)),
+        "a finite number, a list of them or null",
+    ),
+    "flag": (lambda v: isinstance(v, bool), "true or false"),
+    "texts": (
+        lambda v: isinstance(v, list) and all(isinstance(x, str) for x in v),
+        "a list of text",
     ),
 }
 

@@ -288,3 +288,45 @@ def test_a_name_with_a_newline_is_quoted_in_the_one_line(tmp_path, capsys):
     line = refused(code, err, "bad\\nname.json")
     assert "\n" not in line
     np.testing.assert_equal(len(err.strip().splitlines()), 1)
+
+
+# ---- an approximant study's cells (report.approximant_study) -------------------------------
+
+
+def _approximant_study(folder, edit):
+    from tests.studies.test_approximants_study import _fake_doc
+
+    from flatcontact.studies.output import write_approximants
+
+    doc = _fake_doc()
+    write_approximants(doc, folder, "flatcontact study approximants (test)")
+    path = folder / "study.json"
+    written = json.loads(path.read_text())
+    edit(written)
+    path.write_text(json.dumps(written))
+    return path
+
+
+@pytest.mark.parametrize(
+    ("edit", "names"),
+    [
+        (lambda d: d.__setitem__("cells", ["junk", 3]), ["cells[0]", "mapping"]),
+        (lambda d: d["cells"][0].__setitem__("tau0_mpa", "12.5"), ["cells[0].tau0_mpa"]),
+        (lambda d: d["cells"][1].__setitem__("n_atoms", -4), ["cells[1].n_atoms", "count"]),
+        (lambda d: d["cells"][0].__setitem__("strain_percent_slab1", "0 0"), ["strain"]),
+        (lambda d: d["cells"][0].__setitem__("gates", {"fired": "none"}), ["gates.fired"]),
+    ],
+)
+def test_an_approximant_studys_junk_cells_are_one_line_before_any_stage(tmp_path, edit, names):
+    from tests.wiring.test_wiring_approximant_study import _config
+
+    from flatcontact.pipeline import Pipeline
+
+    path = _approximant_study(tmp_path / "study", edit)
+    with pytest.raises(InputError) as info:
+        Pipeline(_config(path), tmp_path / "run")
+    text = str(info.value)
+    assert "\n" not in text and "report.approximant_study" in text, text
+    for name in names:
+        assert name in text, (name, text)
+    assert not (tmp_path / "run" / "01-build").exists()
