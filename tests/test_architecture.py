@@ -47,6 +47,7 @@ LAYERS: tuple[tuple[str, frozenset[str]], ...] = (
                 "errors",
                 "limits",
                 "fileio",
+                "result_json",
                 "rundir",
                 "codegraph",
                 "layout",

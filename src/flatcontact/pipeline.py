@@ -60,7 +60,7 @@ from flatcontact.fileio import (
     write_json_atomic,
     write_text_atomic,
 )
-from flatcontact.ispes.contract import open_ispes
+from flatcontact.ispes.contract import check_grid, open_ispes
 from flatcontact.layout import (
     CONFIG_YAML,
     CONTACT_NC,
@@ -79,6 +79,7 @@ from flatcontact.layout import (
     SUMMARY_JSON,
     VERSIONS_JSON,
 )
+from flatcontact.result_json import read_result_json
 from flatcontact.rundir import (
     RunDirectory,
     RunLock,
@@ -307,7 +308,21 @@ class Pipeline:
         return self.results[name]
 
     def _json(self, name: str, file: str) -> dict:
-        return json.loads((self._upstream(name).folder / file).read_text())
+        """A stage's JSON file checked against its contract (:mod:`flatcontact.result_json`)
+        and against what this run knows: the scan's grid from its stage record, the energy
+        form and the loads p0 from the settings."""
+        folder = self._upstream(name).folder
+        expect: dict[str, Any] = {}
+        if name == "scan":
+            record = self.rundir.read_record(folder) or {}
+            grid = ((record.get("inputs") or {}).get("scan") or {}).get("grid")
+            if grid is not None:
+                expect["grid"] = grid
+        elif name == "laws":
+            expect["energy_form"] = self.config.analysis.energy_form
+        elif name == "contact":
+            expect["p0_gpa"] = list(self.config.contact.p0_gpa)
+        return read_result_json(folder / file, **expect)
 
     def _tell(self, kind: str, name: str, **details: Any) -> None:
         if self.on_event is not None:
@@ -381,7 +396,9 @@ class Pipeline:
                 run_scan(cfg, stage_inputs, folder, progress=bar)
 
         result = self._run("scan", inputs, work)
-        return open_ispes(result.folder / ISPES_NC)
+        ds = open_ispes(result.folder / ISPES_NC)
+        check_grid(ds, self.config.scan.grid, str(result.folder / ISPES_NC))
+        return ds
 
     def _scan_inputs(self) -> dict:
         """What the scan stage reads besides the build: its section (less the execution-only

@@ -13,7 +13,6 @@ no stale warning of the old threshold in ``analyze.json``.
 from __future__ import annotations
 
 import contextlib
-import json
 import logging
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,6 +28,7 @@ from flatcontact.layout import (
     SCAN_JSON,
     analyze_figure,
 )
+from flatcontact.result_json import read_result_json
 from flatcontact.stages._common import captured, renamed_errors, save
 
 #: Parameters of :func:`flatcontact.analysis.analyze.analyze_ispes` -> the settings path.
@@ -152,8 +152,8 @@ def _folds_named(scan_json: Path):
         folds = []
         if "not monotonic" in text:
             try:
-                folds = json.loads(scan_json.read_text()).get("load_folds") or []
-            except (OSError, ValueError, AttributeError):
+                folds = read_result_json(scan_json).get("load_folds") or []
+            except InputError:  # no scan.json beside this ISPES, or not one: no fold named
                 folds = []
         if not folds:
             raise

@@ -434,6 +434,26 @@ def build_generic(recipe, lattice: LatticeChoice | None = None) -> tuple[Atoms, 
 
 
 # --------------------------------------------------------------------------- entry point
+#: Largest increase of the interface thickness (Å) the build's relaxation may make: slabs
+#: that move apart by more are not bound with the model (or the crystal's atoms overlap and
+#: blew the cell apart): a reference that is no contact, refused.
+MAX_RELAXED_SEPARATION_ANGSTROM = 5.0
+
+
+def check_relaxed_separation(before_angstrom: float, after_angstrom: float) -> None:
+    """Refuse a build relaxation that moved the slabs apart by more than
+    :data:`MAX_RELAXED_SEPARATION_ANGSTROM` (one line naming both thicknesses and the bound)."""
+    moved = after_angstrom - before_angstrom
+    if not moved <= MAX_RELAXED_SEPARATION_ANGSTROM:  # NaN too
+        raise InputError(
+            f"{SECTION}: the build relaxation moved the slabs apart by {moved:.3g} Å (thickness "
+            f"{before_angstrom:.4g} -> {after_angstrom:.4g} Å), more than the "
+            f"{MAX_RELAXED_SEPARATION_ANGSTROM:g} Å a bound interface moves: the slabs are not "
+            f"bound with this model, or atoms of the crystal overlap; check the model's "
+            f"cross-interface coupling, {SECTION}.gap_angstrom and the crystal file"
+        )
+
+
 def build_interface(
     recipe: Any,
     *,
@@ -525,10 +545,12 @@ def build_interface(
             if callable(relax_calculator) and not hasattr(relax_calculator, "get_potential_energy")
             else relax_calculator
         )
+        before = thickness(atoms)
         report["interface_relaxation"] = relax(
             atoms, calc, fmax_ev_per_angstrom=recipe.fmax_ev_per_angstrom
         )
         atoms.calc = None
+        check_relaxed_separation(before, thickness(atoms))
     record["thickness_angstrom"] = thickness(atoms)
     atoms.info["recipe"] = json.dumps(record, sort_keys=True)
     report["thickness_angstrom"] = thickness(atoms)

@@ -39,6 +39,7 @@ from pydantic import (
     model_validator,
 )
 
+from flatcontact import limits
 from flatcontact.errors import InputError
 from flatcontact.numbers import Bounds, physical, state_bounds
 from flatcontact.structures.quartz_layers import MIN_LAYERS, check_shipped_layers
@@ -122,6 +123,15 @@ class MatchSettings(_Model):
         description="two materials: slab 2's supercell, with slab1_supercell",
     )
 
+    @field_validator("max_atoms")
+    @classmethod
+    def _atoms_within_bound(cls, value: int) -> int:
+        """The search's candidates grow with the square of its largest cell: bounded before
+        it starts (``FLATCONTACT_MAX_ATOMS``)."""
+        if value > limits.bound("atoms"):
+            raise ValueError(limits.message("atoms", value, "atoms of the largest cell"))
+        return value
+
     @model_validator(mode="after")
     def _supercells(self) -> MatchSettings:
         given = (self.slab1_supercell is not None, self.slab2_supercell is not None)
@@ -134,6 +144,14 @@ class MatchSettings(_Model):
                 raise ValueError(
                     f"{name}: expected a positive determinant (a right-handed supercell), "
                     f"got {[list(r) for r in p]}"
+                )
+            # cells of the primitive cell, each at least one atom: bounded before anything
+            # is allocated (a 100001 supercell tried 224 GiB, a larger one overflowed)
+            if p is not None and p[0][0] * p[1][1] - p[0][1] * p[1][0] > limits.bound("atoms"):
+                det = p[0][0] * p[1][1] - p[0][1] * p[1][0]
+                raise ValueError(
+                    f"{name}: "
+                    + limits.message("atoms", det, "primitive cells, at least one atom each")
                 )
         return self
 
@@ -175,6 +193,19 @@ class _PairOptions(_LatticeOption):
         0.01,
         description="force tolerance of the reference relaxation (when a calculator is given)",
     )
+
+    @field_validator("twist")
+    @classmethod
+    def _twist_within_bound(cls, value):
+        """(m, n) makes m² + mn + n² primitive cells per layer: bounded before it is built."""
+        if value is not None:
+            m, n = value
+            cells = m * m + m * n + n * n
+            if cells > limits.bound("atoms"):
+                raise ValueError(
+                    limits.message("atoms", cells, "primitive cells per layer of the twist")
+                )
+        return value
 
 
 class SheetSlab(_Model):
@@ -415,9 +446,8 @@ def parse_recipe(data: dict[str, Any], field: str = SECTION) -> Any:
         if parts[:1] == ["slab2"] and parts[1:2] in (["bulk"], ["sheet"]):  # slab2's tag
             parts = parts[:1] + parts[2:]
         loc = ".".join(parts)
-        raise InputError(
-            f"{field}.{loc}: {err['msg']}" if loc else f"{field}: {err['msg']}"
-        ) from None
+        msg = str(err["msg"]).removeprefix("Value error, ")  # pydantic's, not the user's
+        raise InputError(f"{field}.{loc}: {msg}" if loc else f"{field}: {msg}") from None
 
 
 def input_files(recipe: Any) -> list[Path]:
