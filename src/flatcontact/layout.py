@@ -16,7 +16,7 @@ A run directory::
     05-elastic/  elastic.json                       (only with elastic.enabled)
     06-contact/  contact.nc  summary.json  (fit.json)  fig4_traction  fig5_force_stiffness(_rms)
                  (fig6_experiment  fig5c_cycle_loops  fig6_lockin  fig6_fit)
-    07-report/   report.html
+    07-report/   report.html  (refusal.json: a run refused after the scan)
 
 and every stage folder holds its record ``stage.json`` (:data:`flatcontact.rundir.RECORD_NAME`).
 """
@@ -99,6 +99,9 @@ FIG6_FIT = "fig6_fit"
 
 # ---- report
 REPORT_HTML = "report.html"
+#: A refused run's refusal: the stage, its message, the gates' points, the remedies
+#: (:mod:`flatcontact.report.sections.refusal`).
+REFUSAL_JSON = "refusal.json"
 
 
 # ---- studies (``flatcontact study ... --out DIR``)

@@ -529,21 +529,26 @@ class Pipeline:
         """``06-contact/summary.json``: parameters, their provenance and the per-p0 results."""
         return self._json("contact", SUMMARY_JSON)
 
-    def report(self) -> Path:
-        """Stage 7: ``report.html`` (self-contained) in ``07-report/`` and the run directory."""
+    def report(self, refusal: dict | None = None) -> Path:
+        """Stage 7: ``report.html`` in ``07-report/`` and the run directory (``refusal``: of a
+        run refused after the scan, its finished stages only, :meth:`refused_report`)."""
         cfg = self.config
         names = ["build", "scan", "analyze", "laws", "contact"]
+        if refusal is not None:
+            names = [name for name in names if name in refusal["finished"]]
         ups = {name: self._upstream(name) for name in names}
         inputs = {"report": cfg.section("report"), **{k: v.fingerprint for k, v in ups.items()}}
-        if cfg.elastic.enabled:  # the report tables the elastic stage's Cij
-            inputs["elastic"] = self._upstream("elastic").fingerprint
+        if cfg.elastic.enabled and (refusal is None or "elastic" in refusal["finished"]):
+            inputs["elastic"] = self._upstream("elastic").fingerprint  # the report tables its Cij
         if cfg.report.approximant_study is not None:  # the report tables that study's files
             inputs["approximant_study"] = approximant_study_digest(cfg.report.approximant_study)
+        if refusal is not None:
+            inputs["refusal"] = refusal
         folders = {name: self.folder(name) for name in STAGES}
         versions = json.loads((self.root / VERSIONS_JSON).read_text())
 
         def work(folder: Path) -> None:
-            run_report(cfg, ReportInputs(folders, versions), folder)
+            run_report(cfg, ReportInputs(folders, versions, refusal), folder)
 
         result = self._run("report", inputs, work)
         target = self.root / REPORT_HTML
@@ -552,10 +557,38 @@ class Pipeline:
         return copy_file_atomic(result.folder / REPORT_HTML, target)
 
     def run(self) -> Path:
-        """Every stage in order; returns the path of ``report.html``."""
+        """Every stage in order; returns the path of ``report.html``. A stage refused after the
+        scan (an InputError: a gate, a fold in the analysis) still leaves the report of what
+        was computed (:meth:`refused_report`); the refusal is raised naming it."""
         for name in ("build", "scan", "analyze", "laws", "elastic", "contact"):
-            getattr(self, name)()
+            try:
+                getattr(self, name)()
+            except InputError as exc:
+                if "scan" not in self.results or self.rundir.read_only is not None:
+                    raise
+                try:
+                    path = self.refused_report(name, exc)
+                except Exception as failed:  # the refusal, not the report's own failure
+                    log.error("report of the refused run: failed: %s", failed)
+                    raise exc from None
+                raise InputError(f"{exc} (report of the run and the remedies: {path})") from None
         return self.report()
+
+    def refused_report(self, stage: str, error: Exception) -> Path:
+        """``report.html`` of a run refused at ``stage`` after the scan: the finished stages,
+        the refusal with its points (gates fired, folds recorded) and the remedies
+        (:func:`flatcontact.report.sections.refusal.refusal_record`, ``refusal.json``)."""
+        from flatcontact.report.sections.refusal import refusal_record
+
+        cfg, findings = self.config, []
+        if stage == "contact" and "laws" in self.results:  # the gates and their points
+            refused = self.gates().refused(cfg.contact.accept_untrusted)
+            findings = [{"gate": f.gate, "message": f.message} for f in refused]
+        folds = self.scan_summary().get("load_folds") or []
+        finished = [name for name in STAGES if name in self.results]
+        log.error("stage %s: refused: %s", stage, error)
+        record = refusal_record(stage, str(error), findings, finished, cfg.scan.grid, folds)
+        return self.report(refusal=record)
 
 
 def run(

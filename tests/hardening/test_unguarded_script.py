@@ -114,7 +114,9 @@ def test_only_calls_from_the_scripts_top_level_outside_the_guard_are_unguarded(t
 
 
 def test_guarded_lines_are_the_bodies_of_main_blocks_in_either_order():
-    src = "x = 1\nif __name__ == '__main__':\n    a()\n    b()\nif '__main__' == __name__:\n    c()\n"
+    src = (
+        "x = 1\nif __name__ == '__main__':\n    a()\n    b()\nif '__main__' == __name__:\n    c()\n"
+    )
     assert guarded_lines(src) == [(3, 4), (6, 6)]
     assert guarded_lines("if __name__ != '__main__':\n    a()\n") == []
     assert guarded_lines("def (:\n") == []
