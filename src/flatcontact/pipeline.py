@@ -584,10 +584,11 @@ class Pipeline:
         if stage == "contact" and "laws" in self.results:  # the gates and their points
             refused = self.gates().refused(cfg.contact.accept_untrusted)
             findings = [{"gate": f.gate, "message": f.message} for f in refused]
-        folds = self.scan_summary().get("load_folds") or []
+        scan = self.scan_summary()
         finished = [name for name in STAGES if name in self.results]
         log.error("stage %s: refused: %s", stage, error)
-        record = refusal_record(stage, str(error), findings, finished, cfg.scan.grid, folds)
+        folds, redone = scan.get("load_folds") or [], scan.get("fold_rerelaxation")
+        record = refusal_record(stage, str(error), findings, finished, cfg.scan.grid, folds, redone)
         return self.report(refusal=record)
 
 

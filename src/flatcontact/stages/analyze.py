@@ -119,29 +119,48 @@ def _folds_named(scan_json: Path):
     """A load that is not monotonic where the scan recorded folds (``scan.json``
     ``load_folds``, :mod:`flatcontact.ispes.grid_bracket`) is named as that fold, with its two
     causes and their remedies (:data:`flatcontact.ispes.thicknesses.FOLD_REMEDY`: a plane that
-    slips, or a relaxation stopped short of its minimum) besides the loads below it."""
+    slips, or a relaxation stopped short of its minimum) besides the loads below it. A fold
+    whose window the scan re-relaxed at a tighter fmax and which survived
+    (``fold_rerelaxation``, :mod:`flatcontact.stages.fold_remedy`) is named as such."""
     try:
         yield
     except InputError as exc:
         text = str(exc)
-        folds = []
-        if "not monotonic" in text:
+        folds, survived = [], []
+        if "not monotonic" in text or "fold" in text:
             try:
-                folds = json.loads(scan_json.read_text()).get("load_folds") or []
-            except (OSError, ValueError, AttributeError):
-                folds = []
-        if not folds:
+                scan = json.loads(scan_json.read_text())
+                folds = scan.get("load_folds") or []
+                redone = scan.get("fold_rerelaxation") or {}
+                survived = [f"{w['column']}" for w in redone.get("surviving") or []]
+                fmax = redone.get("fmax_ev_per_angstrom")
+            except (OSError, ValueError, AttributeError, KeyError, TypeError):
+                folds, survived = [], []
+        if not folds and not survived:
             raise
         # imported here: the CLI imports this module before numpy and ASE may load
         from flatcontact.ispes.thicknesses import FOLD_REMEDY
 
-        first = folds[0]
-        raise InputError(
-            f"{text}; the scan recorded {len(folds)} folding column(s) ({SCAN_JSON} "
-            f"load_folds; first: {first.get('column')}, p = {first.get('p_gpa', float('nan')):.3g} "
-            f"GPa at z = {first.get('z_angstrom', float('nan')):.4g} Å): {FOLD_REMEDY}; or "
-            "use loads below the fold (analysis.p_gpa, scan.p_range_gpa.hi_gpa)"
-        ) from None
+        said = text
+        if folds and "not monotonic" in text:
+            first = folds[0]
+            said += (
+                f"; the scan recorded {len(folds)} folding column(s) ({SCAN_JSON} load_folds; "
+                f"first: {first.get('column')}, p = {first.get('p_gpa', float('nan')):.3g} GPa "
+                f"at z = {first.get('z_angstrom', float('nan')):.4g} Å): {FOLD_REMEDY}; or use "
+                "loads below the fold (analysis.p_gpa, scan.p_range_gpa.hi_gpa)"
+            )
+        if survived:
+            from flatcontact.ispes.rerelax import SURVIVING_FOLD_REMEDY
+
+            said += (
+                f"; the scan re-relaxed the fold's window of {len(survived)} column(s) (first: "
+                f"{survived[0]}) at fmax {fmax:g} eV/Å and the fold survived: it is not the "
+                f"relaxation's; {SURVIVING_FOLD_REMEDY}"
+            )
+        if said == text:
+            raise
+        raise InputError(said) from None
 
 
 def _write(result: AnalyzeResult, folder: Path, svg: bool) -> None:

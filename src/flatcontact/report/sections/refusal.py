@@ -94,8 +94,12 @@ def remedies(record: dict, grid: tuple[int, int] | list[int]) -> list[str]:
     for finding in record.get("findings") or []:
         out += [r.format(grid=fine) for r in GATE_REMEDIES.get(finding["gate"], ())]
     kind = _analysis_kind(record.get("message", "")) if record.get("stage") == "analyze" else None
+    survived = (record.get("fold_rerelaxation") or {}).get("surviving")
     if kind is not None:
         out += [r.format(grid=fine) for r in ANALYSIS_REMEDIES[kind]]
+    folded = kind == "fold" or any(f["gate"] == "load_fold" for f in record.get("findings") or [])
+    if survived and folded:  # the tighter fmax was tried: the fold is not the relaxation's
+        out = [r for r in out if not r.startswith("tighten scan.fmax_ev_per_angstrom")]
     if record.get("findings"):
         out.append(ACCEPT)
     return list(dict.fromkeys(out))
@@ -108,16 +112,20 @@ def refusal_record(
     finished: list[str],
     grid: tuple[int, int] | list[int],
     load_folds: list[dict] | None = None,
+    fold_rerelaxation: dict | None = None,
 ) -> dict:
     """``refusal.json``: the refused ``stage``, its one-line ``message``, the gate
     ``findings`` (``{"gate", "message"}``: the message names the points and numbers), the
-    ``load_folds`` the scan recorded (column, z, p, the loads refused), the stages that
-    ``finished`` and the :func:`remedies`."""
+    ``load_folds`` the scan recorded (column, z, p, the loads refused), the scan's
+    re-relaxation of folds (``scan.json`` ``fold_rerelaxation``,
+    :mod:`flatcontact.ispes.rerelax`), the stages that ``finished`` and the :func:`remedies`
+    (a fold that survived the tighter fmax is not told to tighten it)."""
     record = {
         "stage": stage,
         "message": message,
         "findings": [{"gate": f["gate"], "message": f["message"]} for f in findings],
         "load_folds": list(load_folds or []),
+        "fold_rerelaxation": fold_rerelaxation,
         "finished": list(finished),
     }
     record["remedies"] = remedies(record, grid)
@@ -156,6 +164,16 @@ def refusal_section(record: dict) -> Section:
                 rows,
                 "Folds the scan recorded (scan.json load_folds)",
             )
+        )
+    redone = record.get("fold_rerelaxation") or {}
+    if redone.get("found"):
+        fmax = redone.get("fmax_ev_per_angstrom")
+        gone, kept = redone.get("remedied") or [], redone.get("surviving") or []
+        notes.append(
+            f"Before refusing, the scan re-relaxed the windows of {len(redone['found'])} folding "
+            f"column(s) at fmax {fmax:g} eV/Å ({len(redone.get('points') or [])} points): "
+            f"{len(gone)} fold(s) gone (the relaxation's), {len(kept)} survived"
+            + (f" ({', '.join(w['column'] for w in kept[:4])})" if kept else "")
         )
     remedies_list = record.get("remedies") or []
     if remedies_list:
