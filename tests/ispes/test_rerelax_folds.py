@@ -272,3 +272,36 @@ def test_a_run_whose_fold_survives_is_refused_with_a_report_that_says_so(tmp_pat
     page = (run / "report.html").read_text()
     assert "Before refusing, the scan re-relaxed the windows of" in page
     assert "survived" in page
+
+
+def test_recorded_windows_are_the_columns_the_scans_grid_check_records(
+    toy_scan, toy_reference, tmp_path
+):
+    """With ``recorded``, the windows are exactly the columns the scan's grid check
+    (:func:`flatcontact.ispes.grid_bracket.check_grid`) records in ``load_folds``, which the
+    ``load_fold`` gate refuses whatever the analysis loads."""
+    from flatcontact.ispes.grid_bracket import check_grid
+
+    folder, settings = toy_scan
+    work = tmp_path / "scan"
+    shutil.copytree(folder, work)
+    with PointStore(work / POINTS_DB, settings, toy_reference) as store:
+        z = np.asarray(store.resolved["thickness_angstrom"])
+    _displace(work / POINTS_DB, toy_reference, (0, 0, int(np.argsort(z)[2])))
+    _displace(work / POINTS_DB, toy_reference, (1, 1, int(np.argsort(z)[-3])), 0.03)
+    ds = _dataset(work, settings, toy_reference)
+    n_z = ds["thickness"].size
+    shifts = [(float(a), float(b)) for a in ds["shift_a"].values for b in ds["shift_b"].values]
+    verdict = check_grid(
+        ds["thickness"].values,
+        ds["energy"].values.reshape(-1, n_z),
+        ds["normal_stress"].values.reshape(-1, n_z),
+        float(ds.attrs["area"]),
+        shifts,
+        GRID.p_range_gpa,
+        [0.0],
+    )
+    named = {f.column.rsplit(" (", 1)[0] for f in verdict.folds}  # less its load source
+    windows = fold_windows(ds, [0.0], recorded=True)
+    assert {w.name for w in windows} == named and named
+    assert {w.name for w in fold_windows(ds, [0.0])} <= named

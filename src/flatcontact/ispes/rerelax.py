@@ -109,11 +109,21 @@ def _column_fold(p: np.ndarray, top_gpa: float) -> int | None:
     return s
 
 
+def _recorded_fold(p: np.ndarray) -> int | None:
+    """The node where a column's load first rises with z before its tensile maximum (the
+    scan's grid check, :func:`flatcontact.ispes.grid_bracket.check_grid`, records such a rise
+    in ``load_folds`` and the gate ``load_fold`` refuses it), else None."""
+    m = int(np.argmin(p))
+    rises = np.flatnonzero(np.diff(p[: m + 1]) >= 0)
+    return int(rises[0]) + 1 if rises.size else None
+
+
 def fold_windows(
     ds: Any,
     loads_gpa: Sequence[float],
     load_source: str = "energy",
     window: int = WINDOW_NODES,
+    recorded: bool = False,
 ) -> list[FoldWindow]:
     """The columns of ``ds`` (``ispes.nc``) whose load folds below the largest of
     ``loads_gpa``, lowest fold first.
@@ -121,7 +131,10 @@ def fold_windows(
     The load is the analysis's: ``-(1/A) dU/dz`` at the nodes of the clamped spline
     (:func:`flatcontact.ispes.grid_bracket.node_loads_gpa`, ``load_source="energy"``) or the
     stored ``normal_stress``; the branch rule is
-    :func:`flatcontact.ispes.contract.branch_run`. Columns with a missing point are skipped.
+    :func:`flatcontact.ispes.contract.branch_run`. With ``recorded``, also every column whose
+    energy-derived or stored load rises before its tensile maximum at any load (what the
+    scan's grid check of a pressure-range grid records and the ``load_fold`` gate refuses).
+    Columns with a missing point are skipped.
     """
     z = np.asarray(ds[contract.DIM_Z].values, float)
     energy = np.asarray(ds[contract.VAR_ENERGY].values, float)
@@ -135,8 +148,14 @@ def fold_windows(
             e, s = energy[i, j], stress[i, j]
             if not (np.all(np.isfinite(e)) and np.all(np.isfinite(s))):
                 continue
-            p = node_loads_gpa(z, e[None, :], s[None, :], area)[0] if load_source == "energy" else s
+            from_energy = node_loads_gpa(z, e[None, :], s[None, :], area)[0]
+            p = from_energy if load_source == "energy" else s
             k = _column_fold(p, top)
+            if k is None and recorded:
+                for p in (from_energy, s):
+                    k = _recorded_fold(p)
+                    if k is not None:
+                        break
             if k is None:
                 continue
             lo, hi = max(0, k - 1 - window), min(z.size - 1, k + window)
@@ -222,6 +241,7 @@ def rerelax_folds(
     loads_gpa: Sequence[float],
     load_source: str = "energy",
     rerelax_path: str | Path | None = None,
+    recorded: bool = False,
 ) -> tuple[Any, FoldRerelaxation]:
     """Re-relax the windows of the folds of ``ds`` at ``relax.fmax_ev_per_a`` × FMAX_FACTOR.
 
@@ -238,6 +258,8 @@ def rerelax_folds(
         The scan's relaxation settings (the mode and optimiser are kept).
     loads_gpa, load_source
         The loads the analysis will read and how it reads the load (``"energy"``, ``"stress"``).
+    recorded
+        Also the folds the scan's grid check records (:func:`fold_windows`).
     rerelax_path
         The store of the re-relaxed points (default ``rerelax.db`` beside ``store_path``).
 
@@ -248,7 +270,7 @@ def rerelax_folds(
         (``ds`` itself when nothing folds), and the :class:`FoldRerelaxation`.
     """
     tight = dataclasses.replace(relax, fmax_ev_per_a=relax.fmax_ev_per_a * FMAX_FACTOR)
-    found = fold_windows(ds, loads_gpa, load_source)
+    found = fold_windows(ds, loads_gpa, load_source, recorded=recorded)
     result = FoldRerelaxation(tight.fmax_ev_per_a, found, [], [], [])
     if not found:
         return ds, result
@@ -329,9 +351,8 @@ def rerelax_folds(
     out.attrs["fold_rerelaxed_points"] = len(result.points)
     out.attrs["fold_rerelaxed_fmax_ev_per_a"] = tight.fmax_ev_per_a
     columns = {w.column for w in chosen}
-    result.surviving += [
-        w for w in fold_windows(out, loads_gpa, load_source) if w.column in columns
-    ]
+    again = fold_windows(out, loads_gpa, load_source, recorded=recorded)
+    result.surviving += [w for w in again if w.column in columns]
     for line in result.lines():
         log.warning("scan: %s", line)
     return out, result

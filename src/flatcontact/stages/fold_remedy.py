@@ -1,7 +1,10 @@
 """The scan stage's remedy for folds from relaxation error (:mod:`flatcontact.ispes.rerelax`).
 
-After the grid is stored, every column whose load folds below a load the analysis will read
-(``analysis.p_gpa``, read as ``analysis.load_source`` says) has its fold's window relaxed
+After the grid is stored, every column whose load, read as ``analysis.load_source`` says,
+folds on the compressed side at any load (the analysis refuses the loads above a fold; the
+loads it reads, ``analysis.p_gpa``, are not part of the scan's fingerprint, so the grid must
+not depend on them), and on a pressure-range grid every column the scan's grid check records
+as folding (``load_folds``, refused by the gate ``load_fold``), has its fold's window relaxed
 again at ``scan.fmax_ev_per_angstrom`` / 10, once, into ``02-scan/rerelax.db``; ``ispes.nc``
 then holds those points, ``scan.json`` ``fold_rerelaxation`` says what was re-relaxed and
 which folds survived, its warnings and the run log state it, and the folds the re-relaxation
@@ -12,6 +15,7 @@ message saying that it survived.
 from __future__ import annotations
 
 import dataclasses
+import math
 from typing import Any
 
 from flatcontact.ispes.contract import write_ispes
@@ -37,7 +41,15 @@ def remedy_folds(
     a = settings.analysis
     store = scan_settings(reference, factory, grid, relax, symmetry)
     ds, done = rerelax_folds(
-        reference, factory, scan.dataset, scan.store_path, store, relax, a.p_gpa, a.load_source
+        reference,
+        factory,
+        scan.dataset,
+        scan.store_path,
+        store,
+        relax,
+        [math.inf],  # every fold, whatever analysis.p_gpa (not in the scan's fingerprint)
+        a.load_source,
+        recorded=settings.scan.p_range_gpa is not None,  # the grid check records folds
     )
     if not done.found:
         return scan, None, []
@@ -47,4 +59,7 @@ def remedy_folds(
     folds = [
         f for f in scan.load_folds if not any(name in str(f.get("column", "")) for name in gone)
     ]
-    return dataclasses.replace(scan, dataset=ds, load_folds=folds), done.record(), done.lines()
+    # the grid check's notes on the folds that are gone would say they are still there
+    notes = [n for n in scan.notes if not any(f"{name} (" in n for name in gone)]
+    scan = dataclasses.replace(scan, dataset=ds, load_folds=folds, notes=notes)
+    return scan, done.record(), done.lines()
