@@ -150,17 +150,31 @@ def _folds_named(scan_json: Path):
                 f"at z = {first.get('z_angstrom', float('nan')):.4g} Å): {FOLD_REMEDY}; or use "
                 "loads below the fold (analysis.p_gpa, scan.p_range_gpa.hi_gpa)"
             )
+        named = _shift_in(text)
+        if named is not None:  # the column the analysis names, when it says which
+            survived = [c for c in survived if _shift_in(c) == named]
         if survived:
             from flatcontact.ispes.rerelax import SURVIVING_FOLD_REMEDY
 
             said += (
-                f"; the scan re-relaxed the fold's window of {len(survived)} column(s) (first: "
-                f"{survived[0]}) at fmax {fmax:g} eV/Å and the fold survived: it is not the "
-                f"relaxation's; {SURVIVING_FOLD_REMEDY}"
+                f"; the scan re-relaxed the fold's window of the {survived[0]} at fmax "
+                f"{fmax:g} eV/Å and the fold survived: it is not the relaxation's; "
+                f"{SURVIVING_FOLD_REMEDY}"
             )
         if said == text:
             raise
         raise InputError(said) from None
+
+
+def _shift_in(text: str) -> tuple[str, str] | None:
+    """The lateral shift a message names, ``(shift_a=a, shift_b=b)`` as the analysis labels
+    a column or ``shift (a, b)`` as the scan does, as two strings (``%.4g``), or None."""
+    import re
+
+    found = re.search(r"shift_a=([-\d.e+]+), shift_b=([-\d.e+]+)", text) or re.search(
+        r"shift \(([-\d.e+]+), ([-\d.e+]+)\)", text
+    )
+    return (found.group(1), found.group(2)) if found else None
 
 
 def _write(result: AnalyzeResult, folder: Path, svg: bool) -> None:

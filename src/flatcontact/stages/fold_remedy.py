@@ -61,5 +61,11 @@ def remedy_folds(
     ]
     # the grid check's notes on the folds that are gone would say they are still there
     notes = [n for n in scan.notes if not any(f"{name} (" in n for name in gone)]
+    if gone:
+        grid_folds = sum("grid column" in str(f.get("column", "")) for f in folds)
+        notes = [n for n in notes if "grid columns fold (" not in n] + [
+            f"p-range-gpa: {len(gone)} grid column fold(s) re-relaxed away; {grid_folds} "
+            "remain (scan.json load_folds, fold_rerelaxation)"
+        ]
     scan = dataclasses.replace(scan, dataset=ds, load_folds=folds, notes=notes)
     return scan, done.record(), done.lines()
