@@ -305,3 +305,25 @@ def test_recorded_windows_are_the_columns_the_scans_grid_check_records(
     windows = fold_windows(ds, [0.0], recorded=True)
     assert {w.name for w in windows} == named and named
     assert {w.name for w in fold_windows(ds, [0.0])} <= named
+
+
+def test_a_rigid_scan_has_nothing_to_re_relax_and_says_so(toy_scan, toy_reference, tmp_path):
+    folder, settings = toy_scan
+    work = tmp_path / "scan"
+    shutil.copytree(folder, work)
+    with PointStore(work / POINTS_DB, settings, toy_reference) as store:
+        z = np.asarray(store.resolved["thickness_angstrom"])
+    _displace(work / POINTS_DB, toy_reference, (0, 0, int(np.argsort(z)[2])))
+    ds = _dataset(work, settings, toy_reference)
+    rigid = RelaxSettings(0.005, mode="rigid")
+    same, done = rerelax_folds(
+        toy_reference, None, ds, work / POINTS_DB, settings, rigid, LOADS_GPA
+    )
+    assert same is ds and done.points == [] and not (work / RERELAX_DB).exists()
+    assert done.surviving == [] and done.remedied == [] and len(done.left) == 1
+    assert done.lines() == [
+        "grid column at shift (0, 0): fold not re-relaxed (a rigid scan relaxes nothing)"
+    ]
+    assert done.record()["left"] == [
+        {"column": "grid column at shift (0, 0)", "why": "a rigid scan relaxes nothing"}
+    ]

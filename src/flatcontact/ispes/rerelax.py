@@ -186,9 +186,13 @@ class FoldRerelaxation:
 
     @property
     def remedied(self) -> list[FoldWindow]:
-        """The folds that the re-relaxation removed."""
-        kept = {w.column for w in self.surviving}
+        """The folds that the re-relaxation removed (``surviving``: re-relaxed and still
+        folding; ``left``: not re-relaxed)."""
+        kept = {w.column for w in self.surviving} | {w.column for w in self.found if self._left(w)}
         return [w for w in self.found if w.column not in kept]
+
+    def _left(self, window: FoldWindow) -> bool:
+        return any(name == window.name for name, _ in self.left)
 
     def record(self) -> dict:
         """``scan.json`` ``fold_rerelaxation``."""
@@ -276,7 +280,6 @@ def rerelax_folds(
         return ds, result
     if relax.mode == "rigid":
         result.left += [(w.name, "a rigid scan relaxes nothing") for w in found]
-        result.surviving = list(found)
         return ds, result
     chosen, mapped = [], ds.get(contract.VAR_MAPPED)
     for w in found:
@@ -286,7 +289,6 @@ def rerelax_folds(
             result.left.append((w.name, "its points are filled by symmetry, not stored"))
         else:
             chosen.append(w)
-    result.surviving = [w for w in found if w not in chosen]
     if not chosen:
         return ds, result
     z = np.asarray(ds[contract.DIM_Z].values, float)
