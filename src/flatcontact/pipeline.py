@@ -100,7 +100,7 @@ from flatcontact.stages.elastic import ElasticInputs, run_elastic
 from flatcontact.stages.gates import GateInputs, check_gates, evaluate_gates
 from flatcontact.stages.laws import LawsInputs, run_laws
 from flatcontact.stages.preflight import check_inputs
-from flatcontact.stages.report import ReportInputs, run_report
+from flatcontact.stages.report import ReportInputs, refusal_of, run_report
 from flatcontact.stages.result_files import CONTACT, FRICTION, open_result
 from flatcontact.stages.scan import ScanInputs, run_scan
 from flatcontact.structures.interface_io import read_interface
@@ -218,6 +218,7 @@ class Pipeline:
         self._check_root()
         self._check_config()
         self.results: dict[str, StageResult] = {}
+        self._refusal: InputError | None = None  # the last stage's own refusal (run())
         self._handler: logging.Handler | None = None
         self._lock: RunLock | None = None
         # a finished run on a read-only mount is read, never written (run_stage says so)
@@ -312,12 +313,20 @@ class Pipeline:
         if self.on_event is not None:
             self.on_event(StageEvent(kind, name, STAGES[name], **details))
 
+    def _refused(self, check: Callable, *args: Any) -> Any:
+        """``check(*args)``; its InputError is the run's refusal (:meth:`run` reports it)."""
+        try:
+            return check(*args)
+        except InputError as exc:
+            self._refusal = exc
+            raise
+
     def _run(self, name: str, inputs: dict, work: Callable[[Path], Any]) -> StageResult:
         index = STAGES[name]
         inputs = {**inputs, "code_sha256": stage_code_digest(name)}
         self._tell("start", name)
         try:
-            result = self.rundir.run_stage(index, name, inputs, work)
+            result = self.rundir.run_stage(index, name, inputs, lambda f: self._refused(work, f))
         except KeyboardInterrupt:
             log.warning("stage %s: interrupted; rerun to resume", name)
             self._tell("failed", name, action="interrupted")
@@ -506,9 +515,9 @@ class Pipeline:
         # before the stage folder is touched: a gate that fired, or a refused p0, stops the
         # run with the finished stages kept (rerun with contact.accept_untrusted to go on)
         gates = self.gates()
-        check_gates(cfg, gates)
+        self._refused(check_gates, cfg, gates)
         stage_inputs = self._contact_inputs(gates.to_json(cfg.contact.accept_untrusted))
-        check_contact(cfg, contact_parameters(cfg, stage_inputs)[0])
+        self._refused(lambda: check_contact(cfg, contact_parameters(cfg, stage_inputs)[0]))
         inputs = {
             "contact": portable(cfg.section("contact"), "experiment_csv", "fit_csv"),
             "laws": laws.fingerprint,
@@ -534,8 +543,7 @@ class Pipeline:
         run refused after the scan, its finished stages only, :meth:`refused_report`)."""
         cfg = self.config
         names = ["build", "scan", "analyze", "laws", "contact"]
-        if refusal is not None:
-            names = [name for name in names if name in refusal["finished"]]
+        names = [n for n in names if refusal is None or n in refusal["finished"]]
         ups = {name: self._upstream(name) for name in names}
         inputs = {"report": cfg.section("report"), **{k: v.fingerprint for k, v in ups.items()}}
         if cfg.elastic.enabled and (refusal is None or "elastic" in refusal["finished"]):
@@ -557,15 +565,14 @@ class Pipeline:
         return copy_file_atomic(result.folder / REPORT_HTML, target)
 
     def run(self) -> Path:
-        """Every stage in order; returns the path of ``report.html``. A stage refused after the
-        scan (an InputError: a gate, a fold in the analysis) still leaves the report of what
-        was computed (:meth:`refused_report`); the refusal is raised naming it."""
+        """Every stage in order; returns the path of ``report.html``. A stage that refuses after
+        the scan still leaves the report (:meth:`refused_report`), named in the refusal."""
         for name in ("build", "scan", "analyze", "laws", "elastic", "contact"):
             try:
                 getattr(self, name)()
             except InputError as exc:
-                if "scan" not in self.results or self.rundir.read_only is not None:
-                    raise
+                if exc is not self._refusal or "scan" not in self.results or self.rundir.read_only:
+                    raise  # not a stage's refusal after the scan (a run-directory defect)
                 try:
                     path = self.refused_report(name, exc)
                 except Exception as failed:  # the refusal, not the report's own failure
@@ -575,21 +582,13 @@ class Pipeline:
         return self.report()
 
     def refused_report(self, stage: str, error: Exception) -> Path:
-        """``report.html`` of a run refused at ``stage`` after the scan: the finished stages,
-        the refusal with its points (gates fired, folds recorded) and the remedies
-        (:func:`flatcontact.report.sections.refusal.refusal_record`, ``refusal.json``)."""
-        from flatcontact.report.sections.refusal import refusal_record
-
-        cfg, findings = self.config, []
-        if stage == "contact" and "laws" in self.results:  # the gates and their points
-            refused = self.gates().refused(cfg.contact.accept_untrusted)
-            findings = [{"gate": f.gate, "message": f.message} for f in refused]
-        scan = self.scan_summary()
+        """The report of a run refused at ``stage`` (:func:`flatcontact.stages.report.refusal_of`)."""
+        gated = stage == "contact" and "laws" in self.results  # the gates and their points
+        findings = self.gates().refused(self.config.contact.accept_untrusted) if gated else []
         finished = [name for name in STAGES if name in self.results]
         log.error("stage %s: refused: %s", stage, error)
-        folds, redone = scan.get("load_folds") or [], scan.get("fold_rerelaxation")
-        record = refusal_record(stage, str(error), findings, finished, cfg.scan.grid, folds, redone)
-        return self.report(refusal=record)
+        scan = self.scan_summary()
+        return self.report(refusal_of(self.config, stage, error, findings, finished, scan))
 
 
 def run(

@@ -55,6 +55,9 @@ MAX_ROUNDS = 1
 #: Thickness nodes re-relaxed on each side of the rise (the nodes of the rise itself, and
 #: this many beyond each): the spline's load at a node depends mostly on its neighbours.
 WINDOW_NODES = 2
+#: A column of fewer thicknesses has no fold to read (a rise needs three nodes; the
+#: analysis reads at least four).
+MIN_THICKNESSES = 3
 #: At most this many folding columns are re-relaxed (the lowest folds first); more folding
 #: columns than this is not a local relaxation error.
 MAX_FOLD_COLUMNS = 8
@@ -134,9 +137,12 @@ def fold_windows(
     :func:`flatcontact.ispes.contract.branch_run`. With ``recorded``, also every column whose
     energy-derived or stored load rises before its tensile maximum at any load (what the
     scan's grid check of a pressure-range grid records and the ``load_fold`` gate refuses).
-    Columns with a missing point are skipped.
+    Columns with a missing point are skipped; a grid of fewer than :data:`MIN_THICKNESSES`
+    thicknesses has none.
     """
     z = np.asarray(ds[contract.DIM_Z].values, float)
+    if z.size < MIN_THICKNESSES:
+        return []
     energy = np.asarray(ds[contract.VAR_ENERGY].values, float)
     stress = np.asarray(ds[contract.VAR_STRESS].values, float)
     sa, sb = ds[contract.DIM_A].values, ds[contract.DIM_B].values

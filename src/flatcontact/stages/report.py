@@ -37,6 +37,24 @@ class ReportResult:
         return {"report": str(self.path) if self.path is not None else None}
 
 
+def refusal_of(settings, stage: str, error, findings, finished: list[str], scan: dict) -> dict:
+    """The refusal record of a run refused at ``stage`` with ``error`` after the scan
+    (:func:`flatcontact.report.sections.refusal.refusal_record`): the gate ``findings`` that
+    stopped it (:class:`flatcontact.analysis.gates.Finding`), the ``finished`` stages, and
+    from ``scan`` (``scan.json``) the folds recorded and their re-relaxation."""
+    from flatcontact.report.sections.refusal import refusal_record
+
+    return refusal_record(
+        stage,
+        str(error),
+        [{"gate": f.gate, "message": f.message} for f in findings],
+        finished,
+        settings.scan.grid,
+        scan.get("load_folds") or [],
+        scan.get("fold_rerelaxation"),
+    )
+
+
 def _stage_rows(
     folders: dict[str, Path], refusal: dict | None = None
 ) -> list[tuple[str, str, str, str]]:
