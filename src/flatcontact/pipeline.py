@@ -70,6 +70,7 @@ from flatcontact.layout import (
     INTERFACE,
     ISPES_NC,
     LAWS_JSON,
+    OTHER_FORM_JSON,
     REPORT_HTML,
     RUN_LOG,
     RUN_MARKER,
@@ -78,7 +79,7 @@ from flatcontact.layout import (
     SUMMARY_JSON,
     VERSIONS_JSON,
 )
-from flatcontact.report.sections.approximant_study import approximant_study_digest
+from flatcontact.refused import refused_report
 from flatcontact.rundir import (
     RunDirectory,
     RunLock,
@@ -91,6 +92,7 @@ from flatcontact.stages import _calculator
 from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
 from flatcontact.stages.build import BuildInputs, run_build
 from flatcontact.stages.contact import (
+    QUARTZ_QUICK_LAWS_FILE,
     ContactInputs,
     check_contact,
     contact_parameters,
@@ -100,7 +102,7 @@ from flatcontact.stages.elastic import ElasticInputs, run_elastic
 from flatcontact.stages.gates import GateInputs, check_gates, evaluate_gates
 from flatcontact.stages.laws import LawsInputs, run_laws
 from flatcontact.stages.preflight import check_inputs
-from flatcontact.stages.report import ReportInputs, refusal_of, run_report
+from flatcontact.stages.report import ReportInputs, approximant_study_digest, run_report
 from flatcontact.stages.result_files import CONTACT, FRICTION, open_result
 from flatcontact.stages.scan import ScanInputs, run_scan
 from flatcontact.structures.interface_io import read_interface
@@ -313,8 +315,7 @@ class Pipeline:
         if self.on_event is not None:
             self.on_event(StageEvent(kind, name, STAGES[name], **details))
 
-    def _refused(self, check: Callable, *args: Any) -> Any:
-        """``check(*args)``; its InputError is the run's refusal (:meth:`run` reports it)."""
+    def _refused(self, check: Callable, *args: Any) -> Any:  # InputError: a refusal, run()
         try:
             return check(*args)
         except InputError as exc:
@@ -350,7 +351,7 @@ class Pipeline:
         """
         cfg = self.config
         # the file by name and content (file_sha256), not by where it is
-        structure = portable(cfg.section("structure"), "file")
+        structure = portable(cfg.structure_section(), "file")
         if cfg.structure.kind == "quartz-dense":
             structure.setdefault("file", None)  # the fingerprint of runs made before recipes
         inputs = {"structure": structure, "model": self._model_inputs()}
@@ -377,8 +378,7 @@ class Pipeline:
         """
         cfg = self.config
         build = self._upstream("build")
-        scan_inputs = {k: v for k, v in cfg.section("scan").items() if k not in EXECUTION_ONLY}
-        inputs = {"scan": scan_inputs, "model": self._model_inputs(), "build": build.fingerprint}
+        inputs = {**self._scan_inputs(), "build": build.fingerprint}
 
         def work(folder: Path) -> None:
             stage_inputs = ScanInputs(build.folder / INTERFACE)
@@ -391,6 +391,19 @@ class Pipeline:
 
         result = self._run("scan", inputs, work)
         return open_ispes(result.folder / ISPES_NC)
+
+    def _scan_inputs(self) -> dict:
+        """What the scan stage reads besides the build: its section (less the execution-only
+        keys), the model and, for a pressure-range grid, the load bracket its columns must
+        reach (``ispes.grid_bracket.bracket_targets_gpa``: the lowest and highest load of
+        ``analysis.p_gpa``), so a load added beyond the scanned range re-brackets the scan."""
+        cfg = self.config
+        scan_inputs = {k: v for k, v in cfg.section("scan").items() if k not in EXECUTION_ONLY}
+        inputs = {"scan": scan_inputs, "model": self._model_inputs()}
+        if cfg.scan.p_range_gpa is not None:
+            loads = [float(p) for p in cfg.analysis.p_gpa]
+            inputs["bracket_loads_gpa"] = [min(loads), max(loads)] if loads else None
+        return inputs
 
     def scan_summary(self) -> dict:
         """``02-scan/scan.json``: counts, force calls, thicknesses, adhesion (work of separation)."""
@@ -434,15 +447,14 @@ class Pipeline:
         """
         cfg = self.config
         analyze = self._upstream("analyze")
-        scan = self._upstream("scan")
         inputs = {"threshold_gpa": cfg.analysis.threshold_gpa, "analyze": analyze.fingerprint}
-        # the other energy form comes from the scan's ISPES (analyze's fingerprint covers it
-        # and the analysis settings); the laws' intervals from the uncertainty section
+        # both energy forms come from the analyze stage's files (its fingerprint covers them:
+        # the scan's, the analysis settings, its code); the intervals from the uncertainty section
         inputs["uncertainty"] = cfg.section("uncertainty")
 
         def work(folder: Path) -> None:
-            ispes = scan.folder / ISPES_NC
-            run_laws(cfg, LawsInputs.read(analyze.folder / FRICTION_CSV, ispes), folder)
+            tables = analyze.folder
+            run_laws(cfg, LawsInputs.read(tables / FRICTION_CSV, tables / OTHER_FORM_JSON), folder)
 
         self._run("laws", inputs, work)
         return self._json("laws", LAWS_JSON)
@@ -528,6 +540,8 @@ class Pipeline:
             inputs["gates"] = stage_inputs.gates  # the recorded verdict (a clean run: no key)
         if cfg.contact.experiment.csv:
             inputs["experiment_sha256"] = file_sha256(cfg.contact.experiment.csv)
+        if cfg.contact.experiment.compare:  # the comparison quotes the quick preset's laws
+            inputs["quartz_quick_laws_sha256"] = file_sha256(QUARTZ_QUICK_LAWS_FILE)
         if cfg.contact.fit.csv:
             inputs["fit_sha256"] = [file_sha256(f) for f in cfg.contact.fit.csv]
 
@@ -540,7 +554,7 @@ class Pipeline:
 
     def report(self, refusal: dict | None = None) -> Path:
         """Stage 7: ``report.html`` in ``07-report/`` and the run directory (``refusal``: of a
-        run refused after the scan, its finished stages only, :meth:`refused_report`)."""
+        run refused after the scan, its finished stages only, :mod:`flatcontact.refused`)."""
         cfg = self.config
         names = ["build", "scan", "analyze", "laws", "contact"]
         names = [n for n in names if refusal is None or n in refusal["finished"]]
@@ -565,30 +579,15 @@ class Pipeline:
         return copy_file_atomic(result.folder / REPORT_HTML, target)
 
     def run(self) -> Path:
-        """Every stage in order; returns the path of ``report.html``. A stage that refuses after
-        the scan still leaves the report (:meth:`refused_report`), named in the refusal."""
+        """Every stage in order; ``report.html`` (also of a refusal after the scan, named in it)."""
         for name in ("build", "scan", "analyze", "laws", "elastic", "contact"):
             try:
                 getattr(self, name)()
             except InputError as exc:
                 if exc is not self._refusal or "scan" not in self.results or self.rundir.read_only:
                     raise  # not a stage's refusal after the scan (a run-directory defect)
-                try:
-                    path = self.refused_report(name, exc)
-                except Exception as failed:  # the refusal, not the report's own failure
-                    log.error("report of the refused run: failed: %s", failed)
-                    raise exc from None
-                raise InputError(f"{exc} (report of the run and the remedies: {path})") from None
+                raise InputError(f"{exc} (report: {refused_report(self, name, exc)})") from None
         return self.report()
-
-    def refused_report(self, stage: str, error: Exception) -> Path:
-        """The report of a run refused at ``stage`` (:func:`flatcontact.stages.report.refusal_of`)."""
-        gated = stage == "contact" and "laws" in self.results  # the gates and their points
-        findings = self.gates().refused(self.config.contact.accept_untrusted) if gated else []
-        finished = [name for name in STAGES if name in self.results]
-        log.error("stage %s: refused: %s", stage, error)
-        scan = self.scan_summary()
-        return self.report(refusal_of(self.config, stage, error, findings, finished, scan))
 
 
 def run(

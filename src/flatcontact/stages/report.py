@@ -9,8 +9,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from flatcontact.fileio import write_json_atomic
-from flatcontact.layout import REFUSAL_JSON, REPORT_HTML
+from flatcontact.fileio import file_sha256, write_json_atomic
+from flatcontact.layout import EXPERIMENT_COLLAPSE_JSON, REFUSAL_JSON, REPORT_HTML
 
 
 @dataclass(frozen=True)
@@ -37,17 +37,31 @@ class ReportResult:
         return {"report": str(self.path) if self.path is not None else None}
 
 
-def refusal_of(settings, stage: str, error, findings, finished: list[str], scan: dict) -> dict:
+def approximant_study_digest(path: str | Path) -> dict:
+    """The content of the approximant study's files the report reads (sha256 of
+    ``study.json`` and of ``experiment_collapse.json`` beside it, if present): part of the
+    report stage's fingerprint, so a rerun or an extended study reruns the report."""
+    path = Path(path)
+    collapse = path.parent / EXPERIMENT_COLLAPSE_JSON
+    return {
+        "study_json_sha256": file_sha256(path),
+        "experiment_collapse_sha256": file_sha256(collapse) if collapse.is_file() else None,
+    }
+
+
+def refusal_of(settings, stage: str, error, gates, finished: list[str], scan: dict) -> dict:
     """The refusal record of a run refused at ``stage`` with ``error`` after the scan
-    (:func:`flatcontact.report.sections.refusal.refusal_record`): the gate ``findings`` that
-    stopped it (:class:`flatcontact.analysis.gates.Finding`), the ``finished`` stages, and
-    from ``scan`` (``scan.json``) the folds recorded and their re-relaxation."""
+    (:func:`flatcontact.report.sections.refusal.refusal_record`): the findings of ``gates``
+    (a :class:`flatcontact.analysis.gates.GateReport`, or None) not in
+    ``contact.accept_untrusted``, the ``finished`` stages, and from ``scan`` (``scan.json``)
+    the folds recorded and their re-relaxation."""
     from flatcontact.report.sections.refusal import refusal_record
 
+    refused = gates.refused(settings.contact.accept_untrusted) if gates is not None else []
     return refusal_record(
         stage,
         str(error),
-        [{"gate": f.gate, "message": f.message} for f in findings],
+        [{"gate": f.gate, "message": f.message} for f in refused],
         finished,
         settings.scan.grid,
         scan.get("load_folds") or [],

@@ -138,7 +138,24 @@ class MatchSettings(_Model):
         return self
 
 
-class _PairOptions(_Model):
+#: Where the slabs' lattice comes from (:mod:`flatcontact.structures.lattice`).
+LatticeSource = Literal["potential", "file"]
+
+
+class _LatticeOption(_Model):
+    """The one declaration of ``structure.lattice`` (every recipe that cuts or stacks a
+    material: ``sheets``, ``crystal``, ``fcc111``, ``quartz-dense``)."""
+
+    lattice: LatticeSource = Field(
+        "potential",
+        description="potential: the slabs at the interaction model's own equilibrium lattice "
+        "(the bulk, or a sheet's in-plane cell, relaxed with the run's model first); file: at "
+        "the structure file's (or built-in) lattice, the mismatch and its lateral stress "
+        "reported, refused above 2 % in-plane",
+    )
+
+
+class _PairOptions(_LatticeOption):
     held_layers: int = Field(1, ge=1, description="outer layers held (rigid) per slab")
     rotate_deg: AngleDeg = Field(
         0.0,
@@ -278,7 +295,7 @@ class Fcc111Recipe(_PairOptions):
     slab2: Fcc111Slab | None = Field(None, description="another fcc metal for slab 2")
 
 
-class QuartzDenseRecipe(_Model):
+class QuartzDenseRecipe(_LatticeOption):
     """The paper's α-quartz (0001) dense interface (flatcontact.structures.build)."""
 
     kind: Literal["quartz-dense"] = Field("quartz-dense", description="recipe kind")

@@ -64,7 +64,15 @@ from flatcontact.config.run import RunConfig
 from flatcontact.errors import InputError
 from flatcontact.ispes.executors import make_executor
 from flatcontact.ispes.shift_lattice import scan_grid
-from flatcontact.layout import FRICTION_CSV, FRICTION_NC, INTERFACE, ISPES_NC, LAWS_JSON, SCAN_JSON
+from flatcontact.layout import (
+    FRICTION_CSV,
+    FRICTION_NC,
+    INTERFACE,
+    ISPES_NC,
+    LAWS_JSON,
+    OTHER_FORM_JSON,
+    SCAN_JSON,
+)
 from flatcontact.studies.runner import run_jobs
 from flatcontact.studies.scaling import fit_scaling
 from flatcontact.studies.variants import variant_config
@@ -342,7 +350,9 @@ def run_cell(config: dict, folder: str, planned: int) -> dict:
     if lateral >= RESOLVED_FACTOR * floor:
         run_analyze(cfg, AnalyzeInputs(cell / ISPES_NC), cell / "analyze")
         run_laws(
-            cfg, LawsInputs.read(cell / "analyze" / FRICTION_CSV, cell / ISPES_NC), cell / "laws"
+            cfg,
+            LawsInputs.read(cell / "analyze" / FRICTION_CSV, cell / "analyze" / OTHER_FORM_JSON),
+            cell / "laws",
         )
         laws = json.loads((cell / "laws" / LAWS_JSON).read_text())
         form = laws.get("energy_form") or cfg.analysis.energy_form

@@ -19,7 +19,7 @@ import math
 from pathlib import Path
 
 from flatcontact.errors import InputError
-from flatcontact.fileio import file_sha256, read_text_file
+from flatcontact.fileio import read_text_file
 from flatcontact.layout import EXPERIMENT_COLLAPSE_JSON
 from flatcontact.report.format import fmt
 from flatcontact.report.html import Section, Table
@@ -51,18 +51,6 @@ def read_approximant_study(path: str | Path, field: str = "report.approximant_st
     if collapse.is_file():
         doc = {**doc, "experiment_collapse": _json(collapse, field)}
     return doc
-
-
-def approximant_study_digest(path: str | Path) -> dict:
-    """The content of the study's files the report reads (sha256 of ``study.json`` and of
-    ``experiment_collapse.json`` if present): the report's fingerprint, so a rerun or an
-    extended study reruns the report."""
-    path = Path(path)
-    collapse = path.parent / EXPERIMENT_COLLAPSE_JSON
-    return {
-        "study_json_sha256": file_sha256(path),
-        "experiment_collapse_sha256": file_sha256(collapse) if collapse.is_file() else None,
-    }
 
 
 def _json(path: Path, field: str):
