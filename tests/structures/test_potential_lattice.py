@@ -280,3 +280,20 @@ def test_a_hetero_pair_states_each_slabs_strain_against_its_own_model_lattice():
     assert match["slab2_strain_percent"] == pytest.approx([100 * (a_dia / 2.46 - 1)] * 2, abs=1e-4)
     expected = 100 * (a_dia / a_airebo - 1)  # ≈ +4.26 %
     assert match["slab2_strain_vs_potential_percent"] == pytest.approx([expected] * 2, abs=2e-3)
+
+
+def test_the_lattice_choice_and_its_code_enter_the_build_fingerprint(tmp_path):
+    """``lattice: potential`` fingerprints as another structure than ``file``; ``file`` as the
+    recipe did before the setting existed (its runs and measured blocks keep their
+    fingerprints); the lattice relaxation's module is in the build stage's code digest (the
+    model already is in its inputs)."""
+    from flatcontact.pipeline import stage_code
+    from flatcontact.stages.measured_on import structure_fingerprint
+
+    default, kept = _al_config(tmp_path), _al_config(tmp_path, lattice="file")
+    assert default.structure.lattice == "potential"
+    assert structure_fingerprint(default) != structure_fingerprint(kept)
+    legacy = kept.section("structure")
+    assert legacy.pop("lattice") == "file" and kept.structure_section() == legacy
+    assert "lattice" in default.structure_section()
+    assert "flatcontact.structures.lattice" in stage_code("build")
