@@ -15,6 +15,7 @@ import pandas as pd
 import pytest
 
 from flatcontact.config.load import build_config
+from flatcontact.ispes.work_of_separation import AT_PERFECT_STACKING
 from flatcontact.layout import (
     ANALYZE_JSON,
     BUILD_FIGURE,
@@ -101,7 +102,10 @@ def _stage_folders(tmp_path, atoms, build_record, laws, stackings, elastic=None,
         "area_angstrom2": float(
             abs(atoms.cell[0][0] * atoms.cell[1][1] - atoms.cell[0][1] * atoms.cell[1][0])
         ),
-        "adhesion": {"work_of_separation_j_per_m2": 2.48},
+        "adhesion": {
+            "work_of_separation_j_per_m2": 2.48,
+            "work_of_separation_stacking": AT_PERFECT_STACKING,
+        },
         "notes": [],
         "warnings": [],
     }
@@ -227,6 +231,12 @@ def test_fcc111_stackings_are_the_gamma_surface_names(tmp_path):
         "on-top stacking 48.13" in text
     )
     assert not re.search(r"\b(AB|BA|SP|AA) \d", text)
+    # where W is taken, in the results table and the scan section
+    import html
+
+    plain = html.unescape(text)
+    assert f"work of separation W (J/m²), at the {AT_PERFECT_STACKING}" in plain
+    assert f"work of separation taken at</td><td>{AT_PERFECT_STACKING}" in plain
 
 
 def test_layer_counts_and_relaxation_are_those_built(tmp_path):
