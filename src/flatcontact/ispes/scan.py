@@ -7,7 +7,10 @@ then computes only the points missing from ``points.db``, each committed as soon
 returns, and finally writes ``ispes.nc`` atomically. Interrupted (Ctrl-C, or a kill of
 the driver), the store keeps every finished point and a rerun continues from there;
 because each point's warm start comes from a fixed neighbour
-(:mod:`flatcontact.ispes.order`), the resumed grid equals an uninterrupted one.
+(:mod:`flatcontact.ispes.order`) and each point starts its calculator afresh
+(:func:`flatcontact.ispes.relax.start_afresh`), the resumed grid equals an uninterrupted
+one bit for bit, as do the grids of any number of workers below
+:data:`~flatcontact.ispes.scan_probe.MANY_WORKERS` (whose probe starts segments cold).
 
 The rooms of the driver, in the order :func:`run_scan` goes through them:
 

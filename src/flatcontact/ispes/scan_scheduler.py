@@ -4,7 +4,10 @@ A point runs as soon as its warm-start parent (:mod:`flatcontact.ispes.order`) i
 (:class:`ReadyQueue`); it starts from the parent's relaxed positions (kept in memory for a
 while, :class:`PositionsCache`, else read back from the store: the same float64 array) and,
 where parent and grandparent lie in its column, from their linear extrapolation in z. The
-start of every point is therefore fixed by the tree, whatever order the points finish in.
+start of every point is therefore fixed by the tree, whatever order the points finish in,
+and the worker's calculator starts afresh at every point
+(:func:`flatcontact.ispes.relax.start_afresh`): a point's numbers are a function of the
+grid alone.
 :class:`Scheduler` keeps twice as many points in flight as the executor has workers, stores
 each result as it arrives and commits the store before it waits
 (:data:`COMMIT_INTERVAL_S`).
