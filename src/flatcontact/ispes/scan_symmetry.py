@@ -130,9 +130,12 @@ class SymmetryPlan:
     def _verify(self, scheduler: Scheduler, notes: list[str]) -> None:
         """Compare the verified points with their representatives; on a broken symmetry
         compute the whole grid."""
-        store = scheduler.store
+        # the plan's points only: a scan resumed partway through its fallback has more
+        # points stored, which must not move the tolerances (a function of the grid)
+        computed = self.reduction.computed
+        records = {idx: r for idx, r in scheduler.store.done().items() if idx in computed}
         area = cell_area(*in_plane_vectors(self.reference))
-        check = verification(self.reduction, store.done(), area, self.settings)
+        check = verification(self.reduction, records, area, self.settings)
         self.record["verification"] = check
         if symmetry_broken(check, self.settings):
             reason = fallback_reason(check, self.settings, self.reduction.group.order)
