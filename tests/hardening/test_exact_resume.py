@@ -60,11 +60,22 @@ def _argv(config: Path, interface: Path, out: Path, *extra: str) -> list[str]:
 
 
 def _scan(argv: list[str]) -> None:
+    """``flatcontact argv`` in a process of its own."""
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
     done = subprocess.run(
         [sys.executable, "-m", "flatcontact", *argv], env=env, capture_output=True, text=True
     )
     assert done.returncode == 0, done.stderr
+
+
+def _scan_here(argv: list[str]) -> None:
+    """``flatcontact argv`` in this process: its calculator is this process's cached one
+    (:func:`flatcontact.ispes.relax.worker_calculator`), with whatever it computed before."""
+    from flatcontact.cli import main
+
+    with pytest.raises(SystemExit) as info:
+        main(argv)
+    assert info.value.code in (0, None)
 
 
 def _rows(db: Path) -> int:
@@ -137,15 +148,17 @@ def test_a_point_does_not_depend_on_what_the_engine_computed_before(cu_interface
 
 
 def test_kill_9_mid_grid_then_resume_equals_an_uninterrupted_scan(cu_interface, tmp_path):
-    """A small grid of given thicknesses: killed after a few stored points, resumed."""
+    """A small grid of given thicknesses: killed after a few stored points, resumed (the
+    uninterrupted scan and the resume in this process, one after the other: the resume's
+    engine has relaxed the whole grid before)."""
     ref, interface = cu_interface
     z0 = thickness(ref)
     zs = ", ".join(f"{z0 + d:.4f}" for d in (-0.3, -0.15, 0.0, 0.15, 0.3, 0.5))
     config = _config(tmp_path, f"  grid: [6, 6]\n  thickness_angstrom: [{zs}]\n")
     whole, resumed = tmp_path / "whole", tmp_path / "resumed"
-    _scan(_argv(config, interface, whole))
+    _scan_here(_argv(config, interface, whole))
     _kill_9_when(_argv(config, interface, resumed), lambda: _rows(resumed / "points.db") >= 6)
-    _scan(_argv(config, interface, resumed))
+    _scan_here(_argv(config, interface, resumed))
     _identical(whole, resumed)
 
 
