@@ -97,11 +97,11 @@ def depth(parent: dict[Index, Index | None]) -> int:
 def tree_in_store_order(
     z: np.ndarray, shape: tuple, root: tuple, order: str, allowed: set | None = None
 ) -> dict:
-    """The warm-start tree (:func:`flatcontact.ispes.order.search_tree`) over the
-    thicknesses in ascending order, in the store's indices (``root``, ``allowed`` and the
-    result): ``i_z`` is the position in the resolved list, which a thickness added below
-    the smallest after the scan (:func:`flatcontact.ispes.scan_extend.extend_grid`) joins at its end. For an ascending list
-    (every scan before such an addition) this is the tree itself."""
+    """The warm-start tree (:func:`search_tree`) over the thicknesses ``z`` in ascending
+    order, in the store's indices (``root``, ``allowed`` and the result): ``i_z`` is the
+    position in the resolved list, which a thickness added below the smallest after the
+    scan (:func:`flatcontact.ispes.scan_extend.extend_grid`) joins at its end. For an
+    ascending list (every scan before such an addition) this is the tree itself."""
     rank = np.argsort(z, kind="stable")  # sorted position -> store index
     if np.array_equal(rank, np.arange(z.size)):
         return search_tree(shape, root, order, allowed=allowed)
