@@ -359,7 +359,7 @@ def test_corrupt_or_foreign_point_store_is_refused(tiny_run, tmp_path):
     assert "\n" not in str(info.value)
     # a store from another grid, dropped into this run's scan folder
     other = tmp_path / "other"
-    with Pipeline(build_config(_merge(TINY, {"scan": {"grid": [2, 2]}})), other) as pipe:
+    with Pipeline(build_config(_merge(TINY, {"scan": {"grid": [3, 3]}})), other) as pipe:
         pipe.scan()
     shutil.copyfile(other / "02-scan" / "points.db", root / "02-scan" / "points.db")
     with (

@@ -44,7 +44,7 @@ from ase import Atoms
 from flatcontact.errors import InputError
 from flatcontact.ispes.contract import cell_area
 from flatcontact.ispes.geometry import in_plane_vectors, place_slab2, thickness
-from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point
+from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point, start_afresh
 from flatcontact.structures.interface_contract import continues_crystal, recipe_record
 from flatcontact.units import EV_PER_A2_TO_J_PER_M2
 
@@ -173,6 +173,7 @@ def slabs_apart(
 
     def rigid_energy(z: float) -> float:
         atoms = place_slab2(reference, a, b, z, spread_compression=False)
+        start_afresh(calc)  # a function of z alone, whatever ran before
         atoms.calc = calc
         try:
             return float(atoms.get_potential_energy())

@@ -27,7 +27,12 @@ import numpy as np
 
 LOADS_GPA = np.array([0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0])
 #: The ranges divided by the reference model's in :func:`compare_dilatancy`.
-RATIO_QUANTITIES = ("z_range_angstrom", "gap_range_angstrom", "h_range_mj_per_m2", "u_range_mj_per_m2")
+RATIO_QUANTITIES = (
+    "z_range_angstrom",
+    "gap_range_angstrom",
+    "h_range_mj_per_m2",
+    "u_range_mj_per_m2",
+)
 #: 1 eV/Å² in mJ/m².
 MJ_PER_M2_PER_EV_PER_A2 = 16021.766
 
