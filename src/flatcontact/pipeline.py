@@ -62,6 +62,7 @@ from flatcontact.fileio import (
 )
 from flatcontact.ispes.contract import open_ispes
 from flatcontact.layout import (
+    BUILD_JSON,
     CONFIG_YAML,
     CONTACT_NC,
     ELASTIC_JSON,
@@ -87,7 +88,7 @@ from flatcontact.rundir import (
     portable,
     writable,
 )
-from flatcontact.stages import _calculator
+from flatcontact.stages import _calculator, contact_range
 from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
 from flatcontact.stages.build import BuildInputs, run_build
 from flatcontact.stages.contact import (
@@ -482,6 +483,11 @@ class Pipeline:
             from_scan=True,
             moduli=self._json("elastic", ELASTIC_JSON) if self.config.elastic.enabled else None,
             gates=gates,
+            interface=contact_range.facts(
+                self._upstream("build").folder / INTERFACE,
+                self._upstream("build").folder / BUILD_JSON,
+                open_result(self._upstream("analyze").folder / FRICTION_NC, FRICTION),
+            ),
         )
 
     def contact_parameters(self):
