@@ -40,14 +40,17 @@ from flatcontact.layout import (
     FIG6_EXPERIMENT,
     FIG6_FIT,
     FIG6_LOCKIN,
+    FIG_SLIP_SIZE,
     FIT_JSON,
     SUMMARY_JSON,
 )
 from flatcontact.reference import PAPER, PAPER_LAW_KEYS, is_paper_material
-from flatcontact.stages._common import rename, renamed_errors, save
+from flatcontact.stages._common import renamed_errors, save
 from flatcontact.stages.contact_experiment import (  # noqa: F401  (re-exported)
     QUARTZ_QUICK_LAWS,
+    check_fit_settings,
     experiment_comparison,
+    fit_curves,
     quartz_reference_laws,
 )
 
@@ -192,24 +195,6 @@ def check_cycle(settings, params) -> None:
         )
 
 
-def fit_curves(settings, params) -> list:
-    """The measured curves of ``contact.fit.csv`` (validated with the parameter names, before
-    any work): :func:`flatcontact.contact.measured.load_fit_data`, ``check_free_fixed``."""
-    from flatcontact.contact import fit, measured
-
-    c = settings.contact
-    try:
-        fit.check_free_fixed(c.fit.free, c.fit.fixed, "modified")
-    except InputError as exc:
-        where = "contact.fit.fixed" if "fixed" in str(exc) else "contact.fit.free"
-        raise InputError(f"{where}: {exc} (contact.fit.free = {list(c.fit.free)})") from None
-    try:
-        return measured.load_fit_data(c.fit.csv, params, c.fit.p0_gpa)
-    except InputError as exc:
-        text = rename(str(exc), {"fit_p0_gpa": "contact.fit.p0_gpa"})
-        raise InputError(f"contact.fit.csv: {text}") from None
-
-
 def law_half_widths_used(inputs: ContactInputs, provenance: dict) -> dict[str, float]:
     """Half-widths of the law coefficients the contact model takes from the fitted laws
     (``laws.json`` ``half_widths`` of its configured energy form); 0 for a coefficient set
@@ -313,22 +298,6 @@ def contact_intervals(
                 for n in names:
                     row[n].setdefault("components", {})[part] = [sub[(i, n)][0], sub[(i, n)][2]]
     return doc
-
-
-def check_fit_settings(settings) -> None:
-    """``contact.fit`` checked at the start of a run, before the laws exist (names freed and
-    fixed, files readable, load columns): the loads of a normal-load column are converted with
-    the configured R and E* here; the stage converts them again with the run's moduli."""
-    from flatcontact.contact.parameters import ContactParameters
-
-    c = settings.contact
-    if c.fit.csv:
-        start = ContactParameters(
-            radius_um=c.radius_um,
-            contact_modulus_gpa=c.contact_modulus_gpa,
-            shear_modulus_gpa=c.shear_modulus_gpa,
-        )
-        fit_curves(settings, start)
 
 
 def check_contact(settings, params) -> None:
@@ -579,6 +548,10 @@ def _write(result: ContactResult, settings, folder: Path, measured, comparison) 
             params, shown, c.cycle.amplitude_fractions, model=c.cycle.model
         )
         figs[FIG6_LOCKIN] = fig_lockin_overlay(params, p0c, model=c.cycle.model)
+    if result.slip_size is not None:
+        from flatcontact.plots.slip_size import fig_slip_size
+
+        figs[FIG_SLIP_SIZE] = fig_slip_size(result.slip_size)
     if result.fit is not None:
         from flatcontact.plots.cycle import fig_fit
 

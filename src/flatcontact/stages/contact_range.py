@@ -15,7 +15,6 @@
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
 import numpy as np
@@ -109,7 +108,10 @@ def slip_interface(inputs):
     run = inputs.interface
     if run is None:
         return None
-    kind, why = structure_regime(run.get("recipe"))
+    if run.get("structure"):
+        kind, why = run["structure"], "given"
+    else:
+        kind, why = structure_regime(run.get("recipe"))
     path = run.get("path") or {}
     gus, b = path.get("unstable_stacking_j_m2"), path.get("burgers_angstrom")
     return SlipInterface(
@@ -117,8 +119,8 @@ def slip_interface(inputs):
         why,
         gus if gus and gus > 0 else None,
         b * 1e-10 if b and b > 0 else None,
-        path.get("tau_max_mpa", math.nan) * 1e6 if path else None,
-        f"sliding path of friction.nc at P = {path['p_gpa']:g} GPa" if path else "",
+        path["tau_max_mpa"] * 1e6 if "tau_max_mpa" in path else None,
+        path.get("source") or f"sliding path of friction.nc at P = {path.get('p_gpa', 0.0):g} GPa",
     )
 
 

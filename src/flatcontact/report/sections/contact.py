@@ -12,6 +12,7 @@ from flatcontact.layout import (
     FIG6_EXPERIMENT,
     FIG6_FIT,
     FIG6_LOCKIN,
+    FIG_SLIP_SIZE,
     png,
 )
 from flatcontact.report.format import fmt, pm
@@ -65,6 +66,15 @@ def contact_section(cfg, contact: dict, elastic: dict | None, folder: Path) -> S
         + "; ".join(f"{k}: {v}" for k, v in prov.items() if k != "moduli")
         + ".",
     ]
+    if "slip_size" in contact:
+        contact_figs.append(
+            Figure(
+                folder / png(FIG_SLIP_SIZE),
+                "Effective shear strength against contact radius: concurrent slip (the modified "
+                "Mindlin number, dashed) and the size-limited strength (solid, or the elastic "
+                "bound, dotted); dots: this run's contacts (docs/contact.md).",
+            )
+        )
     if "experiment" in contact:
         e = contact["experiment"]
         contact_figs.append(
