@@ -514,7 +514,9 @@ class Pipeline:
         gates = self.gates()
         check_gates(cfg, gates)
         stage_inputs = self._contact_inputs(gates.to_json(cfg.contact.accept_untrusted))
-        check_contact(cfg, contact_parameters(cfg, stage_inputs)[0])
+        params = contact_parameters(cfg, stage_inputs)[0]
+        check_contact(cfg, params)
+        contact_range.adhesion_of(cfg, stage_inputs, params)  # refuses where no model applies
         inputs = {
             "contact": portable(cfg.section("contact"), "experiment_csv", "fit_csv"),
             "laws": laws.fingerprint,
