@@ -274,3 +274,51 @@ def test_an_approximant_cell_gets_the_elastic_bound():
     tau = row["concurrent_strength_mpa"] * 1e6
     assert row["critical_radius_nm"] == pytest.approx(57.7e9 * 2.556e-10 / (math.pi * tau) * 1e9)
     assert row["size_limited_strength_mpa"] is None
+
+
+def _cli(argv, capsys):
+    from flatcontact.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main([*argv])
+    out = capsys.readouterr()
+    return exc.value.code, out.out, out.err
+
+
+def test_the_cli_reports_the_critical_size_and_draws_both_regimes(tmp_path, capsys):
+    """The paper's quartz laws and moduli (R = 20 µm) with a given γ_us: a_c by hand, the box sentence on
+    the console exactly for the p0 past it, and fig_slip_size written."""
+    gus = 3.9e-3  # J/m²: the quick quartz run's barrier, 0.244 meV/Å²
+    code, out, err = _cli(
+        [
+            "contact",
+            "--p0-gpa",
+            "0.5,3",
+            "--radius-um",
+            "20",
+            "--unstable-stacking-mj-m2",
+            "3.9",
+            "--out",
+            str(tmp_path / "c"),
+            "--no-svg",
+        ],
+        capsys,
+    )
+    assert code in (0, None), err
+    assert (tmp_path / "c" / "fig_slip_size.png").is_file()
+    import json
+
+    doc = json.loads((tmp_path / "c" / "summary.json").read_text())
+    for row in doc["slip_size"]["results"]:
+        ac = 8 * 29e9 * gus / (math.pi * (row["concurrent_strength_mpa"] * 1e6) ** 2)
+        assert row["critical_radius_nm"] == pytest.approx(ac * 1e9, rel=1e-9)
+    exceeded = [r["p0_gpa"] for r in doc["slip_size"]["results"] if r["exceeded"]]
+    assert exceeded == [3.0]  # a = 1.8 µm > a_c ≈ 0.65 µm; at 0.5 GPa a = 0.3 µm < 0.94 µm
+    text = " ".join(out.split())
+    assert text.count("exceeds the critical radius") == len(exceeded)
+
+
+def test_the_cli_refuses_an_unknown_structure_in_one_line(capsys):
+    code, _, err = _cli(["contact", "--burgers-angstrom", "2.5", "--structure", "moire"], capsys)
+    assert code == 2
+    assert "--structure" in err and len(err.strip().splitlines()) == 1

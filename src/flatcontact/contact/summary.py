@@ -70,7 +70,7 @@ class ContactAnalysis:
                 "contact_peak_pressure_gpa": float(pc[i] / units.GPA_TO_PA),
                 "normal_load_un": float(load[i] * units.N_TO_UN),
                 "mean_pressure_gpa": float(2.0 / 3.0 * pc[i] / units.GPA_TO_PA),
-                "hertz_approach_nm": float(a[i] ** 2 / pr.radius_m / units.NM_TO_M),
+                "hertz_approach_nm": float(a_h[i] ** 2 / pr.radius_m / units.NM_TO_M),
             }
             if w > 0.0:
                 for model, key in (("dmt", "dmt"), ("jkr", "jkr")):

@@ -438,7 +438,7 @@ def run_contact(
     result.adhesion = regime.to_json()
     result.slip_size = rng.slip_of(settings, rng.slip_interface(inputs), analysis)
     result.moduli_note = rng.foreign_moduli_note(settings, provenance, params)
-    rng.console_lines(result.adhesion, result.slip_size, result.moduli_note)
+    rng.log_lines(result.adhesion, result.slip_size, result.moduli_note)
     half_widths = law_half_widths_used(inputs, provenance)
     result.intervals = contact_intervals(
         settings, params, half_widths, law_components_used(inputs, provenance), p0c

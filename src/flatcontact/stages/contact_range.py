@@ -193,15 +193,17 @@ def foreign_moduli_note(settings, provenance: dict, params) -> str | None:
     )
 
 
-def console_lines(adhesion: dict | None, slip: dict | None, moduli_note: str | None) -> None:
-    """The contact's range on the console (the ``flatcontact`` logger): the adhesion regime,
-    the moduli note and one line per p0 past the critical size."""
+def log_lines(adhesion: dict | None, slip: dict | None, moduli_note: str | None) -> None:
+    """The contact's range in the run's log (the ``flatcontact`` logger, INFO): the adhesion
+    regime, the moduli note and one line per p0 past the critical size. The console lines are
+    printed by the commands from ``summary.json`` (``flatcontact run``, ``flatcontact
+    contact``)."""
     import logging
 
     from flatcontact.contact.slip_size import slip_sentences
 
     log = logging.getLogger("flatcontact.contact")
     if adhesion is not None:
-        log.warning("contact: %s", adhesion["sentence"])
+        log.info("contact: %s", adhesion["sentence"])
     for line in ([moduli_note] if moduli_note else []) + slip_sentences(slip):
-        log.warning("contact: %s", line)
+        log.info("contact: %s", line)
