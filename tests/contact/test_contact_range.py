@@ -33,7 +33,7 @@ CU = dict(
     work_of_adhesion_j_m2=2.479,
 )
 CU_GAP_ANGSTROM = 3.615 / math.sqrt(3.0)  # (111) plane spacing of fcc Cu
-MEV_A2 = 0.016021766  # J/m² per meV/Å²
+MEV_A2 = 0.01602176634  # J/m² per meV/Å² (e = 1.602176634e-19 C)
 
 
 def _cu_facts(recipe=None):
@@ -322,3 +322,39 @@ def test_the_cli_refuses_an_unknown_structure_in_one_line(capsys):
     code, _, err = _cli(["contact", "--burgers-angstrom", "2.5", "--structure", "moire"], capsys)
     assert code == 2
     assert "--structure" in err and len(err.strip().splitlines()) == 1
+
+
+def test_the_run_facts_from_a_constructed_path_and_interface():
+    """γ_us, b and τ_max of a sinusoidal path E = (γ/2)(1 − cos 2πt/b) along 30°, and the
+    gap between two slabs; the MEP barrier wins where friction.nc has one."""
+    import xarray as xr
+    from ase import Atoms
+
+    from flatcontact.stages.contact_range import interface_gap_angstrom, path_facts
+
+    b, gamma = 2.5, 3.0  # Å, meV/Å²
+    t = np.linspace(0.0, b, 61)
+    e = gamma / 2 * (1 - np.cos(2 * np.pi * t / b))
+    f = gamma / 2 * 2 * np.pi / b * np.sin(2 * np.pi * t / b) * 160.21766  # meV/Å³ -> MPa
+    d = np.radians(30.0)
+    ds = xr.Dataset(
+        {
+            "path_energy": (("p_gpa", "sample"), np.vstack([e, 2 * e])),
+            "path_x": (("p_gpa", "sample"), np.vstack([t * np.cos(d)] * 2)),
+            "path_y": (("p_gpa", "sample"), np.vstack([t * np.sin(d)] * 2)),
+            "path_force": (("p_gpa", "sample"), np.vstack([f, 2 * f])),
+        },
+        coords={"p_gpa": [1.0, 0.0]},
+    )
+    got = path_facts(ds)
+    assert got["p_gpa"] == 0.0  # the lowest load: the contact's edge
+    assert got["unstable_stacking_j_m2"] == pytest.approx(2 * gamma * MEV_A2, rel=1e-9)
+    assert got["burgers_angstrom"] == pytest.approx(b, rel=1e-12)
+    # sinusoid: τ_max = π γ/b, so the shape factor π γ_us/(τ_max b) is 1
+    shape = math.pi * got["unstable_stacking_j_m2"] / (got["tau_max_mpa"] * 1e6 * b * 1e-10)
+    assert shape == pytest.approx(1.0, rel=1e-3)
+    ds["barrier_along_direction_mev_per_a2"] = ("p_gpa", [9.0, 1.5])
+    assert path_facts(ds)["unstable_stacking_j_m2"] == pytest.approx(1.5 * MEV_A2, rel=1e-12)
+    atoms = Atoms("H4", positions=[(0, 0, 0), (0, 0, 2.0), (0, 0, 5.1), (0, 0, 7.0)])
+    atoms.arrays["slab"] = np.array([1, 1, 2, 2])
+    assert interface_gap_angstrom(atoms) == pytest.approx(3.1)

@@ -15,6 +15,7 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -38,20 +39,33 @@ def interface_gap_angstrom(atoms) -> float | None:
 
 def path_facts(friction) -> dict:
     """γ_us (J/m²), b (Å) and τ_max (MPa) of the sliding path at the lowest load of
-    ``friction`` (the opened ``friction.nc``); {} without a path."""
+    ``friction`` (the opened ``friction.nc``); {} without a path.
+
+    γ_us is the lowest minimum-energy-path barrier to the start's image one period along the
+    sliding direction (``barrier_along_direction_mev_per_a2``: the way an interfacial
+    dislocation goes), else the barrier of the reported path (max − min of its energy);
+    b is the straight distance between the path's ends (one period along the direction)."""
     if "path_energy" not in friction:
         return {}
     i = int(np.argmin(friction["p_gpa"].values))
     e = np.asarray(friction["path_energy"].values[i], dtype=float)
-    t = np.asarray(friction["path_t"].values[i], dtype=float)
+    x = np.asarray(friction["path_x"].values[i], dtype=float)
+    y = np.asarray(friction["path_y"].values[i], dtype=float)
     f = np.asarray(friction["path_force"].values[i], dtype=float)
-    ok = np.isfinite(e) & np.isfinite(t)
+    ok = np.isfinite(e) & np.isfinite(x) & np.isfinite(y)
     if ok.sum() < 3:
         return {}
+    x, y = x[ok], y[ok]
+    barrier, source = float(e[ok].max() - e[ok].min()), "the sliding path's barrier"
+    if "barrier_along_direction_mev_per_a2" in friction:
+        mep = float(friction["barrier_along_direction_mev_per_a2"].values[i])
+        if math.isfinite(mep) and mep > 0.0:
+            barrier, source = mep, "the minimum-energy-path barrier along the sliding direction"
     return {
         "p_gpa": float(friction["p_gpa"].values[i]),
-        "unstable_stacking_j_m2": float((e[ok].max() - e[ok].min()) * MEV_PER_A2_TO_J_PER_M2),
-        "burgers_angstrom": float(t[ok].max() - t[ok].min()),
+        "unstable_stacking_j_m2": barrier * MEV_PER_A2_TO_J_PER_M2,
+        "unstable_stacking_source": source,
+        "burgers_angstrom": float(np.hypot(x[-1] - x[0], y[-1] - y[0])),
         "tau_max_mpa": float(np.nanmax(np.abs(f))),
     }
 
@@ -120,7 +134,9 @@ def slip_interface(inputs):
         gus if gus and gus > 0 else None,
         b * 1e-10 if b and b > 0 else None,
         path["tau_max_mpa"] * 1e6 if "tau_max_mpa" in path else None,
-        path.get("source") or f"sliding path of friction.nc at P = {path.get('p_gpa', 0.0):g} GPa",
+        path.get("source")
+        or f"{path.get('unstable_stacking_source', 'the path')} and the path's period, "
+        f"friction.nc at P = {path.get('p_gpa', 0.0):g} GPa",
     )
 
 
