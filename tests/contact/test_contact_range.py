@@ -232,6 +232,10 @@ def test_the_box_appears_exactly_when_a_exceeds_the_critical_size(radius_um, exc
     assert (row["contact_radius_nm"] > row["critical_radius_nm"]) is exceeded
     boxes = [b for b in range_boxes(doc) if "critical radius" in b]
     assert len(boxes) == int(exceeded)
+    # wherever the report prints the concurrent number, it says so past a_c
+    from flatcontact.report.sections.contact import slip_note
+
+    assert bool(slip_note(doc, 0)) is exceeded
     if exceeded:
         assert f"{row['critical_radius_nm']:.3g} nm" in boxes[0]
         assert row["reported"] == "size-limited"

@@ -290,3 +290,18 @@ def range_rows(contact: dict) -> list[tuple]:
         )
         rows.append(("strength reported (contact.slip_regime)", *(r["reported"] for r in res)))
     return rows
+
+
+def slip_note(contact: dict, i: int) -> str:
+    """A short note for the concurrent-slip Q_peak/πa² of the i-th p0 wherever it appears
+    (never silent past the critical size): '' within it."""
+    rows = (contact.get("slip_size") or {}).get("results") or []
+    if i >= len(rows) or not rows[i]["exceeded"]:
+        return ""
+    r = rows[i]
+    if r["size_limited_strength_mpa"] is None:
+        return f" (concurrent slip; a > a_el = {r['critical_radius_nm']:.3g} nm: a lower bound)"
+    return (
+        f" (concurrent slip; a > a_c = {r['critical_radius_nm']:.3g} nm: size-limited ≈ "
+        f"{r['size_limited_strength_mpa']:.4g})"
+    )
