@@ -362,3 +362,23 @@ def test_the_run_facts_from_a_constructed_path_and_interface():
     atoms = Atoms("H4", positions=[(0, 0, 0), (0, 0, 2.0), (0, 0, 5.1), (0, 0, 7.0)])
     atoms.arrays["slab"] = np.array([1, 1, 2, 2])
     assert interface_gap_angstrom(atoms) == pytest.approx(3.1)
+
+
+def test_the_maugis_dugdale_tension_moves_inside_the_contact_from_dmt_to_jkr():
+    """The cohesive zone's σ_D π (c² − a²) is the whole adhesive tension P1 − P as λ -> 0
+    (DMT: adhesion outside the contact) and none of it as λ -> ∞ (JKR: inside)."""
+    from flatcontact.contact.adhesion_regime import adhesive_contact, dugdale_zone_force
+
+    prm = ContactParameters(work_of_adhesion_j_m2=0.3, k_mpa_per_gpa=10.0)
+    fractions = []
+    for lam in (0.1, 0.3, 1.0, 3.0, 4.9):  # the Maugis–Dugdale range of the regime map
+        c = adhesive_contact(0.5e9, prm, lam)
+        out = dugdale_zone_force(c.radius_m, 0.3, prm.radius_m, prm.contact_modulus_pa, lam)
+        assert 0.0 <= out <= c.adhesive_tension_n * (1 + 1e-9)
+        fractions.append(c.tension_inside_n / c.adhesive_tension_n)
+    assert fractions[0] < 0.2 and fractions[-1] > 0.8
+    assert fractions == sorted(fractions)
+    # the regime's ends: DMT puts none inside, JKR all
+    assert adhesive_contact(0.5e9, prm, 0.05).tension_inside_n == 0.0
+    jkr = adhesive_contact(0.5e9, prm, 6.0)
+    assert jkr.tension_inside_n == jkr.adhesive_tension_n > 0.0

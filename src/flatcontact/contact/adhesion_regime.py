@@ -29,12 +29,13 @@ P1 = 4E* a³/(3R) = P + P_adh (P_adh >= 0, the adhesive tension).
 
 - DMT: the adhesive tension acts outside the contact (Derjaguin approximation): inside,
   the pressure is exactly Hertzian with peak p1, so the model at p1 is exact within DMT.
-- JKR, Maugis–Dugdale: part of P_adh acts inside the contact (JKR: −p2/√(1 − r²/a²),
-  singular at the edge); the model at p1 leaves it out. The laws τ = k p + τ0,
-  σ = μ p + σ0 then miss at most |k|·P_adh of the stick force and |μ|·P_adh of the slip
+- JKR, Maugis–Dugdale: part of P_adh acts inside the contact (JKR: all of it,
+  −p2/√(1 − r²/a²), singular at the edge; Maugis–Dugdale: P_adh less the cohesive zone's
+  σ_D π (c² − a²) outside); the model at p1 leaves it out. The laws τ = k p + τ0,
+  σ = μ p + σ0 then miss at most |k|·F_in of the stick force and |μ|·F_in of the slip
   force. The relative bound
 
-      δ = max(|k| P_adh / (τ0 π a² + k P1),  |μ| P_adh / (σ0 π a² + μ P1))
+      δ = max(|k| F_in / (τ0 π a² + k P1),  |μ| F_in / (σ0 π a² + μ P1))
 
   is reported; above :data:`REFUSE_FRACTION` no model of the tool applies and the stage
   refuses that p0 (one line).
@@ -105,7 +106,8 @@ class AdhesiveContact:
     contact_p0_pa : p1 = 2E* a/(πR), the peak of the Hertzian pressure over a
     pull_off_n : pull-off force of ``model`` (magnitude; 0 without adhesion)
     adhesive_tension_n : P1 − P, the adhesive tension the Hertzian part carries
-    tension_inside_n : the part of it that may act inside the contact (0 for DMT)
+    tension_inside_n : the part of it that acts inside the contact (0 for DMT; P1 − P for
+        JKR; P1 − P minus the cohesive zone's σ_D π (c² − a²) for Maugis–Dugdale)
     law_bound : δ, the relative bound on the stick/slip forces the model leaves out
     """
 
@@ -143,6 +145,24 @@ class AdhesiveContact:
             "adhesive_tension_un": self.adhesive_tension_n * 1e6,
             "law_bound": self.law_bound,
         }
+
+
+def dugdale_zone_force(
+    radius_m: float,
+    work_of_adhesion_j_m2: float,
+    tip_radius_m: float,
+    contact_modulus_pa: float,
+    maugis_lambda: float,
+) -> float:
+    """F_out = σ_D π (c² − a²) (N): the adhesive tension of the Maugis–Dugdale cohesive zone
+    a < r < c, outside the contact; σ_D = (λ/2)(π w K²/R)^(1/3), m = c/a from Maugis's
+    equation at Ā = a (K/(π w R²))^(1/3). The rest of P1 − P acts inside the contact."""
+    k = 4.0 * contact_modulus_pa / 3.0
+    w, r = work_of_adhesion_j_m2, tip_radius_m
+    abar = radius_m * (k / (np.pi * w * r * r)) ** (1.0 / 3.0)
+    m = adhesion._md_m(abar, maugis_lambda)
+    sigma_d = 0.5 * maugis_lambda * (np.pi * w * k * k / r) ** (1.0 / 3.0)
+    return float(sigma_d * np.pi * radius_m**2 * (m * m - 1.0))
 
 
 def _law_bound(params: ContactParameters, a: float, p1_load: float, tension: float) -> float:
@@ -185,6 +205,8 @@ def adhesive_contact(
     p1_load = 4.0 * e * a**3 / (3.0 * r)
     tension = max(p1_load - load, 0.0)
     inside = 0.0 if model == "dmt" else tension
+    if model == "maugis-dugdale":
+        inside = max(tension - dugdale_zone_force(a, w, r, e, maugis_lambda), 0.0)
     regime = "Hertz" if abs(a / a_h - 1.0) < HERTZ_TOLERANCE else MODEL_NAMES[model]
     return AdhesiveContact(
         p0_pa=float(p0_pa),
@@ -247,10 +269,17 @@ class AdhesionRegime:
             if self.use_hertz
             else "the adhesive radius is used in Q_peak/πa² and in the modified Mindlin model"
         )
+        bound = max(c.law_bound for c in self.contacts)
+        left_out = (
+            f" (the adhesive tension inside the contact, left out of τ(p) and σ(p), changes "
+            f"their forces by up to {100 * bound:.2g} %)"
+            if bound > 0.01 and not self.use_hertz
+            else ""
+        )
         return (
             f"adhesion regime {' / '.join(names)}: {tabor}{z0}; contact radius "
             f"{min(ratios):.3g}–{max(ratios):.3g} × Hertz, pull-off force "
-            f"{min(pulls):.3g}–{max(pulls):.3g} × the load over the p0 range; {used}"
+            f"{min(pulls):.3g}–{max(pulls):.3g} × the load over the p0 range; {used}{left_out}"
         )
 
     def to_json(self) -> dict:

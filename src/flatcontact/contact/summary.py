@@ -254,7 +254,8 @@ def analyse(
     p0_list = tuple(params.check_p0_gpa(p0_gpa, p0_name))
     contact = None
     if contact_p0_gpa is not None:
-        contact = tuple(params.check_p0_gpa(contact_p0_gpa, p0_name))
+        name = f"{p0_name} (as p1, the adhesive contact's Hertzian peak pressure)"
+        contact = tuple(params.check_p0_gpa(contact_p0_gpa, name))
     p0 = np.asarray(contact or p0_list) * units.GPA_TO_PA
     peaks = mindlin.peak_force(p0, params)
     u = np.linspace(0.0, 1.5, N_DISPLACEMENT)[None, :] * peaks.full_slip_displacement_m[:, None]

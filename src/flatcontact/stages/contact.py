@@ -345,7 +345,13 @@ class ContactResult:
         """One row per p0 and force amplitude (:func:`flatcontact.contact.cycle_output.cycle_records`)."""
         from flatcontact.contact.cycle_output import cycle_records
 
-        return cycle_records(self.cycles) if self.cycles else []
+        pairs = zip(self.analysis.p0_gpa, self.cycles, strict=True) if self.cycles else ()
+        # the cycle runs at the adhesive contact's peak pressure p1; rows keep the given p0
+        return [
+            {**row, "p0_gpa": p0, "contact_peak_pressure_gpa": row["p0_gpa"]}
+            for p0, cyc in pairs
+            for row in cycle_records([cyc])
+        ]
 
     def fit_json(self) -> dict | None:
         """``fit.json``: both models' fitted parameters with standard errors and correlations,
@@ -563,7 +569,7 @@ def _write(result: ContactResult, settings, folder: Path, measured, comparison) 
     if result.cycles:
         from flatcontact.contact.cycle_output import cycle_dataset
 
-        cyc = cycle_dataset(result.cycles, params)
+        cyc = cycle_dataset(result.cycles, params).assign_coords(p0=ds["p0"].values)
         ds = ds.merge(cyc)
         ds.attrs.update(cyc.attrs)
     with atomic_path(folder / CONTACT_NC) as tmp:
