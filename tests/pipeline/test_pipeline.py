@@ -648,6 +648,8 @@ def test_each_stage_through_the_cli_writes_the_files_of_the_run(tiny_run, tmp_pa
     source = "equilibrium_separation_source"
     assert ours["adhesion_regime"].pop(source) != run["adhesion_regime"].pop(source)
     run["adhesion_regime"].pop("sentence"), ours["adhesion_regime"].pop("sentence")
+    # the run's model is Vashishta: the paper's SNAP moduli are named as another potential's
+    assert "vashishta" in run.pop("moduli_note") and "moduli_note" not in ours
     ours_slip, run_slip = ours.pop("slip_size"), run.pop("slip_size")
     assert ours_slip["structure"] == run_slip["structure"] == "commensurate"
     for a, b in zip(ours_slip["results"], run_slip["results"], strict=True):
