@@ -25,43 +25,50 @@ import sys
 from pathlib import Path
 
 
+def _list(values, fmt="{:.3g}") -> str:
+    return ", ".join("—" if v is None else fmt.format(v) for v in values)
+
+
 def row(name: str, summary: dict) -> str:
-    """One markdown row of the table from a run's contact ``summary.json``."""
+    """One markdown row of the table from a run's contact ``summary.json`` (lists over the
+    run's p0)."""
     adh = summary.get("adhesion_regime") or {}
     slip = summary.get("slip_size") or {}
     res = adh.get("results") or []
+    p0 = _list((r["p0_gpa"] for r in summary["results"]), "{:g}")
     regimes = "/".join(dict.fromkeys(r["regime"] for r in res)) or "—"
-    pull = ", ".join(f"{r['pull_off_over_load']:.3g}" for r in res) or "—"
-    tabor = adh.get("tabor_parameter")
-    z0 = adh.get("equilibrium_separation_angstrom")
+    if adh.get("contact_radius") == "hertz":
+        regimes += " (Hertz radius used)"
+    tabor = f"{adh['tabor_parameter']:.3g} ({adh['equilibrium_separation_angstrom']:.3g} Å)"
+    ratio = _list(r["radius_over_hertz"] for r in res)
+    pull = _list(r["pull_off_over_load"] for r in res)
+    a = _list((r["contact_radius_nm"] for r in summary["results"]), "{:.0f}")
+    conc = _list((r["effective_shear_strength_mpa"] for r in summary["results"]), "{:.4g}")
     if not slip:
-        return f"| {name} | — | — | — | {tabor:.3g} ({z0:.3g} Å) | {regimes} | {pull} | — | — |"
-    sizes = "; ".join(
-        f"{r['p0_gpa']:g}: {r['contact_radius_nm']:.0f} / {r['critical_radius_nm']:.3g}"
-        for r in slip["results"]
-    )
-    verdict = ", ".join(
-        (
-            f"size-limited ({r['size_limited_strength_mpa']:.3g} of {r['concurrent_strength_mpa']:.3g} MPa)"
-            if r["exceeded"] and r["size_limited_strength_mpa"] is not None
-            else "past a_el (lower bound)"
-            if r["exceeded"]
-            else "concurrent"
+        return (
+            f"| {name} | {p0} | — | — | — | {tabor} | {regimes} | {ratio} | {pull} | {a} | — | "
+            f"{conc} | — |"
         )
-        for r in slip["results"]
+    rows = slip["results"]
+    crit = _list(r["critical_radius_nm"] for r in rows)
+    reported = ", ".join(
+        f"{r['reported_strength_mpa']:.4g} ({r['reported']})"
+        if r["size_limited_strength_mpa"] is not None or not r["exceeded"]
+        else "≥ concurrent (past a_el)"
+        for r in rows
     )
-    gus = slip.get("unstable_stacking_j_m2")
-    b = slip.get("burgers_angstrom")
+    gus, b = slip.get("unstable_stacking_j_m2"), slip.get("burgers_angstrom")
     return (
-        f"| {name} | {slip['structure']} | {1e3 * gus:.3g} | {b:.3g} | {tabor:.3g} ({z0:.3g} Å) | "
-        f"{regimes} | {pull} | {sizes} | {verdict} |"
+        f"| {name} | {p0} | {slip['structure']} | {1e3 * gus:.3g} | {b:.3g} | {tabor} | "
+        f"{regimes} | {ratio} | {pull} | {a} | {crit} | {conc} | {reported} |"
     )
 
 
 HEADER = (
-    "| example | structure | γ_us (mJ/m²) | b (Å) | Tabor μ_T (z0) | adhesion regime | "
-    "pull-off / load | p0 (GPa): a / critical size (nm) | 5 µm tip |\n"
-    "|---|---|---|---|---|---|---|---|---|"
+    "| example | p0 (GPa) | structure | γ_us (mJ/m²) | b (Å) | Tabor μ_T (z0) | adhesion "
+    "regime | a / a_Hertz | pull-off / load | a (nm) | a_c or a_el (nm) | Q_peak/πa² "
+    "concurrent (MPa) | reported for the 5 µm tip (MPa) |\n"
+    "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 )
 
 
