@@ -47,10 +47,11 @@ from flatcontact.layout import (
 from flatcontact.reference import PAPER, PAPER_LAW_KEYS, is_paper_material
 from flatcontact.stages._common import renamed_errors, save
 from flatcontact.stages.contact_experiment import (  # noqa: F401  (re-exported)
-    QUARTZ_QUICK_LAWS,
+    QUARTZ_QUICK_LAWS_FILE,
     check_fit_settings,
     experiment_comparison,
     fit_curves,
+    quartz_quick_laws,
     quartz_reference_laws,
 )
 
