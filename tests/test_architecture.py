@@ -65,7 +65,7 @@ LAYERS: tuple[tuple[str, frozenset[str]], ...] = (
     ("stages", frozenset({"stages"})),
     # runs of the stages: one run (pipeline) and studies over many runs (studies import the
     # pipeline; the CLI, above, imports both)
-    ("runs", frozenset({"pipeline", "studies"})),
+    ("runs", frozenset({"pipeline", "refused", "studies"})),
     ("front doors", frozenset({"cli", "__main__", "notebook"})),
 )
 

@@ -80,6 +80,7 @@ from flatcontact.layout import (
     SUMMARY_JSON,
     VERSIONS_JSON,
 )
+from flatcontact.refused import refused_report
 from flatcontact.result_json import read_result_json
 from flatcontact.rundir import (
     RunDirectory,
@@ -221,6 +222,7 @@ class Pipeline:
         self._check_root()
         self._check_config()
         self.results: dict[str, StageResult] = {}
+        self._refusal: InputError | None = None  # the last stage's own refusal (run())
         self._handler: logging.Handler | None = None
         self._lock: RunLock | None = None
         # a finished run on a read-only mount is read, never written (run_stage says so)
@@ -329,12 +331,19 @@ class Pipeline:
         if self.on_event is not None:
             self.on_event(StageEvent(kind, name, STAGES[name], **details))
 
+    def _refused(self, check: Callable, *args: Any) -> Any:  # InputError: a refusal, run()
+        try:
+            return check(*args)
+        except InputError as exc:
+            self._refusal = exc
+            raise
+
     def _run(self, name: str, inputs: dict, work: Callable[[Path], Any]) -> StageResult:
         index = STAGES[name]
         inputs = {**inputs, "code_sha256": stage_code_digest(name)}
         self._tell("start", name)
         try:
-            result = self.rundir.run_stage(index, name, inputs, work)
+            result = self.rundir.run_stage(index, name, inputs, lambda f: self._refused(work, f))
         except KeyboardInterrupt:
             log.warning("stage %s: interrupted; rerun to resume", name)
             self._tell("failed", name, action="interrupted")
@@ -541,11 +550,15 @@ class Pipeline:
         # before the stage folder is touched: a gate that fired, or a refused p0, stops the
         # run with the finished stages kept (rerun with contact.accept_untrusted to go on)
         gates = self.gates()
-        check_gates(cfg, gates)
+        self._refused(check_gates, cfg, gates)
         stage_inputs = self._contact_inputs(gates.to_json(cfg.contact.accept_untrusted))
-        params = contact_parameters(cfg, stage_inputs)[0]
-        check_contact(cfg, params)
-        contact_range.adhesion_of(cfg, stage_inputs, params)  # refuses where no model applies
+
+        def checks() -> None:  # a refusal here gets the refused run's report
+            params = contact_parameters(cfg, stage_inputs)[0]
+            check_contact(cfg, params)
+            contact_range.adhesion_of(cfg, stage_inputs, params)  # where no model applies
+
+        self._refused(checks)
         inputs = {
             "contact": portable(cfg.section("contact"), "experiment_csv", "fit_csv"),
             "laws": laws.fingerprint,
@@ -568,21 +581,25 @@ class Pipeline:
         """``06-contact/summary.json``: parameters, their provenance and the per-p0 results."""
         return self._json("contact", SUMMARY_JSON)
 
-    def report(self) -> Path:
-        """Stage 7: ``report.html`` (self-contained) in ``07-report/`` and the run directory."""
+    def report(self, refusal: dict | None = None) -> Path:
+        """Stage 7: ``report.html`` in ``07-report/`` and the run directory (``refusal``: of a
+        run refused after the scan, its finished stages only, :mod:`flatcontact.refused`)."""
         cfg = self.config
         names = ["build", "scan", "analyze", "laws", "contact"]
+        names = [n for n in names if refusal is None or n in refusal["finished"]]
         ups = {name: self._upstream(name) for name in names}
         inputs = {"report": cfg.section("report"), **{k: v.fingerprint for k, v in ups.items()}}
-        if cfg.elastic.enabled:  # the report tables the elastic stage's Cij
-            inputs["elastic"] = self._upstream("elastic").fingerprint
+        if cfg.elastic.enabled and (refusal is None or "elastic" in refusal["finished"]):
+            inputs["elastic"] = self._upstream("elastic").fingerprint  # the report tables its Cij
         if cfg.report.approximant_study is not None:  # the report tables that study's files
             inputs["approximant_study"] = approximant_study_digest(cfg.report.approximant_study)
+        if refusal is not None:
+            inputs["refusal"] = refusal
         folders = {name: self.folder(name) for name in STAGES}
         versions = json.loads((self.root / VERSIONS_JSON).read_text())
 
         def work(folder: Path) -> None:
-            run_report(cfg, ReportInputs(folders, versions), folder)
+            run_report(cfg, ReportInputs(folders, versions, refusal), folder)
 
         result = self._run("report", inputs, work)
         target = self.root / REPORT_HTML
@@ -591,9 +608,14 @@ class Pipeline:
         return copy_file_atomic(result.folder / REPORT_HTML, target)
 
     def run(self) -> Path:
-        """Every stage in order; returns the path of ``report.html``."""
+        """Every stage in order; ``report.html`` (also of a refusal after the scan, named in it)."""
         for name in ("build", "scan", "analyze", "laws", "elastic", "contact"):
-            getattr(self, name)()
+            try:
+                getattr(self, name)()
+            except InputError as exc:
+                if exc is not self._refusal or "scan" not in self.results or self.rundir.read_only:
+                    raise  # not a stage's refusal after the scan (a run-directory defect)
+                raise InputError(f"{exc} (report: {refused_report(self, name, exc)})") from None
         return self.report()
 
 

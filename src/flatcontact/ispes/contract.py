@@ -28,6 +28,9 @@ attrs
     cells: the larger of the round-off and the relaxation floor,
     :mod:`flatcontact.ispes.relax_noise`); absent means not measured
     (:func:`energy_floor_mev_per_a2`).
+    ``fold_rerelaxed_points`` and ``fold_rerelaxed_fmax_ev_per_a`` (optional): that many
+    points of folding columns were relaxed again at that tighter force tolerance (eV/Å) and
+    hold those values (:mod:`flatcontact.ispes.rerelax`).
 
 Points not computed yet are NaN with ``converged = False``.
 

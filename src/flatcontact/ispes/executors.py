@@ -29,6 +29,7 @@ from collections.abc import Callable, Iterable
 from typing import Any
 
 from flatcontact.errors import InputError
+from flatcontact.ispes.main_guard import serial_instead
 from flatcontact.ispes.relax import worker_calculator
 
 
@@ -322,7 +323,7 @@ def make_executor(
     if kind == "serial":
         return SerialExecutor()
     if kind == "processes":
-        if workers == 1:
+        if workers == 1 or serial_instead(workers):  # a script without its __main__ guard
             return SerialExecutor()
         return ProcessExecutor(workers)
     if kind == "dask":
@@ -330,5 +331,7 @@ def make_executor(
             return DaskExecutor(address=dask_address)
         if jobqueue is not None:
             return DaskExecutor(cluster=jobqueue_cluster(jobqueue))
+        if serial_instead(workers):  # a local cluster spawns its workers too
+            return SerialExecutor()
         return DaskExecutor.local(workers or default_workers())
     raise InputError(f"executor: expected serial, processes or dask, got {kind!r}")
