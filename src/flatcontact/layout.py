@@ -101,6 +101,8 @@ FIG6_EXPERIMENT = "fig6_experiment"
 FIG5C_CYCLE_LOOPS = "fig5c_cycle_loops"
 FIG6_LOCKIN = "fig6_lockin"
 FIG6_FIT = "fig6_fit"
+#: Effective shear strength against contact radius, concurrent and size-limited slip.
+FIG_SLIP_SIZE = "fig_slip_size"
 
 # ---- report
 REPORT_HTML = "report.html"

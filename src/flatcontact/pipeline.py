@@ -62,6 +62,7 @@ from flatcontact.fileio import (
 )
 from flatcontact.ispes.contract import check_grid, open_ispes
 from flatcontact.layout import (
+    BUILD_JSON,
     CONFIG_YAML,
     CONTACT_NC,
     ELASTIC_JSON,
@@ -89,7 +90,7 @@ from flatcontact.rundir import (
     portable,
     writable,
 )
-from flatcontact.stages import _calculator
+from flatcontact.stages import _calculator, contact_range
 from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
 from flatcontact.stages.build import BuildInputs, run_build
 from flatcontact.stages.contact import (
@@ -520,6 +521,11 @@ class Pipeline:
             from_scan=True,
             moduli=self._json("elastic", ELASTIC_JSON) if self.config.elastic.enabled else None,
             gates=gates,
+            interface=contact_range.facts(
+                self._upstream("build").folder / INTERFACE,
+                self._upstream("build").folder / BUILD_JSON,
+                open_result(self._upstream("analyze").folder / FRICTION_NC, FRICTION),
+            ),
         )
 
     def contact_parameters(self):
@@ -546,7 +552,13 @@ class Pipeline:
         gates = self.gates()
         self._refused(check_gates, cfg, gates)
         stage_inputs = self._contact_inputs(gates.to_json(cfg.contact.accept_untrusted))
-        self._refused(lambda: check_contact(cfg, contact_parameters(cfg, stage_inputs)[0]))
+
+        def checks() -> None:  # a refusal here gets the refused run's report
+            params = contact_parameters(cfg, stage_inputs)[0]
+            check_contact(cfg, params)
+            contact_range.adhesion_of(cfg, stage_inputs, params)  # where no model applies
+
+        self._refused(checks)
         inputs = {
             "contact": portable(cfg.section("contact"), "experiment_csv", "fit_csv"),
             "laws": laws.fingerprint,

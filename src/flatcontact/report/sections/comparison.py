@@ -26,6 +26,7 @@ from flatcontact.reference import (
 from flatcontact.report.format import LAW_COEFFICIENTS, fmt, pm
 from flatcontact.report.html import Section, Table
 from flatcontact.report.sections.analysis import stacking_rows
+from flatcontact.report.sections.contact import slip_note
 
 A_EXP = QUARTZ_LATTICE_EXPERIMENT_ANGSTROM["a"]
 
@@ -75,11 +76,11 @@ def paper_section(cfg, laws: dict, scan: dict, contact: dict) -> Section:
     )
     res = contact["results"]
     ref = contact["results_with_paper_laws"]
-    for r_run, r_pap in zip(res, ref, strict=True):
+    for i, (r_run, r_pap) in enumerate(zip(res, ref, strict=True)):
         rows.append(
             (
                 f"effective shear strength Q_peak/πa² at p0 = {r_run['p0_gpa']:g} GPa (MPa)",
-                fmt(r_run["effective_shear_strength_mpa"]),
+                fmt(r_run["effective_shear_strength_mpa"]) + slip_note(contact, i),
                 fmt(r_pap["effective_shear_strength_mpa"]),
                 f"{r_run['effective_shear_strength_mpa'] - r_pap['effective_shear_strength_mpa']:+.3g}",
                 "paper column: the same contact model with the paper's k, τ0, μ, σ0",
@@ -131,6 +132,7 @@ def own_results_section(
         if studied and i < len(intervals):
             q = intervals[i]["effective_shear_strength_mpa"]
             cell += f" [{q['low']:.4g}, {q['high']:.4g}]"
+        cell += slip_note(contact, i)
         rows.append(
             (f"effective shear strength Q_peak/πa² at p0 = {r['p0_gpa']:g} GPa (MPa)", cell)
         )
