@@ -560,6 +560,9 @@ class Pipeline:
         versions = json.loads((self.root / VERSIONS_JSON).read_text())
 
         def work(folder: Path) -> None:
+            # the files the report reads, checked against this run's record and settings
+            self.scan_summary()
+            self.contact_summary()
             run_report(cfg, ReportInputs(folders, versions), folder)
 
         result = self._run("report", inputs, work)

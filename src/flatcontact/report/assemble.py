@@ -83,10 +83,10 @@ def build_sections(
     f_build, f_scan = folders["build"], folders["scan"]
     f_an, f_laws, f_ct = folders["analyze"], folders["laws"], folders["contact"]
     build = _json(f_build / BUILD_JSON)
-    scan = _json(f_scan / SCAN_JSON, grid=cfg.scan.grid)
+    scan = _json(f_scan / SCAN_JSON)  # its grid checked by the pipeline against its record
     analyze = _json(f_an / ANALYZE_JSON)
     laws = _json(f_laws / LAWS_JSON, energy_form=cfg.analysis.energy_form)
-    contact = _json(f_ct / SUMMARY_JSON, p0_gpa=list(cfg.contact.p0_gpa))
+    contact = _json(f_ct / SUMMARY_JSON)  # its loads checked by the pipeline (contact.nc)
     table = pd.read_csv(f_an / FRICTION_CSV)
     interface = read(f_build / INTERFACE)
     model = cfg.potential.label
