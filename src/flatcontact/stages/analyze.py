@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from flatcontact.errors import InputError
-from flatcontact.fileio import atomic_path, write_json_atomic, write_text_atomic
+from flatcontact.fileio import atomic_path, read_json_file, write_json_atomic, write_text_atomic
 from flatcontact.layout import (
     ANALYZE_JSON,
     FRICTION_CSV,
@@ -24,7 +24,6 @@ from flatcontact.layout import (
     SCAN_JSON,
     analyze_figure,
 )
-from flatcontact.result_json import read_result_json
 from flatcontact.stages._common import captured, renamed_errors, save
 
 #: Parameters of :func:`flatcontact.analysis.analyze.analyze_ispes` -> the settings path.
@@ -126,10 +125,12 @@ def _folds_named(scan_json: Path):
         text = str(exc)
         folds = []
         if "not monotonic" in text:
-            try:
-                folds = read_result_json(scan_json).get("load_folds") or []
+            try:  # only its load_folds, for the message: the FIFO-safe reader, leniently
+                doc = read_json_file(scan_json, SCAN_JSON, 64_000_000)
             except InputError:  # no scan.json beside this ISPES, or not one: no fold named
-                folds = []
+                doc = None
+            found = doc.get("load_folds") if isinstance(doc, dict) else None
+            folds = [f for f in found if isinstance(f, dict)] if isinstance(found, list) else []
         if not folds:
             raise
         # imported here: the CLI imports this module before numpy and ASE may load
