@@ -599,6 +599,10 @@ class Pipeline:
         versions = json.loads((self.root / VERSIONS_JSON).read_text())
 
         def work(folder: Path) -> None:
+            # the files the report reads, checked against this run's record and settings
+            self.scan_summary()
+            if refusal is None:
+                self.contact_summary()
             run_report(cfg, ReportInputs(folders, versions, refusal), folder)
 
         result = self._run("report", inputs, work)

@@ -9,6 +9,9 @@ or a boxed multi-line message:
   rerun (the rerun resumes: stage records and scan points are written atomically);
 - a resource limit of the process: the file-size limit (``ulimit -f``, ``EFBIG``) and the
   memory limit (``ulimit -v``, ``MemoryError``), one line naming the limit and the file;
+- SIGTERM: raised as :class:`Terminated` (a ``KeyboardInterrupt``) in the main thread, so
+  every stage and standalone command unwinds as on Ctrl-C: temporary files are removed
+  (``.<name>.<random>.part``), the point store commits; one line, exit status 143;
 - Python warnings: flatcontact's own (analysis diagnostics, dated deprecations) as one
   ``warning:`` line each; the libraries' numerical warnings (numpy, scipy, ASE) into the
   run log and one summary line after a successful command
@@ -30,19 +33,34 @@ import os
 # 2-core machine against 0.2 ms on one thread). Worker processes inherit it.
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
+import contextlib
 import errno
 import logging
 import resource
+import signal
 import sqlite3
 import sys
+import threading
 from typing import Annotated
 
 import typer
 
 from flatcontact import __version__
-from flatcontact.cli import commands as _commands  # noqa: F401  (registers the sub-commands)
+from flatcontact.cli import memory_floor  # noqa: F401  (refuses a too low ulimit -v)
 from flatcontact.cli.app import app, check_out_flags, console, print_error
 from flatcontact.errors import InputError
+
+try:  # registers the sub-commands; their modules load numpy and the settings
+    from flatcontact.cli import commands as _commands  # noqa: F401
+except ImportError as _exc:  # numpy's libraries under a memory limit that leaves no room
+    if not any(w in str(_exc).lower() for w in ("failed to map segment", "cannot allocate")):
+        raise
+    _line = (str(_exc).strip().splitlines() or [""])[-1][:200]
+    sys.stderr.write(
+        f"error: out of memory loading the numerical libraries ({_line}); raise the memory "
+        "limit of this process (ulimit -v) and rerun\n"
+    )
+    sys.exit(2)
 
 __all__ = ["app", "main", "usage_error_line"]
 
@@ -112,6 +130,23 @@ def file_size_line(exc: OSError) -> str:
     )
 
 
+#: What the dynamic loader says when the memory limit (ulimit -v) leaves no room for a library.
+_NO_ROOM = ("failed to map segment", "cannot allocate memory", "out of memory")
+
+
+def _first_line(exc: BaseException) -> str:
+    return (str(exc).strip().splitlines() or [""])[0][:200]
+
+
+def _starved(exc: BaseException) -> bool:
+    """Whether ``exc`` (an ImportError, an OSError of ctypes) is a library the memory limit
+    did not let load (the loader's words), not a missing module or another I/O fault."""
+    if isinstance(exc, OSError) and exc.errno == errno.ENOMEM:
+        return True
+    text = str(exc).lower()
+    return any(words in text for words in _NO_ROOM)
+
+
 def memory_line(exc: MemoryError) -> str:
     """One line for an allocation refused by the memory limit (``ulimit -v``) or the machine."""
     said = " ".join(str(exc).split())
@@ -120,6 +155,39 @@ def memory_line(exc: MemoryError) -> str:
         f"out of memory{detail}; raise the memory limit (ulimit -v) or run a smaller study, "
         "then rerun the same command: finished stages and scan points are kept"
     )
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM in a flatcontact command: unwinds like Ctrl-C (every ``finally`` runs)."""
+
+
+@contextlib.contextmanager
+def sigterm_unwinds():
+    """While a command runs, SIGTERM raises :class:`Terminated` in the main thread; yields a
+    list that holds the signal once it came. A process forked from this one dies of SIGTERM
+    as before (a pool's workers); nothing changes where SIGTERM already has a handler."""
+    got: list[int] = []
+    if (
+        threading.current_thread() is not threading.main_thread()
+        or signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL
+    ):
+        yield got
+        return
+    pid = os.getpid()
+
+    def terminated(signum, frame):
+        if os.getpid() != pid:  # a forked child: die as it would have
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)
+            os.kill(os.getpid(), signal.SIGTERM)
+            return
+        got.append(signum)
+        raise Terminated("SIGTERM")
+
+    old = signal.signal(signal.SIGTERM, terminated)
+    try:
+        yield got
+    finally:
+        signal.signal(signal.SIGTERM, old)
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -138,6 +206,28 @@ def main(argv: list[str] | None = None) -> None:
 
 def _run(argv: list[str] | None) -> int:
     """Run the command; its exit status (an error is printed as one line here)."""
+    with sigterm_unwinds() as got:
+        try:
+            code = _command(argv)
+        except KeyboardInterrupt:
+            if not got:  # Ctrl-C in a command that does not say it itself
+                print_error(
+                    "interrupted; temporary files removed, finished work kept: rerun the same "
+                    "command to resume"
+                )
+                return 130
+            code = 0
+        if got:  # the command may have said "interrupted" already; this is the status
+            print_error(
+                "terminated (SIGTERM); temporary files removed, finished work kept: rerun the "
+                "same command to resume"
+            )
+            return 128 + signal.SIGTERM
+        return code
+
+
+def _command(argv: list[str] | None) -> int:
+    """The command's exit status; every refusal and resource fault one line."""
     try:
         check_out_flags([str(a) for a in (sys.argv[1:] if argv is None else argv)])
         rv = app(args=argv, standalone_mode=False, prog_name="flatcontact")
@@ -148,12 +238,22 @@ def _run(argv: list[str] | None) -> int:
         if exc.errno == errno.EFBIG:
             print_error(file_size_line(exc))
             return 2
+        if _starved(exc):  # ctypes could not map LAMMPS's library under ulimit -v
+            print_error(memory_line(MemoryError(f"loading a shared library: {_first_line(exc)}")))
+            return 2
         if exc.errno not in _DISK_FULL:
             raise
         print_error(disk_full_line(exc))
         return 2
     except MemoryError as exc:  # numpy's _ArrayMemoryError included
         print_error(memory_line(exc))
+        return 2
+    except ImportError as exc:
+        # a shared library (numpy's BLAS, LAMMPS) the memory limit leaves no room to map
+        if not _starved(exc):
+            raise
+        name = getattr(exc, "name", None) or "a shared library"
+        print_error(memory_line(MemoryError(f"loading {name}: {_first_line(exc)}")))
         return 2
     except sqlite3.OperationalError as exc:  # the scan's point store on a full disk
         if "full" not in str(exc):

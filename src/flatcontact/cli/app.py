@@ -28,14 +28,26 @@ console = Console()
 err_console = Console(stderr=True, markup=False, highlight=False, soft_wrap=True)
 
 
+#: Control characters as they are shown in a one-line message (a file name may hold them).
+_SHOWN_CONTROLS = {c: repr(chr(c))[1:-1] for c in (*range(0x20), 0x7F)}
+
+
+def one_line(message: object) -> str:
+    """``message`` as one line: a newline, tab or other control character in it (a file name
+    the user gave, a library's text) is shown escaped (``\\n``), so it cannot split the line."""
+    return str(message).translate(_SHOWN_CONTROLS)
+
+
 def print_error(message: object) -> None:
-    """Print ``error: <message>`` on stderr, the message verbatim (no rich markup)."""
-    err_console.print(Text("error: ", style="bold red") + Text(str(message)))
+    """Print ``error: <message>`` on stderr, the message verbatim (no rich markup) and on one
+    line (:func:`one_line`)."""
+    err_console.print(Text("error: ", style="bold red") + Text(one_line(message)))
 
 
 def print_warning(message: object) -> None:
-    """Print ``warning: <message>`` on stderr, the message verbatim (no rich markup)."""
-    err_console.print(Text("warning: ", style="bold yellow") + Text(str(message)))
+    """Print ``warning: <message>`` on stderr, the message verbatim (no rich markup), on one
+    line (:func:`one_line`)."""
+    err_console.print(Text("warning: ", style="bold yellow") + Text(one_line(message)))
 
 
 def print_progress(message: object) -> None:

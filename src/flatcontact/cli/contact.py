@@ -458,12 +458,15 @@ def _given_interface(unstable_stacking_mj_m2, burgers_angstrom, structure) -> di
     kinds = (COMMENSURATE, TWISTED, APPROXIMANT)
     if structure not in kinds:
         raise InputError(f"--structure: expected one of {', '.join(kinds)}, got {structure!r}")
-    for flag, value in (
-        ("--unstable-stacking-mj-m2", unstable_stacking_mj_m2),
-        ("--burgers-angstrom", burgers_angstrom),
+    from flatcontact.cli.app import bounded
+    from flatcontact.numbers import Bounds
+
+    for flag, value, bounds in (
+        ("--unstable-stacking-mj-m2", unstable_stacking_mj_m2, Bounds(1e-3, 1e4, "mJ/m²")),
+        ("--burgers-angstrom", burgers_angstrom, Bounds(0.1, 100.0, "Å")),
     ):
-        if value is not None and not (value > 0 and value < 1e6):
-            raise InputError(f"{flag}: expected a positive number, got {value!r}")
+        if value is not None:
+            bounded(value, flag, bounds)
     if unstable_stacking_mj_m2 is None and burgers_angstrom is None:
         return None
     path = {"source": "given on the command line"}

