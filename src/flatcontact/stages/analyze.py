@@ -57,7 +57,8 @@ class AnalyzeResult:
     files: list[Path] = field(default_factory=list)
 
     def to_json(self) -> dict:
-        """``analyze.json``: warnings, timings, Fig. 2 names, symmetry, energy zero, load noise."""
+        """``analyze.json``: warnings, timings, Fig. 2 names, symmetry, energy zero, load noise
+        and the grid's estimate of its own error (``grid``, :mod:`flatcontact.analysis.grid_error`)."""
         result = self.analysis
         return {
             "warnings": list(self.warnings),
@@ -71,6 +72,7 @@ class AnalyzeResult:
             "energy_reference_ev_per_a2": result.energy_reference_ev_per_a2,
             "load_source": result.load_source,
             "noise": result.noise.to_json(),
+            "grid": result.grid.to_json() if result.grid is not None else None,
         }
 
 
