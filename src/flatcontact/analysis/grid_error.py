@@ -16,10 +16,10 @@ direction from the same start rule (near-degenerate minima, largest τ), with th
 floor, so the two numbers differ only by the grid. With ``q`` a quantity on the full grid and
 ``q_c`` on the coarse one, the estimate of the full grid's error is
 
-.. math:: \\delta q = \\frac{q - q_c}{r^p - 1}
+.. math:: \\delta q = \\frac{q_c - q}{r^p - 1} \\approx q - q_\\infty
 
-(signed: positive when the full grid lies above the converged value), the Richardson
-estimate for a quantity converging as ``h^p``. **Assumed order** ``p = 1``
+(signed: positive when the full grid lies above the converged value ``q_∞``), the
+Richardson estimate for a quantity converging as ``q(h) = q_∞ + C h^p``. **Assumed order** ``p = 1``
 (:data:`ASSUMED_ORDER`): τ and σ_MSS are first derivatives (or barriers over a period) of the
 trigonometric interpolant; for a landscape whose curvature jumps (a relaxation that switches
 branch, the least smooth ISPES whose lateral force is still continuous) the Fourier
@@ -162,8 +162,9 @@ def friction_on(
 
 
 def richardson(fine: float, coarse: float, ratio: float, order: float) -> float:
-    """Signed estimate of the fine value's error, ``(fine − coarse)/(ratio^order − 1)``."""
-    return (fine - coarse) / (ratio**order - 1.0)
+    """Signed estimate of the fine value's error ``fine − q_∞``, ``(coarse − fine)/(ratio^order
+    − 1)`` (exact for ``q(h) = q_∞ + C h^order``)."""
+    return (coarse - fine) / (ratio**order - 1.0)
 
 
 def observed_order(
@@ -266,7 +267,8 @@ class GridEstimate:
             "assumed_order": ASSUMED_ORDER,
             "order_rule": f"observed order of tau clipped to [{MIN_ORDER:g}, {ASSUMED_ORDER:g}] "
             "where the grid has a third level, else the assumed order",
-            "estimate": "(fine - coarse) / (ratio**order - 1), signed",
+            "estimate": "(coarse - fine) / (ratio**order - 1): signed, the fine value minus the "
+            "converged one",
             "unresolved_fraction": self.fraction,
             "p_gpa": clean(self.p_gpa),
             "order": clean(self.order),

@@ -1,0 +1,244 @@
+"""The grid's own estimate of its discretisation error (flatcontact.analysis.grid_error).
+
+Two analytic landscapes of :mod:`flatcontact.analysis.synthetic` (Morse adhesion, c = 0, so
+the internal constant-pressure landscape is exactly const + V·g at every load):
+
+* smooth: g = cos 2π s_a + cos 2π s_b on a rectangular a × b cell pulled along y. The path
+  runs along s_a = 1/2 from the minimum (1/2, 1/2): e(t) = V(−1 − cos 2πt/b), so in closed
+  form τ = 2πV/b, σ_MSS = 2V/b (one barrier 2V per period b), G_int = V(2π/b)². The 3×3
+  sub-grid already holds every harmonic: the estimate must vanish;
+* sharp: Σ_k (−1)^k cos(2πk s_b)/k³ + ½ Σ_k cos(2πk s_a)/k³ (k ≤ 12): coefficients falling as
+  k^−3, the curvature-jump class the assumed order stands for. τ moves by 12 % from 6×6 to
+  9×9; a 48×48 grid holds every harmonic and gives the exact τ.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from flatcontact import units
+from flatcontact.analysis import gates
+from flatcontact.analysis import synthetic as syn
+from flatcontact.analysis.analyze import analyze_ispes
+from flatcontact.analysis.diagnostics import GridResolutionWarning
+from flatcontact.analysis.grid_error import (
+    UNRESOLVED_FRACTION,
+    coarse_grid,
+    observed_order,
+    richardson,
+)
+from flatcontact.analysis.uncertainty import grid_law_components, law_half_widths
+
+A_ANGSTROM, B_ANGSTROM = 4.0, 5.0
+A1, A2 = syn.rectangular_cell(A_ANGSTROM, B_ANGSTROM)
+V = 1e-3  # eV/Å²
+Z = np.linspace(23.6, 27.0, 12)
+SMOOTH = syn.cosine_sum([(1, 0, 1.0), (0, 1, 1.0)])
+SHARP = syn.cosine_sum(
+    [(0, k, (-1) ** k / k**3) for k in range(1, 13)] + [(k, 0, 0.5 / k**3) for k in range(1, 13)]
+)
+
+
+def _analyse(pattern, n: int, p_gpa=(0.0,), **kw):
+    ds = syn.SyntheticInterface(A1, A2, pattern, corrugation_ev_per_a2=V).grid(n, n, Z)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = analyze_ispes(
+            ds, list(p_gpa), direction_deg=90.0, with_symmetry=False, with_stackings=False, **kw
+        )
+    grid_warnings = [str(w.message) for w in caught if w.category is GridResolutionWarning]
+    return result, grid_warnings
+
+
+@pytest.fixture(scope="module")
+def sharp():
+    """τ and its grid estimate of the sharp landscape per grid (48: exact)."""
+    out = {}
+    for n in (6, 9, 12, 48):
+        result, caught = _analyse(SHARP, n)
+        out[n] = (float(result.column("tau_mpa")[0]), result.grid, caught)
+    return out
+
+
+def test_smooth_landscape_matches_the_closed_form_and_its_grid_part_vanishes():
+    result, caught = _analyse(SMOOTH, 6, p_gpa=(0.0, 0.5, 1.0))
+    tau = 2 * np.pi * V / B_ANGSTROM * units.EV_PER_A3_TO_MPA
+    sigma = 2 * V / B_ANGSTROM * units.EV_PER_A3_TO_MPA
+    stiffness = V * (2 * np.pi / B_ANGSTROM) ** 2 * units.EV_PER_A3_TO_GPA * 10  # GPa/nm
+    np.testing.assert_allclose(result.column("tau_mpa"), tau, rtol=1e-7)
+    np.testing.assert_allclose(result.column("sigma_mss_mpa"), sigma, rtol=1e-7)
+    np.testing.assert_allclose(result.column("shear_stiffness_gpa_per_nm"), stiffness, rtol=1e-6)
+    grid = result.grid
+    assert grid.grid.method == "sub-grid" and grid.grid.points == (3, 3)
+    np.testing.assert_allclose(grid.coarse["tau_mpa"], tau, rtol=1e-7)
+    for q, scale in (("tau_mpa", tau), ("sigma_mss_mpa", sigma)):
+        assert np.max(np.abs(grid.error[q])) <= 1e-7 * scale
+    assert np.max(np.abs(grid.error["shear_stiffness_gpa_per_nm"])) <= 1e-6 * stiffness
+    assert not np.any(grid.unresolved) and grid.recommended_grid() is None and caught == []
+    # the laws' grid part is the fit of those estimates: zero within round-off
+    parts = grid_law_components(
+        result.p_gpa,
+        result.column("tau_mpa"),
+        result.column("sigma_mss_mpa"),
+        grid.error["tau_mpa"],
+        grid.error["sigma_mss_mpa"],
+        3.0,
+    )
+    assert all(v is not None and v <= 1e-6 * tau for v in parts.values())
+
+
+@pytest.mark.parametrize(("coarse", "fine"), [(6, 9), (6, 12), (9, 12), (12, 48)])
+def test_grid_part_covers_the_change_to_a_finer_grid(sharp, coarse, fine):
+    tau_c, grid_c, _ = sharp[coarse]
+    tau_f = sharp[fine][0]
+    assert abs(tau_f - tau_c) > 1e-3 * tau_c  # τ really moves with the grid
+    assert abs(grid_c.error["tau_mpa"][0]) >= abs(tau_f - tau_c)
+
+
+def test_grid_part_covers_the_error_to_the_exact_tau(sharp):
+    exact = sharp[48][0]
+    # 48×48 holds every harmonic of the pattern: the 24×24 sub-grid does too (estimate 0)
+    assert abs(sharp[48][1].error["tau_mpa"][0]) <= 1e-6 * exact
+    for n in (6, 9, 12):
+        tau, grid, _ = sharp[n]
+        assert abs(grid.error["tau_mpa"][0]) >= abs(tau - exact)
+
+
+def test_an_unresolved_grid_says_so_and_its_recommended_grid_resolves_tau(sharp):
+    tau6, grid6, caught = sharp[6]
+    exact = sharp[48][0]
+    assert abs(tau6 - exact) > UNRESOLVED_FRACTION * exact  # 6×6 is really 12 % off
+    assert bool(grid6.unresolved[0])
+    (line,) = caught
+    rec = grid6.recommended_grid()
+    assert "does not resolve τ" in line and f"about {rec[0]}×{rec[1]}" in line
+    assert rec[0] == rec[1] and rec[0] % 2 == 0 and rec[0] > 6
+    finer, caught_rec = _analyse(SHARP, rec[0])
+    assert abs(finer.column("tau_mpa")[0] - exact) <= UNRESOLVED_FRACTION * exact
+    assert not bool(finer.grid.unresolved[0]) and caught_rec == []
+
+
+def test_prime_grid_uses_the_low_pass_band_and_still_covers_the_change():
+    tau7, _ = _analyse(SHARP, 7)
+    tau14, _ = _analyse(SHARP, 14)
+    grid = tau7.grid
+    assert grid.grid.method == "low-pass" and grid.grid.max_harmonic == 1
+    change = abs(tau14.column("tau_mpa")[0] - tau7.column("tau_mpa")[0])
+    assert change > 0 and abs(grid.error["tau_mpa"][0]) >= change
+
+
+@pytest.mark.parametrize(
+    ("shape", "method", "points", "ratio"),
+    [
+        ((6, 6), "sub-grid", (3, 3), 2.0),
+        ((9, 9), "sub-grid", (3, 3), 3.0),
+        ((12, 6), "sub-grid", (6, 3), 2.0),
+        ((7, 7), "low-pass", (3, 3), 7 / 3),
+        ((11, 11), "low-pass", (5, 5), 11 / 5),
+        ((6, 7), "low-pass", (3, 3), 2.0),
+    ],
+)
+def test_coarse_grid_rule(shape, method, points, ratio):
+    grid = coarse_grid(shape)
+    assert (grid.method, grid.points) == (method, points)
+    assert grid.ratio == pytest.approx(ratio)
+
+
+def test_a_grid_with_no_coarser_grid_is_named():
+    assert coarse_grid((3, 3)) is None
+    result, caught = _analyse(SMOOTH, 3)
+    assert result.grid.unavailable and "3×3" in result.grid.unavailable
+    assert any("no grid error estimate" in m for m in caught)
+    assert np.all(np.isnan(result.grid.error["tau_mpa"]))
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    exact=st.floats(-1e3, 1e3),
+    c=st.floats(-1e3, 1e3).filter(lambda v: abs(v) > 1e-3),
+    order=st.floats(0.5, 4.0),
+    r=st.sampled_from([2.0, 3.0]),
+    r2=st.sampled_from([2.0, 3.0]),
+    h=st.floats(0.05, 0.5),
+)
+def test_richardson_and_observed_order_are_exact_for_a_power_law(exact, c, order, r, r2, h):
+    """q(h) = q* + C h^p: the estimate is the fine value's error, the order is p."""
+
+    def q(step):
+        return exact + c * step**order
+
+    fine, coarse, coarsest = q(h), q(r * h), q(r * r2 * h)
+    assert richardson(fine, coarse, r, order) == pytest.approx(fine - exact, abs=1e-9 * abs(c))
+    assert observed_order(fine, coarse, coarsest, r, r2) == pytest.approx(order, rel=1e-6)
+
+
+def test_observed_order_is_undefined_without_monotone_convergence():
+    assert np.isnan(observed_order(1.0, 2.0, 1.5, 2.0, 2.0))  # oscillating
+    assert np.isnan(observed_order(1.0, 1.0, 2.0, 2.0, 2.0))  # no change at the fine level
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    loads=st.lists(st.floats(0.0, 3.0), min_size=3, max_size=6, unique=True),
+    a=st.floats(-50, 50),
+    b=st.floats(-50, 50),
+    m=st.floats(-5, 5),
+    s=st.floats(-5, 5),
+)
+def test_grid_law_components_of_linear_estimates_are_their_coefficients(loads, a, b, m, s):
+    """The fit is linear in the data: estimates δτ = a·P + b give |a|, |b| exactly."""
+    p = np.array(loads)
+    if np.ptp(p) < 1e-3:
+        return
+    parts = grid_law_components(p, 100 + 3 * p, 10 + p, a * p + b, m * p + s, 3.0)
+    assert parts["k_mpa_per_gpa"] == pytest.approx(abs(a), abs=1e-7 * (1 + abs(b) / np.ptp(p)))
+    assert parts["tau0_mpa"] == pytest.approx(abs(b), abs=1e-7 * (1 + abs(a) * 3))
+    assert parts["mu_mpa_per_gpa"] == pytest.approx(abs(m), abs=1e-7 * (1 + abs(s) / np.ptp(p)))
+    assert parts["sigma0_mpa"] == pytest.approx(abs(s), abs=1e-7 * (1 + abs(m) * 3))
+
+
+def test_grid_law_components_need_an_estimate_at_every_fitted_load():
+    p = np.array([0.0, 0.5, 1.0, 4.0])
+    tau = np.array([1.0, 2.0, 3.0, 4.0])
+    # a missing estimate above the threshold does not matter, one on a fitted load does
+    ok = grid_law_components(p, tau, tau, [1.0, 1.0, 1.0, np.nan], [0.0] * 4, 3.0)
+    assert ok["tau0_mpa"] == pytest.approx(1.0) and ok["k_mpa_per_gpa"] == pytest.approx(0.0)
+    bad = grid_law_components(p, tau, tau, [1.0, np.nan, 1.0, 1.0], None, 3.0)
+    assert bad == dict.fromkeys(("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa"))
+
+
+def test_the_grid_part_enters_the_half_width_in_quadrature():
+    laws = {"k_mpa_per_gpa": 1.0, "k_stderr_mpa_per_gpa": 3.0, "tau0_mpa": 5.0}
+    hw = law_half_widths(laws, grid={"k_mpa_per_gpa": 4.0, "tau0_mpa": None}, coverage=2.0)
+    assert hw["k_mpa_per_gpa"] == pytest.approx(2.0 * 5.0)  # 2·√(3² + 4²)
+    assert hw["tau0_mpa"] == 0.0  # no fit error, grid not estimated
+
+
+def _negative(k_grid):
+    parts = {"fit": 0.2, "convergence": 0.0, "models": 0.0}
+    if k_grid != "absent":
+        parts["grid"] = k_grid
+    return {
+        "k_mpa_per_gpa": -2.0,
+        "tau0_mpa": 30.0,
+        "p_max_gpa": 1.5,
+        "threshold_gpa": 3.0,
+        "intervals": {
+            "k_mpa_per_gpa": {"value": -2.0, "low": -2.5, "high": -1.5, "components": parts}
+        },
+    }
+
+
+def test_negative_slope_remedy_names_the_grid_where_it_applies():
+    big = gates.negative_slope(_negative(0.4)).message
+    assert "lateral grid" in big and "±0.4 MPa/GPa" in big and "scan.grid" in big
+    unknown = gates.negative_slope(_negative(None)).message
+    assert "could not be estimated" in unknown and "scan.grid" in unknown
+    for small in (gates.negative_slope(_negative(0.05)), gates.negative_slope(_negative("absent"))):
+        assert "grid" not in small.message
+        assert "contact.k_mpa_per_gpa" in small.message
