@@ -382,8 +382,8 @@ def _warn_grid(grid: GridEstimate, source: str) -> None:
         warnings.warn(f"{source}: {text}", GridResolutionWarning, stacklevel=3)
     if grid.unavailable is not None:
         warnings.warn(
-            f"{source}: no grid error estimate where {grid.unavailable}; the laws' intervals "
-            "carry no grid part there",
+            f"{source}: grid error estimate incomplete: {grid.unavailable}; where neither "
+            "estimate exists the laws' intervals carry no grid part",
             GridResolutionWarning,
             stacklevel=3,
         )

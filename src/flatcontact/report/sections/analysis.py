@@ -133,16 +133,21 @@ def grid_paragraphs(grid: dict | None) -> list[str]:
     and, above the threshold, that the grid does not resolve τ and which grid would."""
     if not grid:
         return []
-    if grid.get("method") is None:
-        return [f"Grid error of τ not estimated: {grid.get('unavailable')}."]
     rel = [v for v in grid.get("relative_tau_error") or [] if v is not None]
     n_a, n_b = grid["grid"]
+    made = "two interpolants of the same samples (the symmetrised one and the grid's own), the "
+    made += "interpolant without its outermost harmonic shell"
+    if grid.get("sub_grid"):
+        made += (
+            f" and the {grid['sub_grid']}, Richardson-scaled by 1/(r^p − 1), r = "
+            f"{grid['ratio']:.3g}, p = the convergence order (assumed {grid['assumed_order']:g}; "
+            f"{grid['order_rule']})"
+        )
     text = (
-        f"Grid error: τ, σ_MSS and G_int are recomputed on the {grid['coarse']} of the "
-        f"{n_a}×{n_b} grid (same samples, symmetry, start rule and direction); the difference "
-        f"scaled by 1/(r^p − 1), r = {grid['ratio']:g}, p = the convergence order (assumed "
-        f"{grid['assumed_order']:g}; {grid['order_rule']}), is the ± grid of the table and the "
-        "grid part of the laws' intervals."
+        f"Grid error of the {n_a}×{n_b} grid: τ, σ_MSS and G_int recomputed from {made}, with "
+        "the same symmetry, start rule and direction. Per quantity the largest estimate (rms "
+        f"over the loads; τ: {(grid.get('source') or {}).get('tau_mpa', 'n/a')}) is the ± grid "
+        "of the table and the grid part of the laws' intervals."
     )
     if rel:
         text += f" Largest |δτ|/τ: {100 * max(rel):.3g} %."
@@ -155,7 +160,7 @@ def grid_paragraphs(grid: dict | None) -> list[str]:
             "(scan.grid) would resolve it by the same estimate."
         )
     if grid.get("unavailable"):
-        out.append(f"No grid estimate where {grid['unavailable']}.")
+        out.append(f"Not estimated: {grid['unavailable']}.")
     return out
 
 
