@@ -17,6 +17,7 @@ scans of docs/measured/examples), whose τ moves by 6 % from 6×6 to 9×9.
 
 from __future__ import annotations
 
+import json
 import warnings
 from pathlib import Path
 
@@ -276,3 +277,27 @@ def test_negative_slope_remedy_names_the_grid_where_it_applies():
     for small in (gates.negative_slope(_negative(0.05)), gates.negative_slope(_negative("absent"))):
         assert "grid" not in small.message
         assert "contact.k_mpa_per_gpa" in small.message
+
+
+def test_console_note_of_the_analyze_stage(tmp_path):
+    """The run's console prints the grid's verdict after the analyze stage (StageEvent message)."""
+    from flatcontact.cli.progress import StageLines
+    from flatcontact.pipeline import StageEvent
+    from flatcontact.stages.analyze import grid_note
+
+    doc = {"grid": {"grid": [6, 6], "resolved": False, "relative_tau_error": [0.02, 0.162]}}
+    doc["grid"]["recommended_grid"] = [20, 20]
+    (tmp_path / "analyze.json").write_text(json.dumps(doc))
+    note = grid_note(tmp_path)
+    assert "6×6 grid does not resolve τ" in note and "16.2 %" in note and "20×20" in note
+    printed = []
+
+    class Console:
+        def print(self, text, **kw):
+            printed.append(text)
+
+    StageLines(Console())(StageEvent("end", "analyze", 3, "ran", 1.0, note))
+    assert printed[-1] == f"   warning: {note}"
+    doc["grid"]["resolved"] = True
+    (tmp_path / "analyze.json").write_text(json.dumps(doc))
+    assert grid_note(tmp_path) == "" and grid_note(tmp_path / "missing") == ""

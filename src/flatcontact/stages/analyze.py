@@ -116,6 +116,25 @@ def run_analyze(
     return result
 
 
+def grid_note(folder: Path) -> str:
+    """One line for the console when the analysis's grid does not resolve τ (``analyze.json``
+    ``grid``, :mod:`flatcontact.analysis.grid_error`); "" when it does or the file has none."""
+    try:
+        grid = json.loads((Path(folder) / ANALYZE_JSON).read_text()).get("grid") or {}
+    except (OSError, ValueError, AttributeError):
+        return ""
+    if grid.get("resolved", True):
+        return ""
+    rel = [v for v in grid.get("relative_tau_error") or [] if v is not None]
+    n_a, n_b = grid.get("grid") or ("?", "?")
+    rec = grid.get("recommended_grid") or ("?", "?")
+    return (
+        f"the {n_a}×{n_b} grid does not resolve τ (estimated error up to "
+        f"{100 * max(rel, default=float('nan')):.3g} % of τ); a grid of about {rec[0]}×{rec[1]} "
+        f"would (scan.grid); the intervals carry it ({ANALYZE_JSON} grid)"
+    )
+
+
 @contextlib.contextmanager
 def _folds_named(scan_json: Path):
     """A load that is not monotonic where the scan recorded folds (``scan.json``
