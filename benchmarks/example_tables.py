@@ -46,12 +46,21 @@ RUN_EXAMPLES = (
     "diamond111-h-graphene-airebo",
     "quartz-paper",
 )
+#: The experiment's interfaces of examples/README.md (example, row label).
+PASSIVATED = (
+    ("passivated-tip-bare-diamond-graphene", "(a) bare diamond(111) / graphene, AIREBO"),
+    ("passivated-tip-h-diamond-graphene", "(b) H-diamond(111) / graphene, AIREBO"),
+    ("passivated-tip-graphene-ab", "(c) AB graphene / graphene, REBO + KC"),
+)
+#: Rows of that table measured with a configuration that is no example file.
+PASSIVATED_OTHER = ("(c) twisted 21.787° (`twist: [1, 2]`, 28 atoms), REBO + KC, rigid layers",)
 #: The worked example of docs/your-own-interface.md (its YAML is in that page).
 WORKED = "al111"
 #: The approximant studies (examples/passivated-tip-{bare,h}-diamond-graphene-approximants.yaml).
 STUDIES = {"appx-bare": "(a) bare diamond", "appx-h": "(b) H-diamond"}
 #: Files of a run directory the tables are read from.
 RUN_FILES = (
+    "01-build/build.json",
     "02-scan/scan.json",
     "03-analyze/friction.csv",
     "03-analyze/analyze.json",
@@ -340,7 +349,85 @@ def approximants_table(store: Path = STORE) -> str:
     return head + "\n".join(rows) + "\n"
 
 
+def _lock(build: dict) -> str:
+    match = (build.get("recipe") or {}).get("match") or {}
+    strain = match.get("slab2_strain_percent")
+    if not strain:
+        return "none"
+    return f"{match.get('n_atoms', '?')} atoms, slab 2 {max(strain, key=abs):+.3g} %"
+
+
+def _ratios(row: dict) -> tuple[str, str]:
+    ratio = row.get("ratio_to_measured") or {}
+    return _g(ratio.get("graphene-passivated SiOx"), 2), _g(ratio.get("bare SiOx"), 2)
+
+
+def experiment_table(store: Path = STORE) -> str:
+    """examples/README.md: the experiment's interfaces, their collapse stress at 1.77 GPa."""
+    head = (
+        "| interface (example) | wall (scan) | lock | barrier at P = 0 (meV/Å²) | "
+        "τ = k·P + τ0 (MPa) | σ = μ·P + σ0 (MPa) | grid part; the grid's verdict | W (J/m²) | "
+        "collapse at 1.77 GPa (MPa) [interval] | ÷ 26.7 (passivated) | ÷ 145 (bare SiOx) |\n|"
+        + "---|" * 11
+        + "\n"
+    )
+    rows, comparison = [], None
+    for name, label in PASSIVATED:
+        d = store / name
+        if not (d / "06-contact" / "summary.json").is_file():
+            rows.append(f"| {label} | {NOT_REGENERATED} |" + " — |" * 9)
+            continue
+        laws = _json(d / "04-laws" / "laws.json")
+        summary = _json(d / "06-contact" / "summary.json")
+        comparison = comparison or summary.get("experiment_comparison")
+        run = (summary.get("experiment_comparison") or {}).get("run") or {}
+        first = pd.read_csv(d / "03-analyze" / "friction.csv").sort_values("p_gpa").iloc[0]
+        p0 = (summary.get("experiment_comparison") or {}).get("p0_gpa")
+        bounds = [
+            r["collapse_stress_mpa"]
+            for r in (summary.get("intervals") or {}).get("results", [])
+            if r.get("p0_gpa") == p0
+        ]
+        interval = f" [{_g(bounds[0]['low'])}, {_g(bounds[0]['high'])}]" if bounds else ""
+        form = laws.get("energy_form", "internal")
+        w = (_json(d / "02-scan" / "scan.json").get("adhesion") or {}).get(
+            "work_of_separation_j_per_m2"
+        )
+        cells = (
+            f"{label}" + ("" if form == "internal" else f" ({form} form)"),
+            _wall(_json(d / "timings.json")),
+            _lock(_json(d / "01-build" / "build.json")),
+            _g(first.get("lowest_barrier_mev_per_a2")),
+            _law(laws, "k_mpa_per_gpa", "tau0_mpa", "k_stderr_mpa_per_gpa", "tau0_stderr_mpa"),
+            _law(
+                laws, "mu_mpa_per_gpa", "sigma0_mpa", "mu_stderr_mpa_per_gpa", "sigma0_stderr_mpa"
+            ),
+            _grid_part(laws, _json(d / "03-analyze" / "analyze.json")),
+            _g(w),
+            f"**{_g(run.get('collapse_stress_mpa'))}**{interval}",
+            *_ratios(run),
+        )
+        rows.append("| " + " | ".join(cells) + " |")
+    rows += [f"| {label} | {NOT_REGENERATED} |" + " — |" * 9 for label in PASSIVATED_OTHER]
+    if comparison is None:
+        rows.append(f"| quartz references, measured collapses | {NOT_REGENERATED} |" + " — |" * 9)
+        return head + "\n".join(rows) + "\n"
+    for ref in comparison.get("references", []):
+        law = (
+            f"{_g(ref.get('k_mpa_per_gpa'))}·P + {_g(ref.get('tau0_mpa'))}",
+            f"{_g(ref.get('mu_mpa_per_gpa'))}·P + {_g(ref.get('sigma0_mpa'))}",
+        )
+        rows.append(
+            f"| {ref.get('label')} | — | — | — | {law[0]} | {law[1]} | — | — | "
+            f"**{_g(ref.get('collapse_stress_mpa'), 3)}** | " + " | ".join(_ratios(ref)) + " |"
+        )
+    for what, value in (comparison.get("measured_mpa") or {}).items():
+        rows.append(f"| measured, {what} (paper, Fig. 6) |" + " |" * 7 + f" **~{_g(value)}** | | |")
+    return head + "\n".join(rows) + "\n"
+
+
 TABLES = {
+    "experiment": experiment_table,
     "runs": runs_table,
     "worked": worked_table,
     "approximants": approximants_table,
@@ -362,7 +449,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--studies", type=Path, help="directory of finished approximant studies")
     args = ap.parse_args(argv)
     if args.runs:
-        for name in (*RUN_EXAMPLES, WORKED):
+        for name in (*RUN_EXAMPLES, *(n for n, _ in PASSIVATED), WORKED):
             if (args.runs / name / "04-laws" / "laws.json").is_file():
                 print(f"stored {store_run(args.runs / name, name).relative_to(ROOT)}")
     if args.studies:
