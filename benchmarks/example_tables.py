@@ -304,7 +304,7 @@ def _twist(deg: float) -> str:
 
 def approximants_table(store: Path = STORE) -> str:
     head = (
-        "| interface, cell | atoms | rotation of the sheet (mod 60°) | strain on graphene | "
+        "| interface, cell | atoms | rotation of the sheet (mod 60°) | strain on graphene (largest magnitude) | "
         "shift-lattice index, grid | corrugation (meV/Å²) | floor (meV/Å²) | resolved | "
         "τ = k·P + τ0 (MPa) | σ = μ·P + σ0 (MPa) | gates fired | collapse at 1.77 GPa (MPa) | "
         "÷ 26.7 | scan force calls, cell wall |\n|" + "---|" * 14 + "\n"
