@@ -301,3 +301,25 @@ def test_console_note_of_the_analyze_stage(tmp_path):
     doc["grid"]["resolved"] = True
     (tmp_path / "analyze.json").write_text(json.dumps(doc))
     assert grid_note(tmp_path) == "" and grid_note(tmp_path / "missing") == ""
+
+
+def test_a_comparison_path_that_never_ends_is_abandoned_and_named():
+    """The 8×8 three-cosine landscape pulled along y: the last-shell interpolant's path at
+    P = 0.5 GPa halves its step towards the floor for minutes (measured before the evaluation
+    budget). The analysis now finishes, every load keeps an estimate from another estimator,
+    and every abandoned one is named."""
+    a1, a2 = syn.hexagonal_cell(4.916)
+    iface = syn.SyntheticInterface(
+        a1, a2, syn.three_cosine(a1, a2), corrugation_ev_per_a2=-2e-4, gap_modulation_angstrom=-0.02
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = analyze_ispes(
+            iface.grid(8, 8, np.linspace(24.3, 26.4, 36)), [0.5, 2.0], with_symmetry=False
+        )
+    grid = result.grid
+    assert np.all(np.isfinite(grid.error["tau_mpa"]))
+    for name, estimates in grid.estimates.items():
+        for p, value in zip(grid.p_gpa, estimates["tau_mpa"], strict=True):
+            if not np.isfinite(value):
+                assert f"{name} at P = {p:g} GPa" in grid.unavailable

@@ -339,7 +339,7 @@ def analyze_ispes(
     if with_grid_error:
         clock = time.perf_counter()
         grid = estimate_grid_error(
-            [cp.energy_ev_per_a2[i] for i in range(p.size)],
+            [cp.energy_ev_per_a2[i] - refs[i] for i in range(p.size)],
             a1,
             a2,
             group,

@@ -156,6 +156,38 @@ def last_shell_surface(
     return PeriodicSurface(values, a1, a2, max_harmonic=max(h - 1, 1)).symmetrised(group)
 
 
+#: Surface evaluations one comparison analysis (one load) may spend: a path on a knife-edge
+#: landscape can halve its step towards the floor for minutes (measured: an 8×8 three-cosine
+#: grid's last-shell interpolant pulled along y), while the examples' analyses take about 1700
+#: per load (Al(111), MoS2 6×6). Past it the estimate is NaN at that load, named.
+EVALUATION_BUDGET = 20_000
+
+
+class BudgetExceeded(ArithmeticError):
+    """A comparison analysis spent :data:`EVALUATION_BUDGET` surface evaluations."""
+
+
+class _Budgeted(PeriodicSurface):
+    """The same interpolant, counting its evaluations (:data:`EVALUATION_BUDGET`)."""
+
+    left: int
+
+    def evaluate(self, xy):
+        self.left -= 1
+        if self.left < 0:
+            raise BudgetExceeded(
+                f"the path took more than {EVALUATION_BUDGET} evaluations (abandoned)"
+            )
+        return super().evaluate(xy)
+
+
+def _budgeted(surface: PeriodicSurface) -> PeriodicSurface:
+    out = object.__new__(_Budgeted)
+    out.__dict__.update(surface.__dict__)
+    out.left = EVALUATION_BUDGET
+    return out
+
+
 def friction_on(
     surface: PeriodicSurface,
     direction_deg: float,
@@ -165,7 +197,9 @@ def friction_on(
 ) -> dict[str, float]:
     """τ, σ_MSS and G_int (``QUANTITIES``) of ``surface`` by the analysis's start rule; the
     coarse landscape's own warnings (a path that does not close, degenerate minima) are not
-    passed on: they are about the comparison grid, and its difference is the result."""
+    passed on: they are about the comparison grid, and its difference is the result. At most
+    :data:`EVALUATION_BUDGET` evaluations (:class:`BudgetExceeded`)."""
+    surface = _budgeted(surface)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         starts, k = paths_from_near_degenerate_minima(
