@@ -352,8 +352,8 @@ def approximants_table(store: Path = STORE) -> str:
 def _lock(build: dict) -> str:
     match = (build.get("recipe") or {}).get("match") or {}
     strain = match.get("slab2_strain_percent")
-    if not strain:
-        return "none"
+    if not strain or not any(abs(float(x)) > 1e-9 for x in strain):
+        return "none (unstrained)"
     return f"{match.get('n_atoms', '?')} atoms, slab 2 {max(strain, key=abs):+.3g} %"
 
 
