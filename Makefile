@@ -6,8 +6,11 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 OUT    ?= flatcontact-run
+# two workers (the 2-core machine), one test file per worker at a time: a module's fixtures
+# are built once; `make test PYTEST_ARGS=` runs the suite in one process
+PYTEST_ARGS ?= -n 2 --dist loadfile
 
-.PHONY: run test test-all lint bench clean
+.PHONY: run test test-all lint bench readme clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -22,16 +25,20 @@ run: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q $(PYTEST_ARGS)
 
 test-all: $(STAMP)
-	$(BIN)/python -m pytest -q -m ""
+	$(BIN)/python -m pytest -q -m "" $(PYTEST_ARGS)
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks
 
 bench: $(STAMP)
 	$(BIN)/python -m benchmarks
+
+# the README's run and test figures from benchmarks/run_record.json
+readme: $(STAMP)
+	$(BIN)/python -m benchmarks.readme_block
 
 clean:
 	rm -rf $(VENV) $(OUT) .pytest_cache

@@ -68,8 +68,8 @@ RUN_FILES = (
     "05-elastic/elastic.json",
     "06-contact/summary.json",
 )
-#: Also stored for the worked example: its 6×6 scan, which tests/analysis/test_grid_error.py
-#: analyses against the 9×9 one (``al111-9``, stored by hand from the same YAML at grid 9×9).
+#: Also stored for the worked example: its 6×6 scan (the file-lattice pair that
+#: tests/analysis/test_grid_error.py analyses is stored apart, ``al111-file-lattice-*``).
 WORKED_FILES = ("02-scan/ispes.nc",)
 STAGES = ("build", "scan", "analyze", "laws", "elastic", "contact", "report")
 STUDY_FILES = ("approximants.csv", "experiment_collapse.json")

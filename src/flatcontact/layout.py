@@ -70,6 +70,9 @@ SCAN_FIGURE = "fig_scan_columns"
 FRICTION_CSV = "friction.csv"
 FRICTION_NC = "friction.nc"
 ANALYZE_JSON = "analyze.json"
+#: The energy form not reported (``analysis.energy_form``'s other): per-load table and analysis
+#: warnings, which the laws stage fits (:func:`flatcontact.analysis.energy_forms.form_loads`).
+OTHER_FORM_JSON = "other_form.json"
 
 
 def analyze_figure(p_gpa: float) -> str:

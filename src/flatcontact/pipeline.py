@@ -60,7 +60,7 @@ from flatcontact.fileio import (
     write_json_atomic,
     write_text_atomic,
 )
-from flatcontact.ispes.contract import open_ispes
+from flatcontact.ispes.contract import check_grid, open_ispes
 from flatcontact.layout import (
     CONFIG_YAML,
     CONTACT_NC,
@@ -70,6 +70,7 @@ from flatcontact.layout import (
     INTERFACE,
     ISPES_NC,
     LAWS_JSON,
+    OTHER_FORM_JSON,
     REPORT_HTML,
     RUN_LOG,
     RUN_MARKER,
@@ -78,7 +79,7 @@ from flatcontact.layout import (
     SUMMARY_JSON,
     VERSIONS_JSON,
 )
-from flatcontact.report.sections.approximant_study import approximant_study_digest
+from flatcontact.result_json import read_result_json
 from flatcontact.rundir import (
     RunDirectory,
     RunLock,
@@ -91,6 +92,7 @@ from flatcontact.stages import _calculator
 from flatcontact.stages.analyze import AnalyzeInputs, grid_note, run_analyze
 from flatcontact.stages.build import BuildInputs, run_build
 from flatcontact.stages.contact import (
+    QUARTZ_QUICK_LAWS_FILE,
     ContactInputs,
     check_contact,
     contact_parameters,
@@ -100,7 +102,7 @@ from flatcontact.stages.elastic import ElasticInputs, run_elastic
 from flatcontact.stages.gates import GateInputs, check_gates, evaluate_gates
 from flatcontact.stages.laws import LawsInputs, run_laws
 from flatcontact.stages.preflight import check_inputs
-from flatcontact.stages.report import ReportInputs, run_report
+from flatcontact.stages.report import ReportInputs, approximant_study_digest, run_report
 from flatcontact.stages.result_files import CONTACT, FRICTION, open_result
 from flatcontact.stages.scan import ScanInputs, run_scan
 from flatcontact.structures.interface_io import read_interface
@@ -307,7 +309,21 @@ class Pipeline:
         return self.results[name]
 
     def _json(self, name: str, file: str) -> dict:
-        return json.loads((self._upstream(name).folder / file).read_text())
+        """A stage's JSON file checked against its contract (:mod:`flatcontact.result_json`)
+        and against what this run knows: the scan's grid from its stage record, the energy
+        form and the loads p0 from the settings."""
+        folder = self._upstream(name).folder
+        expect: dict[str, Any] = {}
+        if name == "scan":
+            record = self.rundir.read_record(folder) or {}
+            grid = ((record.get("inputs") or {}).get("scan") or {}).get("grid")
+            if grid is not None:
+                expect["grid"] = grid
+        elif name == "laws":
+            expect["energy_form"] = self.config.analysis.energy_form
+        elif name == "contact":
+            expect["p0_gpa"] = list(self.config.contact.p0_gpa)
+        return read_result_json(folder / file, **expect)
 
     def _tell(self, kind: str, name: str, **details: Any) -> None:
         if self.on_event is not None:
@@ -343,7 +359,7 @@ class Pipeline:
         """
         cfg = self.config
         # the file by name and content (file_sha256), not by where it is
-        structure = portable(cfg.section("structure"), "file")
+        structure = portable(cfg.structure_section(), "file")
         if cfg.structure.kind == "quartz-dense":
             structure.setdefault("file", None)  # the fingerprint of runs made before recipes
         inputs = {"structure": structure, "model": self._model_inputs()}
@@ -370,8 +386,7 @@ class Pipeline:
         """
         cfg = self.config
         build = self._upstream("build")
-        scan_inputs = {k: v for k, v in cfg.section("scan").items() if k not in EXECUTION_ONLY}
-        inputs = {"scan": scan_inputs, "model": self._model_inputs(), "build": build.fingerprint}
+        inputs = {**self._scan_inputs(), "build": build.fingerprint}
 
         def work(folder: Path) -> None:
             stage_inputs = ScanInputs(build.folder / INTERFACE)
@@ -383,7 +398,22 @@ class Pipeline:
                 run_scan(cfg, stage_inputs, folder, progress=bar)
 
         result = self._run("scan", inputs, work)
-        return open_ispes(result.folder / ISPES_NC)
+        ds = open_ispes(result.folder / ISPES_NC)
+        check_grid(ds, self.config.scan.grid, str(result.folder / ISPES_NC))
+        return ds
+
+    def _scan_inputs(self) -> dict:
+        """What the scan stage reads besides the build: its section (less the execution-only
+        keys), the model and, for a pressure-range grid, the load bracket its columns must
+        reach (``ispes.grid_bracket.bracket_targets_gpa``: the lowest and highest load of
+        ``analysis.p_gpa``), so a load added beyond the scanned range re-brackets the scan."""
+        cfg = self.config
+        scan_inputs = {k: v for k, v in cfg.section("scan").items() if k not in EXECUTION_ONLY}
+        inputs = {"scan": scan_inputs, "model": self._model_inputs()}
+        if cfg.scan.p_range_gpa is not None:
+            loads = [float(p) for p in cfg.analysis.p_gpa]
+            inputs["bracket_loads_gpa"] = [min(loads), max(loads)] if loads else None
+        return inputs
 
     def scan_summary(self) -> dict:
         """``02-scan/scan.json``: counts, force calls, thicknesses, adhesion (work of separation)."""
@@ -427,15 +457,14 @@ class Pipeline:
         """
         cfg = self.config
         analyze = self._upstream("analyze")
-        scan = self._upstream("scan")
         inputs = {"threshold_gpa": cfg.analysis.threshold_gpa, "analyze": analyze.fingerprint}
-        # the other energy form comes from the scan's ISPES (analyze's fingerprint covers it
-        # and the analysis settings); the laws' intervals from the uncertainty section
+        # both energy forms come from the analyze stage's files (its fingerprint covers them:
+        # the scan's, the analysis settings, its code); the intervals from the uncertainty section
         inputs["uncertainty"] = cfg.section("uncertainty")
 
         def work(folder: Path) -> None:
-            ispes = scan.folder / ISPES_NC
-            run_laws(cfg, LawsInputs.read(analyze.folder / FRICTION_CSV, ispes), folder)
+            tables = analyze.folder
+            run_laws(cfg, LawsInputs.read(tables / FRICTION_CSV, tables / OTHER_FORM_JSON), folder)
 
         self._run("laws", inputs, work)
         return self._json("laws", LAWS_JSON)
@@ -521,6 +550,8 @@ class Pipeline:
             inputs["gates"] = stage_inputs.gates  # the recorded verdict (a clean run: no key)
         if cfg.contact.experiment.csv:
             inputs["experiment_sha256"] = file_sha256(cfg.contact.experiment.csv)
+        if cfg.contact.experiment.compare:  # the comparison quotes the quick preset's laws
+            inputs["quartz_quick_laws_sha256"] = file_sha256(QUARTZ_QUICK_LAWS_FILE)
         if cfg.contact.fit.csv:
             inputs["fit_sha256"] = [file_sha256(f) for f in cfg.contact.fit.csv]
 

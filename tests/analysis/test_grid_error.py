@@ -11,8 +11,9 @@ the internal constant-pressure landscape is exactly const + V·g at every load):
   k^−3, the curvature-jump class the assumed order stands for. τ moves by 4 % from 8×8 to
   16×16; a 48×48 grid holds every harmonic and gives the exact τ.
 
-And the real case of issue 32: the docs' Al(111) example (Zhou EAM, the stored 6×6 and 9×9
-scans of docs/measured/examples), whose τ moves by 6 % from 6×6 to 9×9.
+And the real case of issue 32: the docs' Al(111) example (Zhou EAM, cut at the CIF's 4.05 Å: the
+stored 6×6 and 9×9 scans of docs/measured/examples/al111-file-lattice-*), whose τ moves by 6 %
+from 6×6 to 9×9.
 """
 
 from __future__ import annotations
@@ -149,14 +150,14 @@ def test_real_al111_grid_part_covers_the_6_to_9_change():
     say that the grid does not resolve τ, and have the right sign (τ falls on the finer grid)."""
     loads = [0.0, 1.5]
     coarse = analyze_ispes(
-        open_ispes(MEASURED / "al111" / "02-scan" / "ispes.nc"),
+        open_ispes(MEASURED / "al111-file-lattice-6" / "02-scan" / "ispes.nc"),
         loads,
         direction_deg=0.0,
         with_symmetry=False,
         threshold_gpa=None,
     )
     fine = analyze_ispes(
-        open_ispes(MEASURED / "al111-9" / "02-scan" / "ispes.nc"),
+        open_ispes(MEASURED / "al111-file-lattice-9" / "02-scan" / "ispes.nc"),
         loads,
         direction_deg=0.0,
         with_symmetry=False,

@@ -337,3 +337,28 @@ def test_fit_tau0_with_negative_k():
     )
     with pytest.raises(InputError, match=r"no tau0 > \|k\|·p0 = 17.7 MPa fits"):
         ex.fit_tau0(0.9 * lowest, p0, NEG)
+
+
+@pytest.mark.parametrize("prm, p0", [(JUMP, JUMP_P0), (ContactParameters(), 1.77e9)])
+def test_breaks_given_once_equal_breaks_per_call(prm, p0):
+    """amplitude_at_stiffness_fraction computes the rising-branch breaks of its p0 once and
+    passes them to every stiffness evaluation: the same numbers as computing them per call,
+    over a grid of amplitudes (one p0 broadcast) and at one amplitude; and its root is k =
+    fraction·k0, found here by brentq on the per-call stiffness."""
+    brk = m.rising_branch_breaks(p0, prm)
+    q = np.linspace(0.0, 1.0, 41)[1:-1] * float(m.peak_force(p0, prm).force_n)
+    np.testing.assert_array_equal(
+        osc.lateral_stiffness(q, p0, prm, brk), osc.lateral_stiffness(q, p0, prm)
+    )
+    for qi in q[::7]:
+        assert float(osc.lateral_stiffness(qi, p0, prm, brk)) == float(
+            osc.lateral_stiffness(qi, p0, prm)
+        )
+    target = 0.5 * float(m.initial_lateral_stiffness(p0, prm))
+    got = osc.amplitude_at_stiffness_fraction(p0, prm, 0.5)
+    k = osc.lateral_stiffness(q, p0, prm)
+    i = int(np.argmax(k < target))
+    want = brentq(
+        lambda x: float(osc.lateral_stiffness(x, p0, prm)) - target, q[i - 1], q[i], rtol=1e-12
+    )
+    assert got == pytest.approx(want, rel=1e-9)

@@ -70,7 +70,13 @@ def test_every_stage_ran_and_wrote_its_files(tiny_run):
     expected = {
         "01-build": ["interface.extxyz", "build.json", "fig1_interface.png"],
         "02-scan": ["points.db", "ispes.nc", "scan.json", "fig_scan_columns.png"],
-        "03-analyze": ["friction.csv", "friction.nc", "analyze.json", "fig2_p1gpa.png"],
+        "03-analyze": [
+            "friction.csv",
+            "friction.nc",
+            "analyze.json",
+            "other_form.json",
+            "fig2_p1gpa.png",
+        ],
         "04-laws": ["laws.json", "fig3_laws.png"],
         "06-contact": [
             "contact.nc",
@@ -700,3 +706,21 @@ def test_cycle_and_fit_in_a_run_match_the_cli_and_the_fit_file_content_reruns_co
     assert again["fit"]["modified"]["fitted"]["tau0_mpa"] == pytest.approx(
         1.6 * fitted["tau0_mpa"], rel=1e-3
     )
+
+
+def test_the_scan_fingerprint_holds_the_load_bracket_it_reads(tmp_path):
+    """The scan brackets ``analysis.p_gpa`` with its thicknesses (pressure-range grids): a load
+    beyond the scanned ones changes the scan's inputs, so the scan re-brackets instead of the
+    analysis failing later outside the data; a load inside them, or any load of a grid of
+    explicit thicknesses (which brackets nothing), leaves the scan alone."""
+
+    def inputs(change: dict) -> dict:
+        return Pipeline(build_config(_merge(TINY, change)), tmp_path / "r")._scan_inputs()
+
+    base = inputs({})
+    assert base["bracket_loads_gpa"] == [0.0, 3.0]
+    assert inputs({"analysis": {"p_gpa": [0.0, 0.25, 1.0, 3.0]}}) == base
+    assert inputs({"analysis": {"p_gpa": [0.0, 1.0, 3.4]}}) != base
+    explicit = {"scan": {"p_range_gpa": None, "thickness_angstrom": [17.0, 17.5, 18.0, 18.5]}}
+    assert "bracket_loads_gpa" not in inputs(explicit)
+    assert inputs(explicit) == inputs(_merge(explicit, {"analysis": {"p_gpa": [0.0, 9.0]}}))

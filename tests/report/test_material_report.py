@@ -120,6 +120,7 @@ def _stage_folders(tmp_path, atoms, build_record, laws, stackings, elastic=None)
             "n_jumps": [0] * 4,
             "force_noise_mpa": [0.1] * 4,
             "start_stacking": ["BA"] * 4,
+            "zero_shift_stacking": ["BA"] * 4,  # the perfect crystal, by geometry
             "stacking_energies_mev_per_a2": [stackings] * 4,
             "lowest_barrier_mev_per_a2": [10.25] * 4,
         }

@@ -19,7 +19,8 @@ from flatcontact import units
 from flatcontact.analysis import synthetic as syn
 from flatcontact.config import MEASURED_LAW_UNCERTAINTY, build_config
 from flatcontact.contact import mindlin
-from flatcontact.layout import FRICTION_CSV, LAWS_JSON
+from flatcontact.errors import InputError
+from flatcontact.layout import FRICTION_CSV, LAWS_JSON, OTHER_FORM_JSON
 from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
 from flatcontact.stages.contact import ContactInputs, run_contact
 from flatcontact.stages.laws import LawsInputs, run_laws
@@ -63,7 +64,7 @@ def stages(tmp_path_factory):
         }
     )
     run_analyze(cfg, AnalyzeInputs(ispes), root / "analyze")
-    inputs = LawsInputs.read(root / "analyze" / FRICTION_CSV, ispes)
+    inputs = LawsInputs.read(root / "analyze" / FRICTION_CSV, root / "analyze" / OTHER_FORM_JSON)
     run_laws(cfg, inputs, root / "laws")
     laws = json.loads((root / "laws" / LAWS_JSON).read_text())
     return cfg, laws, root
@@ -89,6 +90,45 @@ def test_laws_json_has_both_forms_with_their_exact_slopes(stages):
     for form in ("internal", "enthalpy"):
         assert [r["p_gpa"] for r in laws[form]["loads"]] == P_GPA
     assert (root / "laws" / "fig3_laws.png").is_file()
+
+
+def test_the_laws_stage_fits_the_analyze_stages_other_form_and_analyses_nothing(
+    stages, monkeypatch
+):
+    """The other form's block of laws.json is what analysing the ISPES in that form gives
+    (laws_both_forms on the grid, computed here), and the laws stage gets it from the analyze
+    stage's other_form.json: with the analysis disabled it writes the same laws.json."""
+    import flatcontact.analysis.analyze as analyze_module
+    import flatcontact.analysis.energy_forms as energy_forms
+    from flatcontact.analysis.energy_forms import laws_both_forms
+    from flatcontact.ispes.contract import open_ispes
+
+    cfg, laws, root = stages
+    direct = laws_both_forms(open_ispes(root / "ispes.nc"), P_GPA, direction_deg=0.0)
+    want = direct["forms"]["enthalpy"]
+    assert json.dumps(laws["enthalpy"]["loads"]) == json.dumps(want["loads"])
+    assert laws["enthalpy"]["warnings"] == want["warnings"]
+    for key in (*LAW_KEYS, *STDERR.values()):
+        assert laws["enthalpy"][key] == want["laws"][key]
+
+    def refused(*args, **kwargs):
+        raise AssertionError("the laws stage analysed the ISPES")
+
+    monkeypatch.setattr(analyze_module, "analyze_ispes", refused)
+    monkeypatch.setattr(energy_forms, "analyze_ispes", refused)
+    analyze = root / "analyze"
+    again = run_laws(cfg, LawsInputs.read(analyze / FRICTION_CSV, analyze / OTHER_FORM_JSON), None)
+    assert json.dumps(again.to_json()) == json.dumps(laws)
+
+
+def test_an_other_form_file_of_the_wrong_form_is_refused(stages, tmp_path):
+    cfg, _, root = stages
+    stored = json.loads((root / "analyze" / OTHER_FORM_JSON).read_text())
+    assert stored["form"] == "enthalpy"
+    wrong = tmp_path / OTHER_FORM_JSON
+    wrong.write_text(json.dumps(stored | {"form": "internal"}))
+    with pytest.raises(InputError, match=r"other_form\.json: holds the 'internal' energy form"):
+        run_laws(cfg, LawsInputs.read(root / "analyze" / FRICTION_CSV, wrong), None)
 
 
 def test_half_widths_combine_fit_convergence_and_model_spread(stages):

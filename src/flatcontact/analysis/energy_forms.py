@@ -9,9 +9,11 @@ work P·A·Δz done against the load when the gap changes along the path
 P = 0 and differ by the load-dependent gap corrugation above it; their slopes k and μ
 can differ by an order of magnitude.
 
-:func:`laws_both_forms` runs :func:`flatcontact.analysis.analyze.analyze_ispes` on the same
-grid with both forms (everything else equal) and returns per form the per-load table and
-the fitted laws, plus a side-by-side table for the report.
+:func:`form_loads` analyses one form (:func:`flatcontact.analysis.analyze.analyze_ispes`, no
+fit): its per-load table and analysis warnings, what the run's analyze stage stores for the
+form it does not report (``other_form.json``); :func:`form_laws` fits the load laws to such a
+table, which the laws stage does. :func:`laws_both_forms` chains the two for both forms
+(everything else equal) and adds a side-by-side table for the report.
 """
 
 from __future__ import annotations
@@ -20,10 +22,12 @@ import io
 import warnings
 from collections.abc import Sequence
 
+import numpy as np
 import pandas as pd
 
 from flatcontact.analysis.analyze import analyze_ispes
 from flatcontact.analysis.diagnostics import AnalysisWarning
+from flatcontact.analysis.laws import fit_load_laws
 from flatcontact.analysis.outputs import friction_csv_text
 from flatcontact.errors import require
 
@@ -38,6 +42,81 @@ COLUMNS = (
     "tau_grid_error_mpa",
     "sigma_mss_grid_error_mpa",
 )
+
+
+def _caught_text(caught) -> list[str]:
+    """``"Category: message"`` of the analysis warnings among ``caught``."""
+    return [
+        f"{w.category.__name__}: {w.message}"
+        for w in caught
+        if issubclass(w.category, AnalysisWarning)
+    ]
+
+
+def form_loads(
+    ds,
+    p_gpa: Sequence[float],
+    form: str,
+    *,
+    direction_deg: float | str = 90.0,
+    load_source: str = "energy",
+    energy_zero: str = "lowest-p",
+    allow_missing: bool = False,
+) -> dict:
+    """Per-load τ, σ_MSS, G_int, τ's limit and the force noise of one ISPES in one energy form.
+
+    Parameters
+    ----------
+    ds
+        An ISPES grid (``ispes.nc`` contract, :func:`flatcontact.ispes.contract.open_ispes`).
+    p_gpa, direction_deg, load_source, energy_zero, allow_missing
+        As :func:`flatcontact.analysis.analyze.analyze_ispes` (no symmetry report, no MEP,
+        no fit).
+    form
+        ``"internal"`` or ``"enthalpy"``.
+
+    Returns
+    -------
+    dict
+        ``{"form": form, "loads": [one dict per load: p_gpa and :data:`COLUMNS`],
+        "warnings": ["Category: message" of the analysis warnings]}``; the load laws of the
+        table are :func:`form_laws`'s.
+    """
+    require(form in FORMS, f"form: {form!r}: expected internal or enthalpy")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", AnalysisWarning)
+        result = analyze_ispes(
+            ds,
+            list(p_gpa),
+            direction_deg=direction_deg,
+            form=form,
+            load_source=load_source,
+            energy_zero=energy_zero,
+            allow_missing=allow_missing,
+            threshold_gpa=None,
+            with_symmetry=False,
+        )
+    table = pd.read_csv(io.StringIO(friction_csv_text(result)))
+    table = table[["p_gpa", *[c for c in COLUMNS if c in table.columns]]]
+    return {
+        "form": form,
+        "loads": table.to_dict(orient="records"),
+        "warnings": _caught_text(caught),
+    }
+
+
+def form_laws(loads: Sequence[dict], threshold_gpa: float) -> tuple[dict, list[str]]:
+    """The load laws (``laws.json`` dict, :meth:`flatcontact.analysis.laws.LoadLaws.to_json`)
+    fitted on P ≤ ``threshold_gpa`` (GPa) to the per-load rows ``loads`` of :func:`form_loads`,
+    and the fit's warnings (``"Category: message"``)."""
+    p, tau, sigma = (
+        np.array([row[key] for row in loads], dtype=float)
+        for key in ("p_gpa", "tau_mpa", "sigma_mss_mpa")
+    )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", AnalysisWarning)
+        laws = fit_load_laws(p, tau, sigma, threshold_gpa)
+    return laws.to_json(), _caught_text(caught)
 
 
 def laws_both_forms(
@@ -67,38 +146,32 @@ def laws_both_forms(
     dict
         ``{"forms": {form: {"loads": [per-load dict], "laws": laws.json dict,
         "warnings": [str]}}, "table": [per-load dict with <column>_<form> keys],
-        "laws_table": [one dict per law coefficient with one value and stderr per form]}``.
+        "laws_table": [one dict per law coefficient with one value and stderr per form]}``;
+        each form's warnings are its analysis's (:func:`form_loads`), then its fit's
+        (:func:`form_laws`).
     """
     require(len(forms) >= 1, "forms: expected at least one of internal, enthalpy")
     for form in forms:
         require(form in FORMS, f"forms: {form!r}: expected internal or enthalpy")
+    require(threshold_gpa > 0, f"threshold_gpa: expected a positive pressure, got {threshold_gpa}")
     out: dict = {"forms": {}}
     tables = {}
     for form in forms:
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always", AnalysisWarning)
-            result = analyze_ispes(
-                ds,
-                list(p_gpa),
-                direction_deg=direction_deg,
-                form=form,
-                load_source=load_source,
-                energy_zero=energy_zero,
-                allow_missing=allow_missing,
-                threshold_gpa=threshold_gpa,
-                with_symmetry=False,
-            )
-        table = pd.read_csv(io.StringIO(friction_csv_text(result)))
-        table = table[["p_gpa", *[c for c in COLUMNS if c in table.columns]]]
-        tables[form] = table
+        analysed = form_loads(
+            ds,
+            p_gpa,
+            form,
+            direction_deg=direction_deg,
+            load_source=load_source,
+            energy_zero=energy_zero,
+            allow_missing=allow_missing,
+        )
+        laws, fit_warnings = form_laws(analysed["loads"], threshold_gpa)
+        tables[form] = pd.DataFrame.from_records(analysed["loads"])
         out["forms"][form] = {
-            "loads": table.to_dict(orient="records"),
-            "laws": result.laws.to_json(),
-            "warnings": [
-                f"{w.category.__name__}: {w.message}"
-                for w in caught
-                if issubclass(w.category, AnalysisWarning)
-            ],
+            "loads": analysed["loads"],
+            "laws": laws,
+            "warnings": analysed["warnings"] + fit_warnings,
         }
     side = None
     for form, table in tables.items():

@@ -35,7 +35,7 @@ estimators, each a signed per-load series per quantity:
 
 For each quantity the estimator with the largest rms over the loads is used (one estimator per
 quantity, so the per-load series the laws are fitted to is consistent). Measured on the docs'
-Al(111) example (Zhou EAM): 6×6, τ(0) = 2059 MPa, interpolant 170, last shell 333 MPa
+Al(111) example (Zhou EAM, at the CIF's 4.05 Å): 6×6, τ(0) = 2059 MPa, interpolant 170, last shell 333 MPa
 (used: 16 %, "does not resolve"), against τ(9×9) − τ(6×6) = −122 MPa; 9×9: interpolant 15,
 last shell 9 MPa (0.75 %). Cu(111) 6×6: interpolant 15, last shell 40 MPa (1 %) against 6–11 MPa
 to 12×12. **Limit:** a landscape whose harmonics beyond the grid's Nyquist are large (aliased

@@ -137,7 +137,7 @@ def analyze_command(
     from flatcontact.analysis.outputs import per_pressure_rows, summary_json
     from flatcontact.cli.settings import FLAGS_SOURCE, flag_errors
     from flatcontact.config import build_config
-    from flatcontact.layout import FRICTION_CSV
+    from flatcontact.layout import FRICTION_CSV, OTHER_FORM_JSON
     from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
     from flatcontact.stages.laws import LawsInputs, run_laws
 
@@ -166,9 +166,9 @@ def analyze_command(
         cfg = cfg.model_copy(
             update={"analysis": cfg.analysis.model_copy(update={"p_gpa": pressures})}
         )
-        analyzed = run_analyze(cfg, AnalyzeInputs(path), out)
+        analyzed = run_analyze(cfg, AnalyzeInputs(path), out, other_form=out is not None)
         laws_inputs = (
-            LawsInputs.read(out / FRICTION_CSV, path)  # + the other energy form, as the run
+            LawsInputs.read(out / FRICTION_CSV, out / OTHER_FORM_JSON)  # both forms, as the run
             if out is not None
             else LawsInputs.from_analysis(analyzed.analysis)
         )

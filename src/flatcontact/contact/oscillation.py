@@ -60,9 +60,16 @@ def graded_nodes(levels: int = 40, order: int = 6) -> tuple[FloatArray, FloatArr
 
 
 def mean_displacement(
-    q_max_n: ArrayLike, p0_pa: ArrayLike, params: ContactParameters
+    q_max_n: ArrayLike,
+    p0_pa: ArrayLike,
+    params: ContactParameters,
+    breaks: mindlin.RisingBranchBreaks | None = None,
 ) -> tuple[FloatArray, FloatArray]:
     """⟨u⟩ (m) and d⟨u⟩/dQ_max (m/N) for amplitudes 0 < Q_max <= Q_peak (broadcasting).
+
+    ``breaks``: :func:`flatcontact.contact.mindlin.rising_branch_breaks` of ``p0_pa`` and
+    ``params`` when the caller has them (they do not depend on Q_max: a root search over the
+    amplitude computes them once, :func:`amplitude_at_stiffness_fraction`).
 
     The θ integral is split where u(Q_max sin θ) is not smooth
     (:func:`flatcontact.contact.mindlin.rising_branch_breaks`: the kink where the centre
@@ -87,7 +94,7 @@ def mean_displacement(
         "q_max_n exceeds the peak lateral force: no quasi-static oscillation (gross sliding)",
     )
     half = np.pi / 2.0
-    brk = mindlin.rising_branch_breaks(p0, params)
+    brk = mindlin.rising_branch_breaks(p0, params) if breaks is None else breaks
     qm = qmax[..., None]
     active = brk.force_n < qm
     n_split = int(active.sum(axis=-1).max(initial=0))
@@ -136,11 +143,15 @@ def mean_displacement(
 
 
 def lateral_stiffness(
-    q_max_n: ArrayLike, p0_pa: ArrayLike, params: ContactParameters
+    q_max_n: ArrayLike,
+    p0_pa: ArrayLike,
+    params: ContactParameters,
+    breaks: mindlin.RisingBranchBreaks | None = None,
 ) -> FloatArray:
-    """k = d⟨Q⟩/d⟨u⟩ (N/m) at amplitude Q_max (N); k0 at Q_max = 0, 0 at the peak."""
+    """k = d⟨Q⟩/d⟨u⟩ (N/m) at amplitude Q_max (N); k0 at Q_max = 0, 0 at the peak
+    (``breaks`` as :func:`mean_displacement`)."""
     qmax = np.asarray(q_max_n, dtype=float)
-    _, dmean = mean_displacement(qmax, p0_pa, params)
+    _, dmean = mean_displacement(qmax, p0_pa, params, breaks)
     with np.errstate(divide="ignore"):
         k = (1.0 / np.sqrt(2.0)) / dmean
     peak = mindlin.peak_force(np.broadcast_to(p0_pa, qmax.shape), params)
@@ -232,7 +243,8 @@ def amplitude_at_stiffness_fraction(
     target = fraction * float(mindlin.initial_lateral_stiffness(p0, params))
     q_top = q_peak * (1.0 - 1e-13)
     grid = np.append(amplitude_grid(24, 16, closest=1e-12), 1.0 - 1e-13) * q_peak
-    k = lateral_stiffness(grid, p0, params)
+    breaks = mindlin.rising_branch_breaks(p0, params)  # one p0: the same at every amplitude
+    k = lateral_stiffness(grid, p0, params, breaks)
     below = np.nonzero(k < target)[0]
     if below.size == 0:
         return q_peak
@@ -241,7 +253,7 @@ def amplitude_at_stiffness_fraction(
         return 0.0
 
     def excess(q: float) -> float:
-        return float(lateral_stiffness(q, p0, params)) - target
+        return float(lateral_stiffness(q, p0, params, breaks)) - target
 
     return float(brentq(excess, grid[i - 1], min(grid[i], q_top), xtol=1e-15 * q_peak, rtol=1e-12))
 

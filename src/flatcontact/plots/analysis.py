@@ -40,7 +40,9 @@ def figure_pressure(pa: PressureAnalysis, result: AnalysisResult) -> Figure:
     mx, my = np.meshgrid(gx, gy)
     z = surf(np.stack([mx, my], -1)) * MEV
     ax = axes[0]
-    im = ax.pcolormesh(mx, my, z, shading="auto", cmap="viridis")
+    # the map is an image: one raster inside the vector file (axes, path and text stay vector);
+    # 160x160 cells drawn as paths made each SVG 4.9 MB
+    im = ax.pcolormesh(mx, my, z, shading="auto", cmap="viridis", rasterized=True)
     fig.colorbar(im, ax=ax, label="energy (meV/Å²)")
     for b in np.unique(path.branch):
         sel = path.branch == b

@@ -9,12 +9,13 @@ the report and nothing else.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import pandas as pd
 from ase.io import read
 
+from flatcontact.errors import InputError
+from flatcontact.fileio import read_json_file
 from flatcontact.layout import (
     ANALYZE_JSON,
     BUILD_JSON,
@@ -41,10 +42,19 @@ from flatcontact.report.sections.laws import laws_section
 from flatcontact.report.sections.scan import scan_section
 from flatcontact.report.sections.summary import summary_section
 from flatcontact.report.stacking_names import stacking_family
+from flatcontact.result_json import CONTRACTS, MAX_BYTES, read_result_json
 
 
-def _json(path: Path) -> dict:
-    return json.loads(path.read_text())
+def _json(path: Path, **expect) -> dict:
+    """A stage's JSON file, checked against its contract where it has one
+    (:mod:`flatcontact.result_json`; ``expect``: what the settings say it holds);
+    ``build.json`` as a complete JSON mapping."""
+    if path.name in CONTRACTS:
+        return read_result_json(path, **expect)
+    doc = read_json_file(path, path.name, MAX_BYTES)
+    if not isinstance(doc, dict):
+        raise InputError(f"{path}: not a mapping; remove {path.parent} and rerun to recompute it")
+    return doc
 
 
 def _elastic(cfg, folder: Path | None) -> dict | None:
@@ -73,10 +83,10 @@ def build_sections(
     f_build, f_scan = folders["build"], folders["scan"]
     f_an, f_laws, f_ct = folders["analyze"], folders["laws"], folders["contact"]
     build = _json(f_build / BUILD_JSON)
-    scan = _json(f_scan / SCAN_JSON)
+    scan = _json(f_scan / SCAN_JSON, grid=cfg.scan.grid)
     analyze = _json(f_an / ANALYZE_JSON)
-    laws = _json(f_laws / LAWS_JSON)
-    contact = _json(f_ct / SUMMARY_JSON)
+    laws = _json(f_laws / LAWS_JSON, energy_form=cfg.analysis.energy_form)
+    contact = _json(f_ct / SUMMARY_JSON, p0_gpa=list(cfg.contact.p0_gpa))
     table = pd.read_csv(f_an / FRICTION_CSV)
     interface = read(f_build / INTERFACE)
     model = cfg.potential.label

@@ -2,15 +2,17 @@
 
 Files: ``friction.csv``, ``friction.nc`` (:mod:`flatcontact.analysis.outputs`),
 ``analyze.json`` (:meth:`AnalyzeResult.to_json`) and ``fig2_p<P>gpa.png`` (+ ``.svg``) per
-load. The load laws are not fitted here: they are the laws stage's (:mod:`.laws`), so a
-change of ``analysis.threshold_gpa`` reruns only that stage and leaves no stale warning of
-the old threshold in ``analyze.json``.
+load; ``other_form.json``: the per-load values and analysis warnings of the energy form
+``analysis.energy_form`` does not name (:func:`flatcontact.analysis.energy_forms.form_loads`,
+same settings), which the laws stage fits beside the reported form, so the ISPES is analysed
+once per form per run. The load laws are not fitted here: they are the laws stage's
+(:mod:`.laws`), so a change of ``analysis.threshold_gpa`` reruns only that stage and leaves
+no stale warning of the old threshold in ``analyze.json``.
 """
 
 from __future__ import annotations
 
 import contextlib
-import json
 import logging
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,9 +24,11 @@ from flatcontact.layout import (
     ANALYZE_JSON,
     FRICTION_CSV,
     FRICTION_NC,
+    OTHER_FORM_JSON,
     SCAN_JSON,
     analyze_figure,
 )
+from flatcontact.result_json import read_result_json
 from flatcontact.stages._common import captured, renamed_errors, save
 
 #: Parameters of :func:`flatcontact.analysis.analyze.analyze_ispes` -> the settings path.
@@ -50,11 +54,14 @@ class AnalyzeInputs:
 @dataclass
 class AnalyzeResult:
     """The analysis (:class:`flatcontact.analysis.analyze.AnalysisResult`, ``laws`` None)
-    and the analysis warnings raised while computing it (``"Category: message"``)."""
+    and the analysis warnings raised while computing it (``"Category: message"``);
+    ``other_form``: the other energy form's per-load table and warnings
+    (:func:`flatcontact.analysis.energy_forms.form_loads`), None when not asked for."""
 
     analysis: Any
     warnings: list[str] = field(default_factory=list)
     files: list[Path] = field(default_factory=list)
+    other_form: dict | None = None
 
     def to_json(self) -> dict:
         """``analyze.json``: warnings, timings, Fig. 2 names, symmetry, energy zero, load noise
@@ -77,9 +84,10 @@ class AnalyzeResult:
 
 
 def run_analyze(
-    settings, inputs: AnalyzeInputs, folder: Path | None, progress=None
+    settings, inputs: AnalyzeInputs, folder: Path | None, progress=None, other_form: bool = True
 ) -> AnalyzeResult:
-    """Analyse ``inputs.ispes`` at ``settings.analysis.p_gpa`` (see the module docstring).
+    """Analyse ``inputs.ispes`` at ``settings.analysis.p_gpa`` (see the module docstring);
+    with ``other_form`` also in the other energy form (``other_form.json``).
 
     Raises
     ------
@@ -107,10 +115,11 @@ def run_analyze(
                 with_mep=s.with_mep,
                 source=str(inputs.ispes),
             )
+        other = _other_form(ds, s) if other_form else None
     notes = [f"{w.category.__name__}: {w.message}" for w in caught]
     for note in notes:
         log.warning("analyze: %s", note)
-    result = AnalyzeResult(analysis, notes)
+    result = AnalyzeResult(analysis, notes, other_form=other)
     if folder is not None:
         _write(result, folder, settings.report.svg)
     return result
@@ -119,6 +128,8 @@ def run_analyze(
 def grid_note(folder: Path) -> str:
     """One line for the console when the analysis's grid does not resolve τ (``analyze.json``
     ``grid``, :mod:`flatcontact.analysis.grid_error`); "" when it does or the file has none."""
+    import json
+
     try:
         grid = json.loads((Path(folder) / ANALYZE_JSON).read_text()).get("grid") or {}
     except (OSError, ValueError, AttributeError):
@@ -135,6 +146,22 @@ def grid_note(folder: Path) -> str:
     )
 
 
+def _other_form(ds, s) -> dict:
+    """The energy form ``s.energy_form`` does not name, with the same analysis settings (no
+    symmetry report, no MEP: the laws stage uses its per-load τ and σ_MSS)."""
+    from flatcontact.analysis.energy_forms import FORMS, form_loads
+
+    return form_loads(
+        ds,
+        s.p_gpa,
+        FORMS[1 - FORMS.index(s.energy_form)],
+        direction_deg=s.direction_deg,
+        load_source=s.load_source,
+        energy_zero=s.energy_zero,
+        allow_missing=s.allow_missing,
+    )
+
+
 @contextlib.contextmanager
 def _folds_named(scan_json: Path):
     """A load that is not monotonic where the scan recorded folds (``scan.json``
@@ -148,8 +175,8 @@ def _folds_named(scan_json: Path):
         folds = []
         if "not monotonic" in text:
             try:
-                folds = json.loads(scan_json.read_text()).get("load_folds") or []
-            except (OSError, ValueError, AttributeError):
+                folds = read_result_json(scan_json).get("load_folds") or []
+            except InputError:  # no scan.json beside this ISPES, or not one: no fold named
                 folds = []
         if not folds:
             raise
@@ -175,6 +202,8 @@ def _write(result: AnalyzeResult, folder: Path, svg: bool) -> None:
     with atomic_path(folder / FRICTION_NC) as tmp:
         friction_dataset(analysis).to_netcdf(tmp, engine="h5netcdf")
     result.files.append(folder / FRICTION_NC)
+    if result.other_form is not None:
+        result.files.append(write_json_atomic(folder / OTHER_FORM_JSON, result.other_form))
     for pa in analysis.pressures:
         result.files += save(figure_pressure(pa, analysis), folder, analyze_figure(pa.p_gpa), svg)
     result.files.append(write_json_atomic(folder / ANALYZE_JSON, result.to_json()))

@@ -347,26 +347,49 @@ def check_contact(settings, params) -> None:
         )
 
 
-#: flatcontact's own α-quartz laws: ``flatcontact run`` on the built-in default (quick preset,
-#: ``make run``; bundled sio2-snap + Hamaker LJ, (0001) dense interface), its
-#: ``04-laws/laws.json`` (the same before and after issue 20, re-measured 2026-11-25; the check
-#: every branch keeps). Code, not a data file, so a change reruns the contact stage.
-QUARTZ_QUICK_LAWS = {
-    "label": "quartz, flatcontact quick preset (make run)",
-    "k_mpa_per_gpa": 14.370389,
-    "tau0_mpa": 30.503874,
-    "mu_mpa_per_gpa": 4.99966,
-    "sigma0_mpa": 7.014888,
-}
+#: flatcontact's own α-quartz laws, a data file with its provenance: ``flatcontact run`` on
+#: the built-in default (quick preset, ``make run``), its ``04-laws/laws.json``. Its content is
+#: part of the contact stage's fingerprint when the experiment comparison quotes it.
+QUARTZ_QUICK_LAWS_FILE = (
+    Path(__file__).resolve().parents[1] / "data" / "measured" / "quartz_quick_laws.json"
+)
+
+
+def quartz_quick_laws() -> dict:
+    """The quick preset's quartz laws of :data:`QUARTZ_QUICK_LAWS_FILE` (``label``, the four
+    numbers of :data:`~flatcontact.reference.PAPER_LAW_KEYS`, ``source``).
+
+    Raises
+    ------
+    InputError
+        The package's data file is not what it claims (a damaged install): names the file and
+        the key.
+    """
+    import json
+    import math
+
+    doc = json.loads(QUARTZ_QUICK_LAWS_FILE.read_text(encoding="utf-8"))
+    for key in PAPER_LAW_KEYS:
+        value = doc.get(key)
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, int | float)
+            or not math.isfinite(value)
+        ):
+            raise InputError(
+                f"{QUARTZ_QUICK_LAWS_FILE.name}: {key}: expected a finite number, got {value!r}"
+            )
+    return doc
 
 
 def quartz_reference_laws() -> dict[str, dict[str, float]]:
     """The quartz law sets the experiment comparison sets a run against: the paper's
     (:data:`flatcontact.reference.PAPER`) and flatcontact's quick preset
-    (:data:`QUARTZ_QUICK_LAWS`)."""
+    (:func:`quartz_quick_laws`)."""
+    quick = quartz_quick_laws()
     return {
         "quartz, the paper's laws (SNAP + TS-vdW LJ)": {k: PAPER[k] for k in PAPER_LAW_KEYS},
-        QUARTZ_QUICK_LAWS["label"]: {k: float(QUARTZ_QUICK_LAWS[k]) for k in PAPER_LAW_KEYS},
+        quick["label"]: {k: float(quick[k]) for k in PAPER_LAW_KEYS},
     }
 
 

@@ -1,10 +1,12 @@
 """Stage 4, laws: τ = k·P + τ0 and σ = μ·P + σ0 fitted on P ≤ ``analysis.threshold_gpa``.
 
 Both energy forms side by side: the configured ``analysis.energy_form`` from the
-analyze stage's table, the other from the same ISPES (when the inputs carry it); each with
+analyze stage's table, the other from its ``other_form.json`` (when the inputs carry it: the
+analyze stage analysed the ISPES in both forms, nothing is analysed here); each with
 intervals c ± h_c, h_c = coverage·√(se_fit² + δ_conv² + δ_model² + δ_grid²) from the fit, the
 ``uncertainty`` section and the grid's own error estimate per load (``friction.csv``
-``tau_grid_error_mpa``, ``sigma_mss_grid_error_mpa``; :mod:`flatcontact.analysis.grid_error`,
+``tau_grid_error_mpa``, ``sigma_mss_grid_error_mpa``, and the same columns of
+``other_form.json``; :mod:`flatcontact.analysis.grid_error`,
 :func:`flatcontact.analysis.uncertainty.grid_law_components`).
 
 The one place the load laws are fitted (:func:`flatcontact.analysis.laws.fit_load_laws`),
@@ -36,29 +38,30 @@ class LawsInputs:
     """τ and σ_MSS (MPa) per load P (GPa): the analyze stage's ``friction.csv``
     (:meth:`read`) or an analysis in memory (:meth:`from_analysis`).
 
-    ``ispes``: the scan's ``ispes.nc``; when given, the laws of the other energy form are
-    computed from it too (:func:`flatcontact.analysis.energy_forms.laws_both_forms`, same
-    analysis settings), so ``laws.json`` has both forms side by side.
+    ``other_form``: the analyze stage's ``other_form.json`` (the other energy form's per-load
+    values, :func:`flatcontact.analysis.energy_forms.form_loads`); when given, its laws are
+    fitted too (:func:`flatcontact.analysis.energy_forms.form_laws`), so ``laws.json`` has
+    both forms side by side.
     """
 
     p_gpa: tuple[float, ...]
     tau_mpa: tuple[float, ...]
     sigma_mss_mpa: tuple[float, ...]
-    ispes: Path | None = None
+    other_form: Path | None = None
     tau_grid_error_mpa: tuple[float, ...] | None = None
     sigma_mss_grid_error_mpa: tuple[float, ...] | None = None
 
     @classmethod
-    def read(cls, friction_csv: Path, ispes: Path | None = None) -> LawsInputs:
-        """The columns of ``friction.csv`` (and the ISPES for the other energy form); the grid
-        estimates when the file has them (None otherwise: no grid part)."""
+    def read(cls, friction_csv: Path, other_form: Path | None = None) -> LawsInputs:
+        """The columns of ``friction.csv`` (and the other energy form's ``other_form.json``);
+        the grid estimates when the file has them (None otherwise: no grid part)."""
         import pandas as pd
 
         table = pd.read_csv(friction_csv)
         grid = [
             tuple(table[c].to_numpy(float)) if c in table.columns else None for c in _GRID_COLUMNS
         ]
-        return cls(*(tuple(table[c].to_numpy(float)) for c in _COLUMNS), ispes, *grid)
+        return cls(*(tuple(table[c].to_numpy(float)) for c in _COLUMNS), other_form, *grid)
 
     @classmethod
     def from_analysis(cls, analysis) -> LawsInputs:
@@ -201,8 +204,8 @@ def run_laws(settings, inputs: LawsInputs, folder: Path | None, progress=None) -
         inputs.sigma_mss_grid_error_mpa,
         settings.analysis.threshold_gpa,
     )
-    if inputs.ispes is not None:
-        result.other = _other_form(settings, inputs.ispes)
+    if inputs.other_form is not None:
+        result.other = _other_form(settings, inputs.other_form)
         rows = result.other["loads"]
 
         def column(name: str):
@@ -226,25 +229,22 @@ def run_laws(settings, inputs: LawsInputs, folder: Path | None, progress=None) -
     return result
 
 
-def _other_form(settings, ispes: Path) -> dict:
-    """Per-load values and laws of the energy form the analyze stage did not use, from the same
-    ISPES with the same analysis settings."""
-    from flatcontact.analysis.energy_forms import laws_both_forms
-    from flatcontact.ispes.contract import open_ispes
-    from flatcontact.stages._common import renamed_errors
-    from flatcontact.stages.analyze import SETTINGS_NAMES
+def _other_form(settings, other_form_json: Path) -> dict:
+    """Per-load values (as the analyze stage stored them), laws fitted on P ≤
+    ``analysis.threshold_gpa`` and warnings (the analysis's, then the fit's) of the energy form
+    the analyze stage did not report."""
+    import json
 
-    s = settings.analysis
-    form = other_form(s.energy_form)
-    with renamed_errors(SETTINGS_NAMES):
-        both = laws_both_forms(
-            open_ispes(ispes),
-            s.p_gpa,
-            direction_deg=s.direction_deg,
-            threshold_gpa=s.threshold_gpa,
-            load_source=s.load_source,
-            energy_zero=s.energy_zero,
-            allow_missing=s.allow_missing,
-            forms=(form,),
+    from flatcontact.analysis.energy_forms import form_laws
+    from flatcontact.errors import InputError
+
+    stored = json.loads(Path(other_form_json).read_text())
+    form = other_form(settings.analysis.energy_form)
+    if stored.get("form") != form:
+        raise InputError(
+            f"{other_form_json}: holds the {stored.get('form')!r} energy form, expected {form!r} "
+            f"(the form analysis.energy_form = {settings.analysis.energy_form!r} does not name); "
+            "rerun the analyze stage"
         )
-    return both["forms"][form]
+    laws, fit_warnings = form_laws(stored["loads"], settings.analysis.threshold_gpa)
+    return {"loads": stored["loads"], "laws": laws, "warnings": stored["warnings"] + fit_warnings}

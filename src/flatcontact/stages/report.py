@@ -9,7 +9,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from flatcontact.layout import REPORT_HTML
+from flatcontact.fileio import file_sha256
+from flatcontact.layout import EXPERIMENT_COLLAPSE_JSON, REPORT_HTML
 
 
 @dataclass(frozen=True)
@@ -30,6 +31,18 @@ class ReportResult:
 
     def to_json(self) -> dict:
         return {"report": str(self.path) if self.path is not None else None}
+
+
+def approximant_study_digest(path: str | Path) -> dict:
+    """The content of the approximant study's files the report reads (sha256 of
+    ``study.json`` and of ``experiment_collapse.json`` beside it, if present): part of the
+    report stage's fingerprint, so a rerun or an extended study reruns the report."""
+    path = Path(path)
+    collapse = path.parent / EXPERIMENT_COLLAPSE_JSON
+    return {
+        "study_json_sha256": file_sha256(path),
+        "experiment_collapse_sha256": file_sha256(collapse) if collapse.is_file() else None,
+    }
 
 
 def _stage_rows(folders: dict[str, Path]) -> list[tuple[str, str, str, str]]:

@@ -117,10 +117,12 @@ def own_results_section(
         (label, pm(laws.get(key), laws.get(err_key)) + _law_interval(laws, key, studied))
         for key, err_key, label in LAW_COEFFICIENTS
     ]
+    adhesion = scan.get("adhesion") or {}
+    at = adhesion.get("work_of_separation_stacking")
     rows.append(
         (
-            "work of separation W (J/m²)",
-            fmt((scan.get("adhesion") or {}).get("work_of_separation_j_per_m2")),
+            "work of separation W (J/m²)" + (f", at the {at}" if at else ""),
+            fmt(adhesion.get("work_of_separation_j_per_m2")),
         )
     )
     intervals = (contact.get("intervals") or {}).get("results") or []
