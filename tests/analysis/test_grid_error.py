@@ -324,3 +324,12 @@ def test_a_comparison_path_that_never_ends_is_abandoned_and_named():
         for p, value in zip(grid.p_gpa, estimates["tau_mpa"], strict=True):
             if not np.isfinite(value):
                 assert f"{name} at P = {p:g} GPa" in grid.unavailable
+
+
+def test_a_two_load_fit_stays_without_interval_whatever_its_grid_part():
+    """A fit through two loads has no standard error (laws.json: null): its slope's sign is not
+    significant, and a grid part does not make it so (used as fitted, with a note)."""
+    laws = _negative(0.4)
+    laws["k_stderr_mpa_per_gpa"] = None
+    assert gates.negative_slope(laws) is None
+    assert any("without an interval" in n for n in gates.negative_slope_notes(laws))

@@ -148,16 +148,22 @@ NEGATIVE_SLOPE_MIN_RELATIVE_DROP = 0.01
 
 
 def _interval(laws: Mapping, key: str) -> tuple[float, float, float] | None:
-    """(value, low, high) of a coefficient: ``laws["intervals"]``, else value ± stderr."""
+    """(value, low, high) of a coefficient: ``laws["intervals"]``, else value ± stderr. A fit
+    without a standard error (two loads) has no interval whatever its other parts (the grid's,
+    a study's): its slope's sign is not significant, so it stays zero-width here."""
+    err = {"k_mpa_per_gpa": "k_stderr_mpa_per_gpa", "mu_mpa_per_gpa": "mu_stderr_mpa_per_gpa"}
+    se = laws.get(err[key])
+    # laws.json writes a missing standard error as null; a document without the key is judged
+    # by its interval alone
+    fitted = err[key] not in laws or (se is not None and math.isfinite(float(se)))
     iv = (laws.get("intervals") or {}).get(key)
     if iv is not None:
-        return float(iv["value"]), float(iv["low"]), float(iv["high"])
+        v = float(iv["value"])
+        return (v, float(iv["low"]), float(iv["high"])) if fitted else (v, v, v)
     value = laws.get(key)
     if value is None:
         return None
-    err = {"k_mpa_per_gpa": "k_stderr_mpa_per_gpa", "mu_mpa_per_gpa": "mu_stderr_mpa_per_gpa"}
-    se = laws.get(err[key])
-    se = float(se) if se is not None and math.isfinite(float(se)) else 0.0
+    se = float(se) if fitted and se is not None else 0.0
     return float(value), float(value) - se, float(value) + se
 
 
