@@ -91,7 +91,7 @@ from flatcontact.rundir import (
     writable,
 )
 from flatcontact.stages import _calculator, contact_range
-from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
+from flatcontact.stages.analyze import AnalyzeInputs, grid_note, run_analyze
 from flatcontact.stages.build import BuildInputs, run_build
 from flatcontact.stages.contact import (
     QUARTZ_QUICK_LAWS_FILE,
@@ -177,7 +177,8 @@ class StageEvent:
 
     ``kind`` is ``"start"`` (the stage begins: its fingerprint is being checked),
     ``"end"`` (``action`` is ``"ran"``, ``"resumed"`` or ``"skipped"``, ``seconds`` its
-    wall time), ``"failed"`` (an exception, ``"interrupted"`` for Ctrl-C, leaves the stage;
+    wall time; ``message``: the analyze stage's grid verdict when its grid does not resolve τ),
+    ``"failed"`` (an exception, ``"interrupted"`` for Ctrl-C, leaves the stage;
     it propagates after the event) or ``"off"`` (a disabled stage; ``message`` says what
     replaces it). ``index`` is the stage's folder index (:data:`flatcontact.layout.STAGES`).
     """
@@ -353,7 +354,8 @@ class Pipeline:
             self._tell("failed", name, message=str(exc))
             raise
         self.results[name] = result
-        self._tell("end", name, action=result.action, seconds=result.seconds)
+        note = grid_note(result.folder) if name == "analyze" else ""
+        self._tell("end", name, action=result.action, seconds=result.seconds, message=note)
         return result
 
     # ---- stages ------------------------------------------------------------------------

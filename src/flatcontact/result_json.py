@@ -123,6 +123,8 @@ def _laws_block(block: Any, where: str) -> None:
             here,
         )
         for part, v in (iv.get("components") or {}).items():
+            if part == "grid" and v is None:  # the run could not estimate its grid's error
+                continue
             if not _finite(v):
                 raise ContractError(f"'{here}components.{part}' is {_shown(v)}, not finite")
 
@@ -203,7 +205,13 @@ SCAN = JsonContract(
 ANALYZE = JsonContract(
     "analyze.json",
     required={"warnings": "list"},
-    optional={"symmetry": "mapping", "noise": "mapping", "load_source": "text", "fig2": "list"},
+    optional={
+        "symmetry": "mapping",
+        "noise": "mapping",
+        "load_source": "text",
+        "fig2": "list",
+        "grid": "mapping",
+    },
 )
 LAWS = JsonContract(
     "laws.json",

@@ -2,6 +2,7 @@
 
 import itertools
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -283,3 +284,30 @@ def test_two_materials_of_one_lattice_are_refused_naming_slab2():
     same = {"kind": "fcc111", "element": "Cu", "layers": 1, "slab2": {"element": "Cu", "layers": 1}}
     with pytest.raises(InputError, match=r"structure\.slab2: .* same in-plane lattice"):
         approximant_sequence(same, parse_approximants({}))
+
+
+def test_diamond_graphene_ladder_keeps_the_cells_zsl_yields_with_the_other_handedness():
+    """Issue 32: the approximant example lost its 0.3 % cell when pymatgen 2026.10 yielded
+    that coincidence cell only as vector pairs of opposite handedness. The ladder of the
+    example has three cells again, each the smallest of its bound: checked independently by
+    the lengths of the two supercells' vectors (37 diamond cells against 39 graphene cells
+    for 0.3 %: |a_g|√39 / |a_d|√37 − 1 = the strain) and by building it."""
+    from flatcontact.config.load import load_config
+
+    cfg = load_config(
+        Path(__file__).parents[2]
+        / "examples"
+        / "passivated-tip-bare-diamond-graphene-approximants.yaml"
+    )
+    seq = approximant_sequence(cfg.section("structure"), cfg.approximants)
+    assert [a.label for a in seq] == ["zsl-3pct", "zsl-1pct", "zsl-0.3pct"]
+    assert [a.n_atoms for a in seq] == [14, 380, 522]
+    third = seq[2]
+    m = third.structure_override["match"]
+    assert abs(round(np.linalg.det(m["slab1_supercell"]))) == 37
+    assert abs(round(np.linalg.det(m["slab2_supercell"]))) == 39
+    a_d, a_g = 2.52224989, 2.46  # the example's diamond(111) and graphene cells (Å)
+    want = 100 * (a_d * math.sqrt(37) / (a_g * math.sqrt(39)) - 1)
+    np.testing.assert_allclose(third.strain_percent_slab2, [want, want], atol=2e-3)
+    atoms, report = _build(cfg.section("structure"), third)
+    assert len(atoms) == 522 == report["recipe"]["match"]["n_atoms"]

@@ -110,7 +110,8 @@ def test_laws_json_intervals_are_the_fit_and_the_study_in_quadrature(
     thickness_study, tmp_path, capsys
 ):
     """A run with the study's uncertainty block: every interval's half-width is
-    coverage * sqrt(se_fit^2 + delta_conv^2 + delta_model^2) of the numbers in the files."""
+    coverage * sqrt(se_fit^2 + delta_conv^2 + delta_model^2 + delta_grid^2) of the numbers in
+    the files."""
     cfg, out, _doc = thickness_study
     block = yaml.safe_load((out / "uncertainty.yaml").read_text())["uncertainty"]
     block["model_spread_internal"] = {"k_mpa_per_gpa": 3.0, "tau0_mpa": 4.0}
@@ -129,10 +130,12 @@ def test_laws_json_intervals_are_the_fit_and_the_study_in_quadrature(
             fit = laws[form][err_key]
             conv = block[f"convergence_{form}"][key]
             model = block.get(f"model_spread_{form}", {}).get(key, 0.0)
-            assert iv["components"] == pytest.approx(
-                {"fit": fit, "convergence": conv, "models": model}
-            )
-            expected = 2.0 * math.sqrt(fit**2 + conv**2 + model**2)
+            # the run's own grid estimate is the fourth part (docs/analysis.md)
+            grid = laws["uncertainty"]["grid"][form][key]
+            parts = dict(iv["components"])
+            assert parts.pop("grid") == grid
+            assert parts == pytest.approx({"fit": fit, "convergence": conv, "models": model})
+            expected = 2.0 * math.sqrt(fit**2 + conv**2 + model**2 + (grid or 0.0) ** 2)
             assert iv["half_width"] == pytest.approx(expected, rel=1e-12)
             assert iv["high"] - iv["low"] == pytest.approx(2 * expected, rel=1e-9)
     assert laws["uncertainty"]["measured_on"] == measured_on(cfg)

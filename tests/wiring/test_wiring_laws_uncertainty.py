@@ -139,7 +139,12 @@ def test_half_widths_combine_fit_convergence_and_model_spread(stages):
             se = block[STDERR[key]] or 0.0
             conv = UNC.get(f"convergence_{form}", {}).get(key, 0.0)
             model = UNC.get(f"model_spread_{form}", {}).get(key, 0.0)
-            want = UNC["coverage"] * math.sqrt(se**2 + conv**2 + model**2)
+            # the run's own grid estimate: the three-cosine landscape lives on the 3×3 sub-grid
+            # of the 9×9 one, so only the columns' spline error (not band-limited) is left
+            grid = block["intervals"][key]["components"]["grid"]
+            assert grid is not None and 0 <= grid <= 1e-3 * abs(block["tau0_mpa"])
+            assert laws["uncertainty"]["grid"][form][key] == grid
+            want = UNC["coverage"] * math.sqrt(se**2 + conv**2 + model**2 + grid**2)
             assert block["half_widths"][key] == pytest.approx(want, rel=1e-12)
             iv = block["intervals"][key]
             # the interval contains the central value, symmetric by the half-width
@@ -219,7 +224,12 @@ def test_contact_intervals_of_each_part_alone_and_the_report_shows_them(stages):
     iv = res.to_json()["intervals"]
     parts = laws["internal"]["intervals"]["tau0_mpa"]["components"]
     assert parts == pytest.approx(
-        {"fit": laws["internal"]["tau0_stderr_mpa"], "convergence": 3.0, "models": 4.0}
+        {
+            "fit": laws["internal"]["tau0_stderr_mpa"],
+            "convergence": 3.0,
+            "models": 4.0,
+            "grid": laws["uncertainty"]["grid"]["internal"]["tau0_mpa"],
+        }
     )
     # k, μ, σ0 are set in contact: no part of theirs is carried
     for part, hw in iv["component_half_widths"].items():
@@ -240,14 +250,16 @@ def test_contact_intervals_of_each_part_alone_and_the_report_shows_them(stages):
             a = float(mindlin.contact_radius(p0, prm))
             want = float(mindlin.peak_force(p0, prm).force_n) / (np.pi * a**2) / 1e6
             assert got == pytest.approx(want, rel=1e-9)
-    # the report: a fit / convergence / models column per form, the parts in the contact cells
+    # the report: a fit / convergence / models / grid column per form, the parts in the
+    # contact cells
     (table,) = laws_tables(laws)
-    assert "internal: fit / convergence / models" in table.headers
+    head = "internal: fit / convergence / models / grid"
+    assert head in table.headers
     row = dict(
         zip(table.headers, next(r for r in table.rows if r[0].startswith("τ0")), strict=True)
     )
     fit = laws["internal"]["tau0_stderr_mpa"]
-    assert row["internal: fit / convergence / models"] == f"{fit:.3g} / 3 / 4"
+    assert row[head] == f"{fit:.3g} / 3 / 4 / {parts['grid']:.3g}"
     (ct,) = interval_tables(res.to_json())
     cell = ct.rows[0][1]
     lo, hi = r["effective_shear_strength_mpa"]["components"]["models"]

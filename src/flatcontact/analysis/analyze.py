@@ -15,7 +15,10 @@ target load ``P``:
    lie within the noise of the global one, from each of them, reporting the
    largest τ (:mod:`.starts`, :class:`DegenerateMinimaWarning`);
 4. τ, σ_MSS and the shear stiffness (:mod:`.friction`);
-5. optionally the symmetry report (:mod:`.symmetry`).
+5. optionally the symmetry report (:mod:`.symmetry`);
+6. the grid's estimate of its own error in τ, σ_MSS and G_int: steps 2–4 on a coarser grid
+   taken from the same samples (:mod:`.grid_error`), with a :class:`GridResolutionWarning`
+   where it exceeds :data:`~.grid_error.UNRESOLVED_FRACTION` of τ.
 
 Finally the load laws (:mod:`.laws`). Timings per stage are recorded.
 """
@@ -37,8 +40,9 @@ from flatcontact.analysis.constant_pressure import (
     ConstantPressureISPES,
     constant_pressure,
 )
-from flatcontact.analysis.diagnostics import LoadNoiseWarning
+from flatcontact.analysis.diagnostics import GridResolutionWarning, LoadNoiseWarning
 from flatcontact.analysis.friction import FrictionResult
+from flatcontact.analysis.grid_error import QUANTITIES, GridEstimate, estimate_grid_error
 from flatcontact.analysis.laws import LoadLaws, fit_load_laws
 from flatcontact.analysis.noise import NOISE_WARN_FRACTION
 from flatcontact.analysis.path import (
@@ -114,6 +118,7 @@ class AnalysisResult:
     load_source: str = DEFAULT_LOAD_SOURCE
     direction_rule: str = "given"
     tau_start_rule: str = TAU_START_RULE
+    grid: GridEstimate | None = None  #: the grid's estimate of its own error (:mod:`.grid_error`)
 
     @property
     def noise(self):
@@ -157,6 +162,7 @@ def analyze_ispes(
     load_source: str = DEFAULT_LOAD_SOURCE,
     with_stackings: bool = True,
     symmetrise: bool = True,
+    with_grid_error: bool = True,
 ) -> AnalysisResult:
     """Analyse an ISPES grid at the loads ``p_gpa`` (see module docstring).
 
@@ -210,6 +216,10 @@ def analyze_ispes(
         (``symmetry_*`` attributes of the scan, :func:`flatcontact.ispes.contract.symmetry_operations`;
         :meth:`.periodic.PeriodicSurface.symmetrised`); a grid without them (identity only)
         is interpolated as it is.
+    with_grid_error
+        Estimate the grid's discretisation error of τ, σ_MSS and G_int from the same samples
+        (:func:`.grid_error.estimate_grid_error`, ``AnalysisResult.grid``); a
+        :class:`GridResolutionWarning` says when it exceeds the stated fraction of τ.
     """
     p = check_pressures(p_gpa)
     auto = isinstance(direction_deg, str)
@@ -325,6 +335,24 @@ def analyze_ispes(
         )
         _warn_noise(cp, i, fr, source)
 
+    grid = None
+    if with_grid_error:
+        clock = time.perf_counter()
+        grid = estimate_grid_error(
+            [cp.energy_ev_per_a2[i] - refs[i] for i in range(p.size)],
+            a1,
+            a2,
+            group,
+            p,
+            {q: np.array([getattr(r.friction, q) for r in results]) for q in QUANTITIES},
+            float(direction_deg),
+            np.array([r.degeneracy_tolerance_ev_per_a2 for r in results]),
+            np.asarray(floor, float),
+            max_length_angstrom,
+        )
+        timings["grid_error"] = time.perf_counter() - clock
+        _warn_grid(grid, source)
+
     clock = time.perf_counter()
     tau = np.array([r.friction.tau_mpa for r in results])
     sigma = np.array([r.friction.sigma_mss_mpa for r in results])
@@ -343,7 +371,22 @@ def analyze_ispes(
         timings_s=timings,
         load_source=load_source,
         direction_rule=direction_rule,
+        grid=grid,
     )
+
+
+def _warn_grid(grid: GridEstimate, source: str) -> None:
+    """:class:`GridResolutionWarning` when the grid does not resolve τ (or its estimate failed)."""
+    text = grid.message()
+    if text is not None:
+        warnings.warn(f"{source}: {text}", GridResolutionWarning, stacklevel=3)
+    if grid.unavailable is not None:
+        warnings.warn(
+            f"{source}: grid error estimate incomplete: {grid.unavailable}; where neither "
+            "estimate exists the laws' intervals carry no grid part",
+            GridResolutionWarning,
+            stacklevel=3,
+        )
 
 
 def _warn_noise(cp: ConstantPressureISPES, i: int, fr: FrictionResult, source: str) -> None:

@@ -41,3 +41,9 @@ class LoadFoldWarning(AnalysisWarning):
     """A column's load rises with thickness on the compressed side (a fold: a plane slips or
     opens under load, or the energy-derived load is noisy there). Every load asked lies below
     the fold, on the branch that carries P = 0; the nodes above it are not used."""
+
+
+class GridResolutionWarning(AnalysisWarning):
+    """The lateral grid does not resolve τ: τ on the full grid and on a coarser grid from the
+    same samples differ by more than the stated fraction of τ (see
+    :mod:`flatcontact.analysis.grid_error`), or the estimate could not be made."""

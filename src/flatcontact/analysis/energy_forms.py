@@ -39,6 +39,8 @@ COLUMNS = (
     "shear_stiffness_gpa_per_nm",
     "tau_limited_by",
     "force_noise_mpa",
+    "tau_grid_error_mpa",
+    "sigma_mss_grid_error_mpa",
 )
 
 

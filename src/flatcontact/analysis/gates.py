@@ -148,16 +148,22 @@ NEGATIVE_SLOPE_MIN_RELATIVE_DROP = 0.01
 
 
 def _interval(laws: Mapping, key: str) -> tuple[float, float, float] | None:
-    """(value, low, high) of a coefficient: ``laws["intervals"]``, else value ± stderr."""
+    """(value, low, high) of a coefficient: ``laws["intervals"]``, else value ± stderr. A fit
+    without a standard error (two loads) has no interval whatever its other parts (the grid's,
+    a study's): its slope's sign is not significant, so it stays zero-width here."""
+    err = {"k_mpa_per_gpa": "k_stderr_mpa_per_gpa", "mu_mpa_per_gpa": "mu_stderr_mpa_per_gpa"}
+    se = laws.get(err[key])
+    # laws.json writes a missing standard error as null; a document without the key is judged
+    # by its interval alone
+    fitted = err[key] not in laws or (se is not None and math.isfinite(float(se)))
     iv = (laws.get("intervals") or {}).get(key)
     if iv is not None:
-        return float(iv["value"]), float(iv["low"]), float(iv["high"])
+        v = float(iv["value"])
+        return (v, float(iv["low"]), float(iv["high"])) if fitted else (v, v, v)
     value = laws.get(key)
     if value is None:
         return None
-    err = {"k_mpa_per_gpa": "k_stderr_mpa_per_gpa", "mu_mpa_per_gpa": "mu_stderr_mpa_per_gpa"}
-    se = laws.get(err[key])
-    se = float(se) if se is not None and math.isfinite(float(se)) else 0.0
+    se = float(se) if fitted and se is not None else 0.0
     return float(value), float(value) - se, float(value) + se
 
 
@@ -195,13 +201,14 @@ def negative_slope(laws: Mapping) -> Finding | None:
     """``negative_slope``: k or μ whose whole interval of ``laws.json`` is below 0 and whose
     law falls by more than :data:`NEGATIVE_SLOPE_MIN_RELATIVE_DROP` of its intercept over the
     fitted loads."""
-    bad = []
+    bad, grid = [], []
     for key, name, what in _SLOPES:
         iv = _interval(laws, key)
         if iv is not None and _material(laws, key, iv):
             drop = _relative_drop(laws, key, iv[0])
             fall = f"{what} falls" + (f" {100 * drop:.2g} %" if math.isfinite(drop) else "")
             bad.append(f"{name} = {iv[0]:.3g} MPa/GPa ({iv[1]:.3g} .. {iv[2]:.3g}): {fall}")
+            grid += _grid_remedy(laws, key, name, iv[0])
     if not bad:
         return None
     return Finding(
@@ -209,11 +216,41 @@ def negative_slope(laws: Mapping) -> Finding | None:
         "significantly negative load slope, the whole interval below 0: "
         + "; ".join(bad)
         + f" with load on P <= {laws.get('threshold_gpa', float('nan')):g} GPa; check τ and "
-        "σ_MSS per load in 03-analyze/friction.csv (a fold, slip or a change of minimum "
-        "usually causes it; so can the lateral grid, whose discretisation error in τ and "
-        "σ_MSS per load can exceed their change with load: try a finer scan.grid), or give "
-        "contact.k_mpa_per_gpa / contact.mu_mpa_per_gpa",
+        "σ_MSS per load in 03-analyze/friction.csv (a fold, slip, a change of minimum"
+        + (" or the lateral grid" if grid else "")
+        + " usually causes it)"
+        + "".join(f"; {g}" for g in grid)
+        + ", or give contact.k_mpa_per_gpa / contact.mu_mpa_per_gpa",
     )
+
+
+#: The grid part of a slope (``intervals.<c>.components.grid``) at or above this fraction of
+#: the slope makes a finer grid one of the negative-slope gate's remedies.
+GRID_REMEDY_FRACTION = 0.1
+
+
+def _grid_remedy(laws: Mapping, key: str, name: str, slope: float) -> list[str]:
+    """The grid among the remedies of a negative slope, where it applies: the run's own grid
+    estimate of the slope (:mod:`flatcontact.analysis.grid_error`) is at least
+    :data:`GRID_REMEDY_FRACTION` of it, or could not be made. Nothing for a ``laws.json``
+    without a grid part (written before it existed)."""
+    parts = ((laws.get("intervals") or {}).get(key) or {}).get("components") or {}
+    if "grid" not in parts:
+        return []
+    g = parts["grid"]
+    if g is None:
+        return [
+            f"the grid's error in {name} could not be estimated (03-analyze/analyze.json "
+            "grid.unavailable): check the slope on a finer scan.grid"
+        ]
+    if float(g) >= GRID_REMEDY_FRACTION * abs(slope):
+        return [
+            f"the grid's own estimate of its error in {name} is ±{float(g):.3g} MPa/GPa "
+            f"({100 * float(g) / abs(slope):.2g} % of it; 03-analyze/analyze.json grid): a "
+            "finer scan.grid (its recommended_grid where the grid does not resolve τ) "
+            "shows whether the slope is the grid's"
+        ]
+    return []
 
 
 def negative_slope_notes(laws: Mapping) -> list[str]:

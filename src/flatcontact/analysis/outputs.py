@@ -28,6 +28,7 @@ import xarray as xr
 from flatcontact import __version__, units
 from flatcontact.analysis.analyze import AnalysisResult
 from flatcontact.analysis.friction import EV_PER_A4_TO_GPA_PER_NM
+from flatcontact.analysis.grid_error import ERROR_COLUMNS
 from flatcontact.analysis.noise import BARRIER_NOISE_FACTOR
 
 CSV_COLUMNS = (
@@ -54,6 +55,7 @@ CSV_COLUMNS = (
     "lowest_barrier_direction_deg",
     "barrier_along_direction_mev_per_a2",
     "stacking_energies_mev_per_a2",
+    *ERROR_COLUMNS.values(),
 )
 #: Separator of the per-start values in one ``friction.csv`` cell.
 LIST_SEPARATOR = ";"
@@ -97,9 +99,19 @@ def per_pressure_rows(result: AnalysisResult) -> list[dict]:
                 "tau_by_start_mpa": [o.tau_mpa for o in pa.starts] or [fr.tau_mpa],
                 "direction_deg": float(path.direction_deg),
                 **_stacking_columns(pa),
+                **_grid_columns(result, i),
             }
         )
     return [{k: _clean(v) for k, v in row.items()} for row in rows]
+
+
+def _grid_columns(result: AnalysisResult, i: int) -> dict:
+    """The grid's signed error estimates of τ, σ_MSS and G_int at load ``i`` (NaN without)."""
+    grid = result.grid
+    return {
+        col: float(grid.error[q][i]) if grid is not None else float("nan")
+        for q, col in ERROR_COLUMNS.items()
+    }
 
 
 def _stacking_columns(pa) -> dict:
@@ -180,12 +192,14 @@ def summary_json(result: AnalysisResult) -> dict:
                     "lowest_barrier_mev_per_a2",
                     "lowest_barrier_direction_deg",
                     "barrier_along_direction_mev_per_a2",
+                    *ERROR_COLUMNS.values(),
                 )
             }
             | {"stackings": stackings_json(pa)}
             for row, pa in zip(per_pressure_rows(result), result.pressures, strict=True)
         ],
         "laws": result.laws.to_json() if result.laws is not None else None,
+        "grid": result.grid.to_json() if result.grid is not None else None,
     }
     sym = [pa.symmetry for pa in result.pressures if pa.symmetry is not None]
     if sym:
@@ -280,6 +294,10 @@ def friction_dataset(result: AnalysisResult) -> xr.Dataset:
                 col("shear_stiffness_gpa_per_nm"),
                 {"units": "GPa/nm"},
             ),
+            **{
+                c: ("p_gpa", col(c), {"units": "MPa" if c.endswith("_mpa") else "GPa/nm"})
+                for c in ERROR_COLUMNS.values()
+            },
             "n_jumps": ("p_gpa", np.array([len(pa.path.jumps) for pa in result.pressures])),
             "path_t": (
                 ("p_gpa", "sample"),

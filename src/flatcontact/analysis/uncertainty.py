@@ -1,6 +1,6 @@
 """Uncertainty of the load laws and its propagation to the contact outputs (pure functions).
 
-Three independent sources set the uncertainty of each law coefficient
+Four independent sources set the uncertainty of each law coefficient
 c ∈ {k, τ0, μ, σ0} (τ = k·P + τ0, σ = μ·P + σ0, the paper's linear laws):
 
 * the fit: its standard error ``se_fit`` (``laws.json``);
@@ -10,7 +10,15 @@ c ∈ {k, τ0, μ, σ0} (τ = k·P + τ0, σ = μ·P + σ0, the paper's linear l
   surrogate stands for: half the max − min range over the SNAP and every teacher
   compared (:func:`model_spread`, :func:`committee_spread`).
 
-They are combined in quadrature, ``h_c = m·sqrt(se_fit² + δ_conv² + δ_model²)``
+* the lateral grid: the run's own estimate ``δ_grid`` of its discretisation error
+  (:mod:`flatcontact.analysis.grid_error`: the same analysis on a coarser grid from the same
+  samples, Richardson-scaled), carried into the coefficients by fitting the law to the
+  per-load signed estimates δτ(P), δσ(P) (:func:`grid_law_components`; the fit is linear in
+  the data, so this is the coefficients' own Richardson estimate). Every run has it, with or
+  without a study. (A convergence study whose ladder refines ``scan.grid`` measures the same
+  error again: counted twice, on the safe side.)
+
+They are combined in quadrature, ``h_c = m·sqrt(se_fit² + δ_conv² + δ_model² + δ_grid²)``
 (:func:`law_half_widths`, ``m`` the coverage multiple; m = 2 ≈ 95 % for Gaussian errors).
 
 :func:`propagate_box` carries the box ``c ± h_c`` through any output function
@@ -103,29 +111,57 @@ def committee_spread(per_model_results: Mapping[str, Mapping]) -> dict[str, floa
     return model_spread(laws)
 
 
+def grid_law_components(
+    p_gpa: Sequence[float] | None,
+    tau_mpa: Sequence[float] | None,
+    sigma_mss_mpa: Sequence[float] | None,
+    tau_grid_error_mpa: Sequence[float] | None,
+    sigma_mss_grid_error_mpa: Sequence[float] | None,
+    threshold_gpa: float,
+) -> dict[str, float | None]:
+    """``δ_grid`` of each law coefficient: |slope| and |intercept| of the least-squares line
+    through the per-load signed grid estimates on the loads the law is fitted on
+    (``P <= threshold_gpa`` where τ, resp. σ, is finite; :func:`flatcontact.analysis.laws.
+    fit_linear_law`'s points). None for a coefficient whose law has fewer than two such loads
+    or a fitted load without an estimate (not estimated, unlike 0: estimated and zero)."""
+    out: dict[str, float | None] = dict.fromkeys(LAW_COEFFICIENTS)
+    if p_gpa is None:
+        return out
+    p = np.asarray(p_gpa, float)
+    pairs = (
+        (("k_mpa_per_gpa", "tau0_mpa"), tau_mpa, tau_grid_error_mpa),
+        (("mu_mpa_per_gpa", "sigma0_mpa"), sigma_mss_mpa, sigma_mss_grid_error_mpa),
+    )
+    for (slope_key, intercept_key), values, errors in pairs:
+        if errors is None or values is None:
+            continue
+        y, e = np.asarray(values, float), np.asarray(errors, float)
+        fitted = np.isfinite(p) & np.isfinite(y) & (p <= threshold_gpa)
+        if np.unique(p[fitted]).size < 2 or not np.all(np.isfinite(e[fitted])):
+            continue
+        slope, intercept = np.polyfit(p[fitted], e[fitted], 1)
+        out[slope_key], out[intercept_key] = abs(float(slope)), abs(float(intercept))
+    return out
+
+
 def law_half_widths(
     laws: Mapping,
     *,
     convergence: Mapping[str, float] | None = None,
     model: Mapping[str, float] | None = None,
+    grid: Mapping[str, float | None] | None = None,
     coverage: float = 1.0,
 ) -> dict[str, float]:
-    """Half-width of each law coefficient from the fit, the convergence and the model spread.
+    """Half-width of each law coefficient from the fit, the convergence, the model spread and
+    the grid.
 
-    ``h_c = coverage · sqrt(se_fit² + δ_conv² + δ_model²)`` (module docstring). Missing
-    entries count as 0. Returns coefficient -> half-width in the coefficient's unit.
+    ``h_c = coverage · sqrt(se_fit² + δ_conv² + δ_model² + δ_grid²)`` (module docstring).
+    Missing entries count as 0. Returns coefficient -> half-width in the coefficient's unit.
     """
     require(coverage >= 0 and math.isfinite(coverage), f"coverage={coverage}: expected >= 0")
-    convergence = convergence or {}
-    model = model or {}
     out = {}
-    for key, err in LAW_COEFFICIENTS.items():
-        parts = (
-            _num(laws.get(err), f"laws.{err}"),
-            abs(float(convergence.get(key) or 0.0)),
-            _num(model.get(key), f"model.{key}"),
-        )
-        out[key] = coverage * float(np.sqrt(sum(p * p for p in parts)))
+    for key, parts in law_components(laws, convergence=convergence, model=model, grid=grid).items():
+        out[key] = coverage * float(np.sqrt(sum((v or 0.0) ** 2 for v in parts.values())))
     return out
 
 
@@ -134,20 +170,24 @@ def law_components(
     *,
     convergence: Mapping[str, float] | None = None,
     model: Mapping[str, float] | None = None,
-) -> dict[str, dict[str, float]]:
-    """The three parts of each coefficient's uncertainty, before the coverage multiple.
+    grid: Mapping[str, float | None] | None = None,
+) -> dict[str, dict[str, float | None]]:
+    """The four parts of each coefficient's uncertainty, before the coverage multiple.
 
-    ``{coefficient: {"fit": se_fit, "convergence": δ_conv, "models": δ_model}}`` (units of the
-    coefficient); :func:`law_half_widths` is ``coverage · sqrt(fit² + convergence² + models²)``
-    of these.
+    ``{coefficient: {"fit": se_fit, "convergence": δ_conv, "models": δ_model, "grid":
+    δ_grid}}`` (units of the coefficient; ``grid`` None when the run could not estimate it,
+    :func:`grid_law_components`); :func:`law_half_widths` is
+    ``coverage · sqrt(fit² + convergence² + models² + grid²)`` of these.
     """
     convergence = convergence or {}
     model = model or {}
+    grid = grid or {}
     return {
         key: {
             "fit": _num(laws.get(err), f"laws.{err}"),
             "convergence": abs(float(convergence.get(key) or 0.0)),
             "models": _num(model.get(key), f"model.{key}"),
+            "grid": None if grid.get(key) is None else _num(grid.get(key), f"grid.{key}"),
         }
         for key, err in LAW_COEFFICIENTS.items()
     }
@@ -161,7 +201,8 @@ def law_intervals(
     """``{coefficient: {"value", "low", "high", "half_width"[, "components"]}}`` for ``laws.json``.
 
     ``components`` (:func:`law_components`) are stored beside each interval, so a reader
-    sees how much of the half-width is the fit, the convergence and the model spread."""
+    sees how much of the half-width is the fit, the convergence, the model spread and the
+    grid."""
     out = {}
     for key in LAW_COEFFICIENTS:
         if laws.get(key) is None:

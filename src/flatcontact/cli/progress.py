@@ -105,6 +105,8 @@ class StageLines:
             self._stop()
             seconds = f" in {event.seconds:.1f} s" if event.action != "skipped" else ""
             self.console.print(f"   {_ACTION_TEXT[event.action]}{seconds}", highlight=False)
+            if event.message:
+                self.console.print(f"   warning: {event.message}", highlight=False)
         elif event.kind == "off":
             self.console.print(
                 f"[bold]{event.index}. {event.name}[/]\n   off: {event.message}", highlight=False

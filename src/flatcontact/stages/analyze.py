@@ -63,7 +63,8 @@ class AnalyzeResult:
     other_form: dict | None = None
 
     def to_json(self) -> dict:
-        """``analyze.json``: warnings, timings, Fig. 2 names, symmetry, energy zero, load noise."""
+        """``analyze.json``: warnings, timings, Fig. 2 names, symmetry, energy zero, load noise
+        and the grid's estimate of its own error (``grid``, :mod:`flatcontact.analysis.grid_error`)."""
         result = self.analysis
         return {
             "warnings": list(self.warnings),
@@ -77,6 +78,7 @@ class AnalyzeResult:
             "energy_reference_ev_per_a2": result.energy_reference_ev_per_a2,
             "load_source": result.load_source,
             "noise": result.noise.to_json(),
+            "grid": result.grid.to_json() if result.grid is not None else None,
         }
 
 
@@ -120,6 +122,27 @@ def run_analyze(
     if folder is not None:
         _write(result, folder, settings.report.svg)
     return result
+
+
+def grid_note(folder: Path) -> str:
+    """One line for the console when the analysis's grid does not resolve τ (``analyze.json``
+    ``grid``, :mod:`flatcontact.analysis.grid_error`); "" when it does or the file has none."""
+    import json
+
+    try:
+        grid = json.loads((Path(folder) / ANALYZE_JSON).read_text()).get("grid") or {}
+    except (OSError, ValueError, AttributeError):
+        return ""
+    if grid.get("resolved", True):
+        return ""
+    rel = [v for v in grid.get("relative_tau_error") or [] if v is not None]
+    n_a, n_b = grid.get("grid") or ("?", "?")
+    rec = grid.get("recommended_grid") or ("?", "?")
+    return (
+        f"the {n_a}×{n_b} grid does not resolve τ (estimated error up to "
+        f"{100 * max(rel, default=float('nan')):.3g} % of τ); a grid of about {rec[0]}×{rec[1]} "
+        f"would (scan.grid); the intervals carry it ({ANALYZE_JSON} grid)"
+    )
 
 
 def _other_form(ds, s) -> dict:

@@ -210,15 +210,15 @@ def law_half_widths_used(inputs: ContactInputs, provenance: dict) -> dict[str, f
 
 
 #: The parts of a law coefficient's uncertainty (``laws.json`` ``intervals.<c>.components``).
-COMPONENTS = ("fit", "convergence", "models")
+COMPONENTS = ("fit", "convergence", "models", "grid")
 
 
 def law_components_used(inputs: ContactInputs, provenance: dict) -> dict[str, dict[str, float]]:
-    """Per part (fit, convergence, models) the half-widths of the law coefficients the contact
+    """Per part (fit, convergence, models, grid) the half-widths of the law coefficients the contact
     model takes from the fitted laws: coverage × the part (``laws.json`` ``intervals`` of the
     configured form, :func:`flatcontact.analysis.uncertainty.law_components`); 0 for a
-    coefficient set in ``contact``. ``{}`` when laws.json carries no convergence or model part
-    (the fit alone: nothing to split)."""
+    coefficient set in ``contact``. ``{}`` when laws.json carries no convergence, model or grid
+    part (the fit alone: nothing to split)."""
     laws = inputs.laws or {}
     form = laws.get("energy_form")
     intervals = (laws.get(form) or {}).get("intervals", {}) if form else {}
@@ -229,7 +229,7 @@ def law_components_used(inputs: ContactInputs, provenance: dict) -> dict[str, di
         if parts and provenance.get(key) == "fitted laws":
             for part in COMPONENTS:
                 out[part][key] = coverage * float(parts.get(part) or 0.0)
-    if not any(v for part in ("convergence", "models") for v in out[part].values()):
+    if not any(v for part in COMPONENTS[1:] for v in out[part].values()):
         return {}
     return out
 

@@ -3,8 +3,11 @@
 Both energy forms side by side: the configured ``analysis.energy_form`` from the
 analyze stage's table, the other from its ``other_form.json`` (when the inputs carry it: the
 analyze stage analysed the ISPES in both forms, nothing is analysed here); each with
-intervals c ± h_c, h_c = coverage·√(se_fit² + δ_conv² + δ_model²) from the fit and the
-``uncertainty`` section (:mod:`flatcontact.analysis.uncertainty`).
+intervals c ± h_c, h_c = coverage·√(se_fit² + δ_conv² + δ_model² + δ_grid²) from the fit, the
+``uncertainty`` section and the grid's own error estimate per load (``friction.csv``
+``tau_grid_error_mpa``, ``sigma_mss_grid_error_mpa``, and the same columns of
+``other_form.json``; :mod:`flatcontact.analysis.grid_error`,
+:func:`flatcontact.analysis.uncertainty.grid_law_components`).
 
 The one place the load laws are fitted (:func:`flatcontact.analysis.laws.fit_load_laws`),
 from the analyze stage's ``friction.csv``. Files: ``laws.json``
@@ -25,6 +28,8 @@ from flatcontact.layout import LAWS_FIGURE, LAWS_JSON
 from flatcontact.stages._common import captured, save
 
 _COLUMNS = ("p_gpa", "tau_mpa", "sigma_mss_mpa")
+#: ``friction.csv``'s per-load grid estimates of τ and σ_MSS (absent in older files).
+_GRID_COLUMNS = ("tau_grid_error_mpa", "sigma_mss_grid_error_mpa")
 FORMS = ("internal", "enthalpy")
 
 
@@ -43,22 +48,31 @@ class LawsInputs:
     tau_mpa: tuple[float, ...]
     sigma_mss_mpa: tuple[float, ...]
     other_form: Path | None = None
+    tau_grid_error_mpa: tuple[float, ...] | None = None
+    sigma_mss_grid_error_mpa: tuple[float, ...] | None = None
 
     @classmethod
     def read(cls, friction_csv: Path, other_form: Path | None = None) -> LawsInputs:
-        """The columns of ``friction.csv`` (and the other energy form's ``other_form.json``)."""
+        """The columns of ``friction.csv`` (and the other energy form's ``other_form.json``);
+        the grid estimates when the file has them (None otherwise: no grid part)."""
         import pandas as pd
 
         table = pd.read_csv(friction_csv)
-        return cls(*(tuple(table[c].to_numpy(float)) for c in _COLUMNS), other_form=other_form)
+        grid = [
+            tuple(table[c].to_numpy(float)) if c in table.columns else None for c in _GRID_COLUMNS
+        ]
+        return cls(*(tuple(table[c].to_numpy(float)) for c in _COLUMNS), other_form, *grid)
 
     @classmethod
     def from_analysis(cls, analysis) -> LawsInputs:
         """The loads and columns of a :class:`flatcontact.analysis.analyze.AnalysisResult`."""
+        grid = analysis.grid
         return cls(
             tuple(analysis.p_gpa),
             tuple(analysis.column("tau_mpa")),
             tuple(analysis.column("sigma_mss_mpa")),
+            tau_grid_error_mpa=None if grid is None else tuple(grid.error["tau_mpa"]),
+            sigma_mss_grid_error_mpa=None if grid is None else tuple(grid.error["sigma_mss_mpa"]),
         )
 
 
@@ -76,6 +90,7 @@ class LawsResult:
     form: str = "internal"  # the energy form of ``laws`` (analysis.energy_form)
     other: dict | None = None  # the other form: {"loads", "laws", "warnings"} (laws_both_forms)
     uncertainty: dict = field(default_factory=dict)  # settings.uncertainty as a dict
+    grid: dict = field(default_factory=dict)  # form -> coefficient -> δ_grid (None: not estimated)
 
     @property
     def warnings(self) -> list[str]:
@@ -99,6 +114,7 @@ class LawsResult:
             self.form_laws()[form],
             convergence=u.get(f"convergence_{form}", {}),
             model=u.get(f"model_spread_{form}", {}),
+            grid=self.grid.get(form),
             coverage=u.get("coverage", 1.0),
         )
 
@@ -109,7 +125,8 @@ class LawsResult:
         (``internal``, ``enthalpy``: coefficients, standard errors, ``half_widths``,
         ``intervals``, per-load ``loads``, ``warnings``), with ``uncertainty`` stating the
         inputs (fit standard errors, ``convergence_<form>``, ``model_spread_<form>``,
-        ``coverage``, ``source``)."""
+        ``coverage``, ``source``) and ``grid`` the grid part of each form's coefficients
+        (:func:`flatcontact.analysis.uncertainty.grid_law_components`)."""
         from flatcontact.analysis.uncertainty import law_components, law_intervals
 
         doc = {**self.laws.to_json(), "warnings": self.warnings, "energy_form": self.form}
@@ -129,6 +146,7 @@ class LawsResult:
                 laws,
                 convergence=self.uncertainty.get(f"convergence_{form}", {}),
                 model=self.uncertainty.get(f"model_spread_{form}", {}),
+                grid=self.grid.get(form),
             )
             doc[form] = {
                 **laws,
@@ -140,8 +158,14 @@ class LawsResult:
         doc["intervals"] = doc[self.form]["intervals"]
         doc["uncertainty"] = {
             "combination": "half-width = coverage * sqrt(fit stderr^2 + convergence^2 + "
-            "model_spread^2) per coefficient",
+            "model_spread^2 + grid^2) per coefficient",
             **self.uncertainty,
+            "grid": {
+                "rule": "|slope| and |intercept| of the line through the per-load signed grid "
+                "estimates (friction.csv tau_grid_error_mpa, sigma_mss_grid_error_mpa) on the "
+                "fitted loads; null: not estimated",
+                **{form: dict(parts) for form, parts in self.grid.items()},
+            },
         }
         return doc
 
@@ -155,6 +179,7 @@ def run_laws(settings, inputs: LawsInputs, folder: Path | None, progress=None) -
     """Fit the load laws to ``inputs`` on P ≤ ``settings.analysis.threshold_gpa``."""
     from flatcontact.analysis.diagnostics import AnalysisWarning
     from flatcontact.analysis.laws import fit_load_laws
+    from flatcontact.analysis.uncertainty import grid_law_components
 
     p, tau, sigma = (
         np.asarray(v, dtype=float) for v in (inputs.p_gpa, inputs.tau_mpa, inputs.sigma_mss_mpa)
@@ -171,8 +196,29 @@ def run_laws(settings, inputs: LawsInputs, folder: Path | None, progress=None) -
         form=settings.analysis.energy_form,
         uncertainty=unc.model_dump() if unc is not None else {},
     )
+    result.grid[result.form] = grid_law_components(
+        p,
+        tau,
+        sigma,
+        inputs.tau_grid_error_mpa,
+        inputs.sigma_mss_grid_error_mpa,
+        settings.analysis.threshold_gpa,
+    )
     if inputs.other_form is not None:
         result.other = _other_form(settings, inputs.other_form)
+        rows = result.other["loads"]
+
+        def column(name: str):
+            values = [r.get(name) for r in rows]
+            return None if any(v is None for v in values) else [float(v) for v in values]
+
+        result.grid[other_form(result.form)] = grid_law_components(
+            column("p_gpa"),
+            column("tau_mpa"),
+            column("sigma_mss_mpa"),
+            *(column(c) for c in _GRID_COLUMNS),
+            settings.analysis.threshold_gpa,
+        )
     if folder is not None:
         from flatcontact.plots.analysis import figure_laws
 

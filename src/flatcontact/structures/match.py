@@ -206,35 +206,74 @@ def coincidence_match(
         area = float(zm.match_area)
         if best_area is not None and area > best_area * (1.0 + 1e-6):
             break
-        f = np.asarray(zm.film_sl_vectors, float)[:, :2]
-        s = np.asarray(zm.substrate_sl_vectors, float)[:, :2]
-        if np.linalg.det(f) * np.linalg.det(s) <= 0:
-            continue  # opposite handedness: the map would be a reflection
-        if np.linalg.det(s) < 0:
-            f, s = f[::-1], s[::-1]
-        try:
-            p1 = integer_matrix(s, a1, field)
-            p2 = integer_matrix(f, a2, field)
-        except InputError:
-            continue
-        match = Match(p1, p2, common_cell(s, f, strain_on), "coincidence")
-        worst = max(
-            max(abs(x) for x in strain_and_rotation(match.deformation(k, a))[0])
-            for k, a in ((1, a1), (2, a2))
-        )
-        n_atoms = atom_count(match, n1, n2)
-        if worst > max_strain + 1e-12 or n_atoms > max_atoms:
-            continue
-        rotation_deg = abs(strain_and_rotation(match.deformation(2, a2))[1])
-        key = (n_atoms, round(worst, 9), round(rotation_deg, 6))
-        if best is None or key < best[0]:
-            best, best_area = (key, match), area
+        f0 = np.asarray(zm.film_sl_vectors, float)[:, :2]
+        s0 = np.asarray(zm.substrate_sl_vectors, float)[:, :2]
+        for f, s in _proper_pairs(f0, s0, a2):
+            try:
+                p1 = integer_matrix(s, a1, field)
+                p2 = integer_matrix(f, a2, field)
+            except InputError:
+                continue
+            match = Match(p1, p2, common_cell(s, f, strain_on), "coincidence")
+            worst = max(
+                max(abs(x) for x in strain_and_rotation(match.deformation(k, a))[0])
+                for k, a in ((1, a1), (2, a2))
+            )
+            n_atoms = atom_count(match, n1, n2)
+            if worst > max_strain + 1e-12 or n_atoms > max_atoms:
+                continue
+            # ties (same size and strain, e.g. the 0.3 % diamond(111)/graphene cells at 9.18°
+            # and 18.61°): the smaller rotation modulo slab 2's lattice symmetry, whatever
+            # representative pymatgen's enumeration yields
+            rotation = strain_and_rotation(match.deformation(2, a2))[1]
+            rotation_deg = abs(orientation_error_deg(rotation, 0.0, a2))
+            key = (n_atoms, round(worst, 9), round(rotation_deg, 6))
+            if best is None or key < best[0]:
+                best, best_area = (key, match), area
     if best is None:
         raise InputError(
             f"{field}: no coincidence lattice with strain <= {100 * max_strain:g}% on each slab "
             f"and <= {max_atoms} atoms (raise match.max_strain or match.max_atoms)"
         )
     return _without_lattice_rotation(best[1], a2, field)
+
+
+def _proper_pairs(f: np.ndarray, s: np.ndarray, a2: np.ndarray):
+    """The ZSL pair ``(f, s)`` (film = slab 2, substrate = slab 1 supercell vectors) as
+    pairs of one handedness, so that the map from one to the other is a rotation.
+
+    A pair of opposite handedness (the map would be a reflection) is not dropped: the film's
+    vectors swapped (same lengths when its reduced cell is hexagonal or square, paired the
+    other way) and, when slab 2's lattice has a mirror, the film's pair through that mirror
+    (another pair of its lattice vectors, same lengths and angle) are both proper candidates;
+    the strain check decides. (pymatgen 2026.10 yields only reflected pairs for the 0.3 %
+    diamond(111)/graphene cell, which the approximant study then lost.)
+    """
+    if np.linalg.det(f) * np.linalg.det(s) > 0:
+        candidates = [f]
+    else:
+        mirror = lattice_mirror(a2)
+        candidates = [f[::-1]] + ([] if mirror is None else [f @ mirror.T])
+    for fc in candidates:
+        if np.linalg.det(s) < 0:
+            yield fc[::-1], s[::-1]
+        else:
+            yield fc, s
+
+
+def lattice_mirror(cell2: np.ndarray) -> np.ndarray | None:
+    """A mirror (2×2, acting on column vectors) that maps the 2D lattice ``cell2`` onto
+    itself, or None: the reflections across the lines of ``a1``, ``a2``, ``a1 ± a2`` and their
+    normals are tried (every 2D Bravais lattice with a mirror has one of these among its
+    mirror lines)."""
+    a = np.asarray(cell2, float)[:, :2]
+    for v in (a[0], a[1], a[0] + a[1], a[0] - a[1]):
+        for phi in (np.arctan2(v[1], v[0]), np.arctan2(v[1], v[0]) + 0.5 * np.pi):
+            c, s = np.cos(2 * phi), np.sin(2 * phi)
+            m = np.array([[c, s], [s, -c]])
+            if lattice_is_invariant(a, m):
+                return m
+    return None
 
 
 def rotation_symmetry_deg(cell2: np.ndarray) -> float:

@@ -135,6 +135,43 @@ def symmetry_table(symmetry: dict) -> Table:
     )
 
 
+def grid_paragraphs(grid: dict | None) -> list[str]:
+    """What the grid's estimate of its own error says (``analyze.json["grid"]``,
+    :mod:`flatcontact.analysis.grid_error`): how it was made, the largest relative error of τ
+    and, above the threshold, that the grid does not resolve τ and which grid would."""
+    if not grid:
+        return []
+    rel = [v for v in grid.get("relative_tau_error") or [] if v is not None]
+    n_a, n_b = grid["grid"]
+    made = "two interpolants of the same samples (the symmetrised one and the grid's own), the "
+    made += "interpolant without its outermost harmonic shell"
+    if grid.get("sub_grid"):
+        made += (
+            f" and the {grid['sub_grid']}, Richardson-scaled by 1/(r^p − 1), r = "
+            f"{grid['ratio']:.3g}, p = the convergence order (assumed {grid['assumed_order']:g}; "
+            f"{grid['order_rule']})"
+        )
+    text = (
+        f"Grid error of the {n_a}×{n_b} grid: τ, σ_MSS and G_int recomputed from {made}, with "
+        "the same symmetry, start rule and direction. Per quantity the largest estimate (rms "
+        f"over the loads; τ: {(grid.get('source') or {}).get('tau_mpa', 'n/a')}) is the ± grid "
+        "of the table and the grid part of the laws' intervals."
+    )
+    if rel:
+        text += f" Largest |δτ|/τ: {100 * max(rel):.3g} %."
+    out = [text]
+    if not grid.get("resolved", True):
+        rec = grid.get("recommended_grid") or ["?", "?"]
+        out.append(
+            f"The {n_a}×{n_b} grid does not resolve τ: its estimated error exceeds "
+            f"{100 * grid['unresolved_fraction']:g} % of τ; a grid of about {rec[0]}×{rec[1]} "
+            "(scan.grid) would resolve it by the same estimate."
+        )
+    if grid.get("unavailable"):
+        out.append(f"Not estimated: {grid['unavailable']}.")
+    return out
+
+
 def analysis_section(cfg, analyze: dict, table, folder: Path, family: str = "analysis") -> Section:
     """Section 3: the per-load table of ``table`` (``friction.csv`` as a DataFrame), the
     warnings (one box per kind, :func:`flatcontact.report.format.grouped_warnings`) and
@@ -155,10 +192,11 @@ def analysis_section(cfg, analyze: dict, table, folder: Path, family: str = "ana
         for p in ps
         if (folder / png(analyze_figure(p))).exists()
     ]
+    grid_col = "tau_grid_error_mpa" in table.columns
     rows = [
         (
             fmt(r.p_gpa),
-            fmt(r.tau_mpa),
+            fmt(r.tau_mpa) + (f" ± {abs(r.tau_grid_error_mpa):.2g}" if grid_col else ""),
             fmt(r.tau_period_mpa),
             fmt(r.sigma_mss_mpa),
             fmt(r.shear_stiffness_gpa_per_nm),
@@ -178,13 +216,14 @@ def analysis_section(cfg, analyze: dict, table, folder: Path, family: str = "ana
             f"Load at each z from {LOAD_SOURCE_TEXT[analyze.get('load_source', 'stress')]}. "
             f"Energy zero of the maps and profiles: {ENERGY_ZERO_TEXT[cfg.analysis.energy_zero]}.",
             monotonicity_paragraph(table, family),
+            *grid_paragraphs(analyze.get("grid")),
         ],
         notes=grouped_warnings(analyze.get("warnings", [])),
         tables=[
             Table(
                 (
                     "P (GPa)",
-                    "τ (MPa)",
+                    "τ (MPa)" + (" ± grid" if grid_col else ""),
                     "τ_period (MPa)",
                     "σ_MSS (MPa)",
                     "G_int (GPa/nm)",

@@ -208,7 +208,7 @@ def _interval_cell(q: dict) -> str:
     text = f"{q['value']:.3g} [{q['low']:.3g}, {q['high']:.3g}]"
     parts = q.get("components")
     if parts:
-        short = {"fit": "fit", "convergence": "conv.", "models": "models"}
+        short = {"fit": "fit", "convergence": "conv.", "models": "models", "grid": "grid"}
         text += (
             " ("
             + ", ".join(f"{short.get(p, p)} ±{(hi - lo) / 2:.2g}" for p, (lo, hi) in parts.items())
@@ -235,7 +235,7 @@ def interval_tables(contact: dict) -> list:
     if iv.get("component_half_widths"):
         hw += (
             "; in parentheses the half-range over the box of each part alone: fit, "
-            "convergence, models"
+            "convergence, models, grid"
         )
     return [
         Table(

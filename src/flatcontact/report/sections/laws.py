@@ -27,16 +27,20 @@ ENERGY_FORMS_PARAGRAPH = (
 
 
 #: The parts of a coefficient's uncertainty as laws.json names them (``intervals.<c>.components``).
-COMPONENT_NAMES = ("fit", "convergence", "models")
+COMPONENT_NAMES = ("fit", "convergence", "models", "grid")
 
 
 def _has_components(form_doc: dict) -> bool:
-    """Does this form's ``intervals`` carry a convergence or model part (a study's block)?"""
+    """Does this form's ``intervals`` carry a part beside the fit (a study's block, the grid)?"""
     return any(
         (iv.get("components") or {}).get(p)
         for iv in (form_doc.get("intervals") or {}).values()
-        for p in ("convergence", "models")
+        for p in COMPONENT_NAMES[1:]
     )
+
+
+def _part(value) -> str:
+    return "n/a" if value is None else f"{value:.3g}"
 
 
 def laws_tables(laws: dict, paper: bool = False) -> list:
@@ -58,7 +62,7 @@ def laws_tables(laws: dict, paper: bool = False) -> list:
             row.append(f"[{iv['low']:.3g}, {iv['high']:.3g}]" if iv else "n/a")
             if split[form]:
                 parts = (iv or {}).get("components") or {}
-                row.append(" / ".join(f"{parts.get(p, 0.0):.3g}" for p in COMPONENT_NAMES))
+                row.append(" / ".join(_part(parts.get(p, 0.0)) for p in COMPONENT_NAMES))
         if paper:
             row.append(f"{PAPER[key]:g}")
         rows.append(tuple(row))
@@ -67,7 +71,7 @@ def laws_tables(laws: dict, paper: bool = False) -> list:
         tag = f"{form}{' (used)' if form == configured else ''}"
         header += [f"{tag} ± s.e.", f"{form} interval"]
         if split[form]:
-            header.append(f"{form}: fit / convergence / models")
+            header.append(f"{form}: fit / convergence / models / grid")
     if paper:
         header.append(PAPER_COLUMN)
     u = laws.get("uncertainty", {})
@@ -76,12 +80,14 @@ def laws_tables(laws: dict, paper: bool = False) -> list:
         parts += ", convergence"
     if any(u.get(f"model_spread_{f}") for f in forms):
         parts += ", model spread"
+    if any(split.values()):
+        parts += ", grid (the run's own estimate, section 3)"
     caption = (
         f"Load laws in both energy forms; intervals: coefficient ± {u.get('coverage', 1):g} × "
         f"the combined standard error ({parts}, in quadrature)"
         + (
-            "; the fit / convergence / models columns are the parts before the coverage "
-            "multiple (coefficient units)"
+            "; the fit / convergence / models / grid columns are the parts before the coverage "
+            "multiple (coefficient units; n/a: not estimated)"
             if any(split.values())
             else ""
         )
