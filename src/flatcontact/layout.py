@@ -97,6 +97,16 @@ FIG5C_CYCLE_LOOPS = "fig5c_cycle_loops"
 FIG6_LOCKIN = "fig6_lockin"
 FIG6_FIT = "fig6_fit"
 
+# ---- asperity (``flatcontact asperity --out DIR``; docs/asperity.md)
+ASPERITY_NC = "asperity.nc"
+ASPERITY_JSON = "asperity.json"
+#: The saved relaxed states (resume), one folder per load.
+ASPERITY_STATE = "state"
+FIG_ASPERITY_FORCE = "fig_asperity_force"
+FIG_ASPERITY_STICK = "fig_asperity_stick"
+FIG_ASPERITY_TRACTIONS = "fig_asperity_tractions"
+FIG_ASPERITY_SLIP = "fig_asperity_slip"
+
 # ---- report
 REPORT_HTML = "report.html"
 

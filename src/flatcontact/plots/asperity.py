@@ -1,0 +1,127 @@
+"""Figures of the asperity stage: Q(u) atoms vs model, c/a vs Q/Q_peak, traction profiles
+with the laws, the slip map. Inputs: asperity.json's ``loads`` and the asperity.nc dataset."""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+
+
+def fig_force_displacement(loads: list[dict]) -> Figure:
+    """Q(u) of the atoms and of the pointwise model (Hertz, measured pressure), per load."""
+    fig = Figure(figsize=(6.0, 4.2))
+    ax = fig.add_subplot()
+    for i, load in enumerate(loads):
+        c = f"C{i}"
+        atoms = load["atoms"]
+        u = np.asarray(atoms["displacement_angstrom"])
+        ax.plot(
+            u,
+            np.asarray(atoms["lateral_force_n"]) * 1e9,
+            "o-",
+            ms=3,
+            color=c,
+            label=f"atoms, p0 {load['target_p0_gpa']:g} GPa",
+        )
+        ax.plot(
+            u,
+            np.asarray(load["model_hertz"]["lateral_force_n"]) * 1e9,
+            "--",
+            color=c,
+            label="model, Hertz p",
+        )
+        ax.plot(
+            u,
+            np.asarray(load["model_measured_pressure"]["lateral_force_n"]) * 1e9,
+            ":",
+            color=c,
+            label="model, measured p",
+        )
+    ax.set_xlabel("tip displacement u (Å)")
+    ax.set_ylabel("lateral force Q (nN)")
+    ax.legend(fontsize=7)
+    return fig
+
+
+def fig_stick_ratio(loads: list[dict]) -> Figure:
+    """c/a against Q/Q_peak: atoms (markers) and the pointwise model (lines)."""
+    fig = Figure(figsize=(5.0, 4.0))
+    ax = fig.add_subplot()
+    for i, load in enumerate(loads):
+        c = f"C{i}"
+        atoms = load["atoms"]
+        x = np.asarray(atoms["q_over_q_peak"])
+        ax.plot(
+            x,
+            atoms["stick_ratio"],
+            "o",
+            ms=3,
+            color=c,
+            label=f"atoms, p0 {load['target_p0_gpa']:g} GPa",
+        )
+        order = np.argsort(x)
+        ax.plot(
+            x[order],
+            np.asarray(load["model_hertz"]["stick_ratio_at_atoms_q"])[order],
+            "--",
+            color=c,
+            label="pointwise, Hertz p",
+        )
+        if "elastic_stick_ratio_at_atoms_q" in load["model_hertz"]:
+            ax.plot(
+                x[order],
+                np.asarray(load["model_hertz"]["elastic_stick_ratio_at_atoms_q"])[order],
+                "-.",
+                color=c,
+                label="elastic stick zone (Cattaneo-type)",
+            )
+    ax.set_xlabel("Q / Q_peak")
+    ax.set_ylabel("c / a")
+    ax.set_ylim(-0.05, 1.1)
+    ax.legend(fontsize=7)
+    return fig
+
+
+def fig_tractions(load: dict) -> Figure:
+    """p(x), q(x) at a few steps of one load, with τ(p) and σ(p) of the laws."""
+    fig = Figure(figsize=(6.5, 4.2))
+    ax = fig.add_subplot()
+    for j, row in enumerate(load["local_traction"]):
+        c = f"C{j}"
+        x = np.asarray(row["bin_centre_angstrom"])
+        ax.plot(x, row["pressure_gpa"], "-", color=c, alpha=0.4)
+        ax.plot(
+            x,
+            np.asarray(row["shear_gpa"]) * 1e3,
+            "o-",
+            ms=3,
+            color=c,
+            label=f"q, u = {row['displacement_angstrom']:.2f} Å",
+        )
+    last = load["local_traction"][-1]
+    x = np.asarray(last["bin_centre_angstrom"])
+    ax.plot(x, np.asarray(last["tau_gpa"]) * 1e3, "k--", label="τ(p) of the laws")
+    ax.plot(x, np.asarray(last["sigma_gpa"]) * 1e3, "k:", label="σ(p) of the laws")
+    ax.set_xlabel("contact coordinate (Å)")
+    ax.set_ylabel("p (GPa, faint) ;  q, τ, σ (MPa)")
+    ax.legend(fontsize=7)
+    return fig
+
+
+def fig_slip_map(ds, load: int = 0) -> Figure:
+    """Slip (Å) of the facing atoms against the contact coordinate and the step."""
+    fig = Figure(figsize=(6.0, 4.0))
+    ax = fig.add_subplot()
+    slip = np.asarray(ds["slip_angstrom"].isel(load=load))
+    x = np.asarray(ds["bin_centre_angstrom"])
+    u = np.asarray(ds["displacement_angstrom"].isel(load=load))
+    mesh = ax.pcolormesh(x, u, slip, shading="nearest", cmap="viridis", rasterized=True)
+    a = np.asarray(ds["contact_half_width_angstrom"].isel(load=load))
+    c = np.asarray(ds["stick_half_width_angstrom"].isel(load=load))
+    for sign in (1, -1) if x.min() < 0 else (1,):
+        ax.plot(sign * a, u, "w-", lw=1)
+        ax.plot(sign * c, u, "r--", lw=1)
+    fig.colorbar(mesh, ax=ax, label="slip (Å)")
+    ax.set_xlabel("contact coordinate (Å)  [white: a, red: stick edge c]")
+    ax.set_ylabel("tip displacement u (Å)")
+    return fig
