@@ -102,10 +102,14 @@ def plan_sizes(
     lateral_factor: float = 4.0,
     axis_repeats: int = 2,
     rigid_angstrom: float = 6.0,
+    edge_gap_angstrom: float = 6.0,
 ) -> Sizes:
     """Sizes from R, the largest load and E*: depth ``depth_factor``·a per body (at least a
     few planes above the rigid block), lateral period ``lateral_factor``·2a (cylinder: across
-    the axis only; ``axis_repeats`` cells along it).
+    the axis only; ``axis_repeats`` cells along it), and at least wide enough that the cap
+    rises ``edge_gap_angstrom`` above the flat at the period's edge (L/2 >= √(2 R h)): an
+    adhesive coupling (LJ across, range ~ its σ and beyond) would otherwise pull the whole
+    period into contact and the "asperity" would be a flat.
 
     Raises
     ------
@@ -124,7 +128,11 @@ def plan_sizes(
     # the periods across: a1 along x; a2's component perpendicular to a1 (the cell's y)
     width_2 = abs(a2[1])
     width_1 = abs(a1[0])
-    period = max(lateral_factor * 2.0 * a, 4.0 * rigid_angstrom)
+    period = max(
+        lateral_factor * 2.0 * a,
+        4.0 * rigid_angstrom,
+        2.0 * math.sqrt(2.0 * radius_angstrom * edge_gap_angstrom),
+    )
     n2 = max(2, math.ceil(period / width_2))
     n1 = (
         max(1, int(axis_repeats)) if geometry == "cylinder" else max(2, math.ceil(period / width_1))

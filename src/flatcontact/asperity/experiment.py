@@ -112,6 +112,26 @@ def _sizes(spec: ExperimentSpec, recipe):
     return sizes
 
 
+def bin_edges(spec: ExperimentSpec, cell: np.ndarray, repeats) -> np.ndarray:
+    """Bin edges (Å) commensurate with the lattice: the cylinder's bins are whole rows of the
+    primitive cell across the axis (width an odd number of a2's y-period, nearest to
+    ``bin_width_angstrom``), centred on the apex and covering the period, so every bin holds
+    the same atoms per plane (no aliasing between atom rows and bins); the sphere's are
+    annuli of ``bin_width_angstrom`` up to half the shorter period."""
+    if spec.geometry == "cylinder":
+        row = abs(cell[1, 1]) / repeats[1]
+        # an odd number of rows per bin: the centre bin is symmetric about the apex and the
+        # edges fall half a row from the apex's rows (fcc(111): the planes' rows lie at
+        # thirds of a row, so no atom sits on an edge)
+        per_bin = max(1, round(spec.bin_width_angstrom / row))
+        per_bin += 1 - per_bin % 2
+        nb = max(0, (repeats[1] // per_bin - 1) // 2)
+        return (np.arange(-nb, nb + 2) - 0.5) * per_bin * row
+    extent = min(abs(cell[0, 0]), abs(cell[1, 1])) / 2
+    nb = max(1, math.floor(extent / spec.bin_width_angstrom))
+    return np.linspace(0, nb, nb + 1) * spec.bin_width_angstrom
+
+
 def _check_state(state_dir: Path, spec: ExperimentSpec) -> None:
     state_dir.mkdir(parents=True, exist_ok=True)
     path = state_dir / "spec.json"
@@ -160,17 +180,7 @@ def run_experiment(
     _check_state(state_dir, spec)
     cell = atoms.cell.array
     axis = float(np.linalg.norm(cell[0])) if spec.geometry == "cylinder" else 0.0
-    extent = (
-        abs(cell[1, 1]) / 2
-        if spec.geometry == "cylinder"
-        else min(abs(cell[0, 0]), abs(cell[1, 1])) / 2
-    )
-    nb = max(1, math.floor(extent / spec.bin_width_angstrom))
-    edges = (
-        np.linspace(-nb, nb, 2 * nb + 1) * spec.bin_width_angstrom
-        if spec.geometry == "cylinder"
-        else np.linspace(0, nb, nb + 1) * spec.bin_width_angstrom
-    )
+    edges = bin_edges(spec, cell, sizes.repeats)
     bins = Binning(
         edges,
         spec.contact_force_ev_per_angstrom,

@@ -46,6 +46,7 @@ class StepRecord:
     slip_angstrom: np.ndarray
     iterations: int
     converged: bool
+    residual_ev_per_angstrom: float
 
 
 def _flat_top(atoms: Atoms, pressed: np.ndarray) -> np.ndarray:
@@ -105,6 +106,7 @@ def measure_load(atoms: Atoms, states: list[StepState], binning_: Binning) -> li
                 slip_bins,
                 st.iterations,
                 st.converged,
+                st.residual_ev_per_angstrom,
             )
         )
     return out
@@ -129,6 +131,7 @@ def dataset(loads_p0_gpa, records: list[list[StepRecord]], binning_: Binning, at
         "slip_angstrom": (("load", "step", "bin"), stack("slip_angstrom")),
         "iterations": (("load", "step"), stack("iterations")),
         "converged": (("load", "step"), stack("converged").astype("i1")),
+        "residual_ev_per_angstrom": (("load", "step"), stack("residual_ev_per_angstrom")),
     }
     if binning_.geometry == "cylinder":
         data["lateral_force_n_per_m"] = (("load", "step"), stack("lateral_force_n") / length_m)
