@@ -13,7 +13,9 @@ For one load, from the measured records (:mod:`.records`) and the laws τ = k p 
 The pointwise model (the paper's construction) gives Q(Q_fs), where Q_fs is the load a fully
 stuck contact would carry, proportional to u; the compliance of a finite periodic box is not
 the half-space's, so u = Q_fs / K0 with K0 the atoms' initial stiffness (Q/u at the first
-lateral step) — the one fitted number (``fitted_compliance``). For the cylinder the elastic
+lateral step) — the one fitted number (``fitted_compliance``). The atoms' Q is counted from
+the pressed state (Q − Q0; ``lateral_force_at_zero_displacement_n`` = Q0, nonzero where the
+registry has no mirror symmetry along the sliding, as fcc(111) along [11-2]). For the cylinder the elastic
 (generalised Cattaneo) model's stick zone at the atoms' Q/Q_sat is given too.
 
 Compared: Q_peak, the peak mean shear stress (sphere Q_peak/(π a²), cylinder Q'_peak/(2a)),
@@ -123,7 +125,10 @@ def compare_load(
     axis_m = binning_.axis_length_angstrom * ANGSTROM
     pl = laws.point_laws()
     u_m = np.array([r.displacement_angstrom for r in records]) * ANGSTROM
-    q_n = np.array([r.lateral_force_n for r in records])
+    # Q relative to the pressed state: a registry without the mirror y -> -y (fcc(111) along
+    # [11-2]) leaves a lateral force Q0 on the held tip block at u = 0; the model starts at 0
+    q_offset = float(records[0].lateral_force_n)
+    q_n = np.array([r.lateral_force_n for r in records]) - q_offset
     normal_n = float(records[0].normal_force_n)
     a_atoms = records[0].contact_half_width_angstrom * ANGSTROM
     i_peak = int(np.argmax(q_n))
@@ -144,6 +149,7 @@ def compare_load(
         "contact_half_width_angstrom": a_atoms / ANGSTROM,
         "peak_lateral_force_n": q_peak,
         "peak_displacement_angstrom": float(u_m[i_peak] / ANGSTROM),
+        "lateral_force_at_zero_displacement_n": q_offset,
         "peak_shear_stress_mpa": q_peak / area / 1e6 if area > 0 else None,
         "initial_stiffness_n_per_m": k0,
         "displacement_angstrom": (u_m / ANGSTROM).tolist(),

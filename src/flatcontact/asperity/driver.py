@@ -167,6 +167,12 @@ def relax(model, atoms: Atoms, positions: np.ndarray, protocol: Protocol) -> Ste
         forces = _forces(lmp, n)
     finally:
         lmp.close()
+    # LAMMPS's copy starts wrapped into the box: bring each atom back to the image nearest
+    # to where it started, so states are continuous with the built atoms (a relaxation moves
+    # atoms by far less than half a period)
+    cell2 = atoms.cell.array[:2, :2]
+    shift = np.linalg.solve(cell2.T, (new - positions)[:, :2].T).T
+    new[:, :2] -= np.round(shift) @ cell2
     free = block == 0
     residual = float(np.max(np.abs(forces[free]))) if np.any(free) else 0.0
     converged = residual <= protocol.fmax_ev_per_angstrom * (1 + 1e-9)
