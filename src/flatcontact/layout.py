@@ -17,6 +17,7 @@ A run directory::
     06-contact/  contact.nc  summary.json  (fit.json)  fig4_traction  fig5_force_stiffness(_rms)
                  (fig6_experiment  fig5c_cycle_loops  fig6_lockin  fig6_fit)
     07-report/   report.html
+    08-asperity/ asperity.nc  asperity.json  fig_asperity_*  state/   (only with asperity.enabled)
 
 and every stage folder holds its record ``stage.json`` (:data:`flatcontact.rundir.RECORD_NAME`).
 """
@@ -32,6 +33,9 @@ STAGES = {
     "elastic": 5,
     "contact": 6,
     "report": 7,
+    # optional (asperity.enabled), run before the report; numbered after it so that the
+    # folders of existing runs keep their names
+    "asperity": 8,
 }
 
 

@@ -537,6 +537,8 @@ class Pipeline:
         inputs = {"report": cfg.section("report"), **{k: v.fingerprint for k, v in ups.items()}}
         if cfg.elastic.enabled:  # the report tables the elastic stage's Cij
             inputs["elastic"] = self._upstream("elastic").fingerprint
+        if cfg.asperity.enabled:  # the report states the asperity's verdict
+            inputs["asperity"] = self._upstream("asperity").fingerprint
         if cfg.report.approximant_study is not None:  # the report tables that study's files
             inputs["approximant_study"] = approximant_study_digest(cfg.report.approximant_study)
         folders = {name: self.folder(name) for name in STAGES}
@@ -551,9 +553,38 @@ class Pipeline:
             return target if target.is_file() else result.folder / REPORT_HTML
         return copy_file_atomic(result.folder / REPORT_HTML, target)
 
+    def asperity(self) -> dict | None:
+        """Stage 8 (optional, ``asperity.enabled``): the asperity in atoms against the model
+        (``08-asperity/asperity.json``); its saved states resume an interrupted stage."""
+        from flatcontact.layout import ASPERITY_JSON
+        from flatcontact.stages.asperity import AsperityInputs, run_asperity
+
+        cfg = self.config
+        if not cfg.asperity.enabled:
+            self._tell("off", "asperity", message="asperity.enabled is false")
+            return None
+        laws = self._upstream("laws")
+        inputs = {
+            "asperity": cfg.section("asperity"),
+            "structure": cfg.section("structure"),
+            "model": self._model_inputs(),
+            "laws": laws.fingerprint,
+        }
+        e_star = None
+        if cfg.elastic.enabled:
+            inputs["elastic"] = self._upstream("elastic").fingerprint
+            e_star = float(self._json("elastic", ELASTIC_JSON)["contact_modulus_gpa"])
+        doc = self._json("laws", LAWS_JSON)
+
+        def work(folder: Path) -> None:
+            run_asperity(cfg, AsperityInputs(laws=doc, contact_modulus_gpa=e_star), folder)
+
+        self._run("asperity", inputs, work)
+        return self._json("asperity", ASPERITY_JSON)
+
     def run(self) -> Path:
         """Every stage in order; returns the path of ``report.html``."""
-        for name in ("build", "scan", "analyze", "laws", "elastic", "contact"):
+        for name in ("build", "scan", "analyze", "laws", "elastic", "contact", "asperity"):
             getattr(self, name)()
         return self.report()
 

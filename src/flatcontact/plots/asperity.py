@@ -83,13 +83,15 @@ def fig_stick_ratio(loads: list[dict]) -> Figure:
 
 
 def fig_tractions(load: dict) -> Figure:
-    """p(x), q(x) at a few steps of one load, with τ(p) and σ(p) of the laws."""
+    """q(x) at a few steps of one load with τ(p) and σ(p) of the laws (left, MPa), and the
+    pressure p(x) (right, GPa)."""
     fig = Figure(figsize=(6.5, 4.2))
     ax = fig.add_subplot()
+    ax_p = ax.twinx()
     for j, row in enumerate(load["local_traction"]):
         c = f"C{j}"
         x = np.asarray(row["bin_centre_angstrom"])
-        ax.plot(x, row["pressure_gpa"], "-", color=c, alpha=0.4)
+        ax_p.plot(x, row["pressure_gpa"], "-", color=c, alpha=0.35)
         ax.plot(
             x,
             np.asarray(row["shear_gpa"]) * 1e3,
@@ -103,7 +105,8 @@ def fig_tractions(load: dict) -> Figure:
     ax.plot(x, np.asarray(last["tau_gpa"]) * 1e3, "k--", label="τ(p) of the laws")
     ax.plot(x, np.asarray(last["sigma_gpa"]) * 1e3, "k:", label="σ(p) of the laws")
     ax.set_xlabel("contact coordinate (Å)")
-    ax.set_ylabel("p (GPa, faint) ;  q, τ, σ (MPa)")
+    ax.set_ylabel("shear q, τ(p), σ(p) (MPa)")
+    ax_p.set_ylabel("pressure p (GPa, faint lines)")
     ax.legend(fontsize=7)
     return fig
 

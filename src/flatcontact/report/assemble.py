@@ -17,6 +17,7 @@ from ase.io import read
 
 from flatcontact.layout import (
     ANALYZE_JSON,
+    ASPERITY_JSON,
     BUILD_JSON,
     ELASTIC_JSON,
     FRICTION_CSV,
@@ -32,6 +33,7 @@ from flatcontact.report.sections.approximant_study import (
     approximant_study_section,
     read_approximant_study,
 )
+from flatcontact.report.sections.asperity import asperity_section
 from flatcontact.report.sections.build import interface_material, interface_section
 from flatcontact.report.sections.comparison import own_results_section, paper_section
 from flatcontact.report.sections.contact import contact_section
@@ -98,6 +100,10 @@ def build_sections(
     study = cfg.report.approximant_study  # the sequence toward the incommensurate contact
     if study is not None:
         sections.append(approximant_study_section(read_approximant_study(study), study, build))
+    tail = []
+    f_asp = folders.get("asperity")
+    if cfg.asperity.enabled and f_asp is not None and (f_asp / ASPERITY_JSON).exists():
+        tail.append(asperity_section(_json(f_asp / ASPERITY_JSON), f_asp))
     return [
         *sections,
         interface_section(cfg, build, f_build, interface, paper),
@@ -105,4 +111,5 @@ def build_sections(
         analysis_section(cfg, analyze, table, f_an, family),
         laws_section(laws, f_laws, paper),
         contact_section(cfg, contact, _elastic(cfg, folders.get("elastic")), f_ct),
+        *tail,
     ]
