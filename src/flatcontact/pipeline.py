@@ -124,12 +124,12 @@ log = logging.getLogger("flatcontact.run")
 #: it. ``pipeline.py`` itself is in no closure (it orders the stages, it computes nothing).
 STAGE_MODULES: dict[str, str] = {name: f"flatcontact.stages.{name}" for name in STAGES}
 #: The figure modules, left out of the code digest of the expensive stages
-#: (:data:`FIGURES_LEFT_OUT`), so restyling a figure never reruns a build or a scan (the
+#: (:data:`FIGURES_LEFT_OUT`), so restyling a figure never reruns a build, a scan or an asperity (the
 #: figure follows with the next real rerun). The cheap stages (analyze, laws, contact, report)
 #: keep their figures in their digest: editing a figure reruns them and redraws it. The
 #: modules the figures import stay in the closure.
 FIGURE_MODULES = "flatcontact.plots"
-FIGURES_LEFT_OUT = ("build", "scan")
+FIGURES_LEFT_OUT = ("build", "scan", "asperity")
 #: The top-level ``flatcontact/__init__.py`` is in no digest: it computes nothing (the version,
 #: recorded in ``versions.json``, and the lazy map of public names), so growing the public API
 #: never reruns a scan. The sub-packages' ``__init__`` files stay in.

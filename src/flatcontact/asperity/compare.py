@@ -102,14 +102,18 @@ def _side(geometry, x_m, p_pa, a_m, laws, axis_m, u_m, k0_n_per_m, q_ratio):
     peak = float(q[i_peak])
     q_of_u = np.interp(k0_n_per_m * np.asarray(u_m), qfs, q)
     rising = slice(0, i_peak + 1)
-    c_over_a = np.interp(np.asarray(q_ratio) * peak, q[rising], edge[rising] / a_m)
+    # on the rising branch only: c/a at the same Q/Q_peak as the atoms' (None past their peak)
+    c_over_a = [
+        None if f is None else float(np.interp(f * peak, q[rising], edge[rising] / a_m))
+        for f in q_ratio
+    ]
     area = 2 * a_m * axis_m if geometry == "cylinder" else np.pi * a_m**2
     return {
         "half_width_angstrom": a_m / ANGSTROM,
         "peak_lateral_force_n": peak,
         "peak_shear_stress_mpa": peak / area / 1e6,
         "lateral_force_n": q_of_u.tolist(),
-        "stick_ratio_at_atoms_q": c_over_a.tolist(),
+        "stick_ratio_at_atoms_q": c_over_a,
     }
 
 
@@ -135,6 +139,8 @@ def compare_load(
     q_peak = float(q_n[i_peak])
     k0 = float(q_n[1] / u_m[1]) if len(u_m) > 1 and u_m[1] > 0 else float("nan")
     ratio = np.clip(q_n / q_peak, 0.0, 1.0) if q_peak > 0 else np.zeros_like(q_n)
+    # the atoms' rising branch: Q/Q_peak up to their peak, None after it
+    rising = [float(f) if k <= i_peak else None for k, f in enumerate(ratio)]
     c_over_a = np.array(
         [
             r.stick_half_width_angstrom / r.contact_half_width_angstrom
@@ -150,6 +156,8 @@ def compare_load(
         "peak_lateral_force_n": q_peak,
         "peak_displacement_angstrom": float(u_m[i_peak] / ANGSTROM),
         "lateral_force_at_zero_displacement_n": q_offset,
+        # the largest Q at the last step: the slide never passed a peak, Q_peak is a lower bound
+        "peak_reached": bool(i_peak < len(q_n) - 1),
         "peak_shear_stress_mpa": q_peak / area / 1e6 if area > 0 else None,
         "initial_stiffness_n_per_m": k0,
         "displacement_angstrom": (u_m / ANGSTROM).tolist(),
@@ -169,7 +177,7 @@ def compare_load(
         p0_h = 3 * normal_n / (2 * np.pi * a_h**2)
         hx = a_h * np.sin(np.linspace(0, np.pi / 2, 2001))
         hp = p0_h * np.sqrt(np.clip(1 - (hx / a_h) ** 2, 0, None))
-    model_hertz = _side(geometry, hx, hp, a_h, pl, axis_m, u_m, k0, ratio)
+    model_hertz = _side(geometry, hx, hp, a_h, pl, axis_m, u_m, k0, rising)
     model_hertz["peak_pressure_gpa"] = p0_h / GPA
     # (2) the measured pressure of the pressed state, inside the measured contact
     centres = binning_.centres_angstrom * ANGSTROM
@@ -181,7 +189,7 @@ def compare_load(
         mx = np.linspace(0.0, a_atoms, 401)
         mp = np.interp(mx, centres, np.nan_to_num(p_meas))
         mp[-1] = 0.0
-    model_measured = _side(geometry, mx, mp, a_atoms, pl, axis_m, u_m, k0, ratio)
+    model_measured = _side(geometry, mx, mp, a_atoms, pl, axis_m, u_m, k0, rising)
     out = {
         "atoms": atoms,
         "model_hertz": model_hertz,
@@ -200,11 +208,13 @@ def compare_load(
         sat = lc.sliding_force(lc.Profile(hx, hp, a_h), pl) * axis_m
         model_hertz["sliding_force_n"] = sat
         model_hertz["elastic_stick_ratio_at_atoms_q"] = [
-            lc.elastic_response(
-                lc.Profile(hx, hp, a_h), pl, min(f * q_peak, sat) / axis_m
+            None
+            if f is None
+            else lc.elastic_response(
+                lc.Profile(hx, hp, a_h), pl, f * sat / axis_m
             ).stick_half_width_m
             / a_h
-            for f in ratio
+            for f in rising
         ]
     return out
 

@@ -76,7 +76,7 @@ class StepState:
     """One relaxed state: positions (Å, unwrapped), tip block force (eV/Å, 3), the force the
     tip exerts on each atom (eV/Å, n×3; zero on tip atoms), the tip's lateral displacement
     (Å), FIRE iterations, whether it converged (largest force component on a free atom, the
-    residual, <= fmax) and that residual."""
+    residual, <= fmax), that residual, and the wall seconds the step took when computed."""
 
     positions: np.ndarray
     tip_force: np.ndarray
@@ -85,6 +85,7 @@ class StepState:
     iterations: int
     converged: bool
     residual_ev_per_angstrom: float = float("nan")
+    seconds: float = float("nan")
 
 
 def _lammps_for(model, atoms: Atoms, positions: np.ndarray):
@@ -200,6 +201,7 @@ def _save(path: Path, state: StepState) -> None:
         iterations=state.iterations,
         converged=state.converged,
         residual_ev_per_angstrom=state.residual_ev_per_angstrom,
+        seconds=state.seconds,
     )
     os.replace(tmp, path)
 
@@ -215,6 +217,7 @@ def load_state(path: Path) -> StepState:
             int(f["iterations"]),
             bool(f["converged"]),
             float(f["residual_ev_per_angstrom"]),
+            float(f["seconds"]) if "seconds" in f else float("nan"),
         )
 
 
@@ -256,6 +259,7 @@ def run_load(
                 state.iterations,
                 state.converged,
                 state.residual_ev_per_angstrom,
+                time.perf_counter() - t0,
             )
             _save(path, state)
             if progress is not None:

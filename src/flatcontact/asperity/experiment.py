@@ -62,6 +62,7 @@ class Experiment:
     targets_ev_per_angstrom: list[float]
     records: list[list[StepRecord]]
     comparisons: list[dict]
+    states: list[list]
     wall_seconds: float
     memory_bytes: int
 
@@ -133,17 +134,19 @@ def bin_edges(spec: ExperimentSpec, cell: np.ndarray, repeats) -> np.ndarray:
 
 
 def _check_state(state_dir: Path, spec: ExperimentSpec) -> None:
+    """Refuse states of other settings; more (or fewer) ``steps`` extend (or reuse) them, as
+    each step's state depends only on the steps before it."""
     state_dir.mkdir(parents=True, exist_ok=True)
     path = state_dir / "spec.json"
     doc = json.loads(json.dumps(asdict(spec)))
     if path.exists():
-        if json.loads(path.read_text()) != doc:
+        old = json.loads(path.read_text())
+        if {**old, "steps": None} != {**doc, "steps": None}:
             raise InputError(
                 f"{state_dir}: holds the states of other asperity settings; give another --out "
                 "or remove it"
             )
-    else:
-        path.write_text(json.dumps(doc, indent=1))
+    path.write_text(json.dumps(doc, indent=1))
 
 
 def plan(spec: ExperimentSpec, recipe, neighbours_per_atom: int):
@@ -188,7 +191,7 @@ def run_experiment(
         spec.geometry,
         axis,
     )
-    records, comparisons, targets = [], [], []
+    records, comparisons, targets, all_states = [], [], [], []
     for i, p0 in enumerate(spec.p0_gpa):
         target = target_force_ev_per_angstrom(spec, p0, axis)
         targets.append(target)
@@ -204,6 +207,7 @@ def run_experiment(
                 )
 
         states = run_load(model, atoms, protocol, state_dir / f"load_{i}", progress=tell)
+        all_states.append(states)
         recs = measure_load(atoms, states, bins)
         records.append(recs)
         if laws is not None:
@@ -211,5 +215,13 @@ def run_experiment(
                 compare_load(recs, bins, laws, spec.radius_angstrom, spec.contact_modulus_gpa)
             )
     return Experiment(
-        atoms, sizes, bins, targets, records, comparisons, time.perf_counter() - t0, need
+        atoms,
+        sizes,
+        bins,
+        targets,
+        records,
+        comparisons,
+        all_states,
+        time.perf_counter() - t0,
+        need,
     )

@@ -51,30 +51,26 @@ def fig_stick_ratio(loads: list[dict]) -> Figure:
         c = f"C{i}"
         atoms = load["atoms"]
         x = np.asarray(atoms["q_over_q_peak"])
+        # the atoms on their rising branch (the model is compared there only)
+        n_rise = sum(m is not None for m in load["model_hertz"]["stick_ratio_at_atoms_q"])
         ax.plot(
-            x,
-            atoms["stick_ratio"],
+            x[:n_rise],
+            atoms["stick_ratio"][:n_rise],
             "o",
             ms=3,
             color=c,
             label=f"atoms, p0 {load['target_p0_gpa']:g} GPa",
         )
-        order = np.argsort(x)
-        ax.plot(
-            x[order],
-            np.asarray(load["model_hertz"]["stick_ratio_at_atoms_q"])[order],
-            "--",
-            color=c,
-            label="pointwise, Hertz p",
-        )
-        if "elastic_stick_ratio_at_atoms_q" in load["model_hertz"]:
-            ax.plot(
-                x[order],
-                np.asarray(load["model_hertz"]["elastic_stick_ratio_at_atoms_q"])[order],
-                "-.",
-                color=c,
-                label="elastic stick zone (Cattaneo-type)",
-            )
+        for key, style, label in (
+            ("stick_ratio_at_atoms_q", "--", "pointwise, Hertz p"),
+            ("elastic_stick_ratio_at_atoms_q", "-.", "elastic stick zone (Cattaneo-type)"),
+        ):
+            model = load["model_hertz"].get(key)
+            if model is None:
+                continue
+            pts = sorted((xi, m) for xi, m in zip(x, model, strict=True) if m is not None)
+            if pts:
+                ax.plot(*zip(*pts, strict=True), style, color=c, label=label)
     ax.set_xlabel("Q / Q_peak")
     ax.set_ylabel("c / a")
     ax.set_ylim(-0.05, 1.1)

@@ -167,6 +167,11 @@ def run_asperity(
         for k, r in enumerate(recs)
         if not r.converged
     ]
+    unconverged += [
+        f"load {i}: Q still rises at the last step; Q_peak is a lower bound (more steps)"
+        for i, comp in enumerate(exp.comparisons)
+        if not comp["atoms"]["peak_reached"]
+    ]
     doc = {
         "geometry": spec.geometry,
         "radius_angstrom": spec.radius_angstrom,
@@ -176,6 +181,10 @@ def run_asperity(
         "n_atoms": len(exp.atoms),
         "memory_estimate_bytes": exp.memory_bytes,
         "wall_seconds": exp.wall_seconds,
+        # the steps' own wall time when they were computed (a resumed run reads them)
+        "compute_seconds": float(
+            sum(s.seconds for recs in exp.states for s in recs if s.seconds == s.seconds)
+        ),
         "finite_size": {
             "a_over_depth": spec_sizes.hertz_half_width_angstrom / depth,
             "contact_width_over_period": 2 * spec_sizes.hertz_half_width_angstrom / period,
