@@ -49,7 +49,6 @@ def asperity_cmd(
         if not laws.is_file():
             raise InputError(f"--laws: {laws} is not a file")
         laws_doc = json.loads(laws.read_text())
-    out.mkdir(parents=True, exist_ok=True)
     result = run_asperity(
         settings,
         AsperityInputs(laws=laws_doc, contact_modulus_gpa=e_star),

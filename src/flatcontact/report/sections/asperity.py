@@ -72,3 +72,55 @@ def asperity_section(doc: dict, folder: Path) -> Section:
     ]
     notes = list(doc.get("warnings", []))
     return Section("The asperity in atoms", paragraphs, [table], figures, notes)
+
+
+#: The columns of docs/asperity.md's measured table (:func:`measured_row`).
+MEASURED_HEADERS = (
+    "case",
+    "R (nm)",
+    "atoms",
+    "a atoms / Hertz (Å)",
+    "Q_peak atoms (nN)",
+    "model, Hertz p (nN)",
+    "model, measured p (nN)",
+    "atoms / Hertz",
+    "atoms / measured p",
+    "Q_peak/2a atoms (MPa)",
+    "c/a at Q ≥ Q_peak/2: atoms / model",
+    "K0 atoms (N/m)",
+    "wall (s)",
+)
+
+
+def measured_row(case: str, doc: dict, wall_seconds: float) -> tuple[str, ...]:
+    """One row of docs/asperity.md's measured table from an ``asperity.json`` (first load)."""
+    load = doc["loads"][0]
+    at, mh, mm = load["atoms"], load["model_hertz"], load["model_measured_pressure"]
+    ratios = load["ratios_atoms_over_model"]
+    half = next(
+        (k for k, f in enumerate(at["q_over_q_peak"]) if f >= 0.5), len(at["q_over_q_peak"]) - 1
+    )
+    model_c = mh["stick_ratio_at_atoms_q"][half]
+    peak = fmt(at["peak_lateral_force_n"] * 1e9) + ("" if at["peak_reached"] else " (≥)")
+    return (
+        case,
+        fmt(doc["radius_angstrom"] / 10),
+        f"{doc['n_atoms']:,}",
+        f"{fmt(at['contact_half_width_angstrom'])} / {fmt(mh['half_width_angstrom'])}",
+        peak,
+        fmt(mh["peak_lateral_force_n"] * 1e9),
+        fmt(mm["peak_lateral_force_n"] * 1e9),
+        fmt(ratios["peak_lateral_force_hertz"]),
+        fmt(ratios["peak_lateral_force_measured_pressure"]),
+        fmt(at["peak_shear_stress_mpa"]),
+        f"{at['stick_ratio'][half]:.2f} / " + ("–" if model_c is None else f"{model_c:.2f}"),
+        fmt(at["initial_stiffness_n_per_m"]),
+        f"{wall_seconds:.0f}",
+    )
+
+
+def markdown_table(rows) -> str:
+    """The rows under :data:`MEASURED_HEADERS` as a Markdown table."""
+    lines = ["| " + " | ".join(MEASURED_HEADERS) + " |", "|" + "---|" * len(MEASURED_HEADERS)]
+    lines += ["| " + " | ".join(r) + " |" for r in rows]
+    return "\n".join(lines)
