@@ -113,6 +113,12 @@ def _laws(settings, inputs: AsperityInputs):
         ) from None
 
 
+def _compute_seconds(states) -> float | None:
+    """The steps' wall time when computed; None when a state predates the record."""
+    seconds = [s.seconds for recs in states for s in recs]
+    return None if any(x != x for x in seconds) else float(sum(seconds))
+
+
 def verdict(geometry: str, radius_angstrom: float, loads: list[dict]) -> str:
     """One sentence: whether the contact stage's Q_peak holds for this interface and size."""
     if not loads:
@@ -182,9 +188,7 @@ def run_asperity(
         "memory_estimate_bytes": exp.memory_bytes,
         "wall_seconds": exp.wall_seconds,
         # the steps' own wall time when they were computed (a resumed run reads them)
-        "compute_seconds": float(
-            sum(s.seconds for recs in exp.states for s in recs if s.seconds == s.seconds)
-        ),
+        "compute_seconds": _compute_seconds(exp.states),
         "finite_size": {
             "a_over_depth": spec_sizes.hertz_half_width_angstrom / depth,
             "contact_width_over_period": 2 * spec_sizes.hertz_half_width_angstrom / period,
