@@ -67,3 +67,30 @@ def test_the_verdict_says_whether_the_model_holds_and_by_how_much():
     fails = verdict("sphere", 50.0, [_load(3.0)])
     assert "does not hold" in fails and "3.00 times" in fails
     assert "no laws" in verdict("cylinder", 1.0, [])
+
+
+def test_config_check_refuses_an_asperity_without_lammps_or_layers(tmp_path):
+    import pytest
+
+    from flatcontact.config import build_config
+    from flatcontact.errors import InputError
+    from flatcontact.stages.preflight import check_asperity
+
+    ase = build_config(
+        {
+            "structure": {"kind": "fcc111", "element": "Cu"},
+            "potential": {"calculator": {"target": "ase.calculators.emt:EMT"}},
+            "asperity": {"enabled": True},
+        }
+    )
+    with pytest.raises(InputError, match="needs a LAMMPS interaction model"):
+        check_asperity(ase)
+    cfg = build_config(
+        {
+            "structure": {"kind": "file", "file": str(tmp_path / "x.extxyz")},
+            "potential": {"preset": "cu-eam"},
+            "asperity": {"enabled": True},
+        }
+    )
+    with pytest.raises(InputError, match=r"asperity\.enabled: structure\.kind=file has no layers"):
+        check_asperity(cfg)
