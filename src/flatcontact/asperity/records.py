@@ -49,9 +49,11 @@ class StepRecord:
     residual_ev_per_angstrom: float
 
 
-def _flat_top(atoms: Atoms, pressed: np.ndarray) -> np.ndarray:
+def _flat_top(atoms: Atoms) -> np.ndarray:
+    """The flat's top atomic plane, found in the *built* (ideal) geometry: pressed, a bonded or
+    adhesive rim lifts some surface atoms by more than half a plane spacing."""
     slab = np.asarray(atoms.arrays["slab"])
-    z = pressed[:, 2]
+    z = atoms.positions[:, 2]
     top = z[slab == 1].max()
     spacing = float(atoms.info["plane_spacing_angstrom"])
     return np.flatnonzero((slab == 1) & (z > top - 0.5 * spacing))
@@ -64,7 +66,7 @@ def measure_load(atoms: Atoms, states: list[StepState], binning_: Binning) -> li
     cell2 = atoms.cell.array[:2, :2]
     apex = np.asarray(atoms.info["apex"], float)
     pressed = states[0].positions
-    top = _flat_top(atoms, pressed)
+    top = _flat_top(atoms)
     tip_free = np.flatnonzero((slab == 2) & (block == 0))
     spacing = float(atoms.info["plane_spacing_angstrom"])
     pairs_flat, pairs_tip = binning.facing_pairs(
