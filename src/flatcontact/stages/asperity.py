@@ -158,8 +158,8 @@ def run_asperity(
         with tempfile.TemporaryDirectory() as tmp:
             state = (folder or Path(tmp)) / ASPERITY_STATE
             exp = run_experiment(spec, settings.structure, model, laws, state, progress=progress)
-    a = spec_sizes = exp.sizes
-    depth = (a.flat_layers - 1) * float(exp.atoms.info["plane_spacing_angstrom"])
+    spec_sizes = exp.sizes
+    depth = (spec_sizes.flat_layers - 1) * float(exp.atoms.info["plane_spacing_angstrom"])
     cell = exp.atoms.cell.array
     period = (
         abs(cell[1, 1]) if spec.geometry == "cylinder" else min(abs(cell[0, 0]), abs(cell[1, 1]))
