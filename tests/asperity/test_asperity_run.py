@@ -94,7 +94,11 @@ def test_records_are_consistent_and_the_comparison_is_filled(experiment):
     assert load == pytest.approx(target_n, rel=0.05)
     assert all(r.converged for r in recs)
     comp = exp.comparisons[0]
-    assert comp["atoms"]["peak_lateral_force_n"] == max(r.lateral_force_n for r in recs)
+    q0 = recs[0].lateral_force_n  # Q is counted from the pressed state
+    assert comp["atoms"]["lateral_force_at_zero_displacement_n"] == q0
+    assert comp["atoms"]["peak_lateral_force_n"] == pytest.approx(
+        max(r.lateral_force_n for r in recs) - q0, rel=1e-12
+    )
     assert comp["fitted_compliance_m_per_n"] > 0
     assert len(comp["model_hertz"]["lateral_force_n"]) == len(recs)
 
