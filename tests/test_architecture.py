@@ -58,7 +58,16 @@ LAYERS: tuple[tuple[str, frozenset[str]], ...] = (
     (
         "physics cores",
         frozenset(
-            {"structures", "potentials", "ispes", "analysis", "contact", "elastic", "training"}
+            {
+                "structures",
+                "potentials",
+                "ispes",
+                "analysis",
+                "contact",
+                "elastic",
+                "training",
+                "asperity",
+            }
         ),
     ),
     ("presentation", frozenset({"plots", "report"})),
@@ -81,6 +90,9 @@ CORE_DEPENDENCIES: dict[str, frozenset[str]] = {
     "contact": frozenset(),
     "elastic": frozenset({"structures", "potentials"}),
     "training": frozenset({"structures", "potentials", "ispes", "analysis", "elastic"}),
+    # the asperity in atoms: built from the structure recipe, run with the model's LAMMPS
+    # setup, compared with the contact models (plain numbers in)
+    "asperity": frozenset({"structures", "potentials", "contact"}),
 }
 
 #: The settings (``config/``, foundation) validate the ``potential:`` and ``structure:`` sections

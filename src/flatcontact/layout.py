@@ -17,6 +17,7 @@ A run directory::
     06-contact/  contact.nc  summary.json  (fit.json)  fig4_traction  fig5_force_stiffness(_rms)
                  (fig6_experiment  fig5c_cycle_loops  fig6_lockin  fig6_fit)
     07-report/   report.html  (refusal.json: a run refused after the scan)
+    08-asperity/ asperity.nc  asperity.json  fig_asperity_*  state/   (only with asperity.enabled)
 
 and every stage folder holds its record ``stage.json`` (:data:`flatcontact.rundir.RECORD_NAME`).
 """
@@ -32,6 +33,9 @@ STAGES = {
     "elastic": 5,
     "contact": 6,
     "report": 7,
+    # optional (asperity.enabled), run before the report; numbered after it so that the
+    # folders of existing runs keep their names
+    "asperity": 8,
 }
 
 
@@ -103,6 +107,16 @@ FIG6_LOCKIN = "fig6_lockin"
 FIG6_FIT = "fig6_fit"
 #: Effective shear strength against contact radius, concurrent and size-limited slip.
 FIG_SLIP_SIZE = "fig_slip_size"
+
+# ---- asperity (``flatcontact asperity --out DIR``; docs/asperity.md)
+ASPERITY_NC = "asperity.nc"
+ASPERITY_JSON = "asperity.json"
+#: The saved relaxed states (resume), one folder per load.
+ASPERITY_STATE = "state"
+FIG_ASPERITY_FORCE = "fig_asperity_force"
+FIG_ASPERITY_STICK = "fig_asperity_stick"
+FIG_ASPERITY_TRACTIONS = "fig_asperity_tractions"
+FIG_ASPERITY_SLIP = "fig_asperity_slip"
 
 # ---- report
 REPORT_HTML = "report.html"

@@ -128,12 +128,12 @@ log = logging.getLogger("flatcontact.run")
 #: it. ``pipeline.py`` itself is in no closure (it orders the stages, it computes nothing).
 STAGE_MODULES: dict[str, str] = {name: f"flatcontact.stages.{name}" for name in STAGES}
 #: The figure modules, left out of the code digest of the expensive stages
-#: (:data:`FIGURES_LEFT_OUT`), so restyling a figure never reruns a build or a scan (the
+#: (:data:`FIGURES_LEFT_OUT`), so restyling a figure never reruns a build, a scan or an asperity (the
 #: figure follows with the next real rerun). The cheap stages (analyze, laws, contact, report)
 #: keep their figures in their digest: editing a figure reruns them and redraws it. The
 #: modules the figures import stay in the closure.
 FIGURE_MODULES = "flatcontact.plots"
-FIGURES_LEFT_OUT = ("build", "scan")
+FIGURES_LEFT_OUT = ("build", "scan", "asperity")
 #: The top-level ``flatcontact/__init__.py`` is in no digest: it computes nothing (the version,
 #: recorded in ``versions.json``, and the lazy map of public names), so growing the public API
 #: never reruns a scan. The sub-packages' ``__init__`` files stay in.
@@ -593,6 +593,8 @@ class Pipeline:
         inputs = {"report": cfg.section("report"), **{k: v.fingerprint for k, v in ups.items()}}
         if cfg.elastic.enabled and (refusal is None or "elastic" in refusal["finished"]):
             inputs["elastic"] = self._upstream("elastic").fingerprint  # the report tables its Cij
+        if cfg.asperity.enabled and refusal is None:  # the report states the asperity's verdict
+            inputs["asperity"] = self._upstream("asperity").fingerprint
         if cfg.report.approximant_study is not None:  # the report tables that study's files
             inputs["approximant_study"] = approximant_study_digest(cfg.report.approximant_study)
         if refusal is not None:
@@ -613,9 +615,38 @@ class Pipeline:
             return target if target.is_file() else result.folder / REPORT_HTML
         return copy_file_atomic(result.folder / REPORT_HTML, target)
 
+    def asperity(self) -> dict | None:
+        """Stage 8 (optional, ``asperity.enabled``): the asperity in atoms against the model
+        (``08-asperity/asperity.json``); its saved states resume an interrupted stage."""
+        from flatcontact.layout import ASPERITY_JSON
+        from flatcontact.stages.asperity import AsperityInputs, run_asperity
+
+        cfg = self.config
+        if not cfg.asperity.enabled:
+            self._tell("off", "asperity", message="asperity.enabled is false")
+            return None
+        laws = self._upstream("laws")
+        inputs = {
+            "asperity": cfg.section("asperity"),
+            "structure": cfg.section("structure"),
+            "model": self._model_inputs(),
+            "laws": laws.fingerprint,
+        }
+        e_star = None
+        if cfg.elastic.enabled:
+            inputs["elastic"] = self._upstream("elastic").fingerprint
+            e_star = float(self._json("elastic", ELASTIC_JSON)["contact_modulus_gpa"])
+        doc = self._json("laws", LAWS_JSON)
+
+        def work(folder: Path) -> None:
+            run_asperity(cfg, AsperityInputs(laws=doc, contact_modulus_gpa=e_star), folder)
+
+        self._run("asperity", inputs, work)
+        return self._json("asperity", ASPERITY_JSON)
+
     def run(self) -> Path:
         """Every stage in order; ``report.html`` (also of a refusal after the scan, named in it)."""
-        for name in ("build", "scan", "analyze", "laws", "elastic", "contact"):
+        for name in ("build", "scan", "analyze", "laws", "elastic", "contact", "asperity"):
             try:
                 getattr(self, name)()
             except InputError as exc:

@@ -16,6 +16,7 @@ from flatcontact.cli import (  # noqa: F401  (imported for their @app.command re
 
 # isort: split
 from flatcontact.cli import (
+    asperity,  # noqa: F401  (the asperity in atoms, after elastic)
     elastic,  # noqa: F401  (listed after validate-potential)
     study,  # noqa: F401  (study convergence|models, last)
     study_dilatancy,  # noqa: F401  (study dilatancy, registers on study's app)

@@ -16,6 +16,7 @@ from pydantic import Field, field_validator, model_validator
 from flatcontact.config import migration
 from flatcontact.config.analysis import AnalysisConfig
 from flatcontact.config.approximants import ApproximantSettings
+from flatcontact.config.asperity import AsperityConfig
 from flatcontact.config.contact import ContactConfig
 from flatcontact.config.elastic import ElasticConfig
 from flatcontact.config.messages import show
@@ -83,6 +84,12 @@ class RunConfig(Section):
     )
     contact: ContactConfig = Field(
         default_factory=ContactConfig, description="modified Mindlin contact (stage contact)"
+    )
+    asperity: AsperityConfig = Field(
+        default_factory=AsperityConfig,
+        # left out of the dump while default, so the fingerprints of existing runs are unchanged
+        exclude_if=lambda value: value == AsperityConfig(),
+        description="the asperity in atoms against the modified Mindlin model (docs/asperity.md)",
     )
     refine: RefineConfig = Field(
         default_factory=RefineConfig,

@@ -28,6 +28,12 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             "hertz_pressure",
             "solve_hertz",
         ],
+        "line_contact": [
+            "PointLaws",
+            "cattaneo_traction",
+            "elastic_response",
+            "pointwise_response",
+        ],
         "measured": ["load_stiffness_csv"],
         "mindlin": ["LateralResponse", "initial_lateral_stiffness", "lateral_force", "peak_force"],
         "oscillation": ["StiffnessCurve", "lateral_stiffness", "stiffness_curve"],

@@ -18,6 +18,7 @@ from flatcontact.errors import InputError
 from flatcontact.fileio import read_json_file
 from flatcontact.layout import (
     ANALYZE_JSON,
+    ASPERITY_JSON,
     BUILD_JSON,
     ELASTIC_JSON,
     FRICTION_CSV,
@@ -33,6 +34,7 @@ from flatcontact.report.sections.approximant_study import (
     approximant_study_section,
     read_approximant_study,
 )
+from flatcontact.report.sections.asperity import asperity_section
 from flatcontact.report.sections.build import interface_material, interface_section
 from flatcontact.report.sections.comparison import own_results_section, paper_section
 from flatcontact.report.sections.contact import contact_section
@@ -135,4 +137,8 @@ def build_sections(
         sections.append(laws_section(laws, f_laws, paper))
     if contact is not None:
         sections.append(contact_section(cfg, contact, _elastic(cfg, folders.get("elastic")), f_ct))
+    f_asp = folders.get("asperity")
+    if cfg.asperity.enabled and f_asp is not None and (f_asp / ASPERITY_JSON).exists():
+        doc = read_json_file(f_asp / ASPERITY_JSON, ASPERITY_JSON, 256 * 1024 * 1024)
+        sections.append(asperity_section(doc, f_asp))
     return sections

@@ -23,6 +23,7 @@ laws       :func:`.laws.run_laws`                 laws.json, fig3_laws
 elastic    :func:`.elastic.run_elastic`           elastic.json
 contact    :func:`.contact.run_contact`           contact.nc, summary.json, fig4, fig5, (fig6)
 report     :func:`.report.run_report`             report.html
+asperity   :func:`.asperity.run_asperity`         asperity.nc, asperity.json, fig_asperity_*, state/
 =========  =====================================  ==========================================
 """
 
@@ -32,6 +33,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
     __name__,
     submod_attrs={
         "analyze": ["AnalyzeInputs", "run_analyze"],
+        "asperity": ["AsperityInputs", "run_asperity"],
         "build": ["BuildInputs", "run_build"],
         "contact": ["ContactInputs", "run_contact"],
         "elastic": ["ElasticInputs", "run_elastic"],

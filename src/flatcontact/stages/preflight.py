@@ -91,12 +91,29 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
     _check_structure(cfg, source)
     check_measured_on(cfg, source)
     check_moduli_source(cfg, structure_elements(cfg.structure))
+    if cfg.asperity.enabled:
+        check_asperity(cfg, source)
     if cfg.elastic.enabled:
         bulk, _ = bulk_crystal(cfg.structure)
         if bulk is None:
             _calculator.check(cfg)
         else:
             _calculator.check_atoms(cfg, bulk)
+
+
+def check_asperity(cfg: RunConfig, source: str = "config") -> None:
+    """The asperity stage drives LAMMPS itself and makes the recipe deeper: it needs a LAMMPS
+    interaction model and a recipe with ``layers`` (one line naming the field)."""
+    if cfg.potential.calculator is not None:
+        raise InputError(
+            f"{source}: asperity.enabled: the asperity relaxes inside LAMMPS and needs a LAMMPS "
+            f"interaction model, not the ASE calculator {cfg.potential.calculator.target!r}"
+        )
+    if not hasattr(cfg.structure, "layers"):
+        raise InputError(
+            f"{source}: asperity.enabled: structure.kind={cfg.structure.kind} has no layers; the "
+            "asperity makes the recipe deeper (fcc111, crystal, slab, sheets, ...)"
+        )
 
 
 def _check_structure_file(cfg: RunConfig, source: str) -> None:

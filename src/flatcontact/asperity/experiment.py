@@ -1,0 +1,227 @@
+"""One asperity experiment: build, press and slide every load, measure, compare.
+
+Plain inputs (the recipe, the model, an :class:`ExperimentSpec`, the laws, E*); the stage
+(:mod:`flatcontact.stages.asperity`) maps the settings onto them and writes the files.
+
+The saved states live in ``state_dir`` (``load_<i>/step_<k>.npz``) with ``spec.json``, the
+spec they were computed with: a rerun with the same spec resumes, one with another spec is
+refused (one line) rather than mixing states.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from flatcontact.asperity import builder
+from flatcontact.asperity.compare import Laws, compare_load
+from flatcontact.asperity.driver import EV_PER_ANGSTROM_N, Protocol, run_load
+from flatcontact.asperity.records import Binning, StepRecord, measure_load
+from flatcontact.errors import InputError
+
+GPA_ANGSTROM2_TO_EV_PER_ANGSTROM = 1e-11 / EV_PER_ANGSTROM_N
+
+
+@dataclass(frozen=True)
+class ExperimentSpec:
+    """What one experiment computes (lengths Å, pressures GPa, forces eV/Å)."""
+
+    geometry: str
+    radius_angstrom: float
+    p0_gpa: tuple[float, ...]
+    contact_modulus_gpa: float
+    step_angstrom: float
+    steps: int
+    fmax_ev_per_angstrom: float
+    max_iterations: int
+    depth_factor: float
+    lateral_factor: float
+    axis_repeats: int
+    rigid_angstrom: float
+    repeats: tuple[int, int] | None
+    layers: int | None
+    gap_angstrom: float | None
+    bin_width_angstrom: float
+    contact_force_ev_per_angstrom: float
+    slip_threshold_angstrom: float
+
+
+@dataclass
+class Experiment:
+    """The built atoms, their sizes, the per-load records and comparisons."""
+
+    atoms: object
+    sizes: builder.Sizes
+    binning: Binning
+    targets_ev_per_angstrom: list[float]
+    records: list[list[StepRecord]]
+    comparisons: list[dict]
+    states: list[list]
+    wall_seconds: float
+    memory_bytes: int
+
+
+def target_force_ev_per_angstrom(spec: ExperimentSpec, p0_gpa: float, axis_angstrom: float):
+    """The Hertz normal force (eV/Å) at peak pressure p0: cylinder P' L = π a p0 L / 2,
+    sphere P = 2π a² p0 / 3 (a from R and E*)."""
+    a = builder.hertz_half_width_angstrom(
+        spec.geometry, spec.radius_angstrom, p0_gpa, spec.contact_modulus_gpa
+    )
+    if spec.geometry == "cylinder":
+        f = math.pi * a * p0_gpa / 2.0 * axis_angstrom
+    else:
+        f = 2.0 * math.pi * a * a * p0_gpa / 3.0
+    return f * GPA_ANGSTROM2_TO_EV_PER_ANGSTROM
+
+
+def _sizes(spec: ExperimentSpec, recipe):
+    """The planned sizes, with the user's overrides."""
+    from flatcontact.structures.construct import build_interface
+
+    small, _ = build_interface(builder.deep_recipe(recipe, 3))
+    spacing = builder.plane_spacing(small)
+    sizes = builder.plan_sizes(
+        spec.geometry,
+        spec.radius_angstrom,
+        max(spec.p0_gpa),
+        spec.contact_modulus_gpa,
+        small.cell.array[:2, :2],
+        spacing,
+        depth_factor=spec.depth_factor,
+        lateral_factor=spec.lateral_factor,
+        axis_repeats=spec.axis_repeats,
+        rigid_angstrom=spec.rigid_angstrom,
+    )
+    if spec.repeats is not None or spec.layers is not None:
+        rigid_planes = sizes.tip_layers - sizes.flat_layers
+        layers = spec.layers or sizes.flat_layers
+        sizes = builder.Sizes(
+            sizes.geometry,
+            sizes.radius_angstrom,
+            sizes.hertz_half_width_angstrom,
+            tuple(spec.repeats) if spec.repeats else sizes.repeats,
+            layers,
+            layers + rigid_planes,
+            sizes.rigid_angstrom,
+        )
+    return sizes
+
+
+def bin_edges(spec: ExperimentSpec, cell: np.ndarray, repeats) -> np.ndarray:
+    """Bin edges (Å) commensurate with the lattice: the cylinder's bins are whole rows of the
+    primitive cell across the axis (width an odd number of a2's y-period, nearest to
+    ``bin_width_angstrom``), centred on the apex and covering the period, so every bin holds
+    the same atoms per plane (no aliasing between atom rows and bins); the sphere's are
+    annuli of ``bin_width_angstrom`` up to half the shorter period."""
+    if spec.geometry == "cylinder":
+        row = abs(cell[1, 1]) / repeats[1]
+        # an odd number of rows per bin: the centre bin is symmetric about the apex and the
+        # edges fall half a row from the apex's rows (fcc(111): the planes' rows lie at
+        # thirds of a row, so no atom sits on an edge)
+        per_bin = max(1, round(spec.bin_width_angstrom / row))
+        per_bin += 1 - per_bin % 2
+        nb = max(0, (repeats[1] // per_bin - 1) // 2)
+        return (np.arange(-nb, nb + 2) - 0.5) * per_bin * row
+    extent = min(abs(cell[0, 0]), abs(cell[1, 1])) / 2
+    nb = max(1, math.floor(extent / spec.bin_width_angstrom))
+    return np.linspace(0, nb, nb + 1) * spec.bin_width_angstrom
+
+
+def _check_state(state_dir: Path, spec: ExperimentSpec) -> None:
+    """Refuse states of other settings; more (or fewer) ``steps`` extend (or reuse) them, as
+    each step's state depends only on the steps before it."""
+    state_dir.mkdir(parents=True, exist_ok=True)
+    path = state_dir / "spec.json"
+    doc = json.loads(json.dumps(asdict(spec)))
+    if path.exists():
+        old = json.loads(path.read_text())
+        if {**old, "steps": None} != {**doc, "steps": None}:
+            raise InputError(
+                f"{state_dir}: holds the states of other asperity settings; give another --out "
+                "or remove it"
+            )
+    path.write_text(json.dumps(doc, indent=1))
+
+
+def plan(spec: ExperimentSpec, recipe, neighbours_per_atom: int):
+    """(atoms, sizes, memory bytes): built and checked against the machine before any run."""
+    sizes = _sizes(spec, recipe)
+    atoms, sizes = builder.build_asperity(
+        recipe,
+        spec.geometry,
+        spec.radius_angstrom,
+        max(spec.p0_gpa),
+        spec.contact_modulus_gpa,
+        sizes=sizes,
+        gap_angstrom=spec.gap_angstrom,
+        neighbours_per_atom=neighbours_per_atom,
+    )
+    need = builder.check_machine(len(atoms), neighbours_per_atom)
+    return atoms, sizes, need
+
+
+def run_experiment(
+    spec: ExperimentSpec,
+    recipe,
+    model,
+    laws: Laws | None,
+    state_dir: Path,
+    *,
+    neighbours_per_atom: int = 100,
+    progress: Callable[[str], None] | None = None,
+) -> Experiment:
+    """Build, run every load (resuming from ``state_dir``), measure and compare."""
+    t0 = time.perf_counter()
+    atoms, sizes, need = plan(spec, recipe, neighbours_per_atom)
+    model.check_atoms(atoms)
+    _check_state(state_dir, spec)
+    cell = atoms.cell.array
+    axis = float(np.linalg.norm(cell[0])) if spec.geometry == "cylinder" else 0.0
+    edges = bin_edges(spec, cell, sizes.repeats)
+    bins = Binning(
+        edges,
+        spec.contact_force_ev_per_angstrom,
+        spec.slip_threshold_angstrom,
+        spec.geometry,
+        axis,
+    )
+    records, comparisons, targets, all_states = [], [], [], []
+    for i, p0 in enumerate(spec.p0_gpa):
+        target = target_force_ev_per_angstrom(spec, p0, axis)
+        targets.append(target)
+        protocol = Protocol(
+            target, spec.step_angstrom, spec.steps, spec.fmax_ev_per_angstrom, spec.max_iterations
+        )
+
+        def tell(done, total, seconds, i=i, p0=p0):
+            if progress is not None:
+                progress(
+                    f"load {i + 1}/{len(spec.p0_gpa)} (p0 {p0:g} GPa): step {done}/{total} "
+                    f"in {seconds:.1f} s"
+                )
+
+        states = run_load(model, atoms, protocol, state_dir / f"load_{i}", progress=tell)
+        all_states.append(states)
+        recs = measure_load(atoms, states, bins)
+        records.append(recs)
+        if laws is not None:
+            comparisons.append(
+                compare_load(recs, bins, laws, spec.radius_angstrom, spec.contact_modulus_gpa)
+            )
+    return Experiment(
+        atoms,
+        sizes,
+        bins,
+        targets,
+        records,
+        comparisons,
+        all_states,
+        time.perf_counter() - t0,
+        need,
+    )

@@ -1,0 +1,74 @@
+"""``flatcontact asperity CONFIG --out DIR``: the asperity in atoms against the modified Mindlin
+model of the interface's laws (:func:`flatcontact.stages.asperity.run_asperity`)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import typer
+
+from flatcontact.cli.app import app, check_out_dir, console
+from flatcontact.errors import InputError
+
+
+@app.command("asperity")
+def asperity_cmd(
+    config: Path = typer.Argument(..., help="A run configuration with an asperity: section."),
+    out: Path = typer.Option(..., "--out", help="Folder of asperity.nc/.json, figures, state/."),
+    run_dir: Path | None = typer.Option(
+        None,
+        "--run",
+        help="A finished run directory of CONFIG: its laws (04-laws/laws.json) and E* "
+        "(05-elastic/elastic.json).",
+    ),
+    laws: Path | None = typer.Option(None, "--laws", help="A laws.json (overrides --run's)."),
+    json_out: bool = typer.Option(False, "--json", help="Print asperity.json."),
+) -> None:
+    """Press a tip of slab 2's crystal on a flat of slab 1's, slide it quasi-statically in
+    LAMMPS, and compare Q_peak, c/a, Q(u) and q/p with the model (docs/asperity.md).
+
+    Rerunning into the same --out resumes from the last relaxed step.
+    """
+    from flatcontact.cli.settings import resolve_config
+    from flatcontact.layout import ELASTIC_JSON, LAWS_JSON, STAGES
+    from flatcontact.stages.asperity import AsperityInputs, run_asperity
+
+    settings = resolve_config(config, None, {"asperity": {"enabled": True}}, {})
+    out = check_out_dir(out)
+    laws_doc, e_star = None, None
+    if run_dir is not None:
+        laws_path = run_dir / f"{STAGES['laws']:02d}-laws" / LAWS_JSON
+        elastic_path = run_dir / f"{STAGES['elastic']:02d}-elastic" / ELASTIC_JSON
+        if not laws_path.is_file():
+            raise InputError(f"--run: {laws_path} is not a file (run the laws stage first)")
+        laws_doc = json.loads(laws_path.read_text())
+        if elastic_path.is_file():
+            e_star = float(json.loads(elastic_path.read_text())["contact_modulus_gpa"])
+    if laws is not None:
+        if not laws.is_file():
+            raise InputError(f"--laws: {laws} is not a file")
+        laws_doc = json.loads(laws.read_text())
+    result = run_asperity(
+        settings,
+        AsperityInputs(laws=laws_doc, contact_modulus_gpa=e_star),
+        out,
+        progress=lambda line: console.print(line),
+    )
+    doc = result.to_json()
+    if json_out:
+        print(json.dumps(doc, indent=1))
+        return
+    console.print(
+        f"{doc['geometry']} R = {doc['radius_angstrom']:g} Å, {doc['n_atoms']:,} atoms, "
+        f"{doc['wall_seconds']:.0f} s"
+    )
+    for row in doc["peak_shear_stress_mpa"]:
+        console.print(
+            f"  p0 {row['target_p0_gpa']:g} GPa: Q_peak/area atoms {row['atoms']:.1f} MPa, "
+            f"model (Hertz) {row['model_hertz']:.1f}, model (measured p) "
+            f"{row['model_measured_pressure']:.1f}"
+        )
+    console.print(doc["verdict"])
+    for w in doc["warnings"]:
+        console.print(f"warning: {w}")

@@ -1,0 +1,237 @@
+"""Stage asperity (optional, ``asperity.enabled``): the asperity in atoms against the model.
+
+Files: ``asperity.nc`` (per load and step: Q, normal force, contact and stick half-widths,
+binned pressure, shear and slip; :func:`flatcontact.asperity.records.dataset`),
+``asperity.json`` (:meth:`AsperityResult.to_json`: sizes, atom count, memory, wall time,
+finite-size ratios, per load the atoms and the two continuum predictions side by side with
+their ratios, and one verdict sentence), the figures, and ``state/`` (the saved relaxed
+states: rerunning the same settings into the same folder resumes).
+
+E*: ``asperity.contact_modulus_gpa``, else the elastic stage's (``inputs``), else
+``contact.contact_modulus_gpa``. Laws: ``inputs.laws`` (the run's laws stage), else
+``asperity.laws_file``; without laws only the atoms are reported.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from flatcontact.errors import InputError
+from flatcontact.fileio import write_json_atomic
+from flatcontact.layout import (
+    ASPERITY_JSON,
+    ASPERITY_NC,
+    ASPERITY_STATE,
+    FIG_ASPERITY_FORCE,
+    FIG_ASPERITY_SLIP,
+    FIG_ASPERITY_STICK,
+    FIG_ASPERITY_TRACTIONS,
+)
+from flatcontact.stages import _calculator
+from flatcontact.stages._common import renamed_errors, save
+
+#: Q_peak of the atoms within this fraction of the model's: "the contact stage's numbers hold".
+AGREEMENT_FRACTION = 0.25
+
+_NAMES = {
+    "geometry": "asperity.geometry",
+    "radius_angstrom": "asperity.radius_angstrom",
+    "p0_gpa": "asperity.p0_gpa",
+    "contact_modulus_gpa": "asperity.contact_modulus_gpa",
+    "rigid_angstrom": "asperity.rigid_angstrom",
+    "structure": "structure",
+}
+
+
+@dataclass(frozen=True)
+class AsperityInputs:
+    """The laws (laws.json's document) and E* (GPa) from upstream, when the run has them."""
+
+    laws: dict | None = None
+    contact_modulus_gpa: float | None = None
+
+
+@dataclass
+class AsperityResult:
+    """asperity.json's document."""
+
+    doc: dict
+    files: list[Path] = field(default_factory=list)
+
+    def to_json(self) -> dict:
+        return self.doc
+
+
+def _spec(settings, inputs: AsperityInputs):
+    from flatcontact.asperity.experiment import ExperimentSpec
+
+    a = settings.asperity
+    e_star = a.contact_modulus_gpa or inputs.contact_modulus_gpa
+    e_star = e_star or settings.contact.contact_modulus_gpa
+    return ExperimentSpec(
+        a.geometry,
+        a.radius_angstrom,
+        tuple(a.p0_gpa),
+        float(e_star),
+        a.step_angstrom,
+        a.steps,
+        a.fmax_ev_per_angstrom,
+        a.max_iterations,
+        a.depth_factor,
+        a.lateral_factor,
+        a.axis_repeats,
+        a.rigid_angstrom,
+        tuple(a.repeats) if a.repeats else None,
+        a.layers,
+        a.gap_angstrom,
+        a.bin_width_angstrom,
+        a.contact_force_ev_per_angstrom,
+        a.slip_threshold_angstrom,
+    )
+
+
+def _laws(settings, inputs: AsperityInputs):
+    from flatcontact.asperity.compare import Laws
+
+    doc = inputs.laws
+    if doc is None and settings.asperity.laws_file:
+        path = Path(settings.asperity.laws_file)
+        if not path.is_file():
+            raise InputError(f"asperity.laws_file: {path} is not a file")
+        doc = json.loads(path.read_text())
+    if doc is None:
+        return None
+    try:
+        return Laws.from_json(doc)
+    except (KeyError, TypeError, ValueError):
+        raise InputError(
+            "asperity.laws_file: expected laws.json with k_mpa_per_gpa, tau0_mpa, "
+            "mu_mpa_per_gpa, sigma0_mpa"
+        ) from None
+
+
+def _compute_seconds(states) -> float | None:
+    """The steps' wall time when computed; None when a state predates the record."""
+    seconds = [s.seconds for recs in states for s in recs]
+    return None if any(x != x for x in seconds) else float(sum(seconds))
+
+
+def verdict(geometry: str, radius_angstrom: float, loads: list[dict]) -> str:
+    """One sentence: whether the contact stage's Q_peak holds for this interface and size."""
+    if not loads:
+        return "no laws were given: the atoms are reported without a continuum comparison."
+    ratios = [ld["ratios_atoms_over_model"]["peak_lateral_force_hertz"] for ld in loads]
+    lo, hi = min(ratios), max(ratios)
+    holds = all(abs(r - 1.0) <= AGREEMENT_FRACTION for r in ratios)
+    size = f"a {geometry} of R = {radius_angstrom / 10:g} nm"
+    span = f"{lo:.2f}" if math.isclose(lo, hi, rel_tol=1e-3) else f"{lo:.2f} to {hi:.2f}"
+    if holds:
+        return (
+            f"For {size}, the contact stage's model (Hertz pressure, pointwise laws) holds: the "
+            f"atoms' Q_peak is {span} times the model's (within {AGREEMENT_FRACTION:.0%})."
+        )
+    return (
+        f"For {size}, the contact stage's model (Hertz pressure, pointwise laws) does not hold: "
+        f"the atoms' Q_peak is {span} times the model's (more than {AGREEMENT_FRACTION:.0%} off)."
+    )
+
+
+def run_asperity(
+    settings, inputs: AsperityInputs, folder: Path | None, progress=None
+) -> AsperityResult:
+    """Build, press, slide, measure and compare (:mod:`flatcontact.asperity.experiment`).
+
+    ``folder`` None computes into a temporary state folder (nothing kept).
+    """
+    import tempfile
+
+    from flatcontact.asperity.experiment import run_experiment
+    from flatcontact.asperity.records import dataset
+
+    with renamed_errors(_NAMES):
+        spec = _spec(settings, inputs)
+        laws = _laws(settings, inputs)
+        model = _calculator.model(settings)
+        with tempfile.TemporaryDirectory() as tmp:
+            state = (folder or Path(tmp)) / ASPERITY_STATE
+            exp = run_experiment(spec, settings.structure, model, laws, state, progress=progress)
+    spec_sizes = exp.sizes
+    depth = (spec_sizes.flat_layers - 1) * float(exp.atoms.info["plane_spacing_angstrom"])
+    cell = exp.atoms.cell.array
+    period = (
+        abs(cell[1, 1]) if spec.geometry == "cylinder" else min(abs(cell[0, 0]), abs(cell[1, 1]))
+    )
+    loads = []
+    for i, comp in enumerate(exp.comparisons):
+        loads.append({"target_p0_gpa": spec.p0_gpa[i], **comp})
+    unconverged = [
+        f"load {i}, step {k}: the relaxation stopped at max_iterations"
+        for i, recs in enumerate(exp.records)
+        for k, r in enumerate(recs)
+        if not r.converged
+    ]
+    unconverged += [
+        f"load {i}: Q still rises at the last step; Q_peak is a lower bound (more steps)"
+        for i, comp in enumerate(exp.comparisons)
+        if not comp["atoms"]["peak_reached"]
+    ]
+    doc = {
+        "geometry": spec.geometry,
+        "radius_angstrom": spec.radius_angstrom,
+        "contact_modulus_gpa": spec.contact_modulus_gpa,
+        "potential": _calculator.label(settings),
+        "sizes": spec_sizes.to_json(),
+        "n_atoms": len(exp.atoms),
+        "memory_estimate_bytes": exp.memory_bytes,
+        "wall_seconds": exp.wall_seconds,
+        # the steps' own wall time when they were computed (a resumed run reads them)
+        "compute_seconds": _compute_seconds(exp.states),
+        "finite_size": {
+            "a_over_depth": spec_sizes.hertz_half_width_angstrom / depth,
+            "contact_width_over_period": 2 * spec_sizes.hertz_half_width_angstrom / period,
+            "note": "Hertz holds for both -> 0; at 0.25 expect errors of a few per cent in a",
+        },
+        "laws": None if laws is None else laws.__dict__,
+        "peak_shear_stress_mpa": [
+            {
+                "target_p0_gpa": ld["target_p0_gpa"],
+                "atoms": ld["atoms"]["peak_shear_stress_mpa"],
+                "model_hertz": ld["model_hertz"]["peak_shear_stress_mpa"],
+                "model_measured_pressure": ld["model_measured_pressure"]["peak_shear_stress_mpa"],
+            }
+            for ld in loads
+        ],
+        "loads": loads,
+        "verdict": verdict(spec.geometry, spec.radius_angstrom, loads),
+        "warnings": unconverged,
+    }
+    result = AsperityResult(doc)
+    if folder is not None:
+        ds = dataset(
+            spec.p0_gpa,
+            exp.records,
+            exp.binning,
+            {"geometry": spec.geometry, "radius_angstrom": spec.radius_angstrom},
+        )
+        from flatcontact.fileio import atomic_path
+
+        with atomic_path(folder / ASPERITY_NC) as tmp_nc:
+            ds.to_netcdf(tmp_nc, engine="h5netcdf")
+        result.files.append(folder / ASPERITY_NC)
+        result.files.append(write_json_atomic(folder / ASPERITY_JSON, doc))
+        result.files += _figures(doc, ds, folder, settings.report.svg)
+    return result
+
+
+def _figures(doc: dict, ds, folder: Path, svg: bool) -> list[Path]:
+    from flatcontact.plots import asperity as plots
+
+    files = save(plots.fig_slip_map(ds), folder, FIG_ASPERITY_SLIP, svg)
+    if doc["loads"]:
+        files += save(plots.fig_force_displacement(doc["loads"]), folder, FIG_ASPERITY_FORCE, svg)
+        files += save(plots.fig_stick_ratio(doc["loads"]), folder, FIG_ASPERITY_STICK, svg)
+        files += save(plots.fig_tractions(doc["loads"][-1]), folder, FIG_ASPERITY_TRACTIONS, svg)
+    return files
