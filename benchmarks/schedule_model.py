@@ -49,6 +49,8 @@ WORKERS = (1, 2, 4, 8, 16)
 def record_scan(path: Path) -> dict:
     """Run the paper preset's scan serially, recording every relaxation; write ``path``."""
     import flatcontact.ispes.scan as scan_mod
+    import flatcontact.ispes.scan_probe as probe_mod
+    import flatcontact.ispes.scan_scheduler as scheduler_mod
     from flatcontact.config import load_config
     from flatcontact.ispes.executors import SerialExecutor
     from flatcontact.ispes.geometry import thickness
@@ -144,7 +146,7 @@ def record_scan(path: Path) -> dict:
         rec["store_s"].append(time.process_time() - t0)
         return out
 
-    orig_adhesion = scan_mod.adhesion_record
+    orig_adhesion = probe_mod.adhesion_record
 
     def adhesion_record(*args, **kwargs):
         t0 = time.process_time()
@@ -152,8 +154,8 @@ def record_scan(path: Path) -> dict:
         rec["adhesion_record_s"] = time.process_time() - t0
         return out
 
-    scan_mod.adhesion_record = adhesion_record
-    orig_extend = scan_mod._extend
+    probe_mod.adhesion_record = adhesion_record
+    orig_extend = scan_mod.extend_grid
 
     def extend(*args, **kwargs):
         added = orig_extend(*args, **kwargs)
@@ -161,8 +163,8 @@ def record_scan(path: Path) -> dict:
             rec.setdefault("round_starts", []).append(len(rec["grid_points"]))
         return added
 
-    scan_mod._extend = extend
-    orig_work = scan_mod.ideal_work_of_separation
+    scan_mod.extend_grid = extend
+    orig_work = probe_mod.ideal_work_of_separation
 
     def ideal_work(*args, **kwargs):
         t0 = time.process_time()
@@ -170,10 +172,10 @@ def record_scan(path: Path) -> dict:
         rec["work_s"] = time.process_time() - t0
         return out
 
-    scan_mod.ideal_work_of_separation = ideal_work
-    scan_mod.rigid_stackings = timed("rigid", scan_mod.rigid_stackings)
-    scan_mod.relax_column_point = timed("column", scan_mod.relax_column_point)
-    scan_mod.run_task = timed("task", relax_mod.run_task)
+    probe_mod.ideal_work_of_separation = ideal_work
+    probe_mod.rigid_rows = timed("rigid", probe_mod.rigid_rows)
+    probe_mod.relax_column_point = timed("column", probe_mod.relax_column_point)
+    scheduler_mod.run_task = timed("task", relax_mod.run_task)
     wos.relax_point = wos_relax_point
     store_mod.PointStore.write = write
     with tempfile.TemporaryDirectory() as tmp:
@@ -204,7 +206,7 @@ def probe_chains(rec: dict, split: bool) -> list[list[float]]:
     One chain per column (``split`` False: the schedule before issue 22's change), or two per
     column (:func:`flatcontact.ispes.probe.compress_chain`: the reference thickness, cold,
     and the points below it; :func:`~flatcontact.ispes.probe.stretch_chain`: the points above
-    it, from their own cold start), the stretchings first, as ``scan._probe`` submits them.
+    it, from their own cold start), the stretchings first, as ``scan_probe.probe`` submits them.
     """
     columns: dict = {}
     for p in rec["probe"]:
@@ -266,7 +268,7 @@ def grid_makespan(rec: dict, workers: int, start: float = 0.0, busy=()) -> float
     """The grid on its measured warm-start tree (:func:`simulate_tree`), from ``start``, with
     ``busy`` the times at which workers still running other chains become free.
 
-    A thickness the grid's bracket check added after the scan (``scan._extend``) is a round
+    A thickness the grid's bracket check added after the scan (``scan_extend.extend_grid``) is a round
     of its own: its points start once every point before is stored (``round_starts``, the
     positions in the record where a round begins); a parent in an earlier round is stored.
     """
@@ -442,8 +444,11 @@ def report(rec: dict) -> str:
 def add_probe_loads(rec: dict) -> dict:
     """A record written without the probe's loads: the probe alone again (serial, the same
     relaxations: deterministic), its loads added point by point (matched by shift and z)."""
-    import flatcontact.ispes.scan as scan_mod
+    import functools
+
+    import flatcontact.ispes.scan_probe as probe_mod
     from flatcontact.config import load_config
+    from flatcontact.ispes.probe import rigid_stackings
     from flatcontact.stages import _calculator
     from flatcontact.stages.build import BuildInputs, run_build
     from flatcontact.stages.scan import grid_spec, relax_settings
@@ -451,24 +456,24 @@ def add_probe_loads(rec: dict) -> dict:
     settings = load_config(preset_name="paper")
     reference = run_build(settings, BuildInputs(), None).atoms
     loads = {}
-    original = scan_mod.relax_column_point
+    original = probe_mod.relax_column_point
 
     def relax_column_point(*args):
         out = original(*args)
         loads[(args[3], args[4], args[5])] = out[1]
         return out
 
-    scan_mod.relax_column_point = relax_column_point
+    probe_mod.relax_column_point = relax_column_point
     try:
-        probe = scan_mod.probe_thicknesses
+        probe = probe_mod.probe_thicknesses
         grid = grid_spec(settings.scan)
-        calc = scan_mod.worker_calculator(_calculator.factory(settings), reference)
-        relax_one = scan_mod.functools.partial(
+        calc = probe_mod.worker_calculator(_calculator.factory(settings), reference)
+        relax_one = functools.partial(
             relax_column_point, reference, calc, relax_settings(settings.scan)
         )
-        probe(relax_one, reference, scan_mod.rigid_stackings(reference, calc, grid), grid)
+        probe(relax_one, reference, rigid_stackings(reference, calc, grid), grid)
     finally:
-        scan_mod.relax_column_point = original
+        probe_mod.relax_column_point = original
     for p in rec["probe"]:
         p["p"] = loads[(p["shift"][0], p["shift"][1], p["z"])]
     return rec

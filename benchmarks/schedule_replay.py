@@ -94,6 +94,7 @@ class VirtualExecutor:
     """
 
     name = "virtual"
+    inline = False
 
     def __init__(
         self,
@@ -149,6 +150,13 @@ class VirtualExecutor:
         first = min(handles, key=lambda h: (h.end, h.seq))
         self.clock = max(self.clock, first.end)
         return {first}, handles - {first}
+
+    @staticmethod
+    def done(handle: Handle) -> bool:
+        return handle.done()
+
+    def prestart(self, factory: Any, reference: Any) -> None:
+        """No workers to start: tasks run at submission (or come from the cache)."""
 
     def result(self, handle: Handle) -> Any:
         self._tick()

@@ -47,6 +47,7 @@ LAYERS: tuple[tuple[str, frozenset[str]], ...] = (
                 "errors",
                 "limits",
                 "fileio",
+                "result_json",
                 "rundir",
                 "codegraph",
                 "layout",
@@ -64,8 +65,8 @@ LAYERS: tuple[tuple[str, frozenset[str]], ...] = (
     ("stages", frozenset({"stages"})),
     # runs of the stages: one run (pipeline) and studies over many runs (studies import the
     # pipeline; the CLI, above, imports both)
-    ("runs", frozenset({"pipeline", "studies"})),
-    ("front doors", frozenset({"cli", "__main__"})),
+    ("runs", frozenset({"pipeline", "refused", "studies"})),
+    ("front doors", frozenset({"cli", "__main__", "notebook"})),
 )
 
 #: Which other cores each physics core may import: a core package, or one module of it
@@ -440,3 +441,18 @@ def test_checker_exempts_the_public_api_facade(tiny_package):
         },
     )
     assert _keys(tiny_package) == set()
+
+
+def test_the_pipeline_reaches_presentation_only_through_the_stages():
+    """``pipeline.py`` orders stages and fingerprints their inputs; figures and report
+    sections are the stages' business (``stages/report.py`` owns what the report reads,
+    including the approximant study's digest), so the pipeline imports nothing from
+    ``report/`` or ``plots/``."""
+    graph = import_graph(SOURCE_ROOT)
+    found = [
+        f"{e.source}:{e.line} imports {e.target}"
+        for e in graph.edges
+        if e.source == f"{PACKAGE}.pipeline"
+        and (_within(e.target, "report", PACKAGE) or _within(e.target, "plots", PACKAGE))
+    ]
+    assert not found, "\n".join(found)

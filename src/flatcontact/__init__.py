@@ -9,6 +9,9 @@ The pipeline::
 
 The public API, one name per job, for a notebook or a script::
 
+    from flatcontact import make_interface, scan_interface, analyze_ispes, contact_from_laws
+    ispes = scan_interface(interface, calculator, grid=(6, 6), p_range_gpa=(-1, 3, 6))
+
     from flatcontact import load_config, Pipeline
 
     cfg = load_config("my-interface.yaml")      # or load_config(preset_name="quick")
@@ -56,6 +59,7 @@ _EXPORTS: dict[str, list[str]] = {
         "steady_cycle",
     ],
     "elastic": ["elastic_tensor", "isotropic_moduli"],
+    "notebook": ["contact_from_laws", "scan_interface"],
 }
 
 __getattr__, _lazy_dir, _lazy_all = lazy_loader.attach(
@@ -66,6 +70,7 @@ __getattr__, _lazy_dir, _lazy_all = lazy_loader.attach(
         "contact",
         "elastic",
         "ispes",
+        "notebook",
         "pipeline",
         "plots",
         "potentials",

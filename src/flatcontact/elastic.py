@@ -32,12 +32,12 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 from ase import Atoms
-from ase.filters import FrechetCellFilter
 from ase.optimize import BFGS
 
 from flatcontact.errors import require
 from flatcontact.potentials.engines import bulk_calculator
 from flatcontact.potentials.model import InteractionModel
+from flatcontact.structures.lattice import relax_cell  # the build's lattice relaxation
 from flatcontact.units import EV_PER_A3_TO_GPA
 
 _VOIGT_PAIRS = ((0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1))
@@ -58,14 +58,6 @@ def deformed(atoms: Atoms, voigt_strain: np.ndarray) -> Atoms:
         np.asarray(atoms.cell) @ (np.eye(3) + strain_matrix(voigt_strain)), scale_atoms=True
     )
     return out
-
-
-def relax_cell(atoms: Atoms, calc, fmax: float = 1e-4, steps: int = 1000) -> Atoms:
-    """Zero-stress cell and ions (BFGS on ASE's Frechet cell filter); returns a relaxed copy."""
-    a = atoms.copy()
-    a.calc = calc
-    BFGS(FrechetCellFilter(a), logfile=None).run(fmax=fmax, steps=steps)
-    return a
 
 
 def _stress(atoms: Atoms, calc, relax_ions: bool, fmax: float, steps: int) -> np.ndarray:

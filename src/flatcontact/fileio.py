@@ -187,6 +187,8 @@ def file_sha256(path: str | os.PathLike[str]) -> str:
     stage records keep the digest of each output, recipes record their source files.
     """
     digest = hashlib.sha256()
+    if not stat.S_ISREG(os.stat(path).st_mode):  # a FIFO would block, a device never end
+        raise InputError(f"{quoted(path)}: is not a regular file; expected a file to hash")
     with open(path, "rb") as handle:
         for block in iter(lambda: handle.read(1 << 20), b""):
             digest.update(block)
@@ -247,23 +249,78 @@ def read_text_file(path: str | Path, what: str, max_bytes: int) -> str:
         ``max_bytes`` or not UTF-8 text.
     """
     path = Path(path)
-    check_path_length(path, str(path) if len(os.fsencode(path)) <= 200 else what)
-    if not path.exists():
-        raise InputError(f"{path}: no such {what}")
-    if path.is_dir():
-        raise InputError(f"{path}: is a directory, expected a {what}")
+    check_path_length(path, quoted(path) if len(os.fsencode(path)) <= 200 else what)
+    refuse_special(path, what)  # a FIFO would block here, a device never end
     try:
         with path.open("rb") as handle:
             raw = handle.read(max_bytes + 1)
     except OSError as exc:
         reason = exc.strerror or type(exc).__name__
-        raise InputError(f"{path}: cannot read the {what} ({reason})") from None
+        raise InputError(f"{quoted(path)}: cannot read the {what} ({reason})") from None
     if len(raw) > max_bytes:
-        raise InputError(f"{path}: larger than {max_bytes} bytes, expected a {what}")
+        raise InputError(f"{quoted(path)}: larger than {max_bytes} bytes, expected a {what}")
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise InputError(
-            f"{path}: not UTF-8 text (byte 0x{raw[exc.start]:02x} at offset {exc.start}); "
+            f"{quoted(path)}: not UTF-8 text (byte 0x{raw[exc.start]:02x} at offset {exc.start}); "
             f"expected a {what} saved as UTF-8"
         ) from None
+
+
+def refuse_special(path: str | os.PathLike[str], what: str) -> Path:
+    """Refuse ``path`` unless it is a regular file, before it is opened (a FIFO would block the
+    reader, a device would be read without end); a link to a regular file is followed (the
+    user may keep their files anywhere). Returns ``path``.
+
+    Raises
+    ------
+    InputError
+        One line naming the path and ``what`` was expected: missing, a directory, or a FIFO,
+        socket or device.
+    """
+    path = Path(path)
+    try:
+        mode = path.stat().st_mode
+    except FileNotFoundError:
+        raise InputError(f"{quoted(path)}: no such {what}") from None
+    except OSError as exc:
+        raise InputError(
+            f"{quoted(path)}: cannot read the {what} ({exc.strerror or type(exc).__name__})"
+        ) from None
+    if stat.S_ISDIR(mode):
+        raise InputError(f"{quoted(path)}: is a directory, expected a {what}")
+    if not stat.S_ISREG(mode):
+        raise InputError(
+            f"{quoted(path)}: is not a regular file (a FIFO, socket or device), expected a {what}"
+        )
+    return path
+
+
+def read_json_file(path: str | os.PathLike[str], what: str, max_bytes: int) -> Any:
+    """The parsed JSON of a small file, every failure one :class:`InputError` line naming it.
+
+    The file must be a regular file (:func:`refuse_special`, checked before it is opened), at
+    most ``max_bytes``, UTF-8 and one complete JSON document (a truncated write, a foreign
+    file: refused, never a ``JSONDecodeError`` traceback). What the document must hold is its
+    reader's business (:mod:`flatcontact.result_json`).
+    """
+    text = read_text_file(refuse_special(path, what), what, max_bytes)
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise InputError(
+            f"{quoted(path)}: not a complete JSON document ({exc.msg}: line {exc.lineno}, "
+            f"column {exc.colno}); expected a {what}"
+        ) from None
+    except RecursionError:
+        raise InputError(f"{quoted(path)}: nested too deeply, expected a {what}") from None
+
+
+def quoted(path: str | os.PathLike[str]) -> str:
+    """``path`` as text for a one-line message: as it is, or ``repr``-quoted when it holds a
+    newline or another control character (which would split or garble the line)."""
+    text = os.fsdecode(path)
+    if any(ord(c) < 0x20 or ord(c) == 0x7F for c in text):
+        return repr(text)
+    return text

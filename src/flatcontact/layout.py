@@ -10,13 +10,13 @@ A run directory::
 
     run.json  config.yaml  versions.json  run.log  report.html
     01-build/    interface.extxyz  build.json  fig1_interface.{png,svg}
-    02-scan/     points.db  ispes.nc  scan.json  fig_scan_columns.{png,svg}
+    02-scan/     points.db  (rerelax.db)  ispes.nc  scan.json  fig_scan_columns.{png,svg}
     03-analyze/  friction.csv  friction.nc  analyze.json  fig2_p<P>gpa.{png,svg}
     04-laws/     laws.json  fig3_laws.{png,svg}
     05-elastic/  elastic.json                       (only with elastic.enabled)
     06-contact/  contact.nc  summary.json  (fit.json)  fig4_traction  fig5_force_stiffness(_rms)
                  (fig6_experiment  fig5c_cycle_loops  fig6_lockin  fig6_fit)
-    07-report/   report.html
+    07-report/   report.html  (refusal.json: a run refused after the scan)
 
 and every stage folder holds its record ``stage.json`` (:data:`flatcontact.rundir.RECORD_NAME`).
 """
@@ -61,6 +61,8 @@ BUILD_FIGURE = "fig1_interface"
 POINTS_DB = "points.db"
 #: The probe's finished units (:mod:`flatcontact.ispes.probe_units`), beside the store.
 PROBE_JSON = "probe.json"
+#: The points of folding columns relaxed again at a tighter fmax (:mod:`flatcontact.ispes.rerelax`).
+RERELAX_DB = "rerelax.db"
 #: The ISPES contract (:mod:`flatcontact.ispes.contract`).
 ISPES_NC = "ispes.nc"
 SCAN_JSON = "scan.json"
@@ -99,9 +101,14 @@ FIG6_EXPERIMENT = "fig6_experiment"
 FIG5C_CYCLE_LOOPS = "fig5c_cycle_loops"
 FIG6_LOCKIN = "fig6_lockin"
 FIG6_FIT = "fig6_fit"
+#: Effective shear strength against contact radius, concurrent and size-limited slip.
+FIG_SLIP_SIZE = "fig_slip_size"
 
 # ---- report
 REPORT_HTML = "report.html"
+#: A refused run's refusal: the stage, its message, the gates' points, the remedies
+#: (:mod:`flatcontact.report.sections.refusal`).
+REFUSAL_JSON = "refusal.json"
 
 
 # ---- studies (``flatcontact study ... --out DIR``)

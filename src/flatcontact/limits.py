@@ -21,6 +21,9 @@ bound                  default  why
                                 extended XYZ with a dozen per-atom columns is ~20 MB
 ``workers``            4×cores  local worker processes (more only share the same cores)
 ``loads``              1000     pressures per list (``analysis.p_gpa``, ``contact.p0_gpa``)
+``search_seconds``     120      seconds a structure search (coincidence lattices, twists,
+                                approximants) may take before it stops and says which
+                                setting to change (:class:`Deadline`)
 =====================  =======  ==========================================================
 
 Raise one with ``FLATCONTACT_MAX_<NAME>`` (e.g. ``FLATCONTACT_MAX_SCAN_POINTS=1000000``) in
@@ -30,6 +33,7 @@ the environment of the command; it is read every time a bound is checked.
 from __future__ import annotations
 
 import os
+import time
 
 from flatcontact.errors import InputError
 
@@ -43,6 +47,7 @@ DEFAULTS: dict[str, int] = {
     "structure_mb": 200,
     "workers_per_core": 4,
     "loads": 1000,
+    "search_seconds": 120,
 }
 
 
@@ -109,3 +114,35 @@ def message(name: str, value: float, what: str = "") -> str:
     except InputError as exc:
         return str(exc).removeprefix(": ")
     return ""
+
+
+class SearchTimeout(InputError):
+    """A search stopped by its :class:`Deadline` (not "nothing found": a caller that turns
+    "nothing found" into another message lets this one through)."""
+
+
+class Deadline:
+    """The time bound of one search (``search_seconds``, read when the search starts).
+
+    Parameters
+    ----------
+    what
+        The search and the settings it runs on, first in the message
+        (``"structure.slab2: the coincidence search (max_atoms 400, strain 3 %)"``).
+    advice
+        Which setting to change for a search that ends sooner (``"lower
+        structure.match.max_atoms or raise structure.match.max_strain_percent"``).
+    """
+
+    def __init__(self, what: str, advice: str):
+        self.what, self.advice = what, advice
+        self.seconds = bound("search_seconds")
+        self._end = time.monotonic() + self.seconds
+
+    def check(self) -> None:
+        """Raise the one-line :class:`InputError` once the bound has passed."""
+        if time.monotonic() > self._end:
+            raise SearchTimeout(
+                f"{self.what}: no answer within {self.seconds} s; {self.advice}, or set "
+                f"{env_name('search_seconds')}={4 * self.seconds} to search longer"
+            )

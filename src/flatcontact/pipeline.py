@@ -60,8 +60,9 @@ from flatcontact.fileio import (
     write_json_atomic,
     write_text_atomic,
 )
-from flatcontact.ispes.contract import open_ispes
+from flatcontact.ispes.contract import check_grid, open_ispes
 from flatcontact.layout import (
+    BUILD_JSON,
     CONFIG_YAML,
     CONTACT_NC,
     ELASTIC_JSON,
@@ -79,7 +80,8 @@ from flatcontact.layout import (
     SUMMARY_JSON,
     VERSIONS_JSON,
 )
-from flatcontact.report.sections.approximant_study import approximant_study_digest
+from flatcontact.refused import refused_report
+from flatcontact.result_json import read_result_json
 from flatcontact.rundir import (
     RunDirectory,
     RunLock,
@@ -88,10 +90,11 @@ from flatcontact.rundir import (
     portable,
     writable,
 )
-from flatcontact.stages import _calculator
+from flatcontact.stages import _calculator, contact_range
 from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
 from flatcontact.stages.build import BuildInputs, run_build
 from flatcontact.stages.contact import (
+    QUARTZ_QUICK_LAWS_FILE,
     ContactInputs,
     check_contact,
     contact_parameters,
@@ -101,7 +104,7 @@ from flatcontact.stages.elastic import ElasticInputs, run_elastic
 from flatcontact.stages.gates import GateInputs, check_gates, evaluate_gates
 from flatcontact.stages.laws import LawsInputs, run_laws
 from flatcontact.stages.preflight import check_inputs
-from flatcontact.stages.report import ReportInputs, run_report
+from flatcontact.stages.report import ReportInputs, approximant_study_digest, run_report
 from flatcontact.stages.result_files import CONTACT, FRICTION, open_result
 from flatcontact.stages.scan import ScanInputs, run_scan
 from flatcontact.structures.interface_io import read_interface
@@ -219,6 +222,7 @@ class Pipeline:
         self._check_root()
         self._check_config()
         self.results: dict[str, StageResult] = {}
+        self._refusal: InputError | None = None  # the last stage's own refusal (run())
         self._handler: logging.Handler | None = None
         self._lock: RunLock | None = None
         # a finished run on a read-only mount is read, never written (run_stage says so)
@@ -307,18 +311,39 @@ class Pipeline:
         return self.results[name]
 
     def _json(self, name: str, file: str) -> dict:
-        return json.loads((self._upstream(name).folder / file).read_text())
+        """A stage's JSON file checked against its contract (:mod:`flatcontact.result_json`)
+        and against what this run knows: the scan's grid from its stage record, the energy
+        form and the loads p0 from the settings."""
+        folder = self._upstream(name).folder
+        expect: dict[str, Any] = {}
+        if name == "scan":
+            record = self.rundir.read_record(folder) or {}
+            grid = ((record.get("inputs") or {}).get("scan") or {}).get("grid")
+            if grid is not None:
+                expect["grid"] = grid
+        elif name == "laws":
+            expect["energy_form"] = self.config.analysis.energy_form
+        elif name == "contact":
+            expect["p0_gpa"] = list(self.config.contact.p0_gpa)
+        return read_result_json(folder / file, **expect)
 
     def _tell(self, kind: str, name: str, **details: Any) -> None:
         if self.on_event is not None:
             self.on_event(StageEvent(kind, name, STAGES[name], **details))
+
+    def _refused(self, check: Callable, *args: Any) -> Any:  # InputError: a refusal, run()
+        try:
+            return check(*args)
+        except InputError as exc:
+            self._refusal = exc
+            raise
 
     def _run(self, name: str, inputs: dict, work: Callable[[Path], Any]) -> StageResult:
         index = STAGES[name]
         inputs = {**inputs, "code_sha256": stage_code_digest(name)}
         self._tell("start", name)
         try:
-            result = self.rundir.run_stage(index, name, inputs, work)
+            result = self.rundir.run_stage(index, name, inputs, lambda f: self._refused(work, f))
         except KeyboardInterrupt:
             log.warning("stage %s: interrupted; rerun to resume", name)
             self._tell("failed", name, action="interrupted")
@@ -342,7 +367,7 @@ class Pipeline:
         """
         cfg = self.config
         # the file by name and content (file_sha256), not by where it is
-        structure = portable(cfg.section("structure"), "file")
+        structure = portable(cfg.structure_section(), "file")
         if cfg.structure.kind == "quartz-dense":
             structure.setdefault("file", None)  # the fingerprint of runs made before recipes
         inputs = {"structure": structure, "model": self._model_inputs()}
@@ -369,8 +394,7 @@ class Pipeline:
         """
         cfg = self.config
         build = self._upstream("build")
-        scan_inputs = {k: v for k, v in cfg.section("scan").items() if k not in EXECUTION_ONLY}
-        inputs = {"scan": scan_inputs, "model": self._model_inputs(), "build": build.fingerprint}
+        inputs = {**self._scan_inputs(), "build": build.fingerprint}
 
         def work(folder: Path) -> None:
             stage_inputs = ScanInputs(build.folder / INTERFACE)
@@ -382,7 +406,22 @@ class Pipeline:
                 run_scan(cfg, stage_inputs, folder, progress=bar)
 
         result = self._run("scan", inputs, work)
-        return open_ispes(result.folder / ISPES_NC)
+        ds = open_ispes(result.folder / ISPES_NC)
+        check_grid(ds, self.config.scan.grid, str(result.folder / ISPES_NC))
+        return ds
+
+    def _scan_inputs(self) -> dict:
+        """What the scan stage reads besides the build: its section (less the execution-only
+        keys), the model and, for a pressure-range grid, the load bracket its columns must
+        reach (``ispes.grid_bracket.bracket_targets_gpa``: the lowest and highest load of
+        ``analysis.p_gpa``), so a load added beyond the scanned range re-brackets the scan."""
+        cfg = self.config
+        scan_inputs = {k: v for k, v in cfg.section("scan").items() if k not in EXECUTION_ONLY}
+        inputs = {"scan": scan_inputs, "model": self._model_inputs()}
+        if cfg.scan.p_range_gpa is not None:
+            loads = [float(p) for p in cfg.analysis.p_gpa]
+            inputs["bracket_loads_gpa"] = [min(loads), max(loads)] if loads else None
+        return inputs
 
     def scan_summary(self) -> dict:
         """``02-scan/scan.json``: counts, force calls, thicknesses, adhesion (work of separation)."""
@@ -482,6 +521,11 @@ class Pipeline:
             from_scan=True,
             moduli=self._json("elastic", ELASTIC_JSON) if self.config.elastic.enabled else None,
             gates=gates,
+            interface=contact_range.facts(
+                self._upstream("build").folder / INTERFACE,
+                self._upstream("build").folder / BUILD_JSON,
+                open_result(self._upstream("analyze").folder / FRICTION_NC, FRICTION),
+            ),
         )
 
     def contact_parameters(self):
@@ -506,9 +550,15 @@ class Pipeline:
         # before the stage folder is touched: a gate that fired, or a refused p0, stops the
         # run with the finished stages kept (rerun with contact.accept_untrusted to go on)
         gates = self.gates()
-        check_gates(cfg, gates)
+        self._refused(check_gates, cfg, gates)
         stage_inputs = self._contact_inputs(gates.to_json(cfg.contact.accept_untrusted))
-        check_contact(cfg, contact_parameters(cfg, stage_inputs)[0])
+
+        def checks() -> None:  # a refusal here gets the refused run's report
+            params = contact_parameters(cfg, stage_inputs)[0]
+            check_contact(cfg, params)
+            contact_range.adhesion_of(cfg, stage_inputs, params)  # where no model applies
+
+        self._refused(checks)
         inputs = {
             "contact": portable(cfg.section("contact"), "experiment_csv", "fit_csv"),
             "laws": laws.fingerprint,
@@ -519,6 +569,8 @@ class Pipeline:
             inputs["gates"] = stage_inputs.gates  # the recorded verdict (a clean run: no key)
         if cfg.contact.experiment.csv:
             inputs["experiment_sha256"] = file_sha256(cfg.contact.experiment.csv)
+        if cfg.contact.experiment.compare:  # the comparison quotes the quick preset's laws
+            inputs["quartz_quick_laws_sha256"] = file_sha256(QUARTZ_QUICK_LAWS_FILE)
         if cfg.contact.fit.csv:
             inputs["fit_sha256"] = [file_sha256(f) for f in cfg.contact.fit.csv]
 
@@ -529,21 +581,25 @@ class Pipeline:
         """``06-contact/summary.json``: parameters, their provenance and the per-p0 results."""
         return self._json("contact", SUMMARY_JSON)
 
-    def report(self) -> Path:
-        """Stage 7: ``report.html`` (self-contained) in ``07-report/`` and the run directory."""
+    def report(self, refusal: dict | None = None) -> Path:
+        """Stage 7: ``report.html`` in ``07-report/`` and the run directory (``refusal``: of a
+        run refused after the scan, its finished stages only, :mod:`flatcontact.refused`)."""
         cfg = self.config
         names = ["build", "scan", "analyze", "laws", "contact"]
+        names = [n for n in names if refusal is None or n in refusal["finished"]]
         ups = {name: self._upstream(name) for name in names}
         inputs = {"report": cfg.section("report"), **{k: v.fingerprint for k, v in ups.items()}}
-        if cfg.elastic.enabled:  # the report tables the elastic stage's Cij
-            inputs["elastic"] = self._upstream("elastic").fingerprint
+        if cfg.elastic.enabled and (refusal is None or "elastic" in refusal["finished"]):
+            inputs["elastic"] = self._upstream("elastic").fingerprint  # the report tables its Cij
         if cfg.report.approximant_study is not None:  # the report tables that study's files
             inputs["approximant_study"] = approximant_study_digest(cfg.report.approximant_study)
+        if refusal is not None:
+            inputs["refusal"] = refusal
         folders = {name: self.folder(name) for name in STAGES}
         versions = json.loads((self.root / VERSIONS_JSON).read_text())
 
         def work(folder: Path) -> None:
-            run_report(cfg, ReportInputs(folders, versions), folder)
+            run_report(cfg, ReportInputs(folders, versions, refusal), folder)
 
         result = self._run("report", inputs, work)
         target = self.root / REPORT_HTML
@@ -552,9 +608,14 @@ class Pipeline:
         return copy_file_atomic(result.folder / REPORT_HTML, target)
 
     def run(self) -> Path:
-        """Every stage in order; returns the path of ``report.html``."""
+        """Every stage in order; ``report.html`` (also of a refusal after the scan, named in it)."""
         for name in ("build", "scan", "analyze", "laws", "elastic", "contact"):
-            getattr(self, name)()
+            try:
+                getattr(self, name)()
+            except InputError as exc:
+                if exc is not self._refusal or "scan" not in self.results or self.rundir.read_only:
+                    raise  # not a stage's refusal after the scan (a run-directory defect)
+                raise InputError(f"{exc} (report: {refused_report(self, name, exc)})") from None
         return self.report()
 
 

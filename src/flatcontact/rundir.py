@@ -165,12 +165,73 @@ def _inside(name: Any) -> bool:
     )
 
 
+def _process_start(pid: int) -> str | None:
+    """The start time of process ``pid`` (clock ticks since boot, ``/proc/<pid>/stat`` field
+    22), ``"zombie"`` for a dead process not yet reaped, None where it cannot be read."""
+    try:
+        text = Path(f"/proc/{pid}/stat").read_text()
+    except (OSError, ValueError):
+        return None
+    fields = text[text.rfind(")") + 2 :].split()  # after "pid (comm) "
+    if len(fields) < 20:
+        return None
+    return "zombie" if fields[0] in ("Z", "X") else fields[19]
+
+
+def lock_holder_line(pid: int | None = None) -> str:
+    """What the lock file holds: ``"<pid> <host> <start>"`` of this process (or ``pid``)."""
+    pid = os.getpid() if pid is None else pid
+    return f"{pid} {platform.node() or '?'} {_process_start(pid) or '?'}"
+
+
+def stale_holder(text: str) -> str | None:
+    """Why the writer named in a lock file's ``text`` is gone (one phrase), or None when it
+    may be alive.
+
+    Only a holder on this host can be judged: gone when no process has its pid, when that
+    pid is a zombie, or when the process with that pid started at another time (the pid was
+    reused). A holder on another host, or a file that names none, is taken as alive.
+    Lock files of earlier versions hold the pid alone (this host).
+    """
+    parts = text.split()
+    if not parts or not parts[0].isdigit():
+        return None
+    pid = int(parts[0])
+    host = parts[1] if len(parts) > 1 else platform.node()
+    if host != (platform.node() or "?") or pid <= 0:
+        return None
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return f"pid {pid} is not running"
+    except PermissionError:
+        pass  # alive, another user's
+    start = _process_start(pid)
+    if start == "zombie":
+        return f"pid {pid} has exited"
+    if len(parts) > 2 and parts[2] != "?" and start is not None and start != parts[2]:
+        return f"pid {pid} now belongs to another process"
+    return None
+
+
+def _spawned_worker() -> bool:
+    """Whether this process is a ``multiprocessing`` child (a spawned scan worker)."""
+    import multiprocessing
+
+    return multiprocessing.parent_process() is not None
+
+
 class RunLock:
     """One writer per directory: an exclusive advisory ``flock`` on ``<root>/.flatcontact.lock``.
 
-    The file holds the writer's pid (for the refusal message). The lock belongs to the open
+    The file holds the writer's pid, host and process start time (:func:`lock_holder_line`),
+    for the refusal message and to recognise a stale lock. The lock belongs to the open
     file, so it ends with :meth:`release` or with the process, however it ends (``kill -9``
-    included): a later writer takes over without anyone removing a stale file.
+    included): a later writer takes over without anyone removing a stale file. A lock can
+    outlive its writer where another process inherited the open file (a process forked
+    from the writer, a launcher that kept its descriptors); a lock whose recorded writer is
+    gone (:func:`stale_holder`: this host, pid not running, or reused) is taken over, with a
+    log line: the lock file is replaced by a fresh one, which this writer locks.
 
     Parameters
     ----------
@@ -192,27 +253,69 @@ class RunLock:
         one line). Once the lock is held, temporary files that a killed writer left directly
         in the directory are removed (:func:`~flatcontact.fileio.sweep_temporary`).
         """
-        fd = open_nofollow(self.path, append=True, readable=True)
-        handle = open(fd, "a+", closefd=True)
-        try:
-            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
+        for _ in range(5):  # a takeover another writer won is retried, a few times at most
+            handle = open(open_nofollow(self.path, append=True, readable=True), "a+", closefd=True)
+            try:
+                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                handle.seek(0)
+                text = handle.read()
+                handle.close()
+                self._take_over_or_refuse(text)
+                continue
+            if not self._still_the_lock_file(handle):
+                handle.close()  # replaced by a writer taking a stale lock over
+                continue
             handle.seek(0)
-            pid = handle.read().strip() or "?"
-            handle.close()
-            root = self.path.parent
+            handle.truncate()
+            handle.write(lock_holder_line() + "\n")
+            handle.flush()
+            self._handle = handle
+            sweep_temporary(self.path.parent)
+            return self
+        raise InputError(
+            f"{self.flag} {str(self.path.parent)!r}: could not take the lock "
+            f"{self.path.name} (other writers kept replacing it); retry"
+        )
+
+    def _still_the_lock_file(self, handle) -> bool:
+        try:
+            now = os.stat(self.path, follow_symlinks=False)
+        except FileNotFoundError:
+            return False
+        mine = os.fstat(handle.fileno())
+        return (now.st_dev, now.st_ino) == (mine.st_dev, mine.st_ino)
+
+    def _take_over_or_refuse(self, text: str) -> None:
+        """A held lock: replace the lock file when its writer is gone, else refuse."""
+        root = self.path.parent
+        why = stale_holder(text)
+        parts = text.split()
+        pid = parts[0] if parts else "?"
+        if why is None:
+            if pid == str(os.getppid()) and _spawned_worker():
+                raise InputError(
+                    f"{self.flag} {str(root)!r}: this worker process (started by pid {pid}, "
+                    "which writes this directory) imported the main script again and ran its "
+                    "calls; put them under 'if __name__ == \"__main__\":'"
+                )
+            host = f" on host {parts[1]}" if len(parts) > 1 and parts[1] != platform.node() else ""
             raise InputError(
-                f"{self.flag} {str(root)!r}: another flatcontact process (pid {pid}) is writing "
-                "this directory; wait for it to finish (or stop it), or choose another "
+                f"{self.flag} {str(root)!r}: another flatcontact process (pid {pid}{host}) is "
+                "writing this directory; wait for it to finish (or stop it), or choose another "
                 f"{self.flag}"
-            ) from None
-        handle.seek(0)
-        handle.truncate()
-        handle.write(f"{os.getpid()}\n")
-        handle.flush()
-        self._handle = handle
-        sweep_temporary(self.path.parent)
-        return self
+            )
+        log.warning(
+            "%s: the lock %s of pid %s is stale (%s; another process still holds its open "
+            "file); taking it over",
+            root,
+            LOCK_NAME,
+            pid,
+            why,
+        )
+        fd, tmp = tempfile.mkstemp(prefix=".flatcontact-lock.", suffix=".tmp", dir=root)
+        os.close(fd)
+        os.replace(tmp, self.path)
 
     def release(self, tidy: bool | str = False) -> None:
         """Give the lock up (idempotent).

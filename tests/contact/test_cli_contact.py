@@ -60,11 +60,13 @@ def test_json_with_adhesion(capsys):
     )
     r = json.loads(out)["results"][0]
     assert (
-        r["contact_radius_nm"]
+        r["hertz_contact_radius_nm"]
         < r["contact_radius_dmt_nm"]
         < r["contact_radius_maugis_dugdale_nm"]
         < r["contact_radius_jkr_nm"]
     )
+    # λ = 1 is the Maugis–Dugdale regime: its radius is the contact's (issue 32)
+    assert r["contact_radius_nm"] == pytest.approx(r["contact_radius_maugis_dugdale_nm"])
     # pull-off: 2πwR (DMT) > Maugis–Dugdale (λ = 1) > 1.5πwR (JKR), in µN
     w, radius = 0.2, 5e-6
     assert r["pull_off_force_dmt_un"] == pytest.approx(2 * np.pi * w * radius * 1e6)

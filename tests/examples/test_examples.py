@@ -398,8 +398,11 @@ def test_au111_from_a_cif_has_the_stacking_energies_of_an_independent_ase_eam_st
     root = _run("au111-cif-eam", tmp_path / "au")
     named = _stackings(root / "03-analyze" / "friction.csv")[0.0]
     pot = f("Au_u3.eam")
-    isf = _ase_eam_stacking_energy_mev_per_a2(pot, 4.078, (1 / 3, 1 / 3))
-    on_top = _ase_eam_stacking_energy_mev_per_a2(pot, 4.078, (2 / 3, 2 / 3))
+    # the slabs are cut at the EAM's own lattice (structure.lattice: potential), not the CIF's
+    build = json.loads((root / "01-build" / "build.json").read_text())
+    a = build["lattice"]["slabs"]["slab1"]["in_plane_potential_angstrom"][0] * np.sqrt(2.0)
+    isf = _ase_eam_stacking_energy_mev_per_a2(pot, a, (1 / 3, 1 / 3))
+    on_top = _ase_eam_stacking_energy_mev_per_a2(pot, a, (2 / 3, 2 / 3))
     assert min(named.values()) == pytest.approx(0.0, abs=1e-9)
     assert named["BA"] == pytest.approx(isf, rel=0.02)
     assert named["AA"] == pytest.approx(on_top, rel=0.005)

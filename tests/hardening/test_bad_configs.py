@@ -88,6 +88,11 @@ CASES = {
         ["c.yaml", "larger than"],
     ),
     "directory": (_dir_config, ["conf.yaml", "directory"]),
+    # a grid the analysis cannot interpolate: refused before the scan, not after it
+    "grid-2x2": (
+        _yaml(TOY_YAML.replace("grid: [3, 3]", "grid: [2, 2]")),
+        ["scan.grid", "2×2", "at least 3 per axis"],
+    ),
     "missing": (lambda d: d / "nope.yaml", ["nope.yaml", "no such config file"]),
     "unreadable": (lambda d: Path("/proc/self/mem"), ["/proc/self/mem", "cannot read"]),
     # values
@@ -204,11 +209,11 @@ def test_a_bound_is_raised_by_its_environment_variable(workdir, capsys, monkeypa
     from tests.hardening.helpers import run_cli
 
     path = workdir / "c.yaml"
-    path.write_text("scan: {grid: [300, 2]}\n")
+    path.write_text("scan: {grid: [300, 3]}\n")
     monkeypatch.setenv("FLATCONTACT_MAX_GRID_AXIS", "300")
     code, out, err = run_cli(["config", "--check", path], capsys)
     assert code == 0, err
-    assert "grid: [300, 2]" in out
+    assert "grid: [300, 3]" in out
     monkeypatch.setenv("FLATCONTACT_MAX_GRID_AXIS", "lots")
     assert_refused_cleanly(
         ["config", "--check", path],

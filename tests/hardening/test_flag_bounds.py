@@ -34,7 +34,6 @@ CASES: dict[tuple[str, str], tuple[list[str], list[str]]] = {
     ("build", "--lj-cutoff-angstrom"): (["--out", "{tmp}/b"], ["1e6"]),
     ("build", "--fmax-ev-per-angstrom"): (["--out", "{tmp}/b"], [SUBNORMAL]),
     ("build", "--normal-axis"): (["--out", "{tmp}/b"], ["7"]),
-    ("build", "--face-depth-angstrom"): (["--out", "{tmp}/b"], ["nan"]),
     ("contact", "--radius-um"): (["--out", "{tmp}/c"], [SUBNORMAL]),
     ("contact", "--contact-modulus-gpa"): (["--out", "{tmp}/c"], [HUGE]),
     ("contact", "--shear-modulus-gpa"): (["--out", "{tmp}/c"], [SUBNORMAL]),

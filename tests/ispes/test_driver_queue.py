@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from flatcontact.ispes.order import search_tree
-from flatcontact.ispes.scan import PositionsCache, ReadyQueue
+from flatcontact.ispes.scan_scheduler import PositionsCache, ReadyQueue
 
 
 @settings(max_examples=30, deadline=None)

@@ -93,3 +93,40 @@ def test_a_two_worker_scan_leaves_no_process_behind(tmp_path):
 
     _gone, alive = psutil.wait_procs(left(), timeout=10)
     assert not alive, f"processes left in the scan's session: {[p.pid for p in alive]}"
+
+
+def test_the_three_executors_follow_the_executor_protocol():
+    """The scan driver asks every executor the same things (:class:`Executor`), never probing
+    with hasattr: the serial executor, the local pool and Dask all answer them. A serial
+    submission runs at once (``inline``, ``done`` at once); the pool runs it on a worker."""
+    import typing
+
+    from flatcontact.ispes.executors import (
+        DaskExecutor,
+        Executor,
+        ProcessExecutor,
+        SerialExecutor,
+        make_executor,
+    )
+
+    members = {
+        name
+        for name in vars(Executor)
+        if not name.startswith("_") and name not in typing.Protocol.__dict__
+    } | set(typing.get_type_hints(Executor))
+    assert members >= {"name", "inline", "workers", "submit", "wait_first", "done", "result"}
+    for cls in (SerialExecutor, ProcessExecutor, DaskExecutor):
+        assert all(hasattr(cls, m) for m in members), (cls, members - set(dir(cls)))
+    serial = make_executor("serial")
+    assert isinstance(serial, Executor) and serial.inline and serial.workers == 1
+    handle = serial.submit(pow, 2, 10)
+    assert serial.done(handle) and serial.result(handle) == 1024
+    serial.prestart(None, None)  # nothing to start
+    pool = make_executor("processes", workers=2)
+    try:
+        assert isinstance(pool, Executor) and not pool.inline and pool.workers == 2
+        handle = pool.submit(os.getpid)
+        done, _ = pool.wait_first([handle])
+        assert done == {handle} and pool.done(handle) and pool.result(handle) != os.getpid()
+    finally:
+        pool.close()

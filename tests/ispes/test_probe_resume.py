@@ -16,7 +16,8 @@ from flatcontact.ispes.executors import SerialExecutor
 from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.probe_units import ProbeUnitsRepaired, ProbeUnitsReused
 from flatcontact.ispes.relax import RelaxSettings
-from flatcontact.ispes.scan import MANY_WORKERS, run_scan
+from flatcontact.ispes.scan import run_scan
+from flatcontact.ispes.scan_probe import MANY_WORKERS
 from flatcontact.ispes.store import discard_store
 from flatcontact.layout import PROBE_JSON
 from flatcontact.structures.toy import ToyPairCalculator
@@ -26,7 +27,7 @@ GRID = GridSpec(3, 3, p_range_gpa=(-0.05, 0.5, 4))
 
 
 class ManySerial(SerialExecutor):
-    """The driver's many-worker probe (:func:`flatcontact.ispes.scan._probe_many`: segments,
+    """The driver's many-worker probe (:func:`flatcontact.ispes.scan_probe.probe_many`: segments,
     row blocks), each task run at submission in this process so its force calls are counted."""
 
     workers = MANY_WORKERS

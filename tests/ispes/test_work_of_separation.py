@@ -14,7 +14,6 @@ from ase.calculators.eam import EAM
 from ase.constraints import FixAtoms, FixCartesian
 from ase.optimize import BFGS
 
-from flatcontact.ispes.calculators import CalculatorFactory
 from flatcontact.ispes.executors import SerialExecutor
 from flatcontact.ispes.geometry import fixed_mask, in_plane_vectors, place_slab2, thickness
 from flatcontact.ispes.grid import GridSpec
@@ -95,7 +94,9 @@ def _cross_energy_ev(atoms):
 def test_toy_rigid_work_of_separation_is_the_depth_of_the_cross_potential():
     """Rigid slabs: the slabs alone keep their energy, so W = −min_z E_cross(z)/A."""
     ref = toy_interface(layers=3)
-    factory = CalculatorFactory.from_target("flatcontact.ispes.toy:toy_calculator")
+    factory = calculator_factory(
+        InteractionModel(calculator={"target": "flatcontact.ispes.toy:toy_calculator"})
+    )
     w = ideal_work_of_separation(ref, factory, RelaxSettings(mode="rigid"), (0.0, 0.0))
     z0 = thickness(ref)
     zs = np.linspace(z0 - 0.3, z0 + 0.6, 181)
@@ -115,7 +116,9 @@ def test_toy_relaxed_work_of_separation_matches_an_ase_relaxation():
     """Full relaxation: the zero-load interface is the minimum with slab 2's held plane
     (one atom in the toy) free along z; each slab alone is relaxed with its held plane fixed."""
     ref = toy_interface(layers=3)
-    factory = CalculatorFactory.from_target("flatcontact.ispes.toy:toy_calculator")
+    factory = calculator_factory(
+        InteractionModel(calculator={"target": "flatcontact.ispes.toy:toy_calculator"})
+    )
     w = ideal_work_of_separation(ref, factory, RelaxSettings(fmax_ev_per_a=1e-5), (0.0, 0.0))
 
     def relaxed(atoms, constraints):
@@ -147,7 +150,9 @@ def test_toy_relaxed_work_of_separation_matches_an_ase_relaxation():
 def test_hand_written_thicknesses_keep_the_work_of_separation(tmp_path):
     ref = toy_interface(layers=3)
     ref.arrays["held"] = np.isin(ref.arrays["surface"], (1, 4))
-    factory = CalculatorFactory.from_target("flatcontact.ispes.toy:toy_calculator")
+    factory = calculator_factory(
+        InteractionModel(calculator={"target": "flatcontact.ispes.toy:toy_calculator"})
+    )
     relax = RelaxSettings(fmax_ev_per_a=1e-4)
     z0 = thickness(ref)
     auto = run_scan(

@@ -16,10 +16,20 @@ NOT_MONOTONIC = (
 )
 
 
+#: The required keys of a ``scan.json`` (flatcontact.result_json's contract) around the folds.
+SCAN_RECORD = {
+    "points_total": 36,
+    "points_done": 36,
+    "force_calls_total": 500,
+    "thickness_angstrom": [13.2, 13.33, 13.46, 13.6],
+    "area_angstrom2": 20.9,
+}
+
+
 def test_a_recorded_fold_is_named_with_its_column_and_the_physical_remedy(tmp_path):
     scan = tmp_path / "scan.json"
     fold = {"column": "grid column at shift (0.333, 0.167)", "z_angstrom": 13.46, "p_gpa": 1.23}
-    scan.write_text(json.dumps({"load_folds": [fold, fold]}))
+    scan.write_text(json.dumps({**SCAN_RECORD, "load_folds": [fold, fold]}))
     with pytest.raises(InputError) as info, _folds_named(scan):
         raise InputError(NOT_MONOTONIC)
     text = str(info.value)

@@ -10,12 +10,10 @@ from flatcontact.errors import InputError
 from flatcontact.stages.scan import grid_spec, relax_settings
 
 
-def test_default_structure_section_keeps_the_fingerprint_of_runs_before_recipes(tmp_path):
-    """The build stage's structure inputs of the default run are the earlier flat section."""
+def _build_structure_inputs(cfg, root):
     from flatcontact.pipeline import Pipeline
 
-    cfg = load_config()
-    pipe = Pipeline(cfg, tmp_path / "run")
+    pipe = Pipeline(cfg, root)
     captured = {}
 
     class Stop(Exception):
@@ -28,7 +26,15 @@ def test_default_structure_section_keeps_the_fingerprint_of_runs_before_recipes(
     pipe._run = record
     with pytest.raises(Stop):
         pipe.build()
-    assert captured["build"]["structure"] == {
+    return captured["build"]["structure"]
+
+
+def test_default_structure_section_keeps_the_fingerprint_of_runs_before_recipes(tmp_path):
+    """The build stage's structure inputs of the default run are the earlier flat section, plus
+    ``lattice: potential`` since the slabs are cut at the model's own lattice (another
+    structure); with ``lattice: file`` (what every recipe meant before) exactly the earlier one."""
+    cfg = load_config()
+    earlier = {
         "kind": "quartz-dense",
         "layers": 6,
         "source": cfg.structure.source,
@@ -36,6 +42,11 @@ def test_default_structure_section_keeps_the_fingerprint_of_runs_before_recipes(
         "gap_angstrom": 3.0,
         "fmax_ev_per_angstrom": 0.01,
     }
+    assert _build_structure_inputs(cfg, tmp_path / "run") == {**earlier, "lattice": "potential"}
+    kept = cfg.model_copy(
+        update={"structure": cfg.structure.model_copy(update={"lattice": "file"})}
+    )
+    assert _build_structure_inputs(kept, tmp_path / "kept") == earlier
 
 
 def test_legacy_flat_structure_keys_are_converted(tmp_path):

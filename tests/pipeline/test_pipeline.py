@@ -168,7 +168,9 @@ def test_contact_uses_the_fitted_laws(tiny_run):
         # Q_sat/πa² is the mean slip friction σ0 + (2/3)μ p0; Q_peak >= Q_sat, and Q_peak/πa²
         # (a mean traction: < τ where stuck, σ where slipping) is below the largest local
         # τ or σ, at the centre or the edge (either sign of k and μ)
-        p0 = rec["p0_gpa"]
+        # p0 of the Hertzian pressure over the adhesive radius: the pressure the model sees
+        p0 = rec["contact_peak_pressure_gpa"]
+        assert p0 >= rec["p0_gpa"]
         eff = rec["effective_shear_strength_mpa"]
         assert rec["gross_sliding_stress_mpa"] == pytest.approx(sigma0 + 2 / 3 * mu * p0)
         assert rec["gross_sliding_stress_mpa"] <= eff * (1 + 1e-12)
@@ -359,7 +361,7 @@ def test_corrupt_or_foreign_point_store_is_refused(tiny_run, tmp_path):
     assert "\n" not in str(info.value)
     # a store from another grid, dropped into this run's scan folder
     other = tmp_path / "other"
-    with Pipeline(build_config(_merge(TINY, {"scan": {"grid": [2, 2]}})), other) as pipe:
+    with Pipeline(build_config(_merge(TINY, {"scan": {"grid": [3, 3]}})), other) as pipe:
         pipe.scan()
     shutil.copyfile(other / "02-scan" / "points.db", root / "02-scan" / "points.db")
     with (
@@ -473,6 +475,24 @@ def test_measured_stiffness_reruns_contact_and_report_and_recovers_tau0(tiny_run
     )
 
 
+def _range_flags(root) -> list[str]:
+    """The run's facts for the contact's range as `flatcontact contact` flags: z0 exactly as
+    the stage takes it (the built interface's gap), γ_us and b of its sliding path."""
+    import xarray as xr
+
+    from flatcontact.stages.contact_range import interface_gap_angstrom, path_facts
+    from flatcontact.structures.interface_io import read_interface
+
+    gap = interface_gap_angstrom(read_interface(root / "01-build" / "interface.extxyz"))
+    with xr.open_dataset(root / "03-analyze" / "friction.nc", engine="h5netcdf") as ds:
+        path = path_facts(ds)
+    return [
+        f"--equilibrium-separation-angstrom={gap!r}",
+        f"--unstable-stacking-mj-m2={1e3 * path['unstable_stacking_j_m2']!r}",
+        f"--burgers-angstrom={path['burgers_angstrom']!r}",
+    ]
+
+
 def test_negative_slope_runs_and_a_p0_beyond_its_limit_is_refused(tiny_run, tmp_path):
     """k < 0 (a shear strength falling with load) is taken as given; a p0 at which
     τ(centre) = k·p0 + τ0 <= 0 is refused in one line naming contact.p0_gpa and the
@@ -491,7 +511,8 @@ def test_negative_slope_runs_and_a_p0_beyond_its_limit_is_refused(tiny_run, tmp_
     assert summary["parameters"]["k_mpa_per_gpa"] == pytest.approx(k)
     assert summary["provenance"]["k_mpa_per_gpa"] == "config"
     for rec in summary["results"]:
-        assert rec["uniform_shear_strength_mpa"] == pytest.approx(k * 2 / 3 * rec["p0_gpa"] + tau0)
+        p1 = rec["contact_peak_pressure_gpa"]  # the adhesive contact's Hertzian peak
+        assert rec["uniform_shear_strength_mpa"] == pytest.approx(k * 2 / 3 * p1 + tau0)
         assert 0 < rec["peak_lateral_force_un"] and np.isfinite(rec["knee_stress_amplitude_mpa"])
     before = (root / "06-contact" / "summary.json").read_text()
     bad = _merge(TINY, {"contact": {"k_mpa_per_gpa": k, "p0_gpa": [0.5, 2.0]}})
@@ -618,6 +639,8 @@ def test_each_stage_through_the_cli_writes_the_files_of_the_run(tiny_run, tmp_pa
     flags = [f"--{k.replace('_', '-')}={laws[k]!r}" for k in
              ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa")]  # fmt: skip
     p0 = ",".join(f"{p:g}" for p in TINY["contact"]["p0_gpa"])
+    # the run's z0 (the built interface's gap) and its sliding path's γ_us, b as flags
+    flags += _range_flags(src)
     _cli(["contact", "--p0-gpa", p0, *flags, "--no-svg", "--out", str(out),
           f"--work-of-adhesion-j-m2={w['work_of_separation_j_per_m2']!r}"])  # fmt: skip
     _same_netcdf(out / "contact.nc", src / "06-contact" / "contact.nc")
@@ -627,6 +650,22 @@ def test_each_stage_through_the_cli_writes_the_files_of_the_run(tiny_run, tmp_pa
     assert ours.pop("provenance")["tau0_mpa"] == "config"
     # the validity gates judge a run's own scan and laws; numbers given as flags have none
     assert run.pop("gates")["fired"] == [] and "gates" not in ours
+    # the same regime and sizes; only where z0, γ_us and b came from differ (γ_us given in
+    # mJ/m² on the command line: equal to round-off)
+    source = "equilibrium_separation_source"
+    assert ours["adhesion_regime"].pop(source) != run["adhesion_regime"].pop(source)
+    run["adhesion_regime"].pop("sentence"), ours["adhesion_regime"].pop("sentence")
+    # the run's model is Vashishta: the paper's SNAP moduli are named as another potential's
+    assert "vashishta" in run.pop("moduli_note") and "moduli_note" not in ours
+    ours_slip, run_slip = ours.pop("slip_size"), run.pop("slip_size")
+    assert ours_slip["structure"] == run_slip["structure"] == "commensurate"
+    for a, b in zip(ours_slip["results"], run_slip["results"], strict=True):
+        assert a.keys() == b.keys()
+        for key, value in a.items():
+            if isinstance(value, float):
+                assert value == pytest.approx(b[key], rel=1e-12), key
+            else:
+                assert value == b[key], key
     # the fitted laws carry their intervals into the contact outputs; numbers given as flags
     # have none: same central values, zero width from the CLI
     ours_iv, run_iv = ours.pop("intervals"), run.pop("intervals")
@@ -688,7 +727,7 @@ def test_cycle_and_fit_in_a_run_match_the_cli_and_the_fit_file_content_reruns_co
     assert (root / "06-contact" / "fit.json").is_file()
     assert "Multi-load fit of curves.csv" in (root / "07-report" / "report.html").read_text()
 
-    flags = [f"--{k.replace('_', '-')}={v!r}" for k, v in fitted.items()]
+    flags = [f"--{k.replace('_', '-')}={v!r}" for k, v in fitted.items()] + _range_flags(root)
     argv = ["contact", "--p0-gpa", ",".join(map(str, TINY["contact"]["p0_gpa"])), *flags]
     argv += ["--cycle", "--cycle-amplitude-fractions", "0.4,0.8", "--fit", str(csv), "--json"]
     with pytest.raises(SystemExit) as exc:
@@ -707,3 +746,21 @@ def test_cycle_and_fit_in_a_run_match_the_cli_and_the_fit_file_content_reruns_co
     assert again["fit"]["modified"]["fitted"]["tau0_mpa"] == pytest.approx(
         1.6 * fitted["tau0_mpa"], rel=1e-3
     )
+
+
+def test_the_scan_fingerprint_holds_the_load_bracket_it_reads(tmp_path):
+    """The scan brackets ``analysis.p_gpa`` with its thicknesses (pressure-range grids): a load
+    beyond the scanned ones changes the scan's inputs, so the scan re-brackets instead of the
+    analysis failing later outside the data; a load inside them, or any load of a grid of
+    explicit thicknesses (which brackets nothing), leaves the scan alone."""
+
+    def inputs(change: dict) -> dict:
+        return Pipeline(build_config(_merge(TINY, change)), tmp_path / "r")._scan_inputs()
+
+    base = inputs({})
+    assert base["bracket_loads_gpa"] == [0.0, 3.0]
+    assert inputs({"analysis": {"p_gpa": [0.0, 0.25, 1.0, 3.0]}}) == base
+    assert inputs({"analysis": {"p_gpa": [0.0, 1.0, 3.4]}}) != base
+    explicit = {"scan": {"p_range_gpa": None, "thickness_angstrom": [17.0, 17.5, 18.0, 18.5]}}
+    assert "bracket_loads_gpa" not in inputs(explicit)
+    assert inputs(explicit) == inputs(_merge(explicit, {"analysis": {"p_gpa": [0.0, 9.0]}}))

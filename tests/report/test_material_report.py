@@ -15,6 +15,7 @@ import pandas as pd
 import pytest
 
 from flatcontact.config.load import build_config
+from flatcontact.ispes.work_of_separation import AT_PERFECT_STACKING
 from flatcontact.layout import (
     ANALYZE_JSON,
     BUILD_FIGURE,
@@ -78,7 +79,7 @@ def _laws(k, tau0, mu, sigma0):
     }
 
 
-def _stage_folders(tmp_path, atoms, build_record, laws, stackings, elastic=None):
+def _stage_folders(tmp_path, atoms, build_record, laws, stackings, elastic=None, grid=(6, 6)):
     folders = {name: tmp_path / name for name in ("build", "scan", "analyze", "laws", "contact")}
     for folder in folders.values():
         folder.mkdir()
@@ -93,12 +94,18 @@ def _stage_folders(tmp_path, atoms, build_record, laws, stackings, elastic=None)
     write_interface(atoms, folders["build"] / INTERFACE)
     (folders["build"] / BUILD_JSON).write_text(json.dumps(build_record))
     scan = {
-        "points_total": 180,
-        "points_done": 180,
+        "points_total": 3 * grid[0] * grid[1],
+        "points_done": 3 * grid[0] * grid[1],
         "converged": 180,
         "force_calls_total": 9000,
         "thickness_angstrom": [14.0, 14.5, 15.0],
-        "adhesion": {"work_of_separation_j_per_m2": 2.48},
+        "area_angstrom2": float(
+            abs(atoms.cell[0][0] * atoms.cell[1][1] - atoms.cell[0][1] * atoms.cell[1][0])
+        ),
+        "adhesion": {
+            "work_of_separation_j_per_m2": 2.48,
+            "work_of_separation_stacking": AT_PERFECT_STACKING,
+        },
         "notes": [],
         "warnings": [],
     }
@@ -120,6 +127,7 @@ def _stage_folders(tmp_path, atoms, build_record, laws, stackings, elastic=None)
             "n_jumps": [0] * 4,
             "force_noise_mpa": [0.1] * 4,
             "start_stacking": ["BA"] * 4,
+            "zero_shift_stacking": ["BA"] * 4,  # the perfect crystal, by geometry
             "stacking_energies_mev_per_a2": [stackings] * 4,
             "lowest_barrier_mev_per_a2": [10.25] * 4,
         }
@@ -137,7 +145,15 @@ def _stage_folders(tmp_path, atoms, build_record, laws, stackings, elastic=None)
             "work_of_adhesion_j_m2": 2.48,
         },
         "provenance": {"moduli": "elastic stage", "work_of_adhesion_j_m2": "scan"},
-        "results": [{"p0_gpa": 1.0, "effective_shear_strength_mpa": 2206.0}],
+        # Hertz at p0 = 1 GPa, R = 5 µm, E* = 73 GPa: a = pi p0 R / (2 E*), P = 2/3 pi a^2 p0
+        "results": [
+            {
+                "p0_gpa": 1.0,
+                "contact_radius_nm": 107.59,
+                "normal_load_un": 24.24,
+                "effective_shear_strength_mpa": 2206.0,
+            }
+        ],
         "results_with_paper_laws": [{"p0_gpa": 1.0, "effective_shear_strength_mpa": 30.0}],
     }
     (folders["contact"] / SUMMARY_JSON).write_text(json.dumps(contact))
@@ -180,7 +196,13 @@ def _cu_report(tmp_path, layers=4):
         "moduli_gpa": {"e_star": 73.0, "poisson_ratio": 0.34},
     }
     folders = _stage_folders(
-        tmp_path, atoms, build, _laws(-0.9, 3770.0, -0.51, 1099.0), CU_STACKINGS, elastic
+        tmp_path,
+        atoms,
+        build,
+        _laws(-0.9, 3770.0, -0.51, 1099.0),
+        CU_STACKINGS,
+        elastic,
+        grid=tuple(cfg.scan.grid),
     )
     return render_html("Cu(111)", build_sections(cfg, folders, []))
 
@@ -209,6 +231,12 @@ def test_fcc111_stackings_are_the_gamma_surface_names(tmp_path):
         "on-top stacking 48.13" in text
     )
     assert not re.search(r"\b(AB|BA|SP|AA) \d", text)
+    # where W is taken, in the results table and the scan section
+    import html
+
+    plain = html.unescape(text)
+    assert f"work of separation W (J/m²), at the {AT_PERFECT_STACKING}" in plain
+    assert f"work of separation taken at</td><td>{AT_PERFECT_STACKING}" in plain
 
 
 def test_layer_counts_and_relaxation_are_those_built(tmp_path):
@@ -224,11 +252,7 @@ def test_a_one_layer_slab_is_one_layer_and_held_whole(tmp_path):
     cfg = _cu_config(layers=1)
     atoms, report = build_interface(cfg.structure)
     folders = _stage_folders(
-        tmp_path,
-        atoms,
-        report,
-        _laws(1.0, 2.0, 0.5, 1.0),
-        CU_STACKINGS,
+        tmp_path, atoms, report, _laws(1.0, 2.0, 0.5, 1.0), CU_STACKINGS, grid=tuple(cfg.scan.grid)
     )
     text = _text(render_html("Cu", build_sections(cfg, folders, [])))
     assert "1 layers" not in text and "1 layer per slab" in text
@@ -248,7 +272,7 @@ def test_one_box_per_warning_kind_with_its_loads(tmp_path):
 
 
 def test_the_quartz_report_still_compares_with_the_paper(tmp_path):
-    cfg = build_config({"analysis": {"p_gpa": LOADS}})
+    cfg = build_config({"analysis": {"p_gpa": LOADS}, "contact": {"p0_gpa": [1.0]}})
     atoms, _ = build_interface(_cu_config(layers=2).structure)
     folders = _stage_folders(
         tmp_path,
@@ -256,6 +280,7 @@ def test_the_quartz_report_still_compares_with_the_paper(tmp_path):
         {"n_atoms": 36, "layers": 6, "thickness_angstrom": 20.0},
         _laws(14.4, 30.5, 5.0, 7.0),
         "min1=0;min2=0.243;saddle1=0.244;AA=0.591",
+        grid=tuple(cfg.scan.grid),
     )
     text = _text(render_html("quartz", build_sections(cfg, folders, [])))
     assert "This run next to the paper" in text
@@ -303,7 +328,12 @@ def test_results_table_gives_the_study_intervals_beside_the_fit_error(tmp_path):
         laws, hw, law_components(laws, convergence=conv, model=models)
     )
     folders = _stage_folders(
-        tmp_path, atoms, {**report, "interface_relaxation": None}, laws, CU_STACKINGS
+        tmp_path,
+        atoms,
+        {**report, "interface_relaxation": None},
+        laws,
+        CU_STACKINGS,
+        grid=tuple(cfg.scan.grid),
     )
     summary = json.loads((folders["contact"] / SUMMARY_JSON).read_text())
     q = {"value": 2206.0, "low": 2080.0, "high": 2330.0}

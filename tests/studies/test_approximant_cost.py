@@ -113,13 +113,17 @@ def test_a_finished_cell_calibrates_the_force_calls_per_point(tmp_path, monkeypa
             json.dumps(
                 {
                     "points_total": 144,
+                    "points_done": 144,
                     "points_computed": 144,
+                    "thickness_angstrom": [9.0 + 0.1 * i for i in range(4)],
+                    "area_angstrom2": 52.4,
                     "force_calls_total": int(144 * median),
                     "median_force_calls_per_point": median,
                 }
             )
         )
-        (scan_dir / "stage.json").write_text(json.dumps({"stage": "scan", "seconds": 80.0}))
+        record = {"stage": "scan", "fingerprint": "0" * 64, "state": "done", "seconds": 80.0}
+        (scan_dir / "stage.json").write_text(json.dumps(record))
     est = cost.estimate_cost(cfg, cells, tmp_path)
     assert est["calibration"]["label"] == "twist-1-2"  # the smallest finished cell
     r = est["cells"][1]

@@ -5,8 +5,9 @@ import json
 
 import numpy as np
 import pytest
+from tests.cli.cli_helpers import one_error_line, run_cli
 
-from flatcontact.studies.dilatancy import dilatancy, main
+from flatcontact.studies.dilatancy import dilatancy
 
 LOADS = [0.0, 0.25, 0.5]
 
@@ -35,11 +36,33 @@ def test_dilatancy_figures_obey_their_definitions(scan):
     )
 
 
-def test_a_model_against_itself_has_correlation_one_and_ratios_one(scan, tmp_path):
+def test_a_model_against_itself_has_correlation_one_and_ratios_one(scan, tmp_path, capsys):
     out = tmp_path / "d.json"
-    main([f"--p-gpa={','.join(map(str, LOADS))}", str(out), f"a={scan}", f"b={scan}"])
+    argv = ["study", "dilatancy", str(out), f"a={scan}", f"b={scan}"]
+    code, stdout, err = run_cli([*argv, "--p-gpa", ",".join(map(str, LOADS))], capsys)
+    assert code in (0, None), err
     doc = json.loads(out.read_text())
     assert doc["reference"] == "a"
+    assert doc["models"]["a"]["p_gpa"] == LOADS
     b = doc["models"]["b"]
     np.testing.assert_allclose(b["z_pattern_correlation_with_reference"], 1.0, rtol=1e-12)
     np.testing.assert_allclose(b["h_range_mj_per_m2_over_reference"], 1.0, rtol=1e-12)
+    assert "z_range_angstrom_over_reference" in stdout
+
+
+@pytest.mark.parametrize(
+    ("scans", "named"),
+    [(["a"], "LABEL=DIR"), (["=x"], "LABEL=DIR"), (["a=nowhere"], "not a directory")],
+)
+def test_bad_scan_arguments_are_one_line_naming_them(scans, named, tmp_path, capsys):
+    out = tmp_path / "d.json"
+    code, _, err = run_cli(["study", "dilatancy", str(out), *scans], capsys)
+    assert named in one_error_line(code, err)
+    assert not out.exists()
+
+
+def test_a_label_given_twice_is_refused(scan, tmp_path, capsys):
+    code, _, err = run_cli(
+        ["study", "dilatancy", str(tmp_path / "d.json"), f"a={scan}", f"a={scan}"], capsys
+    )
+    assert "given twice" in one_error_line(code, err)

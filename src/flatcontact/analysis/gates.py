@@ -210,7 +210,9 @@ def negative_slope(laws: Mapping) -> Finding | None:
         + "; ".join(bad)
         + f" with load on P <= {laws.get('threshold_gpa', float('nan')):g} GPa; check τ and "
         "σ_MSS per load in 03-analyze/friction.csv (a fold, slip or a change of minimum "
-        "usually causes it), or give contact.k_mpa_per_gpa / contact.mu_mpa_per_gpa",
+        "usually causes it; so can the lateral grid, whose discretisation error in τ and "
+        "σ_MSS per load can exceed their change with load: try a finer scan.grid), or give "
+        "contact.k_mpa_per_gpa / contact.mu_mpa_per_gpa",
     )
 
 

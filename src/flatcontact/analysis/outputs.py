@@ -49,6 +49,7 @@ CSV_COLUMNS = (
     "tau_by_start_mpa",
     "direction_deg",
     "start_stacking",
+    "zero_shift_stacking",
     "lowest_barrier_mev_per_a2",
     "lowest_barrier_direction_deg",
     "barrier_along_direction_mev_per_a2",
@@ -108,6 +109,7 @@ def _stacking_columns(pa) -> dict:
     if st is None:
         return {
             "start_stacking": "",
+            "zero_shift_stacking": "",
             "lowest_barrier_mev_per_a2": float("nan"),
             "lowest_barrier_direction_deg": float("nan"),
             "barrier_along_direction_mev_per_a2": float("nan"),
@@ -115,6 +117,7 @@ def _stacking_columns(pa) -> dict:
         }
     return {
         "start_stacking": start_stacking_name(pa),
+        "zero_shift_stacking": st.name_at((0.0, 0.0)),
         "lowest_barrier_mev_per_a2": st.barrier * mev,
         "lowest_barrier_direction_deg": st.barrier_direction_deg,
         "barrier_along_direction_mev_per_a2": pa.barrier_along_direction_ev_per_a2 * mev,
@@ -173,6 +176,7 @@ def summary_json(result: AnalysisResult) -> dict:
                     "n_degenerate_minima",
                     "tau_by_start_mpa",
                     "start_stacking",
+                    "zero_shift_stacking",
                     "lowest_barrier_mev_per_a2",
                     "lowest_barrier_direction_deg",
                     "barrier_along_direction_mev_per_a2",

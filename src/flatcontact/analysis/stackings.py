@@ -144,6 +144,22 @@ class Stackings:
         c = self.points[index].symmetry_class
         return [i for i, p in enumerate(self.points) if p.symmetry_class == c]
 
+    def name_at(self, xy_angstrom=(0.0, 0.0)) -> str:
+        """Name of the stationary point at ``xy_angstrom`` modulo the lattice (within
+        ``SITE_TOLERANCE`` × the shortest lattice vector), ``''`` if none is there.
+
+        At the origin (the zero shift) this names the reference stacking by geometry: for a
+        3-D crystal continued across the cut it is the perfect crystal, whatever its energy.
+        """
+        lattice = np.linalg.inv(self._inverse)
+        tol = SITE_TOLERANCE * float(np.min(np.linalg.norm(lattice, axis=0)))
+        for p in self.points:
+            ds = self._inverse @ (np.asarray(p.xy_angstrom, float) - np.asarray(xy_angstrom, float))
+            ds -= np.round(ds)
+            if np.linalg.norm(lattice @ ds) < tol:
+                return p.name
+        return ""
+
     def barrier_for(self, vector_angstrom: np.ndarray) -> float:
         """Lowest barrier (surface units) to the start's image translated by a lattice vector."""
         if not self._basis_history:

@@ -33,30 +33,40 @@ _FLAG_OF = {
     "structure.gap_angstrom": "--gap-angstrom",
     "structure.fmax_ev_per_angstrom": "--fmax-ev-per-angstrom",
     "structure.normal_axis": "--normal-axis",
-    "structure.face_depth_angstrom": "--face-depth-angstrom",
+    "potential.lj.cutoff_angstrom": "--lj-cutoff-angstrom",
+    "potential.lj": "--lj-cutoff-angstrom",
     "potential": "--potential",
 }
 
+#: The defaults of the quartz flags when no configuration is given (with ``--config`` a flag
+#: left out keeps the file's value).
+_QUARTZ_DEFAULTS = {
+    "layers": 6,
+    "source": "auto",
+    "gap_angstrom": 3.0,
+    "fmax_ev_per_angstrom": 0.01,
+}
 
-def _check_numbers(gap_angstrom, fmax_ev_per_angstrom, lj_cutoff_angstrom, normal_axis, face_depth):
-    """Every number flag of ``build`` within the bounds of the setting it sets (the recipe's
-    gap and force tolerance, the LJ cutoff), before anything is read or built."""
-    from flatcontact.numbers import Bounds
+
+def _check_numbers(gap_angstrom, fmax_ev_per_angstrom, lj_cutoff_angstrom, normal_axis):
+    """Every number flag of ``build`` that was given within the bounds of the setting it sets
+    (the recipe's gap and force tolerance, the LJ cutoff), before anything is read or built."""
     from flatcontact.potentials.coupling import LJSpec
     from flatcontact.structures.recipe import QuartzDenseRecipe
 
-    bounded(gap_angstrom, "--gap-angstrom", setting_bounds(QuartzDenseRecipe, "gap_angstrom"))
-    bounded(
-        fmax_ev_per_angstrom,
-        "--fmax-ev-per-angstrom",
-        setting_bounds(QuartzDenseRecipe, "fmax_ev_per_angstrom"),
-    )
+    if gap_angstrom is not None:
+        bounded(gap_angstrom, "--gap-angstrom", setting_bounds(QuartzDenseRecipe, "gap_angstrom"))
+    if fmax_ev_per_angstrom is not None:
+        bounded(
+            fmax_ev_per_angstrom,
+            "--fmax-ev-per-angstrom",
+            setting_bounds(QuartzDenseRecipe, "fmax_ev_per_angstrom"),
+        )
     if lj_cutoff_angstrom is not None:
         bounded(
             lj_cutoff_angstrom, "--lj-cutoff-angstrom", setting_bounds(LJSpec, "cutoff_angstrom")
         )
     bounded_int(normal_axis, "--normal-axis", 0, 2, "a cell axis")
-    bounded(face_depth, "--face-depth-angstrom", Bounds(0.1, 20.0, "Å"))
 
 
 def _potential_spec(potential: str | None, lj_cutoff_angstrom: float | None):
@@ -89,11 +99,11 @@ def _potential_spec(potential: str | None, lj_cutoff_angstrom: float | None):
 @app.command("build")
 def build(
     layers: int = typer.Option(
-        6,
+        None,
         "--layers",
-        help="O–Si–O layers per α-quartz (0001) slab, >= 5: a fixed outer and a sliding "
-        "inner dense face layer of 2 units each and at least one inner layer between them "
-        "(the scan relaxes 'surfaces 2, 3 and the inner atomic layers').",
+        help="Layers per slab. α-quartz (0001) (default 6): O–Si–O layers, >= 5: a fixed outer "
+        "and a sliding inner dense face layer of 2 units each and at least one inner layer "
+        "between them. With --config: the recipe's own layers setting.",
     ),
     potential: str = typer.Option(
         None,
@@ -107,19 +117,21 @@ def build(
         help="Output directory (default ./build, where 'flatcontact scan' looks by default).",
     ),
     source: str = typer.Option(
-        "auto",
+        None,
         "--source",
-        help="auto | shipped (CHGNet-relaxed 6-layer slab; 9, 12, ... layers: bulk "
-        "alpha-quartz c-repeats inserted into its interior) | seed",
+        help="α-quartz: auto (default) | shipped (CHGNet-relaxed 6-layer slab; 9, 12, ... "
+        "layers: bulk alpha-quartz c-repeats inserted into its interior) | seed",
     ),
     gap_angstrom: float = typer.Option(
-        3.0, "--gap-angstrom", help="Initial gap between the slabs (Å)."
+        None, "--gap-angstrom", help="Initial gap between the slabs (Å; default 3)."
     ),
     lj_cutoff_angstrom: float = typer.Option(
         None, "--lj-cutoff-angstrom", help="Cross-interface LJ cutoff (Å; default the run's, 10)."
     ),
     fmax_ev_per_angstrom: float = typer.Option(
-        0.01, "--fmax-ev-per-angstrom", help="Relaxation tolerance on the max force."
+        None,
+        "--fmax-ev-per-angstrom",
+        help="Relaxation tolerance on the max force (eV/Å; default 0.01).",
     ),
     structure: Path | None = typer.Option(
         None, "--structure", help="A slab structure file (any crystal) instead of α-quartz."
@@ -127,16 +139,12 @@ def build(
     normal_axis: int = typer.Option(
         2, "--normal-axis", help="With --structure: cell axis (0, 1, 2) along the surface normal."
     ),
-    face_depth_angstrom: float = typer.Option(
-        2.0,
-        "--face-depth-angstrom",
-        help="Ignored (kept for old scripts): the layers are found from the structure.",
-    ),
     config: Path | None = typer.Option(
         None,
         "--config",
         help="A run configuration (YAML): its structure recipe and potential, the same as "
-        "'flatcontact run CONFIG' builds (--structure, --potential override them).",
+        "'flatcontact run CONFIG' builds; every other flag given is laid over the file "
+        "(a flag the file's recipe has no setting for is refused).",
     ),
     svg: bool = typer.Option(True, "--svg/--no-svg", help="Also write fig1_interface.svg."),
     regenerate_dense: bool = typer.Option(
@@ -154,14 +162,43 @@ def build(
     from flatcontact.stages.build import BuildInputs, run_build
     from flatcontact.structures import build as builder
 
-    _check_numbers(
-        gap_angstrom, fmax_ev_per_angstrom, lj_cutoff_angstrom, normal_axis, face_depth_angstrom
-    )
+    _check_numbers(gap_angstrom, fmax_ev_per_angstrom, lj_cutoff_angstrom, normal_axis)
+    if structure is not None and not structure.is_file():
+        raise InputError(f"--structure {structure}: file not found")
+    if structure is None and normal_axis != 2:
+        raise InputError("--normal-axis: the normal of a --structure file; give --structure")
+    given = {
+        "layers": layers,
+        "source": source,
+        "gap_angstrom": gap_angstrom,
+        "fmax_ev_per_angstrom": fmax_ev_per_angstrom,
+    }
+    if config is not None:
+        if regenerate_dense:
+            raise InputError(
+                "--regenerate-dense: not with --config (it rebuilds the shipped quartz slab)"
+            )
+        cfg = _config_settings(
+            config, structure, potential, lj_cutoff_angstrom, given, normal_axis, svg
+        )
+        check_out_dir(out)
+        with flag_errors(_FLAG_OF):
+            result = run_build(cfg, BuildInputs(), out)
+        _print(result, out)
+        return
+    quartz = {k: _QUARTZ_DEFAULTS[k] if v is None else v for k, v in given.items()}
+    layers, source = quartz["layers"], quartz["source"]
+    gap_angstrom, fmax_ev_per_angstrom = quartz["gap_angstrom"], quartz["fmax_ev_per_angstrom"]
     if structure is None:
         builder.check_layers(layers, "--layers")
         limits.check("layers", layers, "--layers", "layers per slab")
         if source == "shipped":
             builder.check_shipped_layers(layers, "--layers")
+    elif given["layers"] is not None or given["source"] is not None:
+        flag = "--layers" if given["layers"] is not None else "--source"
+        raise InputError(
+            f"{flag}: an α-quartz setting; with --structure the layers come from the file"
+        )
     if regenerate_dense:
         provenance = builder.regenerate_shipped_dense_slab(
             layers=layers, fmax_ev_per_angstrom=fmax_ev_per_angstrom
@@ -169,15 +206,6 @@ def build(
         console.print(
             f"wrote {builder.SHIPPED_DENSE_SLAB} (CHGNet energy {provenance['energy_ev']:.4f} eV)"
         )
-        return
-    if structure is not None and not structure.is_file():
-        raise InputError(f"--structure {structure}: file not found")
-    if config is not None:
-        cfg = _config_settings(config, structure, potential, gap_angstrom, svg)
-        check_out_dir(out)
-        with flag_errors(_FLAG_OF):
-            result = run_build(cfg, BuildInputs(), out)
-        _print(result, out)
         return
     spec = _potential_spec(potential, lj_cutoff_angstrom)
     check_out_dir(out)
@@ -210,18 +238,69 @@ def build(
     _print(result, out)
 
 
-def _config_settings(config: Path, structure: Path | None, potential: str | None, gap, svg):
-    """The run settings of ``--config`` with ``--structure`` (a slab file: the ``slab``
-    recipe, layers found from the structure, so a 2D monolayer works) and ``--potential``
-    (a preset name or an intra-slab model) laid over."""
+def _config_settings(
+    config: Path,
+    structure: Path | None,
+    potential: str | None,
+    lj_cutoff_angstrom: float | None,
+    given: dict,
+    normal_axis: int,
+    svg: bool,
+):
+    """The run settings of ``--config`` with every flag that was given laid over: ``--structure``
+    (a slab file: the ``slab`` recipe, layers found from the structure, so a 2D monolayer
+    works), ``--potential`` (a preset name or an intra-slab model), ``--lj-cutoff-angstrom``
+    (the model's LJ coupling) and the recipe flags ``given`` (``layers``, ``source``,
+    ``gap_angstrom``, ``fmax_ev_per_angstrom``; None: not given). A flag the resulting recipe
+    or model has no setting for is one line naming the flag, never ignored; ``--layers`` is
+    judged by the file's recipe (quartz: O–Si–O layers >= 5; fcc(111): planes >= 1)."""
     from flatcontact.cli.settings import resolve_config
+    from flatcontact.config import load_config
 
     flags: dict = {"report": {"svg": svg}}
+    recipe = {k: v for k, v in given.items() if v is not None}
+    kind = "slab" if structure is not None else load_config(config).structure.kind
+    fields = _recipe_fields(kind)
+    for key in recipe:
+        if key not in fields:
+            raise InputError(
+                f"{_FLAG_OF['structure.' + key]}: the structure recipe {kind!r} has no {key} "
+                "setting (remove the flag or change the recipe)"
+            )
+    if kind == "quartz-dense" and "layers" in recipe:
+        from flatcontact.structures import build as builder
+
+        builder.check_layers(recipe["layers"], "--layers")
     if structure is not None:
-        flags["structure"] = {"kind": "slab", "file": str(structure), "gap_angstrom": gap}
+        recipe = {**recipe, "kind": "slab", "file": str(structure)}
+        if normal_axis != 2:
+            recipe["normal_axis"] = normal_axis
+    if recipe:
+        flags["structure"] = recipe
     if potential is not None:
         flags["potential"] = _potential_flag_section(potential)
-    return resolve_config(config, None, flags, _FLAG_OF)
+    cfg = resolve_config(config, None, flags, _FLAG_OF)
+    if lj_cutoff_angstrom is not None:
+        if cfg.potential.coupling != "lj":
+            raise InputError(
+                f"--lj-cutoff-angstrom: the configuration's coupling across the interface is "
+                f"{cfg.potential.coupling!r}, not lj: there is no Lennard-Jones cutoff to set"
+            )
+        lj = {**flags.get("potential", {}), "lj": {"cutoff_angstrom": lj_cutoff_angstrom}}
+        cfg = resolve_config(config, None, {**flags, "potential": lj}, _FLAG_OF)
+    return cfg
+
+
+def _recipe_fields(kind: str) -> set[str]:
+    """The settings of the structure recipe ``kind`` (:data:`flatcontact.structures.recipe.StructureRecipe`)."""
+    import typing
+
+    from flatcontact.structures.recipe import StructureRecipe
+
+    for cls in typing.get_args(typing.get_args(StructureRecipe)[0]):
+        if cls.model_fields["kind"].default == kind:
+            return set(cls.model_fields)
+    return set()
 
 
 def _potential_flag_section(potential: str) -> dict:

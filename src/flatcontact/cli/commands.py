@@ -18,4 +18,5 @@ from flatcontact.cli import (  # noqa: F401  (imported for their @app.command re
 from flatcontact.cli import (
     elastic,  # noqa: F401  (listed after validate-potential)
     study,  # noqa: F401  (study convergence|models, last)
+    study_dilatancy,  # noqa: F401  (study dilatancy, registers on study's app)
 )

@@ -33,6 +33,9 @@ _FLAG_OF = {
         "sigma0_mpa",
         "work_of_adhesion_j_m2",
         "maugis_lambda",
+        "equilibrium_separation_angstrom",
+        "contact_radius",
+        "slip_regime",
         "knee_fraction",
         "collapse_fraction",
     )
@@ -138,6 +141,52 @@ def contact_command(
             "--maugis-lambda", help="Maugis parameter λ: adds the Maugis–Dugdale radius (needs w)."
         ),
     ] = None,
+    equilibrium_separation_angstrom: Annotated[
+        float | None,
+        typer.Option(
+            "--equilibrium-separation-angstrom",
+            help="Equilibrium separation z0 (Å) of the interface for the Tabor parameter "
+            "(default: 3 Å assumed, and said so).",
+        ),
+    ] = None,
+    contact_radius: Annotated[
+        str,
+        typer.Option(
+            "--contact-radius",
+            help="adhesive: the radius of the regime the Tabor parameter names (DMT, "
+            "Maugis–Dugdale, JKR) in Q_peak/πa² and the model; hertz: the paper's.",
+        ),
+    ] = "adhesive",
+    unstable_stacking_mj_m2: Annotated[
+        float | None,
+        typer.Option(
+            "--unstable-stacking-mj-m2",
+            help="Barrier γ_us of the γ-surface along the sliding path (mJ/m²): reports the "
+            "critical contact radius of concurrent slip (commensurate interfaces).",
+        ),
+    ] = None,
+    burgers_angstrom: Annotated[
+        float | None,
+        typer.Option(
+            "--burgers-angstrom",
+            help="Burgers vector b (Å): the shift-lattice period along the sliding direction "
+            "(the elastic bound of superlubricity of twisted/approximant cells).",
+        ),
+    ] = None,
+    structure: Annotated[
+        str,
+        typer.Option(
+            "--structure", help="commensurate, twisted or approximant (which size limit)."
+        ),
+    ] = "commensurate",
+    slip_regime: Annotated[
+        str,
+        typer.Option(
+            "--slip-regime",
+            help="auto (the size-limited strength past the critical size), concurrent or "
+            "size-limited.",
+        ),
+    ] = "auto",
     knee_fraction: Annotated[
         float,
         typer.Option(
@@ -266,6 +315,9 @@ def contact_command(
         "sigma0_mpa": sigma0_mpa,
         "work_of_adhesion_j_m2": work_of_adhesion_j_m2,
         "maugis_lambda": maugis_lambda,
+        "equilibrium_separation_angstrom": equilibrium_separation_angstrom,
+        "contact_radius": contact_radius,
+        "slip_regime": slip_regime,
         "knee_fraction": knee_fraction,
         "collapse_fraction": collapse_fraction,
         "experiment": {
@@ -296,12 +348,19 @@ def contact_command(
     if out is not None:
         check_out_dir(out)
     with flag_errors(_FLAG_OF):
-        result = run_contact(cfg, ContactInputs(), out)
+        result = run_contact(
+            cfg,
+            ContactInputs(
+                interface=_given_interface(unstable_stacking_mj_m2, burgers_angstrom, structure)
+            ),
+            out,
+        )
     doc = result.to_json()
     if as_json:
         typer.echo(json.dumps(doc, indent=2))
         return
     _print_table(doc["results"], doc.get("experiment"), out)
+    _print_range(doc)
     if "cycle" in doc:
         _print_cycle(doc["cycle"])
     if "fit" in doc:
@@ -349,7 +408,8 @@ def _print_table(records, exp_summary, out) -> None:
     from rich.table import Table
 
     rows = [
-        ("contact_radius_nm", "Hertz contact radius a (nm)", "{:.1f}"),
+        ("contact_radius_nm", "contact radius a (nm)", "{:.1f}"),
+        ("hertz_contact_radius_nm", "Hertz contact radius (nm)", "{:.1f}"),
         ("normal_load_un", "normal load P (µN)", "{:.3f}"),
         ("contact_radius_change_dmt_percent", "DMT radius change vs Hertz (%)", "{:.1f}"),
         ("contact_radius_change_jkr_percent", "JKR radius change vs Hertz (%)", "{:.1f}"),
@@ -387,3 +447,49 @@ def _print_table(records, exp_summary, out) -> None:
         )
     if out is not None:
         console.print(f"wrote figures, summary.json and contact.nc to {out}")
+
+
+def _given_interface(unstable_stacking_mj_m2, burgers_angstrom, structure) -> dict | None:
+    """The contact's range facts from the flags (``ContactInputs.interface``); None when
+    neither γ_us nor b is given (no size limit is computed)."""
+    from flatcontact.contact.slip_size import APPROXIMANT, COMMENSURATE, TWISTED
+    from flatcontact.errors import InputError
+
+    kinds = (COMMENSURATE, TWISTED, APPROXIMANT)
+    if structure not in kinds:
+        raise InputError(f"--structure: expected one of {', '.join(kinds)}, got {structure!r}")
+    for flag, value in (
+        ("--unstable-stacking-mj-m2", unstable_stacking_mj_m2),
+        ("--burgers-angstrom", burgers_angstrom),
+    ):
+        if value is not None and not (value > 0 and value < 1e6):
+            raise InputError(f"{flag}: expected a positive number, got {value!r}")
+    if unstable_stacking_mj_m2 is None and burgers_angstrom is None:
+        return None
+    path = {"source": "given on the command line"}
+    if unstable_stacking_mj_m2 is not None:
+        path["unstable_stacking_j_m2"] = unstable_stacking_mj_m2 * 1e-3
+    if burgers_angstrom is not None:
+        path["burgers_angstrom"] = burgers_angstrom
+    return {"structure": structure, "path": path}
+
+
+def _print_range(doc) -> None:
+    """The contact's range: the adhesion regime, and the critical size of concurrent slip."""
+    from flatcontact.contact.slip_size import slip_sentences
+
+    if "adhesion_regime" in doc:
+        console.print(doc["adhesion_regime"]["sentence"])
+    slip = doc.get("slip_size")
+    if slip:
+        name = (
+            "critical radius a_c" if slip["structure"] == "commensurate" else "elastic bound a_el"
+        )
+        sizes = ", ".join(
+            f"{r['p0_gpa']:g} GPa: a = {r['contact_radius_nm']:.4g} nm, {name} = "
+            f"{r['critical_radius_nm']:.3g} nm"
+            for r in slip["results"]
+        )
+        console.print(f"{slip['structure']} interface ({slip['estimate']}): {sizes}")
+    for line in slip_sentences(slip):
+        console.print(line)

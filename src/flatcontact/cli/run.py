@@ -59,7 +59,21 @@ def run_command(
                 highlight=False,
             )
             raise typer.Exit(130) from None
+        _print_contact_range(pipe)
     console.print(f"report: {report.resolve()}", highlight=False)
+
+
+def _print_contact_range(pipe) -> None:
+    """The contact's adhesion regime and each p0 past the critical size of concurrent slip
+    (``06-contact/summary.json``; the report has them in boxes above the contact numbers)."""
+    from flatcontact.contact.slip_size import slip_sentences
+
+    if "contact" not in pipe.results:  # a run that stopped before the contact stage
+        return
+    summary = pipe.contact_summary()
+    lines = [(summary.get("adhesion_regime") or {}).get("sentence"), summary.get("moduli_note")]
+    for line in [x for x in lines if x] + slip_sentences(summary.get("slip_size")):
+        console.print(f"contact: {line}", highlight=False)
 
 
 @app.command("config")

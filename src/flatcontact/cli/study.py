@@ -15,6 +15,7 @@ from typing import Annotated
 import typer
 
 from flatcontact.cli.app import app, check_out_dir, console
+from flatcontact.studies.study_dir import study_directory
 
 study_app = typer.Typer(
     name="study",
@@ -69,12 +70,13 @@ def convergence_command(
     cfg = load_config(config)
     check_out_dir(out)
     console.print(f"flatcontact study convergence: {config} -> {out}", highlight=False)
-    doc = run_convergence(
-        cfg, out, on_done=_progress, on_estimate=_estimate, estimate_only=estimate
-    )
-    if estimate:
-        return
-    write_study(doc, cfg, out, _command_line())
+    with study_directory(out):
+        doc = run_convergence(
+            cfg, out, on_done=_progress, on_estimate=_estimate, estimate_only=estimate
+        )
+        if estimate:
+            return
+        write_study(doc, cfg, out, _command_line())
     for s, st in doc["settings"].items():
         if st["state"] == "failed":
             kept = (
@@ -132,8 +134,9 @@ def models_command(
     cfg = load_config(config)
     check_out_dir(out)
     console.print(f"flatcontact study models: {config} -> {out}", highlight=False)
-    doc = run_models(cfg, models, out, on_done=_progress)
-    write_study(doc, cfg, out, _command_line())
+    with study_directory(out):
+        doc = run_models(cfg, models, out, on_done=_progress)
+        write_study(doc, cfg, out, _command_line())
     for label, why in doc["failed"].items():
         console.print(f"{label}: failed, not in the spread: {why}", highlight=False)
     for form, spread in doc["spread"].items():
@@ -269,8 +272,9 @@ def approximants_command(
     console.print(
         f"flatcontact study approximants: {config} -> {out}", highlight=False, soft_wrap=True
     )
-    doc = run_approximants(cfg, out, on_done=_cell_progress)
-    write_approximants(doc, out, _command_line())
+    with study_directory(out):
+        doc = run_approximants(cfg, out, on_done=_cell_progress)
+        write_approximants(doc, out, _command_line())
     for key, name in (("tau0_mpa", "tau0"), ("barrier_mev_per_a2", "corrugation")):
         console.print(_scaling_line(name, doc["scaling"][key]), highlight=False, soft_wrap=True)
     if doc["tolerance_advice"]:
@@ -281,7 +285,8 @@ def approximants_command(
             soft_wrap=True,
         )
     if cfg.contact.experiment.compare is not None:
-        _print_experiment_collapse(cfg, doc, out)
+        with study_directory(out):
+            _print_experiment_collapse(cfg, doc, out)
     c = doc["cost"]
     console.print(
         f"force calls: {c['force_calls_study']} (stored {c['force_calls_stored']}; "
@@ -307,9 +312,14 @@ def export_uncertainty_command(
     ] = None,
 ) -> None:
     """One uncertainty file (the paper preset's data-file format) from the studies' blocks."""
+    from flatcontact.errors import InputError
     from flatcontact.fileio import write_json_atomic
     from flatcontact.studies.export import export_uncertainty
 
+    if out.is_dir() or (out.exists() and not out.is_file()):
+        raise InputError(
+            f"--out {str(out)!r}: exists and is not a regular file; name the JSON file to write"
+        )
     doc = export_uncertainty(studies, source, _command_line())
     check_out_dir(out.parent, "--out")
     write_json_atomic(out, doc)

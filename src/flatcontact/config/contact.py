@@ -178,6 +178,24 @@ class ContactConfig(Section):
         description="Maugis parameter λ: adds the Maugis–Dugdale radius and pull-off force "
         "(needs a work of adhesion > 0); null: none",
     )
+    equilibrium_separation_angstrom: physical(0.5, 20.0, "Å") | None = Field(
+        None,
+        description="equilibrium separation z0 of the interface for the Tabor parameter "
+        "(Å); null: the gap between the facing atomic planes of the built interface",
+    )
+    contact_radius: Literal["adhesive", "hertz"] = Field(
+        "adhesive",
+        description="adhesive: the radius of the model the Tabor parameter names (DMT, "
+        "Maugis–Dugdale, JKR; Hertz at w = 0) in Q_peak/πa² and the modified Mindlin model; "
+        "hertz: the paper's Hertz radius (adhesion only reported)",
+    )
+    slip_regime: Literal["auto", "concurrent", "size-limited"] = Field(
+        "auto",
+        description="auto: the size-limited strength where the contact radius exceeds the "
+        "critical size of concurrent slip (docs/contact.md); concurrent: the modified Mindlin "
+        "number everywhere (the box still says where it exceeds that size); size-limited: "
+        "the size-limited estimate everywhere",
+    )
     knee_fraction: Fraction = Field(
         0.5, description="knee: stiffness falls to this fraction of its initial value"
     )

@@ -96,6 +96,12 @@ def load_config(path: str | Path | None = None, preset_name: str | None = None) 
     if not isinstance(data, dict):
         raise InputError(f"{path}: expected a mapping of sections, got {type(data).__name__}")
     data = migration.contact_keys(data, str(path))
+    if data.get("calculator") is not None and data.get("potential") is not None:
+        # the deprecated section would replace the potential whole, silently
+        raise InputError(
+            f"{path}: calculator: the deprecated top-level section is given beside potential: "
+            "and would replace it; write it as potential.calculator, or remove one of the two"
+        )
     if isinstance(data.get("uncertainty"), str):
         data["uncertainty"] = _uncertainty_file(data["uncertainty"], path)
     for dotted in FILE_FIELDS:

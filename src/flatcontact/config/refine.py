@@ -23,7 +23,7 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import Field
+from pydantic import Field, field_validator
 
 from flatcontact.config.section import Section
 from flatcontact.numbers import physical
@@ -38,6 +38,22 @@ class RefineConfig(Section):
     settings: list[Literal["grid", "thicknesses", "layers", "fmax", "cutoff"]] | Literal["auto"] = (
         Field("auto", description=f"settings refined one at a time: auto or some of {REFINABLE}")
     )
+
+    @field_validator("settings")
+    @classmethod
+    def _something_once(cls, value):
+        """A list that refines nothing, or one setting twice (a variant compared with itself,
+        called converged), is refused: neither measures a convergence width."""
+        if isinstance(value, list):
+            if not value:
+                raise ValueError(
+                    f"an empty list refines nothing; give some of {', '.join(REFINABLE)}, or auto for all"
+                )
+            twice = sorted({s for s in value if value.count(s) > 1})
+            if twice:
+                raise ValueError(f"{', '.join(twice)} given twice; give each setting once")
+        return value
+
     tolerance_pct: physical(0.01, 100.0, "%") = Field(
         3.0,
         description="a step converges when it moves every per-load τ and σ_MSS by less than "

@@ -135,6 +135,16 @@ class RunConfig(Section):
         value = getattr(self, name)
         return None if value is None else json.loads(value.model_dump_json())
 
+    def structure_section(self) -> dict:
+        """The ``structure`` section as fingerprinted (build stage, ``uncertainty.measured_on``):
+        ``lattice: file`` is left out, since it is what every recipe meant before the setting
+        existed, so the runs and measured blocks of those recipes keep their fingerprints;
+        ``lattice: potential`` (the default) is another structure and fingerprints as one."""
+        out = self.section("structure")
+        if isinstance(out, dict) and out.get("lattice") == "file":
+            out.pop("lattice")
+        return out
+
     def to_dict(self) -> dict:
         """The whole configuration as plain JSON-ready data."""
         return json.loads(self.model_dump_json())

@@ -45,6 +45,10 @@ def parse_dask_address(address: str) -> tuple[str, str, int]:
     if not sep:
         scheme, rest = "tcp", text
     match = _HOST_PORT.fullmatch(rest)
+    if match is not None and not match["host"].startswith("["):
+        labels = match["host"].split(".")  # a host name: labels of 1..63 characters
+        if len(match["host"]) > 253 or any(not 1 <= len(x) <= 63 for x in labels):
+            match = None
     if scheme not in DASK_SCHEMES or match is None or not 1 <= int(match["port"]) <= 65535:
         raise ValueError(
             f"expected a Dask scheduler address [{'|'.join(DASK_SCHEMES)}://]host:port "

@@ -8,10 +8,13 @@ from pydantic import Field, field_validator
 
 from flatcontact.config.messages import show
 from flatcontact.config.section import Section
-from flatcontact.numbers import physical
+from flatcontact.numbers import Bounds, physical
 
 #: The law coefficients an uncertainty block may name (τ = k·P + τ0, σ = μ·P + σ0).
 LAW_KEYS = ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa")
+#: A width δ_conv or δ_model (MPa, or MPa/GPa for k and μ): 0 or a normal double up to
+#: 1e5 (a law coefficient of a solid is below 1e4; 1e200 went into laws.json as Infinity).
+WIDTH_BOUNDS = Bounds(0.0, 1e5, "MPa or MPa/GPa")
 #: The fingerprints of ``measured_on`` (:mod:`flatcontact.stages.measured_on`).
 MEASURED_ON_KEYS = ("structure_sha256", "model_sha256")
 
@@ -72,6 +75,8 @@ class UncertaintyConfig(Section):
         for key, v in value.items():
             if key not in LAW_KEYS:
                 raise ValueError(f"{key!r}: expected law coefficients among {', '.join(LAW_KEYS)}")
-            if not (v == v and 0.0 <= float(v) < float("inf")):
-                raise ValueError(f"{key} = {show(v)}: expected a finite value >= 0")
+            try:
+                WIDTH_BOUNDS.check(v)
+            except (TypeError, ValueError) as exc:
+                raise ValueError(f"{key} = {show(v)}: {exc}") from None
         return {k: float(v) for k, v in value.items()}

@@ -35,27 +35,42 @@ class ContactAnalysis:
     peaks: mindlin.PeakForce
     displacement_m: np.ndarray  # (n_p0, N_DISPLACEMENT)
     response: mindlin.LateralResponse  # arrays (n_p0, N_DISPLACEMENT)
+    #: the peak pressure the model is evaluated at per p0 (the Hertzian part over the
+    #: adhesive radius, :mod:`.adhesion_regime`); None: p0 itself (Hertz)
+    contact_p0_gpa: tuple[float, ...] | None = None
 
     @property
     def p0_pa(self) -> np.ndarray:
+        """The given peak Hertz pressures (Pa): they fix the loads."""
         return np.asarray(self.p0_gpa) * units.GPA_TO_PA
+
+    @property
+    def contact_p0_pa(self) -> np.ndarray:
+        """The peak pressures (Pa) the modified Mindlin model is evaluated at."""
+        if self.contact_p0_gpa is None:
+            return self.p0_pa
+        return np.asarray(self.contact_p0_gpa) * units.GPA_TO_PA
 
     def records(self) -> list[dict[str, Any]]:
         """One JSON-ready dict per p0 (keys carry their units)."""
         pr = self.params
         p0 = self.p0_pa
-        a = mindlin.contact_radius(p0, pr)
+        pc = self.contact_p0_pa
+        a_h = mindlin.contact_radius(p0, pr)
+        a = mindlin.contact_radius(pc, pr)  # the adhesive radius where pc != p0
         area = np.pi * a**2
-        load = 2.0 / 3.0 * area * p0
+        load = 2.0 / 3.0 * np.pi * a_h**2 * p0  # the applied load
         w = pr.work_of_adhesion_j_m2
         out = []
         for i, c in enumerate(self.curves):
             rec: dict[str, Any] = {
                 "p0_gpa": self.p0_gpa[i],
                 "contact_radius_nm": float(a[i] / units.NM_TO_M),
+                "hertz_contact_radius_nm": float(a_h[i] / units.NM_TO_M),
+                "contact_peak_pressure_gpa": float(pc[i] / units.GPA_TO_PA),
                 "normal_load_un": float(load[i] * units.N_TO_UN),
-                "mean_pressure_gpa": float(2.0 / 3.0 * self.p0_gpa[i]),
-                "hertz_approach_nm": float(a[i] ** 2 / pr.radius_m / units.NM_TO_M),
+                "mean_pressure_gpa": float(2.0 / 3.0 * pc[i] / units.GPA_TO_PA),
+                "hertz_approach_nm": float(a_h[i] ** 2 / pr.radius_m / units.NM_TO_M),
             }
             if w > 0.0:
                 for model, key in (("dmt", "dmt"), ("jkr", "jkr")):
@@ -65,7 +80,7 @@ class ContactAnalysis:
                         )
                     )
                     rec[f"contact_radius_{key}_nm"] = am / units.NM_TO_M
-                    rec[f"contact_radius_change_{key}_percent"] = 100.0 * (am / a[i] - 1.0)
+                    rec[f"contact_radius_change_{key}_percent"] = 100.0 * (am / a_h[i] - 1.0)
                 # pull-off (magnitude, load control): 2πwR (DMT), 1.5πwR (JKR)
                 rec["pull_off_force_dmt_un"] = float(
                     adhesion.dmt_pull_off_force(w, pr.radius_m) * units.N_TO_UN
@@ -85,7 +100,9 @@ class ContactAnalysis:
                         )
                     )
                     rec["contact_radius_maugis_dugdale_nm"] = am / units.NM_TO_M
-                    rec["contact_radius_change_maugis_dugdale_percent"] = 100.0 * (am / a[i] - 1.0)
+                    rec["contact_radius_change_maugis_dugdale_percent"] = 100.0 * (
+                        am / a_h[i] - 1.0
+                    )
                     rec["pull_off_force_maugis_dugdale_un"] = float(
                         adhesion.maugis_dugdale_pull_off_force(w, pr.radius_m, self.maugis_lambda)
                         * units.N_TO_UN
@@ -114,7 +131,7 @@ class ContactAnalysis:
                         pk.saturated_force_n[i] / area[i] / units.MPA_TO_PA
                     ),
                     "uniform_shear_strength_mpa": float(
-                        (pr.k * 2.0 / 3.0 * p0[i] + pr.tau0_pa) / units.MPA_TO_PA
+                        (pr.k * 2.0 / 3.0 * pc[i] + pr.tau0_pa) / units.MPA_TO_PA
                     ),
                     "initial_lateral_stiffness_n_per_m": c.initial_stiffness_n_per_m,
                     "knee_fraction": c.knee_fraction,
@@ -220,8 +237,13 @@ def analyse(
     maugis_lambda: float | None = None,
     knee_fraction: float = 0.5,
     p0_name: str = "p0_gpa",
+    contact_p0_gpa: Any = None,
 ) -> ContactAnalysis:
     """Evaluate Q(u), the peak, the stiffness curve and adhesion radii for each p0 (GPa).
+
+    ``contact_p0_gpa`` (one per p0): the peak pressure of the Hertzian part over the
+    adhesive radius (:func:`flatcontact.contact.adhesion_regime.adhesion_regime`) at which
+    the model is evaluated; the p0 then only fix the applied loads. None: Hertz.
 
     Raises
     ------
@@ -230,7 +252,11 @@ def analyse(
         contact (k or μ < 0); the message names ``p0_name`` and the limit.
     """
     p0_list = tuple(params.check_p0_gpa(p0_gpa, p0_name))
-    p0 = np.asarray(p0_list) * units.GPA_TO_PA
+    contact = None
+    if contact_p0_gpa is not None:
+        name = f"{p0_name} (as p1, the adhesive contact's Hertzian peak pressure)"
+        contact = tuple(params.check_p0_gpa(contact_p0_gpa, name))
+    p0 = np.asarray(contact or p0_list) * units.GPA_TO_PA
     peaks = mindlin.peak_force(p0, params)
     u = np.linspace(0.0, 1.5, N_DISPLACEMENT)[None, :] * peaks.full_slip_displacement_m[:, None]
     resp = mindlin.lateral_force(u, p0[:, None], params)
@@ -244,4 +270,5 @@ def analyse(
         peaks=peaks,
         displacement_m=u,
         response=resp,
+        contact_p0_gpa=contact,
     )

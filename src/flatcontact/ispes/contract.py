@@ -28,6 +28,9 @@ attrs
     cells: the larger of the round-off and the relaxation floor,
     :mod:`flatcontact.ispes.relax_noise`); absent means not measured
     (:func:`energy_floor_mev_per_a2`).
+    ``fold_rerelaxed_points`` and ``fold_rerelaxed_fmax_ev_per_a`` (optional): that many
+    points of folding columns were relaxed again at that tighter force tolerance (eV/Å) and
+    hold those values (:mod:`flatcontact.ispes.rerelax`).
 
 Points not computed yet are NaN with ``converged = False``.
 
@@ -366,3 +369,22 @@ def write_ispes(ds: xr.Dataset, path: str | os.PathLike[str]) -> Path:
     with atomic_path(path) as tmp:
         ds.to_netcdf(tmp, engine="h5netcdf")
     return Path(path)
+
+
+def check_grid(ds: xr.Dataset, grid, source: str = "ISPES grid") -> None:
+    """Refuse an ISPES whose lateral grid is not ``grid`` (n_a, n_b): a landscape of another
+    run or another grid beside a stage record that claims this run's (one line naming it).
+
+    Raises
+    ------
+    InputError
+        ``source``, both grids and how to recompute it.
+    """
+    have = (int(ds.sizes[DIMS[0]]), int(ds.sizes[DIMS[1]]))
+    want = (int(grid[0]), int(grid[1]))
+    if have != want:
+        raise InputError(
+            f"{source}: a {have[0]}x{have[1]} landscape, the settings scan a {want[0]}x{want[1]} "
+            "grid (scan.grid); the file is not this run's: remove its stage folder and rerun "
+            "to recompute it"
+        )

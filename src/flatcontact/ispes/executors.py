@@ -1,7 +1,8 @@
 """Where grid points run: serially, in local worker processes, or on a Dask cluster.
 
-Every executor takes ``submit(fn, *args)`` and returns a handle; ``wait_first``
-blocks until at least one handle is finished. Workers build their calculator once
+Every executor follows the :class:`Executor` protocol: ``submit(fn, *args)`` returns a
+handle; ``wait_first`` blocks until at least one handle is finished, ``done`` says whether a
+handle already is, ``result`` gives its value. Workers build their calculator once
 (:func:`flatcontact.ispes.relax.worker_calculator`, cached per worker thread) and
 reuse it for every point they receive. Workers never write files: results come back
 to the driver, which alone writes the point store.
@@ -26,9 +27,10 @@ import os
 import signal
 import sys
 from collections.abc import Callable, Iterable
-from typing import Any
+from typing import Any, Protocol, runtime_checkable
 
 from flatcontact.errors import InputError
+from flatcontact.ispes.main_guard import serial_instead
 from flatcontact.ispes.relax import worker_calculator
 
 
@@ -40,11 +42,42 @@ def default_workers() -> int:
         return max(1, os.cpu_count() or 1)
 
 
+@runtime_checkable
+class Executor(Protocol):
+    """What the scan driver asks of an executor (:mod:`flatcontact.ispes.scan`).
+
+    ``workers``: how many tasks run at once (the driver keeps twice as many in flight and
+    from :data:`flatcontact.ispes.scan_probe.MANY_WORKERS` on probes in parallel chains).
+    ``inline``: tasks run at submission in the driver's process (the driver commits its
+    store before each submission). ``prestart``: start the workers and build their
+    calculators without waiting (a no-op where there is nothing to start).
+    """
+
+    name: str
+    inline: bool
+
+    @property
+    def workers(self) -> int: ...
+
+    def submit(self, fn: Callable, *args: Any) -> Any: ...
+
+    def wait_first(self, handles: Iterable[Any]) -> tuple[set, set]: ...
+
+    def done(self, handle: Any) -> bool: ...
+
+    def result(self, handle: Any) -> Any: ...
+
+    def prestart(self, factory: Any, reference: Any) -> None: ...
+
+    def close(self, cancel: bool = False) -> None: ...
+
+
 class SerialExecutor:
     """Runs each task at submission, in the driver process."""
 
     workers = 1
     name = "serial"
+    inline = True
 
     def submit(self, fn: Callable, *args: Any) -> cf.Future:
         fut: cf.Future = cf.Future()
@@ -60,8 +93,16 @@ class SerialExecutor:
         return cf.wait(list(handles), return_when=cf.FIRST_COMPLETED)
 
     @staticmethod
+    def done(handle: Any) -> bool:
+        """Whether ``handle`` is finished (``concurrent.futures`` and Dask futures alike)."""
+        return bool(handle.done())
+
+    @staticmethod
     def result(handle: cf.Future) -> Any:
         return handle.result()
+
+    def prestart(self, factory: Any, reference: Any) -> None:
+        """Nothing to start: the driver builds its calculator when it first needs it."""
 
     def close(self, cancel: bool = False) -> None:
         pass
@@ -107,6 +148,7 @@ class ProcessExecutor(SerialExecutor):
     """Local worker processes (``spawn``), ``workers`` of them (default: one per core)."""
 
     name = "processes"
+    inline = False
 
     def __init__(self, workers: int | None = None):
         workers = default_workers() if workers is None else workers
@@ -240,6 +282,7 @@ class DaskExecutor(SerialExecutor):
     """
 
     name = "dask"
+    inline = False
 
     def __init__(self, address: str | None = None, cluster: Any = None, timeout_s: float = 5.0):
         from distributed import Client
@@ -311,7 +354,7 @@ def make_executor(
     workers: int | None = None,
     dask_address: str | None = None,
     jobqueue: dict | None = None,
-):
+) -> Executor:
     """Build an executor: ``serial``, ``processes`` (default), or ``dask``.
 
     ``dask_address`` or ``jobqueue`` imply ``dask``; without either, ``dask`` starts a
@@ -322,7 +365,7 @@ def make_executor(
     if kind == "serial":
         return SerialExecutor()
     if kind == "processes":
-        if workers == 1:
+        if workers == 1 or serial_instead(workers):  # a script without its __main__ guard
             return SerialExecutor()
         return ProcessExecutor(workers)
     if kind == "dask":
@@ -330,5 +373,7 @@ def make_executor(
             return DaskExecutor(address=dask_address)
         if jobqueue is not None:
             return DaskExecutor(cluster=jobqueue_cluster(jobqueue))
+        if serial_instead(workers):  # a local cluster spawns its workers too
+            return SerialExecutor()
         return DaskExecutor.local(workers or default_workers())
     raise InputError(f"executor: expected serial, processes or dask, got {kind!r}")

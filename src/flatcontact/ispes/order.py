@@ -26,6 +26,8 @@ from __future__ import annotations
 from collections import deque
 from typing import Literal
 
+import numpy as np
+
 Index = tuple[int, int, int]
 Preference = Literal["columns", "planes", "cold"]
 PREFERENCES = ("columns", "planes", "cold")
@@ -90,3 +92,28 @@ def depth(parent: dict[Index, Index | None]) -> int:
     for node, par in parent.items():  # visiting order: parents come first
         level[node] = 0 if par is None else level[par] + 1
     return max(level.values()) + 1
+
+
+def tree_in_store_order(
+    z: np.ndarray, shape: tuple, root: tuple, order: str, allowed: set | None = None
+) -> dict:
+    """The warm-start tree (:func:`search_tree`) over the thicknesses ``z`` in ascending
+    order, in the store's indices (``root``, ``allowed`` and the result): ``i_z`` is the
+    position in the resolved list, which a thickness added below the smallest after the
+    scan (:func:`flatcontact.ispes.scan_extend.extend_grid`) joins at its end. For an
+    ascending list (every scan before such an addition) this is the tree itself."""
+    rank = np.argsort(z, kind="stable")  # sorted position -> store index
+    if np.array_equal(rank, np.arange(z.size)):
+        return search_tree(shape, root, order, allowed=allowed)
+    position = np.empty_like(rank)
+    position[rank] = np.arange(z.size)  # store index -> sorted position
+
+    def to_sorted(idx):
+        return (idx[0], idx[1], int(position[idx[2]]))
+
+    def to_store(idx):
+        return None if idx is None else (idx[0], idx[1], int(rank[idx[2]]))
+
+    sorted_allowed = None if allowed is None else {to_sorted(i) for i in allowed}
+    tree = search_tree(shape, to_sorted(root), order, allowed=sorted_allowed)
+    return {to_store(idx): to_store(par) for idx, par in tree.items()}

@@ -22,7 +22,7 @@ from flatcontact.errors import InputError
 from flatcontact.ispes.contract import cell_area
 from flatcontact.ispes.geometry import in_plane_vectors, place_slab2, thickness
 from flatcontact.ispes.grid import GridSpec
-from flatcontact.ispes.relax import normal_stress_gpa
+from flatcontact.ispes.relax import normal_stress_gpa, start_afresh
 
 
 @dataclasses.dataclass(frozen=True)
@@ -93,6 +93,7 @@ def rigid_rows(reference: Atoms, calc, grid: GridSpec, rows) -> tuple[np.ndarray
                 atoms = place_slab2(reference, float(a), float(b), z_ref)
             except InputError:
                 continue
+            start_afresh(calc)  # a function of the stacking alone, whatever ran before
             atoms.calc = calc
             energy[i, j] = atoms.get_potential_energy()
             load[i, j] = normal_stress_gpa(atoms, atoms.get_forces(apply_constraint=False))

@@ -121,7 +121,7 @@ def _defect(kind: str, value: Any) -> str | None:
             return "energy and load of a row differ in length or overlap"
         return None
     if kind == "work":
-        numbers = [v for v in dataclasses.astuple(value) if not isinstance(v, bool)]
+        numbers = [v for v in dataclasses.astuple(value) if not isinstance(v, bool | str)]
         numbers = np.asarray([x for v in numbers for x in np.atleast_1d(v)], dtype=float)
         return None if np.all(np.isfinite(numbers)) else "a number of W is not finite"
     fields = (value.thickness_angstrom, value.energy_ev, value.normal_stress_gpa)

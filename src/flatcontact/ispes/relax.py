@@ -283,6 +283,7 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
         )
         atoms.positions = positions
     elif relaxing:
+        start_afresh(calc)
         steps = _relax_with_ase(atoms, calc, fixed, free, groups, settings)
         forces = atoms.get_forces(apply_constraint=False)
         energy = float(atoms.get_potential_energy())
@@ -360,12 +361,24 @@ def constraint_projector(fixed: np.ndarray, mode: str, groups: list[np.ndarray])
     return project
 
 
+def start_afresh(calc) -> None:
+    """Let ``calc`` forget what it computed before, so that its next evaluations depend on
+    their positions alone (:meth:`flatcontact.potentials.calculator.InterfaceCalculator.start_afresh`:
+    LAMMPS runs its full setup again). Every point and every single point of the scan starts
+    so: a point's numbers do not depend on which worker computed it after which other point,
+    and a resumed scan equals an uninterrupted one bit for bit. Any other ASE calculator is
+    taken as it is (it keeps no state across structures, or none the scan can reset)."""
+    afresh = getattr(calc, "start_afresh", None)
+    if afresh is not None:
+        afresh()
+
+
 def point_evaluator(calc, atoms: Atoms):
     """``evaluate(positions) -> (energy_ev, forces)`` of ``atoms`` at new positions.
 
     Calculators of :mod:`flatcontact.potentials` give their engine directly
-    (``calc.position_evaluator``: built once for this structure, one evaluation per call,
-    counted in ``calc.force_calls``); any other ASE calculator is asked through a
+    (``calc.position_evaluator``: built once for this structure, started afresh
+    (:func:`start_afresh`), one evaluation per call, counted in ``calc.force_calls``); any other ASE calculator is asked through a
     constraint-free copy of ``atoms`` (``calculate`` once per new structure). The forces
     returned are valid until the next call (they may be the engine's own array).
     """

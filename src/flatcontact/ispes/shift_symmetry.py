@@ -184,11 +184,6 @@ class ShiftGroup:
         }
 
 
-def identity_group(tolerance_angstrom: float = DEFAULT_TOLERANCE_ANGSTROM) -> ShiftGroup:
-    """The trivial group (symmetry off)."""
-    return ShiftGroup((ShiftOperation(((1, 0), (0, 1)), (0.0, 0.0), False),), tolerance_angstrom)
-
-
 # ----------------------------------------------------------------------------- atoms
 def _labels(atoms: Atoms) -> np.ndarray:
     """Per-atom integer label: species and held flag (what an operation must keep)."""

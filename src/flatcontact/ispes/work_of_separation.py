@@ -3,7 +3,12 @@
 W = [E(slab 1 alone) + E(slab 2 alone) − E(interface at zero load)] / A, in J/m²
 (``EV_PER_A2_TO_J_PER_M2``), A = |a1 × a2| the cell area in Å².
 
-- The interface at zero load is the reference's lowest-energy lateral stacking at the
+- The interface at zero load is taken at the **perfect stacking** when the interface is a
+  3-D crystal continued across the cut (its zero shift, named by geometry whatever its
+  energy: a potential that favours the stacking fault would otherwise put W at the fault;
+  :func:`flatcontact.structures.interface_contract.continues_crystal`), else at the
+  **global minimum** (the lowest-energy lateral stacking of the scan's rigid single points);
+  ``work_of_separation_stacking`` says which (:func:`work_shift`). It is taken at the
   thickness where the normal load p (GPa, > 0 pressed;
   :func:`flatcontact.ispes.relax.normal_stress_gpa`) vanishes: p = −(1/A) dU/dz, so that
   thickness is the minimum of the relaxed energy U(z) of the column. It is found by a
@@ -39,7 +44,8 @@ from ase import Atoms
 from flatcontact.errors import InputError
 from flatcontact.ispes.contract import cell_area
 from flatcontact.ispes.geometry import in_plane_vectors, place_slab2, thickness
-from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point
+from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point, start_afresh
+from flatcontact.structures.interface_contract import continues_crystal, recipe_record
 from flatcontact.units import EV_PER_A2_TO_J_PER_M2
 
 #: first step (Å) away from the reference thickness when bracketing p = 0; doubled each time
@@ -56,6 +62,19 @@ MAX_ITERATIONS = 60
 SEPARATIONS_ANGSTROM = (20.0, 40.0, 80.0, 160.0)
 #: the slabs are apart when the rigid energy changes by less than this per area (J/m²)
 APART_TOL_J_PER_M2 = 1e-6
+
+
+#: ``work_of_separation_stacking``: where W is taken (:func:`work_shift`).
+AT_PERFECT_STACKING = "perfect stacking (zero shift: slab 2 continues slab 1's crystal)"
+AT_GLOBAL_MINIMUM = "global minimum (lowest rigid energy of the grid's stackings)"
+
+
+def work_shift(reference: Atoms, lowest: tuple[float, float]) -> tuple[tuple[float, float], str]:
+    """The lateral stacking W is taken at and its label: the zero shift of a continued 3-D
+    crystal (the perfect stacking), else ``lowest`` (the grid's lowest rigid stacking)."""
+    if continues_crystal(recipe_record(reference)):
+        return (0.0, 0.0), AT_PERFECT_STACKING
+    return (float(lowest[0]), float(lowest[1])), AT_GLOBAL_MINIMUM
 
 
 @dataclasses.dataclass(frozen=True)
@@ -76,6 +95,8 @@ class WorkOfSeparation:
     #: every relaxation met the force tolerance
     converged: bool
     force_calls: int
+    #: where W is taken (:func:`work_shift`)
+    stacking: str = AT_GLOBAL_MINIMUM
 
     def record(self) -> dict[str, Any]:
         """Flat scalar entries for ``scan.json``'s ``adhesion`` and ``ispes.nc``'s attrs."""
@@ -87,6 +108,7 @@ class WorkOfSeparation:
             "work_of_separation_residual_stress_gpa": self.zero_load_stress_gpa,
             "work_of_separation_apart_angstrom": self.separation_angstrom,
             "work_of_separation_converged": self.converged,
+            "work_of_separation_stacking": self.stacking,
         }
 
 
@@ -109,10 +131,12 @@ def ideal_work_of_separation(
     relax
         The scan's relaxation settings (tolerance, optimiser, mode).
     shift
-        The lowest-energy lateral stacking (fractions of a1, a2).
+        The lowest-energy lateral stacking (fractions of a1, a2); replaced by the zero shift
+        (the perfect stacking) for a continued 3-D crystal (:func:`work_shift`).
     calc
         A calculator already built for ``reference`` (the scan driver's), reused.
     """
+    shift, stacking = work_shift(reference, shift)
     a1, a2 = in_plane_vectors(reference)
     area = cell_area(a1, a2)
     calc = factory(reference) if calc is None else calc
@@ -130,6 +154,7 @@ def ideal_work_of_separation(
         area_angstrom2=float(area),
         converged=bool(ok and converged),
         force_calls=int(calls + n),
+        stacking=stacking,
     )
 
 
@@ -148,6 +173,7 @@ def slabs_apart(
 
     def rigid_energy(z: float) -> float:
         atoms = place_slab2(reference, a, b, z, spread_compression=False)
+        start_afresh(calc)  # a function of z alone, whatever ran before
         atoms.calc = calc
         try:
             return float(atoms.get_potential_energy())

@@ -135,10 +135,12 @@ class InterfaceCalculator(Calculator):
         cache, no change check), counted in ``force_calls``. The positions must belong to
         ``atoms``'s structure (same atoms, cell, pbc). ASE's cached results are dropped, so
         a later ``get_forces`` recomputes. The forces returned may be the engine's own
-        array (read-only): valid until the next call, copy what is kept.
+        array (read-only): valid until the next call, copy what is kept. The engine starts
+        afresh (:meth:`start_afresh`): the evaluations depend on their positions alone.
         """
         self._engine_for(atoms)
         self.reset()
+        self.start_afresh()
         fast = self._positions_evaluator(atoms)
 
         def evaluate(positions: np.ndarray) -> tuple[float, np.ndarray]:
@@ -147,6 +149,12 @@ class InterfaceCalculator(Calculator):
             return out[0], out[1]
 
         return evaluate
+
+    def start_afresh(self) -> None:
+        """The next evaluation does not depend on the earlier ones (LAMMPS: a full setup,
+        :meth:`~flatcontact.potentials.lammps_engine.LammpsEngine.restart`). The scan calls
+        it at the start of every point, so a point's numbers are a function of the point."""
+        self.reset()
 
     def _positions_evaluator(self, atoms: Atoms):
         """positions -> engine output, for the structure of ``atoms`` (default: a copy)."""
@@ -173,6 +181,12 @@ class LammpsInterfaceCalculator(InterfaceCalculator):
 
     def _evaluate(self, atoms: Atoms, stress: bool):
         return self.engine.compute(atoms.positions, stress=self.bulk and all(atoms.pbc))
+
+    def start_afresh(self) -> None:
+        super().start_afresh()
+        engine = getattr(self, "engine", None)
+        if engine is not None:
+            engine.restart()
 
     def _positions_evaluator(self, atoms: Atoms):
         # forces not copied where LAMMPS's array is already in the caller's frame and order

@@ -32,6 +32,9 @@ from flatcontact.errors import InputError
 #: Voigt pairs in ASE order (xx, yy, zz, yz, xz, xy).
 VOIGT_PAIRS = ((0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1))
 
+#: z bounds (Å) of a slab's box as created; the first setup shrink-wraps them to the atoms.
+SLAB_Z_BOUNDS = (-1.0, 1.0)
+
 
 def voigt_to_tensor(v: np.ndarray) -> np.ndarray:
     """Voigt 6-vector(s) ``(..., 6)`` (xx, yy, zz, yz, xz, xy) -> symmetric tensors ``(..., 3, 3)``."""
@@ -120,7 +123,7 @@ class LammpsBox:
             )
         else:
             bnd = " ".join("p" if p else "s" for p in self.pbc)
-            zlo, zhi = (0.0, self.lz) if self.pbc[2] else (-1.0, 1.0)
+            zlo, zhi = (0.0, self.lz) if self.pbc[2] else SLAB_Z_BOUNDS
             region = (
                 f"region box prism 0 {self.lx:.17g} 0 {self.ly:.17g} {zlo:.17g} {zhi:.17g} "
                 f"{self.xy:.17g} 0 0 units box"

@@ -48,7 +48,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from flatcontact.errors import InputError
-from flatcontact.potentials.lammps_box import create_box
+from flatcontact.potentials.lammps_box import SLAB_Z_BOUNDS, create_box
 from flatcontact.potentials.lammps_runtime import new_lammps
 
 #: LAMMPS's neighbour skin (Å): lists hold pairs within cutoff + skin and are rebuilt when an
@@ -129,6 +129,8 @@ class LammpsEngine:
                 charges=setup.charges,
             )
             self.lmp.commands_list(list(setup.commands))
+            # the in-plane boundary styles, for the full setups (compute)
+            self._xy = " ".join("p" if p else "s" for p in self.box.pbc[:2])
             # pressures only for periodic cells: a slab cell deletes LAMMPS's pressure compute,
             # else its virial is tallied in every run all the same (module docstring)
             thermo = "pe pxx pyy pzz pyz pxz pxy" if self.box.bulk else "pe"
@@ -211,8 +213,7 @@ class LammpsEngine:
                 x[rows] = current
             lmp.command("run 1 pre no post no")
         else:
-            box = self.box.to_lammps(positions)
-            x[rows] = box
+            box = self._place_for_setup(positions)
             if not self.box.bulk:  # the lattice vectors the wrap added (LammpsBox.place)
                 self._offsets[...] = box - self.box.vectors_to_lammps(positions)
             lmp.command("run 0 post no")
@@ -228,6 +229,40 @@ class LammpsEngine:
             return energy, forces
         p = [self.lmp.get_thermo(k) for k in ("pxx", "pyy", "pzz", "pyz", "pxz", "pxy")]
         return energy, forces, self.box.stress_to_caller(p)
+
+    def _place_for_setup(self, positions: np.ndarray) -> np.ndarray:
+        """Write ``positions`` (Å, wrapped into the box) into LAMMPS before a full setup, the
+        box as created: its LAMMPS coordinates, the same whatever ran before.
+
+        Every setup (and ``change_box``) first maps the atoms through the box it finds
+        (triclinic: x -> lamda -> x) and shrink-wraps a non-periodic z to them, so z bounds
+        left by earlier structures would move the positions in their last bits. The bounds
+        are therefore set back to the created ones
+        (:data:`~flatcontact.potentials.lammps_box.SLAB_Z_BOUNDS`, held fixed) before the
+        positions are written, and shrink-wrapped from there.
+        """
+        lmp = self.lmp
+        shrink = not self.box.pbc[2]
+        if shrink:
+            zlo, zhi = SLAB_Z_BOUNDS
+            lmp.command(f"change_box all boundary {self._xy} f z final {zlo!r} {zhi!r} units box")
+        rows, x, _ = self._views()
+        box = self.box.to_lammps(positions)
+        x[rows] = box
+        if shrink:
+            lmp.command(f"change_box all boundary {self._xy} s")
+        return box
+
+    def restart(self) -> None:
+        """The next :meth:`compute` runs the full setup (``run 0``) from the positions it
+        is given, in the box as created (:meth:`_place_for_setup`): its numbers are then a
+        function of those positions alone, not of what this engine computed before (the
+        images :meth:`compute` places the atoms at, the neighbour lists it keeps and the box
+        it shrink-wrapped last depend on its earlier calls and move the forces in their last
+        bits). The scan restarts the engine at each point, so a point's numbers do not depend
+        on which worker relaxed it after which other point, nor on a resume.
+        """
+        self._ready = False
 
     def minimize(
         self,
@@ -260,8 +295,7 @@ class LammpsEngine:
             raise InputError("LAMMPS minimize: held components must be whole atoms or x and y")
         whole = np.flatnonzero(held.all(axis=1)) + 1
         lateral = np.flatnonzero(xy_only) + 1
-        rows, x, _ = self._views()
-        x[rows] = self.box.to_lammps(positions)  # the start, wrapped: minimize's setup takes it
+        self._place_for_setup(positions)  # the start, wrapped: minimize's setup takes it
         lmp = self.lmp
         fixes = []
         for name, ids, values in (

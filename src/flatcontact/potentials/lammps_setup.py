@@ -26,6 +26,7 @@ from flatcontact.errors import InputError
 from flatcontact.potentials.lammps_engine import NEIGHBOR_SKIN_ANGSTROM, LammpsSetup
 from flatcontact.potentials.lj import LJPair, pair_key
 from flatcontact.potentials.model import slab_ids
+from flatcontact.potentials.styles import style_cutoff_angstrom
 
 #: Largest atom number density of a solid that sizes the neighbour capacity (atoms/Å³;
 #: diamond 0.176, α-quartz 0.080, Cu 0.085).
@@ -239,11 +240,15 @@ def compile_setup(model, atoms, bulk: bool = False) -> LammpsSetup:
             for tj in range(ti, ntypes + 1)
             if (ti, tj) not in covered
         ]
-    # 16 Å interlayer cutoffs in small periodic cells, or a long cross-interface LJ: more
-    # neighbours per atom than LAMMPS's default capacity (2000; "Neighbor list overflow")
+    # 16 Å interlayer cutoffs in small periodic cells, or a long cross-interface LJ or
+    # interlayer cutoff (a convergence study's cutoff ladder): more neighbours per atom than
+    # LAMMPS's default capacity (2000; "Neighbor list overflow")
+    style_cutoffs = [style_cutoff_angstrom(s) for s, _, _ in instances]
+    longest = max((c for c in style_cutoffs if c is not None), default=0.0)
     one = max(
         INTERLAYER_NEIGHBOURS if interlayer else 0,
         neighbour_capacity(cutoff) if lj_table is not None else 0,
+        neighbour_capacity(longest) if longest else 0,
     )
     if one > LAMMPS_DEFAULT_NEIGHBOURS:
         commands.append(f"neigh_modify one {one} page {20 * one}")

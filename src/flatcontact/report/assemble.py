@@ -9,12 +9,13 @@ the report and nothing else.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import pandas as pd
 from ase.io import read
 
+from flatcontact.errors import InputError
+from flatcontact.fileio import read_json_file
 from flatcontact.layout import (
     ANALYZE_JSON,
     BUILD_JSON,
@@ -38,13 +39,23 @@ from flatcontact.report.sections.contact import contact_section
 from flatcontact.report.sections.experiment import experiment_section
 from flatcontact.report.sections.gates import gates_section
 from flatcontact.report.sections.laws import laws_section
+from flatcontact.report.sections.refusal import refusal_section
 from flatcontact.report.sections.scan import scan_section
 from flatcontact.report.sections.summary import summary_section
 from flatcontact.report.stacking_names import stacking_family
+from flatcontact.result_json import CONTRACTS, MAX_BYTES, read_result_json
 
 
-def _json(path: Path) -> dict:
-    return json.loads(path.read_text())
+def _json(path: Path, **expect) -> dict:
+    """A stage's JSON file, checked against its contract where it has one
+    (:mod:`flatcontact.result_json`; ``expect``: what the settings say it holds);
+    ``build.json`` as a complete JSON mapping."""
+    if path.name in CONTRACTS:
+        return read_result_json(path, **expect)
+    doc = read_json_file(path, path.name, MAX_BYTES)
+    if not isinstance(doc, dict):
+        raise InputError(f"{path}: not a mapping; remove {path.parent} and rerun to recompute it")
+    return doc
 
 
 def _elastic(cfg, folder: Path | None) -> dict | None:
@@ -55,7 +66,10 @@ def _elastic(cfg, folder: Path | None) -> dict | None:
 
 
 def build_sections(
-    cfg, folders: dict[str, Path], stage_rows: list[tuple[str, str, str, str]]
+    cfg,
+    folders: dict[str, Path],
+    stage_rows: list[tuple[str, str, str, str]],
+    refusal: dict | None = None,
 ) -> list[Section]:
     """The report's sections from the stage folders (``folders[name]``; figures embedded).
 
@@ -69,40 +83,56 @@ def build_sections(
     ``contact.accept_untrusted`` (``summary.json["gates"]``) puts a box above everything
     (:mod:`flatcontact.report.sections.gates`). Stackings are named for the
     interface's family (:func:`flatcontact.report.stacking_names.stacking_family`).
+
+    A run refused after the scan (``refusal``,
+    :func:`flatcontact.report.sections.refusal.refusal_record`) has folders for the stages
+    that finished only (build and scan at least): the refusal comes first, then the sections
+    of those stages; the results sections need the contact stage and are left out.
     """
     f_build, f_scan = folders["build"], folders["scan"]
-    f_an, f_laws, f_ct = folders["analyze"], folders["laws"], folders["contact"]
+    f_an, f_laws, f_ct = folders.get("analyze"), folders.get("laws"), folders.get("contact")
     build = _json(f_build / BUILD_JSON)
-    scan = _json(f_scan / SCAN_JSON)
-    analyze = _json(f_an / ANALYZE_JSON)
-    laws = _json(f_laws / LAWS_JSON)
-    contact = _json(f_ct / SUMMARY_JSON)
-    table = pd.read_csv(f_an / FRICTION_CSV)
+    scan = _json(f_scan / SCAN_JSON, grid=cfg.scan.grid)
+    analyze = _json(f_an / ANALYZE_JSON) if f_an is not None else None
+    laws = (
+        _json(f_laws / LAWS_JSON, energy_form=cfg.analysis.energy_form)
+        if f_laws is not None
+        else None
+    )
+    contact = (
+        _json(f_ct / SUMMARY_JSON, p0_gpa=list(cfg.contact.p0_gpa)) if f_ct is not None else None
+    )
+    table = pd.read_csv(f_an / FRICTION_CSV) if f_an is not None else None
     interface = read(f_build / INTERFACE)
     model = cfg.potential.label
     material = interface_material(interface)
     paper = is_paper_material(cfg, set(interface.get_chemical_symbols()))
     family = stacking_family(build)
-    gates = gates_section(contact)  # above everything: which numbers are not to be trusted
-    sections = [gates] if gates is not None else []
+    sections = [refusal_section(refusal)] if refusal is not None else []
+    gates = gates_section(contact) if contact is not None else None  # above everything
+    sections += [gates] if gates is not None else []
     sections.append(summary_section(cfg, material, model, scan, stage_rows))
-    if paper:
-        sections.append(paper_section(cfg, laws, scan, contact))
-    else:
-        sections.append(
-            own_results_section(cfg, material, model, laws, scan, contact, table, family)
-        )
-    experiment = experiment_section(contact, build)  # contact.experiment.compare
-    if experiment is not None:
-        sections.append(experiment)
+    if contact is not None and laws is not None:
+        if paper:
+            sections.append(paper_section(cfg, laws, scan, contact))
+        else:
+            sections.append(
+                own_results_section(cfg, material, model, laws, scan, contact, table, family)
+            )
+        experiment = experiment_section(contact, build)  # contact.experiment.compare
+        if experiment is not None:
+            sections.append(experiment)
     study = cfg.report.approximant_study  # the sequence toward the incommensurate contact
     if study is not None:
         sections.append(approximant_study_section(read_approximant_study(study), study, build))
-    return [
-        *sections,
+    sections += [
         interface_section(cfg, build, f_build, interface, paper),
         scan_section(scan, f_scan),
-        analysis_section(cfg, analyze, table, f_an, family),
-        laws_section(laws, f_laws, paper),
-        contact_section(cfg, contact, _elastic(cfg, folders.get("elastic")), f_ct),
     ]
+    if analyze is not None:
+        sections.append(analysis_section(cfg, analyze, table, f_an, family))
+    if laws is not None:
+        sections.append(laws_section(laws, f_laws, paper))
+    if contact is not None:
+        sections.append(contact_section(cfg, contact, _elastic(cfg, folders.get("elastic")), f_ct))
+    return sections

@@ -8,12 +8,15 @@ and ``friction.nc``; the report shows the names of the interface's own family
 (:func:`stacking_family`, from the build stage's record):
 
 ``gamma``
-    A homo-interface cut from a 3-D crystal (``fcc111``, or ``crystal`` with one material):
-    the ISPES is the generalized stacking-fault (γ) surface. The lower of the two three-fold
-    minima is the **perfect stacking** (the crystal continued across the interface; the
-    lower one for any crystal whose stacking fault costs energy), the higher the
-    **intrinsic stacking fault**, the two-fold saddle the **unstable stacking fault** and the
-    maximum the **on-top stacking**.
+    A 3-D crystal continued across the cut (``fcc111``, or ``crystal`` with one material,
+    slab 2 the continuation of slab 1: :func:`~flatcontact.structures.interface_contract.continues_crystal`):
+    the ISPES is the generalized stacking-fault (γ) surface. Names come from the geometry,
+    not from the energies: the stationary point at the zero shift (``zero_shift_stacking``
+    of ``friction.csv``) is the **perfect stacking**, whatever its energy (a potential with
+    γ_isf < 0 puts the fault below it); the other three-fold site the **intrinsic stacking
+    fault**, the two-fold saddle the **unstable stacking fault** and the maximum the
+    **on-top stacking**. Without the zero-shift key (a ``friction.csv`` written before it
+    existed) the points keep their kind-and-rank names.
 ``antiparallel``
     A bilayer of one sheet with slab 2 rotated by 180° (h-BN, 2H TMDs): the lower three-fold
     minimum is **AA′** (each atom above the other species), the other three-fold sites
@@ -23,13 +26,16 @@ and ``friction.nc``; the report shows the names of the interface's own family
 ``analysis``
     The paper's α-quartz (and a build record without a recipe): the analysis's own keys.
 ``generic``
-    Anything else (hetero pairs, twisted cells, files): minima, saddles and maxima by energy
-    rank (``minimum 1``, ``saddle 1``, ``maximum 1``, lowest first).
+    Anything else (hetero pairs, twisted cells, files, a crystal flipped or rotated): minima,
+    saddles and maxima by energy rank (``minimum 1``, ``saddle 1``, ``maximum 1``, lowest
+    first).
 """
 
 from __future__ import annotations
 
 import re
+
+from flatcontact.structures.interface_contract import continues_crystal
 
 #: The analysis's hexagonal-site keys (:mod:`flatcontact.analysis.stackings`).
 THREE_FOLD = ("AB", "BA")
@@ -50,25 +56,30 @@ def stacking_family(build: dict) -> str:
     if not one_material or "twist_angle_deg" in recipe:
         return "generic"
     if kind in ("fcc111", "crystal"):
-        return "gamma"
+        return "gamma" if continues_crystal(recipe) else "generic"
     if kind == "sheets":
         operation = str(recipe.get("slab2_operation", ""))
         return "antiparallel" if "rotated 180°" in operation else "bilayer"
     return "generic"
 
 
-def display_names(energies: dict[str, float], family: str) -> dict[str, str]:
+def display_names(energies: dict[str, float], family: str, zero_shift: str = "") -> dict[str, str]:
     """The report's name of each analysis key of ``energies`` (key → energy at one load, any
-    units) for ``family`` (:func:`stacking_family`); keys it does not rename keep their own."""
+    units) for ``family`` (:func:`stacking_family`); keys it does not rename keep their own.
+
+    ``zero_shift``: the analysis key of the stationary point at the zero shift
+    (``friction.csv`` ``zero_shift_stacking``), the perfect stacking of the ``gamma`` family.
+    """
     names = {key: key for key in energies}
     if family in ("bilayer", "analysis"):
         return names
     three = sorted((k for k in THREE_FOLD if k in energies), key=lambda k: energies[k])
     sps = sorted((k for k in energies if _SP.match(k)), key=lambda k: energies[k])
-    if family == "gamma" and three:
-        names[three[0]] = "perfect stacking"
-        if len(three) > 1:
-            names[three[1]] = "intrinsic stacking fault"
+    if family == "gamma" and zero_shift in energies:
+        names[zero_shift] = "perfect stacking"
+        for k in three:
+            if k != zero_shift and zero_shift in THREE_FOLD:
+                names[k] = "intrinsic stacking fault"
         for i, k in enumerate(sps, start=1):
             names[k] = "unstable stacking fault" + (f" {i}" if len(sps) > 1 else "")
         if "AA" in energies:
@@ -82,7 +93,8 @@ def display_names(energies: dict[str, float], family: str) -> dict[str, str]:
         for i, k in enumerate(sps, start=1):
             names[k] = "saddle" + (f" {i}" if len(sps) > 1 else "")
         return names
-    # generic: every point by kind and energy rank, the hexagonal letters included
+    # generic (and gamma without its zero-shift key): every point by kind and energy rank,
+    # the hexagonal letters included
     kinds: dict[str, list[str]] = {"min": [], "saddle": [], "max": []}
     for k in energies:
         m = _GENERIC.match(k)

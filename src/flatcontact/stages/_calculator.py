@@ -39,6 +39,19 @@ def factory(settings) -> Any:
     return calculator_factory(settings.potential)
 
 
+def bulk_factory(settings) -> Any:
+    """``callable(atoms)`` -> the model as a single-crystal calculator (energy, forces,
+    stress: :func:`flatcontact.potentials.engines.bulk_calculator`), as the elastic stage
+    uses it; the build relaxes each slab material's lattice with it."""
+
+    def bulk(atoms):
+        from flatcontact.potentials.engines import bulk_calculator
+
+        return bulk_calculator(settings.potential, atoms)
+
+    return bulk
+
+
 def check_atoms(settings, atoms) -> None:
     """One-line InputError when the model cannot compute ``atoms`` (element, LJ table)."""
     settings.potential.check_atoms(atoms)

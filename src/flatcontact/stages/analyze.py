@@ -13,7 +13,6 @@ no stale warning of the old threshold in ``analyze.json``.
 from __future__ import annotations
 
 import contextlib
-import json
 import logging
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,6 +28,7 @@ from flatcontact.layout import (
     SCAN_JSON,
     analyze_figure,
 )
+from flatcontact.result_json import read_result_json
 from flatcontact.stages._common import captured, renamed_errors, save
 
 #: Parameters of :func:`flatcontact.analysis.analyze.analyze_ispes` -> the settings path.
@@ -144,29 +144,62 @@ def _folds_named(scan_json: Path):
     """A load that is not monotonic where the scan recorded folds (``scan.json``
     ``load_folds``, :mod:`flatcontact.ispes.grid_bracket`) is named as that fold, with its two
     causes and their remedies (:data:`flatcontact.ispes.thicknesses.FOLD_REMEDY`: a plane that
-    slips, or a relaxation stopped short of its minimum) besides the loads below it."""
+    slips, or a relaxation stopped short of its minimum) besides the loads below it. A fold
+    whose window the scan re-relaxed at a tighter fmax and which survived
+    (``fold_rerelaxation``, :mod:`flatcontact.stages.fold_remedy`) is named as such."""
     try:
         yield
     except InputError as exc:
         text = str(exc)
-        folds = []
-        if "not monotonic" in text:
+        folds, survived = [], []
+        if "not monotonic" in text or "fold" in text:
             try:
-                folds = json.loads(scan_json.read_text()).get("load_folds") or []
-            except (OSError, ValueError, AttributeError):
-                folds = []
-        if not folds:
+                scan = read_result_json(scan_json)
+                folds = scan.get("load_folds") or []
+                redone = scan.get("fold_rerelaxation") or {}
+                survived = [f"{w['column']}" for w in redone.get("surviving") or []]
+                fmax = redone.get("fmax_ev_per_angstrom")
+            except (InputError, KeyError, TypeError):  # no scan.json here, or not one
+                folds, survived = [], []
+        if not folds and not survived:
             raise
         # imported here: the CLI imports this module before numpy and ASE may load
         from flatcontact.ispes.thicknesses import FOLD_REMEDY
 
-        first = folds[0]
-        raise InputError(
-            f"{text}; the scan recorded {len(folds)} folding column(s) ({SCAN_JSON} "
-            f"load_folds; first: {first.get('column')}, p = {first.get('p_gpa', float('nan')):.3g} "
-            f"GPa at z = {first.get('z_angstrom', float('nan')):.4g} Å): {FOLD_REMEDY}; or "
-            "use loads below the fold (analysis.p_gpa, scan.p_range_gpa.hi_gpa)"
-        ) from None
+        said = text
+        if folds and "not monotonic" in text:
+            first = folds[0]
+            said += (
+                f"; the scan recorded {len(folds)} folding column(s) ({SCAN_JSON} load_folds; "
+                f"first: {first.get('column')}, p = {first.get('p_gpa', float('nan')):.3g} GPa "
+                f"at z = {first.get('z_angstrom', float('nan')):.4g} Å): {FOLD_REMEDY}; or use "
+                "loads below the fold (analysis.p_gpa, scan.p_range_gpa.hi_gpa)"
+            )
+        named = _shift_in(text)
+        if named is not None:  # the column the analysis names, when it says which
+            survived = [c for c in survived if _shift_in(c) == named]
+        if survived:
+            from flatcontact.ispes.rerelax import SURVIVING_FOLD_REMEDY
+
+            said += (
+                f"; the scan re-relaxed the fold's window of the {survived[0]} at fmax "
+                f"{fmax:g} eV/Å and the fold survived: it is not the relaxation's; "
+                f"{SURVIVING_FOLD_REMEDY}"
+            )
+        if said == text:
+            raise
+        raise InputError(said) from None
+
+
+def _shift_in(text: str) -> tuple[str, str] | None:
+    """The lateral shift a message names, ``(shift_a=a, shift_b=b)`` as the analysis labels
+    a column or ``shift (a, b)`` as the scan does, as two strings (``%.4g``), or None."""
+    import re
+
+    found = re.search(r"shift_a=([-\d.e+]+), shift_b=([-\d.e+]+)", text) or re.search(
+        r"shift \(([-\d.e+]+), ([-\d.e+]+)\)", text
+    )
+    return (found.group(1), found.group(2)) if found else None
 
 
 def _write(result: AnalyzeResult, folder: Path, svg: bool) -> None:

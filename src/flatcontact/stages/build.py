@@ -82,7 +82,11 @@ def run_build(settings, inputs: BuildInputs, folder: Path | None, progress=None)
     ``quartz-dense`` (the paper's α-quartz (0001) dense interface, relaxed by its builder),
     ``file`` (a finished interface), ``toy-lj``, and ``slab``, ``sheets``, ``crystal``,
     ``fcc111`` (relaxed once with the run's model, no atom held, after the model's element
-    check). Errors name the settings path (``structure.bulk``, ``structure.miller``, ...).
+    check). ``sheets``, ``crystal``, ``fcc111`` and ``quartz-dense`` are cut at the model's
+    own lattice (``structure.lattice: potential``) or the file's (``file``: mismatch and
+    lateral stress in ``build.json["lattice"]``, refused above
+    :data:`flatcontact.structures.lattice.MAX_FILE_MISMATCH_PERCENT`). Errors name the
+    settings path (``structure.bulk``, ``structure.miller``, ``structure.lattice``, ...).
     """
     from flatcontact.structures.construct import build_interface
     from flatcontact.structures.interface_io import write_interface
@@ -92,10 +96,13 @@ def run_build(settings, inputs: BuildInputs, folder: Path | None, progress=None)
     if isinstance(s, ToyRecipe) and not s.params:
         # the toy's geometry follows its calculator's LJ (calculator.kwargs), as before recipes
         s = s.model_copy(update={"params": _calculator.toy_kwargs(settings)})
+    lattice = {"lattice_calculator": _calculator.bulk_factory(settings)}
     if isinstance(s, QuartzDenseRecipe):
         atoms, report = build_interface(s, potential=_calculator.model(settings))
     elif s.kind in RELAXED_KINDS:
-        atoms, report = build_interface(s, relax_calculator=_relax_calculator(settings))
+        atoms, report = build_interface(s, relax_calculator=_relax_calculator(settings), **lattice)
+    elif s.kind in IDEAL_KINDS:
+        atoms, report = build_interface(s, **lattice)
     else:
         atoms, report = build_interface(s)
         if s.kind in IDEAL_KINDS:
@@ -103,7 +110,10 @@ def run_build(settings, inputs: BuildInputs, folder: Path | None, progress=None)
             report["reference_geometry"] = IDEAL_GEOMETRY
     _calculator.check_atoms(settings, atoms)
     fmax = getattr(s, "fmax_ev_per_angstrom", 0.0)
-    result = BuildResult(atoms, report, unconverged_warnings(report, fmax))
+    warnings = unconverged_warnings(report, fmax) + list(
+        (report.get("lattice") or {}).get("warnings", [])
+    )
+    result = BuildResult(atoms, report, warnings)
     if folder is not None:
         from flatcontact.plots.structures import figure_interface
 

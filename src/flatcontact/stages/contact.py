@@ -40,16 +40,20 @@ from flatcontact.layout import (
     FIG6_EXPERIMENT,
     FIG6_FIT,
     FIG6_LOCKIN,
+    FIG_SLIP_SIZE,
     FIT_JSON,
     SUMMARY_JSON,
 )
-from flatcontact.reference import (
-    PAPER,
-    PAPER_EXPERIMENT_COLLAPSE_MPA,
-    PAPER_LAW_KEYS,
-    is_paper_material,
+from flatcontact.reference import PAPER, PAPER_LAW_KEYS, is_paper_material
+from flatcontact.stages._common import renamed_errors, save
+from flatcontact.stages.contact_experiment import (  # noqa: F401  (re-exported)
+    QUARTZ_QUICK_LAWS_FILE,
+    check_fit_settings,
+    experiment_comparison,
+    fit_curves,
+    quartz_quick_laws,
+    quartz_reference_laws,
 )
-from flatcontact.stages._common import rename, renamed_errors, save
 
 #: ContactParameters fields -> the settings path that sets them.
 SETTINGS_NAMES = {
@@ -82,7 +86,8 @@ class ContactInputs:
     is null; ``from_scan`` says a scan was read); ``moduli``: ``elastic.json`` of the elastic
     stage (E*, G* replacing ``contact.contact_modulus_gpa``/``shear_modulus_gpa``);
     ``gates``: the validity gates' report (:meth:`flatcontact.analysis.gates.GateReport.to_json`,
-    :mod:`flatcontact.stages.gates`), recorded in ``summary.json["gates"]``.
+    :mod:`flatcontact.stages.gates`), recorded in ``summary.json["gates"]``; ``interface``:
+    the run's facts for the contact's range (:func:`flatcontact.stages.contact_range.facts`).
     """
 
     laws: dict | None = None
@@ -90,6 +95,7 @@ class ContactInputs:
     from_scan: bool = False
     moduli: dict | None = None
     gates: dict | None = None
+    interface: dict | None = None
 
 
 def contact_parameters(settings, inputs: ContactInputs):
@@ -190,24 +196,6 @@ def check_cycle(settings, params) -> None:
         )
 
 
-def fit_curves(settings, params) -> list:
-    """The measured curves of ``contact.fit.csv`` (validated with the parameter names, before
-    any work): :func:`flatcontact.contact.measured.load_fit_data`, ``check_free_fixed``."""
-    from flatcontact.contact import fit, measured
-
-    c = settings.contact
-    try:
-        fit.check_free_fixed(c.fit.free, c.fit.fixed, "modified")
-    except InputError as exc:
-        where = "contact.fit.fixed" if "fixed" in str(exc) else "contact.fit.free"
-        raise InputError(f"{where}: {exc} (contact.fit.free = {list(c.fit.free)})") from None
-    try:
-        return measured.load_fit_data(c.fit.csv, params, c.fit.p0_gpa)
-    except InputError as exc:
-        text = rename(str(exc), {"fit_p0_gpa": "contact.fit.p0_gpa"})
-        raise InputError(f"contact.fit.csv: {text}") from None
-
-
 def law_half_widths_used(inputs: ContactInputs, provenance: dict) -> dict[str, float]:
     """Half-widths of the law coefficients the contact model takes from the fitted laws
     (``laws.json`` ``half_widths`` of its configured energy form); 0 for a coefficient set
@@ -247,7 +235,7 @@ def law_components_used(inputs: ContactInputs, provenance: dict) -> dict[str, di
 
 
 def contact_intervals(
-    settings, params, half_widths: dict[str, float], components: dict | None = None
+    settings, params, half_widths: dict[str, float], components: dict | None = None, p0c=None
 ) -> dict:
     """Intervals of the effective shear strength Q_peak/πa², the collapse stress (stiffness
     at ``contact.collapse_fraction``·k0) and the knee (``knee_fraction``·k0), amplitude stress,
@@ -259,7 +247,8 @@ def contact_intervals(
     model's domain (e.g. τ(centre) <= 0 for k < 0). With ``components`` (part -> coefficient
     -> half-width, :func:`law_components_used`) each quantity also carries
     ``components: {part: [low, high]}``, the interval over the box of that part alone, and the
-    document ``component_half_widths``.
+    document ``component_half_widths``. ``p0c``: the peak pressures the model is evaluated
+    at (the adhesive contact, :func:`flatcontact.stages.contact_range.contact_p0_gpa`).
     """
     from flatcontact import units
     from flatcontact.analysis.uncertainty import propagate_box
@@ -272,7 +261,7 @@ def contact_intervals(
     def outputs(x: dict[str, float]) -> dict[str, float]:
         prm = params.replace(**x)
         out = {}
-        for i, p0 in enumerate(p0s):
+        for i, p0 in enumerate(p0c or p0s):
             pa = p0 * units.GPA_TO_PA
             area = np.pi * float(mindlin.contact_radius(pa, prm)) ** 2
             peak = float(mindlin.peak_force(pa, prm).force_n)
@@ -312,22 +301,6 @@ def contact_intervals(
     return doc
 
 
-def check_fit_settings(settings) -> None:
-    """``contact.fit`` checked at the start of a run, before the laws exist (names freed and
-    fixed, files readable, load columns): the loads of a normal-load column are converted with
-    the configured R and E* here; the stage converts them again with the run's moduli."""
-    from flatcontact.contact.parameters import ContactParameters
-
-    c = settings.contact
-    if c.fit.csv:
-        start = ContactParameters(
-            radius_um=c.radius_um,
-            contact_modulus_gpa=c.contact_modulus_gpa,
-            shear_modulus_gpa=c.shear_modulus_gpa,
-        )
-        fit_curves(settings, start)
-
-
 def check_contact(settings, params) -> None:
     """Everything the contact stage refuses, before any work (one line naming the setting)."""
     c = settings.contact
@@ -347,49 +320,6 @@ def check_contact(settings, params) -> None:
         )
 
 
-#: flatcontact's own α-quartz laws: ``flatcontact run`` on the built-in default (quick preset,
-#: ``make run``; bundled sio2-snap + Hamaker LJ, (0001) dense interface), its
-#: ``04-laws/laws.json`` (the same before and after issue 20, re-measured 2026-11-25; the check
-#: every branch keeps). Code, not a data file, so a change reruns the contact stage.
-QUARTZ_QUICK_LAWS = {
-    "label": "quartz, flatcontact quick preset (make run)",
-    "k_mpa_per_gpa": 14.370389,
-    "tau0_mpa": 30.503874,
-    "mu_mpa_per_gpa": 4.99966,
-    "sigma0_mpa": 7.014888,
-}
-
-
-def quartz_reference_laws() -> dict[str, dict[str, float]]:
-    """The quartz law sets the experiment comparison sets a run against: the paper's
-    (:data:`flatcontact.reference.PAPER`) and flatcontact's quick preset
-    (:data:`QUARTZ_QUICK_LAWS`)."""
-    return {
-        "quartz, the paper's laws (SNAP + TS-vdW LJ)": {k: PAPER[k] for k in PAPER_LAW_KEYS},
-        QUARTZ_QUICK_LAWS["label"]: {k: float(QUARTZ_QUICK_LAWS[k]) for k in PAPER_LAW_KEYS},
-    }
-
-
-def experiment_comparison(settings, params) -> dict:
-    """``summary.json["experiment_comparison"]`` for ``contact.experiment.compare``: the run's
-    collapse stress at ``contact.experiment.p0_gpa`` against the measured collapses
-    (:data:`flatcontact.reference.PAPER_EXPERIMENT_COLLAPSE_MPA`) and the quartz laws'
-    (:func:`flatcontact.contact.tip_comparison.compare_collapse`)."""
-    from flatcontact.contact.tip_comparison import compare_collapse
-
-    c = settings.contact
-    doc = compare_collapse(
-        settings.report.title or settings.structure.kind,
-        params,
-        c.experiment.p0_gpa,
-        PAPER_EXPERIMENT_COLLAPSE_MPA,
-        quartz_reference_laws(),
-        fraction=c.collapse_fraction,
-    )
-    doc["experiment"] = c.experiment.compare
-    return doc
-
-
 @dataclass
 class ContactResult:
     """The contact analysis, its parameters and provenance, and the paper-laws comparison."""
@@ -407,13 +337,22 @@ class ContactResult:
     bands: tuple | None = None  # analyses at the lower and upper corner of the law box
     gates: dict | None = None  # the validity gates that fired and which were overridden
     experiment_comparison: dict | None = None  # contact.experiment.compare
+    adhesion: dict | None = None  # contact_range.adhesion_of(...).to_json()
+    slip_size: dict | None = None  # contact_range.slip_of
+    moduli_note: str | None = None  # contact_range.foreign_moduli_note
     files: list[Path] = field(default_factory=list)
 
     def cycle_rows(self) -> list[dict]:
         """One row per p0 and force amplitude (:func:`flatcontact.contact.cycle_output.cycle_records`)."""
         from flatcontact.contact.cycle_output import cycle_records
 
-        return cycle_records(self.cycles) if self.cycles else []
+        pairs = zip(self.analysis.p0_gpa, self.cycles, strict=True) if self.cycles else ()
+        # the cycle runs at the adhesive contact's peak pressure p1; rows keep the given p0
+        return [
+            {**row, "p0_gpa": p0, "contact_peak_pressure_gpa": row["p0_gpa"]}
+            for p0, cyc in pairs
+            for row in cycle_records([cyc])
+        ]
 
     def fit_json(self) -> dict | None:
         """``fit.json``: both models' fitted parameters with standard errors and correlations,
@@ -442,6 +381,10 @@ class ContactResult:
             doc["experiment_comparison"] = self.experiment_comparison
         if self.intervals is not None:
             doc["intervals"] = self.intervals
+        extra = {"adhesion_regime": self.adhesion, "slip_size": self.slip_size}
+        doc.update({k: v for k, v in extra.items() if v is not None})
+        if self.moduli_note:
+            doc["moduli_note"] = self.moduli_note
         if self.gates is not None:
             doc["gates"] = self.gates
         if self.cycles:
@@ -470,10 +413,13 @@ def run_contact(
     from flatcontact.contact import experiment as exp
     from flatcontact.contact.measured import load_stiffness_csv
     from flatcontact.contact.summary import analyse
+    from flatcontact.stages import contact_range as rng
 
     c = settings.contact
     params, provenance = contact_parameters(settings, inputs)
     check_contact(settings, params)
+    regime = rng.adhesion_of(settings, inputs, params)  # refuses where no model applies
+    p0c = rng.contact_p0_gpa(regime)
     measured = load_stiffness_csv(c.experiment.csv) if c.experiment.csv else None
     curves = fit_curves(settings, params) if c.fit.csv else None
     analysis = analyse(
@@ -482,6 +428,7 @@ def run_contact(
         maugis_lambda=c.maugis_lambda,
         knee_fraction=c.knee_fraction,
         p0_name="contact.p0_gpa",
+        contact_p0_gpa=p0c,
     )
     paper_laws = {key: PAPER[key] for key in PAPER_LAW_KEYS}
     paper = None
@@ -491,15 +438,20 @@ def run_contact(
             params.replace(**paper_laws),
             maugis_lambda=c.maugis_lambda,
             knee_fraction=c.knee_fraction,
+            contact_p0_gpa=p0c,
         )
     result = ContactResult(analysis, params, provenance, c.knee_fraction, paper)
     result.gates = inputs.gates
+    result.adhesion = regime.to_json()
+    result.slip_size = rng.slip_of(settings, rng.slip_interface(inputs), analysis)
+    result.moduli_note = rng.foreign_moduli_note(settings, provenance, params)
+    rng.log_lines(result.adhesion, result.slip_size, result.moduli_note)
     half_widths = law_half_widths_used(inputs, provenance)
     result.intervals = contact_intervals(
-        settings, params, half_widths, law_components_used(inputs, provenance)
+        settings, params, half_widths, law_components_used(inputs, provenance), p0c
     )
     if any(h > 0 for h in half_widths.values()) and "unavailable" not in result.intervals:
-        result.bands = _band_analyses(settings, params, half_widths)
+        result.bands = _band_analyses(settings, params, half_widths, p0c)
     comparison = None
     if measured is not None:
         comparison = exp.compare_with_measurement(
@@ -516,7 +468,7 @@ def run_contact(
         from flatcontact.contact import cycle
 
         result.cycles = cycle.cycles(
-            c.p0_gpa,
+            p0c or c.p0_gpa,
             params,
             c.cycle.model,
             amplitudes_un=c.cycle.amplitudes_un,
@@ -539,7 +491,7 @@ def run_contact(
     return result
 
 
-def _band_analyses(settings, params, half_widths: dict[str, float]) -> tuple | None:
+def _band_analyses(settings, params, half_widths: dict[str, float], p0c=None) -> tuple | None:
     """The contact analysis at the lower and the upper corner of the law box (every
     coefficient − and + its half-width; τ0, σ0 clipped at 0): the edges of the Fig. 5 band.
     The Mindlin outputs grow with each of k, τ0, μ, σ0, so these corners bound them.
@@ -557,6 +509,7 @@ def _band_analyses(settings, params, half_widths: dict[str, float]) -> tuple | N
                     settings.contact.p0_gpa,
                     params.replace(**corner),
                     knee_fraction=settings.contact.knee_fraction,
+                    contact_p0_gpa=p0c,
                 )
             )
         except InputError:
@@ -570,12 +523,12 @@ def _write(result: ContactResult, settings, folder: Path, measured, comparison) 
     c, analysis, params = settings.contact, result.analysis, result.params
     folder.mkdir(parents=True, exist_ok=True)
     p0_fig4 = 1.0 if 1.0 in analysis.p0_gpa else analysis.p0_gpa[0]
+    p0_fig4 = analysis.contact_p0_pa[analysis.p0_gpa.index(p0_fig4)] / 1e9
     lockin = None
     if result.cycles:
         from flatcontact.contact.cycle import lockin_curve
-        from flatcontact.units import GPA_TO_PA
 
-        lockin = [lockin_curve(p * GPA_TO_PA, params, c.cycle.model) for p in analysis.p0_gpa]
+        lockin = [lockin_curve(p, params, c.cycle.model) for p in analysis.contact_p0_pa]
     figs = {
         FIG4_TRACTION: fig4_traction(params, p0_fig4),
         FIG5_FORCE_STIFFNESS: fig5_force_and_stiffness(analysis, "amplitude", lockin, result.bands),
@@ -596,11 +549,16 @@ def _write(result: ContactResult, settings, folder: Path, measured, comparison) 
     if result.cycles:
         from flatcontact.plots.cycle import fig_lockin_overlay, fig_loops
 
-        shown = sorted({p0_fig4, max(analysis.p0_gpa)})
+        p0c = [float(p) / 1e9 for p in analysis.contact_p0_pa]
+        shown = sorted({p0_fig4, max(p0c)})
         figs[FIG5C_CYCLE_LOOPS] = fig_loops(
             params, shown, c.cycle.amplitude_fractions, model=c.cycle.model
         )
-        figs[FIG6_LOCKIN] = fig_lockin_overlay(params, analysis.p0_gpa, model=c.cycle.model)
+        figs[FIG6_LOCKIN] = fig_lockin_overlay(params, p0c, model=c.cycle.model)
+    if result.slip_size is not None:
+        from flatcontact.plots.slip_size import fig_slip_size
+
+        figs[FIG_SLIP_SIZE] = fig_slip_size(result.slip_size)
     if result.fit is not None:
         from flatcontact.plots.cycle import fig_fit
 
@@ -612,7 +570,7 @@ def _write(result: ContactResult, settings, folder: Path, measured, comparison) 
     if result.cycles:
         from flatcontact.contact.cycle_output import cycle_dataset
 
-        cyc = cycle_dataset(result.cycles, params)
+        cyc = cycle_dataset(result.cycles, params).assign_coords(p0=ds["p0"].values)
         ds = ds.merge(cyc)
         ds.attrs.update(cyc.attrs)
     with atomic_path(folder / CONTACT_NC) as tmp:

@@ -9,7 +9,6 @@ records the report in ``summary.json["gates"]`` and the report puts a box above 
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,6 +16,7 @@ import numpy as np
 
 from flatcontact.errors import InputError
 from flatcontact.ispes.shift_symmetry import DEFAULT_TOLERANCE_ANGSTROM
+from flatcontact.result_json import read_result_json
 
 
 @dataclass(frozen=True)
@@ -65,9 +65,9 @@ def evaluate_gates(inputs: GateInputs):
 
 
 def _read_json(path: Path | None) -> dict | None:
-    if path is None or not Path(path).is_file():
+    if path is None or not Path(path).exists():
         return None
-    return json.loads(Path(path).read_text())
+    return read_result_json(path)
 
 
 def _read_friction(path: Path | None):

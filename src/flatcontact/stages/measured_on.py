@@ -26,7 +26,7 @@ from flatcontact.stages import _calculator
 
 def structure_fingerprint(cfg: RunConfig) -> str:
     """SHA-256 of the structure recipe (files by name and content)."""
-    inputs = {"structure": portable(cfg.section("structure"), "file")}
+    inputs = {"structure": portable(cfg.structure_section(), "file")}
     for dotted, path in recipe_files(cfg.structure):
         inputs[f"{dotted}_sha256"] = file_sha256(path)
     return fingerprint(inputs)

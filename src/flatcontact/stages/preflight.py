@@ -15,6 +15,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from flatcontact import limits
+from flatcontact.analysis.analyze import MIN_LATERAL_POINTS
 from flatcontact.config import RunConfig
 from flatcontact.contact.measured import load_stiffness_csv
 from flatcontact.errors import InputError
@@ -42,13 +43,21 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
     that does not follow the contract (or has more atoms than the ``atoms`` bound), a
     recipe the builder refuses, a model that cannot compute the built interface or whose
     LAMMPS setup fails on it, a measured stiffness CSV that does not parse, a calculator
-    that does not import, a model that cannot compute the elastic stage's crystal.
+    that does not import, a model that cannot compute the elastic stage's crystal, a lateral
+    grid the analysis cannot interpolate (fewer than 3 points per axis: refused here, not
+    after the scan).
 
     Raises
     ------
     InputError
         One line naming ``source``'s field and the file.
     """
+    if min(cfg.scan.grid) < MIN_LATERAL_POINTS:
+        n_a, n_b = cfg.scan.grid
+        raise InputError(
+            f"{source}: scan.grid: {n_a}×{n_b} lateral points; the analysis (periodic "
+            f"interpolation, sliding path) needs at least {MIN_LATERAL_POINTS} per axis"
+        )
     if cfg.structure.kind in ("file", "slab") and getattr(cfg.structure, "file", None) is not None:
         _check_structure_file(cfg, source)
     if cfg.contact.experiment.csv is not None:

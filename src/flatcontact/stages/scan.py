@@ -37,6 +37,7 @@ from flatcontact.ispes.relax import RelaxSettings
 from flatcontact.layout import SCAN_FIGURE, SCAN_JSON
 from flatcontact.stages import _calculator
 from flatcontact.stages._common import save
+from flatcontact.stages.fold_remedy import remedy_folds
 
 log = logging.getLogger("flatcontact.run")
 
@@ -57,6 +58,7 @@ class ScanStageResult:
     files: list[Path] = field(default_factory=list)
     layer_slip: dict | None = None  # flatcontact.ispes.slip.SlipTable.to_json()
     shift_lattice: dict | None = None  # the cell ispes.nc is stated on (module docstring)
+    fold_rerelaxation: dict | None = None  # folds re-relaxed at fmax/10 (stages.fold_remedy)
 
     @property
     def dataset(self):
@@ -89,6 +91,7 @@ class ScanStageResult:
             "load_folds": list(getattr(r, "load_folds", [])),
             "layer_slip": self.layer_slip,
             "shift_lattice": self.shift_lattice,
+            "fold_rerelaxation": self.fold_rerelaxation,
         }
 
 
@@ -215,18 +218,21 @@ def run_scan(
             "(coprime to the index), re-indexed onto one period"
         )
         log.warning("scan: %s", warnings[-1])
+    grid, relax, symmetry = grid_spec(s, lateral), relax_settings(s), symmetry_settings(s)
     scan = ispes_scan.run_scan(
         reference,
         factory,
-        grid_spec(s, lateral),
+        grid,
         folder,
-        relax_settings(s),
+        relax,
         order=s.order,
         executor_options=s.executor_options(),
         progress=progress,
-        symmetry=symmetry_settings(s),
+        symmetry=symmetry,
         bracket_loads_gpa=list(settings.analysis.p_gpa),
     )
+    scan, folds, lines = remedy_folds(settings, reference, factory, scan, grid, relax, symmetry)
+    warnings += lines
     if lattice.index > 1:
         from flatcontact.ispes.contract import write_ispes
         from flatcontact.ispes.shift_lattice import to_shift_cell
@@ -245,6 +251,7 @@ def run_scan(
         log.warning("scan: %s", note)
     result = ScanStageResult(scan, warnings, [scan.store_path, scan.ispes_path])
     result.shift_lattice = record
+    result.fold_rerelaxation = folds
     if "layer" in reference.arrays and "slab" in reference.arrays:
         from flatcontact.ispes.slip import slip_table, store_points
 

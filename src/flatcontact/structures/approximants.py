@@ -54,6 +54,7 @@ import numpy as np
 
 from flatcontact.config.approximants import DEFAULT_STRAIN_LADDER_PERCENT, ApproximantSettings
 from flatcontact.errors import InputError, require
+from flatcontact.limits import SearchTimeout
 from flatcontact.structures.cell2d import is_hexagonal
 from flatcontact.structures.construct import slab_sources
 from flatcontact.structures.match import (
@@ -257,6 +258,8 @@ def _coincidence_sequence(recipe, a1, a2, na1: int, na2: int, settings) -> list[
                 field=f"{APPROXIMANTS}.strain_percent",
                 orientation_deg=orientation,
             )
+        except SearchTimeout:
+            raise  # not "no cell": the search ran out of time, and says which setting
         except InputError:
             if not out:
                 within = (

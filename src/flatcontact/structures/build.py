@@ -39,6 +39,7 @@ from flatcontact.potentials.engines import bulk_calculator, make_calculator
 from flatcontact.potentials.factories import chgnet_r2scan
 from flatcontact.potentials.model import InteractionModel
 from flatcontact.structures.assemble import make_interface
+from flatcontact.structures.bulk import QUARTZ_A_ANGSTROM, QUARTZ_C_ANGSTROM, alpha_quartz
 from flatcontact.structures.dense import (
     QUARTZ_ATOMS_PER_LAYER,
     dense_candidates,
@@ -46,6 +47,7 @@ from flatcontact.structures.dense import (
     verify_dense_slab,
 )
 from flatcontact.structures.interface_contract import thickness
+from flatcontact.structures.lattice import LatticeChoice, LatticeFit
 from flatcontact.structures.layers import chunk_layers
 from flatcontact.structures.quartz_layers import (
     DENSE_FACE_LAYERS,
@@ -123,12 +125,18 @@ def reconstruct_dense_slab(
     *,
     model_label: str,
     fmax_ev_per_angstrom: float = DEFAULT_FMAX_EV_PER_ANGSTROM,
+    a_angstrom: float = QUARTZ_A_ANGSTROM,
+    c_angstrom: float = QUARTZ_C_ANGSTROM,
 ) -> tuple[Atoms | None, dict]:
     """Seed the dense topology on both faces of a cut-2 slab and relax with ``calc_for(atoms)``.
 
-    Returns (the lowest-energy verified dense slab or ``None``, a record of every candidate).
+    The slab is cut from α-quartz at ``a_angstrom``, ``c_angstrom`` (the experimental
+    lattice by default). Returns (the lowest-energy verified dense slab or ``None``, a record
+    of every candidate).
     """
-    base = quartz_0001_slab(layers=layers, cut=SYMMETRIC_CUT)
+    base = quartz_0001_slab(
+        layers=layers, cut=SYMMETRIC_CUT, a_angstrom=a_angstrom, c_angstrom=c_angstrom
+    )
     trials = []
     best = None
     for sites, seeded in dense_candidates(base):
@@ -240,6 +248,27 @@ def regenerate_shipped_dense_slab(layers: int = 6, fmax_ev_per_angstrom: float =
     return provenance
 
 
+def quartz_lattice(spec, source: str = "potential") -> tuple[LatticeChoice, LatticeFit]:
+    """α-quartz (experimental a = 4.916, c = 5.405 Å) relaxed with ``spec``
+    (:class:`~flatcontact.structures.lattice.LatticeChoice`: both lattices, the (0001)
+    in-plane mismatch and lateral stress; ``source`` the one the slabs use)."""
+    choice = LatticeChoice(partial(bulk_calculator, spec), source)
+    bulk = alpha_quartz()
+    fit = choice.bulk("alpha-quartz", bulk, QUARTZ_MATERIAL, (0, 0, 1))
+    choice.note("slab1", fit, bulk.cell.array[:2, :2], fit.potential_cell[:2, :2])
+    return choice, fit
+
+
+def _in_plane_scaled(slab: Atoms, a_angstrom: float) -> Atoms:
+    """``slab`` with its in-plane cell scaled to the hexagonal lattice constant ``a_angstrom``
+    (fractional positions kept, heights unchanged)."""
+    out = slab.copy()
+    cell = out.cell.array.copy()
+    cell[:2] *= a_angstrom / float(np.linalg.norm(cell[0]))
+    out.set_cell(cell, scale_atoms=True)
+    return out
+
+
 def build_quartz_interface(
     spec,
     layers: int = 6,
@@ -247,6 +276,7 @@ def build_quartz_interface(
     source: str = "auto",
     gap_angstrom: float = DEFAULT_GAP_ANGSTROM,
     fmax_ev_per_angstrom: float = DEFAULT_FMAX_EV_PER_ANGSTROM,
+    lattice: str = "potential",
 ) -> tuple[Atoms, dict]:
     """The relaxed, verified dense α-quartz (0001) interface for ``spec`` and a JSON-ready report.
 
@@ -264,6 +294,11 @@ def build_quartz_interface(
         (shipped when the file is installed and reaches ``layers``, else seed).
     gap_angstrom
         Initial vertical gap between the slabs before the interface relaxation.
+    lattice
+        ``"potential"``: the slabs at α-quartz's lattice relaxed with ``spec``
+        (:func:`quartz_lattice`; the shipped slab's in-plane cell scaled to it, seeds cut
+        from it); ``"file"``: at the experimental lattice, the mismatch and lateral stress
+        recorded and refused above the threshold. ``report["lattice"]`` records both.
     """
     check_layers(layers)
     require(
@@ -275,6 +310,14 @@ def build_quartz_interface(
         "potential_label": spec.label,
         "layers": layers,
     }
+    choice, fit = quartz_lattice(spec, lattice)
+    choice.check("structure.lattice")
+    report["lattice"] = choice.record()
+    # the file's lattice is the experimental one exactly (no rescaling: bit-identical slabs)
+    a_used, c_used = QUARTZ_A_ANGSTROM, QUARTZ_C_ANGSTROM
+    if choice.use_potential:
+        a_used = float(np.linalg.norm(fit.potential_cell[0]))
+        c_used = float(np.linalg.norm(fit.potential_cell[2]))
     use_shipped = source == "shipped" or (
         source == "auto" and SHIPPED_DENSE_SLAB.is_file() and shipped_reaches(layers)
     )
@@ -288,6 +331,8 @@ def build_quartz_interface(
                 k: v for k, v in provenance.items() if k not in ("search", "verification")
             },
         }
+        if choice.use_potential:
+            slab = _in_plane_scaled(slab, a_used)
         if layers > SHIPPED_LAYERS:
             slab, report["start"]["thickening"], bulk = thicken_shipped_slab(
                 slab, layers, spec, fmax_ev_per_angstrom
@@ -298,6 +343,8 @@ def build_quartz_interface(
             _single_slab_calculator(spec),
             model_label=spec.label,
             fmax_ev_per_angstrom=fmax_ev_per_angstrom,
+            a_angstrom=a_used,
+            c_angstrom=c_used,
         )
         report["start"] = {"source": "seed", "search": record}
         if slab is None:
@@ -335,6 +382,8 @@ def build_quartz_interface(
         "gap_angstrom": gap_angstrom,
         "fmax_ev_per_angstrom": fmax_ev_per_angstrom,
         "flatcontact_version": _version("flatcontact"),
+        "lattice": lattice,
+        "a_angstrom": a_used,
     }
     if "thickening" in report["start"]:  # absent for the 6-layer slab: its file is unchanged
         recipe["bulk_repeats_inserted"] = report["start"]["thickening"]["insertion"]["repeats"]

@@ -22,10 +22,11 @@ from flatcontact.errors import InputError, require
 from flatcontact.structures.assemble import finish_interface, layer_plane, split_stack, stack_pair
 from flatcontact.structures.build import build_quartz_interface
 from flatcontact.structures.cell2d import lattice_is_invariant, standard_slab
-from flatcontact.structures.crystal import file_record, orient, read_bulk
+from flatcontact.structures.crystal import crystal_slab, file_record, orient, read_bulk
 from flatcontact.structures.dense import relax
-from flatcontact.structures.interface_contract import thickness
+from flatcontact.structures.interface_contract import CONTINUATION, thickness
 from flatcontact.structures.interface_io import read_interface
+from flatcontact.structures.lattice import LatticeChoice
 from flatcontact.structures.layers import slab_layers
 from flatcontact.structures.match import (
     apply_supercell,
@@ -33,6 +34,7 @@ from flatcontact.structures.match import (
     coincidence_match,
     explicit_match,
     identity_match,
+    strain_and_rotation,
     twist_match,
 )
 from flatcontact.structures.recipe import (
@@ -64,7 +66,14 @@ from flatcontact.structures.toy import toy_interface
 
 
 # --------------------------------------------------------------------------- sources
-def _sheet_source(sheet: str, stacking: str, interlayer: float | None, field: str):
+def _sheet_source(
+    sheet: str,
+    stacking: str,
+    interlayer: float | None,
+    field: str,
+    lattice: LatticeChoice | None = None,
+    slab: str = "slab1",
+):
     if sheet in BUILTIN_SHEETS:
         atoms = builtin_sheet(sheet)
         record = {"sheet": sheet, "a_angstrom": BUILTIN_SHEETS[sheet].a_angstrom}
@@ -85,6 +94,16 @@ def _sheet_source(sheet: str, stacking: str, interlayer: float | None, field: st
         record = file_record(path)
         material = atoms.get_chemical_formula(mode="hill")
     record = {**record, "stacking": stacking, "interlayer_angstrom": interlayer}
+    if lattice is not None:
+        fit = lattice.sheet(("sheet", sheet), atoms, material, interlayer)
+        pot = fit.scaled(atoms)
+        record["lattice"] = lattice.note(
+            slab, fit, atoms.cell.array[:2, :2], pot.cell.array[:2, :2]
+        )
+        if lattice.use_potential:
+            atoms = pot
+            if "a_angstrom" in record:
+                record["a_angstrom"] = float(np.linalg.norm(atoms.cell.array[0]))
     return sheet_source(atoms, material, stacking, interlayer, record, f"{field}.stacking")
 
 
@@ -101,6 +120,8 @@ def _crystal_source(
     passivate: str = "none",
     faces: tuple[str, ...] = (),
     same_material: bool = False,
+    lattice: LatticeChoice | None = None,
+    slab: str = "slab1",
 ):
     atoms = read_bulk(bulk, f"{field}.bulk")
     oriented = orient(atoms, miller, f"{field}.miller")
@@ -111,6 +132,16 @@ def _crystal_source(
         termination < n,
         f"{field}.termination={termination}: expected 0..{n - 1} ({n} distinct terminations)",
     )
+    if lattice is not None:
+        fit = lattice.bulk(("bulk", str(bulk)), atoms, material, oriented.miller)
+        at_potential = orient(fit.scaled(atoms), miller, f"{field}.miller")
+        cells = [
+            crystal_slab(o, 1, termination).cell.array[:2, :2] for o in (oriented, at_potential)
+        ]
+        record["lattice"] = lattice.note(slab, fit, *cells)
+        if lattice.use_potential:
+            oriented = at_potential
+            record["repeat_angstrom"] = oriented.repeat_angstrom
     if passivate != "none":
         return passivated_crystal_source(
             oriented,
@@ -125,10 +156,16 @@ def _crystal_source(
     return crystal_source(oriented, termination, material, record, f"{field}.termination")
 
 
-def slab_sources(recipe) -> tuple[Any, Any | None, int, int]:
-    """(source of slab 1, source of slab 2 or None for the same material, layers 1, layers 2)."""
+def slab_sources(recipe, lattice: LatticeChoice | None = None) -> tuple[Any, Any | None, int, int]:
+    """(source of slab 1, source of slab 2 or None for the same material, layers 1, layers 2).
+
+    ``lattice``: each material at the run's model's lattice or the file's, recorded
+    (:class:`~flatcontact.structures.lattice.LatticeChoice`); ``None``: the file's, unrecorded.
+    """
     if isinstance(recipe, SheetsRecipe):
-        s1 = _sheet_source(recipe.sheet, recipe.stacking, recipe.interlayer_angstrom, SECTION)
+        s1 = _sheet_source(
+            recipe.sheet, recipe.stacking, recipe.interlayer_angstrom, SECTION, lattice
+        )
         s2 = None
         n2 = recipe.layers
         if recipe.slab2 is not None:
@@ -137,23 +174,29 @@ def slab_sources(recipe) -> tuple[Any, Any | None, int, int]:
                 recipe.slab2.stacking,
                 recipe.slab2.interlayer_angstrom,
                 f"{SECTION}.slab2",
+                lattice,
+                "slab2",
             )
             n2 = recipe.slab2.layers
         return s1, s2, recipe.layers, n2
     if isinstance(recipe, CrystalRecipe):
         # slab 1's interface face is its top; slab 2's its bottom (its top before a flip)
         args = (recipe.bulk, recipe.miller, recipe.termination, SECTION, recipe.passivate)
-        s1 = _crystal_source(*args, _faces(recipe.passivate_faces, "top"))
+        s1 = _crystal_source(*args, _faces(recipe.passivate_faces, "top"), lattice=lattice)
         e2 = recipe.slab2
         if e2 is None and recipe.passivate == "none":
             return s1, None, recipe.layers, recipe.layers
         if e2 is None:  # the same crystal, its own interface face passivated
             face2 = "top" if recipe.flip else "bottom"
-            s2 = _crystal_source(*args, _faces(recipe.passivate_faces, face2), same_material=True)
+            s2 = _crystal_source(
+                *args, _faces(recipe.passivate_faces, face2), True, lattice, "slab2"
+            )
             return s1, s2, recipe.layers, recipe.layers
         if isinstance(e2, SheetSlab):
             field2 = f"{SECTION}.slab2"
-            s2 = _sheet_source(e2.sheet, e2.stacking, e2.interlayer_angstrom, field2)
+            s2 = _sheet_source(
+                e2.sheet, e2.stacking, e2.interlayer_angstrom, field2, lattice, "slab2"
+            )
             return s1, s2, recipe.layers, e2.layers
         s2 = _crystal_source(
             e2.bulk,
@@ -162,18 +205,30 @@ def slab_sources(recipe) -> tuple[Any, Any | None, int, int]:
             f"{SECTION}.slab2",
             e2.passivate,
             _faces(e2.passivate_faces, "bottom"),
+            lattice=lattice,
+            slab="slab2",
         )
         return s1, s2, recipe.layers, e2.layers
-    s1 = fcc111_source(recipe.element, recipe.a_angstrom, {"element": recipe.element})
+    s1 = _fcc111_source(recipe.element, recipe.a_angstrom, lattice, "slab1")
     if recipe.slab2 is None:
         return s1, None, recipe.layers, recipe.layers
     e2 = recipe.slab2
-    return (
-        s1,
-        fcc111_source(e2.element, e2.a_angstrom, {"element": e2.element}),
-        recipe.layers,
-        e2.layers,
-    )
+    return s1, _fcc111_source(e2.element, e2.a_angstrom, lattice, "slab2"), recipe.layers, e2.layers
+
+
+def _fcc111_source(element: str, a_angstrom: float | None, lattice, slab: str):
+    """fcc(111) planes of ``element`` at ``a_angstrom`` (or ASE's), or at the model's lattice."""
+    if lattice is None:
+        return fcc111_source(element, a_angstrom, {"element": element})
+    from ase.build import bulk as ase_bulk
+
+    a_file = fcc111_source(element, a_angstrom, {}).record["a_angstrom"]
+    crystal = ase_bulk(element, "fcc", a=a_file)  # primitive: (111) is its own (111)
+    fit = lattice.bulk(("fcc", element, a_file), crystal, f"{element}(111)", (1, 1, 1))
+    a_pot = a_file * float(np.linalg.norm(fit.potential_cell[0]) / np.linalg.norm(fit.file_cell[0]))
+    cells = [fcc111_source(element, a, {}).cell2 for a in (a_file, a_pot)]
+    rec = {"element": element, "lattice": lattice.note(slab, fit, *cells)}
+    return fcc111_source(element, a_pot if lattice.use_potential else a_file, rec)
 
 
 # --------------------------------------------------------------------------- assembly
@@ -241,9 +296,29 @@ def build_from_slab_file(recipe: SlabFileRecipe) -> tuple[Atoms, dict]:
     return finish_interface(atoms, recipe.held_layers, material, record), record
 
 
-def build_generic(recipe) -> tuple[Atoms, dict]:
-    """Interface of a ``sheets``, ``crystal`` or ``fcc111`` recipe (unrelaxed) and its report."""
-    s1, s2, n1, n2 = slab_sources(recipe)
+def _strain_vs_potential(match, s1, s2) -> dict:
+    """``slab{i}_strain_vs_potential_percent``: the principal strains of each slab of a
+    coincidence cell against its own potential lattice (the match's own strains are against
+    the lattices used, which are the potential's unless ``structure.lattice: file``)."""
+    out = {}
+    for which, source in ((1, s1), (2, s2)):
+        lat = source.record.get("lattice")
+        if lat is None:
+            continue
+        cell2 = np.asarray(lat["in_plane_potential_cell_angstrom"], float)
+        strains, _ = strain_and_rotation(match.deformation(which, cell2))
+        out[f"slab{which}_strain_vs_potential_percent"] = [round(100 * v, 6) for v in strains]
+    return out
+
+
+def build_generic(recipe, lattice: LatticeChoice | None = None) -> tuple[Atoms, dict]:
+    """Interface of a ``sheets``, ``crystal`` or ``fcc111`` recipe (unrelaxed) and its report.
+
+    ``lattice``: the slabs' lattices (:func:`slab_sources`); with the file's kept, a slab
+    strained beyond the threshold is refused here, before any relaxation."""
+    s1, s2, n1, n2 = slab_sources(recipe, lattice)
+    if lattice is not None:
+        lattice.check(f"{SECTION}.lattice")
     for which, n in ((1, n1), (2, n2)):
         require(
             n == 1 or n >= recipe.held_layers + 1,
@@ -290,7 +365,7 @@ def build_generic(recipe) -> tuple[Atoms, dict]:
             layer, z = np.asarray(stack.arrays["layer"]), stack.positions[:, 2]
             natural = float(z[layer == n1 + 1].min() - z[layer == n1].max())
         atoms = split_stack(stack, n1, spacing - natural)
-        record["slab2_operation"] = "continuation of slab 1's stacking"
+        record["slab2_operation"] = CONTINUATION
         record["match"] = match.report(
             s1.cell2, s1.cell2, n1 * s1.atoms_per_layer, n2 * s1.atoms_per_layer
         )
@@ -348,6 +423,8 @@ def build_generic(recipe) -> tuple[Atoms, dict]:
         "none (another material)" if other else "translated copy"
     )
     record["match"] = match.report(s1.cell2, src2.cell2, na1, na2)
+    if other:  # each slab's strain against its own potential lattice
+        record["match"].update(_strain_vs_potential(match, s1, src2))
     if explicit:
         record["match"]["supercells"] = "given (structure.match.slab1_supercell, slab2_supercell)"
     slab1 = apply_supercell(slab1, match.p1, match.cell)
@@ -357,11 +434,32 @@ def build_generic(recipe) -> tuple[Atoms, dict]:
 
 
 # --------------------------------------------------------------------------- entry point
+#: Largest increase of the interface thickness (Å) the build's relaxation may make: slabs
+#: that move apart by more are not bound with the model (or the crystal's atoms overlap and
+#: blew the cell apart): a reference that is no contact, refused.
+MAX_RELAXED_SEPARATION_ANGSTROM = 5.0
+
+
+def check_relaxed_separation(before_angstrom: float, after_angstrom: float) -> None:
+    """Refuse a build relaxation that moved the slabs apart by more than
+    :data:`MAX_RELAXED_SEPARATION_ANGSTROM` (one line naming both thicknesses and the bound)."""
+    moved = after_angstrom - before_angstrom
+    if not moved <= MAX_RELAXED_SEPARATION_ANGSTROM:  # NaN too
+        raise InputError(
+            f"{SECTION}: the build relaxation moved the slabs apart by {moved:.3g} Å (thickness "
+            f"{before_angstrom:.4g} -> {after_angstrom:.4g} Å), more than the "
+            f"{MAX_RELAXED_SEPARATION_ANGSTROM:g} Å a bound interface moves: the slabs are not "
+            f"bound with this model, or atoms of the crystal overlap; check the model's "
+            f"cross-interface coupling, {SECTION}.gap_angstrom and the crystal file"
+        )
+
+
 def build_interface(
     recipe: Any,
     *,
     potential: Any = None,
     relax_calculator: Any = None,
+    lattice_calculator: Any = None,
 ) -> tuple[Atoms, dict]:
     """The reference interface of ``recipe`` and a JSON-ready report (build stage).
 
@@ -378,6 +476,13 @@ def build_interface(
         when given, the whole interface is relaxed once (no atom held, FIRE to the recipe's
         ``fmax_ev_per_angstrom``), as the quartz builder does; without it the interface is the
         ideal stacking.
+    lattice_calculator
+        ``sheets``/``crystal``/``fcc111``: callable(atoms) → the run's model as a
+        single-crystal calculator. With it each slab material is relaxed first and the slabs
+        are cut at the model's lattice (``recipe.lattice: potential``) or at the file's, the
+        mismatch recorded and refused above the threshold (``file``;
+        :mod:`flatcontact.structures.lattice`); ``report["lattice"]`` records both. Without
+        it the slabs are at the file's lattice and nothing is recorded (geometry only).
 
     Every check of the input (files, Miller index, terminations, match bounds, atom count)
     runs before any relaxation; a bad value is a one-line InputError naming the field.
@@ -395,6 +500,7 @@ def build_interface(
             source=recipe.source,
             gap_angstrom=recipe.gap_angstrom,
             fmax_ev_per_angstrom=recipe.fmax_ev_per_angstrom,
+            lattice=recipe.lattice,
         )
         return atoms, report
     if isinstance(recipe, FileRecipe):
@@ -416,25 +522,35 @@ def build_interface(
             "n_atoms": len(atoms),
             "thickness_angstrom": thickness(atoms),
         }
+    lattice = None
     if isinstance(recipe, SlabFileRecipe):
         atoms, record = build_from_slab_file(recipe)
     else:
-        atoms, record = build_generic(recipe)
+        lattice = (
+            None
+            if lattice_calculator is None
+            else LatticeChoice(lattice_calculator, recipe.lattice)
+        )
+        atoms, record = build_generic(recipe, lattice)
     report: dict[str, Any] = {
         "recipe": record,
         "n_atoms": len(atoms),
         "material": atoms.info["material"],
     }
+    if lattice is not None:
+        report["lattice"] = lattice.record()
     if relax_calculator is not None:
         calc = (
             relax_calculator(atoms)
             if callable(relax_calculator) and not hasattr(relax_calculator, "get_potential_energy")
             else relax_calculator
         )
+        before = thickness(atoms)
         report["interface_relaxation"] = relax(
             atoms, calc, fmax_ev_per_angstrom=recipe.fmax_ev_per_angstrom
         )
         atoms.calc = None
+        check_relaxed_separation(before, thickness(atoms))
     record["thickness_angstrom"] = thickness(atoms)
     atoms.info["recipe"] = json.dumps(record, sort_keys=True)
     report["thickness_angstrom"] = thickness(atoms)

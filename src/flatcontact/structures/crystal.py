@@ -36,6 +36,7 @@ from flatcontact.fileio import file_sha256
 from flatcontact.structures.cell2d import standard_slab
 from flatcontact.structures.layers import repeat_layers
 from flatcontact.structures.passivate import passivate_window
+from flatcontact.structures.site_checks import check_bond_lengths
 from flatcontact.structures.slab import cleavage_heights
 from flatcontact.structures.structure_file import read_structure
 
@@ -69,6 +70,7 @@ def read_bulk(path: str | Path, field_name: str = "bulk") -> Atoms:
         f"{field_name}: '{path}' has no 3D cell (a bulk crystal needs three lattice vectors)",
     )
     atoms.pbc = True
+    check_bond_lengths(atoms, f"{field_name}: {path}")  # before any relaxation
     return atoms
 
 

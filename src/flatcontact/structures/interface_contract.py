@@ -51,6 +51,33 @@ SURFACE_OUTER_2 = 4
 FIXED_SURFACES = (SURFACE_OUTER_1, SURFACE_OUTER_2)
 
 
+#: ``slab2_operation`` of a recipe whose slab 2 continues slab 1's stacking (the builder's).
+CONTINUATION = "continuation of slab 1's stacking"
+#: Recipe kinds cut from a 3-D crystal: their continuation at zero shift is the perfect crystal.
+CRYSTAL_KINDS = ("crystal", "fcc111")
+
+
+def continues_crystal(recipe: dict) -> bool:
+    """Whether an interface's recipe record (``info["recipe"]``, ``build.json["recipe"]``) is
+    a 3-D crystal continued across the cut: its zero shift is the **perfect stacking** by
+    construction, whatever its energy (a potential may favour the stacking fault)."""
+    return recipe.get("kind") in CRYSTAL_KINDS and recipe.get("slab2_operation") == CONTINUATION
+
+
+def recipe_record(atoms: Atoms) -> dict:
+    """The recipe record of an interface (``info["recipe"]``, JSON), ``{}`` if absent."""
+    import json
+
+    raw = atoms.info.get("recipe")
+    if isinstance(raw, dict):
+        return raw
+    try:
+        out = json.loads(raw) if isinstance(raw, str) else {}
+    except ValueError:
+        return {}
+    return out if isinstance(out, dict) else {}
+
+
 def in_plane_vectors(atoms: Atoms) -> tuple[np.ndarray, np.ndarray]:
     """The primitive in-plane vectors (a1, a2) as 2-vectors (Å) from the cell."""
     cell = atoms.cell.array

@@ -27,7 +27,9 @@ import numpy as np
 from ase import Atoms
 from ase.build import make_supercell
 
+from flatcontact import limits
 from flatcontact.errors import InputError
+from flatcontact.limits import Deadline
 from flatcontact.structures.cell2d import (
     integer_matrix,
     is_hexagonal,
@@ -120,6 +122,24 @@ def twist_match(a: np.ndarray, m: int, n: int, field: str = "twist") -> tuple[Ma
     return Match(p1, p2, t, "twist"), theta
 
 
+def check_search_size(max_atoms: int, field: str) -> None:
+    """Refuse a search for cells above the ``atoms`` bound (:mod:`flatcontact.limits`) before
+    it starts: its candidates grow with the square of the largest cell."""
+    if max_atoms > limits.bound("atoms"):
+        raise InputError(
+            f"{field}: " + limits.message("atoms", max_atoms, "atoms of the largest cell searched")
+        )
+
+
+def _deadline(field: str, max_atoms: int, max_strain: float) -> Deadline:
+    return Deadline(
+        f"{field}: the coincidence search (cells of at most {max_atoms} atoms, strain at most "
+        f"{100 * max_strain:g} %)",
+        "lower the atom bound (match.max_atoms, approximants.max_atoms) or raise the strain "
+        "bound (match.max_strain_percent, approximants.strain_percent)",
+    )
+
+
 def coincidence_match(
     a1: np.ndarray,
     a2: np.ndarray,
@@ -147,6 +167,7 @@ def coincidence_match(
         raise InputError(f"strain_on='{strain_on}': expected slab2 or both")
     a1 = np.asarray(a1, float)[:, :2]
     a2 = np.asarray(a2, float)[:, :2]
+    check_search_size(max_atoms, field)
     if orientation_deg is not None:
         found = oriented_coincidence_match(
             a1,
@@ -158,6 +179,7 @@ def coincidence_match(
             target_deg=orientation_deg[0],
             tolerance_deg=orientation_deg[1],
             strain_on=strain_on,
+            deadline=_deadline(field, max_atoms, max_strain),
         )
         if found is None:
             raise InputError(
@@ -169,6 +191,7 @@ def coincidence_match(
     area1, area2 = abs(np.linalg.det(a1)), abs(np.linalg.det(a2))
     density = n1 / area1 + n2 / area2
     max_area = max_atoms / density * (1.0 + max_strain) ** 2
+    deadline = _deadline(field, max_atoms, max_strain)
     gen = ZSLGenerator(
         max_area_ratio_tol=(1.0 + max_strain) ** 2 - 1.0,
         max_area=max_area,
@@ -179,6 +202,7 @@ def coincidence_match(
     best: tuple | None = None
     best_area = None
     for zm in gen(np.hstack([a2, pad]), np.hstack([a1, pad])):
+        deadline.check()
         area = float(zm.match_area)
         if best_area is not None and area > best_area * (1.0 + 1e-6):
             break
@@ -240,6 +264,7 @@ def oriented_coincidence_match(
     target_deg: float,
     tolerance_deg: float,
     strain_on: str = "slab2",
+    deadline: Deadline | None = None,
 ) -> Match | None:
     """The smallest compact coincidence cell that rotates slab 2 by ``target_deg`` ±
     ``tolerance_deg`` (modulo its lattice's rotation symmetry), or None.
@@ -284,6 +309,8 @@ def oriented_coincidence_match(
     p, v, w, length = p[order], v[order], w[order], length[order]
     pairs = []
     for i in range(len(v)):
+        if deadline is not None:
+            deadline.check()
         cross = v[i, 0] * v[:, 1] - v[i, 1] * v[:, 0]
         dot = v @ v[i]
         j = np.nonzero(
@@ -298,6 +325,8 @@ def oriented_coincidence_match(
     for area, i, k in pairs:
         if best_area is not None and area > best_area * (1.0 + 1e-6):
             break
+        if deadline is not None:
+            deadline.check()
         p1 = np.array([p[i], p[k]])
         p2 = np.array([w[i], w[k]])
         if round(np.linalg.det(p2)) <= 0:

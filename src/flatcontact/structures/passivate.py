@@ -121,6 +121,12 @@ def passivate_window(
     """
     if species not in SPECIES:
         raise InputError(f"{field_name}={species!r}: expected one of none, {', '.join(SPECIES)}")
+    elements = sorted(set(block.get_chemical_symbols()))
+    if species == "OH" and "O" not in elements:  # it would build the H termination, called OH
+        raise InputError(
+            f"{field_name}=OH: the crystal has no O (elements {', '.join(elements)}): hydroxyl "
+            "caps the bonds an oxide's cut breaks to O; passivate this crystal with H"
+        )
     inside = np.asarray(inside, bool)
     keep = np.flatnonzero(inside)
     slot = -np.ones(len(block), dtype=int)

@@ -39,6 +39,7 @@ from pydantic import (
     model_validator,
 )
 
+from flatcontact import limits
 from flatcontact.errors import InputError
 from flatcontact.numbers import Bounds, physical, state_bounds
 from flatcontact.structures.quartz_layers import MIN_LAYERS, check_shipped_layers
@@ -122,6 +123,15 @@ class MatchSettings(_Model):
         description="two materials: slab 2's supercell, with slab1_supercell",
     )
 
+    @field_validator("max_atoms")
+    @classmethod
+    def _atoms_within_bound(cls, value: int) -> int:
+        """The search's candidates grow with the square of its largest cell: bounded before
+        it starts (``FLATCONTACT_MAX_ATOMS``)."""
+        if value > limits.bound("atoms"):
+            raise ValueError(limits.message("atoms", value, "atoms of the largest cell"))
+        return value
+
     @model_validator(mode="after")
     def _supercells(self) -> MatchSettings:
         given = (self.slab1_supercell is not None, self.slab2_supercell is not None)
@@ -135,10 +145,35 @@ class MatchSettings(_Model):
                     f"{name}: expected a positive determinant (a right-handed supercell), "
                     f"got {[list(r) for r in p]}"
                 )
+            # cells of the primitive cell, each at least one atom: bounded before anything
+            # is allocated (a 100001 supercell tried 224 GiB, a larger one overflowed)
+            if p is not None and p[0][0] * p[1][1] - p[0][1] * p[1][0] > limits.bound("atoms"):
+                det = p[0][0] * p[1][1] - p[0][1] * p[1][0]
+                raise ValueError(
+                    f"{name}: "
+                    + limits.message("atoms", det, "primitive cells, at least one atom each")
+                )
         return self
 
 
-class _PairOptions(_Model):
+#: Where the slabs' lattice comes from (:mod:`flatcontact.structures.lattice`).
+LatticeSource = Literal["potential", "file"]
+
+
+class _LatticeOption(_Model):
+    """The one declaration of ``structure.lattice`` (every recipe that cuts or stacks a
+    material: ``sheets``, ``crystal``, ``fcc111``, ``quartz-dense``)."""
+
+    lattice: LatticeSource = Field(
+        "potential",
+        description="potential: the slabs at the interaction model's own equilibrium lattice "
+        "(the bulk, or a sheet's in-plane cell, relaxed with the run's model first); file: at "
+        "the structure file's (or built-in) lattice, the mismatch and its lateral stress "
+        "reported, refused above 2 % in-plane",
+    )
+
+
+class _PairOptions(_LatticeOption):
     held_layers: int = Field(1, ge=1, description="outer layers held (rigid) per slab")
     rotate_deg: AngleDeg = Field(
         0.0,
@@ -158,6 +193,19 @@ class _PairOptions(_Model):
         0.01,
         description="force tolerance of the reference relaxation (when a calculator is given)",
     )
+
+    @field_validator("twist")
+    @classmethod
+    def _twist_within_bound(cls, value):
+        """(m, n) makes m² + mn + n² primitive cells per layer: bounded before it is built."""
+        if value is not None:
+            m, n = value
+            cells = m * m + m * n + n * n
+            if cells > limits.bound("atoms"):
+                raise ValueError(
+                    limits.message("atoms", cells, "primitive cells per layer of the twist")
+                )
+        return value
 
 
 class SheetSlab(_Model):
@@ -278,7 +326,7 @@ class Fcc111Recipe(_PairOptions):
     slab2: Fcc111Slab | None = Field(None, description="another fcc metal for slab 2")
 
 
-class QuartzDenseRecipe(_Model):
+class QuartzDenseRecipe(_LatticeOption):
     """The paper's α-quartz (0001) dense interface (flatcontact.structures.build)."""
 
     kind: Literal["quartz-dense"] = Field("quartz-dense", description="recipe kind")
@@ -398,9 +446,8 @@ def parse_recipe(data: dict[str, Any], field: str = SECTION) -> Any:
         if parts[:1] == ["slab2"] and parts[1:2] in (["bulk"], ["sheet"]):  # slab2's tag
             parts = parts[:1] + parts[2:]
         loc = ".".join(parts)
-        raise InputError(
-            f"{field}.{loc}: {err['msg']}" if loc else f"{field}: {err['msg']}"
-        ) from None
+        msg = str(err["msg"]).removeprefix("Value error, ")  # pydantic's, not the user's
+        raise InputError(f"{field}.{loc}: {msg}" if loc else f"{field}: {msg}") from None
 
 
 def input_files(recipe: Any) -> list[Path]:

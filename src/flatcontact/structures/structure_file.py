@@ -24,7 +24,9 @@ After parsing (before anything is built, relaxed or handed to LAMMPS):
   :data:`MIN_CELL_HEIGHT_ANGSTROM` and the volume per atom at most
   :data:`MAX_VOLUME_PER_ATOM_ANGSTROM3`; with two, the same in the plane (heights = area /
   length of the other vector, area per atom at most :data:`MAX_AREA_PER_ATOM_ANGSTROM2`);
-- no two atoms (periodic images included) closer than :data:`MIN_DISTANCE_ANGSTROM`.
+- no two atoms (periodic images included) closer than :data:`MIN_DISTANCE_ANGSTROM`;
+- a CIF has no partly occupied and no mixed site (:mod:`flatcontact.structures.site_checks`,
+  checked before parsing).
 
 The bounds are far outside any solid (the shortest bond, H₂, is 0.74 Å; the shortest
 lattice repeat of a crystal ~2 Å; a solid holds 5-50 Å³ per atom) and well inside what a
@@ -148,6 +150,10 @@ def check_file(path: Path, label: str, format: str | None = None) -> None:
             return
     if format in _XYZ_FORMATS:
         _check_xyz_frames(path, label)
+    if format == "cif":  # disordered sites: ASE would build one full atom per site
+        from flatcontact.structures.site_checks import check_cif_sites
+
+        check_cif_sites(path, label)
 
 
 def _check_xyz_frames(path: Path, label: str) -> None:

@@ -35,7 +35,6 @@ may stretch (load / cores).
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import statistics
@@ -45,9 +44,12 @@ from pathlib import Path
 import numpy as np
 
 from flatcontact.config.run import RunConfig
+from flatcontact.errors import InputError
 from flatcontact.ispes.executors import default_workers
 from flatcontact.layout import SCAN_JSON, STAGES
-from flatcontact.rundir import RECORD_NAME
+from flatcontact.result_json import read_result_json
+from flatcontact.rundir import RunDirectory
+from flatcontact.studies.study_dir import RUNS, folder_name
 
 #: Force calls per grid point when no finished cell measured them and something relaxes:
 #: ``rigid-layers`` 3.6 measured on the H-diamond(111)/graphene lock (examples/README.md),
@@ -115,9 +117,9 @@ def measured_cell(folder: str | Path) -> dict | None:
     record: it carries the machine's load)."""
     scan_dir = Path(folder) / f"{STAGES['scan']:02d}-scan"
     try:
-        scan = json.loads((scan_dir / SCAN_JSON).read_text())
-        record = json.loads((scan_dir / RECORD_NAME).read_text())
-    except (OSError, ValueError):
+        scan = read_result_json(scan_dir / SCAN_JSON)
+        record = RunDirectory.read_record(scan_dir) or {}
+    except InputError:  # no finished cell there (or not one): the assumed calls stand
         return None
     points = int(scan.get("points_computed") or scan.get("points_total") or 0)
     calls = int(scan.get("force_calls_total") or 0)
@@ -172,7 +174,7 @@ def estimate_cost(cfg: RunConfig, cells: list[dict], out: str | Path | None = No
     calibration = None
     if out is not None:
         for c in sorted(cells, key=lambda c: c["n_atoms"]):
-            m = measured_cell(Path(out) / "runs" / c["label"])
+            m = measured_cell(Path(out) / RUNS / folder_name(c["label"]))
             if m is not None:
                 calibration = {"label": c["label"], **m}
                 break

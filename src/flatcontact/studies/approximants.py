@@ -51,7 +51,6 @@ The gates use the group modulo the translations, restated on the shift cell.
 
 from __future__ import annotations
 
-import json
 import math
 import shutil
 import time
@@ -62,6 +61,7 @@ import numpy as np
 
 from flatcontact.config.run import RunConfig
 from flatcontact.errors import InputError
+from flatcontact.fileio import refuse_link
 from flatcontact.ispes.executors import make_executor
 from flatcontact.ispes.shift_lattice import scan_grid
 from flatcontact.layout import (
@@ -73,8 +73,10 @@ from flatcontact.layout import (
     OTHER_FORM_JSON,
     SCAN_JSON,
 )
+from flatcontact.result_json import read_result_json
 from flatcontact.studies.runner import run_jobs
 from flatcontact.studies.scaling import fit_scaling
+from flatcontact.studies.study_dir import RUNS, folder_name, refuse_study_links
 from flatcontact.studies.variants import variant_config
 
 #: Folder of a cell's run directory that holds the ISPES on one shift-lattice period.
@@ -311,6 +313,7 @@ def run_cell(config: dict, folder: str, planned: int) -> dict:
         update={"scan": cfg.scan.model_copy(update={"executor": "serial", "workers": 1})}
     )
     root = Path(folder)
+    refuse_link(root, "a study's variant folder")  # planted after the study's own check
     t0 = time.perf_counter()
     with Pipeline(cfg, root) as pipe:
         pipe.build()
@@ -354,7 +357,7 @@ def run_cell(config: dict, folder: str, planned: int) -> dict:
             LawsInputs.read(cell / "analyze" / FRICTION_CSV, cell / "analyze" / OTHER_FORM_JSON),
             cell / "laws",
         )
-        laws = json.loads((cell / "laws" / LAWS_JSON).read_text())
+        laws = read_result_json(cell / "laws" / LAWS_JSON, energy_form=cfg.analysis.energy_form)
         form = laws.get("energy_form") or cfg.analysis.energy_form
         law = laws.get(form) if isinstance(laws.get(form), dict) else laws
         p_low, barrier = corrugation_mev_per_a2(cell / "analyze" / FRICTION_NC)
@@ -449,6 +452,7 @@ def run_approximants(
     """
     out = Path(out)
     cells = plan(cfg)
+    refuse_study_links(out)
     executor = make_executor(
         cfg.scan.executor, cfg.scan.workers, cfg.scan.dask_address, cfg.scan.jobqueue
     )
@@ -456,7 +460,7 @@ def run_approximants(
         (
             c["label"],
             c["config"],
-            str(out / "runs" / c["label"]),
+            str(out / RUNS / folder_name(c["label"])),
             c["shift_lattice_index"],
         )
         for c in cells

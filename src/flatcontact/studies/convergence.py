@@ -44,8 +44,13 @@ from flatcontact.studies.compare import (
     noise_ratio,
     thickness_step_refines,
 )
-from flatcontact.studies.estimate import base_measurements, estimate_convergence
+from flatcontact.studies.estimate import (
+    base_measurements,
+    cutoff_call_ratios,
+    estimate_convergence,
+)
 from flatcontact.studies.runner import run_jobs, run_variant
+from flatcontact.studies.study_dir import RUNS, refuse_study_links
 from flatcontact.studies.variants import (
     base_value,
     chosen_settings,
@@ -82,7 +87,8 @@ def run_convergence(
         for steps in ladder.values()
         for v in steps
     }
-    runs_dir = out / "runs"
+    refuse_study_links(out)
+    runs_dir = out / RUNS
     base_dir = runs_dir / "base"
     executor = make_executor(
         cfg.scan.executor, cfg.scan.workers, cfg.scan.dask_address, cfg.scan.jobqueue
@@ -93,7 +99,13 @@ def run_convergence(
         )
         if "error" in results["base"]:
             raise InputError(f"the base configuration failed: {results['base']['error']}")
-        estimate = estimate_convergence(cfg, ladder, base_measurements(base_dir), executor.workers)
+        estimate = estimate_convergence(
+            cfg,
+            ladder,
+            base_measurements(base_dir),
+            executor.workers,
+            cutoff_call_ratios(cfg, ladder, configs),
+        )
         if on_estimate is not None:
             on_estimate(estimate)
         if estimate_only:

@@ -5,9 +5,9 @@ enthalpy corrugation ``h(x, y)|_P = U(z*)/A + P z*`` carries the load term ``P z
 so a model whose ``z*`` varies less with the lateral shift has a smaller ``h`` corrugation
 and a smaller τ at the same load. This splits ``z*`` into the interface gap and the slabs.
 
-Usage (no torch; reads the scans, writes nothing else)::
+Command (no torch; reads the scans, writes only ``OUT.json``)::
 
-    python -m flatcontact.studies.dilatancy [--p-gpa=0,0.5,...] OUT.json LABEL=DIR [LABEL=DIR ...]
+    flatcontact study dilatancy OUT.json LABEL=DIR [LABEL=DIR ...] [--p-gpa 0,0.5,...]
 
 Each ``DIR`` holds a scan's ``ispes.nc`` and ``points.db`` (the relaxed atoms); the first
 model is the reference of the ratios. Per load (0, 0.5, …, 3 GPa): the lateral mean of
@@ -21,13 +21,18 @@ extents; both interpolated linearly in thickness at ``z*``.
 
 from __future__ import annotations
 
-import json
-import sys
 from pathlib import Path
 
 import numpy as np
 
 LOADS_GPA = np.array([0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0])
+#: The ranges divided by the reference model's in :func:`compare_dilatancy`.
+RATIO_QUANTITIES = (
+    "z_range_angstrom",
+    "gap_range_angstrom",
+    "h_range_mj_per_m2",
+    "u_range_mj_per_m2",
+)
 #: 1 eV/Å² in mJ/m².
 MJ_PER_M2_PER_EV_PER_A2 = 16021.766
 
@@ -98,55 +103,42 @@ def pattern_correlation(z: np.ndarray, z_ref: np.ndarray) -> list[float]:
     return (num / np.sqrt((d**2).sum(axis=(1, 2)) * (d_ref**2).sum(axis=(1, 2)))).tolist()
 
 
-def main(argv: list[str] | None = None) -> None:
-    argv = sys.argv[1:] if argv is None else argv
-    loads = LOADS_GPA
-    if argv and argv[0].startswith("--p-gpa="):
-        loads = np.array([float(x) for x in argv[0].split("=", 1)[1].split(",")])
-        argv = argv[1:]
-    if len(argv) < 2 or any("=" not in a for a in argv[1:]):
-        sys.exit(
-            "usage: python -m flatcontact.studies.dilatancy [--p-gpa=0,0.5,...] OUT.json "
-            "LABEL=DIR [...]"
-        )
-    out = Path(argv[0])
-    models = {}
-    for item in argv[1:]:
-        label, folder = item.split("=", 1)
-        models[label] = dilatancy(Path(folder), loads)
+def compare_dilatancy(folders: dict[str, Path], loads_gpa=LOADS_GPA) -> dict:
+    """The dilatancy of several stored scans, the first the reference of the ratios.
+
+    Parameters
+    ----------
+    folders
+        Label -> scan folder (``ispes.nc`` and ``points.db``), in order; the first entry is the
+        reference.
+    loads_gpa
+        Loads (GPa) at which z* is taken; default :data:`LOADS_GPA`.
+
+    Returns
+    -------
+    dict
+        ``{"reference": label, "models": {label: figures}}``: per model the figures of
+        :func:`dilatancy`, the correlation of its z* pattern with the reference's, and the
+        ranges of z*, the gap, h and U divided by the reference's (``*_over_reference``).
+
+    Raises
+    ------
+    InputError
+        ``folders``: empty.
+    """
+    from flatcontact.errors import InputError
+
+    if not folders:
+        raise InputError("folders: give at least one LABEL=DIR scan folder")
+    models = {label: dilatancy(Path(folder), loads_gpa) for label, folder in folders.items()}
     ref_label = next(iter(models))
     ref = models[ref_label]
     for m in models.values():
         m["z_pattern_correlation_with_reference"] = pattern_correlation(
             m["_z_star"], ref["_z_star"]
         )
-        for q in (
-            "z_range_angstrom",
-            "gap_range_angstrom",
-            "h_range_mj_per_m2",
-            "u_range_mj_per_m2",
-        ):
+        for q in RATIO_QUANTITIES:
             m[f"{q}_over_reference"] = (np.array(m[q]) / np.array(ref[q])).tolist()
     for m in models.values():
         del m["_z_star"]
-    out.write_text(json.dumps({"reference": ref_label, "models": models}, indent=1) + "\n")
-    for label, m in models.items():
-        print(label)
-        for q in (
-            "z_range_angstrom",
-            "gap_range_angstrom",
-            "slabs_range_angstrom",
-            "h_range_mj_per_m2",
-        ):
-            print(f"  {q:>24}", np.round(m[q], 3))
-        if label != ref_label:
-            print(
-                f"  {'z range / reference':>24}", np.round(m["z_range_angstrom_over_reference"], 3)
-            )
-            print(
-                f"  {'h range / reference':>24}", np.round(m["h_range_mj_per_m2_over_reference"], 3)
-            )
-
-
-if __name__ == "__main__":
-    main()
+    return {"reference": ref_label, "models": models}

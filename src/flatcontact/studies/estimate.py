@@ -27,7 +27,12 @@ Extrapolation from the base (``b``) to a variant (``v``), the rules stated per s
   nothing relaxes in ``rigid``/``rigid-layers`` scans, where it is exact);
 * scan seconds = the base's scan seconds per force call × force calls, times
   ``layers_v / layers_b`` for a layers step (cost per call ∝ atoms for the short-ranged
-  potentials used here); build, analyze and laws take the base's seconds (a layers or cutoff
+  potentials used here), and for a cutoff step times the measured ratio of one force call
+  with the variant's model to one with the base's, on the base's unrelaxed interface
+  (:func:`cutoff_call_ratios`; a longer cutoff multiplies the pairs a call sums: a
+  bilayer-graphene KC rung 16 → 66 Å took 333 s where the per-call-constant rule said
+  about 47 s; one call on its 4-atom cell, timed on a loaded machine: 0.5 ms at 16 Å,
+  16 ms at 66 Å); build, analyze and laws take the base's seconds (a layers or cutoff
   variant rebuilds: the base's build seconds are counted for it, others share the base's).
 
 Wall time: each round runs its variants side by side on ``workers`` processes, so a round
@@ -44,8 +49,9 @@ from pathlib import Path
 from flatcontact.config.run import RunConfig
 from flatcontact.ispes.thicknesses import MIN_THICKNESS_SPACING_ANGSTROM
 from flatcontact.layout import SCAN_JSON, STAGES
+from flatcontact.result_json import read_result_json
 from flatcontact.rundir import RECORD_NAME
-from flatcontact.studies.approximant_cost import duration
+from flatcontact.studies.approximant_cost import duration, time_force_call
 from flatcontact.studies.variants import Variant, base_value, shares_build
 
 #: The stages a variant runs (the study's runner stops after laws).
@@ -64,7 +70,7 @@ def base_measurements(base_dir: str | Path) -> dict:
     """
     root = Path(base_dir)
     folder = {s: root / f"{STAGES[s]:02d}-{s}" for s in STUDY_STAGES}
-    scan = json.loads((folder["scan"] / SCAN_JSON).read_text())
+    scan = read_result_json(folder["scan"] / SCAN_JSON)
     seconds = {}
     for s in STUDY_STAGES:
         record = json.loads((folder[s] / RECORD_NAME).read_text())
@@ -88,7 +94,19 @@ def _requested_thicknesses(cfg: RunConfig) -> int:
     return scan.p_range_gpa.n if scan.p_range_gpa is not None else len(scan.thickness_angstrom)
 
 
-def _variant_estimate(cfg: RunConfig, v: Variant, base: dict) -> dict:
+def cutoff_call_ratios(cfg: RunConfig, ladder: dict[str, list[Variant]], configs: dict) -> dict:
+    """Variant name -> (CPU s of one force call with its model) / (one with the base's), for
+    the cutoff rungs of ``ladder`` (``configs``: variant name -> configuration dict), each
+    timed on the base's interface built unrelaxed
+    (:func:`flatcontact.studies.approximant_cost.time_force_call`)."""
+    rungs = ladder.get("cutoff", [])
+    if not rungs:
+        return {}
+    base_s = time_force_call(cfg.to_dict())["cpu_s"]
+    return {v.name: time_force_call(configs[v.name])["cpu_s"] / max(base_s, 1e-9) for v in rungs}
+
+
+def _variant_estimate(cfg: RunConfig, v: Variant, base: dict, call_ratio: float = 1.0) -> dict:
     grid = list(base["grid"])
     thick = base["thicknesses"]
     if v.setting == "grid":
@@ -115,6 +133,7 @@ def _variant_estimate(cfg: RunConfig, v: Variant, base: dict) -> dict:
     scan_s = per_call * calls
     if v.setting == "layers":
         scan_s *= v.value / base_value(cfg, "layers")
+    scan_s *= call_ratio
     build_s = 0.0 if shares_build(v.setting) else base["seconds"]["build"]
     seconds = build_s + scan_s + base["seconds"]["analyze"] + base["seconds"]["laws"]
     return {
@@ -128,13 +147,18 @@ def _variant_estimate(cfg: RunConfig, v: Variant, base: dict) -> dict:
         "points_computed": round(computed),
         "force_calls": round(calls),
         "seconds": seconds,
+        "call_ratio": call_ratio,
         "lower_bound": v.setting in ("fmax", "cutoff")
         and cfg.scan.relax_mode not in ("rigid", "rigid-layers"),
     }
 
 
 def estimate_convergence(
-    cfg: RunConfig, ladder: dict[str, list[Variant]], base: dict, workers: int
+    cfg: RunConfig,
+    ladder: dict[str, list[Variant]],
+    base: dict,
+    workers: int,
+    call_ratios: dict[str, float] | None = None,
 ) -> dict:
     """The cost of every rung of ``ladder`` extrapolated from the measured ``base``.
 
@@ -149,6 +173,9 @@ def estimate_convergence(
         :func:`base_measurements` of the finished base run.
     workers
         Variants run side by side (the study's executor).
+    call_ratios
+        Variant name -> cost of its force call over the base's (:func:`cutoff_call_ratios`);
+        1 for a variant not named.
 
     Returns
     -------
@@ -160,7 +187,12 @@ def estimate_convergence(
         steps: an upper bound). Seconds are the base's wall seconds scaled: they carry the
         machine's load while the base ran.
     """
-    variants = [_variant_estimate(cfg, v, base) for steps in ladder.values() for v in steps]
+    ratios = call_ratios or {}
+    variants = [
+        _variant_estimate(cfg, v, base, ratios.get(v.name, 1.0))
+        for steps in ladder.values()
+        for v in steps
+    ]
     base_seconds = sum(base["seconds"].values())
     calls = base["force_calls"] + sum(v["force_calls"] for v in variants)
     scratch = calls + base["force_calls"] * max(len(ladder) - 1, 0)
@@ -192,6 +224,8 @@ def estimate_lines(est: dict) -> list[str]:
     for v in est["variants"]:
         bound = " (lower bound)" if v["lower_bound"] else ""
         scanned = f"; ~{v['thicknesses']} scanned" if v["setting"] == "thicknesses" else ""
+        if v.get("call_ratio", 1.0) != 1.0:
+            scanned += f"; a force call ~{v['call_ratio']:.3g}x the base's"
         lines.append(
             f"  {v['name']} ({v['label']}{scanned}): {v['points']} points, ~{v['points_computed']} "
             f"computed, ~{v['force_calls']} force calls{bound}, ~{duration(v['seconds'])}"

@@ -20,7 +20,6 @@ data file ``data/measured/law_uncertainty.json`` that the ``paper`` preset reads
 from __future__ import annotations
 
 import datetime
-import json
 from pathlib import Path
 
 from pydantic import ValidationError
@@ -29,7 +28,8 @@ from flatcontact import __version__
 from flatcontact.config.messages import one_line
 from flatcontact.config.uncertainty import MEASURED_ON_KEYS, UncertaintyConfig
 from flatcontact.errors import InputError
-from flatcontact.fileio import file_sha256, read_text_file
+from flatcontact.fileio import file_sha256, quoted, read_json_file
+from flatcontact.result_json import KINDS, ContractError, check_keys
 
 #: The number blocks an uncertainty file may carry (per energy form).
 NUMBER_BLOCKS = (
@@ -53,17 +53,34 @@ def read_study(path: str | Path) -> dict:
     path = Path(path)
     if path.is_dir():
         path = path / "study.json"
-    text = read_text_file(path, "study.json", MAX_STUDY_BYTES)
-    try:
-        doc = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise InputError(f"{path}: not JSON ({exc.msg} at line {exc.lineno})") from None
+    doc = read_json_file(path, "study.json", MAX_STUDY_BYTES)
     block = doc.get("uncertainty") if isinstance(doc, dict) else None
     if not isinstance(block, dict) or not block.get("measured_on"):
         raise InputError(
-            f"{path}: no uncertainty block with measured_on; expected the study.json "
+            f"{quoted(path)}: no uncertainty block with measured_on; expected the study.json "
             "written by 'flatcontact study convergence' or 'flatcontact study models'"
         )
+    try:
+        check_keys(
+            block,
+            {"measured_on": "mapping"},
+            {"source": "text", "provenance": "mapping", **dict.fromkeys(NUMBER_BLOCKS, "mapping")},
+            "uncertainty.",
+        )
+        for key, value in block["measured_on"].items():
+            if not isinstance(value, str):
+                raise ContractError(f"'uncertainty.measured_on.{key}' is {value!r}, not text")
+        for number in NUMBER_BLOCKS:
+            for key, value in (block.get(number) or {}).items():
+                if not KINDS["number"][0](value):
+                    raise ContractError(
+                        f"'uncertainty.{number}.{key}' is {value!r}, not a finite number"
+                    )
+    except ContractError as exc:
+        raise InputError(
+            f"{quoted(path)}: {exc}; expected the study.json written by 'flatcontact study "
+            "convergence' or 'flatcontact study models'"
+        ) from None
     return doc
 
 

@@ -12,7 +12,6 @@ the ``uncertainty`` block; the per-load spread of τ, σ_MSS and W is reported t
 from __future__ import annotations
 
 import math
-import re
 from pathlib import Path
 
 from pydantic import ValidationError
@@ -27,6 +26,7 @@ from flatcontact.potentials.presets import PRESETS
 from flatcontact.stages.preflight import check_inputs
 from flatcontact.studies.convergence import FORMS
 from flatcontact.studies.runner import run_jobs, run_variant
+from flatcontact.studies.study_dir import RUNS, refuse_study_links, variant_folders
 from flatcontact.studies.variants import without_foreign_uncertainty
 
 
@@ -44,10 +44,6 @@ def model_section(spec: str) -> tuple[str, dict]:
     )
 
 
-def _slug(label: str) -> str:
-    return re.sub(r"[^A-Za-z0-9_.-]+", "_", label)[:60] or "model"
-
-
 def run_models(cfg: RunConfig, models: list[str], out: str | Path, on_done=None) -> dict:
     """Run ``cfg`` with each of ``models`` into ``out``; returns the ``study.json`` document."""
     models = [m for spec in models for m in spec.split(",") if m]  # --models A,B or repeated
@@ -58,6 +54,8 @@ def run_models(cfg: RunConfig, models: list[str], out: str | Path, on_done=None)
     labels = [label for label, _ in entries]
     if len(set(labels)) != len(labels):
         raise InputError(f"--models: a model is given twice ({', '.join(labels)})")
+    folders = variant_folders(labels, "--models")
+    refuse_study_links(out)
     jobs = []
     for label, section in entries:
         data = {**cfg.to_dict(), "potential": section}
@@ -66,7 +64,7 @@ def run_models(cfg: RunConfig, models: list[str], out: str | Path, on_done=None)
         except ValidationError as exc:
             raise one_line(exc, f"--models {label}") from None
         check_inputs(variant, f"--models {label}")
-        jobs.append((label, variant.to_dict(), str(out / "runs" / _slug(label)), None))
+        jobs.append((label, variant.to_dict(), str(out / RUNS / folders[label]), None))
     executor = make_executor(
         cfg.scan.executor, cfg.scan.workers, cfg.scan.dask_address, cfg.scan.jobqueue
     )

@@ -25,6 +25,7 @@ import pandas as pd
 
 from flatcontact.config.run import RunConfig
 from flatcontact.errors import InputError
+from flatcontact.fileio import refuse_link
 from flatcontact.layout import FRICTION_CSV, RUN_MARKER, STAGES
 from flatcontact.pipeline import Pipeline
 
@@ -60,6 +61,7 @@ def run_variant(config: dict, folder: str, share_build_from: str | None = None) 
         update={"scan": cfg.scan.model_copy(update={"executor": "serial", "workers": 1})}
     )
     root = Path(folder)
+    refuse_link(root, "a study's variant folder")  # planted after the study's own check
     if share_build_from is not None:
         _copy_build(Path(share_build_from), root)
     t0 = time.perf_counter()

@@ -37,6 +37,13 @@ def row_energies(row) -> dict[str, float]:
     return {k: float(v) for k, v in (item.split("=") for item in text.split(";") if "=" in item)}
 
 
+def row_zero_shift(row) -> str:
+    """The analysis key of the stacking at the zero shift of one ``friction.csv`` row
+    (``zero_shift_stacking``; ``''`` when absent: an empty cell reads back as NaN)."""
+    value = getattr(row, "zero_shift_stacking", "")
+    return value if isinstance(value, str) else ""
+
+
 def monotonicity_paragraph(table, family: str = "analysis") -> str:
     """Where τ(P) falls with load by more than its noise, and what limits τ on each side.
 
@@ -59,7 +66,8 @@ def monotonicity_paragraph(table, family: str = "analysis") -> str:
         r = by_p[p]
         start = getattr(r, "start_stacking", "")
         if isinstance(start, str) and start:
-            start = display_names({start: 0.0} | row_energies(r), family).get(start, start)
+            names = display_names({start: 0.0} | row_energies(r), family, row_zero_shift(r))
+            start = names.get(start, start)
         jumps = int(r.n_jumps) if np.isfinite(r.n_jumps) else 0
         return (
             f"{fmt(r.tau_mpa)} MPa at {p:g} GPa (limited by the {r.tau_limited_by}, {jumps} "
@@ -97,7 +105,7 @@ def stacking_rows(table, family: str = "analysis") -> list[tuple[str, ...]]:
         energies = row_energies(r)
         if not energies:
             continue
-        names = display_names(energies, family)
+        names = display_names(energies, family, row_zero_shift(r))
         low = min(energies.values())
         named = ", ".join(
             f"{names[k]} {v - low:.4g}" for k, v in sorted(energies.items(), key=lambda kv: kv[1])

@@ -14,15 +14,15 @@ computed here.
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
 from flatcontact.errors import InputError
-from flatcontact.fileio import file_sha256, read_text_file
+from flatcontact.fileio import quoted, read_json_file
 from flatcontact.layout import EXPERIMENT_COLLAPSE_JSON
 from flatcontact.report.format import fmt
 from flatcontact.report.html import Section, Table
+from flatcontact.result_json import KINDS, ContractError, check_keys
 
 #: Largest study.json read (a study of thousands of cells is a few MB).
 MAX_STUDY_BYTES = 64 * 1024 * 1024
@@ -47,30 +47,67 @@ def read_approximant_study(path: str | Path, field: str = "report.approximant_st
         )
     if not isinstance(doc.get("cells"), list) or not doc["cells"]:
         raise InputError(f"{field}: {path}: the study has no cells")
+    _check(
+        path, field, lambda: [_check_cell(c, f"cells[{i}].") for i, c in enumerate(doc["cells"])]
+    )
     collapse = path.parent / EXPERIMENT_COLLAPSE_JSON
-    if collapse.is_file():
-        doc = {**doc, "experiment_collapse": _json(collapse, field)}
+    if collapse.exists():
+        rows = _json(collapse, field)
+        _check(collapse, field, lambda: _check_collapse(rows))
+        doc = {**doc, "experiment_collapse": rows}
     return doc
 
 
-def approximant_study_digest(path: str | Path) -> dict:
-    """The content of the study's files the report reads (sha256 of ``study.json`` and of
-    ``experiment_collapse.json`` if present): the report's fingerprint, so a rerun or an
-    extended study reruns the report."""
-    path = Path(path)
-    collapse = path.parent / EXPERIMENT_COLLAPSE_JSON
-    return {
-        "study_json_sha256": file_sha256(path),
-        "experiment_collapse_sha256": file_sha256(collapse) if collapse.is_file() else None,
-    }
+#: What a cell of the approximant study's ``cells`` holds where it ran (a refused cell:
+#: ``label`` and ``error``).
+CELL_KEYS = {
+    "twist_deg": "number?",
+    "strain_percent_slab1": "strains",
+    "strain_percent_slab2": "strains",
+    "tau0_mpa": "number?",
+    "barrier_mev_per_a2": "number?",
+    "resolved": "flag",
+    "gates": "mapping?",
+}
+
+
+def _check(path: Path, field: str, check) -> None:
+    try:
+        check()
+    except ContractError as exc:
+        raise InputError(
+            f"{field}: {quoted(path)}: {exc}; expected the files of 'flatcontact study "
+            "approximants' (rerun the study)"
+        ) from None
+
+
+def _check_cell(cell, where: str) -> None:
+    check_keys(cell, {"label": "text"}, {"error": "text", "n_atoms": "count"}, where)
+    if "error" not in cell:
+        check_keys(cell, {"n_atoms": "count"}, CELL_KEYS, where)
+        check_keys(cell.get("gates") or {}, {}, {"fired": "texts"}, f"{where}gates.")
+
+
+def _check_collapse(rows) -> None:
+    check_keys(rows, {"cells": "list"}, {"p0_gpa": "number", "measured_mpa": "mapping"})
+    for i, row in enumerate(rows["cells"]):
+        where = f"cells[{i}]."
+        check_keys(
+            row,
+            {"label": "text"},
+            {"collapse_stress_mpa": "number?", "ratio_to_measured": "mapping?"},
+            where,
+        )
+        for k, v in (row.get("ratio_to_measured") or {}).items():
+            if not KINDS["number"][0](v):
+                raise ContractError(f"'{where}ratio_to_measured.{k}' is {v!r}, not a finite number")
 
 
 def _json(path: Path, field: str):
-    text = read_text_file(path, field, MAX_STUDY_BYTES)
     try:
-        return json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise InputError(f"{field}: {path}: not JSON ({exc.msg} at line {exc.lineno})") from None
+        return read_json_file(path, "study file", MAX_STUDY_BYTES)
+    except InputError as exc:
+        raise InputError(f"{field}: {exc}") from None
 
 
 def this_run_label(doc: dict, build: dict | None) -> str | None:

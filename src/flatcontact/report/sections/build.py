@@ -217,6 +217,90 @@ def structure_paragraphs(build: dict) -> list[str]:
     return out
 
 
+#: A slab kept at the file's lattice (``structure.lattice: file``) strained by more than this
+#: (largest in-plane principal strain against the model's own lattice, %) gets a note box.
+FILE_LATTICE_NOTE_PERCENT = 0.1
+
+
+def _pct(values) -> str:
+    return ", ".join(f"{float(v):+.3g}" for v in values)
+
+
+def lattice_paragraph(build: dict) -> str | None:
+    """Which lattice the slabs are cut at (``build.json["lattice"]``): the model's own or the
+    file's, and per slab the file's lattice against the model's (% per lattice vector, the
+    in-plane strain) and the lateral stress the model puts on the bulk at the file's lattice.
+    None for a build without the record (a prepared file or slab, the toy)."""
+    lat = build.get("lattice")
+    if not isinstance(lat, dict) or not lat.get("slabs"):
+        return None
+    used = lat.get("source")
+    parts = []
+    for name, rec in lat["slabs"].items():
+        if "not_computed" in rec:
+            parts.append(
+                f"{name.replace('slab', 'slab ')} ({rec.get('material', '?')}): the model cannot "
+                f"compute this material alone ({rec['not_computed']}), so it is kept at the "
+                "file's lattice, unchecked"
+            )
+            continue
+        pot = "/".join(f"{v:.4f}" for v in rec["potential_lengths_angstrom"])
+        fil = "/".join(f"{v:.4f}" for v in rec["file_lengths_angstrom"])
+        parts.append(
+            f"{name.replace('slab', 'slab ')} ({rec.get('material', '?')}): the model's lattice "
+            f"{pot} Å, the file's {fil} Å ({_pct(rec['file_vs_potential_percent'])} % per "
+            f"lattice vector; in-plane {_pct(rec['in_plane_mismatch_percent'])} %); at the "
+            f"file's lattice the model's bulk carries a lateral stress of "
+            f"{rec['lateral_stress_gpa_at_file_lattice']:.3g} GPa (negative: compressed)"
+        )
+    head = (
+        "Lattice: the slabs are cut at the interaction model's own equilibrium lattice "
+        "(structure.lattice = potential; the bulk, or a sheet's in-plane cell, relaxed with "
+        "the run's model). "
+        if used == "potential"
+        else "Lattice: the slabs are kept at the structure file's lattice (structure.lattice = "
+        f"file; refused above {lat.get('max_file_mismatch_percent', '?')} % in-plane). "
+    )
+    match = (build.get("recipe") or {}).get("match") or {}
+    against = [
+        f"slab {i} {_pct(match[f'slab{i}_strain_vs_potential_percent'])} %"
+        for i in (1, 2)
+        if f"slab{i}_strain_vs_potential_percent" in match
+    ]
+    tail = (
+        f" In the coincidence cell, strain against each slab's own model lattice: {'; '.join(against)}."
+        if against
+        else ""
+    )
+    return head + "; ".join(parts) + "." + tail
+
+
+def file_lattice_note(build: dict) -> str | None:
+    """The note on slabs kept at the file's lattice and strained against the model's by more
+    than :data:`FILE_LATTICE_NOTE_PERCENT`, or None."""
+    lat = build.get("lattice")
+    if not isinstance(lat, dict) or lat.get("source") != "file":
+        return None
+    strained = [
+        (name, rec)
+        for name, rec in (lat.get("slabs") or {}).items()
+        if max(abs(v) for v in rec["in_plane_mismatch_percent"]) > FILE_LATTICE_NOTE_PERCENT
+    ]
+    if not strained:
+        return None
+    what = "; ".join(
+        f"{n.replace('slab', 'slab ')} {_pct(r['in_plane_mismatch_percent'])} % in-plane, "
+        f"lateral stress {r['lateral_stress_gpa_at_file_lattice']:.3g} GPa"
+        for n, r in strained
+    )
+    return (
+        f"Not the model's lattice: {what}. The slabs are kept at the structure file's lattice "
+        "(structure.lattice = file), so every energy, τ and σ here is that of a strained "
+        "crystal under this lateral stress, not of the model's own (structure.lattice: "
+        "potential cuts them at the model's equilibrium)."
+    )
+
+
 def interface_section(
     cfg, build: dict, folder: Path, atoms: Atoms | None = None, paper: bool = False
 ) -> Section:
@@ -230,8 +314,10 @@ def interface_section(
     rel = build.get("interface_relaxation") or {}
     checks = build.get("interface_verification") or {}
     verified = bool(checks) and all(v.get("dense") for v in checks.values())
+    lattice = lattice_paragraph(build)
     paragraphs = [
         *structure_paragraphs(build),
+        *([lattice] if lattice else []),
         f"{build.get('n_atoms', '?')} atoms; reference thickness z = {fmt(build.get('thickness_angstrom'))} Å"
         + (
             f"; interface relaxation {'converged' if rel.get('converged') else 'NOT converged'}"
@@ -252,13 +338,15 @@ def interface_section(
     return Section(
         "1. Interface",
         paragraphs=paragraphs,
-        notes=[]
-        if paper
-        else [
+        notes=[
             n
             for n in (
-                lock_statement(build),
-                approximant_note(build) or COMMENSURATE_WARNING,
+                file_lattice_note(build),
+                *(
+                    ()
+                    if paper
+                    else (lock_statement(build), approximant_note(build) or COMMENSURATE_WARNING)
+                ),
             )
             if n
         ],

@@ -26,6 +26,7 @@ from flatcontact.reference import (
 from flatcontact.report.format import LAW_COEFFICIENTS, fmt, pm
 from flatcontact.report.html import Section, Table
 from flatcontact.report.sections.analysis import stacking_rows
+from flatcontact.report.sections.contact import slip_note
 
 A_EXP = QUARTZ_LATTICE_EXPERIMENT_ANGSTROM["a"]
 
@@ -75,11 +76,11 @@ def paper_section(cfg, laws: dict, scan: dict, contact: dict) -> Section:
     )
     res = contact["results"]
     ref = contact["results_with_paper_laws"]
-    for r_run, r_pap in zip(res, ref, strict=True):
+    for i, (r_run, r_pap) in enumerate(zip(res, ref, strict=True)):
         rows.append(
             (
                 f"effective shear strength Q_peak/πa² at p0 = {r_run['p0_gpa']:g} GPa (MPa)",
-                fmt(r_run["effective_shear_strength_mpa"]),
+                fmt(r_run["effective_shear_strength_mpa"]) + slip_note(contact, i),
                 fmt(r_pap["effective_shear_strength_mpa"]),
                 f"{r_run['effective_shear_strength_mpa'] - r_pap['effective_shear_strength_mpa']:+.3g}",
                 "paper column: the same contact model with the paper's k, τ0, μ, σ0",
@@ -117,10 +118,12 @@ def own_results_section(
         (label, pm(laws.get(key), laws.get(err_key)) + _law_interval(laws, key, studied))
         for key, err_key, label in LAW_COEFFICIENTS
     ]
+    adhesion = scan.get("adhesion") or {}
+    at = adhesion.get("work_of_separation_stacking")
     rows.append(
         (
-            "work of separation W (J/m²)",
-            fmt((scan.get("adhesion") or {}).get("work_of_separation_j_per_m2")),
+            "work of separation W (J/m²)" + (f", at the {at}" if at else ""),
+            fmt(adhesion.get("work_of_separation_j_per_m2")),
         )
     )
     intervals = (contact.get("intervals") or {}).get("results") or []
@@ -129,6 +132,7 @@ def own_results_section(
         if studied and i < len(intervals):
             q = intervals[i]["effective_shear_strength_mpa"]
             cell += f" [{q['low']:.4g}, {q['high']:.4g}]"
+        cell += slip_note(contact, i)
         rows.append(
             (f"effective shear strength Q_peak/πa² at p0 = {r['p0_gpa']:g} GPa (MPa)", cell)
         )

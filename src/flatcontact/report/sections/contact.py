@@ -12,6 +12,7 @@ from flatcontact.layout import (
     FIG6_EXPERIMENT,
     FIG6_FIT,
     FIG6_LOCKIN,
+    FIG_SLIP_SIZE,
     png,
 )
 from flatcontact.report.format import fmt, pm
@@ -27,7 +28,8 @@ def contact_section(cfg, contact: dict, elastic: dict | None, folder: Path) -> S
     params = contact["parameters"]
     prov = contact["provenance"]
     keys = [
-        ("contact_radius_nm", "Hertz contact radius a (nm)"),
+        ("contact_radius_nm", "contact radius a (nm)"),
+        ("hertz_contact_radius_nm", "Hertz contact radius (nm)"),
         ("normal_load_un", "normal load P (µN)"),
         ("contact_radius_change_dmt_percent", "DMT radius change vs Hertz (%)"),
         ("peak_lateral_force_un", "peak lateral force Q_peak (µN)"),
@@ -40,7 +42,7 @@ def contact_section(cfg, contact: dict, elastic: dict | None, folder: Path) -> S
     ]
     res = contact["results"]
     keys = [k for k in keys if k[0] in res[0]]
-    ct_rows = [(label, *(fmt(r[k]) for r in res)) for k, label in keys]
+    ct_rows = [(label, *(fmt(r[k]) for r in res)) for k, label in keys] + range_rows(contact)
     contact_figs = [
         Figure(
             folder / png(FIG4_TRACTION),
@@ -59,10 +61,20 @@ def contact_section(cfg, contact: dict, elastic: dict | None, folder: Path) -> S
         ),
     ]
     notes = [
+        *range_boxes(contact),
         "Where the parameters come from: "
         + "; ".join(f"{k}: {v}" for k, v in prov.items() if k != "moduli")
-        + "."
+        + ".",
     ]
+    if "slip_size" in contact:
+        contact_figs.append(
+            Figure(
+                folder / png(FIG_SLIP_SIZE),
+                "Effective shear strength against contact radius: concurrent slip (the modified "
+                "Mindlin number, dashed) and the size-limited strength (solid, or the elastic "
+                "bound, dotted); dots: this run's contacts (docs/contact.md).",
+            )
+        )
     if "experiment" in contact:
         e = contact["experiment"]
         contact_figs.append(
@@ -232,3 +244,64 @@ def interval_tables(contact: dict) -> list:
             f"Contact outputs over the laws' intervals ({hw}; every corner of the box)",
         )
     ]
+
+
+def range_boxes(contact: dict) -> list[str]:
+    """The boxes above the contact numbers: the adhesion regime, configured moduli of
+    another material or potential, and one sentence per p0 whose contact radius exceeds the
+    critical size of concurrent slip (:mod:`flatcontact.stages.contact_range`)."""
+    from flatcontact.contact.slip_size import slip_sentences
+
+    out = []
+    if "adhesion_regime" in contact:
+        out.append("Contact regime: " + contact["adhesion_regime"]["sentence"] + ".")
+    if contact.get("moduli_note"):
+        out.append(contact["moduli_note"] + ".")
+    return out + slip_sentences(contact.get("slip_size"))
+
+
+def range_rows(contact: dict) -> list[tuple]:
+    """Rows of the per-p0 table: pull-off/load, the regime, the critical size and the
+    size-limited strength beside the concurrent one."""
+    rows = []
+    adh = (contact.get("adhesion_regime") or {}).get("results")
+    if adh:
+        rows.append(("adhesion regime", *(r["regime"] for r in adh)))
+        rows.append(("pull-off force / load", *(fmt(r["pull_off_over_load"]) for r in adh)))
+    slip = contact.get("slip_size")
+    if slip:
+        crit = (
+            "critical radius a_c (nm)"
+            if slip["structure"] == "commensurate"
+            else ("elastic bound of superlubricity a_el (nm)")
+        )
+        res = slip["results"]
+        rows.append((crit, *(fmt(r["critical_radius_nm"]) for r in res)))
+        rows.append(
+            (
+                "size-limited strength (MPa)",
+                *(
+                    "—"
+                    if r["size_limited_strength_mpa"] is None
+                    else fmt(r["size_limited_strength_mpa"])
+                    for r in res
+                ),
+            )
+        )
+        rows.append(("strength reported (contact.slip_regime)", *(r["reported"] for r in res)))
+    return rows
+
+
+def slip_note(contact: dict, i: int) -> str:
+    """A short note for the concurrent-slip Q_peak/πa² of the i-th p0 wherever it appears
+    (never silent past the critical size): '' within it."""
+    rows = (contact.get("slip_size") or {}).get("results") or []
+    if i >= len(rows) or not rows[i]["exceeded"]:
+        return ""
+    r = rows[i]
+    if r["size_limited_strength_mpa"] is None:
+        return f" (concurrent slip; a > a_el = {r['critical_radius_nm']:.3g} nm: a lower bound)"
+    return (
+        f" (concurrent slip; a > a_c = {r['critical_radius_nm']:.3g} nm: size-limited ≈ "
+        f"{r['size_limited_strength_mpa']:.4g})"
+    )

@@ -20,6 +20,57 @@ UNTRUSTED = {
 }
 
 
+#: The numbers each gate's finding reaches (the fitted laws' keys; ``w``: the scan's work of
+#: separation, read from the same landscape).
+REACHES = {
+    "in_slab_slip": ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa", "w"),
+    "broken_symmetry": ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa", "w"),
+    "load_fold": ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa"),
+    "negative_slope": ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa"),
+    "degenerate_minima": ("k_mpa_per_gpa", "tau0_mpa"),
+}
+_NAMES = {
+    "k_mpa_per_gpa": ("k", "MPa/GPa"),
+    "tau0_mpa": ("τ0", "MPa"),
+    "mu_mpa_per_gpa": ("μ", "MPa/GPa"),
+    "sigma0_mpa": ("σ0", "MPa"),
+}
+
+
+def flowed_on(contact: dict, gates: list[str]) -> str | None:
+    """One line: the untrusted numbers the contact stage took (values and where from) after
+    ``gates`` were passed with ``contact.accept_untrusted``, and the results they reach;
+    None when every number they reach was given in the configuration."""
+    params = contact.get("parameters") or {}
+    prov = contact.get("provenance") or {}
+    keys = list(dict.fromkeys(k for g in gates for k in REACHES.get(g, REACHES["in_slab_slip"])))
+    used = [
+        f"{_NAMES[k][0]} = {params[k]:.4g} {_NAMES[k][1]}"
+        for k in keys
+        if k in _NAMES and prov.get(k) == "fitted laws" and k in params
+    ]
+    if "w" in keys and prov.get("work_of_adhesion_j_m2") == "scan work of separation":
+        used.append(f"w = {params.get('work_of_adhesion_j_m2', float('nan')):.4g} J/m² (scan)")
+    if not used:
+        return None
+    p0 = [r.get("p0_gpa") for r in contact.get("results") or [] if r.get("p0_gpa") is not None]
+    where = ", ".join(f"{v:g}" for v in p0)
+    line = (
+        "Untrusted numbers that flowed on into the contact stage: "
+        + ", ".join(used)
+        + " (fitted laws)"
+        + (f"; they enter every contact result (p0 = {where} GPa)" if where else "")
+    )
+    if prov.get("moduli") == "config":
+        line += (
+            f". E* = {params.get('contact_modulus_gpa', float('nan')):g} GPa and G* = "
+            f"{params.get('shear_modulus_gpa', float('nan')):g} GPa are the configuration's "
+            "(contact.contact_modulus_gpa, contact.shear_modulus_gpa), not computed with this "
+            "run's model (elastic.enabled computes them)"
+        )
+    return line
+
+
 def gates_section(contact: dict) -> Section | None:
     """The section of the gates recorded by the contact stage, or None if there is nothing
     to say."""
@@ -33,6 +84,9 @@ def gates_section(contact: dict) -> Section | None:
         f"fired and was passed with contact.accept_untrusted: {f['message']}"
         for f in fired
     ]
+    flowed = flowed_on(contact, [f["gate"] for f in fired if f.get("overridden", True)])
+    if fired and flowed is not None:
+        boxes.append(flowed)
     boxes += [f"Note: {n}" for n in notes]
     paragraphs = []
     if fired:

@@ -43,6 +43,10 @@ def scan_section(scan: dict, folder: Path) -> Section:
     ):
         if key in adh:
             scan_rows.append((label, fmt(adh[key])))
+        if key == "work_of_separation_j_per_m2" and "work_of_separation_stacking" in adh:
+            scan_rows.append(
+                ("work of separation taken at", str(adh["work_of_separation_stacking"]))
+            )
     return Section(
         "2. ISPES scan",
         tables=[Table(("quantity", "value"), scan_rows)],

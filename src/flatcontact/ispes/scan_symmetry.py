@@ -1,0 +1,146 @@
+"""The scan's symmetry plan: one round of the grid, reduced by the shift-space group or in full.
+
+With the reduction on (:mod:`flatcontact.ispes.reduction`) a round relaxes one representative
+per orbit, then a few verified mapped points, checks them against their representatives and,
+if the relaxation breaks the symmetry, computes every point of the grid after all. The plan's
+``mapping`` and ``record`` exist from the start and follow each step, so a round stopped
+partway (Ctrl-C) still assembles the mapped points of its stored representatives.
+"""
+
+from __future__ import annotations
+
+import collections
+
+import numpy as np
+from ase import Atoms
+
+from flatcontact.ispes.contract import cell_area
+from flatcontact.ispes.geometry import in_plane_vectors
+from flatcontact.ispes.grid import GridSpec
+from flatcontact.ispes.order import tree_in_store_order
+from flatcontact.ispes.reduction import (
+    SymmetrySettings,
+    choose_verify,
+    fallback_reason,
+    plan_reduction,
+    symmetry_broken,
+    verification,
+)
+from flatcontact.ispes.relax import RelaxSettings
+from flatcontact.ispes.scan_scheduler import Scheduler
+from flatcontact.ispes.shift_symmetry import shift_space_group
+
+
+class ScanRound:
+    """One round of the grid: its thicknesses ``z`` (the store's order), the warm-start root
+    (the thickness nearest the reference's) and the trees over it."""
+
+    def __init__(self, z: np.ndarray, n_a: int, n_b: int, reference_thickness: float, order: str):
+        self.z = z
+        self.shape = (n_a, n_b, z.size)
+        self.root = (0, 0, int(np.argmin(np.abs(z - reference_thickness))))
+        self.order = order
+        self.full_tree = self.tree()
+
+    def tree(self, allowed: set | None = None) -> dict:
+        """The warm-start tree over ``allowed`` (every point: None), in the store's indices
+        (:func:`flatcontact.ispes.order.tree_in_store_order`)."""
+        return tree_in_store_order(self.z, self.shape, self.root, self.order, allowed)
+
+
+class SymmetryPlan:
+    """Which points a round relaxes and how the others are filled.
+
+    ``reduction``: the :class:`~flatcontact.ispes.reduction.Reduction` (None: symmetry off or
+    a trivial group, every point relaxed). ``mapping``: grid point -> the point whose values
+    it takes, for the store's assembly (None: every point its own). ``record``: the
+    ``symmetry`` entry of ``ispes.nc`` and ``scan.json`` (None without a reduction).
+    """
+
+    def __init__(
+        self,
+        reference: Atoms,
+        grid: GridSpec,
+        relax: RelaxSettings,
+        symmetry: SymmetrySettings,
+        round_: ScanRound,
+    ):
+        self.reference, self.settings, self.round = reference, symmetry, round_
+        self.reduction = None
+        if symmetry.enabled:
+            # modulo the pure translations, lifted onto the grid: a twist cell's N²
+            # translations are never enumerated against each other
+            group = shift_space_group(
+                reference,
+                symmetry.tolerance_angstrom,
+                spread_compression=relax.mode != "rigid",
+                modulo_translations=True,
+            ).for_grid(grid.n_a, grid.n_b)
+            self.reduction = plan_reduction(group, round_.shape, list(round_.full_tree))
+        self.mapping, self.record = None, None
+        if self.reduced:
+            # the record and the mapping exist from the start, so a scan stopped partway
+            # writes the mapped points of its stored representatives
+            self.mapping = self.reduction.representative
+            self.record = {
+                **self.reduction.to_json(),
+                "verification": None,
+                "computed_in_full": False,
+            }
+
+    @property
+    def reduced(self) -> bool:
+        """Whether the round relaxes only representatives (a group of order > 1)."""
+        return self.reduction is not None and self.reduction.group.order > 1
+
+    def run(self, scheduler: Scheduler, notes: list[str]) -> None:
+        """Relax the round's points with ``scheduler``: every point, or the representatives,
+        the verified points and, if the check fails, every point (the reason appended to
+        ``notes``)."""
+        round_, store = self.round, scheduler.store
+        if not self.reduced:
+            scheduler.run(round_.full_tree, round_.z)
+            return
+        # progress over the grid: a representative fills its orbit, a verified point counts
+        # one more
+        fills = collections.Counter(self.reduction.representative.values())
+        grid_points = int(np.prod(round_.shape))
+        scheduler.run(
+            round_.tree(self.reduction.computed),
+            round_.z,
+            weight=fills,
+            total=grid_points + self.settings.verify_points,
+        )
+        if all(rep in store for rep in self.reduction.computed):
+            # chosen from the complete representatives only: a resumed scan verifies the
+            # same points as an uninterrupted one
+            self.reduction = choose_verify(
+                self.reduction, store.done(), round_.shape, self.settings.verify_points
+            )
+            self.record.update(self.reduction.to_json())
+            scheduler.run(
+                round_.tree(self.reduction.computed),
+                round_.z,
+                weight=fills,
+                total=grid_points + len(self.reduction.verify),
+            )
+        if all(idx in store for idx in self.reduction.computed):
+            self._verify(scheduler, notes)
+
+    def _verify(self, scheduler: Scheduler, notes: list[str]) -> None:
+        """Compare the verified points with their representatives; on a broken symmetry
+        compute the whole grid."""
+        # the plan's points only: a scan resumed partway through its fallback has more
+        # points stored, which must not move the tolerances (a function of the grid)
+        computed = self.reduction.computed
+        records = {idx: r for idx, r in scheduler.store.done().items() if idx in computed}
+        area = cell_area(*in_plane_vectors(self.reference))
+        check = verification(self.reduction, records, area, self.settings)
+        self.record["verification"] = check
+        if symmetry_broken(check, self.settings):
+            reason = fallback_reason(check, self.settings, self.reduction.group.order)
+            self.record["computed_in_full"] = True
+            self.record["computed_in_full_reason"] = reason
+            notes.append(reason)
+            self.mapping = None
+            scheduler.run(self.round.full_tree, self.round.z)
