@@ -87,19 +87,23 @@ def rewrite(text: str, doc: dict) -> str:
 
 
 def main(argv: list[str]) -> int:
-    text = README.read_text()
-    new = rewrite(text, record.read())
-    if "--check" in argv:
-        if new != text:
-            print(
-                "error: README.md's benchmark blocks differ from benchmarks/run_record.json; "
-                "run python -m benchmarks.readme_block"
-            )
-            return 1
-        return 0
-    if new != text:
-        README.write_text(new)
-        print(f"rewrote the benchmark blocks of {README.name}")
+    doc, stale = record.read(), []
+    for path in FILES:
+        text = path.read_text()
+        new = rewrite(text, doc)
+        if new == text:
+            continue
+        if "--check" in argv:
+            stale.append(path.relative_to(record.ROOT).as_posix())
+        else:
+            path.write_text(new)
+            print(f"rewrote the benchmark blocks of {path.relative_to(record.ROOT)}")
+    if stale:
+        print(
+            f"error: the benchmark blocks of {', '.join(stale)} differ from "
+            "benchmarks/run_record.json; run python -m benchmarks.readme_block"
+        )
+        return 1
     return 0
 
 

@@ -15,7 +15,6 @@ from pathlib import Path
 import pytest
 from tests.hardening.helpers import (
     assert_refused_cleanly,
-    finished_toy_run,
     refused,
     run_cli,
     tree,
@@ -31,9 +30,9 @@ OUTPUTS = ("02-scan/ispes.nc", "03-analyze/friction.nc", "06-contact/summary.jso
 
 
 @pytest.fixture(scope="module")
-def finished(tmp_path_factory):
-    """(config folder, run directory) of one finished toy study."""
-    return finished_toy_run(tmp_path_factory.mktemp("finished"))
+def finished(finished_toy):
+    """(config folder, run directory) of one finished toy study (built once per process)."""
+    return finished_toy
 
 
 @pytest.fixture

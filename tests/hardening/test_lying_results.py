@@ -16,7 +16,7 @@ import shutil
 import numpy as np
 import pytest
 import xarray as xr
-from tests.hardening.helpers import TOY_YAML, finished_toy_run, refused, run_cli, tree
+from tests.hardening.helpers import TOY_YAML, refused, run_cli, tree
 
 from flatcontact.config import build_config
 from flatcontact.errors import InputError
@@ -25,8 +25,8 @@ from flatcontact.stages.result_files import CONTACT, FRICTION, open_result
 
 
 @pytest.fixture(scope="module")
-def toy_run(tmp_path_factory):
-    return finished_toy_run(tmp_path_factory.mktemp("lying_results"))
+def toy_run(finished_toy):
+    return finished_toy
 
 
 def _edit(path, change):

@@ -628,6 +628,7 @@ def test_each_stage_through_the_cli_writes_the_files_of_the_run(tiny_run, tmp_pa
     assert (out / "friction.csv").read_text() == (src / "03-analyze" / "friction.csv").read_text()
     _same_netcdf(out / "friction.nc", src / "03-analyze" / "friction.nc")
     _same_json(out / "analyze.json", src / "03-analyze" / "analyze.json", ignore=("timings_s",))
+    _same_json(out / "other_form.json", src / "03-analyze" / "other_form.json")
     _same_json(out / "laws.json", src / "04-laws" / "laws.json")
     assert _figures(out) == _figures(src / "03-analyze") | _figures(src / "04-laws")
 
