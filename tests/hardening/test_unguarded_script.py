@@ -182,3 +182,31 @@ def test_a_holder_on_another_host_or_alive_here_is_not_stale():
     assert stale_holder("1 some-other-host 12345") is None
     assert stale_holder("") is None and stale_holder("not-a-pid") is None
     assert stale_holder("999999999") == "pid 999999999 is not running"
+
+
+def _try_lock(root: str, answer) -> None:
+    """In a spawned worker: take the run directory's lock, answer the refusal line."""
+    try:
+        RunLock(root).acquire()
+        answer.put("acquired")
+    except InputError as exc:
+        answer.put(str(exc))
+
+
+def test_a_spawned_worker_meeting_its_parents_lock_is_told_about_the_guard(tmp_path):
+    """What a worker that re-ran an unguarded script would meet (when the script is not
+    recognised, e.g. run through exec): its parent's lock, named as such with the guard."""
+    import multiprocessing
+
+    ctx = multiprocessing.get_context("spawn")
+    answer = ctx.Queue()
+    lock = RunLock(tmp_path).acquire()
+    try:
+        worker = ctx.Process(target=_try_lock, args=(str(tmp_path), answer))
+        worker.start()
+        line = answer.get(timeout=120)
+        worker.join(timeout=60)
+    finally:
+        lock.release()
+    assert "\n" not in line and f"started by pid {os.getpid()}" in line
+    assert 'if __name__ == "__main__":' in line

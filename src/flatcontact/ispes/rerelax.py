@@ -236,6 +236,29 @@ class FoldRerelaxation:
         return out + [f"{name}: fold not re-relaxed ({why})" for name, why in self.left]
 
 
+def _window_tasks(main: PointStore, chosen: list[FoldWindow], z: np.ndarray) -> list[tuple]:
+    """``(node, stored record, PointTask)`` per point of the ``chosen`` windows, each started
+    from its stored positions (the scan's store ``main``; ``z`` the ascending thicknesses)."""
+    resolved_z = np.asarray(main.resolved["thickness_angstrom"], float)
+    tasks = []
+    for w in chosen:
+        for k in w.nodes:
+            index = (w.column[0], w.column[1], _stored_index(resolved_z, z[k]))
+            rec = main.record(index)
+            a, b = rec["shift"]
+            task = PointTask(
+                index,
+                a,
+                b,
+                rec["thickness"],
+                start_positions=main.positions(index),
+                start_shift=(a, b),
+                start_thickness=rec["thickness"],
+            )
+            tasks.append((k, rec, task))
+    return tasks
+
+
 def _stored_index(resolved_z: np.ndarray, z: float) -> int:
     """The store's thickness index (position in ``resolved`` ``thickness_angstrom``) of ``z``."""
     return int(np.argmin(np.abs(resolved_z - z)))
@@ -298,30 +321,9 @@ def rerelax_folds(
     if not chosen:
         return ds, result
     z = np.asarray(ds[contract.DIM_Z].values, float)
-    tasks = []
     with PointStore(store_path, store_settings, reference) as main:
         resolved = main.resolved
-        resolved_z = np.asarray(resolved["thickness_angstrom"], float)
-        for w in chosen:
-            for k in w.nodes:
-                index = (w.column[0], w.column[1], _stored_index(resolved_z, z[k]))
-                rec = main.record(index)
-                shift = rec["shift"]
-                tasks.append(
-                    (
-                        k,
-                        rec,
-                        PointTask(
-                            index,
-                            shift[0],
-                            shift[1],
-                            rec["thickness"],
-                            start_positions=main.positions(index),
-                            start_shift=shift,
-                            start_thickness=rec["thickness"],
-                        ),
-                    )
-                )
+        tasks = _window_tasks(main, chosen, z)
     path = (
         Path(rerelax_path) if rerelax_path is not None else Path(store_path).with_name(RERELAX_DB)
     )

@@ -17,12 +17,12 @@ once. ``flatcontact <stage>`` (:mod:`flatcontact.cli`) and ``flatcontact run``
 stage      function                               files
 =========  =====================================  ==========================================
 build      :func:`.build.run_build`               interface.extxyz, build.json, fig1_interface
-scan       :func:`.scan.run_scan`                 points.db, probe.json, ispes.nc, scan.json, fig_scan_columns
+scan       :func:`.scan.run_scan`                 points.db, (rerelax.db), probe.json, ispes.nc, scan.json, fig_scan_columns
 analyze    :func:`.analyze.run_analyze`           friction.csv, friction.nc, analyze.json, other_form.json, fig2_p*
 laws       :func:`.laws.run_laws`                 laws.json, fig3_laws
 elastic    :func:`.elastic.run_elastic`           elastic.json
 contact    :func:`.contact.run_contact`           contact.nc, summary.json, fig4, fig5, (fig6)
-report     :func:`.report.run_report`             report.html
+report     :func:`.report.run_report`             report.html, (refusal.json: a run refused after the scan)
 asperity   :func:`.asperity.run_asperity`         asperity.nc, asperity.json, fig_asperity_*, state/
 =========  =====================================  ==========================================
 """

@@ -1,21 +1,22 @@
 """The scan stage's remedy for folds from relaxation error (:mod:`flatcontact.ispes.rerelax`).
 
 After the grid is stored, every column whose load, read as ``analysis.load_source`` says,
-folds on the compressed side at any load (the analysis refuses the loads above a fold; the
-loads it reads, ``analysis.p_gpa``, are not part of the scan's fingerprint, so the grid must
-not depend on them), and on a pressure-range grid every column the scan's grid check records
-as folding (``load_folds``, refused by the gate ``load_fold``), has its fold's window relaxed
-again at ``scan.fmax_ev_per_angstrom`` / 10, once, into ``02-scan/rerelax.db``; ``ispes.nc``
+folds where the analysis would refuse a load of ``analysis.p_gpa``, and on a pressure-range
+grid every column the scan's grid check records as folding (``load_folds``, refused by the
+gate ``load_fold``), has its fold's window relaxed again at ``scan.fmax_ev_per_angstrom`` / 10, once, into ``02-scan/rerelax.db``; ``ispes.nc``
 then holds those points, ``scan.json`` ``fold_rerelaxation`` says what was re-relaxed and
 which folds survived, its warnings and the run log state it, and the folds the re-relaxation
 removed leave ``load_folds``. A fold that survives is refused by the analysis as before, its
-message saying that it survived.
+message saying that it survived. Only folds that would stop the run are re-relaxed, so a run
+that passes keeps its numbers. The lowest and highest load of ``analysis.p_gpa`` are part of
+a pressure-range scan's fingerprint (``Pipeline._scan_inputs``); with given thicknesses
+(``scan.thickness_angstrom``) they are not, and a load added later above a fold is refused
+by the analysis without this remedy (rerun the scan, e.g. with a new ``--out``).
 """
 
 from __future__ import annotations
 
 import dataclasses
-import math
 from typing import Any
 
 from flatcontact.ispes.contract import write_ispes
@@ -47,7 +48,7 @@ def remedy_folds(
         scan.store_path,
         store,
         relax,
-        [math.inf],  # every fold, whatever analysis.p_gpa (not in the scan's fingerprint)
+        a.p_gpa,  # only a fold that would be refused: a run that passes keeps its numbers
         a.load_source,
         recorded=settings.scan.p_range_gpa is not None,  # the grid check records folds
     )
