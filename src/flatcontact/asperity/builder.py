@@ -34,6 +34,7 @@ from ase import Atoms
 
 from flatcontact.asperity.binning import contact_coordinate
 from flatcontact.errors import InputError, require
+from flatcontact.structures.layers import atomic_planes
 
 #: Bytes per atom of a LAMMPS run (positions, forces, minimiser vectors, ghosts) besides the
 #: neighbour list; the neighbour list costs 4 bytes per neighbour (half list).
@@ -203,18 +204,6 @@ def plane_spacing(interface: Atoms) -> float:
     return float((planes[-1] - planes[0]) / (len(planes) - 1))
 
 
-def _planes(z: np.ndarray) -> np.ndarray:
-    """Index of the atomic plane of each height (0 lowest; new plane after a 0.3 Å gap)."""
-    order = np.argsort(z)
-    ids = np.empty(len(z), dtype=int)
-    current = 0
-    for k, i in enumerate(order):
-        if k and z[i] - z[order[k - 1]] > 0.3:
-            current += 1
-        ids[i] = current
-    return ids
-
-
 def carve(interface: Atoms, sizes: Sizes, gap_angstrom: float | None = None) -> Atoms:
     """The asperity from a deep interface (slab 1 with >= ``flat_layers`` planes, slab 2 with
     >= ``tip_layers``): laterally repeated, trimmed to the planes, the tip cut to the cap.
@@ -225,8 +214,8 @@ def carve(interface: Atoms, sizes: Sizes, gap_angstrom: float | None = None) -> 
     """
     slab = np.asarray(interface.arrays["slab"])
     z = interface.positions[:, 2]
-    z1 = _planes(np.where(slab == 1, z, np.nan)[slab == 1])
-    z2 = _planes(z[slab == 2])
+    z1 = atomic_planes(np.where(slab == 1, z, np.nan)[slab == 1])
+    z2 = atomic_planes(z[slab == 2])
     require(
         z1.max() + 1 >= sizes.flat_layers and z2.max() + 1 >= sizes.tip_layers,
         f"structure: the interface has {z1.max() + 1} and {z2.max() + 1} planes, the asperity "
