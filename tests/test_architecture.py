@@ -47,6 +47,7 @@ LAYERS: tuple[tuple[str, frozenset[str]], ...] = (
                 "errors",
                 "limits",
                 "fileio",
+                "interrupts",
                 "result_json",
                 "rundir",
                 "codegraph",

@@ -40,7 +40,6 @@ import resource
 import signal
 import sqlite3
 import sys
-import threading
 from typing import Annotated
 
 import typer
@@ -166,28 +165,20 @@ def sigterm_unwinds():
     """While a command runs, SIGTERM raises :class:`Terminated` in the main thread; yields a
     list that holds the signal once it came. A process forked from this one dies of SIGTERM
     as before (a pool's workers); nothing changes where SIGTERM already has a handler."""
+    from flatcontact.interrupts import raise_on_sigterm
+
     got: list[int] = []
-    if (
-        threading.current_thread() is not threading.main_thread()
-        or signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL
-    ):
-        yield got
-        return
-    pid = os.getpid()
 
-    def terminated(signum, frame):
-        if os.getpid() != pid:  # a forked child: die as it would have
-            signal.signal(signal.SIGTERM, signal.SIG_DFL)
-            os.kill(os.getpid(), signal.SIGTERM)
-            return
+    def terminated(signum: int) -> Terminated:
         got.append(signum)
-        raise Terminated("SIGTERM")
+        return Terminated("SIGTERM")
 
-    old = signal.signal(signal.SIGTERM, terminated)
+    old = raise_on_sigterm(terminated)
     try:
         yield got
     finally:
-        signal.signal(signal.SIGTERM, old)
+        if old is not None:
+            signal.signal(signal.SIGTERM, old)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -50,7 +50,6 @@ import json
 import os
 import signal
 import sqlite3
-import threading
 import time
 import types
 import uuid
@@ -62,6 +61,7 @@ from ase import Atoms
 
 from flatcontact.errors import InputError
 from flatcontact.fileio import refuse_link
+from flatcontact.interrupts import raise_on_sigterm
 from flatcontact.ispes import contract
 from flatcontact.ispes.relax import Index, PointResult
 from flatcontact.ispes.store_checks import (
@@ -258,21 +258,11 @@ class PointStore:
         when the store closes; only where SIGTERM would otherwise kill the process at once
         (the main thread, the default action). A process forked from the driver gets the
         default action back."""
-        self._old_sigterm = None
-        if threading.current_thread() is not threading.main_thread():
-            return
-        if signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL:
-            return
-        pid = os.getpid()
-
-        def terminated(signum, frame):
-            if os.getpid() != pid:  # a forked child: die as it would have
-                signal.signal(signal.SIGTERM, signal.SIG_DFL)
-                os.kill(os.getpid(), signal.SIGTERM)
-                return
-            raise StoreTerminated(f"SIGTERM; the points stored so far are kept in {self.path}")
-
-        self._old_sigterm = signal.signal(signal.SIGTERM, terminated)
+        self._old_sigterm = raise_on_sigterm(
+            lambda signum: StoreTerminated(
+                f"SIGTERM; the points stored so far are kept in {self.path}"
+            )
+        )
 
     def _commit(self) -> None:
         if self._db.connection is not None:
