@@ -284,19 +284,15 @@ def contact_from_laws(
 
 
 def _law_numbers(laws) -> dict[str, float]:
-    """k, τ0, μ, σ0 of a :class:`~flatcontact.analysis.laws.LoadLaws` or a mapping."""
-    keys = ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa")
-    if isinstance(laws, dict):
-        missing = [k for k in keys if k not in laws]
-        if missing:
-            raise InputError(f"laws: missing {', '.join(missing)}")
-        return {k: float(laws[k]) for k in keys}
-    tau, sigma = getattr(laws, "tau", None), getattr(laws, "sigma", None)
-    if tau is None or sigma is None:
-        raise InputError("laws: expected fit_load_laws(...)'s result with both τ and σ laws fitted")
-    return {
-        "k_mpa_per_gpa": tau.slope,
-        "tau0_mpa": tau.intercept,
-        "mu_mpa_per_gpa": sigma.slope,
-        "sigma0_mpa": sigma.intercept,
-    }
+    """k, τ0, μ, σ0 of a :class:`~flatcontact.analysis.laws.LoadLaws` (through its
+    ``laws.json`` form, :meth:`~flatcontact.analysis.laws.LoadLaws.to_json`) or a mapping."""
+    from flatcontact.reference import PAPER_LAW_KEYS
+
+    doc = laws if isinstance(laws, dict) else getattr(laws, "to_json", dict)()
+    missing = [k for k in PAPER_LAW_KEYS if doc.get(k) is None]
+    if missing:
+        raise InputError(
+            f"laws: missing {', '.join(missing)} (a mapping as laws.json, or "
+            "fit_load_laws(...)'s result with both τ and σ laws fitted)"
+        )
+    return {k: float(doc[k]) for k in PAPER_LAW_KEYS}
