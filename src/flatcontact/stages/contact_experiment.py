@@ -30,19 +30,14 @@ def quartz_quick_laws() -> dict:
         the key.
     """
     import json
-    import math
+
+    from flatcontact.result_json import ContractError, check_keys
 
     doc = json.loads(QUARTZ_QUICK_LAWS_FILE.read_text(encoding="utf-8"))
-    for key in PAPER_LAW_KEYS:
-        value = doc.get(key)
-        if (
-            isinstance(value, bool)
-            or not isinstance(value, int | float)
-            or not math.isfinite(value)
-        ):
-            raise InputError(
-                f"{QUARTZ_QUICK_LAWS_FILE.name}: {key}: expected a finite number, got {value!r}"
-            )
+    try:
+        check_keys(doc, {key: "number" for key in PAPER_LAW_KEYS}, {"label": "text"})
+    except ContractError as exc:
+        raise InputError(f"{QUARTZ_QUICK_LAWS_FILE.name}: {exc}") from None
     return doc
 
 
