@@ -27,7 +27,7 @@ def native_script(model, atoms, positions, protocol, folder: Path) -> Path:
     """The relaxation of :func:`flatcontact.asperity.driver.relax` as a plain LAMMPS input
     (``folder/asperity.in`` reading ``folder/asperity.data``, written by the same LAMMPS
     setup): the same pair commands, groups, fixes, FIRE and tolerance."""
-    from flatcontact.asperity.driver import _lammps_for
+    from flatcontact.asperity.driver import _lammps_for, group_commands
     from flatcontact.potentials.lammps_setup import compile_setup
 
     setup = compile_setup(model, atoms)
@@ -38,7 +38,6 @@ def native_script(model, atoms, positions, protocol, folder: Path) -> Path:
     finally:
         lmp.close()
     block = np.asarray(atoms.arrays["block"])
-    ids = np.arange(1, len(atoms) + 1)
     n_tip = int(np.sum(block == 2))
     per_atom = -protocol.normal_force_ev_per_angstrom / n_tip
     ftol = min(
@@ -54,8 +53,7 @@ def native_script(model, atoms, positions, protocol, folder: Path) -> Path:
         *setup.commands,
         "neighbor 1.0 bin",
         "neigh_modify every 1 delay 0 check yes",
-        "group flatblock id " + " ".join(str(i) for i in ids[block == 1]),
-        "group tipblock id " + " ".join(str(i) for i in ids[block == 2]),
+        *group_commands(block),
         "fix hold flatblock setforce 0.0 0.0 0.0",
         "fix tiplat tipblock setforce 0.0 0.0 NULL",
         f"fix press tipblock aveforce NULL NULL {per_atom:.17g}",

@@ -12,10 +12,18 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from tests.asperity.test_asperity_run import MODEL, RECIPE, SPEC
 
 from flatcontact.asperity import builder, ranks
-from flatcontact.asperity.driver import Protocol, load_state, run_load, step_path
+from flatcontact.asperity.driver import (
+    Protocol,
+    group_commands,
+    load_state,
+    run_load,
+    step_path,
+)
 from flatcontact.asperity.experiment import plan, target_force_ev_per_angstrom
 from flatcontact.errors import InputError
 from flatcontact.potentials.model import InteractionModel
@@ -190,3 +198,17 @@ def test_kill_and_resume_on_two_ranks_is_bit_identical(one_and_two, tmp_path):
         assert np.array_equal(a.positions, b.positions)
         assert np.array_equal(a.tip_force, b.tip_force)
         assert np.array_equal(a.cross_force, b.cross_force)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.integers(0, 2), min_size=1, max_size=60))
+def test_block_groups_as_id_ranges_hold_exactly_the_block(block):
+    block = np.array(block)
+    for line, value in zip(group_commands(block), (1, 2), strict=True):
+        words = line.split()
+        assert words[:3] == ["group", ("flatblock", "tipblock")[value - 1], "id"]
+        ids = set()
+        for w in words[3:]:
+            a, _, b = w.partition(":")
+            ids.update(range(int(a), int(b or a) + 1))
+        assert ids == set((np.flatnonzero(block == value) + 1).tolist())

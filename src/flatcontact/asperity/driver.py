@@ -127,6 +127,21 @@ def _lammps_for(model, atoms: Atoms, positions: np.ndarray):
     return lmp
 
 
+def group_commands(block: np.ndarray) -> list[str]:
+    """``group flatblock`` / ``group tipblock`` by atom id (1-based), runs of consecutive ids
+    as LAMMPS ranges ``a:b`` (LAMMPS tests every atom against every argument, so a list of
+    single ids costs n_block · n)."""
+    out = []
+    for name, value in (("flatblock", 1), ("tipblock", 2)):
+        ids = np.flatnonzero(np.asarray(block) == value) + 1
+        breaks = np.flatnonzero(np.diff(ids) != 1)
+        starts = np.concatenate([ids[:1], ids[breaks + 1]])
+        stops = np.concatenate([ids[breaks], ids[-1:]])
+        runs = [f"{a}:{b}" if b > a else f"{a}" for a, b in zip(starts, stops, strict=True)]
+        out.append(f"group {name} id " + " ".join(runs))
+    return out
+
+
 def _unwrapped(lmp, n: int, cell: np.ndarray) -> np.ndarray:
     """Positions ordered by atom id, unwrapped by the image flags (slab cell: a1 along x)."""
     x = np.ctypeslib.as_array(lmp.gather_atoms("x", 1, 3)).reshape(n, 3).copy()
@@ -149,9 +164,7 @@ def relax(model, atoms: Atoms, positions: np.ndarray, protocol: Protocol) -> Ste
     n_tip = int(np.sum(block == 2))
     lmp = _lammps_for(model, atoms, positions)
     try:
-        ids = np.arange(1, n + 1)
-        for name, mask in (("flatblock", block == 1), ("tipblock", block == 2)):
-            lmp.command(f"group {name} id " + " ".join(str(i) for i in ids[mask]))
+        lmp.commands_list(group_commands(block))
         per_atom = -protocol.normal_force_ev_per_angstrom / n_tip
         ftol = min(
             protocol.fmax_ev_per_angstrom,
