@@ -33,7 +33,6 @@ forces) besides its share of LAMMPS's (:func:`rank_memory_bytes`).
 
 from __future__ import annotations
 
-import contextlib
 import ctypes
 import os
 import pickle
@@ -98,10 +97,23 @@ def mpiexec() -> str:
     return found
 
 
-def _die_with_parent() -> None:  # pragma: no cover - runs in the forked child
-    """In the child before exec: SIGKILL it when the parent dies (Linux PR_SET_PDEATHSIG)."""
-    with contextlib.suppress(OSError, AttributeError):
-        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)
+#: Linux prctl option: the signal a process gets when its parent dies.
+_PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent():
+    """A ``preexec_fn`` that has the child SIGKILLed when its parent dies (Linux
+    ``PR_SET_PDEATHSIG``); None where there is no such call. libc is resolved here, in the
+    parent: the forked child only makes the call (no loader work between fork and exec)."""
+    try:
+        prctl = ctypes.CDLL(None, use_errno=True).prctl
+    except (OSError, AttributeError):
+        return None
+
+    def preexec() -> None:  # pragma: no cover - runs in the forked child
+        prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
+
+    return preexec
 
 
 def _child_env() -> dict[str, str]:
@@ -179,7 +191,7 @@ def run_steps(
             stdin=subprocess.DEVNULL,
             text=True,
             env=_child_env(),
-            preexec_fn=_die_with_parent,
+            preexec_fn=_die_with_parent(),
         )
         try:
             for line in proc.stdout:
