@@ -42,8 +42,19 @@ def _load() -> float:
     return os.getloadavg()[0]
 
 
-def _script(script: Path, ranks: int, folder: Path) -> tuple[float, int, int, float]:
-    """(wall s, iterations, force evaluations, LAMMPS loop s) of ``mpiexec -n ranks lmp``."""
+def _breakdown(text: str) -> str:
+    """LAMMPS's task timing breakdown (average seconds per section) as one line."""
+    rows = re.findall(r"^(Pair|Neigh|Comm|Output|Modify|Other)\s*\|(.*)$", text, re.M)
+    parts = []
+    for name, rest in rows:
+        cells = [c.strip() for c in rest.split("|")]
+        parts.append(f"{name} {float(cells[1]):.2f}")  # the average over ranks
+    return ", ".join(parts) + " s"
+
+
+def _script(script: Path, ranks: int, folder: Path) -> tuple[float, int, int, float, str]:
+    """(wall s, iterations, force evaluations, LAMMPS loop s, its timing breakdown) of
+    ``mpiexec -n ranks lmp``."""
     from flatcontact.asperity.ranks import mpiexec
 
     log = folder / f"script_{ranks}.log"
@@ -59,7 +70,7 @@ def _script(script: Path, ranks: int, folder: Path) -> tuple[float, int, int, fl
     loop = re.search(r"Loop time of ([\d.eE+-]+) on (\d+) procs", text)
     if m is None or loop is None or int(loop.group(2)) != ranks:
         raise RuntimeError(f"unexpected LAMMPS log {log}")
-    return seconds, int(m.group(1)), int(m.group(2)), float(loop.group(1))
+    return seconds, int(m.group(1)), int(m.group(2)), float(loop.group(1)), _breakdown(text)
 
 
 def _driver(model, atoms, protocol, ranks: int, folder: Path) -> tuple[float, int, bool]:
@@ -137,10 +148,10 @@ def main() -> None:
                 print(f"  driver  {ranks} rank(s): {sec:7.1f} s, {it} iterations", flush=True)
                 if ("driver", ranks) not in best or sec < best["driver", ranks][0]:
                     best["driver", ranks] = (sec, it)
-                sec, it, ev, loop = _script(script, ranks, tmp)
+                sec, it, ev, loop, sections = _script(script, ranks, tmp)
                 print(
-                    f"  script  {ranks} rank(s): {sec:7.1f} s ({loop:.1f} s in LAMMPS's loop), "
-                    f"{it} iterations, {ev} force evaluations",
+                    f"  script  {ranks} rank(s): {sec:7.1f} s ({loop:.1f} s in LAMMPS's loop: "
+                    f"{sections}), {it} iterations, {ev} force evaluations",
                     flush=True,
                 )
                 if ("script", ranks) not in best or sec < best["script", ranks][0]:
