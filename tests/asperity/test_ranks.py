@@ -15,6 +15,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from tests.asperity.test_asperity_run import MODEL, RECIPE, SPEC
+from tests.cli.cli_helpers import one_error_line, run_cli
 
 from flatcontact.asperity import builder, ranks
 from flatcontact.asperity.driver import (
@@ -212,3 +213,51 @@ def test_block_groups_as_id_ranges_hold_exactly_the_block(block):
             a, _, b = w.partition(":")
             ids.update(range(int(a), int(b or a) + 1))
         assert ids == set((np.flatnonzero(block == value) + 1).tolist())
+
+
+# ---------------------------------------------------------------- the command and the stage
+
+
+def _config(tmp_path, ranks_line: str) -> Path:
+    from tests.asperity.test_asperity_cli import CU_LJ
+
+    config = tmp_path / "c.yaml"
+    config.write_text(CU_LJ.replace("steps: 1}", f"steps: 1, {ranks_line}}}"))
+    return config
+
+
+@pytest.mark.parametrize("value", ["0", "257", "two"])
+def test_a_bad_rank_count_is_one_line_naming_the_setting(tmp_path, capsys, value):
+    config = _config(tmp_path, f"mpi_ranks: {value}")
+    code, _, err = run_cli(["asperity", str(config), "--out", str(tmp_path / "o")], capsys)
+    assert "asperity.mpi_ranks" in one_error_line(code, err)
+    assert not (tmp_path / "o").exists()
+
+
+def test_ranks_without_mpiexec_are_refused_before_any_work(tmp_path, capsys, monkeypatch):
+    from flatcontact.config import build_config
+    from flatcontact.stages.preflight import check_asperity
+
+    monkeypatch.setattr(sys, "executable", str(tmp_path / "python"))
+    monkeypatch.setenv("PATH", str(tmp_path))
+    config = _config(tmp_path, "mpi_ranks: 2")
+    code, _, err = run_cli(["asperity", str(config), "--out", str(tmp_path / "o")], capsys)
+    assert "asperity.mpi_ranks: no mpiexec" in one_error_line(code, err)
+    assert not (tmp_path / "o").exists()
+    cfg = build_config({"asperity": {"enabled": True, "mpi_ranks": 2}})
+    with pytest.raises(InputError, match=r"^config: asperity.mpi_ranks: no mpiexec"):
+        check_asperity(cfg)
+
+
+@pytest.mark.slow
+def test_the_command_runs_over_two_ranks_and_says_so(tmp_path, capsys):
+    import json
+
+    config = _config(tmp_path, "mpi_ranks: 2")
+    code, _, err = run_cli(["asperity", str(config), "--out", str(tmp_path / "o")], capsys)
+    assert code in (0, None), err
+    doc = json.loads((tmp_path / "o" / "asperity.json").read_text())
+    assert doc["mpi_ranks"] == 2
+    folder = tmp_path / "o" / "state" / "load_0"
+    assert [load_state(step_path(folder, k)).ranks for k in (0, 1)] == [2, 2]
+    assert not (folder / ranks.JOB_FILE).exists()

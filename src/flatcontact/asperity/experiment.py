@@ -22,7 +22,7 @@ import numpy as np
 from flatcontact.asperity import builder
 from flatcontact.asperity.compare import Laws, compare_load
 from flatcontact.asperity.driver import EV_PER_ANGSTROM_N, Protocol, run_load
-from flatcontact.asperity.ranks import check_ranks
+from flatcontact.asperity.ranks import check_ranks, mpiexec
 from flatcontact.asperity.records import Binning, StepRecord, measure_load
 from flatcontact.errors import InputError
 
@@ -187,7 +187,8 @@ def run_experiment(
     another number of ranks (each saved step records its own).
     """
     t0 = time.perf_counter()
-    check_ranks(mpi_ranks)
+    if check_ranks(mpi_ranks) > 1:
+        mpiexec()  # refused in one line before anything is built or written
     atoms, sizes, need = plan(spec, recipe, neighbours_per_atom, mpi_ranks)
     model.check_atoms(atoms)
     _check_state(state_dir, spec)
