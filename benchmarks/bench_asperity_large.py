@@ -3,7 +3,7 @@
 ``python -m benchmarks asperity_large`` (under 5 minutes on an idle 2-core machine).
 
 One press of a Cu(111) cylinder (EAM inside each body, LJ across, cutoff 10 Å; R = 2600 Å,
-107,000 atoms) as the asperity stage runs it — :func:`flatcontact.asperity.driver.compute_step`
+107,594 atoms) as the asperity stage runs it — :func:`flatcontact.asperity.driver.compute_step`
 in this process for 1 rank, :func:`flatcontact.asperity.ranks.run_steps` (``mpiexec -n 2``, the
 ranks' Python started, the job read, the state saved) for 2 — against the same minimisation
 written as a plain LAMMPS input script (``bench_asperity.native_script``: the same data, pair
@@ -20,7 +20,7 @@ each, the memory estimate of the up-front check at 1 and 2 ranks against the lar
 resident set measured, and the load average before and after (flagged above 0.5 per core:
 the figures are then upper bounds and the speed-up reads low).
 
-``ASPERITY_LARGE_RADIUS_ANGSTROM`` sets the size (2600: 107,634 atoms), ``ASPERITY_LARGE_REPEATS``
+``ASPERITY_LARGE_RADIUS_ANGSTROM`` sets the size (2600: 107,594 atoms), ``ASPERITY_LARGE_REPEATS``
 the repetitions (default 1; with more, each run's fastest is kept).
 """
 

@@ -254,8 +254,10 @@ def test_the_command_runs_over_two_ranks_and_says_so(tmp_path, capsys):
     import json
 
     config = _config(tmp_path, "mpi_ranks: 2")
-    code, _, err = run_cli(["asperity", str(config), "--out", str(tmp_path / "o")], capsys)
+    code, out, err = run_cli(["asperity", str(config), "--out", str(tmp_path / "o")], capsys)
     assert code in (0, None), err
+    # rank 0's progress reaches the console, step by step
+    assert "step 1/2" in out and "step 2/2" in out
     doc = json.loads((tmp_path / "o" / "asperity.json").read_text())
     assert doc["mpi_ranks"] == 2
     folder = tmp_path / "o" / "state" / "load_0"
