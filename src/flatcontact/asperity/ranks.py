@@ -1,18 +1,23 @@
-"""Relax asperity steps over MPI ranks: ``mpiexec -n N python -m flatcontact.asperity.rank_worker JOB``.
+"""Relax asperity steps over MPI ranks (``asperity.mpi_ranks``; docs/asperity.md).
 
 Design
 ------
-Every rank runs the same Python (:mod:`flatcontact.asperity.rank_worker`): it reads the job (the atoms, the interaction model, the
-:class:`~flatcontact.asperity.driver.Protocol`, the first step and its starting positions) and
-calls :func:`flatcontact.asperity.driver.compute_step` step after step, exactly as the 1-rank
-run does. The LAMMPS Python module needs no mpi4py for this: without a communicator it opens
-LAMMPS on ``MPI_COMM_WORLD``, so the N processes ``mpiexec`` starts are one N-rank LAMMPS, and
-every library call the driver makes is collective (``scatter_atoms``, ``gather_atoms``,
-``commands_list``, ``extract_fix`` of a global vector): every rank holds the same positions
-and forces after each relaxation. Rank 0 alone writes each step's state (atomically) and
-prints one progress line; the parent process reads those lines and, once ``mpiexec`` has
-exited, the saved states. So a run over ranks has the same protocol, the same files and the
-same resume points as the 1-rank run (a step is saved the moment it is relaxed).
+:func:`run_steps` writes the job (the atoms, the interaction model, the
+:class:`~flatcontact.asperity.driver.Protocol`, the first step and its starting positions) to
+``ranks_job.pkl`` in the load's state folder and runs ``mpiexec -n N python -m
+flatcontact.asperity.rank_worker JOB``. Every rank runs the same Python
+(:mod:`flatcontact.asperity.rank_worker`): it reads the job and calls
+:func:`flatcontact.asperity.driver.compute_step` step after step, exactly as the 1-rank run
+does. The LAMMPS Python module needs no mpi4py for this: without a communicator it opens LAMMPS
+on ``MPI_COMM_WORLD``, so the N processes ``mpiexec`` starts are one N-rank LAMMPS, and every
+library call the driver makes is collective (``scatter_atoms``, ``gather_atoms``,
+``commands_list``, ``extract_fix`` of a global vector): every rank holds the same positions and
+forces after each relaxation (the driver hands each atom to the rank of its position,
+``displace_atoms … move 0 0 0``, when the world has more than one). Rank 0 alone writes each
+step's state (atomically) and prints one progress line; the parent process reads those lines
+and, once ``mpiexec`` has exited, the saved states. So a run over ranks has the same protocol,
+the same files and the same resume points as the 1-rank run (a step is saved the moment it is
+relaxed).
 
 Equality: N ranks sum forces in another order than one, so FIRE takes another path to the same
 minimum; states agree within the minimiser's tolerance, not bit for bit
