@@ -43,13 +43,16 @@ def _load() -> float:
 
 
 def _breakdown(text: str) -> str:
-    """LAMMPS's task timing breakdown (average seconds per section) as one line."""
+    """LAMMPS's processor grid and task timing breakdown (average seconds per section) as
+    one line."""
+    grid = re.search(r"(\d+) by (\d+) by (\d+) MPI processor grid", text)
     rows = re.findall(r"^(Pair|Neigh|Comm|Output|Modify|Other)\s*\|(.*)$", text, re.M)
     parts = []
     for name, rest in rows:
         cells = [c.strip() for c in rest.split("|")]
         parts.append(f"{name} {float(cells[1]):.2f}")  # the average over ranks
-    return ", ".join(parts) + " s"
+    where = "x".join(grid.groups()) + " grid; " if grid else ""
+    return where + ", ".join(parts) + " s"
 
 
 def _script(script: Path, ranks: int, folder: Path) -> tuple[float, int, int, float, str]:
