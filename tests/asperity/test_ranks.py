@@ -86,6 +86,9 @@ def test_error_line_prefers_the_ranks_own_line():
         "asperity: mpiexec -n 3 failed (hydra: cannot launch)"
     )
     assert ranks.error_line(9, "", 2) == "asperity: mpiexec -n 2 failed (exit code 9)"
+    # two ranks' lines run together by mpiexec's forwarding
+    merged = "error: asperity over MPI ranks: KeyError: 'b'error: asperity over MPI ranks: X\n"
+    assert ranks.error_line(1, merged, 2) == "asperity over MPI ranks: X"
 
 
 def test_a_failing_rank_is_one_line_through_mpiexec(tmp_path):

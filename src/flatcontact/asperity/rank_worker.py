@@ -48,18 +48,25 @@ def _work(job_path: str) -> None:
         positions = state.positions
 
 
+def _say(line: str) -> None:
+    """``line`` on stderr in one write (an unbuffered stream, PYTHONUNBUFFERED, would write
+    print's text and its newline apart, and the ranks' lines would run together)."""
+    sys.stderr.write(line + "\n")
+    sys.stderr.flush()
+
+
 def main(argv: list[str]) -> int:
     """A rank's entry point: relax the job's steps; an error is one ``error:`` line."""
     try:
         _work(argv[0])
     except InputError as exc:
-        print(f"error: {exc}", file=sys.stderr, flush=True)
+        _say(f"error: {exc}")
         return 1
     except Exception as exc:  # a LAMMPS or Python error on this rank: one line, named
         said = " ".join(str(exc).split())
         if not said.startswith("ERROR"):  # LAMMPS's own messages name themselves
             said = f"{type(exc).__name__}: {said}"
-        print(f"error: asperity over MPI ranks: {said}", file=sys.stderr, flush=True)
+        _say(f"error: asperity over MPI ranks: {said}")
         return 1
     return 0
 

@@ -41,6 +41,7 @@ from __future__ import annotations
 import ctypes
 import os
 import pickle
+import re
 import shutil
 import signal
 import subprocess
@@ -138,9 +139,15 @@ def _child_env() -> dict[str, str]:
 
 def error_line(returncode: int, stderr: str, ranks: int) -> str:
     """One line for a failed ``mpiexec``: the ranks' own ``error:`` line when they wrote one,
-    else the last line of its output, else the exit code."""
+    else the last line of its output, else the exit code. ``mpiexec`` passes on each rank's
+    output as it comes, so two ranks' lines may run together: each ``error:`` starts one."""
     lines = [" ".join(x.split()) for x in stderr.splitlines() if x.strip()]
-    said = [x for x in lines if x.startswith("error:")]
+    said = [
+        part.strip()
+        for x in lines
+        for part in re.split(r"(?=error: )", x)
+        if part.startswith("error:")
+    ]
     if said:
         return said[-1][len("error:") :].strip()
     last = lines[-1] if lines else f"exit code {returncode}"
