@@ -171,13 +171,19 @@ def available_memory_bytes() -> int:
     return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
 
 
-def check_machine(n_atoms: int, neighbours_per_atom: int, field: str = "asperity") -> int:
+def check_machine(
+    n_atoms: int, neighbours_per_atom: int, field: str = "asperity", ranks: int = 1
+) -> int:
     """Refuse in one line a run whose atoms or memory exceed the machine; return the bytes.
 
-    Memory ≈ n (BYTES_PER_ATOM + 4 · neighbours/2); refused above MEMORY_FRACTION of
-    MemAvailable or above FLATCONTACT_MAX_ASPERITY_ATOMS atoms.
+    Memory ≈ n (BYTES_PER_ATOM + 4 · neighbours/2), plus over ``ranks`` > 1 MPI ranks what
+    each rank's Python holds (:func:`flatcontact.asperity.ranks.rank_memory_bytes`); refused
+    above MEMORY_FRACTION of MemAvailable or above FLATCONTACT_MAX_ASPERITY_ATOMS atoms.
     """
+    from flatcontact.asperity.ranks import rank_memory_bytes
+
     need = int(n_atoms * (BYTES_PER_ATOM + 2 * neighbours_per_atom))
+    need += rank_memory_bytes(n_atoms, ranks)
     have = available_memory_bytes()
     limit = int(os.environ.get("FLATCONTACT_MAX_ASPERITY_ATOMS", MAX_ATOMS_DEFAULT))
     if n_atoms > limit:
@@ -187,7 +193,9 @@ def check_machine(n_atoms: int, neighbours_per_atom: int, field: str = "asperity
         )
     if need > MEMORY_FRACTION * have:
         raise InputError(
-            f"{field}: {n_atoms:,} atoms need ~{need / 1e9:.2f} GB, more than "
+            f"{field}: {n_atoms:,} atoms need ~{need / 1e9:.2f} GB"
+            + (f" over {ranks} MPI ranks" if ranks > 1 else "")
+            + ", more than "
             f"{MEMORY_FRACTION:.0%} of the {have / 1e9:.2f} GB available"
         )
     return need
@@ -304,10 +312,12 @@ def build_asperity(
     sizes: Sizes | None = None,
     gap_angstrom: float | None = None,
     neighbours_per_atom: int = 100,
+    ranks: int = 1,
     **plan,
 ) -> tuple[Atoms, Sizes]:
     """The asperity of ``recipe`` (the run's structure): sizes planned (or given), the atom
-    count and memory checked against the machine before anything is built, then carved."""
+    count and memory (run over ``ranks`` MPI ranks) checked against the machine before
+    anything is built, then carved."""
     # imported here: building needs the structures core, planning does not
     from flatcontact.structures.construct import build_interface
 
@@ -324,6 +334,6 @@ def build_asperity(
             **plan,
         )
     per_plane = float(np.sum(np.asarray(small.arrays["slab"]) == 1)) / 3.0
-    check_machine(estimate_atoms(sizes, per_plane), neighbours_per_atom)
+    check_machine(estimate_atoms(sizes, per_plane), neighbours_per_atom, ranks=ranks)
     deep, _ = build_interface(deep_recipe(recipe, max(sizes.flat_layers, sizes.tip_layers)))
     return carve(deep, sizes, gap_angstrom), sizes

@@ -29,6 +29,7 @@ the sign reversed: at equilibrium the full force on a free atom is zero), and th
 from __future__ import annotations
 
 import ctypes
+import dataclasses
 import os
 import time
 from collections.abc import Callable
@@ -76,7 +77,8 @@ class StepState:
     """One relaxed state: positions (Å, unwrapped), tip block force (eV/Å, 3), the force the
     tip exerts on each atom (eV/Å, n×3; zero on tip atoms), the tip's lateral displacement
     (Å), FIRE iterations, whether it converged (largest force component on a free atom, the
-    residual, <= fmax), that residual, and the wall seconds the step took when computed."""
+    residual, <= fmax), that residual, the wall seconds the step took when computed and the
+    MPI ranks it was relaxed on."""
 
     positions: np.ndarray
     tip_force: np.ndarray
@@ -86,6 +88,7 @@ class StepState:
     converged: bool
     residual_ev_per_angstrom: float = float("nan")
     seconds: float = float("nan")
+    ranks: int = 1
 
 
 def _lammps_for(model, atoms: Atoms, positions: np.ndarray):
@@ -107,6 +110,11 @@ def _lammps_for(model, atoms: Atoms, positions: np.ndarray):
     x = box.to_lammps(positions)
     n = len(atoms)
     lmp.scatter_atoms("x", 1, 3, (ctypes.c_double * (3 * n))(*x.ravel().tolist()))
+    if lmp.extract_setting("world_size") > 1:
+        # over MPI ranks (flatcontact.asperity.ranks) the rank owning the origin holds every
+        # atom: hand each to the rank of its position (LAMMPS's irregular migration; a run's
+        # setup only passes atoms to adjacent ranks, which loses them beyond two per axis)
+        lmp.command("displace_atoms all move 0 0 0 units box")
     lmp.commands_list(list(setup.commands))
     lmp.commands_list(
         [
@@ -117,6 +125,21 @@ def _lammps_for(model, atoms: Atoms, positions: np.ndarray):
         ]
     )
     return lmp
+
+
+def group_commands(block: np.ndarray) -> list[str]:
+    """``group flatblock`` / ``group tipblock`` by atom id (1-based), runs of consecutive ids
+    as LAMMPS ranges ``a:b`` (LAMMPS tests every atom against every argument, so a list of
+    single ids costs n_block · n)."""
+    out = []
+    for name, value in (("flatblock", 1), ("tipblock", 2)):
+        ids = np.flatnonzero(np.asarray(block) == value) + 1
+        breaks = np.flatnonzero(np.diff(ids) != 1)
+        starts = np.concatenate([ids[:1], ids[breaks + 1]])
+        stops = np.concatenate([ids[breaks], ids[-1:]])
+        runs = [f"{a}:{b}" if b > a else f"{a}" for a, b in zip(starts, stops, strict=True)]
+        out.append(f"group {name} id " + " ".join(runs))
+    return out
 
 
 def _unwrapped(lmp, n: int, cell: np.ndarray) -> np.ndarray:
@@ -141,9 +164,7 @@ def relax(model, atoms: Atoms, positions: np.ndarray, protocol: Protocol) -> Ste
     n_tip = int(np.sum(block == 2))
     lmp = _lammps_for(model, atoms, positions)
     try:
-        ids = np.arange(1, n + 1)
-        for name, mask in (("flatblock", block == 1), ("tipblock", block == 2)):
-            lmp.command(f"group {name} id " + " ".join(str(i) for i in ids[mask]))
+        lmp.commands_list(group_commands(block))
         per_atom = -protocol.normal_force_ev_per_angstrom / n_tip
         ftol = min(
             protocol.fmax_ev_per_angstrom,
@@ -190,7 +211,8 @@ def relax(model, atoms: Atoms, positions: np.ndarray, protocol: Protocol) -> Ste
     return StepState(new, tip_force, cross, 0.0, iterations, converged, residual)
 
 
-def _save(path: Path, state: StepState) -> None:
+def save_state(path: Path, state: StepState) -> None:
+    """Write a step atomically (a temporary file renamed over ``path``)."""
     tmp = path.with_suffix(".tmp.npz")
     np.savez(
         tmp,
@@ -202,6 +224,7 @@ def _save(path: Path, state: StepState) -> None:
         converged=state.converged,
         residual_ev_per_angstrom=state.residual_ev_per_angstrom,
         seconds=state.seconds,
+        ranks=state.ranks,
     )
     os.replace(tmp, path)
 
@@ -218,7 +241,31 @@ def load_state(path: Path) -> StepState:
             bool(f["converged"]),
             float(f["residual_ev_per_angstrom"]),
             float(f["seconds"]) if "seconds" in f else float("nan"),
+            int(f["ranks"]) if "ranks" in f else 1,
         )
+
+
+def step_path(folder: Path, k: int) -> Path:
+    """Where step k's state is saved (0 = pressed)."""
+    return folder / f"step_{k:04d}.npz"
+
+
+def compute_step(
+    model, atoms: Atoms, positions: np.ndarray, protocol: Protocol, k: int, ranks: int = 1
+) -> StepState:
+    """Step k from the previous step's ``positions``: the tip block moved by ``step_angstrom``
+    along y (k > 0), relaxed; its wall seconds and the MPI ranks it ran on recorded."""
+    t0 = time.perf_counter()
+    start = positions.copy()
+    if k:
+        start[np.asarray(atoms.arrays["block"]) == 2, 1] += protocol.step_angstrom
+    state = relax(model, atoms, start, protocol)
+    return dataclasses.replace(
+        state,
+        displacement_angstrom=k * protocol.step_angstrom,
+        seconds=time.perf_counter() - t0,
+        ranks=ranks,
+    )
 
 
 def run_load(
@@ -227,43 +274,36 @@ def run_load(
     protocol: Protocol,
     folder: Path,
     progress: Callable[[int, int, float], None] | None = None,
+    ranks: int = 1,
 ) -> list[StepState]:
     """Press and slide one load; step k's state in ``folder/step_<k>.npz`` (0 = pressed).
 
     Steps already saved are read, not recomputed (resume). ``progress(done, total, seconds)``
-    after each step.
+    after each step. ``ranks`` > 1 relaxes the missing steps over that many MPI ranks
+    (:mod:`flatcontact.asperity.ranks`: the same relaxations, one ``mpiexec`` per call).
     """
     if protocol.steps < 1 or not protocol.step_angstrom > 0:
         raise InputError("asperity: give steps >= 1 and step_angstrom > 0")
     folder.mkdir(parents=True, exist_ok=True)
-    block = np.asarray(atoms.arrays["block"])
+    total = protocol.steps + 1
+    if ranks > 1:
+        first = next((k for k in range(total) if not step_path(folder, k).exists()), total)
+        if first < total:
+            from flatcontact.asperity.ranks import run_steps
+
+            start = load_state(step_path(folder, first - 1)).positions if first else None
+            run_steps(model, atoms, protocol, folder, first, start, ranks, progress)
     states: list[StepState] = []
     positions = atoms.positions.copy()
-    total = protocol.steps + 1
     for k in range(total):
-        path = folder / f"step_{k:04d}.npz"
+        path = step_path(folder, k)
         if path.exists():
             state = load_state(path)
         else:
-            t0 = time.perf_counter()
-            start = positions.copy()
-            u = k * protocol.step_angstrom
-            if k:
-                start[block == 2, 1] += protocol.step_angstrom
-            state = relax(model, atoms, start, protocol)
-            state = StepState(
-                state.positions,
-                state.tip_force,
-                state.cross_force,
-                u,
-                state.iterations,
-                state.converged,
-                state.residual_ev_per_angstrom,
-                time.perf_counter() - t0,
-            )
-            _save(path, state)
+            state = compute_step(model, atoms, positions, protocol, k)
+            save_state(path, state)
             if progress is not None:
-                progress(k + 1, total, time.perf_counter() - t0)
+                progress(k + 1, total, state.seconds)
         states.append(state)
         positions = state.positions
     return states

@@ -22,6 +22,7 @@ import numpy as np
 from flatcontact.asperity import builder
 from flatcontact.asperity.compare import Laws, compare_load
 from flatcontact.asperity.driver import EV_PER_ANGSTROM_N, Protocol, run_load
+from flatcontact.asperity.ranks import check_ranks, mpiexec
 from flatcontact.asperity.records import Binning, StepRecord, measure_load
 from flatcontact.errors import InputError
 
@@ -149,8 +150,9 @@ def _check_state(state_dir: Path, spec: ExperimentSpec) -> None:
     path.write_text(json.dumps(doc, indent=1))
 
 
-def plan(spec: ExperimentSpec, recipe, neighbours_per_atom: int):
-    """(atoms, sizes, memory bytes): built and checked against the machine before any run."""
+def plan(spec: ExperimentSpec, recipe, neighbours_per_atom: int, ranks: int = 1):
+    """(atoms, sizes, memory bytes): built and checked against the machine (run over
+    ``ranks`` MPI ranks) before any run."""
     sizes = _sizes(spec, recipe)
     atoms, sizes = builder.build_asperity(
         recipe,
@@ -161,8 +163,9 @@ def plan(spec: ExperimentSpec, recipe, neighbours_per_atom: int):
         sizes=sizes,
         gap_angstrom=spec.gap_angstrom,
         neighbours_per_atom=neighbours_per_atom,
+        ranks=ranks,
     )
-    need = builder.check_machine(len(atoms), neighbours_per_atom)
+    need = builder.check_machine(len(atoms), neighbours_per_atom, ranks=ranks)
     return atoms, sizes, need
 
 
@@ -175,10 +178,18 @@ def run_experiment(
     *,
     neighbours_per_atom: int = 100,
     progress: Callable[[str], None] | None = None,
+    mpi_ranks: int = 1,
 ) -> Experiment:
-    """Build, run every load (resuming from ``state_dir``), measure and compare."""
+    """Build, run every load (resuming from ``state_dir``), measure and compare.
+
+    ``mpi_ranks`` > 1 relaxes each step over that many MPI ranks
+    (:mod:`flatcontact.asperity.ranks`); it is not part of the spec: a run may be resumed on
+    another number of ranks (each saved step records its own).
+    """
     t0 = time.perf_counter()
-    atoms, sizes, need = plan(spec, recipe, neighbours_per_atom)
+    if check_ranks(mpi_ranks) > 1:
+        mpiexec()  # refused in one line before anything is built or written
+    atoms, sizes, need = plan(spec, recipe, neighbours_per_atom, mpi_ranks)
     model.check_atoms(atoms)
     _check_state(state_dir, spec)
     cell = atoms.cell.array
@@ -206,7 +217,9 @@ def run_experiment(
                     f"in {seconds:.1f} s"
                 )
 
-        states = run_load(model, atoms, protocol, state_dir / f"load_{i}", progress=tell)
+        states = run_load(
+            model, atoms, protocol, state_dir / f"load_{i}", progress=tell, ranks=mpi_ranks
+        )
         all_states.append(states)
         recs = measure_load(atoms, states, bins)
         records.append(recs)

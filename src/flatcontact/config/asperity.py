@@ -12,6 +12,9 @@ from pydantic import Field
 from flatcontact.config.section import Section
 from flatcontact.numbers import physical
 
+#: Largest ``asperity.mpi_ranks`` (flatcontact.asperity.ranks checks against it too).
+MAX_MPI_RANKS = 256
+
 
 class AsperityConfig(Section):
     """A cap of slab 2's crystal pressed and slid on a flat of slab 1's (``flatcontact asperity``)."""
@@ -66,6 +69,14 @@ class AsperityConfig(Section):
     )
     slip_threshold_angstrom: physical(1e-4, 10.0, "Å") = Field(
         0.1, description="a pair of facing atoms slipped less than this sticks"
+    )
+    mpi_ranks: int = Field(
+        1,
+        ge=1,
+        le=MAX_MPI_RANKS,
+        description="MPI ranks LAMMPS relaxes each step on (mpiexec of the mpich wheel; "
+        "1: in this process). Same protocol and resume points; states equal to the 1-rank "
+        "run's within the minimiser's tolerance. docs/asperity.md",
     )
     laws_file: str | None = Field(
         None, description="laws.json to compare with (default: the run's laws stage)"

@@ -157,7 +157,15 @@ def run_asperity(
         model = _calculator.model(settings)
         with tempfile.TemporaryDirectory() as tmp:
             state = (folder or Path(tmp)) / ASPERITY_STATE
-            exp = run_experiment(spec, settings.structure, model, laws, state, progress=progress)
+            exp = run_experiment(
+                spec,
+                settings.structure,
+                model,
+                laws,
+                state,
+                progress=progress,
+                mpi_ranks=settings.asperity.mpi_ranks,
+            )
     spec_sizes = exp.sizes
     depth = (spec_sizes.flat_layers - 1) * float(exp.atoms.info["plane_spacing_angstrom"])
     cell = exp.atoms.cell.array
@@ -187,6 +195,7 @@ def run_asperity(
         "n_atoms": len(exp.atoms),
         "memory_estimate_bytes": exp.memory_bytes,
         "wall_seconds": exp.wall_seconds,
+        "mpi_ranks": settings.asperity.mpi_ranks,
         # the steps' own wall time when they were computed (a resumed run reads them)
         "compute_seconds": _compute_seconds(exp.states),
         "finite_size": {

@@ -103,7 +103,8 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
 
 def check_asperity(cfg: RunConfig, source: str = "config") -> None:
     """The asperity stage drives LAMMPS itself and makes the recipe deeper: it needs a LAMMPS
-    interaction model and a recipe with ``layers`` (one line naming the field)."""
+    interaction model, a recipe with ``layers`` and, over MPI ranks, an ``mpiexec`` (one line
+    naming the field)."""
     if cfg.potential.calculator is not None:
         raise InputError(
             f"{source}: asperity.enabled: the asperity relaxes inside LAMMPS and needs a LAMMPS "
@@ -114,6 +115,13 @@ def check_asperity(cfg: RunConfig, source: str = "config") -> None:
             f"{source}: asperity.enabled: structure.kind={cfg.structure.kind} has no layers; the "
             "asperity makes the recipe deeper (fcc111, crystal, slab, sheets, ...)"
         )
+    if cfg.asperity.mpi_ranks > 1:
+        from flatcontact.asperity.ranks import mpiexec
+
+        try:
+            mpiexec()
+        except InputError as exc:
+            raise InputError(f"{source}: {exc}") from None
 
 
 def _check_structure_file(cfg: RunConfig, source: str) -> None:
