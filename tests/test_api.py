@@ -26,6 +26,7 @@ TAUGHT = {
     "GridSpec": "flatcontact.ispes.grid",
     "open_ispes": "flatcontact.ispes.contract",
     "analyze_ispes": "flatcontact.analysis.analyze",
+    "AnalysisOptions": "flatcontact.analysis.options",
     "fit_load_laws": "flatcontact.analysis.laws",
     "ContactParameters": "flatcontact.contact.parameters",
     "solve_hertz": "flatcontact.contact.hertz",

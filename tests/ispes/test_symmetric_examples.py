@@ -80,9 +80,12 @@ def test_reduced_scan_equals_the_full_scan(
 
 def test_symmetrised_analysis_of_cu111_6x6_has_one_saddle_class_and_keeps_c3(tmp_path):
     from flatcontact.analysis.analyze import analyze_ispes
+    from flatcontact.analysis.options import AnalysisOptions
 
     def at_zero_load(scan):
-        result = analyze_ispes(scan.dataset, [0.0], direction_deg="auto", threshold_gpa=None)
+        result = analyze_ispes(
+            scan.dataset, [0.0], AnalysisOptions(direction_deg="auto", threshold_gpa=None)
+        )
         pa = result.pressures[0]
         saddles = [p for p in pa.stackings.points if p.kind == "saddle"]
         return pa, {p.symmetry_class for p in saddles}, saddles

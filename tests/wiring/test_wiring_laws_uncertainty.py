@@ -101,10 +101,13 @@ def test_the_laws_stage_fits_the_analyze_stages_other_form_and_analyses_nothing(
     import flatcontact.analysis.analyze as analyze_module
     import flatcontact.analysis.energy_forms as energy_forms
     from flatcontact.analysis.energy_forms import laws_both_forms
+    from flatcontact.analysis.options import AnalysisOptions
     from flatcontact.ispes.contract import open_ispes
 
     cfg, laws, root = stages
-    direct = laws_both_forms(open_ispes(root / "ispes.nc"), P_GPA, direction_deg=0.0)
+    direct = laws_both_forms(
+        open_ispes(root / "ispes.nc"), P_GPA, AnalysisOptions(direction_deg=0.0)
+    )
     want = direct["forms"]["enthalpy"]
     assert json.dumps(laws["enthalpy"]["loads"]) == json.dumps(want["loads"])
     assert laws["enthalpy"]["warnings"] == want["warnings"]
