@@ -28,6 +28,7 @@ from flatcontact.errors import InputError
 from flatcontact.ispes.contract import open_ispes
 from flatcontact.layout import STAGES
 from flatcontact.pipeline import Pipeline
+from flatcontact.stages.fingerprints import settings_inputs
 
 TINY = {
     "structure": {"kind": "quartz-dense", "layers": 5, "source": "seed"},
@@ -755,7 +756,7 @@ def test_the_scan_fingerprint_holds_the_load_bracket_it_reads(tmp_path):
     explicit thicknesses (which brackets nothing), leaves the scan alone."""
 
     def inputs(change: dict) -> dict:
-        return Pipeline(build_config(_merge(TINY, change)), tmp_path / "r")._scan_inputs()
+        return settings_inputs("scan", build_config(_merge(TINY, change)))
 
     base = inputs({})
     assert base["bracket_loads_gpa"] == [0.0, 3.0]
