@@ -20,7 +20,7 @@ What each stage's fingerprint takes from the settings is :mod:`flatcontact.stage
 The run directory's folders and file names are :mod:`flatcontact.layout`.
 
 This module keeps only the order of the stages and their fingerprints. What a stage computes
-and writes is :mod:`flatcontact.stages` (``run_<stage>(settings, inputs, folder)``), which
+and writes is :mod:`flatcontact.stages` (``<stage>_stage(settings, inputs, folder)``), which
 ``flatcontact <stage>`` calls too; figures are in :mod:`flatcontact.plots`, the report's
 content in :mod:`flatcontact.report`. The pipeline prints nothing: it tells an observer
 (``on_event``, called with a :class:`StageEvent`) when a stage starts and ends, and
@@ -89,15 +89,15 @@ from flatcontact.rundir import (
     writable,
 )
 from flatcontact.stages import contact_range
-from flatcontact.stages.analyze import AnalyzeInputs, grid_note, run_analyze
-from flatcontact.stages.build import BuildInputs, run_build
+from flatcontact.stages.analyze import AnalyzeInputs, analyze_stage, grid_note
+from flatcontact.stages.build import BuildInputs, build_stage
 from flatcontact.stages.contact import (
     ContactInputs,
     check_contact,
     contact_parameters,
-    run_contact,
+    contact_stage,
 )
-from flatcontact.stages.elastic import ElasticInputs, run_elastic
+from flatcontact.stages.elastic import ElasticInputs, elastic_stage
 from flatcontact.stages.fingerprints import (
     FIGURE_MODULES,
     FIGURES_LEFT_OUT,
@@ -109,11 +109,11 @@ from flatcontact.stages.fingerprints import (
     stage_code_digest,
 )
 from flatcontact.stages.gates import GateInputs, check_gates, evaluate_gates
-from flatcontact.stages.laws import LawsInputs, run_laws
+from flatcontact.stages.laws import LawsInputs, laws_stage
 from flatcontact.stages.preflight import check_inputs
-from flatcontact.stages.report import ReportInputs, run_report
+from flatcontact.stages.report import ReportInputs, report_stage
 from flatcontact.stages.result_files import CONTACT, FRICTION, open_result
-from flatcontact.stages.scan import ScanInputs, run_scan
+from flatcontact.stages.scan import ScanInputs, scan_stage
 from flatcontact.structures.interface_io import read_interface
 
 __all__ = [
@@ -338,7 +338,7 @@ class Pipeline:
         inputs = settings_inputs("build", cfg)
 
         def work(folder: Path) -> None:
-            for line in run_build(cfg, BuildInputs(), folder).warnings:
+            for line in build_stage(cfg, BuildInputs(), folder).warnings:
                 log.warning("build: %s", line)
 
         result = self._run("build", inputs, work)
@@ -361,9 +361,9 @@ class Pipeline:
             bar = self.scan_progress
             if hasattr(bar, "__enter__"):
                 with bar:
-                    run_scan(cfg, stage_inputs, folder, progress=bar)
+                    scan_stage(cfg, stage_inputs, folder, progress=bar)
             else:
-                run_scan(cfg, stage_inputs, folder, progress=bar)
+                scan_stage(cfg, stage_inputs, folder, progress=bar)
 
         result = self._run("scan", inputs, work)
         ds = open_ispes(result.folder / ISPES_NC)
@@ -390,7 +390,7 @@ class Pipeline:
         inputs = {**settings_inputs("analyze", cfg), "scan": scan.fingerprint}
 
         def work(folder: Path) -> None:
-            run_analyze(cfg, AnalyzeInputs(scan.folder / ISPES_NC), folder)
+            analyze_stage(cfg, AnalyzeInputs(scan.folder / ISPES_NC), folder)
 
         result = self._run("analyze", inputs, work)
         return open_result(result.folder / FRICTION_NC, FRICTION, cfg.analysis.p_gpa)
@@ -414,7 +414,9 @@ class Pipeline:
 
         def work(folder: Path) -> None:
             tables = analyze.folder
-            run_laws(cfg, LawsInputs.read(tables / FRICTION_CSV, tables / OTHER_FORM_JSON), folder)
+            laws_stage(
+                cfg, LawsInputs.read(tables / FRICTION_CSV, tables / OTHER_FORM_JSON), folder
+            )
 
         self._run("laws", inputs, work)
         return self._json("laws", LAWS_JSON)
@@ -435,7 +437,7 @@ class Pipeline:
             )
             return None
         inputs = settings_inputs("elastic", cfg)
-        self._run("elastic", inputs, lambda folder: run_elastic(cfg, ElasticInputs(), folder))
+        self._run("elastic", inputs, lambda folder: elastic_stage(cfg, ElasticInputs(), folder))
         return self._json("elastic", ELASTIC_JSON)
 
     def gates(self):
@@ -508,7 +510,7 @@ class Pipeline:
         if stage_inputs.gates["fired"] or stage_inputs.gates["notes"]:
             inputs["gates"] = stage_inputs.gates  # the recorded verdict (a clean run: no key)
 
-        result = self._run("contact", inputs, lambda f: run_contact(cfg, stage_inputs, f))
+        result = self._run("contact", inputs, lambda f: contact_stage(cfg, stage_inputs, f))
         return open_result(result.folder / CONTACT_NC, CONTACT, cfg.contact.p0_gpa)
 
     def contact_summary(self) -> dict:
@@ -536,7 +538,7 @@ class Pipeline:
             self.scan_summary()
             if refusal is None:
                 self.contact_summary()
-            run_report(cfg, ReportInputs(folders, versions, refusal), folder)
+            report_stage(cfg, ReportInputs(folders, versions, refusal), folder)
 
         result = self._run("report", inputs, work)
         target = self.root / REPORT_HTML
@@ -548,7 +550,7 @@ class Pipeline:
         """Stage 8 (optional, ``asperity.enabled``): the asperity in atoms against the model
         (``08-asperity/asperity.json``); its saved states resume an interrupted stage."""
         from flatcontact.layout import ASPERITY_JSON
-        from flatcontact.stages.asperity import AsperityInputs, run_asperity
+        from flatcontact.stages.asperity import AsperityInputs, asperity_stage
 
         cfg = self.config
         if not cfg.asperity.enabled:
@@ -563,7 +565,7 @@ class Pipeline:
         doc = self._json("laws", LAWS_JSON)
 
         def work(folder: Path) -> None:
-            run_asperity(cfg, AsperityInputs(laws=doc, contact_modulus_gpa=e_star), folder)
+            asperity_stage(cfg, AsperityInputs(laws=doc, contact_modulus_gpa=e_star), folder)
 
         self._run("asperity", inputs, work)
         return self._json("asperity", ASPERITY_JSON)

@@ -17,7 +17,7 @@ from flatcontact.config.load import load_config
 from flatcontact.ispes.executors import SerialExecutor
 from flatcontact.ispes.scan import run_scan
 from flatcontact.stages import _calculator
-from flatcontact.stages.build import BuildInputs, run_build
+from flatcontact.stages.build import BuildInputs, build_stage
 from flatcontact.stages.scan import grid_spec, relax_settings, symmetry_settings
 
 pytestmark = pytest.mark.slow
@@ -32,7 +32,7 @@ def _scan(name, out, reduced, grid=(6, 6)):
     settings = load_config(EXAMPLES / f"{name}.yaml")
     settings = settings.model_copy(update={"scan": settings.scan.model_copy(update={"grid": grid})})
     if name not in _BUILT:
-        _BUILT[name] = run_build(settings, BuildInputs(), None).atoms
+        _BUILT[name] = build_stage(settings, BuildInputs(), None).atoms
     s = settings.scan
     sym = symmetry_settings(s)
     return run_scan(

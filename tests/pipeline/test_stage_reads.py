@@ -1,6 +1,6 @@
 """Everything a stage reads from the settings is in its fingerprint (issue 31).
 
-Each stage function (``run_<stage>``) runs on the finished toy study's inputs with settings that
+Each stage function (``<stage>_stage``) runs on the finished toy study's inputs with settings that
 record every field read: an attribute (``settings.analysis.p_gpa`` -> ``analysis.p_gpa``) or a
 dump of a section (``settings.section("scan")``, ``model_dump`` -> every leaf below it). Its
 fingerprint's settings part (:func:`flatcontact.stages.fingerprints.settings_inputs`) is built
@@ -35,9 +35,9 @@ from flatcontact.layout import (
     VERSIONS_JSON,
 )
 from flatcontact.rundir import RunDirectory
-from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
-from flatcontact.stages.build import BuildInputs, run_build
-from flatcontact.stages.contact import run_contact
+from flatcontact.stages.analyze import AnalyzeInputs, analyze_stage
+from flatcontact.stages.build import BuildInputs, build_stage
+from flatcontact.stages.contact import contact_stage
 from flatcontact.stages.fingerprints import (
     EXECUTION_ONLY,
     FIGURE_SETTINGS,
@@ -45,9 +45,9 @@ from flatcontact.stages.fingerprints import (
     report_stages,
     settings_inputs,
 )
-from flatcontact.stages.laws import LawsInputs, run_laws
-from flatcontact.stages.report import ReportInputs, run_report
-from flatcontact.stages.scan import ScanInputs, run_scan
+from flatcontact.stages.laws import LawsInputs, laws_stage
+from flatcontact.stages.report import ReportInputs, report_stage
+from flatcontact.stages.scan import ScanInputs, scan_stage
 
 
 def _leaves(value, prefix: str) -> set[str]:
@@ -158,27 +158,27 @@ def _folder(run: Path, name: str) -> Path:
 
 
 def _stage_call(name: str, cfg, run: Path, out: Path):
-    """``run_<name>`` on the finished toy run's inputs, writing into ``out``."""
+    """``<name>_stage`` on the finished toy run's inputs, writing into ``out``."""
     if name == "build":
-        return lambda: run_build(cfg, BuildInputs(), out)
+        return lambda: build_stage(cfg, BuildInputs(), out)
     if name == "scan":
-        return lambda: run_scan(cfg, ScanInputs(_folder(run, "build") / INTERFACE), out)
+        return lambda: scan_stage(cfg, ScanInputs(_folder(run, "build") / INTERFACE), out)
     if name == "analyze":
-        return lambda: run_analyze(cfg, AnalyzeInputs(_folder(run, "scan") / ISPES_NC), out)
+        return lambda: analyze_stage(cfg, AnalyzeInputs(_folder(run, "scan") / ISPES_NC), out)
     if name == "laws":
         tables = _folder(run, "analyze")
         inputs = LawsInputs.read(tables / FRICTION_CSV, tables / OTHER_FORM_JSON)
-        return lambda: run_laws(cfg, inputs, out)
+        return lambda: laws_stage(cfg, inputs, out)
     if name == "contact":
         from flatcontact.pipeline import Pipeline
 
         with Pipeline(cfg, run) as pipe:  # the finished run: every stage is skipped
             inputs = pipe._contact_inputs(pipe.gates().to_json(cfg.contact.accept_untrusted))
-        return lambda: run_contact(cfg, inputs, out)
+        return lambda: contact_stage(cfg, inputs, out)
     if name == "report":
         folders = {stage: _folder(run, stage) for stage in STAGES}
         versions = json.loads((run / VERSIONS_JSON).read_text())
-        return lambda: run_report(cfg, ReportInputs(folders, versions, None), out)
+        return lambda: report_stage(cfg, ReportInputs(folders, versions, None), out)
     raise AssertionError(name)
 
 

@@ -82,7 +82,7 @@ class AnalyzeResult:
         }
 
 
-def run_analyze(
+def analyze_stage(
     settings, inputs: AnalyzeInputs, folder: Path | None, progress=None, other_form: bool = True
 ) -> AnalyzeResult:
     """Analyse ``inputs.ispes`` at ``settings.analysis.p_gpa`` (see the module docstring);
