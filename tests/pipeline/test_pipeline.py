@@ -314,11 +314,11 @@ def test_a_retrained_potential_file_reruns_from_the_build(tmp_path):
         shutil_copy = (tmp_path / f"my{suffix}").write_bytes
         shutil_copy((bundled / f"sio2-snap{suffix}").read_bytes())
     cfg = _merge(TINY, {"potential": {"intra": f"snap:{tmp_path / 'my.snapcoeff'}"}})
-    with Pipeline(build_config(cfg), tmp_path / "run") as pipe:
-        before = pipe._model_inputs()
-        coeff = tmp_path / "my.snapcoeff"
-        coeff.write_text(coeff.read_text() + "\n")
-        after = pipe._model_inputs()
+    config = build_config(cfg)
+    before = settings_inputs("build", config)["model"]  # the model's part of the build's inputs
+    coeff = tmp_path / "my.snapcoeff"
+    coeff.write_text(coeff.read_text() + "\n")
+    after = settings_inputs("build", config)["model"]
     assert before["model"] == after["model"]
     assert before["files_sha256"]["my.snapparam"] == after["files_sha256"]["my.snapparam"]
     assert before["files_sha256"]["my.snapcoeff"] != after["files_sha256"]["my.snapcoeff"]
