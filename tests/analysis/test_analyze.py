@@ -148,6 +148,28 @@ def test_bad_arguments_fail_before_any_work():
         analyze_ispes(ds, [1.0, 80.0])
 
 
+def test_options_are_checked_on_construction_and_on_replace():
+    """The options object is frozen and refuses a bad field when made or changed, naming the
+    field; a mapping in its place is refused naming the parameter."""
+    import dataclasses
+
+    ds = _cobblestone().grid(4, 4, Z)
+    with pytest.raises(InputError, match=r"^options: expected an AnalysisOptions, got dict"):
+        analyze_ispes(ds, [1.0], {"form": "internal"})
+    base = AnalysisOptions(form="enthalpy", threshold_gpa=2.0)
+    with pytest.raises(InputError, match=r"^load_source: expected one of energy, stress"):
+        dataclasses.replace(base, load_source="virial")
+    with pytest.raises(InputError, match=r"^threshold_gpa: expected a positive pressure"):
+        dataclasses.replace(base, threshold_gpa=0.0)
+    with pytest.raises(InputError, match=r"^direction_deg auto: needs the stackings"):
+        AnalysisOptions(direction_deg="auto", with_stackings=False)
+    with pytest.raises(InputError, match=r"^direction_deg: expected an angle in degrees or 'auto'"):
+        AnalysisOptions(direction_deg="north")
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        base.form = "internal"
+    assert dataclasses.replace(base, form="internal").threshold_gpa == 2.0
+
+
 def test_energy_zero_at_the_lowest_pressure_minimum():
     res = analyze_ispes(
         _cobblestone().grid(8, 8, Z), [0.5, 2.0], AnalysisOptions(with_symmetry=False)
