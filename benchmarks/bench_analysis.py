@@ -18,6 +18,7 @@ import numpy as np
 from flatcontact.analysis import synthetic as syn
 from flatcontact.analysis.analyze import LOAD_SOURCES, analyze_ispes
 from flatcontact.analysis.diagnostics import AnalysisWarning
+from flatcontact.analysis.options import AnalysisOptions
 from flatcontact.analysis.periodic import PeriodicSurface
 
 P_GPA = np.linspace(0.0, 4.5, 10)
@@ -60,7 +61,9 @@ def main() -> None:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", AnalysisWarning)
                 clock = time.perf_counter()
-                res = analyze_ispes(ds, P_GPA, load_source=load_source, with_symmetry=True)
+                res = analyze_ispes(
+                    ds, P_GPA, AnalysisOptions(load_source=load_source, with_symmetry=True)
+                )
                 total = time.perf_counter() - clock
             if best is None or total < best[0]:
                 best = (total, res)
@@ -79,7 +82,7 @@ def main() -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", AnalysisWarning)
         clock = time.perf_counter()
-        res = analyze_ispes(ds, P_GPA, with_mep=True, with_symmetry=True)
+        res = analyze_ispes(ds, P_GPA, AnalysisOptions(with_mep=True, with_symmetry=True))
         total = time.perf_counter() - clock
     _print_run(f"{res.load_source} load, with MEP", total, res)
     print(f"  MEP iterations per load: {[pa.mep.iterations for pa in res.pressures]}")

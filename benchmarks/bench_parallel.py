@@ -43,7 +43,7 @@ def main(argv: list[str] | None = None) -> None:
     from flatcontact.ispes.executors import make_executor
     from flatcontact.ispes.scan import run_scan
     from flatcontact.stages import _calculator
-    from flatcontact.stages.build import BuildInputs, run_build
+    from flatcontact.stages.build import BuildInputs, build_stage
     from flatcontact.stages.scan import grid_spec, relax_settings
 
     workers = [int(w) for w in argv] if argv else [1, 2]
@@ -52,7 +52,7 @@ def main(argv: list[str] | None = None) -> None:
     cores = os.cpu_count() or 1
     settings = load_config(preset_name="paper")
     s = settings.scan
-    reference = run_build(settings, BuildInputs(), None).atoms
+    reference = build_stage(settings, BuildInputs(), None).atoms
     factory = _calculator.factory(settings)
     relax = relax_settings(s)
     with tempfile.TemporaryDirectory() as tmp_name:

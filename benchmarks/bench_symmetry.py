@@ -41,7 +41,7 @@ def scan_example(name: str, out: Path, enabled: bool, grid: tuple[int, int] | No
     from flatcontact.config.load import load_config
     from flatcontact.ispes.scan import run_scan
     from flatcontact.stages import _calculator
-    from flatcontact.stages.build import BuildInputs, run_build
+    from flatcontact.stages.build import BuildInputs, build_stage
     from flatcontact.stages.scan import grid_spec, relax_settings, symmetry_settings
 
     settings = load_config(EXAMPLES / f"{name}.yaml")
@@ -49,7 +49,7 @@ def scan_example(name: str, out: Path, enabled: bool, grid: tuple[int, int] | No
         settings = settings.model_copy(
             update={"scan": settings.scan.model_copy(update={"grid": grid})}
         )
-    reference = _build(settings, run_build, BuildInputs)
+    reference = _build(settings, build_stage, BuildInputs)
     s = settings.scan
     sym = symmetry_settings(s)
     sym = type(sym)(**{**sym.as_dict(), "enabled": enabled})
@@ -70,10 +70,10 @@ def scan_example(name: str, out: Path, enabled: bool, grid: tuple[int, int] | No
 _BUILT: dict = {}
 
 
-def _build(settings, run_build, inputs_type):
+def _build(settings, build_stage, inputs_type):
     key = settings.model_dump_json()
     if key not in _BUILT:
-        _BUILT[key] = run_build(settings, inputs_type(), None).atoms
+        _BUILT[key] = build_stage(settings, inputs_type(), None).atoms
     return _BUILT[key]
 
 

@@ -90,7 +90,7 @@ GRAPHENE_PERIOD_ANGSTROM = 2.46
 def approximant_rows() -> None:
     """The second table (see the module)."""
     from flatcontact.config.load import build_config
-    from flatcontact.stages.contact import ContactInputs, run_contact
+    from flatcontact.stages.contact import ContactInputs, contact_stage
 
     keys = ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa")
     facts = {
@@ -109,7 +109,9 @@ def approximant_rows() -> None:
             "p0_gpa": list(P0_GPA),
             "work_of_adhesion_j_m2": 0.0,
         }
-        doc = run_contact(build_config({"contact": contact}), ContactInputs(interface=facts), None)
+        doc = contact_stage(
+            build_config({"contact": contact}), ContactInputs(interface=facts), None
+        )
         rows = doc.to_json()["slip_size"]["results"]
         tau = [r["concurrent_strength_mpa"] for r in rows]
         if "lock" in name:

@@ -35,14 +35,14 @@ def main(argv: list[str] | None = None) -> None:
     from flatcontact.ispes.scan import run_scan
     from flatcontact.ispes.shift_symmetry import shift_space_group
     from flatcontact.stages import _calculator
-    from flatcontact.stages.build import BuildInputs, run_build
+    from flatcontact.stages.build import BuildInputs, build_stage
     from flatcontact.stages.scan import relax_settings
 
     argv = list(argv or [])
     preset = argv[0] if argv else "quick"
     n = int(argv[1]) if len(argv) > 1 else 12
     settings = load_config(preset_name=preset)
-    reference = run_build(settings, BuildInputs(), None).atoms
+    reference = build_stage(settings, BuildInputs(), None).atoms
     factory = _calculator.factory(settings)
     relax = relax_settings(settings.scan)
     z0 = thickness(reference)

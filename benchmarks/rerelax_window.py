@@ -37,6 +37,7 @@ import xarray as xr
 
 from flatcontact.analysis.analyze import analyze_ispes
 from flatcontact.analysis.constant_pressure import constant_pressure
+from flatcontact.analysis.options import AnalysisOptions
 from flatcontact.config.load import load_config
 from flatcontact.ispes.calculators import count_force_calls
 from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point
@@ -71,7 +72,9 @@ def tau(ds: xr.Dataset, p_gpa: float, form: str, direction_deg: float) -> tuple[
     """(τ, σ_MSS, number of near-degenerate starts) at P with the pipeline's analysis (MPa)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        pa = analyze_ispes(ds, [p_gpa], direction_deg=direction_deg, form=form, threshold_gpa=None)
+        pa = analyze_ispes(
+            ds, [p_gpa], AnalysisOptions(direction_deg=direction_deg, form=form, threshold_gpa=None)
+        )
     fr = pa.pressures[0]
     return fr.friction.tau_mpa, fr.friction.sigma_mss_mpa, max(1, len(fr.starts))
 

@@ -55,12 +55,12 @@ def record_scan(path: Path) -> dict:
     from flatcontact.ispes.executors import SerialExecutor
     from flatcontact.ispes.geometry import thickness
     from flatcontact.stages import _calculator
-    from flatcontact.stages.build import BuildInputs, run_build
+    from flatcontact.stages.build import BuildInputs, build_stage
     from flatcontact.stages.scan import grid_spec, relax_settings
 
     settings = load_config(preset_name="paper")
     s = settings.scan
-    reference = run_build(settings, BuildInputs(), None).atoms
+    reference = build_stage(settings, BuildInputs(), None).atoms
     factory = _calculator.factory(settings)
     relax = relax_settings(s)
     grid = grid_spec(s)
@@ -450,11 +450,11 @@ def add_probe_loads(rec: dict) -> dict:
     from flatcontact.config import load_config
     from flatcontact.ispes.probe import rigid_stackings
     from flatcontact.stages import _calculator
-    from flatcontact.stages.build import BuildInputs, run_build
+    from flatcontact.stages.build import BuildInputs, build_stage
     from flatcontact.stages.scan import grid_spec, relax_settings
 
     settings = load_config(preset_name="paper")
-    reference = run_build(settings, BuildInputs(), None).atoms
+    reference = build_stage(settings, BuildInputs(), None).atoms
     loads = {}
     original = probe_mod.relax_column_point
 

@@ -174,11 +174,11 @@ def paper_inputs():
     """The paper preset's interface, factory, grid and relaxation settings."""
     from flatcontact.config import load_config
     from flatcontact.stages import _calculator
-    from flatcontact.stages.build import BuildInputs, run_build
+    from flatcontact.stages.build import BuildInputs, build_stage
     from flatcontact.stages.scan import grid_spec, relax_settings
 
     settings = load_config(preset_name="paper")
-    reference = run_build(settings, BuildInputs(), None).atoms
+    reference = build_stage(settings, BuildInputs(), None).atoms
     return (
         reference,
         _calculator.factory(settings),

@@ -28,18 +28,21 @@ GAMMA_USF_MEV_PER_A2 = 10.116
 
 def analyse(ds, symmetrise: bool, example: str = "cu111-eam"):
     from flatcontact.analysis.analyze import analyze_ispes
+    from flatcontact.analysis.options import AnalysisOptions
     from flatcontact.config.load import load_config
 
     a = load_config(EXAMPLES / f"{example}.yaml").analysis
     return analyze_ispes(
         ds,
         a.p_gpa,
-        direction_deg=a.direction_deg,
-        form=a.energy_form,
-        load_source=a.load_source,
-        energy_zero=a.energy_zero,
-        threshold_gpa=None,
-        symmetrise=symmetrise,
+        AnalysisOptions(
+            direction_deg=a.direction_deg,
+            form=a.energy_form,
+            load_source=a.load_source,
+            energy_zero=a.energy_zero,
+            threshold_gpa=None,
+            symmetrise=symmetrise,
+        ),
     )
 
 

@@ -26,6 +26,7 @@ TAUGHT = {
     "GridSpec": "flatcontact.ispes.grid",
     "open_ispes": "flatcontact.ispes.contract",
     "analyze_ispes": "flatcontact.analysis.analyze",
+    "AnalysisOptions": "flatcontact.analysis.options",
     "fit_load_laws": "flatcontact.analysis.laws",
     "ContactParameters": "flatcontact.contact.parameters",
     "solve_hertz": "flatcontact.contact.hertz",
@@ -62,13 +63,20 @@ def test_every_exported_name_resolves(package):
     assert set(mod.__all__) <= set(dir(mod))
 
 
-def test_the_top_level_scan_is_the_core_and_the_stage_keeps_its_rule_name():
+def test_the_top_level_scan_is_the_core_and_the_stage_door_has_its_own_name():
+    """``flatcontact.run_scan`` is the ISPES core; every stage door is ``<stage>_stage``, so no
+    stage door shares a name (and a different signature) with a public function."""
     from flatcontact import stages
     from flatcontact.ispes import scan as ispes_scan
+    from flatcontact.layout import STAGES
     from flatcontact.stages import scan as stage_scan
 
     assert flatcontact.run_scan is ispes_scan.run_scan
-    assert stages.run_scan is stage_scan.run_scan
+    assert stages.scan_stage is stage_scan.scan_stage
+    doors = {name for name in stages.__all__ if name.endswith("_stage")}
+    assert doors == {f"{stage}_stage" for stage in STAGES}
+    assert not doors & set(flatcontact.__all__)
+    assert not any(name.startswith("run_") for name in stages.__all__)
 
 
 def test_an_unknown_name_is_an_attribute_error():

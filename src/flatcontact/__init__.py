@@ -50,7 +50,7 @@ _EXPORTS: dict[str, list[str]] = {
     ],
     "structures": ["build_interface", "make_interface", "read_interface", "write_interface"],
     "ispes": ["GridSpec", "RelaxSettings", "open_ispes", "run_scan", "write_ispes"],
-    "analysis": ["analyze_ispes", "constant_pressure", "fit_load_laws"],
+    "analysis": ["AnalysisOptions", "analyze_ispes", "constant_pressure", "fit_load_laws"],
     "contact": [
         "ContactParameters",
         "lateral_force",

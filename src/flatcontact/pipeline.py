@@ -4,7 +4,7 @@
 with the stage's inputs = its configuration section + the content of the files it reads
 (potential coefficients, structure and measurement files) + the digest of the source code
 that computes it (:func:`stage_code_digest`: the stage module's import closure, figure
-modules left out for build and scan, see :data:`FIGURE_MODULES`) + the fingerprints of the
+modules left out for build and scan, see :data:`~flatcontact.stages.fingerprints.FIGURE_MODULES`) + the fingerprints of the
 stages it reads, so that
 
 - a rerun skips every stage whose inputs are unchanged;
@@ -13,13 +13,14 @@ stages it reads, so that
 - changing one setting reruns exactly the stages that depend on it (e.g.
   ``analysis.threshold_gpa`` reruns ``laws``, ``contact`` and ``report``, not the scan).
 
-Settings that do not change numbers (``scan.executor``, ``scan.workers``,
-``scan.dask_address``) are not part of any fingerprint.
+What each stage's fingerprint takes from the settings is :mod:`flatcontact.stages.fingerprints`
+(everything the stage reads; settings that do not change numbers, ``scan.executor``,
+``scan.workers``, ``scan.dask_address``, are not part of any fingerprint).
 
 The run directory's folders and file names are :mod:`flatcontact.layout`.
 
 This module keeps only the order of the stages and their fingerprints. What a stage computes
-and writes is :mod:`flatcontact.stages` (``run_<stage>(settings, inputs, folder)``), which
+and writes is :mod:`flatcontact.stages` (``<stage>_stage(settings, inputs, folder)``), which
 ``flatcontact <stage>`` calls too; figures are in :mod:`flatcontact.plots`, the report's
 content in :mod:`flatcontact.report`. The pipeline prints nothing: it tells an observer
 (``on_event``, called with a :class:`StageEvent`) when a stage starts and ends, and
@@ -50,12 +51,10 @@ from typing import Any
 import pandas as pd
 
 from flatcontact import __version__
-from flatcontact.codegraph import SOURCE_ROOT, closure_digest, import_closure
-from flatcontact.config import RunConfig, recipe_files, to_yaml
+from flatcontact.config import RunConfig, to_yaml
 from flatcontact.errors import InputError
 from flatcontact.fileio import (
     copy_file_atomic,
-    file_sha256,
     open_nofollow,
     write_json_atomic,
     write_text_atomic,
@@ -87,29 +86,40 @@ from flatcontact.rundir import (
     RunLock,
     StageResult,
     package_versions,
-    portable,
     writable,
 )
-from flatcontact.stages import _calculator, contact_range
-from flatcontact.stages.analyze import AnalyzeInputs, grid_note, run_analyze
-from flatcontact.stages.build import BuildInputs, run_build
+from flatcontact.stages import contact_range
+from flatcontact.stages.analyze import AnalyzeInputs, analyze_stage, grid_note
+from flatcontact.stages.build import BuildInputs, build_stage
 from flatcontact.stages.contact import (
-    QUARTZ_QUICK_LAWS_FILE,
     ContactInputs,
     check_contact,
     contact_parameters,
-    run_contact,
+    contact_stage,
 )
-from flatcontact.stages.elastic import ElasticInputs, run_elastic
+from flatcontact.stages.elastic import ElasticInputs, elastic_stage
+from flatcontact.stages.fingerprints import (
+    FIGURE_MODULES,
+    FIGURES_LEFT_OUT,
+    PUBLIC_API_MODULE,
+    STAGE_MODULES,
+    report_stages,
+    settings_inputs,
+    stage_code,
+    stage_code_digest,
+)
 from flatcontact.stages.gates import GateInputs, check_gates, evaluate_gates
-from flatcontact.stages.laws import LawsInputs, run_laws
+from flatcontact.stages.laws import LawsInputs, laws_stage
 from flatcontact.stages.preflight import check_inputs
-from flatcontact.stages.report import ReportInputs, approximant_study_digest, run_report
+from flatcontact.stages.report import ReportInputs, report_stage
 from flatcontact.stages.result_files import CONTACT, FRICTION, open_result
-from flatcontact.stages.scan import ScanInputs, run_scan
+from flatcontact.stages.scan import ScanInputs, scan_stage
 from flatcontact.structures.interface_io import read_interface
 
 __all__ = [
+    "FIGURES_LEFT_OUT",
+    "FIGURE_MODULES",
+    "PUBLIC_API_MODULE",
     "STAGES",
     "STAGE_MODULES",
     "Pipeline",
@@ -121,47 +131,7 @@ __all__ = [
 
 log = logging.getLogger("flatcontact.run")
 
-#: The module of each stage; the flatcontact code a stage runs is that module's import
-#: closure (:func:`flatcontact.codegraph.import_closure`): every flatcontact module it imports,
-#: directly or not, at module or function level, with their parent packages' ``__init__``.
-#: Editing any of them reruns the stage and, through the fingerprints, every stage that reads
-#: it. ``pipeline.py`` itself is in no closure (it orders the stages, it computes nothing).
-STAGE_MODULES: dict[str, str] = {name: f"flatcontact.stages.{name}" for name in STAGES}
-#: The figure modules, left out of the code digest of the expensive stages
-#: (:data:`FIGURES_LEFT_OUT`), so restyling a figure never reruns a build, a scan or an asperity (the
-#: figure follows with the next real rerun). The cheap stages (analyze, laws, contact, report)
-#: keep their figures in their digest: editing a figure reruns them and redraws it. The
-#: modules the figures import stay in the closure.
-FIGURE_MODULES = "flatcontact.plots"
-FIGURES_LEFT_OUT = ("build", "scan", "asperity")
-#: The top-level ``flatcontact/__init__.py`` is in no digest: it computes nothing (the version,
-#: recorded in ``versions.json``, and the lazy map of public names), so growing the public API
-#: never reruns a scan. The sub-packages' ``__init__`` files stay in.
-PUBLIC_API_MODULE = "flatcontact"
-
-
-def stage_code(name: str, root: Path = SOURCE_ROOT) -> frozenset[str]:
-    """The flatcontact modules whose source enters stage ``name``'s code digest.
-
-    Parameters
-    ----------
-    name
-        A stage of :data:`STAGES`.
-    root
-        The source folder holding the ``flatcontact`` package (default: the installed one).
-    """
-    exclude = (FIGURE_MODULES,) if name in FIGURES_LEFT_OUT else ()
-    return import_closure(STAGE_MODULES[name], root, exclude) - {PUBLIC_API_MODULE}
-
-
-def stage_code_digest(name: str, root: Path = SOURCE_ROOT) -> str:
-    """SHA-256 of the source of :func:`stage_code` (``code_sha256`` of the stage's inputs)."""
-    return closure_digest(stage_code(name, root), root)
-
-
 RUN_FORMAT = "flatcontact.run/1"
-#: Scan settings that change how, not what, is computed (kept out of the fingerprint).
-EXECUTION_ONLY = ("executor", "workers", "dask_address", "jobqueue")
 
 
 class _NoFollowFileHandler(logging.FileHandler):
@@ -303,9 +273,6 @@ class Pipeline:
         """The folder of stage ``name``."""
         return self.rundir.folder(STAGES[name], name)
 
-    def _model_inputs(self) -> dict:
-        return _calculator.fingerprint(self.config)
-
     def _upstream(self, name: str) -> StageResult:
         if name not in self.results:
             getattr(self, name)()
@@ -368,19 +335,10 @@ class Pipeline:
             The interface (``slab``/``surface`` arrays, ``a1``/``a2``/``recipe`` info).
         """
         cfg = self.config
-        # the file by name and content (file_sha256), not by where it is
-        structure = portable(cfg.structure_section(), "file")
-        if cfg.structure.kind == "quartz-dense":
-            structure.setdefault("file", None)  # the fingerprint of runs made before recipes
-        inputs = {"structure": structure, "model": self._model_inputs()}
-        if cfg.structure.kind in ("file", "slab"):
-            inputs["file_sha256"] = file_sha256(cfg.structure.file)
-        for dotted, path in recipe_files(cfg.structure):
-            if dotted != "file":
-                inputs[f"{dotted}_sha256"] = file_sha256(path)
+        inputs = settings_inputs("build", cfg)
 
         def work(folder: Path) -> None:
-            for line in run_build(cfg, BuildInputs(), folder).warnings:
+            for line in build_stage(cfg, BuildInputs(), folder).warnings:
                 log.warning("build: %s", line)
 
         result = self._run("build", inputs, work)
@@ -396,34 +354,21 @@ class Pipeline:
         """
         cfg = self.config
         build = self._upstream("build")
-        inputs = {**self._scan_inputs(), "build": build.fingerprint}
+        inputs = {**settings_inputs("scan", cfg), "build": build.fingerprint}
 
         def work(folder: Path) -> None:
             stage_inputs = ScanInputs(build.folder / INTERFACE)
             bar = self.scan_progress
             if hasattr(bar, "__enter__"):
                 with bar:
-                    run_scan(cfg, stage_inputs, folder, progress=bar)
+                    scan_stage(cfg, stage_inputs, folder, progress=bar)
             else:
-                run_scan(cfg, stage_inputs, folder, progress=bar)
+                scan_stage(cfg, stage_inputs, folder, progress=bar)
 
         result = self._run("scan", inputs, work)
         ds = open_ispes(result.folder / ISPES_NC)
         check_grid(ds, self.config.scan.grid, str(result.folder / ISPES_NC))
         return ds
-
-    def _scan_inputs(self) -> dict:
-        """What the scan stage reads besides the build: its section (less the execution-only
-        keys), the model and, for a pressure-range grid, the load bracket its columns must
-        reach (``ispes.grid_bracket.bracket_targets_gpa``: the lowest and highest load of
-        ``analysis.p_gpa``), so a load added beyond the scanned range re-brackets the scan."""
-        cfg = self.config
-        scan_inputs = {k: v for k, v in cfg.section("scan").items() if k not in EXECUTION_ONLY}
-        inputs = {"scan": scan_inputs, "model": self._model_inputs()}
-        if cfg.scan.p_range_gpa is not None:
-            loads = [float(p) for p in cfg.analysis.p_gpa]
-            inputs["bracket_loads_gpa"] = [min(loads), max(loads)] if loads else None
-        return inputs
 
     def scan_summary(self) -> dict:
         """``02-scan/scan.json``: counts, force calls, thicknesses, adhesion (work of separation)."""
@@ -442,12 +387,10 @@ class Pipeline:
         """
         cfg = self.config
         scan = self._upstream("scan")
-        a = cfg.section("analysis")
-        a.pop("threshold_gpa")  # the laws stage's: analyze fits no law and stores no fit warning
-        inputs = {"analysis": a, "scan": scan.fingerprint}
+        inputs = {**settings_inputs("analyze", cfg), "scan": scan.fingerprint}
 
         def work(folder: Path) -> None:
-            run_analyze(cfg, AnalyzeInputs(scan.folder / ISPES_NC), folder)
+            analyze_stage(cfg, AnalyzeInputs(scan.folder / ISPES_NC), folder)
 
         result = self._run("analyze", inputs, work)
         return open_result(result.folder / FRICTION_NC, FRICTION, cfg.analysis.p_gpa)
@@ -467,14 +410,13 @@ class Pipeline:
         """
         cfg = self.config
         analyze = self._upstream("analyze")
-        inputs = {"threshold_gpa": cfg.analysis.threshold_gpa, "analyze": analyze.fingerprint}
-        # both energy forms come from the analyze stage's files (its fingerprint covers them:
-        # the scan's, the analysis settings, its code); the intervals from the uncertainty section
-        inputs["uncertainty"] = cfg.section("uncertainty")
+        inputs = {**settings_inputs("laws", cfg), "analyze": analyze.fingerprint}
 
         def work(folder: Path) -> None:
             tables = analyze.folder
-            run_laws(cfg, LawsInputs.read(tables / FRICTION_CSV, tables / OTHER_FORM_JSON), folder)
+            laws_stage(
+                cfg, LawsInputs.read(tables / FRICTION_CSV, tables / OTHER_FORM_JSON), folder
+            )
 
         self._run("laws", inputs, work)
         return self._json("laws", LAWS_JSON)
@@ -494,10 +436,8 @@ class Pipeline:
                 f"G* = {cfg.contact.shear_modulus_gpa:g} GPa from the configuration",
             )
             return None
-        inputs = {"elastic": cfg.section("elastic"), "model": self._model_inputs()}
-        if cfg.structure.kind != "quartz-dense":  # the bulk crystal follows the recipe
-            inputs["structure"] = cfg.section("structure")
-        self._run("elastic", inputs, lambda folder: run_elastic(cfg, ElasticInputs(), folder))
+        inputs = settings_inputs("elastic", cfg)
+        self._run("elastic", inputs, lambda folder: elastic_stage(cfg, ElasticInputs(), folder))
         return self._json("elastic", ELASTIC_JSON)
 
     def gates(self):
@@ -562,21 +502,15 @@ class Pipeline:
 
         self._refused(checks)
         inputs = {
-            "contact": portable(cfg.section("contact"), "experiment_csv", "fit_csv"),
+            **settings_inputs("contact", cfg),
             "laws": laws.fingerprint,
             "scan": scan.fingerprint,
             "elastic": elastic.fingerprint if elastic else None,
         }
         if stage_inputs.gates["fired"] or stage_inputs.gates["notes"]:
             inputs["gates"] = stage_inputs.gates  # the recorded verdict (a clean run: no key)
-        if cfg.contact.experiment.csv:
-            inputs["experiment_sha256"] = file_sha256(cfg.contact.experiment.csv)
-        if cfg.contact.experiment.compare:  # the comparison quotes the quick preset's laws
-            inputs["quartz_quick_laws_sha256"] = file_sha256(QUARTZ_QUICK_LAWS_FILE)
-        if cfg.contact.fit.csv:
-            inputs["fit_sha256"] = [file_sha256(f) for f in cfg.contact.fit.csv]
 
-        result = self._run("contact", inputs, lambda f: run_contact(cfg, stage_inputs, f))
+        result = self._run("contact", inputs, lambda f: contact_stage(cfg, stage_inputs, f))
         return open_result(result.folder / CONTACT_NC, CONTACT, cfg.contact.p0_gpa)
 
     def contact_summary(self) -> dict:
@@ -587,16 +521,13 @@ class Pipeline:
         """Stage 7: ``report.html`` in ``07-report/`` and the run directory (``refusal``: of a
         run refused after the scan, its finished stages only, :mod:`flatcontact.refused`)."""
         cfg = self.config
-        names = ["build", "scan", "analyze", "laws", "contact"]
-        names = [n for n in names if refusal is None or n in refusal["finished"]]
+        names = [  # a refused run: its finished stages (the asperity never runs after one)
+            n
+            for n in report_stages(cfg)
+            if refusal is None or (n in refusal["finished"] and n != "asperity")
+        ]
         ups = {name: self._upstream(name) for name in names}
-        inputs = {"report": cfg.section("report"), **{k: v.fingerprint for k, v in ups.items()}}
-        if cfg.elastic.enabled and (refusal is None or "elastic" in refusal["finished"]):
-            inputs["elastic"] = self._upstream("elastic").fingerprint  # the report tables its Cij
-        if cfg.asperity.enabled and refusal is None:  # the report states the asperity's verdict
-            inputs["asperity"] = self._upstream("asperity").fingerprint
-        if cfg.report.approximant_study is not None:  # the report tables that study's files
-            inputs["approximant_study"] = approximant_study_digest(cfg.report.approximant_study)
+        inputs = {**settings_inputs("report", cfg), **{k: v.fingerprint for k, v in ups.items()}}
         if refusal is not None:
             inputs["refusal"] = refusal
         folders = {name: self.folder(name) for name in STAGES}
@@ -607,7 +538,7 @@ class Pipeline:
             self.scan_summary()
             if refusal is None:
                 self.contact_summary()
-            run_report(cfg, ReportInputs(folders, versions, refusal), folder)
+            report_stage(cfg, ReportInputs(folders, versions, refusal), folder)
 
         result = self._run("report", inputs, work)
         target = self.root / REPORT_HTML
@@ -619,19 +550,14 @@ class Pipeline:
         """Stage 8 (optional, ``asperity.enabled``): the asperity in atoms against the model
         (``08-asperity/asperity.json``); its saved states resume an interrupted stage."""
         from flatcontact.layout import ASPERITY_JSON
-        from flatcontact.stages.asperity import AsperityInputs, run_asperity
+        from flatcontact.stages.asperity import AsperityInputs, asperity_stage
 
         cfg = self.config
         if not cfg.asperity.enabled:
             self._tell("off", "asperity", message="asperity.enabled is false")
             return None
         laws = self._upstream("laws")
-        inputs = {
-            "asperity": cfg.section("asperity"),
-            "structure": cfg.section("structure"),
-            "model": self._model_inputs(),
-            "laws": laws.fingerprint,
-        }
+        inputs = {**settings_inputs("asperity", cfg), "laws": laws.fingerprint}
         e_star = None
         if cfg.elastic.enabled:
             inputs["elastic"] = self._upstream("elastic").fingerprint
@@ -639,7 +565,7 @@ class Pipeline:
         doc = self._json("laws", LAWS_JSON)
 
         def work(folder: Path) -> None:
-            run_asperity(cfg, AsperityInputs(laws=doc, contact_modulus_gpa=e_star), folder)
+            asperity_stage(cfg, AsperityInputs(laws=doc, contact_modulus_gpa=e_star), folder)
 
         self._run("asperity", inputs, work)
         return self._json("asperity", ASPERITY_JSON)

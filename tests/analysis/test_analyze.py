@@ -6,6 +6,7 @@ import pytest
 from flatcontact import units
 from flatcontact.analysis import synthetic as syn
 from flatcontact.analysis.analyze import analyze_ispes
+from flatcontact.analysis.options import AnalysisOptions
 from flatcontact.errors import InputError
 
 A = 4.916
@@ -33,7 +34,9 @@ def test_load_laws_are_exact_for_the_cobblestone_model(form, load_source):
     v, delta = -2e-4, -0.02
     ds = _cobblestone(v, delta).grid(9, 9, Z)
     res = analyze_ispes(
-        ds, P_GPA, direction_deg=0.0, form=form, with_symmetry=False, load_source=load_source
+        ds,
+        P_GPA,
+        AnalysisOptions(direction_deg=0.0, form=form, with_symmetry=False, load_source=load_source),
     )
     # the cubic spline's -dU/dz errs as h³ (p's spline as h⁴); the internal form feels it at
     # first order (P δz), the enthalpy form at second
@@ -62,7 +65,7 @@ def test_results_converge_with_lateral_resolution():
     exact_tau = 2e-4 * w * 2 * np.pi / b * units.EV_PER_A3_TO_MPA
     errors = []
     for n in (8, 12, 16, 24):
-        res = analyze_ispes(model.grid(n, n, Z), [1.0], with_symmetry=False)
+        res = analyze_ispes(model.grid(n, n, Z), [1.0], AnalysisOptions(with_symmetry=False))
         errors.append(abs(res.column("tau_mpa")[0] - exact_tau) / exact_tau)
     assert errors[0] > errors[1] > errors[2] > errors[3]
     assert errors[-1] < 1e-6  # spectral convergence of the lateral interpolant
@@ -73,7 +76,7 @@ def test_shifting_the_grid_laterally_or_adding_a_constant_changes_nothing():
     model = syn.SyntheticInterface(
         A1, A2, pattern, depth_modulation=0.2, corrugation_ev_per_a2=-2e-4
     )
-    base = analyze_ispes(model.grid(12, 12, Z), [0.5, 1.5], with_symmetry=True)
+    base = analyze_ispes(model.grid(12, 12, Z), [0.5, 1.5], AnalysisOptions(with_symmetry=True))
     moved_model = syn.SyntheticInterface(
         A1,
         A2,
@@ -83,7 +86,7 @@ def test_shifting_the_grid_laterally_or_adding_a_constant_changes_nothing():
     )
     ds = moved_model.grid(12, 12, Z)
     ds["energy"] = ds.energy + 123.456
-    moved = analyze_ispes(ds, [0.5, 1.5], with_symmetry=True)
+    moved = analyze_ispes(ds, [0.5, 1.5], AnalysisOptions(with_symmetry=True))
     for name in ("tau_mpa", "sigma_mss_mpa", "shear_stiffness_gpa_per_nm"):
         np.testing.assert_allclose(moved.column(name), base.column(name), rtol=1e-3)
     # the fractional shift is not a grid multiple, so the comparison is limited by the
@@ -99,23 +102,27 @@ def test_shifting_the_grid_laterally_or_adding_a_constant_changes_nothing():
 
 def test_exact_grid_shift_and_constant_give_identical_numbers():
     model = _cobblestone()
-    base = analyze_ispes(model.grid(12, 12, Z), [0.5], direction_deg=20.0, with_symmetry=False)
+    base = analyze_ispes(
+        model.grid(12, 12, Z), [0.5], AnalysisOptions(direction_deg=20.0, with_symmetry=False)
+    )
     moved_model = _cobblestone(pattern=syn.shifted(syn.three_cosine(A1, A2), (5 / 12, 7 / 12)))
     ds = moved_model.grid(12, 12, Z)
     ds["energy"] = ds.energy - 1e3
-    moved = analyze_ispes(ds, [0.5], direction_deg=20.0, with_symmetry=False)
+    moved = analyze_ispes(ds, [0.5], AnalysisOptions(direction_deg=20.0, with_symmetry=False))
     for name in ("tau_mpa", "sigma_mss_mpa", "shear_stiffness_gpa_per_nm"):
         np.testing.assert_allclose(moved.column(name), base.column(name), rtol=1e-9)
 
 
 def test_noise_moves_the_numbers_in_proportion_to_its_size():
     model = _cobblestone()
-    clean = analyze_ispes(model.grid(12, 12, Z), [1.0], direction_deg=0.0, with_symmetry=False)
+    clean = analyze_ispes(
+        model.grid(12, 12, Z), [1.0], AnalysisOptions(direction_deg=0.0, with_symmetry=False)
+    )
     corrugation_ev = 4.5 * 2e-4 * model.area  # peak-to-peak of the lateral landscape (eV per cell)
     errs = []
     for rel in (1e-4, 1e-3):
         ds = model.grid(12, 12, Z, energy_noise_ev=rel * corrugation_ev, seed=7)
-        noisy = analyze_ispes(ds, [1.0], direction_deg=0.0, with_symmetry=False)
+        noisy = analyze_ispes(ds, [1.0], AnalysisOptions(direction_deg=0.0, with_symmetry=False))
         errs.append(abs(noisy.column("tau_mpa")[0] / clean.column("tau_mpa")[0] - 1))
         assert (
             abs(noisy.column("sigma_mss_mpa")[0] / clean.column("sigma_mss_mpa")[0] - 1) < 30 * rel
@@ -132,17 +139,41 @@ def test_bad_arguments_fail_before_any_work():
     with pytest.raises(InputError, match="distinct"):
         analyze_ispes(ds, [1.0, 1.0])
     with pytest.raises(InputError, match=r"^form: expected one of internal, enthalpy"):
-        analyze_ispes(ds, [1.0], form="gibbs")
+        analyze_ispes(ds, [1.0], AnalysisOptions(form="gibbs"))
     with pytest.raises(InputError, match=r"^energy_zero: expected one of"):
-        analyze_ispes(ds, [1.0], energy_zero="min")
+        analyze_ispes(ds, [1.0], AnalysisOptions(energy_zero="min"))
     with pytest.raises(InputError, match=r"^direction_deg: expected a finite angle"):
-        analyze_ispes(ds, [1.0], direction_deg=float("nan"))
+        analyze_ispes(ds, [1.0], AnalysisOptions(direction_deg=float("nan")))
     with pytest.raises(InputError, match="outside the data"):
         analyze_ispes(ds, [1.0, 80.0])
 
 
+def test_options_are_checked_on_construction_and_on_replace():
+    """The options object is frozen and refuses a bad field when made or changed, naming the
+    field; a mapping in its place is refused naming the parameter."""
+    import dataclasses
+
+    ds = _cobblestone().grid(4, 4, Z)
+    with pytest.raises(InputError, match=r"^options: expected an AnalysisOptions, got dict"):
+        analyze_ispes(ds, [1.0], {"form": "internal"})
+    base = AnalysisOptions(form="enthalpy", threshold_gpa=2.0)
+    with pytest.raises(InputError, match=r"^load_source: expected one of energy, stress"):
+        dataclasses.replace(base, load_source="virial")
+    with pytest.raises(InputError, match=r"^threshold_gpa: expected a positive pressure"):
+        dataclasses.replace(base, threshold_gpa=0.0)
+    with pytest.raises(InputError, match=r"^direction_deg auto: needs the stackings"):
+        AnalysisOptions(direction_deg="auto", with_stackings=False)
+    with pytest.raises(InputError, match=r"^direction_deg: expected an angle in degrees or 'auto'"):
+        AnalysisOptions(direction_deg="north")
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        base.form = "internal"
+    assert dataclasses.replace(base, form="internal").threshold_gpa == 2.0
+
+
 def test_energy_zero_at_the_lowest_pressure_minimum():
-    res = analyze_ispes(_cobblestone().grid(8, 8, Z), [0.5, 2.0], with_symmetry=False)
+    res = analyze_ispes(
+        _cobblestone().grid(8, 8, Z), [0.5, 2.0], AnalysisOptions(with_symmetry=False)
+    )
     low, high = res.pressures
     assert low.path.energy[0] == pytest.approx(0.0, abs=1e-12)
     assert np.min(low.surface.values) >= -1e-12

@@ -119,7 +119,7 @@ def test_a_core_error_names_the_flag_for_the_cli_and_the_settings_path_for_the_r
     from flatcontact.config import build_config
     from flatcontact.errors import InputError
     from flatcontact.ispes.contract import open_ispes
-    from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
+    from flatcontact.stages.analyze import AnalyzeInputs, analyze_stage
 
     holed = open_ispes(grid_file).load()
     holed["energy"][2, 1, 5] = np.nan
@@ -131,12 +131,12 @@ def test_a_core_error_names_the_flag_for_the_cli_and_the_settings_path_for_the_r
     assert "1 grid points are missing" in err and "(--allow-missing)" in err
     settings = build_config({"analysis": {"p_gpa": [0.5, 1.0]}})
     with pytest.raises(InputError, match=r"missing.*\(analysis\.allow_missing\)$"):
-        run_analyze(settings, AnalyzeInputs(path), None)
+        analyze_stage(settings, AnalyzeInputs(path), None)
     # allowed: the hole is interpolated and both doors give the same τ
     code, out, _ = _run(
         ["analyze", str(path), "--p-gpa", "0.5,1", "--allow-missing", "--json"], capsys
     )
     assert code == 0
     allowed = build_config({"analysis": {"p_gpa": [0.5, 1.0], "allow_missing": True}})
-    tau = run_analyze(allowed, AnalyzeInputs(path), None).analysis.column("tau_mpa")
+    tau = analyze_stage(allowed, AnalyzeInputs(path), None).analysis.column("tau_mpa")
     np.testing.assert_array_equal([r["tau_mpa"] for r in json.loads(out)["pressures"]], tau)

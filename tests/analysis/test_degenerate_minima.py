@@ -22,6 +22,7 @@ from flatcontact.analysis import synthetic as syn
 from flatcontact.analysis.analyze import analyze_ispes
 from flatcontact.analysis.diagnostics import DegenerateMinimaWarning
 from flatcontact.analysis.friction import friction_along_path
+from flatcontact.analysis.options import AnalysisOptions
 from flatcontact.analysis.path import zero_perpendicular_force_path
 from flatcontact.analysis.periodic import PeriodicSurface
 from flatcontact.analysis.starts import (
@@ -111,7 +112,7 @@ def test_pipeline_warns_and_reports_the_largest_tau_for_exactly_degenerate_minim
     model = syn.SyntheticInterface(a1, a2, _two_minima(), corrugation_ev_per_a2=V)
     ds = model.grid(8, 8, np.linspace(24.3, 25.6, 12))
     with pytest.warns(DegenerateMinimaWarning) as rec:
-        res = analyze_ispes(ds, [0.5, 1.5], with_symmetry=False)
+        res = analyze_ispes(ds, [0.5, 1.5], AnalysisOptions(with_symmetry=False))
     tau_low_top, tau_high_top = (t * EV_PER_A3_TO_MPA for t in _analytic_taus())
     msg = str(rec[0].message)
     assert f"{tau_low_top:.4g} MPa" in msg and f"{tau_high_top:.4g} MPa" in msg
@@ -180,7 +181,9 @@ def test_probe_landscape_gives_the_same_tau_for_every_thickness_grid_and_load_so
         ds = model.grid(8, 8, z)
         for source in ("energy", "stress"):
             with pytest.warns(DegenerateMinimaWarning):
-                res = analyze_ispes(ds, [0.5], load_source=source, with_symmetry=False)
+                res = analyze_ispes(
+                    ds, [0.5], AnalysisOptions(load_source=source, with_symmetry=False)
+                )
             pa = res.pressures[0]
             assert sorted(o.tau_mpa for o in pa.starts) == pytest.approx(ref, rel=1e-4)
             taus.append(pa.friction.tau_mpa)
@@ -334,7 +337,7 @@ def test_a_measured_noise_floor_widens_the_degeneracy_window(tmp_path, floor_mev
     ds = open_ispes(path)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DegenerateMinimaWarning)
-        res = analyze_ispes(ds, [1.0], with_symmetry=False)
+        res = analyze_ispes(ds, [1.0], AnalysisOptions(with_symmetry=False))
     pa = res.pressures[0]
     # 2 ε below the window here: the window or the floor
     expected = max(DEGENERACY_FLOOR_MEV_PER_A2, floor_mev_per_a2 or 0.0)

@@ -39,6 +39,7 @@ from flatcontact.analysis.grid_error import (
     observed_order,
     richardson,
 )
+from flatcontact.analysis.options import AnalysisOptions
 from flatcontact.analysis.uncertainty import grid_law_components, law_half_widths
 from flatcontact.ispes.contract import open_ispes
 
@@ -53,12 +54,14 @@ SHARP = syn.cosine_sum(
 )
 
 
-def _analyse(pattern, n: int, p_gpa=(0.0,), **kw):
+def _analyse(pattern, n: int, p_gpa=(0.0,)):
     ds = syn.SyntheticInterface(A1, A2, pattern, corrugation_ev_per_a2=V).grid(n, n, Z)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         result = analyze_ispes(
-            ds, list(p_gpa), direction_deg=90.0, with_symmetry=False, with_stackings=False, **kw
+            ds,
+            list(p_gpa),
+            AnalysisOptions(direction_deg=90.0, with_symmetry=False, with_stackings=False),
         )
     grid_warnings = [str(w.message) for w in caught if w.category is GridResolutionWarning]
     return result, grid_warnings
@@ -152,17 +155,14 @@ def test_real_al111_grid_part_covers_the_6_to_9_change():
     coarse = analyze_ispes(
         open_ispes(MEASURED / "al111-file-lattice-6" / "02-scan" / "ispes.nc"),
         loads,
-        direction_deg=0.0,
-        with_symmetry=False,
-        threshold_gpa=None,
+        AnalysisOptions(direction_deg=0.0, with_symmetry=False, threshold_gpa=None),
     )
     fine = analyze_ispes(
         open_ispes(MEASURED / "al111-file-lattice-9" / "02-scan" / "ispes.nc"),
         loads,
-        direction_deg=0.0,
-        with_symmetry=False,
-        with_grid_error=False,
-        threshold_gpa=None,
+        AnalysisOptions(
+            direction_deg=0.0, with_symmetry=False, with_grid_error=False, threshold_gpa=None
+        ),
     )
     change = fine.column("tau_mpa") - coarse.column("tau_mpa")
     assert np.all(np.abs(change) > 0.04 * coarse.column("tau_mpa"))
@@ -316,7 +316,9 @@ def test_a_comparison_path_that_never_ends_is_abandoned_and_named():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         result = analyze_ispes(
-            iface.grid(8, 8, np.linspace(24.3, 26.4, 36)), [0.5, 2.0], with_symmetry=False
+            iface.grid(8, 8, np.linspace(24.3, 26.4, 36)),
+            [0.5, 2.0],
+            AnalysisOptions(with_symmetry=False),
         )
     grid = result.grid
     assert np.all(np.isfinite(grid.error["tau_mpa"]))

@@ -8,6 +8,7 @@ from flatcontact.analysis import synthetic as syn
 from flatcontact.analysis.analyze import analyze_ispes
 from flatcontact.analysis.constant_pressure import constant_pressure
 from flatcontact.analysis.friction import merge_shallow_minima
+from flatcontact.analysis.options import AnalysisOptions
 from flatcontact.errors import InputError
 
 A1, A2 = syn.hexagonal_cell()
@@ -97,7 +98,9 @@ def test_both_sources_give_the_closed_form_friction(form):
     a = np.linalg.norm(A1)
     res = {
         src: analyze_ispes(
-            ds, [0.5, 2.0], direction_deg=0.0, form=form, with_symmetry=False, load_source=src
+            ds,
+            [0.5, 2.0],
+            AnalysisOptions(direction_deg=0.0, form=form, with_symmetry=False, load_source=src),
         )
         for src in ("energy", "stress")
     }

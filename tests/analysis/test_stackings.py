@@ -30,6 +30,7 @@ from scipy.optimize import minimize
 
 from flatcontact.analysis import synthetic as syn
 from flatcontact.analysis.analyze import analyze_ispes
+from flatcontact.analysis.options import AnalysisOptions
 from flatcontact.analysis.path import minimum_energy_path
 from flatcontact.analysis.periodic import PeriodicSurface
 from flatcontact.analysis.stackings import analyze_stackings, lattice_kind
@@ -216,7 +217,9 @@ def test_equivalent_minima_give_identical_tau_along_the_lowest_barrier_direction
     a1, a2 = syn.hexagonal_cell(2.46)
     model = syn.SyntheticInterface(a1, a2, syn.three_cosine(a1, a2), corrugation_ev_per_a2=1e-4)
     ds = model.grid(9, 9, np.linspace(24.3, 25.6, 12))
-    res = analyze_ispes(ds, [0.5, 1.0, 2.0, 3.0], direction_deg="auto", with_symmetry=False)
+    res = analyze_ispes(
+        ds, [0.5, 1.0, 2.0, 3.0], AnalysisOptions(direction_deg="auto", with_symmetry=False)
+    )
     assert res.direction_deg == 0.0 and res.direction_rule.startswith("lowest-barrier")
     starts = set()
     for pa in res.pressures:
@@ -313,7 +316,7 @@ def test_outputs_carry_the_stackings_barriers_and_rules(tmp_path):
     a1, a2 = syn.hexagonal_cell(2.46)
     model = syn.SyntheticInterface(a1, a2, syn.three_cosine(a1, a2), corrugation_ev_per_a2=v)
     ds = model.grid(9, 9, np.linspace(24.3, 25.6, 12))
-    res = analyze_ispes(ds, [0.5, 1.0], direction_deg="auto", energy_zero="each")
+    res = analyze_ispes(ds, [0.5, 1.0], AnalysisOptions(direction_deg="auto", energy_zero="each"))
     (tmp_path / "friction.csv").write_text(friction_csv_text(res))
     friction_dataset(res).to_netcdf(tmp_path / "friction.nc", engine="h5netcdf")
     mev = 1e3
@@ -355,7 +358,7 @@ def test_an_unknown_direction_word_is_a_one_line_error(bad):
         4, 4, np.linspace(24.3, 25.6, 8)
     )
     with pytest.raises(InputError, match="direction_deg") as err:
-        analyze_ispes(ds, [1.0], direction_deg=bad)
+        analyze_ispes(ds, [1.0], AnalysisOptions(direction_deg=bad))
     assert "\n" not in str(err.value)
 
 
@@ -372,7 +375,7 @@ def test_without_equivalent_minima_the_results_are_those_of_the_old_rule():
     ds = model.grid(12, 12, np.linspace(24.3, 25.6, 12))
     p = [0.0, 1.0, 2.0, 3.0]
     new = analyze_ispes(ds, p)
-    old = analyze_ispes(ds, p, with_stackings=False)
+    old = analyze_ispes(ds, p, AnalysisOptions(with_stackings=False))
     for name in ("tau_mpa", "sigma_mss_mpa", "shear_stiffness_gpa_per_nm"):
         np.testing.assert_array_equal(new.column(name), old.column(name))
     for a, b in zip(new.pressures, old.pressures, strict=True):
@@ -403,7 +406,9 @@ def test_a_shift_lattice_landscape_names_its_points_by_kind_not_as_bilayer_stack
         ds = base.copy()
         if index is not None:
             ds.attrs["shift_lattice_index"] = index
-        res = analyze_ispes(ds, [0.5, 1.0], direction_deg="auto", energy_zero="each")
+        res = analyze_ispes(
+            ds, [0.5, 1.0], AnalysisOptions(direction_deg="auto", energy_zero="each")
+        )
         rows = list(csv.DictReader(io.StringIO(friction_csv_text(res))))
         for row in rows:
             named = {

@@ -19,7 +19,7 @@ from flatcontact.contact.adhesion_regime import (
 )
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.errors import InputError
-from flatcontact.stages.contact import ContactInputs, run_contact
+from flatcontact.stages.contact import ContactInputs, contact_stage
 
 #: Cu(111)/Cu(111) with the Mishin EAM (examples/README.md: laws, W, elastic stage's moduli).
 CU = dict(
@@ -111,7 +111,7 @@ def test_the_dmt_contact_is_the_hertz_contact_at_load_plus_pull_off():
 
 def test_a_strongly_adhesive_cu_contact_is_named_jkr_and_uses_the_adhesive_radius():
     cfg = build_config({"contact": {**CU, "p0_gpa": [0.5, 1.0]}})
-    doc = run_contact(cfg, ContactInputs(interface=_cu_facts()), None).to_json()
+    doc = contact_stage(cfg, ContactInputs(interface=_cu_facts()), None).to_json()
     reg = doc["adhesion_regime"]
     # μ_T by hand with z0 = the (111) spacing: ≈ 8.6 -> λ ≈ 10 > 5: JKR
     mu = (5e-6 * 2.479**2 / (73e9**2 * (CU_GAP_ANGSTROM * 1e-10) ** 3)) ** (1 / 3)
@@ -137,10 +137,10 @@ def test_where_no_model_applies_the_stage_refuses_in_one_line():
     prm = dict(CU, k_mpa_per_gpa=800.0, tau0_mpa=50.0, mu_mpa_per_gpa=300.0, sigma0_mpa=10.0)
     cfg = build_config({"contact": {**prm, "p0_gpa": [0.5]}})
     with pytest.raises(InputError, match=r"contact.p0_gpa = 0.5 GPa: no contact model") as exc:
-        run_contact(cfg, ContactInputs(interface=_cu_facts()), None)
+        contact_stage(cfg, ContactInputs(interface=_cu_facts()), None)
     assert "\n" not in str(exc.value)
     cfg = build_config({"contact": {**prm, "p0_gpa": [0.5], "contact_radius": "hertz"}})
-    doc = run_contact(cfg, ContactInputs(interface=_cu_facts()), None).to_json()
+    doc = contact_stage(cfg, ContactInputs(interface=_cu_facts()), None).to_json()
     assert doc["results"][0]["contact_radius_nm"] == pytest.approx(
         math.pi * 5e-6 * 0.5e9 / (2 * 73e9) * 1e9, rel=1e-12
     )
@@ -156,12 +156,12 @@ def test_a_paper_like_quartz_contact_keeps_its_hertz_numbers_within_the_adhesion
         "mu_mpa_per_gpa": 0.21,
         "sigma0_mpa": 11.1,
     }
-    hertz = run_contact(
+    hertz = contact_stage(
         build_config({"contact": {**q, "work_of_adhesion_j_m2": 0.0}}), ContactInputs(), None
     ).to_json()
     assert hertz["results"][1]["contact_radius_nm"] == pytest.approx(149.6, abs=0.05)  # NOTES
     assert hertz["adhesion_regime"]["sentence"].startswith("adhesion: none")
-    run = run_contact(
+    run = contact_stage(
         build_config({"contact": {**q, "work_of_adhesion_j_m2": 0.062}}), ContactInputs(), None
     ).to_json()
     for h, r in zip(hertz["results"], run["results"], strict=True):
@@ -226,7 +226,7 @@ def test_the_box_appears_exactly_when_a_exceeds_the_critical_size(radius_um, exc
     cfg = build_config(
         {"contact": {**CU, "radius_um": radius_um, "p0_gpa": [1.0], "work_of_adhesion_j_m2": 0.0}}
     )
-    doc = run_contact(cfg, ContactInputs(interface=_cu_facts()), None).to_json()
+    doc = contact_stage(cfg, ContactInputs(interface=_cu_facts()), None).to_json()
     row = doc["slip_size"]["results"][0]
     assert row["exceeded"] is exceeded
     assert (row["contact_radius_nm"] > row["critical_radius_nm"]) is exceeded
@@ -246,7 +246,7 @@ def test_the_box_appears_exactly_when_a_exceeds_the_critical_size(radius_um, exc
 
 def test_slip_regime_concurrent_keeps_the_mindlin_number_but_still_says_so():
     cfg = build_config({"contact": {**CU, "p0_gpa": [1.0], "slip_regime": "concurrent"}})
-    doc = run_contact(cfg, ContactInputs(interface=_cu_facts()), None).to_json()
+    doc = contact_stage(cfg, ContactInputs(interface=_cu_facts()), None).to_json()
     row = doc["slip_size"]["results"][0]
     assert row["exceeded"] and row["reported"] == "concurrent"
     assert row["reported_strength_mpa"] == row["concurrent_strength_mpa"]
@@ -271,7 +271,7 @@ def test_an_approximant_cell_gets_the_elastic_bound():
             }
         }
     )
-    doc = run_contact(cfg, ContactInputs(interface=facts), None).to_json()
+    doc = contact_stage(cfg, ContactInputs(interface=facts), None).to_json()
     s = doc["slip_size"]
     assert s["structure"] == "twisted"
     row = s["results"][0]

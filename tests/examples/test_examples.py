@@ -175,16 +175,16 @@ def test_graphene_kc_ispes_equals_plain_lammps_point_by_point(tmp_path):
     """The scan stage's energies (6×6 grid, two thicknesses, rigid sheets) are the plain
     LAMMPS energies of the geometry built here, to round-off; AB = BA exactly."""
     from flatcontact.ispes.contract import open_ispes
-    from flatcontact.stages.build import BuildInputs, run_build
-    from flatcontact.stages.scan import ScanInputs, run_scan
+    from flatcontact.stages.build import BuildInputs, build_stage
+    from flatcontact.stages.scan import ScanInputs, scan_stage
 
     cfg = load_config(EXAMPLES / "graphene-bilayer-kc.yaml")
     scan = cfg.scan.model_copy(
         update={"p_range_gpa": None, "thickness_angstrom": [3.3, 3.5], "executor": "serial"}
     )
     cfg = cfg.model_copy(update={"scan": scan})
-    run_build(cfg, BuildInputs(), tmp_path / "build")
-    run_scan(cfg, ScanInputs(tmp_path / "build" / "interface.extxyz"), tmp_path / "scan")
+    build_stage(cfg, BuildInputs(), tmp_path / "build")
+    scan_stage(cfg, ScanInputs(tmp_path / "build" / "interface.extxyz"), tmp_path / "scan")
     from flatcontact.structures.interface_io import read_interface
 
     reference = read_interface(tmp_path / "build" / "interface.extxyz")
@@ -235,7 +235,7 @@ def test_element_the_potential_lacks_is_refused_before_any_work(tmp_path):
 def test_miller_index_giving_no_slab_names_the_field(tmp_path):
     from ase.build import bulk
 
-    from flatcontact.stages.build import BuildInputs, run_build
+    from flatcontact.stages.build import BuildInputs, build_stage
 
     bulk("Cu", "fcc", a=3.615).write(tmp_path / "cu.cif")
     path = tmp_path / "c.yaml"
@@ -244,12 +244,12 @@ def test_miller_index_giving_no_slab_names_the_field(tmp_path):
         "potential: {preset: cu-eam}\nelastic: {enabled: true}\n"
     )
     with pytest.raises(InputError) as exc:
-        run_build(load_config(path), BuildInputs(), None)
+        build_stage(load_config(path), BuildInputs(), None)
     assert "structure.miller" in _one_line(exc)
 
 
 def test_hetero_pair_without_a_match_under_the_strain_bound_names_the_field(tmp_path):
-    from flatcontact.stages.build import BuildInputs, run_build
+    from flatcontact.stages.build import BuildInputs, build_stage
 
     path = tmp_path / "c.yaml"
     path.write_text(
@@ -259,13 +259,13 @@ def test_hetero_pair_without_a_match_under_the_strain_bound_names_the_field(tmp_
         "contact: {contact_modulus_gpa: 50, shear_modulus_gpa: 30}\n"
     )
     with pytest.raises(InputError) as exc:
-        run_build(load_config(path), BuildInputs(), None)
+        build_stage(load_config(path), BuildInputs(), None)
     text = _one_line(exc)
     assert "structure.slab2" in text and "max_strain" in text and "0.5%" in text
 
 
 def test_too_many_atoms_names_the_field(tmp_path):
-    from flatcontact.stages.build import BuildInputs, run_build
+    from flatcontact.stages.build import BuildInputs, build_stage
 
     path = tmp_path / "c.yaml"
     path.write_text(
@@ -274,7 +274,7 @@ def test_too_many_atoms_names_the_field(tmp_path):
         "contact: {contact_modulus_gpa: 50, shear_modulus_gpa: 30}\n"
     )
     with pytest.raises(InputError) as exc:
-        run_build(load_config(path), BuildInputs(), None)
+        build_stage(load_config(path), BuildInputs(), None)
     assert "max_atoms" in _one_line(exc)
 
 

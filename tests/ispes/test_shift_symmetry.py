@@ -226,9 +226,9 @@ def test_quartz_two_fold_axis_is_kept_on_the_scan_grids():
     translation the atoms give 1.5e-7 off (7e-7 Å, far inside the 1e-3 Å structure
     tolerance); on a 12 × 12 grid that is 1.8e-6 grid steps, which a fixed 1e-6 dropped."""
     from flatcontact.config import load_config as preset_config
-    from flatcontact.stages.build import BuildInputs, run_build
+    from flatcontact.stages.build import BuildInputs, build_stage
 
-    reference = run_build(preset_config(preset_name="quick"), BuildInputs(), None).atoms
+    reference = build_stage(preset_config(preset_name="quick"), BuildInputs(), None).atoms
     group = shift_space_group(reference)
     assert group.order == 2 and group.operations[1].swaps_slabs
     # the quick preset cuts the slabs at the bundled SNAP's own lattice, a = 4.9422 Å

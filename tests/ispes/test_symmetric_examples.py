@@ -17,7 +17,7 @@ from flatcontact.config.load import load_config
 from flatcontact.ispes.executors import SerialExecutor
 from flatcontact.ispes.scan import run_scan
 from flatcontact.stages import _calculator
-from flatcontact.stages.build import BuildInputs, run_build
+from flatcontact.stages.build import BuildInputs, build_stage
 from flatcontact.stages.scan import grid_spec, relax_settings, symmetry_settings
 
 pytestmark = pytest.mark.slow
@@ -32,7 +32,7 @@ def _scan(name, out, reduced, grid=(6, 6)):
     settings = load_config(EXAMPLES / f"{name}.yaml")
     settings = settings.model_copy(update={"scan": settings.scan.model_copy(update={"grid": grid})})
     if name not in _BUILT:
-        _BUILT[name] = run_build(settings, BuildInputs(), None).atoms
+        _BUILT[name] = build_stage(settings, BuildInputs(), None).atoms
     s = settings.scan
     sym = symmetry_settings(s)
     return run_scan(
@@ -80,9 +80,12 @@ def test_reduced_scan_equals_the_full_scan(
 
 def test_symmetrised_analysis_of_cu111_6x6_has_one_saddle_class_and_keeps_c3(tmp_path):
     from flatcontact.analysis.analyze import analyze_ispes
+    from flatcontact.analysis.options import AnalysisOptions
 
     def at_zero_load(scan):
-        result = analyze_ispes(scan.dataset, [0.0], direction_deg="auto", threshold_gpa=None)
+        result = analyze_ispes(
+            scan.dataset, [0.0], AnalysisOptions(direction_deg="auto", threshold_gpa=None)
+        )
         pa = result.pressures[0]
         saddles = [p for p in pa.stackings.points if p.kind == "saddle"]
         return pa, {p.symmetry_class for p in saddles}, saddles

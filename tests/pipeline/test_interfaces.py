@@ -109,7 +109,7 @@ def test_direction_auto_and_angles():
 
 def test_elastic_stage_on_fcc_copper_gives_mishins_elastic_constants():
     """Mishin et al. (2001), Table: C11 = 169.9, C12 = 122.6, C44 = 76.2 GPa for this EAM."""
-    from flatcontact.stages.elastic import ElasticInputs, run_elastic
+    from flatcontact.stages.elastic import ElasticInputs, elastic_stage
 
     cfg = build_config(
         {
@@ -118,7 +118,7 @@ def test_elastic_stage_on_fcc_copper_gives_mishins_elastic_constants():
             "elastic": {"enabled": True},
         }
     )
-    doc = run_elastic(cfg, ElasticInputs(), None).to_json()
+    doc = elastic_stage(cfg, ElasticInputs(), None).to_json()
     c = doc["tensor_gpa"]
     assert c[0][0] == pytest.approx(169.9, rel=0.01)
     assert c[0][1] == pytest.approx(122.6, rel=0.01)

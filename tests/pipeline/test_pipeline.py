@@ -28,6 +28,7 @@ from flatcontact.errors import InputError
 from flatcontact.ispes.contract import open_ispes
 from flatcontact.layout import STAGES
 from flatcontact.pipeline import Pipeline
+from flatcontact.stages.fingerprints import settings_inputs
 
 TINY = {
     "structure": {"kind": "quartz-dense", "layers": 5, "source": "seed"},
@@ -313,11 +314,11 @@ def test_a_retrained_potential_file_reruns_from_the_build(tmp_path):
         shutil_copy = (tmp_path / f"my{suffix}").write_bytes
         shutil_copy((bundled / f"sio2-snap{suffix}").read_bytes())
     cfg = _merge(TINY, {"potential": {"intra": f"snap:{tmp_path / 'my.snapcoeff'}"}})
-    with Pipeline(build_config(cfg), tmp_path / "run") as pipe:
-        before = pipe._model_inputs()
-        coeff = tmp_path / "my.snapcoeff"
-        coeff.write_text(coeff.read_text() + "\n")
-        after = pipe._model_inputs()
+    config = build_config(cfg)
+    before = settings_inputs("build", config)["model"]  # the model's part of the build's inputs
+    coeff = tmp_path / "my.snapcoeff"
+    coeff.write_text(coeff.read_text() + "\n")
+    after = settings_inputs("build", config)["model"]
     assert before["model"] == after["model"]
     assert before["files_sha256"]["my.snapparam"] == after["files_sha256"]["my.snapparam"]
     assert before["files_sha256"]["my.snapcoeff"] != after["files_sha256"]["my.snapcoeff"]
@@ -755,7 +756,7 @@ def test_the_scan_fingerprint_holds_the_load_bracket_it_reads(tmp_path):
     explicit thicknesses (which brackets nothing), leaves the scan alone."""
 
     def inputs(change: dict) -> dict:
-        return Pipeline(build_config(_merge(TINY, change)), tmp_path / "r")._scan_inputs()
+        return settings_inputs("scan", build_config(_merge(TINY, change)))
 
     base = inputs({})
     assert base["bracket_loads_gpa"] == [0.0, 3.0]

@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 from flatcontact.analysis.analyze import analyze_ispes
+from flatcontact.analysis.options import AnalysisOptions
 from flatcontact.config import build_config
 from flatcontact.ispes.contract import open_ispes, symmetry_operations
 from flatcontact.ispes.shift_lattice import reindex, shift_lattice_of
@@ -93,8 +94,7 @@ def test_a_plain_run_of_the_1_2_twist_reads_the_real_period(tmp_path):
     aliased = analyze_ispes(
         _on_the_supercell(open_ispes(root / "02-scan" / "ispes.nc"), shift_lattice_of(reference)),
         [0.0],
-        direction_deg="auto",
-        threshold_gpa=None,
+        AnalysisOptions(direction_deg="auto", threshold_gpa=None),
     )
     tau_aliased = aliased.pressures[0].friction.tau_mpa
     assert tau_aliased == pytest.approx(0.200, abs=0.01)

@@ -14,6 +14,7 @@ import pytest
 
 from flatcontact.analysis import synthetic as syn
 from flatcontact.analysis.analyze import analyze_ispes
+from flatcontact.analysis.options import AnalysisOptions
 from flatcontact.plots import save_figure
 from flatcontact.plots.analysis import figure_pressure
 
@@ -27,7 +28,7 @@ def fig2_svg(tmp_path_factory):
     grid = syn.SyntheticInterface(
         a1, a2, syn.three_cosine(a1, a2), corrugation_ev_per_a2=-2e-4
     ).grid(9, 9, np.linspace(24.3, 26.4, 36))
-    result = analyze_ispes(grid, [1.0], direction_deg=90.0, threshold_gpa=None)
+    result = analyze_ispes(grid, [1.0], AnalysisOptions(direction_deg=90.0, threshold_gpa=None))
     folder = tmp_path_factory.mktemp("fig2")
     (svg,) = save_figure(figure_pressure(result.pressures[0], result), folder / "fig2", ("svg",))
     return svg.read_text()

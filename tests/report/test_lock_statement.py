@@ -15,7 +15,7 @@ from flatcontact.report.sections.build import (
     interface_section,
     lock_statement,
 )
-from flatcontact.stages.build import BuildInputs, run_build
+from flatcontact.stages.build import BuildInputs, build_stage
 from flatcontact.structures.construct import build_interface
 from flatcontact.structures.interface_io import read_interface
 
@@ -32,7 +32,7 @@ def test_diamond_graphene_lock_strain_is_in_build_json_and_in_the_report(tmp_pat
     """The issue's case: H-diamond(111) against graphene, locked 1×1; graphene stretched by
     a_diamond/√2 / a_graphene − 1 (the diamond.cif lattice against graphene's 2.46 Å)."""
     cfg = load_config(EXAMPLES / "diamond111-h-graphene-airebo.yaml")
-    run_build(cfg, BuildInputs(), tmp_path / "build")
+    build_stage(cfg, BuildInputs(), tmp_path / "build")
     build = json.loads((tmp_path / "build" / "build.json").read_text())
     match = build["recipe"]["match"]
     a_diamond = read(EXAMPLES / "structures" / "diamond.cif").cell.cellpar()[0]

@@ -138,7 +138,7 @@ def test_a_report_of_a_run_refused_in_the_analysis_holds_the_fold_and_its_remedi
     no analysis, laws or contact section; the fold's column, z, p and refused loads; the
     relaxation, the thicknesses (the grid) and lower loads among the remedies."""
     from flatcontact.layout import STAGES
-    from flatcontact.stages.report import ReportInputs, run_report
+    from flatcontact.stages.report import ReportInputs, report_stage
 
     cfg, run, _, _ = refused_run
     fold = {
@@ -154,7 +154,7 @@ def test_a_report_of_a_run_refused_in_the_analysis_holds_the_fold_and_its_remedi
     )
     record = refusal_record("analyze", message, [], ["build", "scan"], (7, 7), [fold])
     folders = {name: run / f"{index:02d}-{name}" for name, index in STAGES.items()}
-    run_report(cfg, ReportInputs(folders, {}, record), tmp_path)
+    report_stage(cfg, ReportInputs(folders, {}, record), tmp_path)
     assert json.loads((tmp_path / REFUSAL_JSON).read_text()) == record
     text = _text((tmp_path / REPORT_HTML).read_text())
     assert "Refused (analyze)" in text and "not converged enough" in text

@@ -15,7 +15,7 @@ from ase.build import bulk, fcc111
 
 from flatcontact.config.load import load_config
 from flatcontact.errors import InputError
-from flatcontact.stages.build import BuildInputs, run_build
+from flatcontact.stages.build import BuildInputs, build_stage
 from flatcontact.structures.lattice import MAX_FILE_MISMATCH_PERCENT
 from flatcontact.units import EV_PER_A2_TO_J_PER_M2
 
@@ -121,7 +121,7 @@ def _fcc_a(atoms) -> float:
 def test_the_al_slab_is_built_at_the_zhou_eam_lattice(tmp_path):
     a_lammps = plain_lammps_fcc_lattice()
     assert a_lammps == pytest.approx(4.0817, abs=2e-4)  # NOTES: Zhou EAM fcc Al
-    result = run_build(_al_config(tmp_path), BuildInputs(), None)
+    result = build_stage(_al_config(tmp_path), BuildInputs(), None)
     assert _fcc_a(result.atoms) == pytest.approx(a_lammps, abs=2e-4)
     lat = result.report["lattice"]
     assert lat["source"] == "potential"
@@ -140,7 +140,7 @@ def test_the_al_slab_is_built_at_the_zhou_eam_lattice(tmp_path):
 
 
 def test_lattice_file_keeps_the_cif_and_states_the_mismatch(tmp_path):
-    result = run_build(_al_config(tmp_path, lattice="file"), BuildInputs(), None)
+    result = build_stage(_al_config(tmp_path, lattice="file"), BuildInputs(), None)
     assert _fcc_a(result.atoms) == pytest.approx(4.05, abs=1e-9)
     slab = result.report["lattice"]["slabs"]["slab1"]
     assert result.report["lattice"]["source"] == slab["used"] == "file"
@@ -171,14 +171,14 @@ def test_lattice_file_keeps_the_cif_and_states_the_mismatch(tmp_path):
 def test_a_file_lattice_beyond_the_threshold_is_refused_in_one_line(tmp_path):
     cfg = _al_config(tmp_path, a_cif=4.20, lattice="file")  # +2.9 % against 4.0817 Å
     with pytest.raises(InputError) as err:
-        run_build(cfg, BuildInputs(), None)
+        build_stage(cfg, BuildInputs(), None)
     text = str(err.value)
     assert "\n" not in text
     assert text.startswith("structure.lattice=file: slab1 (Al(111))")
     assert f"above {MAX_FILE_MISMATCH_PERCENT:g} %" in text
     assert "structure.lattice: potential" in text
     # the default builds it at the potential's lattice, with a warning that the file is far
-    result = run_build(_al_config(tmp_path, a_cif=4.20), BuildInputs(), None)
+    result = build_stage(_al_config(tmp_path, a_cif=4.20), BuildInputs(), None)
     assert _fcc_a(result.atoms) == pytest.approx(4.0817, abs=2e-4)
     assert len(result.warnings) == 1 and "differs from the file's by 2.9" in result.warnings[0]
 
@@ -197,7 +197,7 @@ def test_the_isf_energy_of_the_built_slab_is_the_plain_lammps_one_at_4_0817(tmp_
     reference = plain_lammps_isf_mj_per_m2(4.0817)
     assert reference == pytest.approx(50.2, abs=0.6)  # NOTES: the plain slab at 4.0817 Å
     cfg = _al_config(tmp_path)
-    built = run_build(cfg, BuildInputs(), None).atoms
+    built = build_stage(cfg, BuildInputs(), None).atoms
     calc = make_calculator(cfg.potential, built)
     relax = RelaxSettings(fmax_ev_per_a=1e-4, mode="normal")
     a1, a2 = in_plane_vectors(built)

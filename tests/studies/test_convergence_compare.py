@@ -107,13 +107,14 @@ def test_halving_the_thickness_spacing_of_a_toy_scan_moves_tau_and_sigma_below_o
     from tests.studies.toy import toy_scan
 
     from flatcontact.analysis.analyze import analyze_ispes
+    from flatcontact.analysis.options import AnalysisOptions
     from flatcontact.analysis.outputs import friction_csv_text
 
     ds = toy_scan(tmp_path, grid=4, n_thicknesses=13, fmax_ev_per_angstrom=1e-4).dataset
     loads = [0.25, 0.5, 0.75, 1.0]
 
     def table(grid):
-        res = analyze_ispes(grid, loads, direction_deg=90.0, with_symmetry=False)
+        res = analyze_ispes(grid, loads, AnalysisOptions(direction_deg=90.0, with_symmetry=False))
         return pd.read_csv(io.StringIO(friction_csv_text(res)))
 
     fine, coarse = table(ds), table(ds.isel(thickness=slice(None, None, 2)))

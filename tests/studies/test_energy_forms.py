@@ -6,6 +6,7 @@ import pytest
 from flatcontact import units
 from flatcontact.analysis import synthetic as syn
 from flatcontact.analysis.energy_forms import laws_both_forms
+from flatcontact.analysis.options import AnalysisOptions
 from flatcontact.errors import InputError
 
 A = 4.916
@@ -26,7 +27,7 @@ def cobblestone():
 
 def test_each_form_gives_its_exact_load_slope(cobblestone):
     grid, v, delta = cobblestone
-    out = laws_both_forms(grid, P_GPA, direction_deg=0.0)
+    out = laws_both_forms(grid, P_GPA, AnalysisOptions(direction_deg=0.0))
     internal = out["forms"]["internal"]["laws"]
     enthalpy = out["forms"]["enthalpy"]["laws"]
     tau0 = 4 * np.pi * -v / A * units.EV_PER_A3_TO_MPA
@@ -41,7 +42,7 @@ def test_each_form_gives_its_exact_load_slope(cobblestone):
 
 def test_side_by_side_table_matches_the_per_form_results(cobblestone):
     grid, _, _ = cobblestone
-    out = laws_both_forms(grid, P_GPA, direction_deg=0.0)
+    out = laws_both_forms(grid, P_GPA, AnalysisOptions(direction_deg=0.0))
     rows = out["table"]
     assert [r["p_gpa"] for r in rows] == P_GPA
     for form in ("internal", "enthalpy"):

@@ -1,6 +1,6 @@
 """Issue 13 wiring: ``contact --cycle/--model/--fit`` and the same settings in a run config.
 
-The CLI and the contact stage of ``flatcontact run`` (``run_contact`` with a config read by
+The CLI and the contact stage of ``flatcontact run`` (``contact_stage`` with a config read by
 ``load_config``) must give the same cycle rows and fit results; the cycle rows must obey
 the first-harmonic energy identity W = π·Q_amp·u″₁ and, for ``classical``, Johnson's
 Mindlin–Deresiewicz energy with μ = k and G*_J = G*/4 (computed here independently).
@@ -21,7 +21,7 @@ from flatcontact.contact import fit
 from flatcontact.contact.cycle import CycleModel
 from flatcontact.contact.measured import LoadCurve
 from flatcontact.contact.parameters import ContactParameters
-from flatcontact.stages.contact import ContactInputs, run_contact
+from flatcontact.stages.contact import ContactInputs, contact_stage
 
 ROW_KEYS = {
     "p0_gpa",
@@ -131,7 +131,7 @@ def test_cli_and_run_config_give_the_same_cycle_and_fit(tmp_path, capsys):
     )
     cfg = load_config(cfg_path)
     assert cfg.contact.fit.csv == [str(data.resolve())]
-    run_doc = run_contact(cfg, ContactInputs(), tmp_path / "stage").to_json()
+    run_doc = contact_stage(cfg, ContactInputs(), tmp_path / "stage").to_json()
     cli_doc = _cli_json(
         [
             "--p0-gpa",

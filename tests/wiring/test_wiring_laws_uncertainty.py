@@ -21,9 +21,9 @@ from flatcontact.config import MEASURED_LAW_UNCERTAINTY, build_config
 from flatcontact.contact import mindlin
 from flatcontact.errors import InputError
 from flatcontact.layout import FRICTION_CSV, LAWS_JSON, OTHER_FORM_JSON
-from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
-from flatcontact.stages.contact import ContactInputs, run_contact
-from flatcontact.stages.laws import LawsInputs, run_laws
+from flatcontact.stages.analyze import AnalyzeInputs, analyze_stage
+from flatcontact.stages.contact import ContactInputs, contact_stage
+from flatcontact.stages.laws import LawsInputs, laws_stage
 
 A = 4.916
 A1, A2 = syn.hexagonal_cell(A)
@@ -63,9 +63,9 @@ def stages(tmp_path_factory):
             "report": {"svg": False},
         }
     )
-    run_analyze(cfg, AnalyzeInputs(ispes), root / "analyze")
+    analyze_stage(cfg, AnalyzeInputs(ispes), root / "analyze")
     inputs = LawsInputs.read(root / "analyze" / FRICTION_CSV, root / "analyze" / OTHER_FORM_JSON)
-    run_laws(cfg, inputs, root / "laws")
+    laws_stage(cfg, inputs, root / "laws")
     laws = json.loads((root / "laws" / LAWS_JSON).read_text())
     return cfg, laws, root
 
@@ -101,10 +101,13 @@ def test_the_laws_stage_fits_the_analyze_stages_other_form_and_analyses_nothing(
     import flatcontact.analysis.analyze as analyze_module
     import flatcontact.analysis.energy_forms as energy_forms
     from flatcontact.analysis.energy_forms import laws_both_forms
+    from flatcontact.analysis.options import AnalysisOptions
     from flatcontact.ispes.contract import open_ispes
 
     cfg, laws, root = stages
-    direct = laws_both_forms(open_ispes(root / "ispes.nc"), P_GPA, direction_deg=0.0)
+    direct = laws_both_forms(
+        open_ispes(root / "ispes.nc"), P_GPA, AnalysisOptions(direction_deg=0.0)
+    )
     want = direct["forms"]["enthalpy"]
     assert json.dumps(laws["enthalpy"]["loads"]) == json.dumps(want["loads"])
     assert laws["enthalpy"]["warnings"] == want["warnings"]
@@ -117,7 +120,9 @@ def test_the_laws_stage_fits_the_analyze_stages_other_form_and_analyses_nothing(
     monkeypatch.setattr(analyze_module, "analyze_ispes", refused)
     monkeypatch.setattr(energy_forms, "analyze_ispes", refused)
     analyze = root / "analyze"
-    again = run_laws(cfg, LawsInputs.read(analyze / FRICTION_CSV, analyze / OTHER_FORM_JSON), None)
+    again = laws_stage(
+        cfg, LawsInputs.read(analyze / FRICTION_CSV, analyze / OTHER_FORM_JSON), None
+    )
     assert json.dumps(again.to_json()) == json.dumps(laws)
 
 
@@ -128,7 +133,7 @@ def test_an_other_form_file_of_the_wrong_form_is_refused(stages, tmp_path):
     wrong = tmp_path / OTHER_FORM_JSON
     wrong.write_text(json.dumps(stored | {"form": "internal"}))
     with pytest.raises(InputError, match=r"other_form\.json: holds the 'internal' energy form"):
-        run_laws(cfg, LawsInputs.read(root / "analyze" / FRICTION_CSV, wrong), None)
+        laws_stage(cfg, LawsInputs.read(root / "analyze" / FRICTION_CSV, wrong), None)
 
 
 def test_half_widths_combine_fit_convergence_and_model_spread(stages):
@@ -169,7 +174,7 @@ def test_contact_intervals_contain_the_central_values_and_match_the_tau0_edges(s
             "report": {"svg": False},
         }
     )
-    res = run_contact(contact_cfg, ContactInputs(laws=doc), None)
+    res = contact_stage(contact_cfg, ContactInputs(laws=doc), None)
     iv = res.to_json()["intervals"]
     h = laws["internal"]["half_widths"]["tau0_mpa"]
     assert iv["half_widths"] == {
@@ -220,7 +225,7 @@ def test_contact_intervals_of_each_part_alone_and_the_report_shows_them(stages):
             "report": {"svg": False},
         }
     )
-    res = run_contact(cfg, ContactInputs(laws=doc), None)
+    res = contact_stage(cfg, ContactInputs(laws=doc), None)
     iv = res.to_json()["intervals"]
     parts = laws["internal"]["intervals"]["tau0_mpa"]["components"]
     assert parts == pytest.approx(

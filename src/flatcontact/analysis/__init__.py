@@ -10,6 +10,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
     submod_attrs={
         "analyze": ["AnalysisResult", "PressureAnalysis", "analyze_ispes"],
         "constant_pressure": ["ConstantPressureISPES", "constant_pressure"],
+        "options": ["AnalysisOptions"],
         "friction": ["FrictionResult", "friction_along_path"],
         "laws": ["LinearLaw", "LoadLaws", "fit_linear_law", "fit_load_laws"],
     },

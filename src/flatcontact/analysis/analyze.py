@@ -1,7 +1,8 @@
 """The whole ISPES analysis of one grid: constant-pressure maps → paths → τ, σ, G_int → load laws.
 
-:func:`analyze_ispes` validates every argument before any work, then for each
-target load ``P``:
+:func:`analyze_ispes` takes the grid, the loads and its choices
+(:class:`~flatcontact.analysis.options.AnalysisOptions`, validated on construction), checks the
+loads and the grid before any work, then for each target load ``P``:
 
 1. the constant-pressure landscape on the grid (:mod:`.constant_pressure`),
    per area, in eV/Å², zeroed at the global minimum of the landscape at the
@@ -35,8 +36,7 @@ import xarray as xr
 from flatcontact import units
 from flatcontact.analysis.constant_pressure import (
     DEFAULT_LOAD_SOURCE,
-    FORMS,
-    LOAD_SOURCES,
+    LOAD_SOURCES,  # noqa: F401 (re-exported: the analysis's choices in one place)
     ConstantPressureISPES,
     constant_pressure,
 )
@@ -45,6 +45,11 @@ from flatcontact.analysis.friction import FrictionResult
 from flatcontact.analysis.grid_error import QUANTITIES, GridEstimate, estimate_grid_error
 from flatcontact.analysis.laws import LoadLaws, fit_load_laws
 from flatcontact.analysis.noise import NOISE_WARN_FRACTION
+from flatcontact.analysis.options import (  # noqa: F401 (re-exported with the analysis)
+    AUTO_DIRECTION,
+    ENERGY_ZEROS,
+    AnalysisOptions,
+)
 from flatcontact.analysis.path import (
     MinimumEnergyPath,
     SlidingPath,
@@ -63,7 +68,6 @@ from flatcontact.analysis.symmetry import SymmetryReport, symmetry_report
 from flatcontact.errors import InputError
 from flatcontact.ispes import contract
 
-ENERGY_ZEROS = ("lowest-p", "each", "none")
 #: Lateral points per axis: a periodic interpolant needs the first harmonic (k = -1, 0, 1).
 MIN_LATERAL_POINTS = 3
 #: Attribute of a grid re-indexed onto one shift-lattice period and its index
@@ -150,19 +154,9 @@ def check_pressures(p_gpa: list[float] | np.ndarray) -> np.ndarray:
 def analyze_ispes(
     ds: xr.Dataset,
     p_gpa: list[float] | np.ndarray,
-    direction_deg: float | str = 90.0,
-    form: str = "internal",
-    energy_zero: str = "lowest-p",
-    allow_missing: bool = False,
-    threshold_gpa: float | None = 3.0,
-    with_mep: bool = False,
-    with_symmetry: bool = True,
-    max_length_angstrom: float | None = None,
+    options: AnalysisOptions | None = None,
+    *,
     source: str = "ISPES grid",
-    load_source: str = DEFAULT_LOAD_SOURCE,
-    with_stackings: bool = True,
-    symmetrise: bool = True,
-    with_grid_error: bool = True,
 ) -> AnalysisResult:
     """Analyse an ISPES grid at the loads ``p_gpa`` (see module docstring).
 
@@ -172,79 +166,93 @@ def analyze_ispes(
         Grid following the ``ispes.nc`` contract.
     p_gpa
         Target loads (GPa, positive when pressed).
-    direction_deg
-        Pulling direction in degrees from x (90 = y, the paper's, the default), or
-        ``"auto"``: the lowest-barrier direction of the landscape at the lowest load
-        (:data:`AUTO_DIRECTION_RULE`; needs the stackings).
-    form
-        ``"internal"`` (paper) or ``"enthalpy"``.
-    energy_zero
-        ``"lowest-p"``, ``"each"`` or ``"none"``.
-    allow_missing
-        Interpolate columns with missing thickness points instead of refusing.
-    threshold_gpa
-        Upper end of the load range of the linear fits; ``None``: no fit (``laws`` is
-        ``None``; the run's laws stage fits them from ``friction.csv``).
+    options
+        How to analyse it (:class:`~flatcontact.analysis.options.AnalysisOptions`: direction,
+        energy form, energy zero, load source, fit threshold, optional reports); ``None``: the
+        defaults, the paper's analysis. A grid re-indexed onto one period of a twisted or
+        coincidence cell's shift lattice (attribute ``shift_lattice_index`` > 1,
+        :func:`flatcontact.ispes.shift_lattice.to_shift_cell`) has its stationary points named
+        by kind and rank (``min1``, ``saddle1``, ``max1``), not AB/BA/SP/AA.
+    source
+        Name of the grid in messages.
 
     Raises
     ------
     InputError
-        One line naming the parameter (``p_gpa``, ``form``, ``energy_zero``, ...); the CLI and
-        the run translate it to the flag or the settings path.
-    with_mep, with_symmetry
-        Also compute the string-method MEP / the symmetry report per load.
-    max_length_angstrom
-        Tracking limit of the path (default: see :func:`.path.default_max_length`).
-    source
-        Name of the grid in messages.
-    load_source
-        ``"energy"`` (default): the load is ``-(1/A) dU/dz`` of the energy spline
-        per column; ``"stress"``: the stored ``normal_stress``. Barriers below
-        ``BARRIER_NOISE_FACTOR`` × the energy-noise estimate of the chosen source
-        and form do not count (:mod:`.noise`); a :class:`LoadNoiseWarning` says
-        when that noise is a sizeable fraction of τ or of the largest barrier.
-    with_stackings
-        Find, classify and name the stationary points of each load's landscape and the
-        minimum-energy-path barrier (:mod:`.stackings`); their symmetry classes make
-        equivalent minima starts (:mod:`.starts`).
-        A grid re-indexed onto one period of a twisted or coincidence cell's shift lattice
-        (attribute ``shift_lattice_index`` > 1, :func:`flatcontact.ispes.shift_lattice.
-        to_shift_cell`) has its points named by kind and rank (``min1``, ``saddle1``,
-        ``max1``), not AB/BA/SP/AA: its minima are not bilayer stackings.
-    symmetrise
-        Average each load's interpolant over the shift-space group the grid stores
-        (``symmetry_*`` attributes of the scan, :func:`flatcontact.ispes.contract.symmetry_operations`;
-        :meth:`.periodic.PeriodicSurface.symmetrised`); a grid without them (identity only)
-        is interpolated as it is.
-    with_grid_error
-        Estimate the grid's discretisation error of τ, σ_MSS and G_int from the same samples
-        (:func:`.grid_error.estimate_grid_error`, ``AnalysisResult.grid``); a
-        :class:`GridResolutionWarning` says when it exceeds the stated fraction of τ.
+        One line naming the parameter or option field (``p_gpa``, ``form``, ``energy_zero``,
+        ...); the CLI and the run translate it to the flag or the settings path.
     """
+    opts = AnalysisOptions() if options is None else options
+    if not isinstance(opts, AnalysisOptions):
+        raise InputError(f"options: expected an AnalysisOptions, got {type(opts).__name__}")
     p = check_pressures(p_gpa)
-    auto = isinstance(direction_deg, str)
-    if auto and direction_deg != AUTO_DIRECTION:
-        raise InputError(
-            f"direction_deg: expected an angle in degrees or {AUTO_DIRECTION!r}, got {direction_deg!r}"
+    _check_lateral_grid(ds, source)
+    timings = {"constant_pressure": 0.0, "interpolation": 0.0, "path": 0.0, "friction": 0.0}
+    timings.update({"mep": 0.0} if opts.with_mep else {})
+    timings.update({"symmetry": 0.0} if opts.with_symmetry else {})
+    timings.update({"stackings": 0.0} if opts.with_stackings else {})
+
+    clock = time.perf_counter()
+    cp = constant_pressure(
+        ds,
+        p,
+        form=opts.form,
+        allow_missing=opts.allow_missing,
+        source=source,
+        load_source=opts.load_source,
+    )
+    timings["constant_pressure"] = time.perf_counter() - clock
+    group = contract.symmetry_operations(ds) if opts.symmetrise else []
+    surfaces, refs = _zeroed_surfaces(cp, group, opts.energy_zero, timings)
+    stackings = _stackings(ds, surfaces, opts.with_stackings, timings)
+    direction_deg, direction_rule = opts.direction_deg, "given"
+    if opts.auto_direction:
+        direction_deg, direction_rule = _lowest_barrier_direction(stackings[0], cp.a1, float(p[0]))
+    results = _per_load(ds, cp, surfaces, stackings, float(direction_deg), opts, source, timings)
+
+    grid = None
+    if opts.with_grid_error:
+        clock = time.perf_counter()
+        grid = estimate_grid_error(
+            [cp.energy_ev_per_a2[i] - refs[i] for i in range(p.size)],
+            cp.a1,
+            cp.a2,
+            group,
+            p,
+            {q: np.array([getattr(r.friction, q) for r in results]) for q in QUANTITIES},
+            float(direction_deg),
+            np.array([r.degeneracy_tolerance_ev_per_a2 for r in results]),
+            np.asarray(cp.noise.barrier_threshold_ev_per_a2, float),
+            opts.max_length_angstrom,
         )
-    if auto and not with_stackings:
-        raise InputError(
-            "direction_deg auto: needs the stackings analysis (the lowest-barrier direction)"
-        )
-    if not auto and not np.isfinite(direction_deg):
-        raise InputError(f"direction_deg: expected a finite angle, got {direction_deg}")
-    if form not in FORMS:
-        raise InputError(f"form: expected one of {', '.join(FORMS)}, got {form!r}")
-    if energy_zero not in ENERGY_ZEROS:
-        raise InputError(
-            f"energy_zero: expected one of {', '.join(ENERGY_ZEROS)}, got {energy_zero!r}"
-        )
-    if threshold_gpa is not None and not threshold_gpa > 0:
-        raise InputError(f"threshold_gpa: expected a positive pressure, got {threshold_gpa}")
-    if load_source not in LOAD_SOURCES:
-        raise InputError(
-            f"load_source: expected one of {', '.join(LOAD_SOURCES)}, got {load_source!r}"
-        )
+        timings["grid_error"] = time.perf_counter() - clock
+        _warn_grid(grid, source)
+
+    laws = None
+    if opts.threshold_gpa is not None:
+        clock = time.perf_counter()
+        tau = np.array([r.friction.tau_mpa for r in results])
+        sigma = np.array([r.friction.sigma_mss_mpa for r in results])
+        laws = fit_load_laws(p, tau, sigma, opts.threshold_gpa)
+        timings["laws"] = time.perf_counter() - clock
+    return AnalysisResult(
+        pressures=tuple(results),
+        constant_pressure=cp,
+        laws=laws,
+        direction_deg=float(direction_deg),
+        form=opts.form,
+        energy_zero=opts.energy_zero,
+        energy_reference_ev_per_a2=float(refs[0]),
+        supercell=rectangular_supercell(cp.a1, cp.a2),
+        timings_s=timings,
+        load_source=opts.load_source,
+        direction_rule=direction_rule,
+        grid=grid,
+    )
+
+
+def _check_lateral_grid(ds: xr.Dataset, source: str) -> None:
+    """InputError unless the grid has :data:`MIN_LATERAL_POINTS` shifts along each axis."""
     n_lateral = (ds.sizes.get(contract.DIM_A, 0), ds.sizes.get(contract.DIM_B, 0))
     if min(n_lateral) < MIN_LATERAL_POINTS:
         raise InputError(
@@ -253,53 +261,62 @@ def analyze_ispes(
             f"{MIN_LATERAL_POINTS} points per axis"
         )
 
-    timings = {"constant_pressure": 0.0, "interpolation": 0.0, "path": 0.0, "friction": 0.0}
-    timings.update({"mep": 0.0} if with_mep else {})
-    timings.update({"symmetry": 0.0} if with_symmetry else {})
-    timings.update({"stackings": 0.0} if with_stackings else {})
+
+def _zeroed_surfaces(
+    cp: ConstantPressureISPES, group: list, energy_zero: str, timings: dict[str, float]
+) -> tuple[list[PeriodicSurface], list[float]]:
+    """Each load's periodic interpolant (symmetrised over ``group``) minus its energy zero
+    (eV/Å², :attr:`AnalysisOptions.energy_zero`), and the zeros subtracted."""
     clock = time.perf_counter()
-    cp = constant_pressure(
-        ds, p, form=form, allow_missing=allow_missing, source=source, load_source=load_source
-    )
+
+    def surface(values: np.ndarray) -> PeriodicSurface:
+        return PeriodicSurface(values, cp.a1, cp.a2).symmetrised(group)
+
+    raw = [surface(values) for values in cp.energy_ev_per_a2]
+    minima = [surf.global_minimum()[1] for surf in raw]
+    if energy_zero == "lowest-p":
+        refs = [minima[0]] * len(raw)
+    elif energy_zero == "each":
+        refs = list(minima)
+    else:
+        refs = [0.0] * len(raw)
+    surfaces = [surface(s.values - r) for s, r in zip(raw, refs, strict=True)]
+    timings["interpolation"] = time.perf_counter() - clock
+    return surfaces, refs
+
+
+def _stackings(
+    ds: xr.Dataset, surfaces: list[PeriodicSurface], wanted: bool, timings: dict[str, float]
+) -> list[Stackings | None]:
+    """Each load's stationary points (:mod:`.stackings`), or ``None`` per load if not wanted;
+    named by stacking only on an ordinary cell (not a shift-lattice period)."""
+    if not wanted:
+        return [None] * len(surfaces)
+    clock = time.perf_counter()
+    site_names = int(ds.attrs.get(SHIFT_LATTICE_INDEX_ATTR, 1)) <= 1
+    found = [analyze_stackings(surf, site_names=site_names) for surf in surfaces]
+    timings["stackings"] = time.perf_counter() - clock
+    return found
+
+
+def _per_load(
+    ds: xr.Dataset,
+    cp: ConstantPressureISPES,
+    surfaces: list[PeriodicSurface],
+    stackings: list[Stackings | None],
+    direction_deg: float,
+    opts: AnalysisOptions,
+    source: str,
+    timings: dict[str, float],
+) -> list[PressureAnalysis]:
+    """Path, friction and the optional MEP and symmetry report at each load, from the
+    near-degenerate minima (:mod:`.starts`); each load's search starts near the previous one's."""
     floor = cp.noise.barrier_threshold_ev_per_a2
     # the grid's measured noise floor (approximant cells), NaN when the grid carries none
     measured_floor = contract.energy_floor_mev_per_a2(ds, source) / units.EV_PER_A2_TO_MEV_PER_A2
-    timings["constant_pressure"] = time.perf_counter() - clock
-
-    a1, a2 = cp.a1, cp.a2
-    group = contract.symmetry_operations(ds) if symmetrise else []
-
-    def surface(values: np.ndarray) -> PeriodicSurface:
-        return PeriodicSurface(values, a1, a2).symmetrised(group)
-
-    surfaces, minima = [], []
-    clock = time.perf_counter()
-    for i in range(p.size):
-        surf = surface(cp.energy_ev_per_a2[i])
-        surfaces.append(surf)
-        minima.append(surf.global_minimum())
-    if energy_zero == "lowest-p":
-        refs = [minima[0][1]] * p.size
-    elif energy_zero == "each":
-        refs = [m[1] for m in minima]
-    else:
-        refs = [0.0] * p.size
-    surfaces = [surface(s.values - r) for s, r in zip(surfaces, refs, strict=True)]
-    timings["interpolation"] = time.perf_counter() - clock
-
-    stackings: list[Stackings | None] = [None] * p.size
-    if with_stackings:
-        clock = time.perf_counter()
-        site_names = int(ds.attrs.get(SHIFT_LATTICE_INDEX_ATTR, 1)) <= 1
-        stackings = [analyze_stackings(surf, site_names=site_names) for surf in surfaces]
-        timings["stackings"] = time.perf_counter() - clock
-    direction_rule = "given"
-    if auto:
-        direction_deg, direction_rule = _lowest_barrier_direction(stackings[0], a1, float(p[0]))
-
-    results = []
+    results: list[PressureAnalysis] = []
     previous_xy = None
-    for i, pk in enumerate(p):
+    for i, pk in enumerate(cp.p_gpa):
         surf = surfaces[i]
         tol = degeneracy_tolerance_ev_per_a2(float(floor[i]), measured_floor)
         starts, k = paths_from_near_degenerate_minima(
@@ -307,7 +324,7 @@ def analyze_ispes(
             direction_deg,
             tol,
             min_barrier_ev_per_a2=float(floor[i]),
-            max_length_angstrom=max_length_angstrom,
+            max_length_angstrom=opts.max_length_angstrom,
             timings_s=timings,
             stackings=stackings[i],
             previous_xy=previous_xy,
@@ -316,17 +333,17 @@ def analyze_ispes(
         previous_xy = r0
         warn_if_tau_depends_on_start(starts, k, float(pk), tol, source)
         mep = None
-        if with_mep:
+        if opts.with_mep:
             clock = time.perf_counter()
-            end = r0 + (
+            step = (
                 path.period_vector
                 if path.periodic
-                else _shortest_forward_vector(a1, a2, direction_deg)
+                else _shortest_forward_vector(cp.a1, cp.a2, direction_deg)
             )
-            mep = minimum_energy_path(surf, r0, end)
+            mep = minimum_energy_path(surf, r0, r0 + step)
             timings["mep"] += time.perf_counter() - clock
         sym = None
-        if with_symmetry:
+        if opts.with_symmetry:
             clock = time.perf_counter()
             sym = symmetry_report(surf)
             timings["symmetry"] += time.perf_counter() - clock
@@ -334,45 +351,7 @@ def analyze_ispes(
             PressureAnalysis(float(pk), surf, r0, path, fr, mep, sym, starts, k, tol, stackings[i])
         )
         _warn_noise(cp, i, fr, source)
-
-    grid = None
-    if with_grid_error:
-        clock = time.perf_counter()
-        grid = estimate_grid_error(
-            [cp.energy_ev_per_a2[i] - refs[i] for i in range(p.size)],
-            a1,
-            a2,
-            group,
-            p,
-            {q: np.array([getattr(r.friction, q) for r in results]) for q in QUANTITIES},
-            float(direction_deg),
-            np.array([r.degeneracy_tolerance_ev_per_a2 for r in results]),
-            np.asarray(floor, float),
-            max_length_angstrom,
-        )
-        timings["grid_error"] = time.perf_counter() - clock
-        _warn_grid(grid, source)
-
-    clock = time.perf_counter()
-    tau = np.array([r.friction.tau_mpa for r in results])
-    sigma = np.array([r.friction.sigma_mss_mpa for r in results])
-    laws = None if threshold_gpa is None else fit_load_laws(p, tau, sigma, threshold_gpa)
-    if laws is not None:
-        timings["laws"] = time.perf_counter() - clock
-    return AnalysisResult(
-        pressures=tuple(results),
-        constant_pressure=cp,
-        laws=laws,
-        direction_deg=float(direction_deg),
-        form=form,
-        energy_zero=energy_zero,
-        energy_reference_ev_per_a2=float(refs[0]),
-        supercell=rectangular_supercell(a1, a2),
-        timings_s=timings,
-        load_source=load_source,
-        direction_rule=direction_rule,
-        grid=grid,
-    )
+    return results
 
 
 def _warn_grid(grid: GridEstimate, source: str) -> None:
@@ -408,12 +387,10 @@ def _warn_noise(cp: ConstantPressureISPES, i: int, fr: FrictionResult, source: s
                 else ""
             ),
             LoadNoiseWarning,
-            stacklevel=3,
+            stacklevel=4,
         )
 
 
-#: ``direction_deg`` value that asks for the lowest-barrier direction.
-AUTO_DIRECTION = "auto"
 #: How the ``"auto"`` direction is chosen, as stored with the outputs.
 AUTO_DIRECTION_RULE = (
     "lowest-barrier: the shortest lattice translation the slider reaches from the global "

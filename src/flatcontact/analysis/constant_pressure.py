@@ -251,7 +251,7 @@ def _warn_fold(labels, p_nodes, start, z, what) -> None:
         "below the fold and is read on the branch that carries P = 0, splined without the "
         "nodes before it",
         LoadFoldWarning,
-        stacklevel=4,
+        stacklevel=5,
     )
 
 
@@ -430,6 +430,63 @@ def _missing_message(ds: xr.Dataset, bad: np.ndarray, source: str) -> str:
     )
 
 
+def _invert_grid(
+    z: np.ndarray,
+    e_cols: np.ndarray,
+    p_cols: np.ndarray,
+    fin_cols: np.ndarray,
+    targets: np.ndarray,
+    labels: list[str],
+    load_source: str,
+) -> tuple[np.ndarray, ...]:
+    """Every column inverted at the loads ``targets`` (eV/Å³): the complete columns together,
+    each one with missing points through its remaining points (at least
+    :data:`MIN_THICKNESS_POINTS`). Returns, column-wise, z*, the energy there, the branch's load
+    range, the tail start, the stress-energy mismatch, dp/dz at z* and the sums behind the
+    noise estimates (mismatch Σ², derivative-spread Σ², branch node count)."""
+    n_col, n_z = e_cols.shape
+    zstar = np.empty((targets.size, n_col))
+    estar = np.empty((targets.size, n_col))
+    prange = np.empty((n_col, 2))
+    tail = np.empty(n_col)
+    mismatch = np.empty(n_col)
+    slope = np.empty((targets.size, n_col))
+    sq = np.empty((3, n_col))
+
+    def store(sel: np.ndarray, res: ColumnInversion) -> None:
+        zstar[:, sel] = res.thickness_angstrom
+        estar[:, sel] = res.energy_ev_per_a2
+        prange[sel] = res.branch_p_range_ev_per_a3
+        tail[sel] = res.tail_start_angstrom
+        mismatch[sel] = res.mismatch
+        slope[:, sel] = res.slope_ev_per_a4
+        sq[:, sel] = [res.mismatch_sq_sum, res.derivative_spread_sq_sum, res.n_branch_nodes]
+
+    full = np.all(fin_cols, axis=1)
+    if np.any(full):
+        sel = np.flatnonzero(full)
+        store(
+            sel,
+            invert_columns(
+                z, e_cols[sel], p_cols[sel], targets, [labels[j] for j in sel], load_source
+            ),
+        )
+    for j in np.flatnonzero(~full):
+        keep = fin_cols[j]
+        if keep.sum() < MIN_THICKNESS_POINTS:
+            raise InputError(
+                f"{labels[j]}: only {int(keep.sum())} of {n_z} thickness points are present; "
+                f"at least {MIN_THICKNESS_POINTS} are needed"
+            )
+        store(
+            np.array([j]),
+            invert_columns(
+                z[keep], e_cols[j, keep], p_cols[j, keep], targets, [labels[j]], load_source
+            ),
+        )
+    return zstar, estar, prange, tail, mismatch, slope, sq
+
+
 def constant_pressure(
     ds: xr.Dataset,
     p_gpa: np.ndarray | list[float],
@@ -493,47 +550,9 @@ def constant_pressure(
         for i in range(n_a)
         for j in range(n_b)
     ]
-    n_col = n_a * n_b
-    zstar = np.empty((targets.size, n_col))
-    estar = np.empty((targets.size, n_col))
-    prange = np.empty((n_col, 2))
-    tail = np.empty(n_col)
-    mismatch = np.empty(n_col)
-    slope = np.empty((targets.size, n_col))
-    sq = np.empty((3, n_col))  # mismatch Σ², derivative-spread Σ², branch node count
-
-    def store(sel: np.ndarray, res: ColumnInversion) -> None:
-        zstar[:, sel] = res.thickness_angstrom
-        estar[:, sel] = res.energy_ev_per_a2
-        prange[sel] = res.branch_p_range_ev_per_a3
-        tail[sel] = res.tail_start_angstrom
-        mismatch[sel] = res.mismatch
-        slope[:, sel] = res.slope_ev_per_a4
-        sq[:, sel] = [res.mismatch_sq_sum, res.derivative_spread_sq_sum, res.n_branch_nodes]
-
-    full = np.all(fin_cols, axis=1)
-    if np.any(full):
-        sel = np.flatnonzero(full)
-        store(
-            sel,
-            invert_columns(
-                z, e_cols[sel], p_cols[sel], targets, [labels[j] for j in sel], load_source
-            ),
-        )
-    for j in np.flatnonzero(~full):
-        keep = fin_cols[j]
-        if keep.sum() < MIN_THICKNESS_POINTS:
-            raise InputError(
-                f"{labels[j]}: only {int(keep.sum())} of {n_z} thickness points are present; "
-                f"at least {MIN_THICKNESS_POINTS} are needed"
-            )
-        store(
-            np.array([j]),
-            invert_columns(
-                z[keep], e_cols[j, keep], p_cols[j, keep], targets, [labels[j]], load_source
-            ),
-        )
-
+    zstar, estar, prange, tail, mismatch, slope, sq = _invert_grid(
+        z, e_cols, p_cols, fin_cols, targets, labels, load_source
+    )
     worst = float(np.max(mismatch))
     if worst > MISMATCH_WARN:
         j = int(np.argmax(mismatch))

@@ -21,6 +21,7 @@ from __future__ import annotations
 import io
 import warnings
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
@@ -28,6 +29,7 @@ import pandas as pd
 from flatcontact.analysis.analyze import analyze_ispes
 from flatcontact.analysis.diagnostics import AnalysisWarning
 from flatcontact.analysis.laws import fit_load_laws
+from flatcontact.analysis.options import AnalysisOptions
 from flatcontact.analysis.outputs import friction_csv_text
 from flatcontact.errors import require
 
@@ -54,14 +56,7 @@ def _caught_text(caught) -> list[str]:
 
 
 def form_loads(
-    ds,
-    p_gpa: Sequence[float],
-    form: str,
-    *,
-    direction_deg: float | str = 90.0,
-    load_source: str = "energy",
-    energy_zero: str = "lowest-p",
-    allow_missing: bool = False,
+    ds, p_gpa: Sequence[float], form: str, options: AnalysisOptions | None = None
 ) -> dict:
     """Per-load τ, σ_MSS, G_int, τ's limit and the force noise of one ISPES in one energy form.
 
@@ -69,11 +64,13 @@ def form_loads(
     ----------
     ds
         An ISPES grid (``ispes.nc`` contract, :func:`flatcontact.ispes.contract.open_ispes`).
-    p_gpa, direction_deg, load_source, energy_zero, allow_missing
-        As :func:`flatcontact.analysis.analyze.analyze_ispes` (no symmetry report, no MEP,
-        no fit).
+    p_gpa
+        The loads (GPa).
     form
-        ``"internal"`` or ``"enthalpy"``.
+        ``"internal"`` or ``"enthalpy"`` (replaces ``options.form``).
+    options
+        The rest of the analysis (:class:`flatcontact.analysis.options.AnalysisOptions`;
+        ``None``: the defaults); its symmetry report, MEP and fit are not computed here.
 
     Returns
     -------
@@ -85,17 +82,14 @@ def form_loads(
     require(form in FORMS, f"form: {form!r}: expected internal or enthalpy")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", AnalysisWarning)
-        result = analyze_ispes(
-            ds,
-            list(p_gpa),
-            direction_deg=direction_deg,
+        one_form = replace(
+            options or AnalysisOptions(),
             form=form,
-            load_source=load_source,
-            energy_zero=energy_zero,
-            allow_missing=allow_missing,
             threshold_gpa=None,
             with_symmetry=False,
+            with_mep=False,
         )
+        result = analyze_ispes(ds, list(p_gpa), one_form)
     table = pd.read_csv(io.StringIO(friction_csv_text(result)))
     table = table[["p_gpa", *[c for c in COLUMNS if c in table.columns]]]
     return {
@@ -122,12 +116,7 @@ def form_laws(loads: Sequence[dict], threshold_gpa: float) -> tuple[dict, list[s
 def laws_both_forms(
     ds,
     p_gpa: Sequence[float],
-    *,
-    direction_deg: float = 90.0,
-    threshold_gpa: float = 3.0,
-    load_source: str = "energy",
-    energy_zero: str = "lowest-p",
-    allow_missing: bool = False,
+    options: AnalysisOptions | None = None,
     forms: Sequence[str] = FORMS,
 ) -> dict:
     """Per-load τ, σ_MSS, G_int and the load laws of one ISPES in each energy form.
@@ -136,8 +125,11 @@ def laws_both_forms(
     ----------
     ds
         An ISPES grid (``ispes.nc`` contract, :func:`flatcontact.ispes.contract.open_ispes`).
-    p_gpa, direction_deg, threshold_gpa, load_source, energy_zero, allow_missing
-        As :func:`flatcontact.analysis.analyze.analyze_ispes` (same for both forms).
+    p_gpa
+        The loads (GPa).
+    options
+        The analysis, the same for both forms (:class:`flatcontact.analysis.options.AnalysisOptions`,
+        ``None``: the defaults); its ``threshold_gpa`` bounds the fits (``None``: 3 GPa).
     forms
         Which forms (default both, internal first).
 
@@ -150,22 +142,15 @@ def laws_both_forms(
         each form's warnings are its analysis's (:func:`form_loads`), then its fit's
         (:func:`form_laws`).
     """
+    options = options or AnalysisOptions()
+    threshold_gpa = 3.0 if options.threshold_gpa is None else options.threshold_gpa
     require(len(forms) >= 1, "forms: expected at least one of internal, enthalpy")
     for form in forms:
         require(form in FORMS, f"forms: {form!r}: expected internal or enthalpy")
-    require(threshold_gpa > 0, f"threshold_gpa: expected a positive pressure, got {threshold_gpa}")
     out: dict = {"forms": {}}
     tables = {}
     for form in forms:
-        analysed = form_loads(
-            ds,
-            p_gpa,
-            form,
-            direction_deg=direction_deg,
-            load_source=load_source,
-            energy_zero=energy_zero,
-            allow_missing=allow_missing,
-        )
+        analysed = form_loads(ds, p_gpa, form, options)
         laws, fit_warnings = form_laws(analysed["loads"], threshold_gpa)
         tables[form] = pd.DataFrame.from_records(analysed["loads"])
         out["forms"][form] = {

@@ -59,6 +59,7 @@ CSV_COLUMNS = (
 )
 #: Separator of the per-start values in one ``friction.csv`` cell.
 LIST_SEPARATOR = ";"
+_MEV = units.EV_PER_A2_TO_MEV_PER_A2
 
 
 def _clean(v: object) -> object:
@@ -232,206 +233,100 @@ def friction_csv_text(result: AnalysisResult) -> str:
     return buf.getvalue()
 
 
+#: Per-load columns of the ``friction.csv`` rows carried into ``friction.nc``: name -> attributes.
+FRICTION_COLUMNS = {
+    "tau_mpa": {"units": "MPa"},
+    "tau_period_mpa": {"units": "MPa"},
+    "sigma_mss_mpa": {"units": "MPa"},
+    "shear_stiffness_gpa_per_nm": {"units": "GPa/nm"},
+    **{c: {"units": "MPa" if c.endswith("_mpa") else "GPa/nm"} for c in ERROR_COLUMNS.values()},
+}
+#: The sliding path per load, NaN-padded on ``sample``: name -> (value of the path, attributes).
+PATH_SAMPLES = {
+    "path_t": (lambda path: path.t_angstrom, {"units": "angstrom"}),
+    "path_x": (lambda path: path.xy_angstrom[:, 0], {"units": "angstrom"}),
+    "path_y": (lambda path: path.xy_angstrom[:, 1], {"units": "angstrom"}),
+    "path_energy": (lambda path: path.energy * _MEV, {"units": "meV/angstrom^2"}),
+    "path_force": (lambda path: path.force * units.EV_PER_A3_TO_MPA, {"units": "MPa"}),
+    "path_stiffness": (
+        lambda path: path.curvature * EV_PER_A4_TO_GPA_PER_NM,
+        {"units": "GPa/nm"},
+    ),
+}
+#: The load's noise (:mod:`.noise`), columns of the rows: name -> attributes.
+NOISE_COLUMNS = {
+    "energy_noise_mev_per_a2": {
+        "units": "meV/angstrom^2",
+        "long_name": "energy noise from the load's error",
+    },
+    "force_noise_mpa": {"units": "MPa", "long_name": "energy noise / lateral grid spacing"},
+}
+#: Each near-degenerate start (:mod:`.starts`), NaN-padded on ``start``:
+#: name -> (value of the start, attributes).
+START_VALUES = {
+    "tau_by_start_mpa": (
+        lambda o: o.tau_mpa,
+        {"units": "MPa", "long_name": "tau from each near-degenerate minimum"},
+    ),
+    "sigma_mss_by_start_mpa": (lambda o: o.friction.sigma_mss_mpa, {"units": "MPa"}),
+    "shear_stiffness_by_start_gpa_per_nm": (
+        lambda o: o.friction.shear_stiffness_gpa_per_nm,
+        {"units": "GPa/nm"},
+    ),
+    "start_x": (lambda o: o.xy_angstrom[0], {"units": "angstrom"}),
+    "start_y": (lambda o: o.xy_angstrom[1], {"units": "angstrom"}),
+    "start_energy_above_lowest_mev_per_a2": (
+        lambda o: o.above_lowest_mev_per_a2,
+        {"units": "meV/angstrom^2"},
+    ),
+}
+#: The lowest barrier of each load's landscape (:mod:`.stackings`), columns of the rows.
+BARRIER_COLUMNS = {
+    "lowest_barrier_mev_per_a2": {
+        "units": "meV/angstrom^2",
+        "long_name": "lowest minimum-energy-path barrier from the global minimum "
+        "to an equivalent one",
+    },
+    "lowest_barrier_direction_deg": {
+        "units": "degree",
+        "long_name": "shortest translation over that barrier",
+    },
+    "barrier_along_direction_mev_per_a2": {
+        "units": "meV/angstrom^2",
+        "long_name": "lowest MEP barrier to the start's image one lattice period "
+        "along the pulling direction",
+    },
+}
+#: Each named stationary point, NaN where a load lacks it: name -> (value of the point, attributes).
+STACKING_VALUES = {
+    "stacking_energy_mev_per_a2": (
+        lambda pt: pt.energy * _MEV,
+        {"units": "meV/angstrom^2", "long_name": "energy of each named stationary point"},
+    ),
+    "stacking_x": (lambda pt: pt.xy_angstrom[0], {"units": "angstrom"}),
+    "stacking_y": (lambda pt: pt.xy_angstrom[1], {"units": "angstrom"}),
+}
+FORCE_SIGN = "path_force = de/dt, the resisting lateral stress (positive while climbing)"
+
+
 def friction_dataset(result: AnalysisResult) -> xr.Dataset:
-    """``friction.nc`` as an xarray Dataset (units in attributes)."""
-    p = result.p_gpa
-    n = max(len(pa.path.t_angstrom) for pa in result.pressures)
-
-    def padded(get) -> np.ndarray:
-        out = np.full((p.size, n), np.nan)
-        for i, pa in enumerate(result.pressures):
-            v = get(pa)
-            out[i, : len(v)] = v
-        return out
-
-    mev = units.EV_PER_A2_TO_MEV_PER_A2
-    cp = result.constant_pressure
-    maps = np.stack([pa.surface.values for pa in result.pressures]) * mev
+    """``friction.nc`` as an xarray Dataset (units in attributes): per load (dim ``p_gpa``) the
+    friction, the path (``sample``), the noise and the starts (``start``), the stationary points
+    (``stacking``) and the constant-pressure maps (``shift_a``, ``shift_b``), built from the
+    tables above, one function per group."""
     rows = per_pressure_rows(result)
-
-    def col(name: str) -> np.ndarray:
-        return np.array([np.nan if r[name] is None else r[name] for r in rows], dtype=float)
-
-    n_start = max(max(len(pa.starts), 1) for pa in result.pressures)
-
-    def by_start(get) -> np.ndarray:
-        out = np.full((p.size, n_start), np.nan)
-        for i, pa in enumerate(result.pressures):
-            for j, o in enumerate(pa.starts):
-                out[i, j] = get(o, pa)
-        return out
-
-    names = list(
-        dict.fromkeys(
-            name for pa in result.pressures if pa.stackings for name in pa.stackings.energies()
-        )
-    )
-    kinds = {}
-    for pa in result.pressures:
-        if pa.stackings:
-            kinds.update({k: v for k, v in pa.stackings.kinds().items() if k not in kinds})
-
-    def by_stacking(get) -> np.ndarray:
-        out = np.full((p.size, len(names)), np.nan)
-        for i, pa in enumerate(result.pressures):
-            if pa.stackings is None:
-                continue
-            first = {}
-            for pt in pa.stackings.points:
-                first.setdefault(pt.name, pt)
-            for j, name in enumerate(names):
-                if name in first:
-                    out[i, j] = get(first[name])
-        return out
-
-    ds = xr.Dataset(
+    names, kinds = _stacking_names(result)
+    cp = result.constant_pressure
+    return xr.Dataset(
         {
-            "tau_mpa": ("p_gpa", col("tau_mpa"), {"units": "MPa"}),
-            "tau_period_mpa": ("p_gpa", col("tau_period_mpa"), {"units": "MPa"}),
-            "sigma_mss_mpa": ("p_gpa", col("sigma_mss_mpa"), {"units": "MPa"}),
-            "shear_stiffness_gpa_per_nm": (
-                "p_gpa",
-                col("shear_stiffness_gpa_per_nm"),
-                {"units": "GPa/nm"},
-            ),
-            **{
-                c: ("p_gpa", col(c), {"units": "MPa" if c.endswith("_mpa") else "GPa/nm"})
-                for c in ERROR_COLUMNS.values()
-            },
-            "n_jumps": ("p_gpa", np.array([len(pa.path.jumps) for pa in result.pressures])),
-            "path_t": (
-                ("p_gpa", "sample"),
-                padded(lambda pa: pa.path.t_angstrom),
-                {"units": "angstrom"},
-            ),
-            "path_x": (
-                ("p_gpa", "sample"),
-                padded(lambda pa: pa.path.xy_angstrom[:, 0]),
-                {"units": "angstrom"},
-            ),
-            "path_y": (
-                ("p_gpa", "sample"),
-                padded(lambda pa: pa.path.xy_angstrom[:, 1]),
-                {"units": "angstrom"},
-            ),
-            "path_energy": (
-                ("p_gpa", "sample"),
-                padded(lambda pa: pa.path.energy * mev),
-                {"units": "meV/angstrom^2"},
-            ),
-            "path_force": (
-                ("p_gpa", "sample"),
-                padded(lambda pa: pa.path.force * units.EV_PER_A3_TO_MPA),
-                {"units": "MPa"},
-            ),
-            "path_stiffness": (
-                ("p_gpa", "sample"),
-                padded(lambda pa: pa.path.curvature * EV_PER_A4_TO_GPA_PER_NM),
-                {"units": "GPa/nm"},
-            ),
-            "energy_noise_mev_per_a2": (
-                "p_gpa",
-                col("energy_noise_mev_per_a2"),
-                {"units": "meV/angstrom^2", "long_name": "energy noise from the load's error"},
-            ),
-            "force_noise_mpa": (
-                "p_gpa",
-                col("force_noise_mpa"),
-                {"units": "MPa", "long_name": "energy noise / lateral grid spacing"},
-            ),
-            "n_degenerate_minima": ("p_gpa", col("n_degenerate_minima").astype(int)),
-            "selected_start": (
-                "p_gpa",
-                np.array([pa.selected_start for pa in result.pressures]),
-                {"long_name": "index along start of the reported path and tau"},
-            ),
-            "degeneracy_tolerance_mev_per_a2": (
-                "p_gpa",
-                np.array([pa.degeneracy_tolerance_ev_per_a2 for pa in result.pressures]) * mev,
-                {
-                    "units": "meV/angstrom^2",
-                    "long_name": "minima this close to the lowest are starts",
-                },
-            ),
-            "tau_by_start_mpa": (
-                ("p_gpa", "start"),
-                by_start(lambda o, pa: o.tau_mpa),
-                {"units": "MPa", "long_name": "tau from each near-degenerate minimum"},
-            ),
-            "sigma_mss_by_start_mpa": (
-                ("p_gpa", "start"),
-                by_start(lambda o, pa: o.friction.sigma_mss_mpa),
-                {"units": "MPa"},
-            ),
-            "shear_stiffness_by_start_gpa_per_nm": (
-                ("p_gpa", "start"),
-                by_start(lambda o, pa: o.friction.shear_stiffness_gpa_per_nm),
-                {"units": "GPa/nm"},
-            ),
-            "start_x": (
-                ("p_gpa", "start"),
-                by_start(lambda o, pa: o.xy_angstrom[0]),
-                {"units": "angstrom"},
-            ),
-            "start_y": (
-                ("p_gpa", "start"),
-                by_start(lambda o, pa: o.xy_angstrom[1]),
-                {"units": "angstrom"},
-            ),
-            "start_energy_above_lowest_mev_per_a2": (
-                ("p_gpa", "start"),
-                by_start(lambda o, pa: o.above_lowest_mev_per_a2),
-                {"units": "meV/angstrom^2"},
-            ),
-            "lowest_barrier_mev_per_a2": (
-                "p_gpa",
-                col("lowest_barrier_mev_per_a2"),
-                {
-                    "units": "meV/angstrom^2",
-                    "long_name": "lowest minimum-energy-path barrier from the global minimum "
-                    "to an equivalent one",
-                },
-            ),
-            "lowest_barrier_direction_deg": (
-                "p_gpa",
-                col("lowest_barrier_direction_deg"),
-                {"units": "degree", "long_name": "shortest translation over that barrier"},
-            ),
-            "barrier_along_direction_mev_per_a2": (
-                "p_gpa",
-                col("barrier_along_direction_mev_per_a2"),
-                {
-                    "units": "meV/angstrom^2",
-                    "long_name": "lowest MEP barrier to the start's image one lattice period "
-                    "along the pulling direction",
-                },
-            ),
-            "start_stacking": ("p_gpa", np.array([r["start_stacking"] for r in rows], dtype=str)),
-            "stacking_energy_mev_per_a2": (
-                ("p_gpa", "stacking"),
-                by_stacking(lambda pt: pt.energy * mev),
-                {"units": "meV/angstrom^2", "long_name": "energy of each named stationary point"},
-            ),
-            "stacking_x": (
-                ("p_gpa", "stacking"),
-                by_stacking(lambda pt: pt.xy_angstrom[0]),
-                {"units": "angstrom"},
-            ),
-            "stacking_y": (
-                ("p_gpa", "stacking"),
-                by_stacking(lambda pt: pt.xy_angstrom[1]),
-                {"units": "angstrom"},
-            ),
-            "stacking_kind": ("stacking", np.array([kinds[n] for n in names], dtype=str)),
-            "energy_map": (("p_gpa", "shift_a", "shift_b"), maps, {"units": "meV/angstrom^2"}),
-            "thickness_at_p": (
-                ("p_gpa", "shift_a", "shift_b"),
-                cp.thickness_angstrom,
-                {"units": "angstrom"},
-            ),
+            **_friction_variables(result, rows),
+            **_path_variables(result),
+            **_start_variables(result, rows),
+            **_stacking_variables(result, rows, names, kinds),
+            **_map_variables(result),
         },
         coords={
-            "p_gpa": ("p_gpa", p, {"units": "GPa"}),
+            "p_gpa": ("p_gpa", result.p_gpa, {"units": "GPa"}),
             "shift_a": cp.shift_a,
             "shift_b": cp.shift_b,
             "stacking": ("stacking", np.array(names, dtype=str)),
@@ -450,11 +345,112 @@ def friction_dataset(result: AnalysisResult) -> xr.Dataset:
             "barrier_noise_factor": BARRIER_NOISE_FACTOR,
             "tau_start_rule": result.tau_start_rule,
             "direction_rule": result.direction_rule,
-            "force_sign": "path_force = de/dt, the resisting lateral stress (positive while climbing)",
+            "force_sign": FORCE_SIGN,
             "flatcontact_version": __version__,
         },
     )
-    return ds
+
+
+def _column(rows: list[dict], name: str) -> np.ndarray:
+    """One per-load column of the rows as floats (NaN for an undefined cell)."""
+    return np.array([np.nan if r[name] is None else r[name] for r in rows], dtype=float)
+
+
+def _friction_variables(result: AnalysisResult, rows: list[dict]) -> dict:
+    """τ, τ over a period, σ_MSS, G_int, the grid's error estimates and the path's jumps."""
+    out = {name: ("p_gpa", _column(rows, name), attrs) for name, attrs in FRICTION_COLUMNS.items()}
+    out["n_jumps"] = ("p_gpa", np.array([len(pa.path.jumps) for pa in result.pressures]))
+    return out
+
+
+def _path_variables(result: AnalysisResult) -> dict:
+    """:data:`PATH_SAMPLES` on ``(p_gpa, sample)``, each path NaN-padded to the longest."""
+    n = max(len(pa.path.t_angstrom) for pa in result.pressures)
+    out = {}
+    for name, (get, attrs) in PATH_SAMPLES.items():
+        values = np.full((len(result.pressures), n), np.nan)
+        for i, pa in enumerate(result.pressures):
+            v = get(pa.path)
+            values[i, : len(v)] = v
+        out[name] = (("p_gpa", "sample"), values, attrs)
+    return out
+
+
+def _start_variables(result: AnalysisResult, rows: list[dict]) -> dict:
+    """The load's noise, the near-degenerate starts and :data:`START_VALUES` on
+    ``(p_gpa, start)``, NaN-padded to the most starts."""
+    pressures = result.pressures
+    out = {name: ("p_gpa", _column(rows, name), attrs) for name, attrs in NOISE_COLUMNS.items()}
+    out["n_degenerate_minima"] = ("p_gpa", _column(rows, "n_degenerate_minima").astype(int))
+    out["selected_start"] = (
+        "p_gpa",
+        np.array([pa.selected_start for pa in pressures]),
+        {"long_name": "index along start of the reported path and tau"},
+    )
+    out["degeneracy_tolerance_mev_per_a2"] = (
+        "p_gpa",
+        np.array([pa.degeneracy_tolerance_ev_per_a2 for pa in pressures]) * _MEV,
+        {"units": "meV/angstrom^2", "long_name": "minima this close to the lowest are starts"},
+    )
+    n_start = max(max(len(pa.starts), 1) for pa in pressures)
+    for name, (get, attrs) in START_VALUES.items():
+        values = np.full((len(pressures), n_start), np.nan)
+        for i, pa in enumerate(pressures):
+            for j, o in enumerate(pa.starts):
+                values[i, j] = get(o)
+        out[name] = (("p_gpa", "start"), values, attrs)
+    return out
+
+
+def _stacking_names(result: AnalysisResult) -> tuple[list[str], dict[str, str]]:
+    """The stationary points named at any load, in order of first appearance, and the kind of
+    each (as first named)."""
+    named = [pa.stackings for pa in result.pressures if pa.stackings]
+    names = list(dict.fromkeys(name for st in named for name in st.energies()))
+    kinds: dict[str, str] = {}
+    for st in named:
+        kinds.update({k: v for k, v in st.kinds().items() if k not in kinds})
+    return names, kinds
+
+
+def _stacking_variables(
+    result: AnalysisResult, rows: list[dict], names: list[str], kinds: dict[str, str]
+) -> dict:
+    """The barriers of :data:`BARRIER_COLUMNS`, the start's stacking and :data:`STACKING_VALUES`
+    on ``(p_gpa, stacking)`` (the first point of each name; NaN where a load lacks it)."""
+    out = {name: ("p_gpa", _column(rows, name), attrs) for name, attrs in BARRIER_COLUMNS.items()}
+    out["start_stacking"] = ("p_gpa", np.array([r["start_stacking"] for r in rows], dtype=str))
+    first_points = [
+        {} if pa.stackings is None else _first_of_each_name(pa.stackings.points)
+        for pa in result.pressures
+    ]
+    for name, (get, attrs) in STACKING_VALUES.items():
+        values = np.full((len(result.pressures), len(names)), np.nan)
+        for i, first in enumerate(first_points):
+            for j, stacking in enumerate(names):
+                if stacking in first:
+                    values[i, j] = get(first[stacking])
+        out[name] = (("p_gpa", "stacking"), values, attrs)
+    out["stacking_kind"] = ("stacking", np.array([kinds[n] for n in names], dtype=str))
+    return out
+
+
+def _first_of_each_name(points) -> dict:
+    first: dict = {}
+    for pt in points:
+        first.setdefault(pt.name, pt)
+    return first
+
+
+def _map_variables(result: AnalysisResult) -> dict:
+    """The constant-pressure maps (meV/Å², zeroed as the analysis says) and z* (Å)."""
+    cp = result.constant_pressure
+    maps = np.stack([pa.surface.values for pa in result.pressures]) * _MEV
+    dims = ("p_gpa", "shift_a", "shift_b")
+    return {
+        "energy_map": (dims, maps, {"units": "meV/angstrom^2"}),
+        "thickness_at_p": (dims, cp.thickness_angstrom, {"units": "angstrom"}),
+    }
 
 
 def _attr(v: float) -> float:

@@ -93,12 +93,6 @@ class SpaceOperation:
     def __call__(self, xy: np.ndarray) -> np.ndarray:
         return np.asarray(xy, float) @ self.matrix.T + self.translation_angstrom
 
-    def keeps_direction(self, direction_deg: float, atol: float = 1e-9) -> bool:
-        """Whether ``R d = d`` for the unit vector at ``direction_deg``."""
-        th = np.deg2rad(direction_deg)
-        d = np.array([np.cos(th), np.sin(th)])
-        return bool(np.allclose(self.matrix @ d, d, atol=atol))
-
 
 @dataclass(frozen=True)
 class Stackings:

@@ -335,5 +335,5 @@ def warn_if_tau_depends_on_start(
         f"{outcomes[selected].tau_mpa:.4g} MPa, the largest (the pull that starts sliding from "
         "either)",
         DegenerateMinimaWarning,
-        stacklevel=3,
+        stacklevel=4,
     )

@@ -235,13 +235,6 @@ class SyntheticInterface:
         """Closed-form constant-pressure energy per area (eV/Å²) at fractional points ``s``."""
         return self.landscape_of_g(self.pattern(s)[0], p_ev_per_a3, form)
 
-    def landscape_slope(
-        self, g: np.ndarray, p_ev_per_a3: float, form: str = "internal"
-    ) -> np.ndarray:
-        """``dẽ/dg`` by the complex step (exact to rounding)."""
-        h = 1e-20
-        return np.imag(self.landscape_of_g(np.asarray(g) + 1j * h, p_ev_per_a3, form)) / h
-
     def grid(
         self,
         n_a: int,

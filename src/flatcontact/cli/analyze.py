@@ -138,8 +138,8 @@ def analyze_command(
     from flatcontact.cli.settings import FLAGS_SOURCE, flag_errors
     from flatcontact.config import build_config
     from flatcontact.layout import FRICTION_CSV, OTHER_FORM_JSON
-    from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
-    from flatcontact.stages.laws import LawsInputs, run_laws
+    from flatcontact.stages.analyze import AnalyzeInputs, analyze_stage
+    from flatcontact.stages.laws import LawsInputs, laws_stage
 
     for flag, value, allowed in (
         ("--energy", energy, FORMS),
@@ -166,13 +166,13 @@ def analyze_command(
         cfg = cfg.model_copy(
             update={"analysis": cfg.analysis.model_copy(update={"p_gpa": pressures})}
         )
-        analyzed = run_analyze(cfg, AnalyzeInputs(path), out, other_form=out is not None)
+        analyzed = analyze_stage(cfg, AnalyzeInputs(path), out, other_form=out is not None)
         laws_inputs = (
             LawsInputs.read(out / FRICTION_CSV, out / OTHER_FORM_JSON)  # both forms, as the run
             if out is not None
             else LawsInputs.from_analysis(analyzed.analysis)
         )
-        fitted = run_laws(cfg, laws_inputs, out)
+        fitted = laws_stage(cfg, laws_inputs, out)
     result = analyzed.analysis
     for line in analyzed.warnings:
         print_warning(line)

@@ -1,5 +1,5 @@
 """``flatcontact asperity CONFIG --out DIR``: the asperity in atoms against the modified Mindlin
-model of the interface's laws (:func:`flatcontact.stages.asperity.run_asperity`)."""
+model of the interface's laws (:func:`flatcontact.stages.asperity.asperity_stage`)."""
 
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ def asperity_cmd(
     """
     from flatcontact.cli.settings import resolve_config
     from flatcontact.layout import ELASTIC_JSON, LAWS_JSON, STAGES
-    from flatcontact.stages.asperity import AsperityInputs, run_asperity
+    from flatcontact.stages.asperity import AsperityInputs, asperity_stage
 
     settings = resolve_config(config, None, {"asperity": {"enabled": True}}, {})
     out = check_out_dir(out)
@@ -49,7 +49,7 @@ def asperity_cmd(
         if not laws.is_file():
             raise InputError(f"--laws: {laws} is not a file")
         laws_doc = json.loads(laws.read_text())
-    result = run_asperity(
+    result = asperity_stage(
         settings,
         AsperityInputs(laws=laws_doc, contact_modulus_gpa=e_star),
         out,

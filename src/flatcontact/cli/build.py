@@ -1,7 +1,7 @@
 """``flatcontact build``: the relaxed, verified two-slab interface.
 
 Thin: maps the flags to run settings (``structure``, ``potential``, ``report.svg``) and runs
-the build stage (:func:`flatcontact.stages.build.run_build`), the one ``flatcontact run``
+the build stage (:func:`flatcontact.stages.build.build_stage`), the one ``flatcontact run``
 runs, so it writes the same files under the same names as ``01-build/``:
 ``interface.extxyz``, ``build.json`` and ``fig1_interface.png`` (+ ``.svg``).
 """
@@ -159,7 +159,7 @@ def build(
     """
     from flatcontact.cli.settings import FLAGS_SOURCE, flag_errors
     from flatcontact.config import build_config
-    from flatcontact.stages.build import BuildInputs, run_build
+    from flatcontact.stages.build import BuildInputs, build_stage
     from flatcontact.structures import build as builder
 
     _check_numbers(gap_angstrom, fmax_ev_per_angstrom, lj_cutoff_angstrom, normal_axis)
@@ -183,7 +183,7 @@ def build(
         )
         check_out_dir(out)
         with flag_errors(_FLAG_OF):
-            result = run_build(cfg, BuildInputs(), out)
+            result = build_stage(cfg, BuildInputs(), out)
         _print(result, out)
         return
     quartz = {k: _QUARTZ_DEFAULTS[k] if v is None else v for k, v in given.items()}
@@ -234,7 +234,7 @@ def build(
     }
     with flag_errors(_FLAG_OF):
         cfg = build_config(data, source=FLAGS_SOURCE)
-        result = run_build(cfg, BuildInputs(), out)
+        result = build_stage(cfg, BuildInputs(), out)
     _print(result, out)
 
 

@@ -2,7 +2,7 @@
 
 Thin: maps the flags (named by quantity and unit) to the run settings' ``contact`` section
 (k, τ0, μ, σ0 default to the paper's, :mod:`flatcontact.reference`) and ``report.svg``, runs
-the contact stage (:func:`flatcontact.stages.contact.run_contact`, the one ``flatcontact run``
+the contact stage (:func:`flatcontact.stages.contact.contact_stage`, the one ``flatcontact run``
 runs) and prints a rich table or JSON; with ``--out`` the stage writes its figures,
 ``summary.json`` and ``contact.nc`` there.
 """
@@ -300,7 +300,7 @@ def contact_command(
     """Hertz + adhesion + modified Mindlin: Q(u), peak and gross-sliding forces, oscillatory stiffness."""
     from flatcontact.cli.settings import flag_errors, settings_from_flags
     from flatcontact.contact.moduli import paper_shear_modulus_from_johnson
-    from flatcontact.stages.contact import ContactInputs, run_contact
+    from flatcontact.stages.contact import ContactInputs, contact_stage
 
     p0_list = _parse_p0(p0_gpa)
     g = float(paper_shear_modulus_from_johnson(shear_modulus_gpa)) if johnson else shear_modulus_gpa
@@ -348,7 +348,7 @@ def contact_command(
     if out is not None:
         check_out_dir(out)
     with flag_errors(_FLAG_OF):
-        result = run_contact(
+        result = contact_stage(
             cfg,
             ContactInputs(
                 interface=_given_interface(unstable_stacking_mj_m2, burgers_angstrom, structure)

@@ -1,5 +1,5 @@
 """``flatcontact elastic``: Cij and the contact moduli of a bulk crystal, the run's elastic
-stage with a configuration (:func:`flatcontact.stages.elastic.run_elastic`) or α-quartz with a
+stage with a configuration (:func:`flatcontact.stages.elastic.elastic_stage`) or α-quartz with a
 named potential (:func:`flatcontact.elastic.quartz_contact_moduli`)."""
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ def elastic_cmd(
 ) -> None:
     """Cij (relaxed ions), Voigt-Reuss-Hill K, G, E, nu and the contact moduli E*, G*.
 
-    With CONFIG this is the run's elastic stage (:func:`flatcontact.stages.elastic.run_elastic`)
+    With CONFIG this is the run's elastic stage (:func:`flatcontact.stages.elastic.elastic_stage`)
     for any material; without it, alpha-quartz with ``--potential``.
     """
     from flatcontact.config.elastic import ElasticConfig
@@ -81,13 +81,13 @@ def elastic_cmd(
 def _elastic_stage(config: Path, strain: float, out: Path | None) -> dict:
     """The run's elastic stage for ``config`` (strain from ``--strain``), writing ``--out``."""
     from flatcontact.cli.settings import resolve_config
-    from flatcontact.stages.elastic import ElasticInputs, run_elastic
+    from flatcontact.stages.elastic import ElasticInputs, elastic_stage
 
     flags = {"elastic": {"enabled": True, "strain": strain}}
     settings = resolve_config(config, None, flags, {"elastic.strain": "--strain"})
     if out is not None:
         out = check_out_dir(out)
-    return run_elastic(settings, ElasticInputs(), out).to_json()
+    return elastic_stage(settings, ElasticInputs(), out).to_json()
 
 
 def _cij_of_tensor(tensor) -> dict[str, float]:

@@ -2,7 +2,7 @@
 
 Thin: reads the run configuration (:func:`flatcontact.config.load_config`, the file
 ``flatcontact run`` reads; its ``potential``/``calculator`` and ``scan`` sections), lays the
-flags over it, runs the scan stage (:func:`flatcontact.stages.scan.run_scan`, the one
+flags over it, runs the scan stage (:func:`flatcontact.stages.scan.scan_stage`, the one
 ``flatcontact run`` runs: ``points.db``, ``ispes.nc``, ``scan.json`` and
 ``fig_scan_columns.png``, + ``.svg`` with ``report.svg``) with a progress bar and prints its
 summary and warnings.
@@ -201,7 +201,7 @@ def scan_command(
     from flatcontact.cli.progress import ScanBar
     from flatcontact.ispes.scan import ScanInterrupted
     from flatcontact.rundir import RunLock
-    from flatcontact.stages.scan import ScanInputs, run_scan
+    from flatcontact.stages.scan import ScanInputs, scan_stage
 
     if thickness and p_range_gpa is not None:
         raise InputError("give either --thickness or --p-range-gpa, not both")
@@ -240,7 +240,7 @@ def scan_command(
     lock = RunLock(out_dir).acquire()  # one writer per --out (a run or another scan)
     try:
         with ScanBar(console) as bar:
-            result = run_scan(cfg, ScanInputs(where), out_dir, progress=None if as_json else bar)
+            result = scan_stage(cfg, ScanInputs(where), out_dir, progress=None if as_json else bar)
     except ScanInterrupted as stop:
         r = stop.result
         err_console.print(

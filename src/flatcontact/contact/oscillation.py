@@ -211,15 +211,6 @@ class StiffnessCurve:
         self.stress_pa(measure)
         return self.knee_stress_amplitude_pa if measure == "amplitude" else self.knee_stress_rms_pa
 
-    def collapse_stress_pa(self, measure: str) -> float:
-        """The collapse stress in ``measure``."""
-        self.stress_pa(measure)
-        return (
-            self.collapse_stress_amplitude_pa
-            if measure == "amplitude"
-            else self.collapse_stress_rms_pa
-        )
-
 
 def amplitude_grid(n_linear: int = 200, n_log: int = 60, closest: float = 1e-9) -> FloatArray:
     """Q_max/Q_peak in [0, 1): uniform points plus points clustered at the collapse

@@ -207,23 +207,6 @@ def size_limits(
     )
 
 
-def strength_against_radius(
-    interface: SlipInterface,
-    concurrent_strength_pa: float,
-    shear_modulus_pa: float,
-    radius_m: ArrayLike,
-) -> FloatArray:
-    """The size-limited strength (Pa) over contact radii at one concurrent strength:
-    min(τ_c, τ_dis(a)) for a commensurate interface; τ_c (a lower bound beyond a_el) else."""
-    a = np.asarray(radius_m, dtype=float)
-    if interface.kind == COMMENSURATE and interface.unstable_stacking_j_m2 is not None:
-        return np.minimum(
-            concurrent_strength_pa,
-            dislocation_strength(a, shear_modulus_pa, interface.unstable_stacking_j_m2),
-        )
-    return np.full(a.shape, float(concurrent_strength_pa))
-
-
 def slip_sentences(doc: dict | None) -> list[str]:
     """One sentence per p0 whose contact radius exceeds the critical size (the report box
     and the console) of ``summary.json["slip_size"]``."""

@@ -75,10 +75,6 @@ class GridSpec:
                 raise InputError(f"p-range-gpa: N must be an integer >= 2, got {n}")
             object.__setattr__(self, "p_range_gpa", (float(lo), float(hi), int(n)))
 
-    @property
-    def shape_lateral(self) -> tuple[int, int]:
-        return (self.n_a, self.n_b)
-
     def shifts(self) -> tuple[np.ndarray, np.ndarray]:
         return fractional_shifts(self.n_a), fractional_shifts(self.n_b)
 

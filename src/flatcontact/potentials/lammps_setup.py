@@ -19,6 +19,7 @@ A single instance and no coupling is written as a plain ``pair_style`` (no hybri
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -93,11 +94,33 @@ def plane_ids(z: np.ndarray, groups: np.ndarray, symbols: list[str]) -> list[int
     return out
 
 
+@dataclass(frozen=True)
+class _Types:
+    """The LAMMPS atom types of one structure: each atom's type, and per type (index t - 1) its
+    element, its group (one set of intra-slab pair styles) and its slab (0: none)."""
+
+    types: list[int]
+    type_elements: list[str]
+    type_group: list[int]
+    type_slab: list[int]
+    group_ids: list[int]
+
+    @property
+    def n(self) -> int:
+        return len(self.type_elements)
+
+    def cross_pairs(self):
+        """Type pairs ``ti < tj`` in two different slabs (the LJ across the interface)."""
+        slab = self.type_slab
+        for ti in range(1, self.n + 1):
+            for tj in range(ti + 1, self.n + 1):
+                if slab[ti - 1] and slab[tj - 1] and slab[ti - 1] != slab[tj - 1]:
+                    yield ti, tj
+
+
 def compile_setup(model, atoms, bulk: bool = False) -> LammpsSetup:
     """The :class:`LammpsSetup` of ``model`` for ``atoms`` (see the module docstring)."""
     symbols = atoms.get_chemical_symbols()
-    elements = sorted(set(symbols))
-    ne = len(elements)
     slabs = slab_ids(atoms) if not bulk else np.ones(len(atoms), dtype=int)
     interlayer = model.coupling == "interlayer"
     layers = (
@@ -113,6 +136,45 @@ def compile_setup(model, atoms, bulk: bool = False) -> LammpsSetup:
         groups = np.ones(len(atoms), dtype=int)
     else:
         groups = slabs
+    t = _atom_types(model, atoms, symbols, groups, slabs)
+    single = model.coupling == "same" or (bulk and model.intra_scope != "layer")
+    instances, pair_lines = _style_instances(model, t, single, interlayer)
+    lj_table = None
+    if model.coupling == "lj" and not bulk and len(set(slabs.tolist())) > 1:
+        sym = np.array(symbols)
+        lj_table = model.lj.table(sorted(set(sym[slabs == 1])), sorted(set(sym[slabs != 1])))
+    if not instances and lj_table is None:
+        raise InputError(
+            f"potential {model.label}: nothing to compute (no intra model and no cross-slab LJ)"
+        )
+    cutoff = model.lj.cutoff_angstrom
+    commands = _pair_commands(t, instances, pair_lines, lj_table, cutoff)
+    # 16 Å interlayer cutoffs in small periodic cells, or a long cross-interface LJ or
+    # interlayer cutoff (a convergence study's cutoff ladder): more neighbours per atom than
+    # LAMMPS's default capacity (2000; "Neighbor list overflow")
+    style_cutoffs = [style_cutoff_angstrom(s) for s, _, _ in instances]
+    longest = max((c for c in style_cutoffs if c is not None), default=0.0)
+    one = max(
+        INTERLAYER_NEIGHBOURS if interlayer else 0,
+        neighbour_capacity(cutoff) if lj_table is not None else 0,
+        neighbour_capacity(longest) if longest else 0,
+    )
+    if one > LAMMPS_DEFAULT_NEIGHBOURS:
+        commands.append(f"neigh_modify one {one} page {20 * one}")
+    return LammpsSetup(
+        types=tuple(t.types),
+        type_elements=tuple(t.type_elements),
+        commands=tuple(commands),
+        atom_style="full" if interlayer else "atomic",
+        molecules=tuple(int(v) for v in layers) if interlayer else None,
+        charges=tuple(float(model.charges.get(s, 0.0)) for s in symbols) if model.charges else None,
+    )
+
+
+def _atom_types(model, atoms, symbols: list[str], groups: np.ndarray, slabs: np.ndarray) -> _Types:
+    """One type per (group, element), or per (group, element, plane) for ``type_per_plane``."""
+    elements = sorted(set(symbols))
+    ne = len(elements)
     group_ids = sorted(set(groups.tolist()))
     if model.type_per_plane:
         planes = plane_ids(atoms.positions[:, 2], groups, symbols)
@@ -129,29 +191,34 @@ def compile_setup(model, atoms, bulk: bool = False) -> LammpsSetup:
         ]
         type_elements = [e for _ in group_ids for e in elements]
         type_group = [g for g in group_ids for _ in elements]
-    ntypes = len(type_elements)
     # the slab of each type (for LJ across slabs): groups never straddle slabs
-    type_slab = [0] * ntypes
+    type_slab = [0] * len(type_elements)
     for t, s in zip(types, slabs.tolist(), strict=True):
         type_slab[t - 1] = s
+    return _Types(types, type_elements, type_group, type_slab, group_ids)
+
+
+def _style_instances(
+    model, t: _Types, single: bool, interlayer: bool
+) -> tuple[list[tuple[str, str, str | None]], dict[int, list[tuple[int, int, str]]]]:
+    """``(pair_style, coeff args, map)`` for each ``pair_coeff * *`` style instance (map None for
+    a per-pair style, whose ``(ti, tj, args)`` lines are in the second value by instance)."""
 
     def element_map(style, group=None) -> str:
         # types without atoms are mapped too: LAMMPS wants every type pair covered
         known = set(style.known_elements)
         return " ".join(
-            e if e in known and (group is None or type_group[t] == group) else "NULL"
-            for t, e in enumerate(type_elements)
+            e if e in known and (group is None or t.type_group[k] == group) else "NULL"
+            for k, e in enumerate(t.type_elements)
         )
 
-    # (pair_style, coeff args, map) for "pair_coeff * *" styles; map None for per-pair styles
     instances: list[tuple[str, str, str | None]] = []
     pair_lines: dict[int, list[tuple[int, int, str]]] = {}  # instance -> (ti, tj, args)
-    single = model.coupling == "same" or (bulk and model.intra_scope != "layer")
     for style in model.intra_styles:
         if not style.map_elements:
             instances.append((style.pair_style, style.coeff_args(), ""))
             continue
-        for g in [None] if single else group_ids:
+        for g in [None] if single else t.group_ids:
             mapping = element_map(style, g)
             if set(mapping.split()) != {"NULL"}:
                 instances.append((style.pair_style, style.coeff_args(), mapping))
@@ -160,103 +227,77 @@ def compile_setup(model, atoms, bulk: bool = False) -> LammpsSetup:
             instances.append((style.pair_style, style.coeff_args(), element_map(style)))
             continue
         lines = []
-        for ti in range(1, ntypes + 1):
-            for tj in range(ti, ntypes + 1):
-                key = "-".join(sorted((type_elements[ti - 1], type_elements[tj - 1])))
+        for ti in range(1, t.n + 1):
+            for tj in range(ti, t.n + 1):
+                key = "-".join(sorted((t.type_elements[ti - 1], t.type_elements[tj - 1])))
                 if key in style.pair_coeff_pairs:
                     lines.append((ti, tj, style.pair_coeff_pairs[key]))
         pair_lines[len(instances)] = lines
         instances.append((style.pair_style, "", None))
-    lj_table = None
-    if model.coupling == "lj" and not bulk and len(set(slabs.tolist())) > 1:
-        sym = np.array(symbols)
-        lj_table = model.lj.table(sorted(set(sym[slabs == 1])), sorted(set(sym[slabs != 1])))
-    if not instances and lj_table is None:
-        raise InputError(
-            f"potential {model.label}: nothing to compute (no intra model and no cross-slab LJ)"
-        )
-    cutoff = model.lj.cutoff_angstrom
-    commands: list[str] = []
+    return instances, pair_lines
 
-    def cross_pairs():
-        for ti in range(1, ntypes + 1):
-            for tj in range(ti + 1, ntypes + 1):
-                if (
-                    type_slab[ti - 1]
-                    and type_slab[tj - 1]
-                    and type_slab[ti - 1] != type_slab[tj - 1]
-                ):
-                    yield ti, tj
+
+def _pair_commands(
+    t: _Types,
+    instances: list[tuple[str, str, str | None]],
+    pair_lines: dict[int, list[tuple[int, int, str]]],
+    lj_table,
+    cutoff: float,
+) -> list[str]:
+    """The ``pair_style`` and ``pair_coeff`` commands: LJ alone, one style, or a hybrid/overlay
+    of every instance (and the LJ across the slabs), every type pair declared."""
+    commands: list[str] = []
 
     def lj_coeffs(substyle: str) -> list[str]:
         out = []
-        for ti, tj in cross_pairs():
-            p: LJPair = lj_table[pair_key(type_elements[ti - 1], type_elements[tj - 1])]
+        for ti, tj in t.cross_pairs():
+            p: LJPair = lj_table[pair_key(t.type_elements[ti - 1], t.type_elements[tj - 1])]
             out.append(
                 f"pair_coeff {ti} {tj} {substyle}{p.epsilon_ev:.17g} {p.sigma_angstrom:.17g}"
             )
         return out
 
+    slab = t.type_slab
     if not instances:  # LJ only: plain lj/cut, zero within each slab
         commands.append(f"pair_style lj/cut {cutoff:.17g}")
-        for ti in range(1, ntypes + 1):
-            for tj in range(ti, ntypes + 1):
-                if type_slab[ti - 1] == type_slab[tj - 1] or not (
-                    type_slab[ti - 1] and type_slab[tj - 1]
-                ):
+        for ti in range(1, t.n + 1):
+            for tj in range(ti, t.n + 1):
+                if slab[ti - 1] == slab[tj - 1] or not (slab[ti - 1] and slab[tj - 1]):
                     commands.append(f"pair_coeff {ti} {tj} 0.0 1.0")
         commands += lj_coeffs("")
         commands.append("pair_modify shift yes")
-    elif len(instances) == 1 and lj_table is None and instances[0][2] is not None:
+        return commands
+    if len(instances) == 1 and lj_table is None and instances[0][2] is not None:
         style, args, mapping = instances[0]
         commands.append(f"pair_style {style}")
         commands.append(" ".join(f"pair_coeff * * {args} {mapping}".split()))
-    else:
-        names = [s.split()[0] for s, _, _ in instances]
-        substyles = [s for s, _, _ in instances] + ([f"lj/cut {cutoff:.17g}"] if lj_table else [])
-        commands.append("pair_style hybrid/overlay " + " ".join(substyles))
-        seen: dict[str, int] = {}
-        covered = set()
-        for k, ((_style, args, mapping), name) in enumerate(zip(instances, names, strict=True)):
-            seen[name] = seen.get(name, 0) + 1
-            index = f" {seen[name]}" if names.count(name) > 1 else ""
-            if mapping is None:  # per type pair
-                for ti, tj, pair_args in pair_lines[k]:
-                    commands.append(f"pair_coeff {ti} {tj} {name}{index} {pair_args}")
-                    covered.add((ti, tj))
-                continue
-            commands.append(" ".join(f"pair_coeff * * {name}{index} {args} {mapping}".split()))
-            on = [t + 1 for t, e in enumerate(mapping.split()) if e != "NULL"] if mapping else []
-            covered |= {(ti, tj) for ti in on for tj in on if ti <= tj}
-        if lj_table is not None:
-            commands += lj_coeffs("lj/cut ")
-            commands.append("pair_modify pair lj/cut shift yes")
-            covered |= set(cross_pairs())
-        # type pairs no sub-style covers (e.g. different layers with coupling none) interact
-        # through nothing; LAMMPS wants them declared
-        commands += [
-            f"pair_coeff {ti} {tj} none"
-            for ti in range(1, ntypes + 1)
-            for tj in range(ti, ntypes + 1)
-            if (ti, tj) not in covered
-        ]
-    # 16 Å interlayer cutoffs in small periodic cells, or a long cross-interface LJ or
-    # interlayer cutoff (a convergence study's cutoff ladder): more neighbours per atom than
-    # LAMMPS's default capacity (2000; "Neighbor list overflow")
-    style_cutoffs = [style_cutoff_angstrom(s) for s, _, _ in instances]
-    longest = max((c for c in style_cutoffs if c is not None), default=0.0)
-    one = max(
-        INTERLAYER_NEIGHBOURS if interlayer else 0,
-        neighbour_capacity(cutoff) if lj_table is not None else 0,
-        neighbour_capacity(longest) if longest else 0,
-    )
-    if one > LAMMPS_DEFAULT_NEIGHBOURS:
-        commands.append(f"neigh_modify one {one} page {20 * one}")
-    return LammpsSetup(
-        types=tuple(types),
-        type_elements=tuple(type_elements),
-        commands=tuple(commands),
-        atom_style="full" if interlayer else "atomic",
-        molecules=tuple(int(v) for v in layers) if interlayer else None,
-        charges=tuple(float(model.charges.get(s, 0.0)) for s in symbols) if model.charges else None,
-    )
+        return commands
+    names = [s.split()[0] for s, _, _ in instances]
+    substyles = [s for s, _, _ in instances] + ([f"lj/cut {cutoff:.17g}"] if lj_table else [])
+    commands.append("pair_style hybrid/overlay " + " ".join(substyles))
+    seen: dict[str, int] = {}
+    covered = set()
+    for k, ((_style, args, mapping), name) in enumerate(zip(instances, names, strict=True)):
+        seen[name] = seen.get(name, 0) + 1
+        index = f" {seen[name]}" if names.count(name) > 1 else ""
+        if mapping is None:  # per type pair
+            for ti, tj, pair_args in pair_lines[k]:
+                commands.append(f"pair_coeff {ti} {tj} {name}{index} {pair_args}")
+                covered.add((ti, tj))
+            continue
+        commands.append(" ".join(f"pair_coeff * * {name}{index} {args} {mapping}".split()))
+        on = [i + 1 for i, e in enumerate(mapping.split()) if e != "NULL"] if mapping else []
+        covered |= {(ti, tj) for ti in on for tj in on if ti <= tj}
+    if lj_table is not None:
+        commands += lj_coeffs("lj/cut ")
+        commands.append("pair_modify pair lj/cut shift yes")
+        covered |= set(t.cross_pairs())
+    # type pairs no sub-style covers (e.g. different layers with coupling none) interact
+    # through nothing; LAMMPS wants them declared
+    commands += [
+        f"pair_coeff {ti} {tj} none"
+        for ti in range(1, t.n + 1)
+        for tj in range(ti, t.n + 1)
+        if (ti, tj) not in covered
+    ]
+    return commands

@@ -1,6 +1,6 @@
 """The stages of a study, one module each, and the only code that writes a stage's files.
 
-Every stage is a function ``run_<stage>(settings, inputs, folder, progress=None)``:
+Every stage is a function ``<stage>_stage(settings, inputs, folder, progress=None)``:
 
 - ``settings`` is the validated run configuration (:class:`flatcontact.config.RunConfig`);
   the stage reads only its own sections (and ``report.svg`` for its figures);
@@ -16,14 +16,14 @@ once. ``flatcontact <stage>`` (:mod:`flatcontact.cli`) and ``flatcontact run``
 =========  =====================================  ==========================================
 stage      function                               files
 =========  =====================================  ==========================================
-build      :func:`.build.run_build`               interface.extxyz, build.json, fig1_interface
-scan       :func:`.scan.run_scan`                 points.db, (rerelax.db), probe.json, ispes.nc, scan.json, fig_scan_columns
-analyze    :func:`.analyze.run_analyze`           friction.csv, friction.nc, analyze.json, other_form.json, fig2_p*
-laws       :func:`.laws.run_laws`                 laws.json, fig3_laws
-elastic    :func:`.elastic.run_elastic`           elastic.json
-contact    :func:`.contact.run_contact`           contact.nc, summary.json, fig4, fig5, (fig6)
-report     :func:`.report.run_report`             report.html, (refusal.json: a run refused after the scan)
-asperity   :func:`.asperity.run_asperity`         asperity.nc, asperity.json, fig_asperity_*, state/
+build      :func:`.build.build_stage`             interface.extxyz, build.json, fig1_interface
+scan       :func:`.scan.scan_stage`               points.db, (rerelax.db), probe.json, ispes.nc, scan.json, fig_scan_columns
+analyze    :func:`.analyze.analyze_stage`         friction.csv, friction.nc, analyze.json, other_form.json, fig2_p*
+laws       :func:`.laws.laws_stage`               laws.json, fig3_laws
+elastic    :func:`.elastic.elastic_stage`         elastic.json
+contact    :func:`.contact.contact_stage`         contact.nc, summary.json, fig4, fig5, (fig6)
+report     :func:`.report.report_stage`           report.html, (refusal.json: a run refused after the scan)
+asperity   :func:`.asperity.asperity_stage`       asperity.nc, asperity.json, fig_asperity_*, state/
 =========  =====================================  ==========================================
 """
 
@@ -32,13 +32,13 @@ import lazy_loader
 __getattr__, __dir__, __all__ = lazy_loader.attach(
     __name__,
     submod_attrs={
-        "analyze": ["AnalyzeInputs", "run_analyze"],
-        "asperity": ["AsperityInputs", "run_asperity"],
-        "build": ["BuildInputs", "run_build"],
-        "contact": ["ContactInputs", "run_contact"],
-        "elastic": ["ElasticInputs", "run_elastic"],
-        "laws": ["LawsInputs", "run_laws"],
-        "report": ["ReportInputs", "run_report"],
-        "scan": ["ScanInputs", "run_scan"],
+        "analyze": ["AnalyzeInputs", "analyze_stage"],
+        "asperity": ["AsperityInputs", "asperity_stage"],
+        "build": ["BuildInputs", "build_stage"],
+        "contact": ["ContactInputs", "contact_stage"],
+        "elastic": ["ElasticInputs", "elastic_stage"],
+        "laws": ["LawsInputs", "laws_stage"],
+        "report": ["ReportInputs", "report_stage"],
+        "scan": ["ScanInputs", "scan_stage"],
     },
 )

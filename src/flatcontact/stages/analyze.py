@@ -82,7 +82,7 @@ class AnalyzeResult:
         }
 
 
-def run_analyze(
+def analyze_stage(
     settings, inputs: AnalyzeInputs, folder: Path | None, progress=None, other_form: bool = True
 ) -> AnalyzeResult:
     """Analyse ``inputs.ispes`` at ``settings.analysis.p_gpa`` (see the module docstring);
@@ -100,21 +100,11 @@ def run_analyze(
 
     s = settings.analysis
     with renamed_errors(SETTINGS_NAMES), _folds_named(Path(inputs.ispes).parent / SCAN_JSON):
+        options = analysis_options(s)
         ds = open_ispes(inputs.ispes)
         with captured(AnalysisWarning) as caught:
-            analysis = analyze_ispes(
-                ds,
-                s.p_gpa,
-                direction_deg=s.direction_deg,
-                form=s.energy_form,
-                load_source=s.load_source,
-                energy_zero=s.energy_zero,
-                allow_missing=s.allow_missing,
-                threshold_gpa=None,
-                with_mep=s.with_mep,
-                source=str(inputs.ispes),
-            )
-        other = _other_form(ds, s) if other_form else None
+            analysis = analyze_ispes(ds, s.p_gpa, options, source=str(inputs.ispes))
+        other = _other_form(ds, s.p_gpa, options) if other_form else None
     notes = [f"{w.category.__name__}: {w.message}" for w in caught]
     for note in notes:
         log.warning("analyze: %s", note)
@@ -145,20 +135,28 @@ def grid_note(folder: Path) -> str:
     )
 
 
-def _other_form(ds, s) -> dict:
-    """The energy form ``s.energy_form`` does not name, with the same analysis settings (no
-    symmetry report, no MEP: the laws stage uses its per-load τ and σ_MSS)."""
+def analysis_options(s):
+    """The :class:`flatcontact.analysis.options.AnalysisOptions` of the ``analysis:`` settings
+    section ``s``: no fit (the laws stage's), the MEP when asked for."""
+    from flatcontact.analysis.options import AnalysisOptions
+
+    return AnalysisOptions(
+        direction_deg=s.direction_deg,
+        form=s.energy_form,
+        energy_zero=s.energy_zero,
+        load_source=s.load_source,
+        allow_missing=s.allow_missing,
+        threshold_gpa=None,
+        with_mep=s.with_mep,
+    )
+
+
+def _other_form(ds, p_gpa, options) -> dict:
+    """The energy form ``options.form`` does not name, with the same options (no symmetry
+    report, no MEP: the laws stage uses its per-load τ and σ_MSS)."""
     from flatcontact.analysis.energy_forms import FORMS, form_loads
 
-    return form_loads(
-        ds,
-        s.p_gpa,
-        FORMS[1 - FORMS.index(s.energy_form)],
-        direction_deg=s.direction_deg,
-        load_source=s.load_source,
-        energy_zero=s.energy_zero,
-        allow_missing=s.allow_missing,
-    )
+    return form_loads(ds, p_gpa, FORMS[1 - FORMS.index(options.form)], options)
 
 
 @contextlib.contextmanager

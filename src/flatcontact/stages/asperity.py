@@ -139,7 +139,7 @@ def verdict(geometry: str, radius_angstrom: float, loads: list[dict]) -> str:
     )
 
 
-def run_asperity(
+def asperity_stage(
     settings, inputs: AsperityInputs, folder: Path | None, progress=None
 ) -> AsperityResult:
     """Build, press, slide, measure and compare (:mod:`flatcontact.asperity.experiment`).

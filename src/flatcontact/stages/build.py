@@ -75,7 +75,7 @@ def _relax_calculator(settings):
     return calculator
 
 
-def run_build(settings, inputs: BuildInputs, folder: Path | None, progress=None) -> BuildResult:
+def build_stage(settings, inputs: BuildInputs, folder: Path | None, progress=None) -> BuildResult:
     """Build the interface of the recipe ``settings.structure`` with the run's interaction model.
 
     Every kind goes through :func:`flatcontact.structures.construct.build_interface`:

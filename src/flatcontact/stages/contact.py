@@ -406,7 +406,7 @@ class ContactResult:
         return doc
 
 
-def run_contact(
+def contact_stage(
     settings, inputs: ContactInputs, folder: Path | None, progress=None
 ) -> ContactResult:
     """The modified Mindlin contact of ``settings.contact`` with the upstream ``inputs``."""

@@ -127,7 +127,7 @@ def _layered_bulk(recipe):
     return atoms, record
 
 
-def run_elastic(
+def elastic_stage(
     settings, inputs: ElasticInputs, folder: Path | None, progress=None
 ) -> ElasticResult:
     """Cij of the relaxed bulk crystal of the slabs (:func:`bulk_crystal`) by finite strains

@@ -9,7 +9,7 @@ which folds survived, its warnings and the run log state it, and the folds the r
 removed leave ``load_folds``. A fold that survives is refused by the analysis as before, its
 message saying that it survived. Only folds that would stop the run are re-relaxed, so a run
 that passes keeps its numbers. The lowest and highest load of ``analysis.p_gpa`` are part of
-a pressure-range scan's fingerprint (``Pipeline._scan_inputs``); with given thicknesses
+a pressure-range scan's fingerprint (:func:`flatcontact.stages.fingerprints.scan`); with given thicknesses
 (``scan.thickness_angstrom``) they are not, and a load added later above a fold is refused
 by the analysis without this remedy (rerun the scan, e.g. with a new ``--out``).
 """

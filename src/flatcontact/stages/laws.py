@@ -175,7 +175,7 @@ def other_form(form: str) -> str:
     return FORMS[1 - FORMS.index(form)]
 
 
-def run_laws(settings, inputs: LawsInputs, folder: Path | None, progress=None) -> LawsResult:
+def laws_stage(settings, inputs: LawsInputs, folder: Path | None, progress=None) -> LawsResult:
     """Fit the load laws to ``inputs`` on P ≤ ``settings.analysis.threshold_gpa``."""
     from flatcontact.analysis.diagnostics import AnalysisWarning
     from flatcontact.analysis.laws import fit_load_laws

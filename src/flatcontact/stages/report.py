@@ -89,7 +89,9 @@ def _stage_rows(
     return rows
 
 
-def run_report(settings, inputs: ReportInputs, folder: Path | None, progress=None) -> ReportResult:
+def report_stage(
+    settings, inputs: ReportInputs, folder: Path | None, progress=None
+) -> ReportResult:
     """Write ``folder/report.html`` (title ``report.title``) from ``inputs.folders``; a refused
     run's also ``refusal.json`` (``inputs.refusal``)."""
     from flatcontact import __version__

@@ -97,7 +97,7 @@ class ScanStageResult:
 
 def grid_spec(scan, lateral: tuple[int, int] | None = None) -> GridSpec:
     """The scan grid of the ``scan`` settings (:class:`flatcontact.ispes.grid.GridSpec`);
-    ``lateral`` replaces ``scan.grid`` (the grid chosen for a shift lattice, :func:`run_scan`)."""
+    ``lateral`` replaces ``scan.grid`` (the grid chosen for a shift lattice, :func:`scan_stage`)."""
     r = scan.p_range_gpa
     n_a, n_b = lateral if lateral is not None else scan.grid
     return GridSpec(
@@ -180,7 +180,7 @@ def _no_repulsive_branch(ds) -> str | None:
     return None
 
 
-def run_scan(
+def scan_stage(
     settings,
     inputs: ScanInputs,
     folder: Path,

@@ -269,6 +269,72 @@ def _in_plane_scaled(slab: Atoms, a_angstrom: float) -> Atoms:
     return out
 
 
+def _starting_slab(
+    spec,
+    layers: int,
+    source: str,
+    fmax_ev_per_angstrom: float,
+    at_potential_lattice: bool,
+    lattice_angstrom: tuple[float, float],
+    report: dict,
+) -> tuple[Atoms, Atoms | None]:
+    """The unrelaxed dense slab: the shipped one (scaled in-plane to the potential's lattice,
+    thickened past 6 layers) or a seeded reconstruction relaxed with ``spec``; ``report["start"]``
+    says which. Returns the slab and the bulk its thickening inserted (None without)."""
+    a_used, c_used = lattice_angstrom
+    bulk = None
+    use_shipped = source == "shipped" or (
+        source == "auto" and SHIPPED_DENSE_SLAB.is_file() and shipped_reaches(layers)
+    )
+    if use_shipped:
+        check_shipped_layers(layers)
+        slab, provenance = load_shipped_dense_slab()
+        report["start"] = {
+            "source": "shipped",
+            "file": SHIPPED_DENSE_SLAB.name,
+            "provenance": {
+                k: v for k, v in provenance.items() if k not in ("search", "verification")
+            },
+        }
+        if at_potential_lattice:
+            slab = _in_plane_scaled(slab, a_used)
+        if layers > SHIPPED_LAYERS:
+            slab, report["start"]["thickening"], bulk = thicken_shipped_slab(
+                slab, layers, spec, fmax_ev_per_angstrom
+            )
+    else:
+        slab, record = reconstruct_dense_slab(
+            layers,
+            _single_slab_calculator(spec),
+            model_label=spec.label,
+            fmax_ev_per_angstrom=fmax_ev_per_angstrom,
+            a_angstrom=a_used,
+            c_angstrom=c_used,
+        )
+        report["start"] = {"source": "seed", "search": record}
+        if slab is None:
+            raise InputError(
+                f"potential {spec.label} does not reach a defect-free dense (0001) surface from any seeded start ({layers} layers); try the shipped CHGNet slab (layers=6)"
+            )
+    return slab, bulk
+
+
+def _verify_interface(interface: Atoms, label: str) -> dict:
+    """Each slab of the relaxed interface still dense (:func:`verify_dense_slab`); InputError
+    naming the failures otherwise."""
+    checks = {}
+    for which in (1, 2):
+        part = interface[interface.arrays["slab"] == which]
+        checks[f"slab{which}"] = verify_dense_slab(part)
+    bad = [f"slab {k[-1]}: {'; '.join(v['failures'])}" for k, v in checks.items() if not v["dense"]]
+    if bad:
+        raise InputError(
+            f"the dense surface did not survive the interface relaxation with {label}: "
+            + " | ".join(bad)
+        )
+    return checks
+
+
 def build_quartz_interface(
     spec,
     layers: int = 6,
@@ -318,39 +384,9 @@ def build_quartz_interface(
     if choice.use_potential:
         a_used = float(np.linalg.norm(fit.potential_cell[0]))
         c_used = float(np.linalg.norm(fit.potential_cell[2]))
-    use_shipped = source == "shipped" or (
-        source == "auto" and SHIPPED_DENSE_SLAB.is_file() and shipped_reaches(layers)
+    slab, bulk = _starting_slab(
+        spec, layers, source, fmax_ev_per_angstrom, choice.use_potential, (a_used, c_used), report
     )
-    if use_shipped:
-        check_shipped_layers(layers)
-        slab, provenance = load_shipped_dense_slab()
-        report["start"] = {
-            "source": "shipped",
-            "file": SHIPPED_DENSE_SLAB.name,
-            "provenance": {
-                k: v for k, v in provenance.items() if k not in ("search", "verification")
-            },
-        }
-        if choice.use_potential:
-            slab = _in_plane_scaled(slab, a_used)
-        if layers > SHIPPED_LAYERS:
-            slab, report["start"]["thickening"], bulk = thicken_shipped_slab(
-                slab, layers, spec, fmax_ev_per_angstrom
-            )
-    else:
-        slab, record = reconstruct_dense_slab(
-            layers,
-            _single_slab_calculator(spec),
-            model_label=spec.label,
-            fmax_ev_per_angstrom=fmax_ev_per_angstrom,
-            a_angstrom=a_used,
-            c_angstrom=c_used,
-        )
-        report["start"] = {"source": "seed", "search": record}
-        if slab is None:
-            raise InputError(
-                f"potential {spec.label} does not reach a defect-free dense (0001) surface from any seeded start ({layers} layers); try the shipped CHGNet slab (layers=6)"
-            )
     slab = slab.copy()
     slab.calc = None
     outcome = relax(slab, make_calculator(spec, slab), fmax_ev_per_angstrom=fmax_ev_per_angstrom)
@@ -401,78 +437,9 @@ def build_quartz_interface(
     )
     interface.calc = None
     report["interface_relaxation"] = {**outcome, "thickness_angstrom": thickness(interface)}
-    checks = {}
-    for which in (1, 2):
-        part = interface[interface.arrays["slab"] == which]
-        checks[f"slab{which}"] = verify_dense_slab(part)
-    report["interface_verification"] = checks
-    bad = [f"slab {k[-1]}: {'; '.join(v['failures'])}" for k, v in checks.items() if not v["dense"]]
-    if bad:
-        raise InputError(
-            f"the dense surface did not survive the interface relaxation with {spec.label}: "
-            + " | ".join(bad)
-        )
+    report["interface_verification"] = _verify_interface(interface, spec.label)
     recipe["thickness_angstrom"] = thickness(interface)
     interface.info["recipe"] = json.dumps(recipe, sort_keys=True)
     report["thickness_angstrom"] = thickness(interface)
     report["n_atoms"] = len(interface)
-    return interface, report
-
-
-def interface_from_slab(
-    slab: Atoms,
-    spec,
-    *,
-    normal_axis: int = 2,
-    face_depth_angstrom: float | None = None,
-    face_atoms: int | None = None,
-    gap_angstrom: float = DEFAULT_GAP_ANGSTROM,
-    relax_interface: bool = True,
-    fmax_ev_per_angstrom: float = DEFAULT_FMAX_EV_PER_ANGSTROM,
-    source: str = "structure file",
-) -> tuple[Atoms, dict]:
-    """An interface of any crystal: two copies of ``slab`` whose surface normal is cell axis ``normal_axis``.
-
-    The cell is permuted cyclically so that ``normal_axis`` becomes the third vector, brought to
-    ASE's standard form (a1 ∥ x, a2 in the x-y plane), faces tagged by height (``face_atoms``
-    or ``face_depth_angstrom``), and the interface relaxed with ``spec`` (no surface check:
-    the dense-silica verification applies only to quartz).
-    """
-    require(normal_axis in (0, 1, 2), f"normal_axis={normal_axis}: expected 0, 1 or 2")
-    atoms = slab.copy()
-    atoms.calc = None
-    order = [(normal_axis + 1) % 3, (normal_axis + 2) % 3, normal_axis]
-    scaled = atoms.get_scaled_positions(wrap=False)[:, order]
-    cell = atoms.cell.array[order]
-    pbc = np.array(atoms.pbc)[order]
-    require(
-        bool(pbc[0] and pbc[1]),
-        f"slab must be periodic along the two in-plane axes (pbc={atoms.pbc.tolist()})",
-    )
-    standard, _ = atoms.cell.__class__(cell).standard_form()
-    atoms = Atoms(atoms.numbers, scaled_positions=scaled, cell=standard, pbc=(True, True, False))
-    spec.check_atoms(atoms)
-    interface = make_interface(
-        atoms,
-        gap_angstrom,
-        face_atoms=face_atoms,
-        face_depth_angstrom=face_depth_angstrom,
-        recipe={
-            "source": source,
-            "normal_axis": normal_axis,
-            "face_atoms": face_atoms,
-            "face_depth_angstrom": face_depth_angstrom,
-            "potential": spec.label,
-            "potential_spec": json.loads(spec.model_dump_json()),
-            "gap_angstrom": gap_angstrom,
-        },
-    )
-    report: dict = {"potential_label": spec.label, "source": source, "n_atoms": len(interface)}
-    if relax_interface:
-        outcome = relax(
-            interface, make_calculator(spec, interface), fmax_ev_per_angstrom=fmax_ev_per_angstrom
-        )
-        interface.calc = None
-        report["interface_relaxation"] = outcome
-    report["thickness_angstrom"] = thickness(interface)
     return interface, report

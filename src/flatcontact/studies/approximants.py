@@ -303,8 +303,8 @@ def run_cell(config: dict, folder: str, planned: int) -> dict:
     from flatcontact.ispes.shift_lattice import shift_lattice_of, translation_noise_ev_per_a2
     from flatcontact.pipeline import Pipeline
     from flatcontact.potentials.engines import make_calculator
-    from flatcontact.stages.analyze import AnalyzeInputs, run_analyze
-    from flatcontact.stages.laws import LawsInputs, run_laws
+    from flatcontact.stages.analyze import AnalyzeInputs, analyze_stage
+    from flatcontact.stages.laws import LawsInputs, laws_stage
     from flatcontact.stages.scan import relax_settings
     from flatcontact.structures.interface_io import read_interface
 
@@ -351,8 +351,8 @@ def run_cell(config: dict, folder: str, planned: int) -> dict:
     nan = math.nan
     form, law, p_low, barrier, gates = cfg.analysis.energy_form, {}, nan, lateral, None
     if lateral >= RESOLVED_FACTOR * floor:
-        run_analyze(cfg, AnalyzeInputs(cell / ISPES_NC), cell / "analyze")
-        run_laws(
+        analyze_stage(cfg, AnalyzeInputs(cell / ISPES_NC), cell / "analyze")
+        laws_stage(
             cfg,
             LawsInputs.read(cell / "analyze" / FRICTION_CSV, cell / "analyze" / OTHER_FORM_JSON),
             cell / "laws",

@@ -125,45 +125,63 @@ def run_convergence(
             for s in open_:
                 v = ladder[s][level - 1]
                 status[s]["steps"] = level
-                if "error" in results[v.name] or "error" in results[previous[s]]:
-                    failed = results[v.name].get("error") or results[previous[s]].get("error")
-                    # an earlier analysable step (in last_step/last_change) stays this
-                    # setting's measured change: a refused finer step does not erase it
-                    status[s].update(
-                        state="failed", error=failed, failed_step=[previous[s], v.name]
-                    )
-                    continue
-                change = largest_change(
-                    results[previous[s]], results[v.name], r.tolerance_floor_mpa
-                )
-                status[s]["last_change"] = change
-                status[s]["last_step"] = [previous[s], v.name]
-                # the base's error is what the block carries: the total movement of the
-                # laws from the base to this (the finest analysable) level
-                status[s]["measured_step"] = ["base", v.name]
-                ratio = noise_ratio(results["base"], results[v.name])
-                if ratio >= NOISIER_FACTOR:
-                    # counted all the same (an over-estimate, not an erasure), but said
-                    status[s]["noisier"] = round(ratio, 2)
-                else:
-                    status[s].pop("noisier", None)
-                why = (
-                    thickness_step_refines(
-                        results[previous[s]], results[v.name], v.name, previous[s]
-                    )
-                    if s == "thicknesses"
-                    else None
-                )
-                if why is not None:
-                    status[s].update(state="not refined", reason=why)
-                elif change["max_pct"] < r.tolerance_pct:
-                    status[s]["state"] = "converged"
-                    status[s]["converged_at"] = previous[s]
-                elif level == r.max_steps:
-                    status[s]["state"] = "not converged"
-                previous[s] = v.name
+                _judge_step(status[s], s, v, results, previous[s], level, r)
+                if status[s]["state"] != "failed":  # a failed step is no setting's previous
+                    previous[s] = v.name
     finally:
         executor.close()
+    return _study_document(cfg, settings, skipped, ladder, status, results, estimate, executor)
+
+
+def _judge_step(st: dict, s: str, v, results: dict, previous: str, level: int, r) -> None:
+    """Update the status ``st`` of setting ``s`` with its step ``v`` (level ``level``) against
+    the ``previous`` variant: failed, converged, not refined (a thickness step that refines
+    nothing), not converged (the last step) or still open; the largest law change measured."""
+    if "error" in results[v.name] or "error" in results[previous]:
+        failed = results[v.name].get("error") or results[previous].get("error")
+        # an earlier analysable step (in last_step/last_change) stays this
+        # setting's measured change: a refused finer step does not erase it
+        st.update(state="failed", error=failed, failed_step=[previous, v.name])
+        return
+    change = largest_change(results[previous], results[v.name], r.tolerance_floor_mpa)
+    st["last_change"] = change
+    st["last_step"] = [previous, v.name]
+    # the base's error is what the block carries: the total movement of the
+    # laws from the base to this (the finest analysable) level
+    st["measured_step"] = ["base", v.name]
+    ratio = noise_ratio(results["base"], results[v.name])
+    if ratio >= NOISIER_FACTOR:
+        # counted all the same (an over-estimate, not an erasure), but said
+        st["noisier"] = round(ratio, 2)
+    else:
+        st.pop("noisier", None)
+    why = (
+        thickness_step_refines(results[previous], results[v.name], v.name, previous)
+        if s == "thicknesses"
+        else None
+    )
+    if why is not None:
+        st.update(state="not refined", reason=why)
+    elif change["max_pct"] < r.tolerance_pct:
+        st["state"] = "converged"
+        st["converged_at"] = previous
+    elif level == r.max_steps:
+        st["state"] = "not converged"
+
+
+def _study_document(
+    cfg: RunConfig,
+    settings: list[str],
+    skipped,
+    ladder: dict,
+    status: dict,
+    results: dict,
+    estimate: dict,
+    executor,
+) -> dict:
+    """The ``study.json`` document: every variant that ran, each setting's status, the largest
+    law change per energy form (``delta``, the convergence error the laws carry) and the cost."""
+    r = cfg.refine
     variants = [
         {
             "name": "base",

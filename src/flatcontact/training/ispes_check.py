@@ -172,6 +172,7 @@ def scan_and_analyze(
         ``force_calls``, ``seconds``, ``label``.
     """
     from flatcontact.analysis.analyze import analyze_ispes
+    from flatcontact.analysis.options import AnalysisOptions
     from flatcontact.analysis.outputs import friction_csv_text
     from flatcontact.ispes.grid import GridSpec
     from flatcontact.ispes.relax import RelaxSettings
@@ -180,6 +181,10 @@ def scan_and_analyze(
     require(
         (p_range_gpa is None) != (thickness_angstrom is None),
         "give exactly one of p_range_gpa and thickness_angstrom",
+    )
+    # checked before the scan: a bad form or direction costs nothing
+    options = AnalysisOptions(
+        direction_deg=direction_deg, form=form, load_source=load_source, allow_missing=True
     )
     factory = _factory_of(model)
     spec = GridSpec(
@@ -200,14 +205,7 @@ def scan_and_analyze(
         executor_options={"kind": "serial" if workers == 1 else "processes", "workers": workers},
     )
     seconds = time.perf_counter() - t0
-    analysis = analyze_ispes(
-        result.dataset,
-        list(p_gpa),
-        direction_deg=direction_deg,
-        form=form,
-        load_source=load_source,
-        allow_missing=True,
-    )
+    analysis = analyze_ispes(result.dataset, list(p_gpa), options)
     table = pd.read_csv(io.StringIO(friction_csv_text(analysis)))
     keep = [
         c for c in (*ISPES_QUANTITIES, "tau_limited_by", "n_jumps", "force_noise_mpa") if c in table

@@ -247,20 +247,7 @@ def sio2_recipe(
     add(frames, "quartz_pressure")
 
     say("polymorph")
-    frames = []
-    for name, rep in (
-        ("cristobalite", (1, 1, 1)),
-        ("coesite", (1, 1, 1)),
-        ("stishovite", (2, 2, 2)),
-    ):
-        p0 = build_polymorph(name).repeat(rep)
-        frames += _relax_frames(p0, calc, fmax=0.02, steps=200, every=25, pressure_gpa=0.0)
-        for _ in range(n(10)):
-            a = strain_cell(p0, rng.uniform(-0.03, 0.03, 6))
-            a.positions += rng.normal(0.0, 0.03, a.positions.shape)
-            frames.append(a)
-        for s in (0.97, 0.94):
-            frames.append(strain_cell(p0, np.array([s - 1, s - 1, s - 1, 0, 0, 0])))
+    frames = _polymorph_frames(calc, rng, n)
     add(frames, "polymorph")
 
     say("md")
@@ -292,6 +279,22 @@ def sio2_recipe(
     add(frames, "slab")
 
     say("dense_slab")
+    frames, relaxed = _dense_slab_frames(calc, seed, n)
+    add(frames, "dense_slab")
+
+    say("defect")
+    frames = _defect_frames(q0, rng, n)
+    add(frames, "defect")
+
+    say("close_contact")
+    frames = _close_contact_frames(q0, relaxed, rng, n)
+    add(frames, "close_contact")
+    return out
+
+
+def _dense_slab_frames(calc, seed: int, n: Callable[[int], int]) -> tuple[list[Atoms], list[Atoms]]:
+    """The dense (0001) slabs relaxed with the teacher, their MD and strained relaxations;
+    and the relaxed slabs (hosts of the close contacts)."""
     from flatcontact.training.lammps_bulk import vashishta_calculator
 
     frames = []
@@ -314,9 +317,11 @@ def sio2_recipe(
         frames += vashishta_md(
             d0.repeat((2, 2, 1)), 300.0, n_frames=n(3), stride=500, seed=seed + 401
         )
-    add(frames, "dense_slab")
+    return frames, relaxed
 
-    say("defect")
+
+def _defect_frames(q0: Atoms, rng, n: Callable[[int], int]) -> list[Atoms]:
+    """Vacancies, stretched or broken Si-O bonds and compressed cells of a 2x2x1 quartz."""
     frames = []
     big = q0.repeat((2, 2, 1))
     symbols = np.array(big.get_chemical_symbols())
@@ -345,9 +350,13 @@ def sio2_recipe(
         a = strain_cell(big, np.array([-0.06, -0.06, -0.06, 0, 0, 0]))
         a.positions += rng.normal(0.0, 0.04, a.positions.shape)
         frames.append(a)
-    add(frames, "defect")
+    return frames
 
-    say("close_contact")
+
+def _close_contact_frames(
+    q0: Atoms, relaxed: list[Atoms], rng, n: Callable[[int], int]
+) -> list[Atoms]:
+    """Pairs of atoms pushed closer than in any crystal, in quartz and a relaxed dense slab."""
     frames = []
     targets = {("O", "O"): (1.1, 2.2), ("Si", "O"): (1.2, 1.5), ("Si", "Si"): (1.8, 2.7)}
     hosts = [q0.repeat((2, 1, 1))] + [d.copy() for d in relaxed[:1]]
@@ -359,5 +368,23 @@ def sio2_recipe(
         if a is not None:
             frames.append(a)
             n_made += 1
-    add(frames, "close_contact")
-    return out
+    return frames
+
+
+def _polymorph_frames(calc, rng, n: Callable[[int], int]) -> list[Atoms]:
+    """Cristobalite, coesite and stishovite relaxed with the teacher, strained and compressed."""
+    frames = []
+    for name, rep in (
+        ("cristobalite", (1, 1, 1)),
+        ("coesite", (1, 1, 1)),
+        ("stishovite", (2, 2, 2)),
+    ):
+        p0 = build_polymorph(name).repeat(rep)
+        frames += _relax_frames(p0, calc, fmax=0.02, steps=200, every=25, pressure_gpa=0.0)
+        for _ in range(n(10)):
+            a = strain_cell(p0, rng.uniform(-0.03, 0.03, 6))
+            a.positions += rng.normal(0.0, 0.03, a.positions.shape)
+            frames.append(a)
+        for s in (0.97, 0.94):
+            frames.append(strain_cell(p0, np.array([s - 1, s - 1, s - 1, 0, 0, 0])))
+    return frames
