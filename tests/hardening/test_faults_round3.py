@@ -129,3 +129,68 @@ def test_sigterm_in_a_forked_child_of_a_command_still_kills_it():
         [sys.executable, "-c", code], capture_output=True, text=True, env=_env(), timeout=60
     )
     assert proc.stdout.strip() == "True", proc.stderr
+
+
+def _signal_once(argv, cwd, ready, sig, seconds=240.0):
+    """Start ``flatcontact argv`` and send ``sig`` the moment ``ready()`` holds; (status,
+    stderr, whether the signal was sent). SIGINT is restored to its default in the child, as
+    in a terminal (a background shell would have it ignored)."""
+    proc = subprocess.Popen(
+        _flatcontact(*argv),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_env(),
+        cwd=cwd,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+    sent = False
+    t0 = time.monotonic()
+    while proc.poll() is None and time.monotonic() - t0 < seconds:
+        if ready():
+            proc.send_signal(sig)
+            sent = True
+            break
+        time.sleep(0.001)
+    code = proc.wait(timeout=seconds)
+    return code, proc.stderr.read(), sent
+
+
+def _rows(db) -> int:
+    import sqlite3
+
+    try:
+        with sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=0.05) as con:
+            return con.execute("SELECT count(*) FROM systems").fetchone()[0]
+    except sqlite3.Error:
+        return 0
+
+
+@pytest.mark.parametrize("command", ["run", "scan"])
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
+def test_a_signal_in_the_scan_is_one_error_line(tmp_path, finished_toy, command, sig):
+    """SIGTERM (or Ctrl-C) once the scan has stored points: before, ``flatcontact run`` printed
+    its own "interrupted; ..." line and then the "error: terminated (SIGTERM)" line, and a
+    Ctrl-C outside the scan's points printed nothing (typer turns it into status 130 without
+    a word); now exactly one line, naming what was kept where the command knows it."""
+    conf, run = finished_toy
+    out = tmp_path / "out"
+    if command == "run":
+        argv, db = ["run", conf / "run.yaml", "--out", out], out / "02-scan" / "points.db"
+    else:
+        interface = run / "01-build" / "interface.extxyz"
+        argv = ["scan", conf / "run.yaml", "--interface", interface, "--out", out]
+        db = out / "points.db"
+    code, err, sent = _signal_once(argv, tmp_path, lambda: db.exists() and _rows(db) > 0, sig)
+    if not sent:
+        pytest.skip("the scan finished before a point was seen")
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert "Traceback" not in err
+    if sig == signal.SIGTERM:
+        assert code == 128 + signal.SIGTERM, err
+        assert lines[0].startswith("error: terminated (SIGTERM); temporary files removed"), err
+    else:
+        assert code == 130, err
+        assert "interrupted;" in lines[0], err
+    assert "rerun the same command" in lines[0]

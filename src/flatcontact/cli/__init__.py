@@ -160,6 +160,25 @@ class Terminated(KeyboardInterrupt):
     """SIGTERM in a flatcontact command: unwinds like Ctrl-C (every ``finally`` runs)."""
 
 
+#: The SIGTERMs of the running command and what it said it kept (:func:`say_interrupted`).
+_STOPPED: dict[str, list] = {"signals": [], "kept": []}
+
+
+def say_interrupted(kept: str) -> None:
+    """A command stopped by Ctrl-C or SIGTERM says what it kept, ``kept`` (one clause, e.g.
+    ``"finished work is kept in OUT"``): after Ctrl-C one line ``interrupted; <kept>; rerun the
+    same command to resume``; after SIGTERM nothing here, the clause goes into the command's one
+    ``error: terminated (SIGTERM)`` line (:func:`main`), so stderr holds one line either way."""
+    from flatcontact.cli.app import err_console
+
+    _STOPPED["kept"].append(kept)
+    if _STOPPED["signals"]:
+        return
+    err_console.print(
+        f"interrupted; {kept}; rerun the same command to resume", highlight=False, soft_wrap=True
+    )
+
+
 @contextlib.contextmanager
 def sigterm_unwinds():
     """While a command runs, SIGTERM raises :class:`Terminated` in the main thread; yields a
@@ -167,7 +186,9 @@ def sigterm_unwinds():
     as before (a pool's workers); nothing changes where SIGTERM already has a handler."""
     from flatcontact.interrupts import raise_on_sigterm
 
-    got: list[int] = []
+    got: list[int] = _STOPPED["signals"]
+    got.clear()
+    _STOPPED["kept"].clear()
 
     def terminated(signum: int) -> Terminated:
         got.append(signum)
@@ -201,17 +222,20 @@ def _run(argv: list[str] | None) -> int:
         try:
             code = _command(argv)
         except KeyboardInterrupt:
-            if not got:  # Ctrl-C in a command that does not say it itself
-                print_error(
-                    "interrupted; temporary files removed, finished work kept: rerun the same "
-                    "command to resume"
-                )
-                return 130
-            code = 0
-        if got:  # the command may have said "interrupted" already; this is the status
+            code = 130
+        # typer turns a KeyboardInterrupt it sees into exit status 130 without a word
+        if code == 130 and not got and not _STOPPED["kept"]:
+            # Ctrl-C in a command that does not say it itself
             print_error(
-                "terminated (SIGTERM); temporary files removed, finished work kept: rerun the "
-                "same command to resume"
+                "interrupted; temporary files removed, finished work kept: rerun the same "
+                "command to resume"
+            )
+            return 130
+        if got:  # the one line: what the command kept (say_interrupted) and the status
+            kept = "; ".join(_STOPPED["kept"]) or "finished work kept"
+            print_error(
+                f"terminated (SIGTERM); temporary files removed, {kept}: rerun the same "
+                "command to resume"
             )
             return 128 + signal.SIGTERM
         return code
