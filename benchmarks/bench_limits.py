@@ -82,7 +82,8 @@ LIMITS = {
 
 
 def attempt(workload: str, limit: str, value: int, folder: Path) -> tuple[bool, str]:
-    """Run ``workload`` under ``limit`` = ``value`` bytes in a fresh folder: (exit 0, last line)."""
+    """Run ``workload`` under ``limit`` = ``value`` bytes in a fresh folder: (exit 0, what it
+    said: the status, the count of stderr lines and the last one)."""
     text, args = WORKLOADS[workload]
     folder.mkdir(parents=True)
     argv = list(args)
@@ -104,8 +105,9 @@ def attempt(workload: str, limit: str, value: int, folder: Path) -> tuple[bool, 
         text=True,
         timeout=900,
     )
-    said = (proc.stderr.strip().splitlines() or [""])[-1][:160]
-    return proc.returncode == 0, f"exit {proc.returncode}: {said}"
+    lines = [x for x in proc.stderr.strip().splitlines() if x.strip()]
+    said = (lines or [""])[-1][:160]
+    return proc.returncode == 0, f"exit {proc.returncode}, {len(lines)} stderr line(s): {said}"
 
 
 def smallest(workload: str, limit: str, root: Path) -> dict:
@@ -163,6 +165,25 @@ def main(workloads: list[str] | None = None) -> None:
     print(table(record))
 
 
+#: Limits (MiB of address space) at which :func:`modes` records how a workload fails with
+#: the floor off: the round-3 corpus's 40 000 and 100 000 kB, and steps up to the floor.
+MODE_LIMITS_MIB = (39, 98, 195, 256, 384, 448, 511)
+
+
+def modes(workloads: list[str]) -> None:
+    """How each workload ends under ``ulimit -v`` below the floor, with the floor off: the
+    record's ``modes`` (limit in MiB -> what it said), printed as they come."""
+    record = json.loads(RECORD.read_text()) if RECORD.exists() else {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for workload in workloads:
+            seen = record.setdefault("modes", {}).setdefault(workload, {})
+            for mib in MODE_LIMITS_MIB:
+                _, said = attempt(workload, "ulimit -v", mib * MIB, Path(tmp) / f"{workload}-{mib}")
+                seen[str(mib)] = said
+                print(f"{workload:7s} ulimit -v {mib} MiB: {said}", flush=True)
+    RECORD.write_text(json.dumps(record, indent=1) + "\n")
+
+
 def _mib(value: int | None) -> str:
     return "— (passes at the lower end)" if value is None else f"{value / MIB:.3f} MiB"
 
@@ -192,5 +213,7 @@ if __name__ == "__main__":
     args = sys.argv[1:]
     if args == ["--table"]:
         print(table(json.loads(RECORD.read_text())))
+    elif args[:1] == ["--modes"]:
+        modes(args[1:] or list(WORKLOADS))
     else:
         main(args or None)

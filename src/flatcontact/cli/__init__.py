@@ -46,7 +46,7 @@ import typer
 
 from flatcontact import __version__
 from flatcontact.cli import memory_floor  # noqa: F401  (refuses a too low ulimit -v)
-from flatcontact.cli.app import app, check_out_flags, console, print_error
+from flatcontact.cli.app import STOPPED, app, check_out_flags, console, print_error
 from flatcontact.errors import InputError
 
 try:  # registers the sub-commands; their modules load numpy and the settings
@@ -160,25 +160,6 @@ class Terminated(KeyboardInterrupt):
     """SIGTERM in a flatcontact command: unwinds like Ctrl-C (every ``finally`` runs)."""
 
 
-#: The SIGTERMs of the running command and what it said it kept (:func:`say_interrupted`).
-_STOPPED: dict[str, list] = {"signals": [], "kept": []}
-
-
-def say_interrupted(kept: str) -> None:
-    """A command stopped by Ctrl-C or SIGTERM says what it kept, ``kept`` (one clause, e.g.
-    ``"finished work is kept in OUT"``): after Ctrl-C one line ``interrupted; <kept>; rerun the
-    same command to resume``; after SIGTERM nothing here, the clause goes into the command's one
-    ``error: terminated (SIGTERM)`` line (:func:`main`), so stderr holds one line either way."""
-    from flatcontact.cli.app import err_console
-
-    _STOPPED["kept"].append(kept)
-    if _STOPPED["signals"]:
-        return
-    err_console.print(
-        f"interrupted; {kept}; rerun the same command to resume", highlight=False, soft_wrap=True
-    )
-
-
 @contextlib.contextmanager
 def sigterm_unwinds():
     """While a command runs, SIGTERM raises :class:`Terminated` in the main thread; yields a
@@ -186,9 +167,9 @@ def sigterm_unwinds():
     as before (a pool's workers); nothing changes where SIGTERM already has a handler."""
     from flatcontact.interrupts import raise_on_sigterm
 
-    got: list[int] = _STOPPED["signals"]
+    got: list[int] = STOPPED["signals"]
     got.clear()
-    _STOPPED["kept"].clear()
+    STOPPED["kept"].clear()
 
     def terminated(signum: int) -> Terminated:
         got.append(signum)
@@ -224,7 +205,7 @@ def _run(argv: list[str] | None) -> int:
         except KeyboardInterrupt:
             code = 130
         # typer turns a KeyboardInterrupt it sees into exit status 130 without a word
-        if code == 130 and not got and not _STOPPED["kept"]:
+        if code == 130 and not got and not STOPPED["kept"]:
             # Ctrl-C in a command that does not say it itself
             print_error(
                 "interrupted; temporary files removed, finished work kept: rerun the same "
@@ -232,7 +213,7 @@ def _run(argv: list[str] | None) -> int:
             )
             return 130
         if got:  # the one line: what the command kept (say_interrupted) and the status
-            kept = "; ".join(_STOPPED["kept"]) or "finished work kept"
+            kept = "; ".join(STOPPED["kept"]) or "finished work kept"
             print_error(
                 f"terminated (SIGTERM); temporary files removed, {kept}: rerun the same "
                 "command to resume"

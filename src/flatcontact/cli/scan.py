@@ -16,7 +16,7 @@ from typing import Annotated, Any
 
 import typer
 
-from flatcontact.cli.app import app, check_out_dir, console, parse_floats
+from flatcontact.cli.app import app, check_out_dir, console, parse_floats, say_interrupted
 from flatcontact.errors import InputError
 from flatcontact.layout import INTERFACE
 
@@ -243,8 +243,6 @@ def scan_command(
             result = run_scan(cfg, ScanInputs(where), out_dir, progress=None if as_json else bar)
     except ScanInterrupted as stop:
         r = stop.result
-        from flatcontact.cli import say_interrupted
-
         say_interrupted(
             f"{r.points_done} of {r.points_total} points done ({r.points_stored} relaxed) "
             f"and kept in {r.store_path}"
