@@ -236,3 +236,40 @@ def test_a_file_size_limit_under_the_point_stores_log_is_one_line_and_the_rerun_
     ):
         for name in ("energy", "normal_stress"):
             assert np.array_equal(resumed[name].values, whole[name].values), name
+
+
+def test_the_floors_are_what_their_measurement_says():
+    """The floors against ``benchmarks/limits_measured.json`` (``python -m benchmarks limits``):
+    the address-space floor lies above the libraries' need and above every limit at which a
+    command ended in more than one line (MPI_Init's abort, numpy's and OpenBLAS's), and below
+    what a run needs; the file-size floor above MPI_Init's measured pool; and
+    docs/measured/resource-floors.md shows the record's tables."""
+    import json
+    from pathlib import Path
+
+    from benchmarks.bench_limits import RECORD, table
+
+    from flatcontact.cli.memory_floor import MIN_ADDRESS_SPACE_BYTES
+    from flatcontact.potentials.lammps_runtime import MPI_MIN_FILE_BYTES
+
+    record = json.loads(RECORD.read_text())
+    mib = 1024 * 1024
+    assert record["floors_bytes"] == {
+        "ulimit -v": MIN_ADDRESS_SPACE_BYTES,
+        "ulimit -f": MPI_MIN_FILE_BYTES,
+    }
+    assert record["libraries"]["ulimit -v"]["passes_at_bytes"] < MIN_ADDRESS_SPACE_BYTES
+    many_lines = [
+        int(limit)
+        for seen in record["modes"].values()
+        for limit, said in seen.items()
+        if not said.startswith(("exit 0", "exit 2, 1 stderr line"))
+    ]
+    assert many_lines and max(many_lines) * mib < MIN_ADDRESS_SPACE_BYTES
+    for run in ("toy", "lammps"):
+        assert record[run]["ulimit -v"]["passes_at_bytes"] > MIN_ADDRESS_SPACE_BYTES
+    pool = record["libraries"]["ulimit -f"]["passes_at_bytes"]
+    assert pool == record["lammps"]["ulimit -f"]["passes_at_bytes"] < MPI_MIN_FILE_BYTES
+    doc = (Path(__file__).parents[2] / "docs" / "measured" / "resource-floors.md").read_text()
+    for part in table(record).split("\n\n"):
+        assert part in doc
