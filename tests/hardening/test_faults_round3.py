@@ -129,3 +129,147 @@ def test_sigterm_in_a_forked_child_of_a_command_still_kills_it():
         [sys.executable, "-c", code], capture_output=True, text=True, env=_env(), timeout=60
     )
     assert proc.stdout.strip() == "True", proc.stderr
+
+
+def _signal_once(argv, cwd, ready, sig, seconds=240.0):
+    """Start ``flatcontact argv`` and send ``sig`` the moment ``ready()`` holds; (status,
+    stderr, whether the signal was sent). SIGINT is restored to its default in the child, as
+    in a terminal (a background shell would have it ignored)."""
+    proc = subprocess.Popen(
+        _flatcontact(*argv),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_env(),
+        cwd=cwd,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+    sent = False
+    t0 = time.monotonic()
+    while proc.poll() is None and time.monotonic() - t0 < seconds:
+        if ready():
+            proc.send_signal(sig)
+            sent = True
+            break
+        time.sleep(0.001)
+    code = proc.wait(timeout=seconds)
+    return code, proc.stderr.read(), sent
+
+
+def _rows(db) -> int:
+    import sqlite3
+
+    try:
+        with sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=0.05) as con:
+            return con.execute("SELECT count(*) FROM systems").fetchone()[0]
+    except sqlite3.Error:
+        return 0
+
+
+@pytest.mark.parametrize("command", ["run", "scan"])
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
+def test_a_signal_in_the_scan_is_one_error_line(tmp_path, finished_toy, command, sig):
+    """SIGTERM (or Ctrl-C) once the scan has stored points: before, ``flatcontact run`` printed
+    its own "interrupted; ..." line and then the "error: terminated (SIGTERM)" line, and a
+    Ctrl-C outside the scan's points printed nothing (typer turns it into status 130 without
+    a word); now exactly one line, naming what was kept where the command knows it."""
+    conf, run = finished_toy
+    out = tmp_path / "out"
+    if command == "run":
+        argv, db = ["run", conf / "run.yaml", "--out", out], out / "02-scan" / "points.db"
+    else:
+        interface = run / "01-build" / "interface.extxyz"
+        argv = ["scan", conf / "run.yaml", "--interface", interface, "--out", out]
+        db = out / "points.db"
+    code, err, sent = _signal_once(argv, tmp_path, lambda: db.exists() and _rows(db) > 0, sig)
+    if not sent:
+        pytest.skip("the scan finished before a point was seen")
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert "Traceback" not in err
+    if sig == signal.SIGTERM:
+        assert code == 128 + signal.SIGTERM, err
+        assert lines[0].startswith("error: terminated (SIGTERM); temporary files removed"), err
+    else:
+        assert code == 130, err
+        assert "interrupted;" in lines[0], err
+    assert "rerun the same command" in lines[0]
+
+
+def test_a_file_size_limit_under_the_point_stores_log_is_one_line_and_the_rerun_resumes(
+    tmp_path, finished_toy
+):
+    """3 MB: the toy run's point store grows its write-ahead log to 4 MB before a checkpoint;
+    SQLite reported the write past the limit as "disk I/O error", a traceback (exit 1,
+    measured by ``python -m benchmarks limits``: the toy run passes at 3.94 MiB, fails at
+    3.88). Now one line naming ulimit -f and the limit, and the rerun without it resumes to
+    the finished run's grid."""
+    import numpy as np
+    import xarray as xr
+
+    conf, finished = finished_toy
+    out = tmp_path / "run"
+    limit = 3_000 * 1024
+    proc = subprocess.run(
+        _flatcontact("run", conf / "run.yaml", "--out", out),
+        capture_output=True,
+        text=True,
+        env=_env(),
+        cwd=tmp_path,
+        preexec_fn=_limited(resource.RLIMIT_FSIZE, limit),
+        timeout=600,
+    )
+    refused(proc.returncode, proc.stderr, "ulimit -f", f"{limit} bytes")
+    assert (out / "02-scan" / "points.db").is_file()
+    again = subprocess.run(
+        _flatcontact("run", conf / "run.yaml", "--out", out),
+        capture_output=True,
+        text=True,
+        env=_env(),
+        cwd=tmp_path,
+        timeout=600,
+    )
+    assert again.returncode == 0, again.stderr
+    with (
+        xr.open_dataset(out / "02-scan" / "ispes.nc", engine="h5netcdf") as resumed,
+        xr.open_dataset(finished / "02-scan" / "ispes.nc", engine="h5netcdf") as whole,
+    ):
+        for name in ("energy", "normal_stress"):
+            assert np.array_equal(resumed[name].values, whole[name].values), name
+
+
+def test_the_floors_are_what_their_measurement_says():
+    """The floors against ``benchmarks/limits_measured.json`` (``python -m benchmarks limits``):
+    the address-space floor lies above the libraries' need and above every limit at which a
+    command ended in more than one line (MPI_Init's abort, numpy's and OpenBLAS's), and below
+    what a run needs; the file-size floor above MPI_Init's measured pool; and
+    docs/measured/resource-floors.md shows the record's tables."""
+    import json
+    from pathlib import Path
+
+    from benchmarks.bench_limits import RECORD, table
+
+    from flatcontact.cli.memory_floor import MIN_ADDRESS_SPACE_BYTES
+    from flatcontact.potentials.lammps_runtime import MPI_MIN_FILE_BYTES
+
+    record = json.loads(RECORD.read_text())
+    mib = 1024 * 1024
+    assert record["floors_bytes"] == {
+        "ulimit -v": MIN_ADDRESS_SPACE_BYTES,
+        "ulimit -f": MPI_MIN_FILE_BYTES,
+    }
+    assert record["libraries"]["ulimit -v"]["passes_at_bytes"] < MIN_ADDRESS_SPACE_BYTES
+    many_lines = [
+        int(limit)
+        for seen in record["modes"].values()
+        for limit, said in seen.items()
+        if not said.startswith(("exit 0", "exit 2, 1 stderr line"))
+    ]
+    assert many_lines and max(many_lines) * mib < MIN_ADDRESS_SPACE_BYTES
+    for run in ("toy", "lammps"):
+        assert record[run]["ulimit -v"]["passes_at_bytes"] > MIN_ADDRESS_SPACE_BYTES
+    pool = record["libraries"]["ulimit -f"]["passes_at_bytes"]
+    assert pool == record["lammps"]["ulimit -f"]["passes_at_bytes"] < MPI_MIN_FILE_BYTES
+    doc = (Path(__file__).parents[2] / "docs" / "measured" / "resource-floors.md").read_text()
+    for part in table(record).split("\n\n"):
+        assert part in doc

@@ -46,7 +46,7 @@ import typer
 
 from flatcontact import __version__
 from flatcontact.cli import memory_floor  # noqa: F401  (refuses a too low ulimit -v)
-from flatcontact.cli.app import app, check_out_flags, console, print_error
+from flatcontact.cli.app import STOPPED, app, check_out_flags, console, print_error
 from flatcontact.errors import InputError
 
 try:  # registers the sub-commands; their modules load numpy and the settings
@@ -120,11 +120,19 @@ def disk_full_line(exc: OSError) -> str:
     )
 
 
+def _file_size_limited() -> bool:
+    """Whether this process runs under a file-size limit (``ulimit -f``)."""
+    return resource.getrlimit(resource.RLIMIT_FSIZE)[0] != resource.RLIM_INFINITY
+
+
 def file_size_line(exc: OSError) -> str:
     """One line for a write stopped by the process's file-size limit (``ulimit -f``)."""
     where = f" writing {exc.filename}" if exc.filename else ""
+    soft = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
+    limit = f" (ulimit -f: {soft} bytes)" if soft != resource.RLIM_INFINITY else ""
     return (
-        f"file size limit of this process reached{where} ({exc.strerror or 'File too large'}); "
+        f"file size limit of this process{limit} reached{where} "
+        f"({exc.strerror or 'File too large'}); "
         "raise it (ulimit -f) and rerun the same command: finished stages and scan points are kept"
     )
 
@@ -167,7 +175,9 @@ def sigterm_unwinds():
     as before (a pool's workers); nothing changes where SIGTERM already has a handler."""
     from flatcontact.interrupts import raise_on_sigterm
 
-    got: list[int] = []
+    got: list[int] = STOPPED["signals"]
+    got.clear()
+    STOPPED["kept"].clear()
 
     def terminated(signum: int) -> Terminated:
         got.append(signum)
@@ -201,17 +211,20 @@ def _run(argv: list[str] | None) -> int:
         try:
             code = _command(argv)
         except KeyboardInterrupt:
-            if not got:  # Ctrl-C in a command that does not say it itself
-                print_error(
-                    "interrupted; temporary files removed, finished work kept: rerun the same "
-                    "command to resume"
-                )
-                return 130
-            code = 0
-        if got:  # the command may have said "interrupted" already; this is the status
+            code = 130
+        # typer turns a KeyboardInterrupt it sees into exit status 130 without a word
+        if code == 130 and not got and not STOPPED["kept"]:
+            # Ctrl-C in a command that does not say it itself
             print_error(
-                "terminated (SIGTERM); temporary files removed, finished work kept: rerun the "
-                "same command to resume"
+                "interrupted; temporary files removed, finished work kept: rerun the same "
+                "command to resume"
+            )
+            return 130
+        if got:  # the one line: what the command kept (say_interrupted) and the status
+            kept = "; ".join(STOPPED["kept"]) or "finished work kept"
+            print_error(
+                f"terminated (SIGTERM); temporary files removed, {kept}: rerun the same "
+                "command to resume"
             )
             return 128 + signal.SIGTERM
         return code
@@ -247,10 +260,15 @@ def _command(argv: list[str] | None) -> int:
         print_error(memory_line(MemoryError(f"loading {name}: {_first_line(exc)}")))
         return 2
     except sqlite3.OperationalError as exc:  # the scan's point store on a full disk
-        if "full" not in str(exc):
-            raise
-        print_error(disk_full_line(OSError(errno.ENOSPC, str(exc))))
-        return 2
+        if "full" in str(exc):
+            print_error(disk_full_line(OSError(errno.ENOSPC, str(exc))))
+            return 2
+        if "disk I/O error" in str(exc) and _file_size_limited():
+            # SQLite reports a write past ulimit -f (its write-ahead log grows to 4 MB before
+            # a checkpoint) as an I/O error, not as EFBIG
+            print_error(file_size_line(OSError(errno.EFBIG, f"SQLite: {exc}")))
+            return 2
+        raise
     except typer.TyperException as exc:  # typer's (vendored click's) usage errors
         code = getattr(exc, "exit_code", 2)
         if type(exc).__name__ != "NoArgsIsHelpError":  # that one has printed the help already

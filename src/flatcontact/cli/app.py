@@ -221,3 +221,21 @@ def setting_bounds(model, field: str):
     if found is None:
         raise TypeError(f"{model.__name__}.{field} is not a bounded float")
     return found
+
+
+#: The SIGTERMs of the running command and what it said it kept (:func:`say_interrupted`).
+STOPPED: dict[str, list] = {"signals": [], "kept": []}
+
+
+def say_interrupted(kept: str) -> None:
+    """A command stopped by Ctrl-C or SIGTERM says what it kept, ``kept`` (one clause, e.g.
+    ``"finished work is kept in OUT"``): after Ctrl-C one line ``interrupted; <kept>; rerun the
+    same command to resume``; after SIGTERM nothing here, the clause goes into the command's
+    one ``error: terminated (SIGTERM)`` line (:func:`flatcontact.cli.main`), so stderr holds one
+    line either way."""
+    STOPPED["kept"].append(kept)
+    if STOPPED["signals"]:
+        return
+    err_console.print(
+        f"interrupted; {kept}; rerun the same command to resume", highlight=False, soft_wrap=True
+    )

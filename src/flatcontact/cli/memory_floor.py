@@ -9,9 +9,15 @@ its own line); here the command stops with one ``error:`` line naming the limit,
 import resource as _resource
 import sys as _sys
 
-#: Smallest memory limit (ulimit -v, bytes of address space) a command starts under: loading
-#: numpy, SciPy, pandas, matplotlib, xarray, ASE and LAMMPS maps about 370 MB; below it a
-#: library fails to load (an ImportError stack) or OpenBLAS gives up at start (exit 1).
+#: Smallest memory limit (ulimit -v, bytes of address space) a command starts under. Measured
+#: with this floor off (``python -m benchmarks limits``, tables in
+#: docs/measured/resource-floors.md; 2-core Linux, the pinned wheels): below about 195 MiB a
+#: command dies in numpy's import (a MemoryError stack, 39 MiB) or in OpenBLAS's own line (exit
+#: 1, 98 MiB); the libraries of a LAMMPS run (numpy, SciPy, pandas, xarray, matplotlib, ASE,
+#: LAMMPS) with MPI started need 432 MiB, and just below, MPI_Init aborts the process with a
+#: 6-line stack (exit 143: at 424 MiB alone, at 448 MiB in a Cu(111) EAM run). 512 MiB is the
+#: power of two above that window; from there up to what a run needs (a toy run 656 MiB, a
+#: 3x3 Cu(111) EAM run 816 MiB) a run ends in the one "out of memory" line of the command line.
 MIN_ADDRESS_SPACE_BYTES = 512 * 1024 * 1024
 _limit = _resource.getrlimit(_resource.RLIMIT_AS)[0]
 if _limit != _resource.RLIM_INFINITY and _limit < MIN_ADDRESS_SPACE_BYTES:

@@ -13,7 +13,7 @@ from typing import Annotated
 
 import typer
 
-from flatcontact.cli.app import app, check_out_dir, console, err_console
+from flatcontact.cli.app import app, check_out_dir, console, say_interrupted
 from flatcontact.cli.progress import ScanBar, StageLines
 from flatcontact.layout import RUN_MARKER
 
@@ -54,10 +54,7 @@ def run_command(
         try:
             report = pipe.run()
         except KeyboardInterrupt:
-            err_console.print(
-                f"interrupted; finished work is kept in {out}. Rerun the same command to resume.",
-                highlight=False,
-            )
+            say_interrupted(f"finished work is kept in {out}")
             raise typer.Exit(130) from None
         _print_contact_range(pipe)
     console.print(f"report: {report.resolve()}", highlight=False)

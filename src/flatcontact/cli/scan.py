@@ -16,7 +16,7 @@ from typing import Annotated, Any
 
 import typer
 
-from flatcontact.cli.app import app, check_out_dir, console, err_console, parse_floats
+from flatcontact.cli.app import app, check_out_dir, console, parse_floats, say_interrupted
 from flatcontact.errors import InputError
 from flatcontact.layout import INTERFACE
 
@@ -243,11 +243,9 @@ def scan_command(
             result = scan_stage(cfg, ScanInputs(where), out_dir, progress=None if as_json else bar)
     except ScanInterrupted as stop:
         r = stop.result
-        err_console.print(
-            f"interrupted: {r.points_done} of {r.points_total} points done "
-            f"({r.points_stored} relaxed) in {r.store_path}; "
-            "rerun the same command to continue",
-            highlight=False,
+        say_interrupted(
+            f"{r.points_done} of {r.points_total} points done ({r.points_stored} relaxed) "
+            f"and kept in {r.store_path}"
         )
         raise typer.Exit(130) from None
     finally:

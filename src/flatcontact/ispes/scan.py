@@ -72,7 +72,8 @@ class ScanResult:
     #: the shift-space group, the verification and whether the grid was computed in full
     #: (:mod:`flatcontact.ispes.reduction`); None when the scan computed every point
     symmetry: dict | None = None
-    #: relaxed points in the store (``points_done`` also counts the points filled by symmetry)
+    #: relaxed points in ``ispes.nc`` (``points_done`` also counts the points filled by
+    #: symmetry; a stored row at a mapped point is not counted, ``symmetry["rows_not_used"]``)
     points_stored: int = 0
     #: folds of the probed and of the grid's columns and the loads they refuse
     #: (:meth:`flatcontact.ispes.thicknesses.LoadFold.record`; ``scan.json`` ``load_folds``)
@@ -330,6 +331,9 @@ def _rounds(
 
 def _assemble(store: PointStore, scanned: _Scanned, out_dir: Path, t0: float) -> ScanResult:
     """``ispes.nc`` from the store (mapped points filled) and the scan's result."""
+    left_out = None if scanned.plan is None else scanned.plan.rows_left_out(store)
+    if left_out is not None and left_out not in scanned.notes:
+        scanned.notes.append(left_out)
     ds = store.assemble(scanned.mapping, scanned.symmetry_record)
     path = contract.write_ispes(ds, out_dir / ISPES_NC)
     return ScanResult(
@@ -345,7 +349,7 @@ def _assemble(store: PointStore, scanned: _Scanned, out_dir: Path, t0: float) ->
         notes=scanned.notes,
         interrupted=scanned.interrupted,
         symmetry=scanned.symmetry_record,
-        points_stored=len(store),
+        points_stored=int(ds.attrs["computed_points"]),
         load_folds=list(store.resolved.get("load_folds", [])),
     )
 

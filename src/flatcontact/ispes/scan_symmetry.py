@@ -5,6 +5,14 @@ per orbit, then a few verified mapped points, checks them against their represen
 if the relaxation breaks the symmetry, computes every point of the grid after all. The plan's
 ``mapping`` and ``record`` exist from the start and follow each step, so a round stopped
 partway (Ctrl-C) still assembles the mapped points of its stored representatives.
+
+A fallback is final: the reason and the verification that refuted the symmetry go into the
+store's ``resolved`` metadata (:data:`FALLBACK_KEY`), and every later round of the grid (a
+thickness added to bracket the loads) and every resumed scan computes every point too, so
+that no round maps points that an earlier one found to break the group, and a resumed scan
+follows the rounds of an uninterrupted one. A stored row at a point the last plan maps is
+not used (:meth:`flatcontact.ispes.store.PointStore.rows_outside_plan`); the plan's record
+names such rows (``rows_not_used``) and :meth:`SymmetryPlan.rows_left_out` says why.
 """
 
 from __future__ import annotations
@@ -29,6 +37,13 @@ from flatcontact.ispes.reduction import (
 from flatcontact.ispes.relax import RelaxSettings
 from flatcontact.ispes.scan_scheduler import Scheduler
 from flatcontact.ispes.shift_symmetry import shift_space_group
+from flatcontact.ispes.store import PointStore
+
+#: The key of the store's ``resolved`` metadata that records a fallback to the full grid:
+#: ``{"reason": ..., "verification": ...}`` (module docstring).
+FALLBACK_KEY = "symmetry_fallback"
+#: meV per eV.
+_MEV = 1e3
 
 
 class ScanRound:
@@ -101,6 +116,13 @@ class SymmetryPlan:
         if not self.reduced:
             scheduler.run(round_.full_tree, round_.z)
             return
+        fallback = (store.resolved or {}).get(FALLBACK_KEY)
+        if isinstance(fallback, dict) and isinstance(fallback.get("reason"), str):
+            # an earlier round (or the interrupted run) found the symmetry broken
+            self._compute_in_full(
+                scheduler, notes, fallback["reason"], fallback.get("verification")
+            )
+            return
         # progress over the grid: a representative fills its orbit, a verified point counts
         # one more
         fills = collections.Counter(self.reduction.representative.values())
@@ -139,8 +161,53 @@ class SymmetryPlan:
         self.record["verification"] = check
         if symmetry_broken(check, self.settings):
             reason = fallback_reason(check, self.settings, self.reduction.group.order)
-            self.record["computed_in_full"] = True
-            self.record["computed_in_full_reason"] = reason
-            notes.append(reason)
-            self.mapping = None
-            scheduler.run(self.round.full_tree, self.round.z)
+            store = scheduler.store
+            store.set_resolved(
+                {**store.resolved, FALLBACK_KEY: {"reason": reason, "verification": check}}
+            )
+            self._compute_in_full(scheduler, notes, reason, check)
+
+    def _compute_in_full(
+        self, scheduler: Scheduler, notes: list[str], reason: str, check: dict | None
+    ) -> None:
+        """Relax every point of the round (the symmetry found broken, ``reason``)."""
+        self.record["verification"] = check
+        self.record["computed_in_full"] = True
+        self.record["computed_in_full_reason"] = reason
+        notes.append(reason)
+        self.mapping = None
+        scheduler.run(self.round.full_tree, self.round.z)
+
+    def rows_left_out(self, store: PointStore) -> str | None:
+        """Why the assembly leaves stored rows out (None: it uses every row).
+
+        The rows at points this plan maps (:meth:`PointStore.rows_outside_plan`) are
+        listed in the record's ``rows_not_used`` (``points``, ``reason``); the reason
+        names the file, the row farthest from its representative and the energy between
+        them (meV/Å²)."""
+        rows = store.rows_outside_plan(self.mapping, self.record)
+        if not rows:
+            if self.record is not None:
+                self.record.pop("rows_not_used", None)
+            return None
+        done = store.done()
+        area = cell_area(*in_plane_vectors(self.reference))
+
+        def apart(idx):  # |E(row) - E(representative)| per area, meV/Å² (-1: no representative)
+            rep = self.mapping[idx]
+            if rep not in done:
+                return -1.0
+            return abs(done[idx]["energy_ev"] - done[rep]["energy_ev"]) / area * _MEV
+
+        worst = max(rows, key=apart)
+        gap = apart(worst)
+        said = f", {gap:.3g} meV/Å² from it" if gap >= 0 else ", not stored yet"
+        reason = (
+            f"{store.path}: {len(rows)} stored row(s) at points this symmetry-reduced scan maps "
+            f"are not used (the farthest, {worst}, has the representative "
+            f"{self.mapping[worst]}{said}): a mapped point takes its representative's values "
+            "(ispes.nc declares the group); such rows come from another scan, an edit of the "
+            "store, or an earlier round of this grid"
+        )
+        self.record["rows_not_used"] = {"points": [list(r) for r in rows], "reason": reason}
+        return reason

@@ -425,11 +425,16 @@ class PointStore:
         """The ``ispes.nc`` dataset of this store (missing points NaN, ``converged=False``).
 
         ``mapping`` (a symmetry-reduced scan, :mod:`flatcontact.ispes.reduction`): grid index
-        -> the index of its representative; a point not stored takes its representative's
-        energy, normal stress and convergence, with ``mapped = True`` and ``force_calls = 0``.
-        ``symmetry``: the scan's group record; its operations are stored as attributes
-        (``symmetry_order``, ``symmetry_matrices``, ``symmetry_translations``, see
-        :mod:`flatcontact.ispes.contract`) when the points were mapped, else the identity.
+        -> the index of its representative; every point the reduced plan does not relax
+        takes its representative's energy, normal stress and convergence, with
+        ``mapped = True`` and ``force_calls = 0``. A stored row at such a point (one that is
+        neither a representative nor one of ``symmetry["verify_points"]``,
+        :meth:`rows_outside_plan`) is not used: the file declares the group, so a mapped
+        point's value is its representative's, whatever the store holds there (the scan
+        driver notes the rows left out). ``symmetry``: the scan's group record; its
+        operations are stored as attributes (``symmetry_order``, ``symmetry_matrices``,
+        ``symmetry_translations``, see :mod:`flatcontact.ispes.contract`) when the points
+        were mapped, else the identity. ``computed_points`` counts the rows used.
         """
         resolved = self.resolved
         if resolved is None:
@@ -442,8 +447,10 @@ class PointStore:
             "interface_sha256": self.settings["interface_sha256"],
             "points_total": int(grid["n_a"] * grid["n_b"] * z.size),
             "grid_points": int(grid["n_a"] * grid["n_b"] * z.size),
-            "computed_points": len(self._done),
         }
+        outside = set(self.rows_outside_plan(mapping, symmetry))
+        used = {idx: rec for idx, rec in self._done.items() if idx not in outside}
+        extra["computed_points"] = len(used)
         ops = (symmetry or {}).get("operations") if mapping is not None else None
         if not ops:
             ops = [{"matrix": [[1, 0], [0, 1]], "translation": [0.0, 0.0]}]
@@ -470,7 +477,7 @@ class PointStore:
         stress = ds[contract.VAR_STRESS].values
         converged = ds[contract.VAR_CONVERGED].values
         calls = ds[contract.VAR_FORCE_CALLS].values
-        for (ia, ib, iz), rec in self._done.items():
+        for (ia, ib, iz), rec in used.items():
             k = int(rank[iz])
             energy[ia, ib, k] = rec["energy_ev"]
             stress[ia, ib, k] = rec["normal_stress_gpa"]
@@ -478,7 +485,7 @@ class PointStore:
             calls[ia, ib, k] = rec["force_calls"]
         mapped = np.zeros(energy.shape, dtype=bool)
         for (ia, ib, iz), rep in (mapping or {}).items():
-            if (ia, ib, iz) in self._done or tuple(rep) not in self._done:
+            if (ia, ib, iz) in used or tuple(rep) not in used:
                 continue
             rec, k = self._done[tuple(rep)], int(rank[iz])
             energy[ia, ib, k] = rec["energy_ev"]
@@ -486,8 +493,24 @@ class PointStore:
             converged[ia, ib, k] = rec["converged"]
             mapped[ia, ib, k] = True
         ds[contract.VAR_MAPPED] = (contract.DIMS, mapped)
-        ds.attrs["points_done"] = len(self._done) + int(mapped.sum())
+        ds.attrs["points_done"] = len(used) + int(mapped.sum())
         return ds
+
+    def rows_outside_plan(self, mapping: dict | None, symmetry: dict | None) -> list[Index]:
+        """Stored points a symmetry-reduced plan did not relax (sorted; empty without one).
+
+        ``mapping`` and ``symmetry`` as in :meth:`assemble`: the plan relaxes the
+        representatives (the values of ``mapping``) and the verified points
+        (``symmetry["verify_points"]``); a row at any other point is a mapped point's, whose
+        value is its representative's. Such a row comes from another scan, a hand edit, or
+        an earlier round of this one that computed points the last round's plan maps (a
+        fallback to the full grid recorded before this rule, a verified point the last
+        round no longer verifies)."""
+        if mapping is None:
+            return []
+        planned = {tuple(rep) for rep in mapping.values()}
+        planned |= {tuple(int(i) for i in v) for v in (symmetry or {}).get("verify_points", ())}
+        return sorted(idx for idx in self._done if idx in mapping and idx not in planned)
 
     def write_ispes(self, path: str | os.PathLike[str]) -> Path:
         """Assemble and write ``ispes.nc`` atomically."""

