@@ -14,7 +14,7 @@ import json
 import math
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -50,6 +50,9 @@ class ExperimentSpec:
     bin_width_angstrom: float
     contact_force_ev_per_angstrom: float
     slip_threshold_angstrom: float
+    #: lock-in cycles after the slide (:mod:`.ramp`); their states live apart (``ramp/``), so
+    #: adding or extending a ramp reuses a finished slide
+    ramp_amplitudes_angstrom: tuple[float, ...] = ()
 
 
 @dataclass
@@ -65,6 +68,7 @@ class Experiment:
     states: list[list]
     wall_seconds: float
     memory_bytes: int
+    ramps: list[dict] = field(default_factory=list)
 
 
 def target_force_ev_per_angstrom(spec: ExperimentSpec, p0_gpa: float, axis_angstrom: float):
@@ -141,7 +145,8 @@ def _check_state(state_dir: Path, spec: ExperimentSpec) -> None:
     doc = json.loads(json.dumps(asdict(spec)))
     if path.exists():
         old = json.loads(path.read_text())
-        if {**old, "steps": None} != {**doc, "steps": None}:
+        free = {"steps": None, "ramp_amplitudes_angstrom": None}
+        if {**old, **free} != {**doc, **free}:
             raise InputError(
                 f"{state_dir}: holds the states of other asperity settings; give another --out "
                 "or remove it"
@@ -175,12 +180,21 @@ def run_experiment(
     *,
     neighbours_per_atom: int = 100,
     progress: Callable[[str], None] | None = None,
+    executor=None,
 ) -> Experiment:
-    """Build, run every load (resuming from ``state_dir``), measure and compare."""
+    """Build, run every load (resuming from ``state_dir``), measure and compare.
+
+    ``executor`` (:class:`flatcontact.ispes.executors.Executor`, not inline): the loads run
+    as independent jobs on it first (:func:`run_cases`); the loop then reads their states.
+    """
     t0 = time.perf_counter()
     atoms, sizes, need = plan(spec, recipe, neighbours_per_atom)
     model.check_atoms(atoms)
     _check_state(state_dir, spec)
+    if executor is not None and not executor.inline and len(spec.p0_gpa) > 1:
+        parallel = min(executor.workers, len(spec.p0_gpa))
+        builder.check_machine(len(atoms) * parallel, neighbours_per_atom)
+        run_cases(spec, recipe, model, state_dir, executor, progress)
     cell = atoms.cell.array
     axis = float(np.linalg.norm(cell[0])) if spec.geometry == "cylinder" else 0.0
     edges = bin_edges(spec, cell, sizes.repeats)
@@ -191,13 +205,10 @@ def run_experiment(
         spec.geometry,
         axis,
     )
-    records, comparisons, targets, all_states = [], [], [], []
+    records, comparisons, targets, all_states, ramps = [], [], [], [], []
     for i, p0 in enumerate(spec.p0_gpa):
-        target = target_force_ev_per_angstrom(spec, p0, axis)
-        targets.append(target)
-        protocol = Protocol(
-            target, spec.step_angstrom, spec.steps, spec.fmax_ev_per_angstrom, spec.max_iterations
-        )
+        protocol = case_protocol(spec, i, axis)
+        targets.append(protocol.normal_force_ev_per_angstrom)
 
         def tell(done, total, seconds, i=i, p0=p0):
             if progress is not None:
@@ -214,6 +225,23 @@ def run_experiment(
             comparisons.append(
                 compare_load(recs, bins, laws, spec.radius_angstrom, spec.contact_modulus_gpa)
             )
+        if spec.ramp_amplitudes_angstrom:
+            ramps.append(
+                _ramp(
+                    spec,
+                    model,
+                    atoms,
+                    protocol,
+                    states[0],
+                    state_dir / f"load_{i}",
+                    recs,
+                    bins,
+                    laws,
+                    comparisons[-1] if laws is not None else None,
+                    progress,
+                    i,
+                )
+            )
     return Experiment(
         atoms,
         sizes,
@@ -224,4 +252,82 @@ def run_experiment(
         all_states,
         time.perf_counter() - t0,
         need,
+        ramps,
     )
+
+
+def case_protocol(spec: ExperimentSpec, i: int, axis_angstrom: float) -> Protocol:
+    """The press-and-slide protocol of load ``i``."""
+    target = target_force_ev_per_angstrom(spec, spec.p0_gpa[i], axis_angstrom)
+    return Protocol(
+        target, spec.step_angstrom, spec.steps, spec.fmax_ev_per_angstrom, spec.max_iterations
+    )
+
+
+def compute_case(spec: ExperimentSpec, recipe, model, i: int, state_dir: str) -> float:
+    """One job: build the atoms (deterministic: the driver's build) and press, slide and
+    ramp load ``i`` into ``state_dir/load_<i>`` (resuming its saved steps); the wall seconds.
+
+    The job writes its own states, step by step, so it resumes per step wherever it ran;
+    on Dask the workers must see ``state_dir`` (a shared filesystem).
+    """
+    t0 = time.perf_counter()
+    atoms, _, _ = plan(spec, recipe, 100)
+    cell = atoms.cell.array
+    axis = float(np.linalg.norm(cell[0])) if spec.geometry == "cylinder" else 0.0
+    protocol = case_protocol(spec, i, axis)
+    folder = Path(state_dir) / f"load_{i}"
+    states = run_load(model, atoms, protocol, folder)
+    if spec.ramp_amplitudes_angstrom:
+        from flatcontact.asperity import ramp
+
+        ramp.run_ramp(
+            model, atoms, states[0], protocol, spec.ramp_amplitudes_angstrom, folder / "ramp"
+        )
+    return time.perf_counter() - t0
+
+
+def run_cases(spec, recipe, model, state_dir: Path, executor, progress=None) -> None:
+    """Every load as a job on ``executor`` (the scan's: local processes or Dask); the
+    results are the states they saved, identical to a sequential run's (each load depends
+    only on the built atoms; tested)."""
+    pending = {
+        executor.submit(compute_case, spec, recipe, model, i, str(state_dir)): i
+        for i in range(len(spec.p0_gpa))
+    }
+    while pending:
+        done, _ = executor.wait_first(list(pending))
+        for handle in done:
+            i = pending.pop(handle)
+            seconds = executor.result(handle)
+            if progress is not None:
+                progress(
+                    f"load {i + 1}/{len(spec.p0_gpa)} (p0 {spec.p0_gpa[i]:g} GPa): done on "
+                    f"{executor.name} in {seconds:.1f} s"
+                )
+
+
+def _ramp(spec, model, atoms, protocol, pressed, folder, recs, bins, laws, comparison, progress, i):
+    """The lock-in ramp of one load (:mod:`.ramp`) and its comparison with the models."""
+    from flatcontact.asperity import ramp
+    from flatcontact.asperity.compare import profiles
+
+    def tell(done, total, seconds):
+        if progress is not None:
+            progress(f"load {i + 1}: ramp step {done}/{total} in {seconds:.1f} s")
+
+    path, q, loops, converged = ramp.run_ramp(
+        model, atoms, pressed, protocol, spec.ramp_amplitudes_angstrom, folder / "ramp", tell
+    )
+    models, q_peak, k0 = {}, None, None
+    if comparison is not None:
+        q_peak = comparison["atoms"]["peak_lateral_force_n"]
+        k0 = comparison["atoms"]["initial_stiffness_n_per_m"]
+        axis_m = bins.axis_length_angstrom * 1e-10
+        for name, (x, p, a) in profiles(
+            recs, bins, spec.radius_angstrom, spec.contact_modulus_gpa
+        ).items():
+            models[name] = ramp.elements(bins.geometry, x, p, a, laws.point_laws(), axis_m)
+    out = ramp.compare_ramp(path, q, loops, q_peak, k0, models)
+    out["converged"] = bool(all(converged))
+    return out

@@ -321,3 +321,45 @@ def run_ramp(
             progress(k, len(path) - 1, time.perf_counter() - t0)
     q = np.array([-float(s.tip_force[1]) * EV_PER_ANGSTROM_N for s in states])
     return path, q, loops, [s.converged for s in states]
+
+
+def compare_ramp(
+    path_angstrom,
+    q_n,
+    loops,
+    q_peak_n: float | None,
+    k0_n_per_m: float | None,
+    models: dict[str, Elements],
+) -> dict:
+    """Per amplitude: the atoms' k′ and loss tangent, the models' k′ at the same Q_amp/Q_peak
+    (u = Q_fs/K0), and the ratios atoms/model (asperity.json's ``ramp``). Q is counted from
+    the pressed state (the lock-in is blind to a constant offset)."""
+    q_n = np.asarray(q_n, float) - float(q_n[0])
+    rows = []
+    fit = q_peak_n is not None and q_peak_n > 0 and k0_n_per_m and math.isfinite(k0_n_per_m)
+    for first, last in loops:
+        li = loop_lockin(path_angstrom[first : last + 1] * 1e-10, q_n[first : last + 1])
+        frac = li.force_amplitude / q_peak_n if fit else None
+        row = {
+            "displacement_amplitude_angstrom": li.displacement_amplitude * 1e10,
+            "force_amplitude_n": li.force_amplitude,
+            "q_amp_over_q_peak": frac,
+            "atoms_lockin_n_per_m": li.stiffness,
+            "atoms_loss_tangent": li.loss_tangent,
+            "atoms_secant_n_per_m": li.force_amplitude / li.displacement_amplitude,
+        }
+        for name, el in models.items():
+            k = model_lockin(el, [frac], k0_n_per_m)[1][0] if fit else None
+            row[f"model_{name}_lockin_n_per_m"] = k
+            row[f"ratio_atoms_over_model_{name}"] = None if k is None else li.stiffness / k
+        rows.append(row)
+    return {
+        "displacement_angstrom": np.asarray(path_angstrom, float).tolist(),
+        "lateral_force_n": q_n.tolist(),
+        "loops": [list(lp) for lp in loops],
+        "initial_stiffness_n_per_m": k0_n_per_m,
+        "amplitudes": rows,
+        "note": "k' = Q_amp/u'_1 (first harmonic under load control, contact/cycle.py); the "
+        "models at the atoms' Q_amp/Q_peak with u = Q_fs/K0 (K0 the atoms' initial stiffness); "
+        "None where Q_amp >= Q_peak (no steady cycle)",
+    }

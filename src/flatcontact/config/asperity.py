@@ -5,9 +5,10 @@ Off by default (the default run is unchanged). docs/asperity.md.
 
 from __future__ import annotations
 
+import itertools
 from typing import Literal
 
-from pydantic import Field
+from pydantic import Field, field_validator
 
 from flatcontact.config.section import Section
 from flatcontact.numbers import physical
@@ -67,6 +68,19 @@ class AsperityConfig(Section):
     slip_threshold_angstrom: physical(1e-4, 10.0, "Å") = Field(
         0.1, description="a pair of facing atoms slipped less than this sticks"
     )
+    ramp_amplitudes_angstrom: list[physical(1e-3, 10.0, "Å")] | None = Field(
+        None,
+        description="lock-in cycles at these lateral amplitudes of the tip's block, increasing "
+        "(the stiffness against amplitude of the paper's Fig. 6); steps of step_angstrom; "
+        "default: none",
+    )
     laws_file: str | None = Field(
         None, description="laws.json to compare with (default: the run's laws stage)"
     )
+
+    @field_validator("ramp_amplitudes_angstrom")
+    @classmethod
+    def _ramp(cls, value):
+        if value is not None and (not value or any(b <= a for a, b in itertools.pairwise(value))):
+            raise ValueError(f"expected strictly increasing amplitudes in Å, got {value}")
+        return value

@@ -14,6 +14,7 @@ E*: ``asperity.contact_modulus_gpa``, else the elastic stage's (``inputs``), els
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 from dataclasses import dataclass, field
@@ -26,6 +27,7 @@ from flatcontact.layout import (
     ASPERITY_NC,
     ASPERITY_STATE,
     FIG_ASPERITY_FORCE,
+    FIG_ASPERITY_RAMP,
     FIG_ASPERITY_SLIP,
     FIG_ASPERITY_STICK,
     FIG_ASPERITY_TRACTIONS,
@@ -90,6 +92,7 @@ def _spec(settings, inputs: AsperityInputs):
         a.bin_width_angstrom,
         a.contact_force_ev_per_angstrom,
         a.slip_threshold_angstrom,
+        tuple(a.ramp_amplitudes_angstrom or ()),
     )
 
 
@@ -139,6 +142,33 @@ def verdict(geometry: str, radius_angstrom: float, loads: list[dict]) -> str:
     )
 
 
+@contextlib.contextmanager
+def _executor(settings, spec):
+    """The scan's executor (``scan.executor``, ``scan.workers``, ``scan.dask_address``,
+    ``scan.jobqueue``) when there are several loads to run as jobs; else None (in-process,
+    with per-step progress)."""
+    if len(spec.p0_gpa) < 2:
+        yield None
+        return
+    from flatcontact.ispes.executors import make_executor
+
+    options = settings.scan.executor_options()
+    if options["kind"] == "processes" and options["workers"] is None:
+        options["workers"] = min(len(spec.p0_gpa), _default_workers())
+    with renamed_errors({"workers": "scan.workers", "dask-address": "scan.dask_address"}):
+        executor = make_executor(**options)
+    try:
+        yield executor
+    finally:
+        executor.close()
+
+
+def _default_workers() -> int:
+    from flatcontact.ispes.executors import default_workers
+
+    return default_workers()
+
+
 def run_asperity(
     settings, inputs: AsperityInputs, folder: Path | None, progress=None
 ) -> AsperityResult:
@@ -155,9 +185,11 @@ def run_asperity(
         spec = _spec(settings, inputs)
         laws = _laws(settings, inputs)
         model = _calculator.model(settings)
-        with tempfile.TemporaryDirectory() as tmp:
+        with tempfile.TemporaryDirectory() as tmp, _executor(settings, spec) as executor:
             state = (folder or Path(tmp)) / ASPERITY_STATE
-            exp = run_experiment(spec, settings.structure, model, laws, state, progress=progress)
+            exp = run_experiment(
+                spec, settings.structure, model, laws, state, progress=progress, executor=executor
+            )
     spec_sizes = exp.sizes
     depth = (spec_sizes.flat_layers - 1) * float(exp.atoms.info["plane_spacing_angstrom"])
     cell = exp.atoms.cell.array
@@ -178,9 +210,15 @@ def run_asperity(
         for i, comp in enumerate(exp.comparisons)
         if not comp["atoms"]["peak_reached"]
     ]
+    unconverged += [
+        f"load {i}: a ramp relaxation stopped at max_iterations"
+        for i, rp in enumerate(exp.ramps)
+        if not rp["converged"]
+    ]
     doc = {
         "geometry": spec.geometry,
         "radius_angstrom": spec.radius_angstrom,
+        "target_p0_gpa": list(spec.p0_gpa),
         "contact_modulus_gpa": spec.contact_modulus_gpa,
         "potential": _calculator.label(settings),
         "sizes": spec_sizes.to_json(),
@@ -206,6 +244,8 @@ def run_asperity(
         ],
         "loads": loads,
         "verdict": verdict(spec.geometry, spec.radius_angstrom, loads),
+        # per load, the lock-in cycles of asperity.ramp_amplitudes_angstrom (:mod:`..ramp`)
+        "ramp": exp.ramps or None,
         "warnings": unconverged,
     }
     result = AsperityResult(doc)
@@ -216,6 +256,10 @@ def run_asperity(
             exp.binning,
             {"geometry": spec.geometry, "radius_angstrom": spec.radius_angstrom},
         )
+        if exp.ramps:
+            from flatcontact.asperity.records import ramp_dataset
+
+            ds = ds.merge(ramp_dataset(exp.ramps))
         from flatcontact.fileio import atomic_path
 
         with atomic_path(folder / ASPERITY_NC) as tmp_nc:
@@ -234,4 +278,7 @@ def _figures(doc: dict, ds, folder: Path, svg: bool) -> list[Path]:
         files += save(plots.fig_force_displacement(doc["loads"]), folder, FIG_ASPERITY_FORCE, svg)
         files += save(plots.fig_stick_ratio(doc["loads"]), folder, FIG_ASPERITY_STICK, svg)
         files += save(plots.fig_tractions(doc["loads"][-1]), folder, FIG_ASPERITY_TRACTIONS, svg)
+    if doc["ramp"]:
+        fig = plots.fig_lockin_ramp(doc["ramp"], doc["target_p0_gpa"])
+        files += save(fig, folder, FIG_ASPERITY_RAMP, svg)
     return files
