@@ -184,14 +184,14 @@ def run_experiment(
 ) -> Experiment:
     """Build, run every load (resuming from ``state_dir``), measure and compare.
 
-    ``executor`` (:class:`flatcontact.ispes.executors.Executor`, not inline): the loads run
-    as independent jobs on it first (:func:`run_cases`); the loop then reads their states.
+    ``executor`` (:class:`flatcontact.ispes.executors.Executor`): the loads run as
+    independent jobs on it first (:func:`run_cases`); the loop then reads their states.
     """
     t0 = time.perf_counter()
     atoms, sizes, need = plan(spec, recipe, neighbours_per_atom)
     model.check_atoms(atoms)
     _check_state(state_dir, spec)
-    if executor is not None and not executor.inline and len(spec.p0_gpa) > 1:
+    if executor is not None and len(spec.p0_gpa) > 1:
         parallel = min(executor.workers, len(spec.p0_gpa))
         builder.check_machine(len(atoms) * parallel, neighbours_per_atom)
         run_cases(spec, recipe, model, state_dir, executor, progress)

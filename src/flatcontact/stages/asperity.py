@@ -158,7 +158,8 @@ def _executor(settings, spec):
     with renamed_errors({"workers": "scan.workers", "dask-address": "scan.dask_address"}):
         executor = make_executor(**options)
     try:
-        yield executor
+        # inline (one worker): the in-process loop, with its per-step progress
+        yield None if executor.inline else executor
     finally:
         executor.close()
 
