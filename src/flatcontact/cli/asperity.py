@@ -69,6 +69,14 @@ def asperity_cmd(
             f"model (Hertz) {row['model_hertz']:.1f}, model (measured p) "
             f"{row['model_measured_pressure']:.1f}"
         )
+    for p0, ramp in zip(doc["target_p0_gpa"], doc.get("ramp") or [], strict=False):
+        for r in ramp["amplitudes"]:
+            model = r.get("model_hertz_lockin_n_per_m")
+            console.print(
+                f"  p0 {p0:g} GPa, U {r['displacement_amplitude_angstrom']:.3g} Å: lock-in k' "
+                f"atoms {r['atoms_lockin_n_per_m']:.4g} N/m, model (Hertz) "
+                + ("-" if model is None else f"{model:.4g}")
+            )
     console.print(doc["verdict"])
     for w in doc["warnings"]:
         console.print(f"warning: {w}")

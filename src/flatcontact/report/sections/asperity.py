@@ -150,7 +150,7 @@ MEASURED_HEADERS = (
     "Q_peak/area atoms (MPa)",
     "c/a at Q ≥ Q_peak/2: atoms / model",
     "K0 atoms (N/m)",
-    "k′ ramp, U (Å): atoms / model (N/m)",
+    "k′(U)/k′(U₁), U₁→U (Å): atoms / model",
     "wall (s)",
 )
 
@@ -185,14 +185,23 @@ def measured_row(case: str, doc: dict, wall_seconds: float) -> tuple[str, ...]:
 
 
 def _ramp_cell(doc: dict) -> str:
-    """The first load's lock-in stiffness at the largest ramp amplitude: atoms / model (Hertz
-    p, same Q_amp/Q_peak); "–" without a ramp."""
+    """The first load's ramp: k′(Uₙ)/k′(U₁) of the atoms / of the model (Hertz p, same
+    Q_amp/Q_peak), Uₙ the largest amplitude where the model has a steady cycle; "–" without
+    a ramp."""
     if not doc.get("ramp"):
         return "–"
-    r = doc["ramp"][0]["amplitudes"][-1]
+    rows = doc["ramp"][0]["amplitudes"]
+    key = "model_hertz_lockin_n_per_m"
+    with_model = [r for r in rows if r.get(key) is not None]
+    last = with_model[-1] if len(with_model) > 1 else rows[-1]
+    first = rows[0]
+    atoms = last["atoms_lockin_n_per_m"] / first["atoms_lockin_n_per_m"]
+    model = (
+        "–" if first.get(key) is None or last.get(key) is None else f"{last[key] / first[key]:.3f}"
+    )
     return (
-        f"{fmt(r['displacement_amplitude_angstrom'])}: {fmt(r['atoms_lockin_n_per_m'])} / "
-        f"{_opt(r.get('model_hertz_lockin_n_per_m'))}"
+        f"{fmt(first['displacement_amplitude_angstrom'])}→"
+        f"{fmt(last['displacement_amplitude_angstrom'])}: {atoms:.3f} / {model}"
     )
 
 
