@@ -53,6 +53,8 @@ class ExperimentSpec:
     #: lock-in cycles after the slide (:mod:`.ramp`); their states live apart (``ramp/``), so
     #: adding or extending a ramp reuses a finished slide
     ramp_amplitudes_angstrom: tuple[float, ...] = ()
+    #: the crystal cut to the cap (:func:`.builder.oriented`)
+    tip: str = "slab2"
 
 
 @dataclass
@@ -88,7 +90,7 @@ def _sizes(spec: ExperimentSpec, recipe):
     """The planned sizes, with the user's overrides."""
     from flatcontact.structures.construct import build_interface
 
-    small, _ = build_interface(builder.deep_recipe(recipe, 3))
+    small = builder.oriented(build_interface(builder.deep_recipe(recipe, 3))[0], spec.tip)
     spacing = builder.plane_spacing(small)
     sizes = builder.plan_sizes(
         spec.geometry,
@@ -101,6 +103,7 @@ def _sizes(spec: ExperimentSpec, recipe):
         lateral_factor=spec.lateral_factor,
         axis_repeats=spec.axis_repeats,
         rigid_angstrom=spec.rigid_angstrom,
+        tip_plane_spacing_angstrom=builder.plane_spacing(small, 2),
     )
     if spec.repeats is not None or spec.layers is not None:
         rigid_planes = sizes.tip_layers - sizes.flat_layers
@@ -144,7 +147,7 @@ def _check_state(state_dir: Path, spec: ExperimentSpec) -> None:
     path = state_dir / "spec.json"
     doc = json.loads(json.dumps(asdict(spec)))
     if path.exists():
-        old = json.loads(path.read_text())
+        old = {"tip": "slab2", **json.loads(path.read_text())}  # states from before `tip`
         free = {"steps": None, "ramp_amplitudes_angstrom": None}
         if {**old, **free} != {**doc, **free}:
             raise InputError(
@@ -166,6 +169,7 @@ def plan(spec: ExperimentSpec, recipe, neighbours_per_atom: int):
         sizes=sizes,
         gap_angstrom=spec.gap_angstrom,
         neighbours_per_atom=neighbours_per_atom,
+        tip=spec.tip,
     )
     need = builder.check_machine(len(atoms), neighbours_per_atom)
     return atoms, sizes, need

@@ -23,6 +23,11 @@ class AsperityConfig(Section):
         description="cylinder (line contact, periodic along its axis a1: quasi-2D, cheap) or "
         "sphere (the paper's geometry)",
     )
+    tip: Literal["slab2", "slab1"] = Field(
+        "slab2",
+        description="the crystal cut to the cap: slab2 (on a flat of slab 1) or slab1 (the "
+        "interface turned upside down: on a flat of slab 2)",
+    )
     radius_angstrom: physical(5.0, 1e5, "Å") = Field(300.0, description="tip radius R")
     p0_gpa: list[physical(1e-3, 100.0, "GPa")] = Field(
         [1.0], description="target loads as Hertz peak pressures p0 (from R and E*)"

@@ -93,6 +93,7 @@ def _spec(settings, inputs: AsperityInputs):
         a.contact_force_ev_per_angstrom,
         a.slip_threshold_angstrom,
         tuple(a.ramp_amplitudes_angstrom or ()),
+        a.tip,
     )
 
 
