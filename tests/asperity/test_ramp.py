@@ -152,3 +152,29 @@ def test_the_ramp_path_cycles_each_amplitude_in_small_steps():
 def test_a_ramp_that_is_not_increasing_and_positive_is_refused(amps):
     with pytest.raises(InputError, match="ramp_amplitudes_angstrom"):
         ramp.check_amplitudes(amps)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (
+            "asperity: {ramp_amplitudes_angstrom: [0.2, 0.1]}\n",
+            "c.yaml: asperity.ramp_amplitudes_angstrom: expected strictly increasing amplitudes",
+        ),
+        (
+            "asperity: {ramp_amplitudes_angstrom: [0.1, 20]}\n",
+            "c.yaml: asperity.ramp_amplitudes_angstrom.1: expected 0.001 <= value <= 10 Å, got 20",
+        ),
+        ("asperity: {ramp_amplitudes_angstrom: []}\n", "asperity.ramp_amplitudes_angstrom"),
+        ("asperity: {tip: slab3}\n", "c.yaml: asperity.tip: expected 'slab2' or 'slab1'"),
+    ],
+)
+def test_bad_ramp_settings_are_one_line_naming_the_field(tmp_path, text, message):
+    from flatcontact.config import load_config
+
+    path = tmp_path / "c.yaml"
+    path.write_text(text)
+    with pytest.raises(InputError) as info:
+        load_config(path)
+    assert message in str(info.value)
+    assert "\n" not in str(info.value)

@@ -70,6 +70,11 @@ def test_a_passivated_diamond_cap_on_graphite(h_diamond):
     assert gap_here == pytest.approx(gap_built, abs=1e-9)
     # the flat's planes are graphene sheets: the spacing is the sheets' (not diamond's bilayers)
     assert atoms.info["plane_spacing_angstrom"] == pytest.approx(3.35, abs=0.1)
+    # each body is the planned depth (two rigid blocks) in its own planes: many more diamond
+    # planes than graphite sheets for the same height
+    for body in (1, 2):
+        assert np.ptp(z[slab == body]) >= 2 * sizes.rigid_angstrom - 1e-6
+    assert sizes.tip_layers > 2 * sizes.flat_layers
 
 
 def test_an_unknown_tip_is_refused(h_diamond):
