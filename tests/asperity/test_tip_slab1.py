@@ -54,9 +54,7 @@ def test_a_passivated_diamond_cap_on_graphite(h_diamond):
     face at the apex, the flat is graphene sheets; every H is in the tip and the facing gap
     is the built interface's."""
     cfg, small = h_diamond
-    atoms, sizes = builder.build_asperity(
-        cfg.structure, "cylinder", 60.0, 1.0, 69.64, tip="slab1"
-    )
+    atoms, sizes = builder.build_asperity(cfg.structure, "cylinder", 60.0, 1.0, 69.64, tip="slab1")
     slab = atoms.arrays["slab"]
     symbols = np.array(atoms.get_chemical_symbols())
     assert set(symbols[slab == 1]) == {"C"}
