@@ -178,3 +178,35 @@ def test_bad_ramp_settings_are_one_line_naming_the_field(tmp_path, text, message
         load_config(path)
     assert message in str(info.value)
     assert "\n" not in str(info.value)
+
+
+def test_compare_ramp_on_a_linear_atom_loop_and_a_hertz_line_contact():
+    """Atoms that are a linear spring K0 read k' = K0 at every amplitude; the model (the
+    element rule on a Hertz line contact, u = Q_fs/K0) starts at K0 and softens, and the
+    ratios are atoms/model; the figure draws both."""
+    from flatcontact.plots.asperity import fig_lockin_ramp
+
+    k0 = 40.0
+    path, loops = ramp.ramp_path([0.1, 0.2, 0.3], 0.05)
+    q = k0 * path * 1e-10 + 3e-12  # an offset at u = 0 (fcc(111)'s Q0) changes nothing
+    a = 2e-9
+    prof = lc.hertz_profile(a, 1e9)
+    laws = lc.PointLaws(k=0.1, tau0_pa=50e6, mu=0.05, sigma0_pa=20e6)
+    el = ramp.elements("cylinder", prof.x_m, prof.p_pa, a, laws, axis_m=5e-10)
+    peak, _ = ramp.model_lockin(el, [0.5], k0)
+    q_peak = 1.5 * k0 * 0.3e-10  # the atoms' slide peaked above the ramp
+    out = ramp.compare_ramp(path, q, loops, q_peak, k0, {"hertz": el})
+    rows = out["amplitudes"]
+    for r, amp in zip(rows, [0.1, 0.2, 0.3], strict=True):
+        assert r["atoms_lockin_n_per_m"] == pytest.approx(k0, rel=1e-9)
+        assert r["q_amp_over_q_peak"] == pytest.approx(k0 * amp * 1e-10 / q_peak, rel=1e-9)
+        assert r["ratio_atoms_over_model_hertz"] == pytest.approx(
+            k0 / r["model_hertz_lockin_n_per_m"], rel=1e-12
+        )
+    k_model = [r["model_hertz_lockin_n_per_m"] for r in rows]
+    assert np.all(np.diff(k_model) < 0) and k_model[0] < k0
+    curve = out["model_curve"]["model_hertz_lockin_n_per_m"]
+    assert curve[0] == pytest.approx(k0, rel=0.02)  # Q_amp -> 0: all stuck, the fitted K0
+    assert np.all(np.diff(curve) < 0)
+    fig = fig_lockin_ramp([out], [1.0])
+    assert len(fig.axes[0].lines) == 3  # atoms, the model's points, the model's curve

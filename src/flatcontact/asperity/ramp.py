@@ -353,8 +353,16 @@ def compare_ramp(
             row[f"model_{name}_lockin_n_per_m"] = k
             row[f"ratio_atoms_over_model_{name}"] = None if k is None else li.stiffness / k
         rows.append(row)
+    curve = None
+    if fit and models:
+        fr = np.linspace(0.02, 0.98, 25)
+        curve = {"q_amp_over_q_peak": fr.tolist(), "force_amplitude_n": (fr * q_peak_n).tolist()}
+        for name, el in models.items():
+            curve[f"model_{name}_lockin_n_per_m"] = model_lockin(el, fr, k0_n_per_m)[1]
     return {
         "displacement_angstrom": np.asarray(path_angstrom, float).tolist(),
+        # the models' k′ over amplitudes (their own Q_amp/Q_peak), at the atoms' Q_peak scale
+        "model_curve": curve,
         "lateral_force_n": q_n.tolist(),
         "loops": [list(lp) for lp in loops],
         "initial_stiffness_n_per_m": k0_n_per_m,

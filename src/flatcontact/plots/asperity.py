@@ -142,17 +142,20 @@ def fig_lockin_ramp(ramps: list[dict], p0_gpa) -> Figure:
             color=c,
             label=f"atoms, p0 {p0:g} GPa",
         )
+        curve = ramp.get("model_curve")
         for name, style in (("hertz", "--"), ("measured_pressure", ":")):
             key = f"model_{name}_lockin_n_per_m"
             k = [np.nan if r.get(key) is None else r[key] for r in rows]
+            label = "model, " + ("Hertz p" if name == "hertz" else "measured p")
             if not np.all(np.isnan(k)):
+                ax.plot(qa, k, "x", color=c)
+            if curve is not None and key in curve:
                 ax.plot(
-                    qa,
-                    k,
+                    np.asarray(curve["force_amplitude_n"]) * 1e9,
+                    curve[key],
                     style,
-                    marker="x",
                     color=c,
-                    label="model, " + ("Hertz p" if name == "hertz" else "measured p"),
+                    label=label + " (at the atoms' Q_amp/Q_peak)",
                 )
     ax.set_xlabel("force amplitude Q_amp (nN)")
     ax.set_ylabel("lock-in stiffness k′ = Q_amp/u′₁ (N/m)")
