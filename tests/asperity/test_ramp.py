@@ -194,6 +194,9 @@ def test_compare_ramp_on_a_linear_atom_loop_and_a_hertz_line_contact():
     laws = lc.PointLaws(k=0.1, tau0_pa=50e6, mu=0.05, sigma0_pa=20e6)
     el = ramp.elements("cylinder", prof.x_m, prof.p_pa, a, laws, axis_m=5e-10)
     peak, _ = ramp.model_lockin(el, [0.5], k0)
+    # τ > σ everywhere: the pointwise model peaks above its sliding force ∫σ dx
+    sliding = lc.sliding_force(prof, laws) * 5e-10
+    assert sliding < peak < 1.5 * sliding
     q_peak = 1.5 * k0 * 0.3e-10  # the atoms' slide peaked above the ramp
     out = ramp.compare_ramp(path, q, loops, q_peak, k0, {"hertz": el})
     rows = out["amplitudes"]
