@@ -87,3 +87,45 @@ def test_the_ramp_end_to_end(tmp_path):
     exp2 = run_experiment(longer, parse_recipe(RECIPE), model, LAWS, tmp_path / "state")
     assert (ramp_dir / "step_0005.npz").stat().st_mtime_ns == stamp
     assert exp2.ramps[0]["amplitudes"][0] == row
+
+
+def test_radii_as_jobs_equal_one_run_per_radius(tmp_path):
+    """``flatcontact asperity --radii``: every (radius, load) a job on the scan's pool gives
+    each radius the asperity.json of its own sequential run."""
+    import json
+
+    import yaml
+
+    from flatcontact.config import load_config
+    from flatcontact.stages.asperity import (
+        AsperityInputs,
+        radius_settings,
+        run_asperity,
+        run_asperity_radii,
+    )
+
+    doc = {
+        "structure": RECIPE,
+        "potential": MODEL,
+        "scan": {"executor": "processes", "workers": 2},
+        "asperity": {
+            "enabled": True,
+            "radius_angstrom": 100.0,
+            "p0_gpa": [1.0],
+            "contact_modulus_gpa": 73.0,
+            "step_angstrom": 0.1,
+            "steps": 1,
+            "depth_factor": 2.0,
+        },
+    }
+    path = tmp_path / "run.yaml"
+    path.write_text(yaml.safe_dump(doc))
+    settings = load_config(path)
+    inputs = AsperityInputs(laws=dataclasses.asdict(LAWS))
+    results = run_asperity_radii(settings, inputs, tmp_path / "par", [100.0, 120.0])
+    for radius, result in zip([100.0, 120.0], results, strict=True):
+        alone = run_asperity(radius_settings(settings, radius), inputs, tmp_path / f"seq{radius}")
+        assert result.doc["radius_angstrom"] == radius
+        assert json.dumps(result.doc["loads"]) == json.dumps(alone.doc["loads"])
+        assert (tmp_path / "par" / f"R{radius:g}" / "asperity.json").is_file()
+    assert results[0].doc["n_atoms"] < results[1].doc["n_atoms"]

@@ -6,7 +6,7 @@ import yaml
 
 from flatcontact.config import load_config
 from flatcontact.errors import InputError
-from flatcontact.stages.asperity import AsperityInputs, _executor, _spec
+from flatcontact.stages.asperity import _executor
 
 
 def _settings(tmp_path, p0, **scan):
@@ -30,7 +30,7 @@ def _settings(tmp_path, p0, **scan):
 )
 def test_the_loads_go_to_the_scans_executor(tmp_path, p0, scan, expected):
     settings = _settings(tmp_path, p0, **scan)
-    with _executor(settings, _spec(settings, AsperityInputs())) as ex:
+    with _executor(settings, len(settings.asperity.p0_gpa)) as ex:
         if expected is None:
             assert ex is None
         else:
@@ -43,7 +43,7 @@ def test_the_loads_go_to_the_scans_executor(tmp_path, p0, scan, expected):
 def test_an_unreachable_dask_scheduler_is_one_line_naming_the_setting(tmp_path):
     settings = _settings(tmp_path, [0.5, 1.0], dask_address="tcp://127.0.0.1:9")
     with pytest.raises(InputError) as info:
-        with _executor(settings, _spec(settings, AsperityInputs())):
+        with _executor(settings, len(settings.asperity.p0_gpa)):
             pass
     assert str(info.value).startswith("scan.dask_address tcp://127.0.0.1:9: no Dask scheduler")
     assert "\n" not in str(info.value)

@@ -140,7 +140,7 @@ def bin_edges(spec: ExperimentSpec, cell: np.ndarray, repeats) -> np.ndarray:
     return np.linspace(0, nb, nb + 1) * spec.bin_width_angstrom
 
 
-def _check_state(state_dir: Path, spec: ExperimentSpec) -> None:
+def check_state(state_dir: Path, spec: ExperimentSpec) -> None:
     """Refuse states of other settings; more (or fewer) ``steps`` extend (or reuse) them, as
     each step's state depends only on the steps before it."""
     state_dir.mkdir(parents=True, exist_ok=True)
@@ -194,7 +194,7 @@ def run_experiment(
     t0 = time.perf_counter()
     atoms, sizes, need = plan(spec, recipe, neighbours_per_atom)
     model.check_atoms(atoms)
-    _check_state(state_dir, spec)
+    check_state(state_dir, spec)
     if executor is not None and len(spec.p0_gpa) > 1:
         parallel = min(executor.workers, len(spec.p0_gpa))
         builder.check_machine(len(atoms) * parallel, neighbours_per_atom)
@@ -295,19 +295,26 @@ def run_cases(spec, recipe, model, state_dir: Path, executor, progress=None) -> 
     """Every load as a job on ``executor`` (the scan's: local processes or Dask); the
     results are the states they saved, identical to a sequential run's (each load depends
     only on the built atoms; tested)."""
+    run_all_cases([(spec, state_dir)], recipe, model, executor, progress)
+
+
+def run_all_cases(experiments, recipe, model, executor, progress=None) -> None:
+    """Every (experiment, load) of ``experiments`` — (spec, state_dir) pairs, e.g. one per
+    radius — as one job on ``executor``, all in flight at once (:func:`compute_case`)."""
     pending = {
-        executor.submit(compute_case, spec, recipe, model, i, str(state_dir)): i
+        executor.submit(compute_case, spec, recipe, model, i, str(state_dir)): (spec, i)
+        for spec, state_dir in experiments
         for i in range(len(spec.p0_gpa))
     }
     while pending:
         done, _ = executor.wait_first(list(pending))
         for handle in done:
-            i = pending.pop(handle)
+            spec, i = pending.pop(handle)
             seconds = executor.result(handle)
             if progress is not None:
                 progress(
-                    f"load {i + 1}/{len(spec.p0_gpa)} (p0 {spec.p0_gpa[i]:g} GPa): done on "
-                    f"{executor.name} in {seconds:.1f} s"
+                    f"R {spec.radius_angstrom:g} Å, load {i + 1}/{len(spec.p0_gpa)} "
+                    f"(p0 {spec.p0_gpa[i]:g} GPa): done on {executor.name} in {seconds:.1f} s"
                 )
 
 

@@ -144,18 +144,18 @@ def verdict(geometry: str, radius_angstrom: float, loads: list[dict]) -> str:
 
 
 @contextlib.contextmanager
-def _executor(settings, spec):
+def _executor(settings, cases: int):
     """The scan's executor (``scan.executor``, ``scan.workers``, ``scan.dask_address``,
-    ``scan.jobqueue``) when there are several loads to run as jobs; else None (in-process,
-    with per-step progress)."""
-    if len(spec.p0_gpa) < 2:
+    ``scan.jobqueue``) when there are several (radius, load) cases to run as jobs; else None
+    (in-process, with per-step progress)."""
+    if cases < 2:
         yield None
         return
     from flatcontact.ispes.executors import make_executor
 
     options = settings.scan.executor_options()
     if options["kind"] == "processes" and options["workers"] is None:
-        options["workers"] = min(len(spec.p0_gpa), _default_workers())
+        options["workers"] = min(cases, _default_workers())
     with renamed_errors({"workers": "scan.workers", "dask-address": "scan.dask_address"}):
         executor = make_executor(**options)
     try:
@@ -171,12 +171,63 @@ def _default_workers() -> int:
     return default_workers()
 
 
+def radius_settings(settings, radius_angstrom: float):
+    """``settings`` with ``asperity.radius_angstrom`` replaced, within the field's bounds."""
+    from pydantic import ValidationError
+
+    from flatcontact.config.asperity import AsperityConfig
+
+    try:
+        section = AsperityConfig.model_validate(
+            {**settings.asperity.model_dump(), "radius_angstrom": radius_angstrom}
+        )
+    except ValidationError:
+        raise InputError(
+            f"--radii: {radius_angstrom!r}: expected radii in Å, 5 <= R <= 100000"
+        ) from None
+    return settings.model_copy(update={"asperity": section})
+
+
+def radius_folder(folder: Path, radius_angstrom: float) -> Path:
+    """Where one radius of :func:`run_asperity_radii` writes: ``folder/R<radius in Å>``."""
+    return folder / f"R{radius_angstrom:g}"
+
+
+def run_asperity_radii(
+    settings, inputs: AsperityInputs, folder: Path, radii, progress=None
+) -> list[AsperityResult]:
+    """One asperity per radius (``folder/R<r>``, each as :func:`run_asperity` writes it),
+    every (radius, load) case a job on the scan's executor, all in flight at once; each
+    radius then reads its states and measures. Every radius's saved states are checked
+    against its settings before any job starts."""
+    from flatcontact.asperity.experiment import check_state, run_all_cases
+
+    per = [radius_settings(settings, float(r)) for r in radii]
+    with renamed_errors(_NAMES):
+        specs = [_spec(s, inputs) for s in per]
+        for spec in specs:
+            check_state(radius_folder(folder, spec.radius_angstrom) / ASPERITY_STATE, spec)
+        model = _calculator.model(settings)
+        with _executor(settings, sum(len(sp.p0_gpa) for sp in specs)) as executor:
+            if executor is not None:
+                experiments = [
+                    (sp, radius_folder(folder, sp.radius_angstrom) / ASPERITY_STATE) for sp in specs
+                ]
+                run_all_cases(experiments, settings.structure, model, executor, progress)
+    return [
+        run_asperity(s, inputs, radius_folder(folder, sp.radius_angstrom), progress, jobs=False)
+        for s, sp in zip(per, specs, strict=True)
+    ]
+
+
 def run_asperity(
-    settings, inputs: AsperityInputs, folder: Path | None, progress=None
+    settings, inputs: AsperityInputs, folder: Path | None, progress=None, jobs: bool = True
 ) -> AsperityResult:
     """Build, press, slide, measure and compare (:mod:`flatcontact.asperity.experiment`).
 
-    ``folder`` None computes into a temporary state folder (nothing kept).
+    ``folder`` None computes into a temporary state folder (nothing kept). ``jobs``: several
+    loads run as jobs on the scan's executor (:func:`_executor`); False runs them in process
+    (:func:`run_asperity_radii` has run them already and only reads the states).
     """
     import tempfile
 
@@ -187,7 +238,8 @@ def run_asperity(
         spec = _spec(settings, inputs)
         laws = _laws(settings, inputs)
         model = _calculator.model(settings)
-        with tempfile.TemporaryDirectory() as tmp, _executor(settings, spec) as executor:
+        cases = len(spec.p0_gpa) if jobs else 1
+        with tempfile.TemporaryDirectory() as tmp, _executor(settings, cases) as executor:
             state = (folder or Path(tmp)) / ASPERITY_STATE
             exp = run_experiment(
                 spec, settings.structure, model, laws, state, progress=progress, executor=executor
