@@ -117,6 +117,7 @@ FIG_ASPERITY_FORCE = "fig_asperity_force"
 FIG_ASPERITY_STICK = "fig_asperity_stick"
 FIG_ASPERITY_TRACTIONS = "fig_asperity_tractions"
 FIG_ASPERITY_SLIP = "fig_asperity_slip"
+FIG_ASPERITY_RAMP = "fig_asperity_ramp"
 
 # ---- report
 REPORT_HTML = "report.html"

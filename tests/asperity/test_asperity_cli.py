@@ -94,3 +94,19 @@ def test_config_check_refuses_an_asperity_without_lammps_or_layers(tmp_path):
     )
     with pytest.raises(InputError, match=r"asperity\.enabled: structure\.kind=file has no layers"):
         check_asperity(cfg)
+
+
+def test_bad_radii_are_one_line_before_any_work(tmp_path, capsys):
+    config = tmp_path / "c.yaml"
+    config.write_text(CU_LJ)
+    for radii, expected in (
+        ("100,abc", "--radii: '100,abc': expected comma-separated radii in Å"),
+        ("100,100", "--radii: '100,100': expected distinct"),
+        ("100,2", "--radii: 2.0: expected radii in Å, 5 <= R <= 100000"),
+    ):
+        out = tmp_path / "o"
+        code, _, err = run_cli(
+            ["asperity", str(config), "--out", str(out), "--radii", radii], capsys
+        )
+        assert expected in one_error_line(code, err)
+        assert not out.exists()

@@ -104,6 +104,7 @@ def plan_sizes(
     axis_repeats: int = 2,
     rigid_angstrom: float = 6.0,
     edge_gap_angstrom: float = 6.0,
+    tip_plane_spacing_angstrom: float | None = None,
 ) -> Sizes:
     """Sizes from R, the largest load and E*: depth ``depth_factor``·a per body (at least a
     few planes above the rigid block), lateral period ``lateral_factor``·2a (cylinder: across
@@ -111,6 +112,10 @@ def plan_sizes(
     rises ``edge_gap_angstrom`` above the flat at the period's edge (L/2 >= √(2 R h)): an
     adhesive coupling (LJ across, range ~ its σ and beyond) would otherwise pull the whole
     period into contact and the "asperity" would be a flat.
+
+    ``tip_plane_spacing_angstrom``: the tip crystal's mean plane spacing when it differs from
+    the flat's (a hetero interface: graphite on diamond); the tip gets the same depth in its
+    own planes.
 
     Raises
     ------
@@ -140,15 +145,17 @@ def plan_sizes(
     )
     depth = max(depth_factor * a, 2.0 * rigid_angstrom)
     layers = max(3, math.ceil(depth / plane_spacing_angstrom) + 1)
-    # the tip also needs the cap's height at the box edge (not above R)
-    rigid_planes = math.ceil(rigid_angstrom / plane_spacing_angstrom)
+    # the tip: the same depth in its own planes, plus its rigid block
+    tip_spacing = tip_plane_spacing_angstrom or plane_spacing_angstrom
+    tip_layers = max(3, math.ceil(depth / tip_spacing) + 1)
+    rigid_planes = math.ceil(rigid_angstrom / tip_spacing)
     return Sizes(
         geometry,
         float(radius_angstrom),
         float(a),
         (n1, n2),
         layers,
-        layers + rigid_planes,
+        tip_layers + rigid_planes,
         float(rigid_angstrom),
     )
 
@@ -201,9 +208,9 @@ def check_machine(
     return need
 
 
-def plane_spacing(interface: Atoms) -> float:
-    """Mean spacing (Å) of slab 1's atomic planes (heights grouped within 0.3 Å)."""
-    z = np.sort(interface.positions[np.asarray(interface.arrays["slab"]) == 1, 2])
+def plane_spacing(interface: Atoms, slab: int = 1) -> float:
+    """Mean spacing (Å) of slab ``slab``'s atomic planes (heights grouped within 0.3 Å)."""
+    z = np.sort(interface.positions[np.asarray(interface.arrays["slab"]) == slab, 2])
     planes = [z[0]]
     for v in z[1:]:
         if v - planes[-1] > 0.3:
@@ -282,6 +289,37 @@ def carve(interface: Atoms, sizes: Sizes, gap_angstrom: float | None = None) -> 
     return out
 
 
+TIPS = ("slab2", "slab1")
+
+
+def flipped(interface: Atoms) -> Atoms:
+    """The interface turned upside down, slab 1 on top: a rotation by 180° about x
+    ((x, y, z) → (x, −y, z_min + z_max − z)), a proper rotation, so each crystal, its
+    termination and the registry of the facing planes are the same; the slab labels swap.
+    The cell's a2 is negated after the rotation (the same lattice, a2 back in the upper
+    half-plane as LAMMPS wants). Sliding along +y here is sliding along −y there."""
+    out = interface.copy()
+    pos = out.positions
+    pos[:, 1] *= -1.0
+    pos[:, 2] = pos[:, 2].min() + pos[:, 2].max() - pos[:, 2]
+    out.positions = pos
+    cell = out.cell.array.copy()
+    cell[1, 1] *= -1.0
+    cell[1] *= -1.0
+    out.set_cell(cell)
+    out.arrays["slab"] = 3 - np.asarray(out.arrays["slab"])
+    for name in ("surface", "held", "layer"):
+        out.arrays.pop(name, None)
+    return out
+
+
+def oriented(interface: Atoms, tip: str) -> Atoms:
+    """The interface with the tip's crystal on top: slab 2 as built (``tip="slab2"``) or the
+    flipped interface (``tip="slab1"``, :func:`flipped`)."""
+    require(tip in TIPS, f"tip must be one of {', '.join(TIPS)}, got {tip!r}")
+    return interface if tip == "slab2" else flipped(interface)
+
+
 def deep_recipe(recipe, layers: int):
     """The run's structure recipe with ``layers`` planes per slab (slab 2's own ``layers`` too).
 
@@ -313,15 +351,16 @@ def build_asperity(
     gap_angstrom: float | None = None,
     neighbours_per_atom: int = 100,
     ranks: int = 1,
+    tip: str = "slab2",
     **plan,
 ) -> tuple[Atoms, Sizes]:
     """The asperity of ``recipe`` (the run's structure): sizes planned (or given), the atom
     count and memory (run over ``ranks`` MPI ranks) checked against the machine before
-    anything is built, then carved."""
+    anything is built, then carved. ``tip``: the crystal cut to the cap (:func:`oriented`)."""
     # imported here: building needs the structures core, planning does not
     from flatcontact.structures.construct import build_interface
 
-    small, _ = build_interface(deep_recipe(recipe, 3))
+    small = oriented(build_interface(deep_recipe(recipe, 3))[0], tip)
     spacing = plane_spacing(small)
     if sizes is None:
         sizes = plan_sizes(
@@ -331,9 +370,10 @@ def build_asperity(
             contact_modulus_gpa,
             small.cell.array[:2, :2],
             spacing,
+            tip_plane_spacing_angstrom=plane_spacing(small, 2),
             **plan,
         )
     per_plane = float(np.sum(np.asarray(small.arrays["slab"]) == 1)) / 3.0
     check_machine(estimate_atoms(sizes, per_plane), neighbours_per_atom, ranks=ranks)
     deep, _ = build_interface(deep_recipe(recipe, max(sizes.flat_layers, sizes.tip_layers)))
-    return carve(deep, sizes, gap_angstrom), sizes
+    return carve(oriented(deep, tip), sizes, gap_angstrom), sizes

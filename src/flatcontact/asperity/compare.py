@@ -117,6 +117,40 @@ def _side(geometry, x_m, p_pa, a_m, laws, axis_m, u_m, k0_n_per_m, q_ratio):
     }
 
 
+def profiles(
+    records: list[StepRecord], binning_: Binning, radius_angstrom: float, contact_modulus_gpa: float
+) -> dict[str, tuple[np.ndarray, np.ndarray, float]]:
+    """The two pressure profiles of the comparison, (x (m) on 0..a, p (Pa), a (m)):
+    ``hertz`` at the measured normal load (R, E*) and ``measured_pressure`` (the pressed
+    state's binned pressure inside the atoms' contact)."""
+    geometry = binning_.geometry
+    axis_m = binning_.axis_length_angstrom * ANGSTROM
+    normal_n = float(records[0].normal_force_n)
+    a_atoms = records[0].contact_half_width_angstrom * ANGSTROM
+    e_star = contact_modulus_gpa * GPA
+    R = radius_angstrom * ANGSTROM
+    if geometry == "cylinder":
+        a_h = float(lc.line_half_width(normal_n / axis_m, R, e_star))
+        p0_h = float(lc.line_peak_pressure(normal_n / axis_m, a_h))
+        hertz = lc.hertz_profile(a_h, p0_h)
+        hx, hp = hertz.x_m, hertz.p_pa
+    else:
+        a_h = (3 * normal_n * R / (4 * e_star)) ** (1 / 3)
+        p0_h = 3 * normal_n / (2 * np.pi * a_h**2)
+        hx = a_h * np.sin(np.linspace(0, np.pi / 2, 2001))
+        hp = p0_h * np.sqrt(np.clip(1 - (hx / a_h) ** 2, 0, None))
+    centres = binning_.centres_angstrom * ANGSTROM
+    p_meas = np.asarray(records[0].pressure_gpa) * GPA
+    if geometry == "cylinder":
+        prof = lc.measured_profile(centres, np.nan_to_num(p_meas), a_atoms)
+        mx, mp = prof.x_m, prof.p_pa
+    else:
+        mx = np.linspace(0.0, a_atoms, 401)
+        mp = np.interp(mx, centres, np.nan_to_num(p_meas))
+        mp[-1] = 0.0
+    return {"hertz": (hx, hp, a_h), "measured_pressure": (mx, mp, a_atoms)}
+
+
 def compare_load(
     records: list[StepRecord],
     binning_: Binning,
@@ -165,30 +199,11 @@ def compare_load(
         "q_over_q_peak": ratio.tolist(),
         "stick_ratio": c_over_a.tolist(),
     }
-    e_star = contact_modulus_gpa * GPA
-    R = radius_angstrom * ANGSTROM
-    if geometry == "cylinder":
-        a_h = float(lc.line_half_width(normal_n / axis_m, R, e_star))
-        p0_h = float(lc.line_peak_pressure(normal_n / axis_m, a_h))
-        hertz = lc.hertz_profile(a_h, p0_h)
-        hx, hp = hertz.x_m, hertz.p_pa
-    else:
-        a_h = (3 * normal_n * R / (4 * e_star)) ** (1 / 3)
-        p0_h = 3 * normal_n / (2 * np.pi * a_h**2)
-        hx = a_h * np.sin(np.linspace(0, np.pi / 2, 2001))
-        hp = p0_h * np.sqrt(np.clip(1 - (hx / a_h) ** 2, 0, None))
+    prof = profiles(records, binning_, radius_angstrom, contact_modulus_gpa)
+    (hx, hp, a_h), (mx, mp, _) = prof["hertz"], prof["measured_pressure"]
+    p0_h = float(hp[0])
     model_hertz = _side(geometry, hx, hp, a_h, pl, axis_m, u_m, k0, rising)
     model_hertz["peak_pressure_gpa"] = p0_h / GPA
-    # (2) the measured pressure of the pressed state, inside the measured contact
-    centres = binning_.centres_angstrom * ANGSTROM
-    p_meas = np.asarray(records[0].pressure_gpa) * GPA
-    if geometry == "cylinder":
-        prof = lc.measured_profile(centres, np.nan_to_num(p_meas), a_atoms)
-        mx, mp = prof.x_m, prof.p_pa
-    else:
-        mx = np.linspace(0.0, a_atoms, 401)
-        mp = np.interp(mx, centres, np.nan_to_num(p_meas))
-        mp[-1] = 0.0
     model_measured = _side(geometry, mx, mp, a_atoms, pl, axis_m, u_m, k0, rising)
     out = {
         "atoms": atoms,

@@ -148,3 +148,38 @@ def dataset(loads_p0_gpa, records: list[list[StepRecord]], binning_: Binning, at
         },
         attrs=attrs,
     )
+
+
+def ramp_dataset(ramps: list[dict]):
+    """The lock-in ramp's variables of asperity.nc: per load and amplitude (dim ``amplitude``)
+    the atoms' and the models' k′ (N/m, NaN where the model has no steady cycle), and the
+    path (dim ``ramp_step``): the tip's displacement (Å) and Q (N, from the pressed state)."""
+    import xarray as xr
+
+    def col(key):
+        return np.array(
+            [[np.nan if r.get(key) is None else r[key] for r in rp["amplitudes"]] for rp in ramps],
+            dtype=float,
+        )
+
+    dims = ("load", "amplitude")
+    data = {
+        f"ramp_{key}": (dims, col(key))
+        for key in (
+            "displacement_amplitude_angstrom",
+            "force_amplitude_n",
+            "atoms_lockin_n_per_m",
+            "atoms_loss_tangent",
+            "model_hertz_lockin_n_per_m",
+            "model_measured_pressure_lockin_n_per_m",
+        )
+    }
+    data["ramp_displacement_angstrom"] = (
+        ("load", "ramp_step"),
+        np.array([rp["displacement_angstrom"] for rp in ramps]),
+    )
+    data["ramp_lateral_force_n"] = (
+        ("load", "ramp_step"),
+        np.array([rp["lateral_force_n"] for rp in ramps]),
+    )
+    return xr.Dataset(data, coords={"load": np.arange(len(ramps))})

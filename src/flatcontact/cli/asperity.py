@@ -24,6 +24,12 @@ def asperity_cmd(
     ),
     laws: Path | None = typer.Option(None, "--laws", help="A laws.json (overrides --run's)."),
     json_out: bool = typer.Option(False, "--json", help="Print asperity.json."),
+    radii: str | None = typer.Option(
+        None,
+        "--radii",
+        help="Comma-separated radii in Å (overrides asperity.radius_angstrom): one asperity "
+        "per radius in OUT/R<r>, every (radius, load) a job on the scan's executor.",
+    ),
 ) -> None:
     """Press a tip of slab 2's crystal on a flat of slab 1's, slide it quasi-statically in
     LAMMPS, and compare Q_peak, c/a, Q(u) and q/p with the model (docs/asperity.md).
@@ -32,9 +38,19 @@ def asperity_cmd(
     """
     from flatcontact.cli.settings import resolve_config
     from flatcontact.layout import ELASTIC_JSON, LAWS_JSON, STAGES
-    from flatcontact.stages.asperity import AsperityInputs, asperity_stage
+    from flatcontact.stages.asperity import (
+        AsperityInputs,
+        asperity_stage,
+        radius_settings,
+        run_asperity_radii,
+    )
 
     settings = resolve_config(config, None, {"asperity": {"enabled": True}}, {})
+    values = None
+    if radii is not None:  # refused before anything is written
+        values = _radii(radii)
+        for r in values:
+            radius_settings(settings, r)
     out = check_out_dir(out)
     laws_doc, e_star = None, None
     if run_dir is not None:
@@ -49,13 +65,32 @@ def asperity_cmd(
         if not laws.is_file():
             raise InputError(f"--laws: {laws} is not a file")
         laws_doc = json.loads(laws.read_text())
-    result = asperity_stage(
-        settings,
-        AsperityInputs(laws=laws_doc, contact_modulus_gpa=e_star),
-        out,
-        progress=lambda line: console.print(line),
-    )
-    doc = result.to_json()
+    inputs = AsperityInputs(laws=laws_doc, contact_modulus_gpa=e_star)
+
+    def tell(line: str) -> None:
+        console.print(line)
+
+    if values is not None:
+        results = run_asperity_radii(settings, inputs, out, values, progress=tell)
+        for result in results:
+            _print(result.to_json(), json_out)
+        return
+    _print(asperity_stage(settings, inputs, out, progress=tell).to_json(), json_out)
+
+
+def _radii(text: str) -> list[float]:
+    """``--radii 200,400``: distinct finite numbers (Å)."""
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise InputError(f"--radii: {text!r}: expected comma-separated radii in Å") from None
+    if not values or len(set(values)) != len(values):
+        raise InputError(f"--radii: {text!r}: expected distinct comma-separated radii in Å")
+    return values
+
+
+def _print(doc: dict, json_out: bool) -> None:
+    """asperity.json (``--json``) or its summary lines."""
     if json_out:
         print(json.dumps(doc, indent=1))
         return
@@ -69,6 +104,14 @@ def asperity_cmd(
             f"model (Hertz) {row['model_hertz']:.1f}, model (measured p) "
             f"{row['model_measured_pressure']:.1f}"
         )
+    for p0, ramp in zip(doc["target_p0_gpa"], doc.get("ramp") or [], strict=False):
+        for r in ramp["amplitudes"]:
+            model = r.get("model_hertz_lockin_n_per_m")
+            console.print(
+                f"  p0 {p0:g} GPa, U {r['displacement_amplitude_angstrom']:.3g} Å: lock-in k' "
+                f"atoms {r['atoms_lockin_n_per_m']:.4g} N/m, model (Hertz) "
+                + ("-" if model is None else f"{model:.4g}")
+            )
     console.print(doc["verdict"])
     for w in doc["warnings"]:
         console.print(f"warning: {w}")

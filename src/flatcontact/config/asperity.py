@@ -5,9 +5,10 @@ Off by default (the default run is unchanged). docs/asperity.md.
 
 from __future__ import annotations
 
+import itertools
 from typing import Literal
 
-from pydantic import Field
+from pydantic import Field, field_validator
 
 from flatcontact.config.section import Section
 from flatcontact.numbers import physical
@@ -24,6 +25,11 @@ class AsperityConfig(Section):
         "cylinder",
         description="cylinder (line contact, periodic along its axis a1: quasi-2D, cheap) or "
         "sphere (the paper's geometry)",
+    )
+    tip: Literal["slab2", "slab1"] = Field(
+        "slab2",
+        description="the crystal cut to the cap: slab2 (on a flat of slab 1) or slab1 (the "
+        "interface turned upside down: on a flat of slab 2)",
     )
     radius_angstrom: physical(5.0, 1e5, "Å") = Field(300.0, description="tip radius R")
     p0_gpa: list[physical(1e-3, 100.0, "GPa")] = Field(
@@ -78,6 +84,19 @@ class AsperityConfig(Section):
         "1: in this process). Same protocol and resume points; states equal to the 1-rank "
         "run's within the minimiser's tolerance. docs/asperity.md",
     )
+    ramp_amplitudes_angstrom: list[physical(1e-3, 10.0, "Å")] | None = Field(
+        None,
+        description="lock-in cycles at these lateral amplitudes of the tip's block, increasing "
+        "(the stiffness against amplitude of the paper's Fig. 6); steps of step_angstrom; "
+        "default: none",
+    )
     laws_file: str | None = Field(
         None, description="laws.json to compare with (default: the run's laws stage)"
     )
+
+    @field_validator("ramp_amplitudes_angstrom")
+    @classmethod
+    def _ramp(cls, value):
+        if value is not None and (not value or any(b <= a for a, b in itertools.pairwise(value))):
+            raise ValueError(f"expected strictly increasing amplitudes in Å, got {value}")
+        return value

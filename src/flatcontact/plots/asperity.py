@@ -124,3 +124,40 @@ def fig_slip_map(ds, load: int = 0) -> Figure:
     ax.set_xlabel("contact coordinate (Å)  [white: a, red: stick edge c]")
     ax.set_ylabel("tip displacement u (Å)")
     return fig
+
+
+def fig_lockin_ramp(ramps: list[dict], p0_gpa) -> Figure:
+    """The lock-in stiffness k′ against the force amplitude (the paper's Fig. 6 reading):
+    atoms (markers) and the model on Hertz and on the measured pressure (lines), per load."""
+    fig = Figure(figsize=(5.6, 4.0))
+    ax = fig.add_subplot()
+    for i, (ramp, p0) in enumerate(zip(ramps, p0_gpa, strict=True)):
+        c = f"C{i}"
+        rows = ramp["amplitudes"]
+        qa = np.array([r["force_amplitude_n"] for r in rows]) * 1e9
+        ax.plot(
+            qa,
+            [r["atoms_lockin_n_per_m"] for r in rows],
+            "o-",
+            color=c,
+            label=f"atoms, p0 {p0:g} GPa",
+        )
+        curve = ramp.get("model_curve")
+        for name, style in (("hertz", "--"), ("measured_pressure", ":")):
+            key = f"model_{name}_lockin_n_per_m"
+            k = [np.nan if r.get(key) is None else r[key] for r in rows]
+            label = "model, " + ("Hertz p" if name == "hertz" else "measured p")
+            if not np.all(np.isnan(k)):
+                ax.plot(qa, k, "x", color=c)
+            if curve is not None and key in curve:
+                ax.plot(
+                    np.asarray(curve["force_amplitude_n"]) * 1e9,
+                    curve[key],
+                    style,
+                    color=c,
+                    label=label + " (at the atoms' Q_amp/Q_peak)",
+                )
+    ax.set_xlabel("force amplitude Q_amp (nN)")
+    ax.set_ylabel("lock-in stiffness k′ = Q_amp/u′₁ (N/m)")
+    ax.legend(fontsize=7)
+    return fig

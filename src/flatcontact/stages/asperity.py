@@ -14,6 +14,7 @@ E*: ``asperity.contact_modulus_gpa``, else the elastic stage's (``inputs``), els
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 from dataclasses import dataclass, field
@@ -26,6 +27,7 @@ from flatcontact.layout import (
     ASPERITY_NC,
     ASPERITY_STATE,
     FIG_ASPERITY_FORCE,
+    FIG_ASPERITY_RAMP,
     FIG_ASPERITY_SLIP,
     FIG_ASPERITY_STICK,
     FIG_ASPERITY_TRACTIONS,
@@ -90,6 +92,8 @@ def _spec(settings, inputs: AsperityInputs):
         a.bin_width_angstrom,
         a.contact_force_ev_per_angstrom,
         a.slip_threshold_angstrom,
+        tuple(a.ramp_amplitudes_angstrom or ()),
+        a.tip,
     )
 
 
@@ -139,12 +143,91 @@ def verdict(geometry: str, radius_angstrom: float, loads: list[dict]) -> str:
     )
 
 
+@contextlib.contextmanager
+def _executor(settings, cases: int):
+    """The scan's executor (``scan.executor``, ``scan.workers``, ``scan.dask_address``,
+    ``scan.jobqueue``) when there are several (radius, load) cases to run as jobs; else None
+    (in-process, with per-step progress)."""
+    if cases < 2:
+        yield None
+        return
+    from flatcontact.ispes.executors import make_executor
+
+    options = settings.scan.executor_options()
+    if options["kind"] == "processes" and options["workers"] is None:
+        options["workers"] = min(cases, _default_workers())
+    with renamed_errors({"workers": "scan.workers", "dask-address": "scan.dask_address"}):
+        executor = make_executor(**options)
+    try:
+        # inline (one worker): the in-process loop, with its per-step progress
+        yield None if executor.inline else executor
+    finally:
+        executor.close()
+
+
+def _default_workers() -> int:
+    from flatcontact.ispes.executors import default_workers
+
+    return default_workers()
+
+
+def radius_settings(settings, radius_angstrom: float):
+    """``settings`` with ``asperity.radius_angstrom`` replaced, within the field's bounds."""
+    from pydantic import ValidationError
+
+    from flatcontact.config.asperity import AsperityConfig
+
+    try:
+        section = AsperityConfig.model_validate(
+            {**settings.asperity.model_dump(), "radius_angstrom": radius_angstrom}
+        )
+    except ValidationError:
+        raise InputError(
+            f"--radii: {radius_angstrom!r}: expected radii in Å, 5 <= R <= 100000"
+        ) from None
+    return settings.model_copy(update={"asperity": section})
+
+
+def radius_folder(folder: Path, radius_angstrom: float) -> Path:
+    """Where one radius of :func:`run_asperity_radii` writes: ``folder/R<radius in Å>``."""
+    return folder / f"R{radius_angstrom:g}"
+
+
+def run_asperity_radii(
+    settings, inputs: AsperityInputs, folder: Path, radii, progress=None
+) -> list[AsperityResult]:
+    """One asperity per radius (``folder/R<r>``, each as :func:`asperity_stage` writes it),
+    every (radius, load) case a job on the scan's executor, all in flight at once; each
+    radius then reads its states and measures. Every radius's saved states are checked
+    against its settings before any job starts."""
+    from flatcontact.asperity.experiment import check_state, run_all_cases
+
+    per = [radius_settings(settings, float(r)) for r in radii]
+    with renamed_errors(_NAMES):
+        specs = [_spec(s, inputs) for s in per]
+        for spec in specs:
+            check_state(radius_folder(folder, spec.radius_angstrom) / ASPERITY_STATE, spec)
+        model = _calculator.model(settings)
+        with _executor(settings, sum(len(sp.p0_gpa) for sp in specs)) as executor:
+            if executor is not None:
+                experiments = [
+                    (sp, radius_folder(folder, sp.radius_angstrom) / ASPERITY_STATE) for sp in specs
+                ]
+                run_all_cases(experiments, settings.structure, model, executor, progress)
+    return [
+        asperity_stage(s, inputs, radius_folder(folder, sp.radius_angstrom), progress, jobs=False)
+        for s, sp in zip(per, specs, strict=True)
+    ]
+
+
 def asperity_stage(
-    settings, inputs: AsperityInputs, folder: Path | None, progress=None
+    settings, inputs: AsperityInputs, folder: Path | None, progress=None, jobs: bool = True
 ) -> AsperityResult:
     """Build, press, slide, measure and compare (:mod:`flatcontact.asperity.experiment`).
 
-    ``folder`` None computes into a temporary state folder (nothing kept).
+    ``folder`` None computes into a temporary state folder (nothing kept). ``jobs``: several
+    loads run as jobs on the scan's executor (:func:`_executor`); False runs them in process
+    (:func:`run_asperity_radii` has run them already and only reads the states).
     """
     import tempfile
 
@@ -155,7 +238,8 @@ def asperity_stage(
         spec = _spec(settings, inputs)
         laws = _laws(settings, inputs)
         model = _calculator.model(settings)
-        with tempfile.TemporaryDirectory() as tmp:
+        cases = len(spec.p0_gpa) if jobs else 1
+        with tempfile.TemporaryDirectory() as tmp, _executor(settings, cases) as executor:
             state = (folder or Path(tmp)) / ASPERITY_STATE
             exp = run_experiment(
                 spec,
@@ -165,6 +249,7 @@ def asperity_stage(
                 state,
                 progress=progress,
                 mpi_ranks=settings.asperity.mpi_ranks,
+                executor=executor,
             )
     spec_sizes = exp.sizes
     depth = (spec_sizes.flat_layers - 1) * float(exp.atoms.info["plane_spacing_angstrom"])
@@ -186,9 +271,15 @@ def asperity_stage(
         for i, comp in enumerate(exp.comparisons)
         if not comp["atoms"]["peak_reached"]
     ]
+    unconverged += [
+        f"load {i}: a ramp relaxation stopped at max_iterations"
+        for i, rp in enumerate(exp.ramps)
+        if not rp["converged"]
+    ]
     doc = {
         "geometry": spec.geometry,
         "radius_angstrom": spec.radius_angstrom,
+        "target_p0_gpa": list(spec.p0_gpa),
         "contact_modulus_gpa": spec.contact_modulus_gpa,
         "potential": _calculator.label(settings),
         "sizes": spec_sizes.to_json(),
@@ -215,6 +306,8 @@ def asperity_stage(
         ],
         "loads": loads,
         "verdict": verdict(spec.geometry, spec.radius_angstrom, loads),
+        # per load, the lock-in cycles of asperity.ramp_amplitudes_angstrom (:mod:`..ramp`)
+        "ramp": exp.ramps or None,
         "warnings": unconverged,
     }
     result = AsperityResult(doc)
@@ -225,6 +318,10 @@ def asperity_stage(
             exp.binning,
             {"geometry": spec.geometry, "radius_angstrom": spec.radius_angstrom},
         )
+        if exp.ramps:
+            from flatcontact.asperity.records import ramp_dataset
+
+            ds = ds.merge(ramp_dataset(exp.ramps))
         from flatcontact.fileio import atomic_path
 
         with atomic_path(folder / ASPERITY_NC) as tmp_nc:
@@ -243,4 +340,7 @@ def _figures(doc: dict, ds, folder: Path, svg: bool) -> list[Path]:
         files += save(plots.fig_force_displacement(doc["loads"]), folder, FIG_ASPERITY_FORCE, svg)
         files += save(plots.fig_stick_ratio(doc["loads"]), folder, FIG_ASPERITY_STICK, svg)
         files += save(plots.fig_tractions(doc["loads"][-1]), folder, FIG_ASPERITY_TRACTIONS, svg)
+    if doc["ramp"]:
+        fig = plots.fig_lockin_ramp(doc["ramp"], doc["target_p0_gpa"])
+        files += save(fig, folder, FIG_ASPERITY_RAMP, svg)
     return files

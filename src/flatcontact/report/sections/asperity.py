@@ -7,6 +7,7 @@ from pathlib import Path
 
 from flatcontact.layout import (
     FIG_ASPERITY_FORCE,
+    FIG_ASPERITY_RAMP,
     FIG_ASPERITY_SLIP,
     FIG_ASPERITY_STICK,
     FIG_ASPERITY_TRACTIONS,
@@ -67,16 +68,77 @@ def asperity_section(doc: dict, folder: Path) -> Section:
             (FIG_ASPERITY_STICK, "stick-zone size c/a against Q/Q_peak"),
             (FIG_ASPERITY_TRACTIONS, "tractions along the contact with τ(p) and σ(p)"),
             (FIG_ASPERITY_SLIP, "slip of facing atoms along the contact, per step"),
+            (FIG_ASPERITY_RAMP, "lock-in stiffness k′ against the force amplitude (Fig. 6)"),
         )
         if (folder / png(stem)).exists()
     ]
     notes = list(doc.get("warnings", []))
-    return Section("The asperity in atoms", paragraphs, [table], figures, notes)
+    tables = [table]
+    if doc.get("ramp"):
+        paragraphs.append(ramp_sentence(doc))
+        tables.append(ramp_table(doc))
+    return Section("The asperity in atoms", paragraphs, tables, figures, notes)
+
+
+def _opt(value) -> str:
+    return "–" if value is None else fmt(value)
+
+
+def ramp_table(doc: dict) -> Table:
+    """Per load and amplitude: the atoms' lock-in stiffness k′ = Q_amp/u′₁ and loss tangent,
+    the model's k′ (Hertz and measured pressure) at the same Q_amp/Q_peak, the ratios."""
+    rows = []
+    for p0, ramp in zip(doc["target_p0_gpa"], doc["ramp"], strict=True):
+        for r in ramp["amplitudes"]:
+            rows.append(
+                (
+                    fmt(p0),
+                    fmt(r["displacement_amplitude_angstrom"]),
+                    fmt(r["force_amplitude_n"] * 1e9),
+                    _opt(r["q_amp_over_q_peak"]),
+                    fmt(r["atoms_lockin_n_per_m"]),
+                    fmt(r["atoms_loss_tangent"]),
+                    _opt(r.get("model_hertz_lockin_n_per_m")),
+                    _opt(r.get("model_measured_pressure_lockin_n_per_m")),
+                    _opt(r.get("ratio_atoms_over_model_hertz")),
+                )
+            )
+    return Table(
+        (
+            "p0 (GPa)",
+            "U (Å)",
+            "Q_amp (nN)",
+            "Q_amp/Q_peak",
+            "k′ atoms (N/m)",
+            "loss tangent atoms",
+            "k′ model, Hertz p (N/m)",
+            "k′ model, measured p (N/m)",
+            "atoms/model (Hertz)",
+        ),
+        rows,
+    )
+
+
+def ramp_sentence(doc: dict) -> str:
+    """How much the atoms' lock-in stiffness falls over the ramp, against the model's."""
+    rows = doc["ramp"][0]["amplitudes"]
+    first, last = rows[0], rows[-1]
+    atoms = last["atoms_lockin_n_per_m"] / first["atoms_lockin_n_per_m"]
+    text = (
+        f"Amplitude ramp (first load): the atoms' lock-in stiffness falls to {atoms:.2f} of its "
+        f"value at U = {fmt(first['displacement_amplitude_angstrom'])} Å by "
+        f"U = {fmt(last['displacement_amplitude_angstrom'])} Å"
+    )
+    m0, m1 = first.get("model_hertz_lockin_n_per_m"), last.get("model_hertz_lockin_n_per_m")
+    if m0 and m1:
+        text += f"; the model's (Hertz p, same Q_amp/Q_peak) to {m1 / m0:.2f}"
+    return text + " (k′ = Q_amp/u′₁, the first harmonic a lock-in reads)."
 
 
 #: The columns of docs/asperity.md's measured table (:func:`measured_row`).
 MEASURED_HEADERS = (
     "case",
+    "geometry",
     "R (nm)",
     "atoms",
     "a atoms / Hertz (Å)",
@@ -85,9 +147,10 @@ MEASURED_HEADERS = (
     "model, measured p (nN)",
     "atoms / Hertz",
     "atoms / measured p",
-    "Q_peak/2a atoms (MPa)",
+    "Q_peak/area atoms (MPa)",
     "c/a at Q ≥ Q_peak/2: atoms / model",
     "K0 atoms (N/m)",
+    "k′(U)/k′(U₁), U₁→U (Å): atoms / model",
     "wall (s)",
 )
 
@@ -104,6 +167,7 @@ def measured_row(case: str, doc: dict, wall_seconds: float) -> tuple[str, ...]:
     peak = fmt(at["peak_lateral_force_n"] * 1e9) + ("" if at["peak_reached"] else " (≥)")
     return (
         case,
+        doc["geometry"],
         fmt(doc["radius_angstrom"] / 10),
         f"{doc['n_atoms']:,}",
         f"{fmt(at['contact_half_width_angstrom'])} / {fmt(mh['half_width_angstrom'])}",
@@ -115,7 +179,29 @@ def measured_row(case: str, doc: dict, wall_seconds: float) -> tuple[str, ...]:
         fmt(at["peak_shear_stress_mpa"]),
         f"{at['stick_ratio'][half]:.2f} / " + ("–" if model_c is None else f"{model_c:.2f}"),
         fmt(at["initial_stiffness_n_per_m"]),
+        _ramp_cell(doc),
         f"{wall_seconds:.0f}",
+    )
+
+
+def _ramp_cell(doc: dict) -> str:
+    """The first load's ramp: k′(Uₙ)/k′(U₁) of the atoms / of the model (Hertz p, same
+    Q_amp/Q_peak), Uₙ the largest amplitude where the model has a steady cycle; "–" without
+    a ramp."""
+    if not doc.get("ramp"):
+        return "–"
+    rows = doc["ramp"][0]["amplitudes"]
+    key = "model_hertz_lockin_n_per_m"
+    with_model = [r for r in rows if r.get(key) is not None]
+    last = with_model[-1] if len(with_model) > 1 else rows[-1]
+    first = rows[0]
+    atoms = last["atoms_lockin_n_per_m"] / first["atoms_lockin_n_per_m"]
+    model = (
+        "–" if first.get(key) is None or last.get(key) is None else f"{last[key] / first[key]:.3f}"
+    )
+    return (
+        f"{fmt(first['displacement_amplitude_angstrom'])}→"
+        f"{fmt(last['displacement_amplitude_angstrom'])}: {atoms:.3f} / {model}"
     )
 
 
