@@ -33,7 +33,6 @@ CASES: dict[tuple[str, str], tuple[list[str], list[str]]] = {
     ("build", "--gap-angstrom"): (["--out", "{tmp}/b"], [HUGE]),
     ("build", "--lj-cutoff-angstrom"): (["--out", "{tmp}/b"], ["1e6"]),
     ("build", "--fmax-ev-per-angstrom"): (["--out", "{tmp}/b"], [SUBNORMAL]),
-    ("build", "--normal-axis"): (["--out", "{tmp}/b"], ["7"]),
     ("contact", "--radius-um"): (["--out", "{tmp}/c"], [SUBNORMAL]),
     ("contact", "--contact-modulus-gpa"): (["--out", "{tmp}/c"], [HUGE]),
     ("contact", "--shear-modulus-gpa"): (["--out", "{tmp}/c"], [SUBNORMAL]),

@@ -30,8 +30,9 @@ def test_cli_scan_and_rerun(tmp_path, toy_file, toy_reference, capsys):
     z0 = thickness(toy_reference)
     cfg = tmp_path / "run.yaml"
     cfg.write_text(
-        "calculator:\n"
-        f"  target: {TOY}\n"
+        "potential:\n"
+        "  calculator:\n"
+        f"    target: {TOY}\n"
         "scan:\n"
         "  grid: [2, 2]\n"
         f"  thickness_angstrom: [{z0 - 0.2}, {z0 + 0.2}]\n"

@@ -231,9 +231,10 @@ def test_a_fold_of_the_interaction_survives_and_the_analysis_refuses_it_with_the
 
 FOLDED_RUN = """\
 structure: {kind: toy-lj, layers: 3}
-calculator:
-  target: "tests.ispes.fold_toy:folded_toy"
-  kwargs: {z0_angstrom: 11.1, width_angstrom: 0.05, bump_gpa: 1.5}
+potential:
+  calculator:
+    target: "tests.ispes.fold_toy:folded_toy"
+    kwargs: {z0_angstrom: 11.1, width_angstrom: 0.05, bump_gpa: 1.5}
 scan:
   grid: [3, 3]
   thickness_angstrom: [10.95, 11.0, 11.05, 11.1, 11.15, 11.2, 11.25, 11.3, 11.35, 11.4, 11.5, 11.6, 11.7]

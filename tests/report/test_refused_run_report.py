@@ -27,7 +27,7 @@ from flatcontact.report.sections.refusal import (
 
 REFUSED_YAML = """\
 structure: {kind: toy-lj, layers: 3}
-calculator: {target: "flatcontact.ispes.toy:toy_calculator"}
+potential: {calculator: {target: "flatcontact.ispes.toy:toy_calculator"}}
 scan:
   grid: [7, 7]
   p_range_gpa: {lo_gpa: -0.2, hi_gpa: 1.5, n: 4}

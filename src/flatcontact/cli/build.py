@@ -16,7 +16,6 @@ from flatcontact import limits
 from flatcontact.cli.app import (
     app,
     bounded,
-    bounded_int,
     check_out_dir,
     console,
     print_warning,
@@ -32,7 +31,6 @@ _FLAG_OF = {
     "structure.source": "--source",
     "structure.gap_angstrom": "--gap-angstrom",
     "structure.fmax_ev_per_angstrom": "--fmax-ev-per-angstrom",
-    "structure.normal_axis": "--normal-axis",
     "potential.lj.cutoff_angstrom": "--lj-cutoff-angstrom",
     "potential.lj": "--lj-cutoff-angstrom",
     "potential": "--potential",
@@ -48,7 +46,7 @@ _QUARTZ_DEFAULTS = {
 }
 
 
-def _check_numbers(gap_angstrom, fmax_ev_per_angstrom, lj_cutoff_angstrom, normal_axis):
+def _check_numbers(gap_angstrom, fmax_ev_per_angstrom, lj_cutoff_angstrom):
     """Every number flag of ``build`` that was given within the bounds of the setting it sets
     (the recipe's gap and force tolerance, the LJ cutoff), before anything is read or built."""
     from flatcontact.potentials.coupling import LJSpec
@@ -66,7 +64,6 @@ def _check_numbers(gap_angstrom, fmax_ev_per_angstrom, lj_cutoff_angstrom, norma
         bounded(
             lj_cutoff_angstrom, "--lj-cutoff-angstrom", setting_bounds(LJSpec, "cutoff_angstrom")
         )
-    bounded_int(normal_axis, "--normal-axis", 0, 2, "a cell axis")
 
 
 def _potential_spec(potential: str | None, lj_cutoff_angstrom: float | None):
@@ -134,10 +131,10 @@ def build(
         help="Relaxation tolerance on the max force (eV/Å; default 0.01).",
     ),
     structure: Path | None = typer.Option(
-        None, "--structure", help="A slab structure file (any crystal) instead of α-quartz."
-    ),
-    normal_axis: int = typer.Option(
-        2, "--normal-axis", help="With --structure: cell axis (0, 1, 2) along the surface normal."
+        None,
+        "--structure",
+        help="A slab structure file (any crystal, surface normal along cell vector 3) instead "
+        "of α-quartz.",
     ),
     config: Path | None = typer.Option(
         None,
@@ -162,11 +159,9 @@ def build(
     from flatcontact.stages.build import BuildInputs, run_build
     from flatcontact.structures import build as builder
 
-    _check_numbers(gap_angstrom, fmax_ev_per_angstrom, lj_cutoff_angstrom, normal_axis)
+    _check_numbers(gap_angstrom, fmax_ev_per_angstrom, lj_cutoff_angstrom)
     if structure is not None and not structure.is_file():
         raise InputError(f"--structure {structure}: file not found")
-    if structure is None and normal_axis != 2:
-        raise InputError("--normal-axis: the normal of a --structure file; give --structure")
     given = {
         "layers": layers,
         "source": source,
@@ -178,9 +173,7 @@ def build(
             raise InputError(
                 "--regenerate-dense: not with --config (it rebuilds the shipped quartz slab)"
             )
-        cfg = _config_settings(
-            config, structure, potential, lj_cutoff_angstrom, given, normal_axis, svg
-        )
+        cfg = _config_settings(config, structure, potential, lj_cutoff_angstrom, given, svg)
         check_out_dir(out)
         with flag_errors(_FLAG_OF):
             result = run_build(cfg, BuildInputs(), out)
@@ -217,16 +210,14 @@ def build(
         "fmax_ev_per_angstrom": fmax_ev_per_angstrom,
     }
     if structure is not None:
-        # the slab recipe finds the layers from the structure (a monolayer works); a normal
-        # other than cell vector 3 is refused naming --normal-axis
+        # the slab recipe finds the layers from the structure (a monolayer works) and takes
+        # the surface normal along cell vector 3
         section = {
             "kind": "slab",
             "file": str(structure),
             "gap_angstrom": gap_angstrom,
             "fmax_ev_per_angstrom": fmax_ev_per_angstrom,
         }
-        if normal_axis != 2:  # the default is the only axis taken (no deprecation warning)
-            section["normal_axis"] = normal_axis
     data = {
         "structure": section,
         "potential": spec.model_dump(mode="json"),
@@ -244,7 +235,6 @@ def _config_settings(
     potential: str | None,
     lj_cutoff_angstrom: float | None,
     given: dict,
-    normal_axis: int,
     svg: bool,
 ):
     """The run settings of ``--config`` with every flag that was given laid over: ``--structure``
@@ -273,8 +263,6 @@ def _config_settings(
         builder.check_layers(recipe["layers"], "--layers")
     if structure is not None:
         recipe = {**recipe, "kind": "slab", "file": str(structure)}
-        if normal_axis != 2:
-            recipe["normal_axis"] = normal_axis
     if recipe:
         flags["structure"] = recipe
     if potential is not None:

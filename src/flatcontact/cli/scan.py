@@ -109,14 +109,14 @@ def scan_command(
         str | None,
         typer.Option(
             "--calculator",
-            help="calculator.target: an ASE calculator 'module:callable' instead of --potential.",
+            help="potential.calculator.target: an ASE calculator 'module:callable' instead of --potential.",
         ),
     ] = None,
     calculator_kwarg: Annotated[
         list[str] | None,
         typer.Option(
             "--calculator-kwarg",
-            help="calculator.kwargs: key=value (value read as YAML), repeatable, e.g. "
+            help="potential.calculator.kwargs: key=value (value read as YAML), repeatable, e.g. "
             "--calculator-kwarg model=medium --calculator-kwarg device=cpu.",
         ),
     ] = None,
@@ -231,7 +231,9 @@ def scan_command(
     if calculator is not None:
         from flatcontact.potentials.loader import parse_kwargs
 
-        flags["calculator"] = {"target": calculator, "kwargs": parse_kwargs(calculator_kwarg)}
+        flags["potential"] = {
+            "calculator": {"target": calculator, "kwargs": parse_kwargs(calculator_kwarg)}
+        }
     cfg = resolve_config(config, preset, flags)
     out_dir = check_out_dir(out or "ispes")
     where = Path(interface or DEFAULT_INTERFACE)

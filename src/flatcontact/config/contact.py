@@ -6,9 +6,6 @@ At the top: the loads (``p0_gpa``), the tip (``radius_um``), the moduli, the law
 - ``cycle``: the steady load-controlled oscillation cycle per p0;
 - ``fit``: the multi-load least-squares fit of measured stiffness curves;
 - ``experiment``: one measured stiffness curve overlaid on Fig. 6.
-
-The flat keys of the earlier one-level section (``fit_csv``, ``cycle_amplitudes_un``, ...)
-are read through :mod:`flatcontact.config.migration`.
 """
 
 from __future__ import annotations

@@ -447,6 +447,8 @@ def parse_recipe(data: dict[str, Any], field: str = SECTION) -> Any:
             parts = parts[:1] + parts[2:]
         loc = ".".join(parts)
         msg = str(err["msg"]).removeprefix("Value error, ")  # pydantic's, not the user's
+        if err["type"] == "extra_forbidden":
+            msg = "unknown field"
         raise InputError(f"{field}.{loc}: {msg}" if loc else f"{field}: {msg}") from None
 
 
