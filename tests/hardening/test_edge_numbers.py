@@ -54,14 +54,17 @@ CONTACT_CASES = {
     "tau0-huge": (["--tau0-mpa", "1e300"], "--tau0-mpa"),
     "sigma0-huge": (["--sigma0-mpa", "1e300"], "--sigma0-mpa"),
     "k-subnormal": (["--k-mpa-per-gpa", SUBNORMAL], "--k-mpa-per-gpa"),
-    "work-of-adhesion-huge": (["--work-of-adhesion-j-m2", "1e300"], "--work-of-adhesion-j-m2"),
+    "work-of-adhesion-huge": (
+        ["--work-of-adhesion-j-per-m2", "1e300"],
+        "--work-of-adhesion-j-per-m2",
+    ),
     # tiny but normal: with λ its cohesive-zone width overflowed; 0 (no adhesion) stays valid
     "work-of-adhesion-tiny": (
-        ["--work-of-adhesion-j-m2", "1e-300", "--maugis-lambda", "1"],
-        "--work-of-adhesion-j-m2",
+        ["--work-of-adhesion-j-per-m2", "1e-300", "--maugis-lambda", "1"],
+        "--work-of-adhesion-j-per-m2",
     ),
     "maugis-lambda-subnormal": (
-        ["--work-of-adhesion-j-m2", "0.1", "--maugis-lambda", SUBNORMAL],
+        ["--work-of-adhesion-j-per-m2", "0.1", "--maugis-lambda", SUBNORMAL],
         "--maugis-lambda",
     ),
     "cycle-fraction-subnormal": (
@@ -104,7 +107,7 @@ def test_elastic_strain_subnormal(capsys):
         ("elastic: {strain: 1.0e-320}", "elastic.strain"),
         ("contact: {shear_modulus_gpa: 1.0e-320}", "contact.shear_modulus_gpa"),
         ("analysis: {p_gpa: [0.0, 1.0e-320]}", "analysis.p_gpa"),
-        ("contact: {maugis_lambda: 1.0e-320, work_of_adhesion_j_m2: 0.1}", "maugis_lambda"),
+        ("contact: {maugis_lambda: 1.0e-320, work_of_adhesion_j_per_m2: 0.1}", "maugis_lambda"),
     ],
 )
 def test_config_field_at_the_edge_is_one_line(section, field, tmp_path, capsys):
@@ -120,13 +123,20 @@ def test_config_field_at_the_edge_is_one_line(section, field, tmp_path, capsys):
         ["--radius-um", "1e-3", "--contact-modulus-gpa", "1e4", "--shear-modulus-gpa", "0.01"],
         ["--radius-um", "1e4", "--contact-modulus-gpa", "0.01", "--shear-modulus-gpa", "1e4"],
         ["--p0-gpa", "1e-6,1e3", "--tau0-mpa", "1e5", "--sigma0-mpa", "1e5"],
-        ["--work-of-adhesion-j-m2", "100", "--maugis-lambda", "1e-3"],
-        ["--work-of-adhesion-j-m2", "100", "--maugis-lambda", "1e3", "--radius-um", "1e4"],
+        ["--work-of-adhesion-j-per-m2", "100", "--maugis-lambda", "1e-3"],
+        ["--work-of-adhesion-j-per-m2", "100", "--maugis-lambda", "1e3", "--radius-um", "1e4"],
         [
-            *("--work-of-adhesion-j-m2", "1e-6", "--maugis-lambda", "1e-3", "--radius-um", "1e4"),
+            *(
+                "--work-of-adhesion-j-per-m2",
+                "1e-6",
+                "--maugis-lambda",
+                "1e-3",
+                "--radius-um",
+                "1e4",
+            ),
             *("--contact-modulus-gpa", "1e4", "--shear-modulus-gpa", "0.01", "--p0-gpa", "1e3"),
         ],
-        ["--work-of-adhesion-j-m2", "0", "--tau0-mpa", "0", "--sigma0-mpa", "0"],
+        ["--work-of-adhesion-j-per-m2", "0", "--tau0-mpa", "0", "--sigma0-mpa", "0"],
     ],
 )
 def test_contact_at_the_bounds_runs_clean(argv, capsys):

@@ -155,7 +155,7 @@ def test_contact_uses_the_fitted_laws(tiny_run):
         assert prov[key] == "fitted laws"
         assert params[key] == pytest.approx(laws[key])
     scan = json.loads((root / "02-scan" / "scan.json").read_text())
-    assert params["work_of_adhesion_j_m2"] == pytest.approx(
+    assert params["work_of_adhesion_j_per_m2"] == pytest.approx(
         scan["adhesion"]["work_of_separation_j_per_m2"]
     )
     with xr.open_dataset(root / "06-contact" / "contact.nc", engine="h5netcdf") as ds:
@@ -488,7 +488,7 @@ def _range_flags(root) -> list[str]:
         path = path_facts(ds)
     return [
         f"--equilibrium-separation-angstrom={gap!r}",
-        f"--unstable-stacking-mj-m2={1e3 * path['unstable_stacking_j_m2']!r}",
+        f"--unstable-stacking-mj-per-m2={1e3 * path['unstable_stacking_j_per_m2']!r}",
         f"--burgers-angstrom={path['burgers_angstrom']!r}",
     ]
 
@@ -642,7 +642,7 @@ def test_each_stage_through_the_cli_writes_the_files_of_the_run(tiny_run, tmp_pa
     # the run's z0 (the built interface's gap) and its sliding path's γ_us, b as flags
     flags += _range_flags(src)
     _cli(["contact", "--p0-gpa", p0, *flags, "--no-svg", "--out", str(out),
-          f"--work-of-adhesion-j-m2={w['work_of_separation_j_per_m2']!r}"])  # fmt: skip
+          f"--work-of-adhesion-j-per-m2={w['work_of_separation_j_per_m2']!r}"])  # fmt: skip
     _same_netcdf(out / "contact.nc", src / "06-contact" / "contact.nc")
     ours = json.loads((out / "summary.json").read_text())
     run = json.loads((src / "06-contact" / "summary.json").read_text())

@@ -31,7 +31,7 @@ _FLAG_OF = {
         "tau0_mpa",
         "mu_mpa_per_gpa",
         "sigma0_mpa",
-        "work_of_adhesion_j_m2",
+        "work_of_adhesion_j_per_m2",
         "maugis_lambda",
         "equilibrium_separation_angstrom",
         "contact_radius",
@@ -128,10 +128,10 @@ def contact_command(
             "--sigma0-mpa", help=f"σ0 in σ = μ·p + σ0 (MPa); default {PAPER['sigma0_mpa']:g}."
         ),
     ] = PAPER["sigma0_mpa"],
-    work_of_adhesion_j_m2: Annotated[
+    work_of_adhesion_j_per_m2: Annotated[
         float | None,
         typer.Option(
-            "--work-of-adhesion-j-m2",
+            "--work-of-adhesion-j-per-m2",
             help="Work of adhesion w (J/m²): adds DMT/JKR radii and their change vs Hertz.",
         ),
     ] = None,
@@ -157,10 +157,10 @@ def contact_command(
             "Maugis–Dugdale, JKR) in Q_peak/πa² and the model; hertz: the paper's.",
         ),
     ] = "adhesive",
-    unstable_stacking_mj_m2: Annotated[
+    unstable_stacking_mj_per_m2: Annotated[
         float | None,
         typer.Option(
-            "--unstable-stacking-mj-m2",
+            "--unstable-stacking-mj-per-m2",
             help="Barrier γ_us of the γ-surface along the sliding path (mJ/m²): reports the "
             "critical contact radius of concurrent slip (commensurate interfaces).",
         ),
@@ -313,7 +313,7 @@ def contact_command(
         "tau0_mpa": tau0_mpa,
         "mu_mpa_per_gpa": mu_mpa_per_gpa,
         "sigma0_mpa": sigma0_mpa,
-        "work_of_adhesion_j_m2": work_of_adhesion_j_m2,
+        "work_of_adhesion_j_per_m2": work_of_adhesion_j_per_m2,
         "maugis_lambda": maugis_lambda,
         "equilibrium_separation_angstrom": equilibrium_separation_angstrom,
         "contact_radius": contact_radius,
@@ -351,7 +351,7 @@ def contact_command(
         result = run_contact(
             cfg,
             ContactInputs(
-                interface=_given_interface(unstable_stacking_mj_m2, burgers_angstrom, structure)
+                interface=_given_interface(unstable_stacking_mj_per_m2, burgers_angstrom, structure)
             ),
             out,
         )
@@ -449,7 +449,7 @@ def _print_table(records, exp_summary, out) -> None:
         console.print(f"wrote figures, summary.json and contact.nc to {out}")
 
 
-def _given_interface(unstable_stacking_mj_m2, burgers_angstrom, structure) -> dict | None:
+def _given_interface(unstable_stacking_mj_per_m2, burgers_angstrom, structure) -> dict | None:
     """The contact's range facts from the flags (``ContactInputs.interface``); None when
     neither γ_us nor b is given (no size limit is computed)."""
     from flatcontact.contact.slip_size import APPROXIMANT, COMMENSURATE, TWISTED
@@ -462,16 +462,16 @@ def _given_interface(unstable_stacking_mj_m2, burgers_angstrom, structure) -> di
     from flatcontact.numbers import Bounds
 
     for flag, value, bounds in (
-        ("--unstable-stacking-mj-m2", unstable_stacking_mj_m2, Bounds(1e-3, 1e4, "mJ/m²")),
+        ("--unstable-stacking-mj-per-m2", unstable_stacking_mj_per_m2, Bounds(1e-3, 1e4, "mJ/m²")),
         ("--burgers-angstrom", burgers_angstrom, Bounds(0.1, 100.0, "Å")),
     ):
         if value is not None:
             bounded(value, flag, bounds)
-    if unstable_stacking_mj_m2 is None and burgers_angstrom is None:
+    if unstable_stacking_mj_per_m2 is None and burgers_angstrom is None:
         return None
     path = {"source": "given on the command line"}
-    if unstable_stacking_mj_m2 is not None:
-        path["unstable_stacking_j_m2"] = unstable_stacking_mj_m2 * 1e-3
+    if unstable_stacking_mj_per_m2 is not None:
+        path["unstable_stacking_j_per_m2"] = unstable_stacking_mj_per_m2 * 1e-3
     if burgers_angstrom is not None:
         path["burgers_angstrom"] = burgers_angstrom
     return {"structure": structure, "path": path}

@@ -165,10 +165,11 @@ class ContactConfig(Section):
         "null: fitted",
     )
     sigma0_mpa: StressMPa | None = Field(None, description="override σ0 (MPa); null: fitted")
-    work_of_adhesion_j_m2: physical(1e-6, 100.0, "J/m²", or_zero=True) | None = Field(
+    work_of_adhesion_j_per_m2: physical(1e-6, 100.0, "J/m²", or_zero=True) | None = Field(
         None,
-        description="work of adhesion w (J/m²) for DMT/JKR radii; null: the work of separation "
-        "measured by the scan",
+        description="work of adhesion w (J/m²) of the contact for DMT/JKR radii (measured or "
+        "chosen); null: the ideal work of separation W of the scan's slabs, a distinct "
+        "quantity taken in its place",
     )
     maugis_lambda: physical(1e-3, 1e3) | None = Field(
         None,
