@@ -72,8 +72,8 @@ CONTACT_CASES = {
         "--cycle-amplitude-fractions",
     ),
     "cycle-amplitude-subnormal": (
-        ["--cycle", "--cycle-amplitude-un", SUBNORMAL],
-        "--cycle-amplitude-un",
+        ["--cycle", "--cycle-amplitudes-un", SUBNORMAL],
+        "--cycle-amplitudes-un",
     ),
     "experiment-p0-subnormal": (["--experiment-p0-gpa", SUBNORMAL], "--experiment-p0-gpa"),
 }
@@ -221,7 +221,7 @@ def _synthetic_rows() -> list[str]:
 
 def _tau0(path: Path, capsys) -> float:
     code, out, err = run_cli(
-        ["contact", "--p0-gpa", "1.77", "--experiment", str(path), "--json"], capsys
+        ["contact", "--p0-gpa", "1.77", "--experiment-csv", str(path), "--json"], capsys
     )
     assert code in (0, None), err
     return json.loads(out)["experiment"]["fitted_tau0_mpa"]
@@ -259,7 +259,7 @@ def test_shuffled_and_repeated_csv_gives_the_sorted_result(tmp_path, capsys):
 def test_impossible_csv_is_one_line_naming_file_and_row(body, line, words, tmp_path, capsys):
     path = tmp_path / "measured.csv"
     path.write_text(HEADER + body)
-    code, _, err = run_cli(["contact", "--p0-gpa", "1.77", "--experiment", str(path)], capsys)
+    code, _, err = run_cli(["contact", "--p0-gpa", "1.77", "--experiment-csv", str(path)], capsys)
     text = _clean_refusal(code, err, "measured.csv", *words)
     if line is not None:
         assert line in text

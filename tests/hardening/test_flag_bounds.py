@@ -141,7 +141,10 @@ LIST_CASES = {
         ["contact", "--out", "{tmp}/c", "--fit-p0-gpa", "1e-320"],
         "--fit-p0-gpa",
     ),
-    "scan-thickness-huge": (["scan", "--out", "{tmp}/s", "--thickness", "1e300"], "--thickness"),
+    "scan-thickness-huge": (
+        ["scan", "--out", "{tmp}/s", "--thickness-angstrom", "1e300"],
+        "--thickness-angstrom",
+    ),
 }
 
 

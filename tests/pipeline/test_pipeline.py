@@ -729,7 +729,7 @@ def test_cycle_and_fit_in_a_run_match_the_cli_and_the_fit_file_content_reruns_co
 
     flags = [f"--{k.replace('_', '-')}={v!r}" for k, v in fitted.items()] + _range_flags(root)
     argv = ["contact", "--p0-gpa", ",".join(map(str, TINY["contact"]["p0_gpa"])), *flags]
-    argv += ["--cycle", "--cycle-amplitude-fractions", "0.4,0.8", "--fit", str(csv), "--json"]
+    argv += ["--cycle", "--cycle-amplitude-fractions", "0.4,0.8", "--fit-csv", str(csv), "--json"]
     with pytest.raises(SystemExit) as exc:
         main(argv)
     assert exc.value.code in (0, None)

@@ -2,7 +2,7 @@
 with the same loader as ``flatcontact run``; errors are translated to the flag the user typed.
 
 A stage's errors name settings paths (``analysis.energy_form``, ``contact.p0_gpa``) or core
-parameters; :func:`flag_errors` renames them to the command's flags (``--energy``,
+parameters; :func:`flag_errors` renames them to the command's flags (``--energy-form``,
 ``--p0-gpa``), so a YAML user reads the YAML path and a command-line user the flag.
 """
 

@@ -78,7 +78,7 @@ def validate_potential_cmd(
     ),
     energy: str = typer.Option(
         "internal",
-        "--energy",
+        "--energy-form",
         help="With --ispes: energy form, internal (the paper's) or enthalpy.",
     ),
     lj_cutoff_angstrom: float = typer.Option(
