@@ -21,20 +21,20 @@ from flatcontact.cli.app import (
     print_warning,
     setting_bounds,
 )
+from flatcontact.cli.options import flags_of, setting_options, settings_command
 from flatcontact.errors import InputError
 from flatcontact.layout import BUILD_JSON
 
-#: Settings path -> the flag that sets it, to name the flag in errors.
-_FLAG_OF = {
-    "structure.file": "--structure",
-    "structure.layers": "--layers",
-    "structure.source": "--source",
-    "structure.gap_angstrom": "--gap-angstrom",
-    "structure.fmax_ev_per_angstrom": "--fmax-ev-per-angstrom",
-    "potential.lj.cutoff_angstrom": "--lj-cutoff-angstrom",
-    "potential.lj": "--lj-cutoff-angstrom",
-    "potential": "--potential",
-}
+#: The settings the command exposes, one flag each (:mod:`flatcontact.cli.options`): the
+#: quartz recipe's (with ``--config``, the file's recipe's: a flag it has no setting for is
+#: refused) and the cutoff of the model's Lennard-Jones coupling.
+PATHS = (
+    "structure.layers",
+    "structure.source",
+    "structure.gap_angstrom",
+    "structure.fmax_ev_per_angstrom",
+    "potential.lj.cutoff_angstrom",
+)
 
 #: The defaults of the quartz flags when no configuration is given (with ``--config`` a flag
 #: left out keeps the file's value).
@@ -43,6 +43,23 @@ _QUARTZ_DEFAULTS = {
     "source": "auto",
     "gap_angstrom": 3.0,
     "fmax_ev_per_angstrom": 0.01,
+}
+OPTIONS = setting_options(
+    PATHS,
+    {
+        **{
+            f"structure.{k}": f"{v} (α-quartz; with --config the file's)"
+            for k, v in _QUARTZ_DEFAULTS.items()
+        },
+        "potential.lj.cutoff_angstrom": "the run's (10; with --config the file's)",
+    },
+)
+#: Settings path -> the flag that sets it, to name the flag in errors.
+_FLAG_OF = {
+    **flags_of(OPTIONS),
+    "structure.file": "--structure",
+    "potential.lj": "--lj-cutoff-angstrom",
+    "potential": "--potential",
 }
 
 
@@ -94,14 +111,9 @@ def _potential_spec(potential: str | None, lj_cutoff_angstrom: float | None):
 
 
 @app.command("build")
+@settings_command(OPTIONS)
 def build(
-    layers: int = typer.Option(
-        None,
-        "--layers",
-        help="Layers per slab. α-quartz (0001) (default 6): O–Si–O layers, >= 5: a fixed outer "
-        "and a sliding inner dense face layer of 2 units each and at least one inner layer "
-        "between them. With --config: the recipe's own layers setting.",
-    ),
+    settings: dict,
     potential: str = typer.Option(
         None,
         "--potential",
@@ -112,23 +124,6 @@ def build(
         Path("build"),
         "--out",
         help="Output directory (default ./build, where 'flatcontact scan' looks by default).",
-    ),
-    source: str = typer.Option(
-        None,
-        "--source",
-        help="α-quartz: auto (default) | shipped (CHGNet-relaxed 6-layer slab; 9, 12, ... "
-        "layers: bulk alpha-quartz c-repeats inserted into its interior) | seed",
-    ),
-    gap_angstrom: float = typer.Option(
-        None, "--gap-angstrom", help="Initial gap between the slabs (Å; default 3)."
-    ),
-    lj_cutoff_angstrom: float = typer.Option(
-        None, "--lj-cutoff-angstrom", help="Cross-interface LJ cutoff (Å; default the run's, 10)."
-    ),
-    fmax_ev_per_angstrom: float = typer.Option(
-        None,
-        "--fmax-ev-per-angstrom",
-        help="Relaxation tolerance on the max force (eV/Å; default 0.01).",
     ),
     structure: Path | None = typer.Option(
         None,
@@ -159,15 +154,13 @@ def build(
     from flatcontact.stages.build import BuildInputs, run_build
     from flatcontact.structures import build as builder
 
+    given = {k: settings.get("structure", {}).get(k) for k in _QUARTZ_DEFAULTS}
+    layers, source = given["layers"], given["source"]
+    gap_angstrom, fmax_ev_per_angstrom = given["gap_angstrom"], given["fmax_ev_per_angstrom"]
+    lj_cutoff_angstrom = settings.get("potential", {}).get("lj", {}).get("cutoff_angstrom")
     _check_numbers(gap_angstrom, fmax_ev_per_angstrom, lj_cutoff_angstrom)
     if structure is not None and not structure.is_file():
         raise InputError(f"--structure {structure}: file not found")
-    given = {
-        "layers": layers,
-        "source": source,
-        "gap_angstrom": gap_angstrom,
-        "fmax_ev_per_angstrom": fmax_ev_per_angstrom,
-    }
     if config is not None:
         if regenerate_dense:
             raise InputError(

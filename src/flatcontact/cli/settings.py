@@ -23,7 +23,10 @@ def _flag_error(exc: InputError, flag_of: dict[str, str]) -> InputError:
     text = str(exc).removeprefix(f"{FLAGS_SOURCE}: ")
     where, sep, msg = text.partition(": ")
     field, sep2, rest = msg.partition(": ")  # a section validator naming its field first
-    if sep2 and f"{where}.{field}" in flag_of:
+    name, eq, value = field.partition("=")  # ... or the field and its value (layers=5)
+    if sep2 and f"{where}.{name}" in flag_of:
+        if eq:
+            return InputError(f"{flag_of[f'{where}.{name}']}={value}: {rest}")
         where, msg = f"{where}.{field}", rest
     for key in sorted(flag_of, key=len, reverse=True):
         if sep and where == key:

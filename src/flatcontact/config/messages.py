@@ -85,12 +85,12 @@ def one_line(exc: ValidationError, source: str, meant=None) -> InputError:
     else:
         msg = str(first.get("msg", "invalid")).removeprefix("Value error, ")
         field, sep, rest = msg.partition(": ")
-        if sep and field.isidentifier() and field.islower() and where:
-            where, msg = f"{where}.{field}", rest  # a model check naming its field
-        elif sep and where and (field == where or field.startswith(f"{where}.")):
+        if sep and where and (field == where or field.startswith(f"{where}.")):
             where, msg = field, rest  # a sub-model's own one line naming its whole path
             if msg == "unknown field":
                 msg += _meant(where)
+        elif sep and field.isidentifier() and field.islower() and where:
+            where, msg = f"{where}.{field}", rest  # a model check naming its field
         if where == "potential" and msg.startswith("potential "):  # InteractionModel's InputError
             return InputError(f"{source}: potential.{msg.removeprefix('potential ')}")
     return InputError(f"{source}: {where}: {msg}" if where else f"{source}: {msg}")

@@ -1,7 +1,8 @@
 """The dotted paths of the run settings (``contact.fit.csv``) and the field each one names.
 
 One walk over :class:`~flatcontact.config.run.RunConfig`'s pydantic fields, descending into
-every sub-model (a section, the interaction model's ``lj``); what the command line derives
+every sub-model (a section, the interaction model's ``lj``, each structure recipe: a field
+several recipes have is the first one's, the default ``quartz-dense`` recipe first); what the command line derives
 its options from (:mod:`flatcontact.cli.options`) and what an unknown key's message
 suggests instead (:func:`suggestion`).
 """
@@ -20,23 +21,25 @@ from pydantic.fields import FieldInfo
 from flatcontact.config.run import RunConfig
 
 
-def _sub_model(annotation: Any) -> type[BaseModel] | None:
-    """The pydantic model of a field typed ``Model`` or ``Model | None``, else None."""
+def _sub_models(annotation: Any) -> list[type[BaseModel]]:
+    """The pydantic models of a field typed ``Model``, ``Model | None`` or a union of models
+    (the structure recipes, by ``kind``), else none."""
+    if typing.get_origin(annotation) is typing.Annotated:
+        return _sub_models(typing.get_args(annotation)[0])
     if isinstance(annotation, type) and issubclass(annotation, BaseModel):
-        return annotation
+        return [annotation]
     if typing.get_origin(annotation) in (typing.Union, types.UnionType):
-        models = [a for a in typing.get_args(annotation) if a is not type(None)]
-        if len(models) == 1:
-            return _sub_model(models[0])
-    return None
+        members = [a for a in typing.get_args(annotation) if a is not type(None)]
+        models = [m for a in members for m in _sub_models(a)]
+        return models if len(models) == len(members) else []
+    return []
 
 
 def _walk(model: type[BaseModel], prefix: str, out: dict[str, tuple[type[BaseModel], str]]):
     for name, info in model.model_fields.items():
         path = f"{prefix}{name}"
-        out[path] = (model, name)
-        sub = _sub_model(info.annotation)
-        if sub is not None:
+        out.setdefault(path, (model, name))  # a field of several recipes: the first's
+        for sub in _sub_models(info.annotation):
             _walk(sub, path + ".", out)
 
 
