@@ -6,8 +6,9 @@ the pydantic field (:mod:`flatcontact.config`), and hands the command the values
 nested mapping of settings sections, ready to lay over a configuration. The rename of
 settings paths to flags in error messages (:func:`flags_of`) follows from the same list.
 
-The name of a flag is the settings path below the command's section with ``-`` for ``_`` and
-``.``: ``contact.fit.csv`` -> ``--fit-csv``, ``analysis.energy_form`` -> ``--energy-form``; a
+The name of a flag is the settings path below its section with ``-`` for ``_`` and ``.``:
+``contact.fit.csv`` -> ``--fit-csv``, ``analysis.energy_form`` -> ``--energy-form``,
+``report.svg`` -> ``--svg``, ``potential.lj.cutoff_angstrom`` -> ``--lj-cutoff-angstrom``; a
 sub-section's ``enabled`` is the sub-section's name (``contact.cycle.enabled`` ->
 ``--cycle``); a true/false setting has its ``--no-`` form (``--svg/--no-svg``).
 
@@ -64,6 +65,8 @@ class SettingOption:
         if self.kind == "number-or-text":
             value = _number_or_text(given)
             words = (self.metavar or "").split("|")[1:]
+            if isinstance(value, str) and value.strip().lower() in words:
+                value = value.strip().lower()
             if isinstance(value, str) and value not in words:
                 raise InputError(
                     f"{self.flag}: expected a number or {' or '.join(words)}, got {given!r}"
@@ -82,7 +85,6 @@ def _number_or_text(text: str) -> Any:
 
 def flag_name(path: str) -> str:
     """The flag of the settings path ``path``: the path below its section (see the module)."""
-    # below the command's section, or below its own section (``report.svg`` -> ``--svg``)
     parts = path.split(".")[1:]
     if len(parts) > 1 and parts[-1] == "enabled":
         parts = parts[:-1]

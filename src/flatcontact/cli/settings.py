@@ -3,7 +3,8 @@ with the same loader as ``flatcontact run``; errors are translated to the flag t
 
 A stage's errors name settings paths (``analysis.energy_form``, ``contact.p0_gpa``) or core
 parameters; :func:`flag_errors` renames them to the command's flags (``--energy-form``,
-``--p0-gpa``), so a YAML user reads the YAML path and a command-line user the flag.
+``--p0-gpa``), so a YAML user reads the YAML path and a command-line user the flag. The
+table settings path -> flag is derived with the options (:func:`flatcontact.cli.options.flags_of`).
 """
 
 from __future__ import annotations
