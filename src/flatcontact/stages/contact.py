@@ -23,12 +23,14 @@ so both the stick and the slip zone show whatever the laws.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from flatcontact.config.contact import ContactConfig
+from flatcontact.contact.parameters import ContactParameters
 from flatcontact.errors import InputError
 from flatcontact.fileio import atomic_path, file_sha256, write_json_atomic
 from flatcontact.layout import (
@@ -55,16 +57,12 @@ from flatcontact.stages.contact_experiment import (  # noqa: F401  (re-exported)
     quartz_reference_laws,
 )
 
-#: ContactParameters fields -> the settings path that sets them.
+#: ContactParameters fields -> the settings path that sets them: the fields the ``contact``
+#: section has under the same name (R, E*, G*, the four law coefficients, w).
 SETTINGS_NAMES = {
-    name: f"contact.{name}"
-    for name in (
-        "radius_um",
-        "contact_modulus_gpa",
-        "shear_modulus_gpa",
-        "work_of_adhesion_j_per_m2",
-        *PAPER_LAW_KEYS,
-    )
+    f.name: f"contact.{f.name}"
+    for f in fields(ContactParameters)
+    if f.name in ContactConfig.model_fields
 }
 
 
