@@ -40,7 +40,7 @@ def test_a_flag_is_its_settings_path(path, flag):
 @pytest.mark.parametrize("command", sorted(COMMANDS))
 def test_each_derived_option_is_its_field(command):
     module = COMMANDS[command]
-    flag_of = getattr(module, "FLAG_OF", None) or module._FLAG_OF
+    flag_of = module.FLAG_OF
     flags = [o.flag for o in module.OPTIONS]
     assert len(set(flags)) == len(flags)
     for option in module.OPTIONS:

@@ -55,7 +55,7 @@ OPTIONS = setting_options(
     },
 )
 #: Settings path -> the flag that sets it, to name the flag in errors.
-_FLAG_OF = {
+FLAG_OF = {
     **flags_of(OPTIONS),
     "structure.file": "--structure",
     "potential.lj": "--lj-cutoff-angstrom",
@@ -168,7 +168,7 @@ def build(
             )
         cfg = _config_settings(config, structure, potential, lj_cutoff_angstrom, given, svg)
         check_out_dir(out)
-        with flag_errors(_FLAG_OF):
+        with flag_errors(FLAG_OF):
             result = run_build(cfg, BuildInputs(), out)
         _print(result, out)
         return
@@ -216,7 +216,7 @@ def build(
         "potential": spec.model_dump(mode="json"),
         "report": {"svg": svg},
     }
-    with flag_errors(_FLAG_OF):
+    with flag_errors(FLAG_OF):
         cfg = build_config(data, source=FLAGS_SOURCE)
         result = run_build(cfg, BuildInputs(), out)
     _print(result, out)
@@ -247,7 +247,7 @@ def _config_settings(
     for key in recipe:
         if key not in fields:
             raise InputError(
-                f"{_FLAG_OF['structure.' + key]}: the structure recipe {kind!r} has no {key} "
+                f"{FLAG_OF['structure.' + key]}: the structure recipe {kind!r} has no {key} "
                 "setting (remove the flag or change the recipe)"
             )
     if kind == "quartz-dense" and "layers" in recipe:
@@ -260,7 +260,7 @@ def _config_settings(
         flags["structure"] = recipe
     if potential is not None:
         flags["potential"] = _potential_flag_section(potential)
-    cfg = resolve_config(config, None, flags, _FLAG_OF)
+    cfg = resolve_config(config, None, flags, FLAG_OF)
     if lj_cutoff_angstrom is not None:
         if cfg.potential.coupling != "lj":
             raise InputError(
@@ -268,7 +268,7 @@ def _config_settings(
                 f"{cfg.potential.coupling!r}, not lj: there is no Lennard-Jones cutoff to set"
             )
         lj = {**flags.get("potential", {}), "lj": {"cutoff_angstrom": lj_cutoff_angstrom}}
-        cfg = resolve_config(config, None, {**flags, "potential": lj}, _FLAG_OF)
+        cfg = resolve_config(config, None, {**flags, "potential": lj}, FLAG_OF)
     return cfg
 
 

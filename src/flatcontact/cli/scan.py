@@ -82,7 +82,7 @@ def scan_command(
         Path | None,
         typer.Argument(
             help="Run configuration (YAML), the same file 'flatcontact run' reads: its "
-            "potential/calculator and scan sections are used, flags override them. "
+            "potential and scan sections are used, flags override them. "
             "Default: the built-in quick preset."
         ),
     ] = None,
