@@ -67,7 +67,10 @@ def suggestion(path: str) -> str | None:
     """The setting an unknown key ``path`` (``contact.fit_csv``) probably means: one spelled
     the same with dots as underscores (``contact.fit.csv``), one of the same name one level
     down (``calculator`` -> ``potential.calculator``), or a close spelling at its level
-    (``contact.work_of_adhesion_j_m2`` -> ``contact.work_of_adhesion_j_per_m2``); None."""
+    (``contact.work_of_adhesion_j_m2`` -> ``contact.work_of_adhesion_j_per_m2``); None, also
+    for a key of another structure recipe (``structure.layers`` under ``kind: slab``)."""
+    if path in settings_paths():
+        return None  # a setting of another variant (a recipe kind that has it): nothing closer
     parent, _, key = path.rpartition(".")
     prefix = f"{parent}." if parent else ""
     below = [p for p in settings_paths() if p.startswith(prefix) and p != path]
@@ -78,5 +81,5 @@ def suggestion(path: str) -> str | None:
         if p[len(prefix) :].count(".") == 1 and p.rpartition(".")[2] == key:
             return p
     level = [p[len(prefix) :] for p in below if "." not in p[len(prefix) :]]
-    close = difflib.get_close_matches(key, level, n=1, cutoff=0.8)
+    close = difflib.get_close_matches(key, level, n=1, cutoff=0.75)
     return f"{prefix}{close[0]}" if close else None
