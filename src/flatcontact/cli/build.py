@@ -117,7 +117,7 @@ def build(
     potential: str = typer.Option(
         None,
         "--potential",
-        help="vashishta | tersoff | [snap:]NAME | [snap:]path/X.snapcoeff | ase:module:factory "
+        help="vashishta | tersoff | \\[snap:]NAME | \\[snap:]path/X.snapcoeff | ase:module:factory "
         "(default: the run's default, snap:sio2-snap; vashishta if that is not installed).",
     ),
     out: Path = typer.Option(

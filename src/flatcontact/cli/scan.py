@@ -101,7 +101,7 @@ def scan_command(
         str | None,
         typer.Option(
             "--potential",
-            help="potential.intra: vashishta | tersoff | [snap:]NAME | [snap:]path/X.snapcoeff | "
+            help="potential.intra: vashishta | tersoff | \\[snap:]NAME | \\[snap:]path/X.snapcoeff | "
             "ase:module:factory; or a "
             "InteractionModel .json whose fields replace the potential section's (default "
             "snap:sio2-snap, "

@@ -27,7 +27,7 @@ from flatcontact.reference import (
 def validate_potential_cmd(
     potential: str = typer.Argument(
         ...,
-        help="vashishta | tersoff | [snap:]NAME (sio2-snap) | [snap:]path/X.snapcoeff | chgnet.",
+        help="vashishta | tersoff | \\[snap:]NAME (sio2-snap) | \\[snap:]path/X.snapcoeff | chgnet.",
     ),
     reference: str = typer.Option(
         None,
