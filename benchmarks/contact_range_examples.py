@@ -57,7 +57,7 @@ def row(name: str, summary: dict) -> str:
         else "≥ concurrent (past a_el)"
         for r in rows
     )
-    gus, b = slip.get("unstable_stacking_j_m2"), slip.get("burgers_angstrom")
+    gus, b = slip.get("unstable_stacking_j_per_m2"), slip.get("burgers_angstrom")
     return (
         f"| {name} | {p0} | {slip['structure']} | {1e3 * gus:.3g} | {b:.3g} | {tabor} | "
         f"{regimes} | {ratio} | {pull} | {a} | {crit} | {conc} | {reported} |"
@@ -107,7 +107,7 @@ def approximant_rows() -> None:
             **EXPERIMENT,
             **dict(zip(keys, laws, strict=True)),
             "p0_gpa": list(P0_GPA),
-            "work_of_adhesion_j_m2": 0.0,
+            "work_of_adhesion_j_per_m2": 0.0,
         }
         doc = contact_stage(
             build_config({"contact": contact}), ContactInputs(interface=facts), None

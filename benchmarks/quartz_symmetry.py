@@ -50,8 +50,8 @@ def main(argv: list[str] | None = None) -> None:
     group = shift_space_group(reference, spread_compression=relax.mode != "rigid").for_grid(n, n)
     area = cell_area(*in_plane_vectors(reference))
     print(
-        f"{preset}: {len(reference)} atoms, relax {relax.mode}, fmax {relax.fmax_ev_per_a} eV/Å "
-        f"({relax.fmax_ev_per_a / area * 160.2176634:.3g} GPa over the cell), group order "
+        f"{preset}: {len(reference)} atoms, relax {relax.mode}, fmax {relax.fmax_ev_per_angstrom} eV/Å "
+        f"({relax.fmax_ev_per_angstrom / area * 160.2176634:.3g} GPa over the cell), group order "
         f"{group.order} on {n}x{n}: {[op.as_dict() for op in group.operations]}",
         flush=True,
     )

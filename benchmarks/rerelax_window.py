@@ -94,7 +94,7 @@ def main(argv: list[str] | None = None) -> None:
     ds = xr.load_dataset(args.run / "02-scan" / "ispes.nc")
     nodes = window_nodes(ds, args.p_gpa, offsets)
     calc = count_force_calls(calculator_factory(settings.potential)(reference))
-    relax = RelaxSettings(fmax_ev_per_a=args.fmax, optimizer="LBFGS", max_steps=5000)
+    relax = RelaxSettings(fmax_ev_per_angstrom=args.fmax, optimizer="LBFGS", max_steps=5000)
     n_a, n_b = nodes.shape[:2]
     order = np.random.default_rng(21).permutation(n_a * n_b)[: args.columns]
     tight = ds.copy(deep=True)
@@ -122,7 +122,7 @@ def main(argv: list[str] | None = None) -> None:
                     "i_a": i,
                     "i_b": j,
                     "i_z": iz,
-                    "fmax_ev_per_a": args.fmax,
+                    "fmax_ev_per_angstrom": args.fmax,
                     "energy_stored_ev": row.energy,
                     "energy_ev": res.energy_ev,
                     "p_stored_gpa": row.normal_stress_gpa,

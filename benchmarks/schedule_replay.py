@@ -208,7 +208,7 @@ def warm_up() -> None:
             factory,
             grid,
             Path(tmp) / "toy",
-            RelaxSettings(fmax_ev_per_a=1e-3),
+            RelaxSettings(fmax_ev_per_angstrom=1e-3),
             executor=VirtualExecutor(4),
         )
 

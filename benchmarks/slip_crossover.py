@@ -45,7 +45,7 @@ def interface() -> dict:
     barrier = float(friction["barrier_along_direction_mev_per_a2"].iloc[0])
     return {
         "shear_modulus_pa": summary["parameters"]["shear_modulus_gpa"] * 1e9,
-        "unstable_stacking_j_m2": barrier * 1e-3 * 1.602176634e-19 / 1e-20,
+        "unstable_stacking_j_per_m2": barrier * 1e-3 * 1.602176634e-19 / 1e-20,
     }
 
 
@@ -84,7 +84,7 @@ def table() -> str:
     facts = interface()
     lines = [
         f"G* = {facts['shear_modulus_pa'] / 1e9:.1f} GPa, γ_us = "
-        f"{facts['unstable_stacking_j_m2'] * 1e3:.0f} mJ/m² (the flat run of "
+        f"{facts['unstable_stacking_j_per_m2'] * 1e3:.0f} mJ/m² (the flat run of "
         "`examples/cu111-eam.yaml`); cylinders at p0 = 1 GPa, bonded (EAM across).",
         "",
         "| R (nm) | atoms | a atoms (nm) | a_c (nm) | Q'/2a atoms (MPa) | concurrent model (MPa) "

@@ -224,7 +224,7 @@ def scan_interface(
         thickness_angstrom=None if thickness_angstrom is None else tuple(thickness_angstrom),
         p_range_gpa=None if p_range_gpa is None else tuple(p_range_gpa),
     )
-    relax = RelaxSettings(fmax_ev_per_a=fmax_ev_per_angstrom, mode=relax_mode)
+    relax = RelaxSettings(fmax_ev_per_angstrom=fmax_ev_per_angstrom, mode=relax_mode)
     options = {"kind": "serial"} if workers == 1 else {"kind": "processes", "workers": workers}
 
     def scan(folder: Path):
@@ -277,7 +277,7 @@ def contact_from_laws(
         radius_um=radius_um,
         contact_modulus_gpa=contact_modulus_gpa,
         shear_modulus_gpa=shear_modulus_gpa,
-        work_of_adhesion_j_m2=work_of_separation_j_per_m2,
+        work_of_adhesion_j_per_m2=work_of_separation_j_per_m2,
         **numbers,
     )
     return analyse(list(p0_gpa), params)

@@ -62,7 +62,7 @@ def test_out_writes_contract_files_and_figures(grid_file, tmp_path, capsys):
             "0.5,1",
             "--p-gpa",
             "2",
-            "--energy",
+            "--energy-form",
             "enthalpy",
             "--out",
             str(out),
@@ -93,8 +93,8 @@ def test_out_writes_contract_files_and_figures(grid_file, tmp_path, capsys):
     "args, message",
     [
         (
-            ["--p-gpa", "0.5", "--energy", "gibbs"],
-            "error: --energy: expected one of internal, enthalpy",
+            ["--p-gpa", "0.5", "--energy-form", "gibbs"],
+            "error: --energy-form: expected 'internal' or 'enthalpy', got \"gibbs\"",
         ),
         (["--p-gpa", "90"], "error: P = 90 GPa is outside the data of"),
         ([], "error: --p-gpa: give at least one target pressure"),

@@ -17,7 +17,7 @@ QUARTZ = EXAMPLES / "quartz-paper.yaml"
 def _settings(config, **given):
     recipe = {k: None for k in ("layers", "source", "gap_angstrom", "fmax_ev_per_angstrom")}
     recipe.update({k: v for k, v in given.items() if k in recipe})
-    return _config_settings(config, None, None, given.get("lj_cutoff_angstrom"), recipe, 2, False)
+    return _config_settings(config, None, None, given.get("lj_cutoff_angstrom"), recipe, False)
 
 
 def test_given_flags_are_laid_over_the_file():
@@ -38,7 +38,7 @@ def test_given_flags_are_laid_over_the_file():
         (CU, ["--lj-cutoff-angstrom", "12"], "--lj-cutoff-angstrom: the configuration's coupling"),
         (QUARTZ, ["--layers", "4"], "--layers=4: expected an integer >= 5"),
         (CU, ["--face-depth-angstrom", "2"], "No such option: --face-depth-angstrom"),
-        (None, ["--normal-axis", "1"], "--normal-axis: the normal of a --structure file"),
+        (None, ["--normal-axis", "1"], "No such option: --normal-axis"),
     ],
 )
 def test_a_flag_that_cannot_apply_is_one_line_naming_it(config, argv, named, tmp_path, capsys):

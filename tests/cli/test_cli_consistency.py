@@ -22,7 +22,7 @@ _one_error_line = one_error_line
     [
         (["contact", "--p0-gpa"], "--p0-gpa"),
         (["analyze", "ispes.nc", "--p-gpa"], "--p-gpa"),
-        (["scan", "--interface", "missing.extxyz", "--thickness"], "--thickness"),
+        (["scan", "--interface", "missing.extxyz", "--thickness-angstrom"], "--thickness-angstrom"),
     ],
 )
 def test_empty_list_item_is_one_line_before_work(tmp_path, monkeypatch, capsys, argv, flag, bad):
@@ -235,7 +235,7 @@ def test_analyze_bad_load_source_is_one_line(grids, tmp_path, capsys, bad):
     out = tmp_path / "res"
     argv = ["analyze", str(grids["clean"]), "--p-gpa", "1", "--load-source", bad, "--out", str(out)]
     line = _one_error_line(*_run(argv, capsys)[::2])
-    assert line == f"error: --load-source: expected one of energy, stress, got {bad!r}"
+    assert line == f"error: --load-source: expected 'energy' or 'stress', got \"{bad}\""
     assert not out.exists()
 
 

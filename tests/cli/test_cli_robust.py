@@ -13,7 +13,7 @@ _one_error_line = one_error_line
 def test_error_keeps_square_brackets(tmp_path, capsys):
     csv = tmp_path / "nounit.csv"
     csv.write_text("stress,stiffness\n1,2\n")
-    line = _one_error_line(*_run(["contact", "--experiment", str(csv)], capsys)[::2])
+    line = _one_error_line(*_run(["contact", "--experiment-csv", str(csv)], capsys)[::2])
     assert "'name [unit]'" in line and "'mean shear stress [MPa]'" in line
 
 
@@ -179,7 +179,7 @@ def test_build_then_scan_chain_with_the_run_model(tmp_path, monkeypatch, capsys)
     run_model = load_config(None).potential
     assert recipe["potential_spec"] == json.loads(run_model.model_dump_json())
     z = f"{thickness(reference) - 0.5:.3f}"  # compressed: p > 0, no repulsive-branch warning
-    argv = ["scan", "--grid", "1", "1", "--thickness", z, "--executor", "serial", "--json"]
+    argv = ["scan", "--grid", "1", "1", "--thickness-angstrom", z, "--executor", "serial", "--json"]
     code, out, err = _run(argv, capsys)
     assert code in (0, None) and "warning" not in err
     assert json.loads(out)["points_done"] == 1 and (tmp_path / "ispes" / "ispes.nc").is_file()
@@ -209,7 +209,7 @@ def test_failed_scan_leaves_no_store(tmp_path, monkeypatch, capsys, existing_dir
         out.mkdir()
     z = f"{thickness(reference):.4f}"
     argv = ["scan", "--interface", iface, "--calculator", "flatcontact.ispes.toy:toy_calculator"]
-    argv += ["--thickness", z, "--out", str(out)]
+    argv += ["--thickness-angstrom", z, "--out", str(out)]
     make_executor = executors.make_executor
 
     def unreachable(**options):  # what a dead --dask-address gives, without its 5 s timeout
@@ -239,10 +239,16 @@ def test_scan_warns_without_repulsive_branch(tmp_path, capsys):
     z0 = thickness(reference)
     argv = ["scan", "--interface", iface, "--calculator", "flatcontact.ispes.toy:toy_calculator"]
     argv += ["--grid", "1", "1", "--executor", "serial", "--json"]
-    separated = [*argv, "--thickness", f"{z0 + 1.0:.4f},{z0 + 1.5:.4f}", "--out", "far"]
+    separated = [*argv, "--thickness-angstrom", f"{z0 + 1.0:.4f},{z0 + 1.5:.4f}", "--out", "far"]
     code, _, err = _run([*separated[:-1], str(tmp_path / "far")], capsys)
     assert code in (0, None)
     assert err.strip().startswith("warning: no scanned thickness reached p > 0")
-    compressed = [*argv, "--thickness", f"{z0 - 0.3:.4f},{z0:.4f}", "--out", str(tmp_path / "n")]
+    compressed = [
+        *argv,
+        "--thickness-angstrom",
+        f"{z0 - 0.3:.4f},{z0:.4f}",
+        "--out",
+        str(tmp_path / "n"),
+    ]
     code, _, err = _run(compressed, capsys)
     assert code in (0, None) and "warning" not in err

@@ -72,7 +72,10 @@ def test_file_overlays_preset_and_resolves_paths(tmp_path):
             "scan:\n  p_range_gpa: {lo_gpa: 2, hi_gpa: 1, n: 4}\n",
             "c.yaml: scan.p_range_gpa: expected lo_gpa < hi_gpa",
         ),
-        ("structure: {kind: toy-lj}\n", "c.yaml: structure.kind 'toy-lj' needs calculator.target"),
+        (
+            "structure: {kind: toy-lj}\n",
+            "c.yaml: structure.kind 'toy-lj' needs potential.calculator.target",
+        ),
         ("preset: fast\n", "c.yaml: preset: expected quick or paper"),
         ("- 1\n- 2\n", "c.yaml: expected a mapping of sections"),
         ("scan: [1\n", "c.yaml: not valid YAML (line"),

@@ -50,7 +50,7 @@ def test_json_with_adhesion(capsys):
             "contact",
             "--p0-gpa",
             "0.5",
-            "--work-of-adhesion-j-m2",
+            "--work-of-adhesion-j-per-m2",
             "0.2",
             "--maugis-lambda",
             "1",
@@ -89,7 +89,16 @@ def test_out_dir_and_experiment(tmp_path, capsys):
     )
     out = tmp_path / "run"
     code, stdout, _ = _run(
-        ["contact", "--p0-gpa", "1,1.77", "--experiment", str(csv), "--out", str(out), "--json"],
+        [
+            "contact",
+            "--p0-gpa",
+            "1,1.77",
+            "--experiment-csv",
+            str(csv),
+            "--out",
+            str(out),
+            "--json",
+        ],
         capsys,
     )
     assert code in (0, None)
@@ -122,9 +131,9 @@ def test_out_dir_and_experiment(tmp_path, capsys):
         (["--tau0-mpa", "nan"], "--tau0-mpa"),
         (["--p0-gpa", "0"], "--p0-gpa"),
         (["--p0-gpa", "abc"], "--p0-gpa"),
-        (["--work-of-adhesion-j-m2", "-0.1"], "--work-of-adhesion-j-m2"),
+        (["--work-of-adhesion-j-per-m2", "-0.1"], "--work-of-adhesion-j-per-m2"),
         (["--maugis-lambda", "1"], "--maugis-lambda"),
-        (["--experiment", "/nonexistent.csv"], "does not exist"),
+        (["--experiment-csv", "/nonexistent.csv"], "does not exist"),
     ],
 )
 def test_bad_input_one_line_exit_2(argv, needle, capsys, tmp_path):
@@ -138,7 +147,7 @@ def test_bad_input_one_line_exit_2(argv, needle, capsys, tmp_path):
 def test_bad_csv_exit_2(tmp_path, capsys):
     f = tmp_path / "x.csv"
     f.write_text("stress,stiffness\n1,2\n2,3\n3,4\n4,5\n")
-    code, _, err = _run(["contact", "--experiment", str(f)], capsys)
+    code, _, err = _run(["contact", "--experiment-csv", str(f)], capsys)
     assert code == 2 and "no unit" in err and len(err.strip().splitlines()) == 1
 
 

@@ -30,7 +30,7 @@ CU = dict(
     tau0_mpa=3786.4,
     mu_mpa_per_gpa=-1.18,
     sigma0_mpa=1100.3,
-    work_of_adhesion_j_m2=2.479,
+    work_of_adhesion_j_per_m2=2.479,
 )
 CU_GAP_ANGSTROM = 3.615 / math.sqrt(3.0)  # (111) plane spacing of fcc Cu
 MEV_A2 = 0.01602176634  # J/m² per meV/Å² (e = 1.602176634e-19 C)
@@ -42,7 +42,7 @@ def _cu_facts(recipe=None):
         "recipe": recipe if recipe is not None else {"match": {"kind": "identity"}},
         "path": {
             "p_gpa": 0.0,
-            "unstable_stacking_j_m2": 10.16 * MEV_A2,
+            "unstable_stacking_j_per_m2": 10.16 * MEV_A2,
             "burgers_angstrom": 2.556,
             "tau_max_mpa": 3786.0,
         },
@@ -95,7 +95,7 @@ def test_maugis_dugdale_tends_to_dmt_and_jkr():
 def test_the_dmt_contact_is_the_hertz_contact_at_load_plus_pull_off():
     """Inside a DMT contact the pressure is Hertzian at P + 2πwR: the model's peak pressure
     is p1 = 2E*a/(πR), and the law bound is 0 (the tension acts outside)."""
-    prm = ContactParameters(work_of_adhesion_j_m2=0.2)
+    prm = ContactParameters(work_of_adhesion_j_per_m2=0.2)
     reg = adhesion_regime([0.5], prm, maugis_lambda=0.05)
     c = reg.contacts[0]
     assert c.model == "dmt"
@@ -157,12 +157,12 @@ def test_a_paper_like_quartz_contact_keeps_its_hertz_numbers_within_the_adhesion
         "sigma0_mpa": 11.1,
     }
     hertz = contact_stage(
-        build_config({"contact": {**q, "work_of_adhesion_j_m2": 0.0}}), ContactInputs(), None
+        build_config({"contact": {**q, "work_of_adhesion_j_per_m2": 0.0}}), ContactInputs(), None
     ).to_json()
     assert hertz["results"][1]["contact_radius_nm"] == pytest.approx(149.6, abs=0.05)  # NOTES
     assert hertz["adhesion_regime"]["sentence"].startswith("adhesion: none")
     run = contact_stage(
-        build_config({"contact": {**q, "work_of_adhesion_j_m2": 0.062}}), ContactInputs(), None
+        build_config({"contact": {**q, "work_of_adhesion_j_per_m2": 0.062}}), ContactInputs(), None
     ).to_json()
     for h, r in zip(hertz["results"], run["results"], strict=True):
         change = r["effective_shear_strength_mpa"] / h["effective_shear_strength_mpa"] - 1
@@ -224,7 +224,14 @@ def test_the_box_appears_exactly_when_a_exceeds_the_critical_size(radius_um, exc
     from flatcontact.report.sections.contact import range_boxes
 
     cfg = build_config(
-        {"contact": {**CU, "radius_um": radius_um, "p0_gpa": [1.0], "work_of_adhesion_j_m2": 0.0}}
+        {
+            "contact": {
+                **CU,
+                "radius_um": radius_um,
+                "p0_gpa": [1.0],
+                "work_of_adhesion_j_per_m2": 0.0,
+            }
+        }
     )
     doc = contact_stage(cfg, ContactInputs(interface=_cu_facts()), None).to_json()
     row = doc["slip_size"]["results"][0]
@@ -267,7 +274,7 @@ def test_an_approximant_cell_gets_the_elastic_bound():
                 "mu_mpa_per_gpa": 0.0034,
                 "sigma0_mpa": 0.0063,
                 "p0_gpa": [1.0],
-                "work_of_adhesion_j_m2": 0.0,
+                "work_of_adhesion_j_per_m2": 0.0,
             }
         }
     )
@@ -300,7 +307,7 @@ def test_the_cli_reports_the_critical_size_and_draws_both_regimes(tmp_path, caps
             "0.5,3",
             "--radius-um",
             "20",
-            "--unstable-stacking-mj-m2",
+            "--unstable-stacking-mj-per-m2",
             "3.9",
             "--out",
             str(tmp_path / "c"),
@@ -352,13 +359,13 @@ def test_the_run_facts_from_a_constructed_path_and_interface():
     )
     got = path_facts(ds)
     assert got["p_gpa"] == 0.0  # the lowest load: the contact's edge
-    assert got["unstable_stacking_j_m2"] == pytest.approx(2 * gamma * MEV_A2, rel=1e-9)
+    assert got["unstable_stacking_j_per_m2"] == pytest.approx(2 * gamma * MEV_A2, rel=1e-9)
     assert got["burgers_angstrom"] == pytest.approx(b, rel=1e-12)
     # sinusoid: τ_max = π γ/b, so the shape factor π γ_us/(τ_max b) is 1
-    shape = math.pi * got["unstable_stacking_j_m2"] / (got["tau_max_mpa"] * 1e6 * b * 1e-10)
+    shape = math.pi * got["unstable_stacking_j_per_m2"] / (got["tau_max_mpa"] * 1e6 * b * 1e-10)
     assert shape == pytest.approx(1.0, rel=1e-3)
     ds["barrier_along_direction_mev_per_a2"] = ("p_gpa", [9.0, 1.5])
-    assert path_facts(ds)["unstable_stacking_j_m2"] == pytest.approx(1.5 * MEV_A2, rel=1e-12)
+    assert path_facts(ds)["unstable_stacking_j_per_m2"] == pytest.approx(1.5 * MEV_A2, rel=1e-12)
     atoms = Atoms("H4", positions=[(0, 0, 0), (0, 0, 2.0), (0, 0, 5.1), (0, 0, 7.0)])
     atoms.arrays["slab"] = np.array([1, 1, 2, 2])
     assert interface_gap_angstrom(atoms) == pytest.approx(3.1)
@@ -369,7 +376,7 @@ def test_the_maugis_dugdale_tension_moves_inside_the_contact_from_dmt_to_jkr():
     (DMT: adhesion outside the contact) and none of it as λ -> ∞ (JKR: inside)."""
     from flatcontact.contact.adhesion_regime import adhesive_contact, dugdale_zone_force
 
-    prm = ContactParameters(work_of_adhesion_j_m2=0.3, k_mpa_per_gpa=10.0)
+    prm = ContactParameters(work_of_adhesion_j_per_m2=0.3, k_mpa_per_gpa=10.0)
     fractions = []
     for lam in (0.1, 0.3, 1.0, 3.0, 4.9):  # the Maugis–Dugdale range of the regime map
         c = adhesive_contact(0.5e9, prm, lam)

@@ -362,8 +362,8 @@ def test_cu111_gamma_surface_has_mishins_stacking_fault_energy(tmp_path):
     energies = sorted(named.values())
     assert energies[0] == pytest.approx(0.0, abs=1e-9)
     # the second-lowest stationary stacking is the fault (the fcc perfect crystal is 0)
-    isf_mj_m2 = energies[1] * 16.021766  # meV/Å² -> mJ/m²
-    assert isf_mj_m2 == pytest.approx(44.4, rel=0.1)
+    isf_mj_per_m2 = energies[1] * 16.021766  # meV/Å² -> mJ/m²
+    assert isf_mj_per_m2 == pytest.approx(44.4, rel=0.1)
 
 
 def _ase_eam_stacking_energy_mev_per_a2(potential_file: str, a_angstrom: float, shift) -> float:
@@ -475,9 +475,9 @@ def test_h_diamond_on_graphene_adhesion_and_registries(tmp_path):
         return lammps_energy(atoms, types, commands, ntypes=2)
 
     plain_w = energy(reference[slab == 1]) + energy(reference[slab == 2]) - energy(reference)
-    plain_w_j_m2 = plain_w / area * 16.0217663
+    plain_w_j_per_m2 = plain_w / area * 16.0217663
     w = float(ds.attrs["work_of_separation_j_per_m2"])
-    assert w == pytest.approx(plain_w_j_m2, rel=0.02)
+    assert w == pytest.approx(plain_w_j_per_m2, rel=0.02)
     assert 0.05 < w < 0.5
     iz = int(np.argmin(np.abs(ds.thickness.values - ds.attrs["equilibrium_thickness_angstrom"])))
     e = ds["energy"].values[:, :, iz]

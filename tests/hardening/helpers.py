@@ -16,7 +16,7 @@ from flatcontact.cli import main
 #: about files and faults, accept.
 TOY_YAML = """\
 structure: {kind: toy-lj, layers: 3}
-calculator: {target: "flatcontact.ispes.toy:toy_calculator"}
+potential: {calculator: {target: "flatcontact.ispes.toy:toy_calculator"}}
 scan:
   grid: [3, 3]
   p_range_gpa: {lo_gpa: -0.2, hi_gpa: 1.5, n: 4}

@@ -72,7 +72,7 @@ def test_a_factory_that_gives_no_calculator_is_one_line_naming_it(
     name, said, executor, factories, interface, tmp_path, capsys
 ):
     target = f"{factories}:{name}"
-    argv = ["scan", "--interface", interface, "--calculator", target, "--thickness", "11"]
+    argv = ["scan", "--interface", interface, "--calculator", target, "--thickness-angstrom", "11"]
     argv += ["--grid", "2", "2", "--executor", executor, "--out", tmp_path / "o"]
     if executor == "processes":
         argv += ["--workers", "1"]
@@ -85,7 +85,7 @@ def test_a_non_finite_keyword_argument_is_refused_naming_it(
     value, factories, interface, tmp_path, capsys
 ):
     argv = ["scan", "--interface", interface, "--calculator", f"{factories}:toy"]
-    argv += ["--calculator-kwarg", f"sigma_angstrom={value}", "--thickness", "11"]
+    argv += ["--calculator-kwarg", f"sigma_angstrom={value}", "--thickness-angstrom", "11"]
     argv += ["--out", tmp_path / "o"]
     assert_refused_cleanly(argv, capsys, tmp_path, ["sigma_angstrom", "finite"])
     assert not (tmp_path / "o").exists()

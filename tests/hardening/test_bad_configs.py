@@ -171,7 +171,7 @@ CASES = {
         ["contact.experiment.csv", "m.csv", "not numeric"],
     ),
     "calculator-import": (
-        _yaml("calculator: {target: 'nosuchmodule_xyz:make'}\n"),
+        _yaml("potential: {calculator: {target: 'nosuchmodule_xyz:make'}}\n"),
         ["calculator", "nosuchmodule_xyz"],
     ),
     "calculator-attribute": (

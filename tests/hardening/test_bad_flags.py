@@ -59,8 +59,8 @@ CASES = {
         ["--workers", "FLATCONTACT_MAX_WORKERS"],
     ),
     "scan-repeated-thickness": (
-        ["scan", "--interface", "{iface}", *TOY, "--thickness", "7,7.5,7"],
-        ["--thickness", "distinct"],
+        ["scan", "--interface", "{iface}", *TOY, "--thickness-angstrom", "7,7.5,7"],
+        ["--thickness-angstrom", "distinct"],
     ),
     "scan-bad-calculator": (
         ["scan", "--interface", "{iface}", "--calculator", "nosuchmodule_xyz:make"],
@@ -76,11 +76,14 @@ CASES = {
     "contact-radius-huge": (["contact", "--radius-um", "1e300"], ["--radius-um", "<="]),
     "contact-radius-zero": (["contact", "--radius-um", "0"], ["--radius-um"]),
     "contact-experiment-binary": (
-        ["contact", "--experiment", "{binary_csv}"],
+        ["contact", "--experiment-csv", "{binary_csv}"],
         ["binary.csv", "UTF-8"],
     ),
-    "contact-experiment-dir": (["contact", "--experiment", "{adir}"], ["adir"]),
-    "contact-experiment-proc": (["contact", "--experiment", "/proc/self/mem"], ["/proc/self/mem"]),
+    "contact-experiment-dir": (["contact", "--experiment-csv", "{adir}"], ["adir"]),
+    "contact-experiment-proc": (
+        ["contact", "--experiment-csv", "/proc/self/mem"],
+        ["/proc/self/mem"],
+    ),
     "elastic-strain-zero": (["elastic", "--potential", "vashishta", "--strain", "0"], ["--strain"]),
     "elastic-strain-negative": (
         ["elastic", "--potential", "vashishta", "--strain", "-0.01"],

@@ -54,14 +54,17 @@ CONTACT_CASES = {
     "tau0-huge": (["--tau0-mpa", "1e300"], "--tau0-mpa"),
     "sigma0-huge": (["--sigma0-mpa", "1e300"], "--sigma0-mpa"),
     "k-subnormal": (["--k-mpa-per-gpa", SUBNORMAL], "--k-mpa-per-gpa"),
-    "work-of-adhesion-huge": (["--work-of-adhesion-j-m2", "1e300"], "--work-of-adhesion-j-m2"),
+    "work-of-adhesion-huge": (
+        ["--work-of-adhesion-j-per-m2", "1e300"],
+        "--work-of-adhesion-j-per-m2",
+    ),
     # tiny but normal: with λ its cohesive-zone width overflowed; 0 (no adhesion) stays valid
     "work-of-adhesion-tiny": (
-        ["--work-of-adhesion-j-m2", "1e-300", "--maugis-lambda", "1"],
-        "--work-of-adhesion-j-m2",
+        ["--work-of-adhesion-j-per-m2", "1e-300", "--maugis-lambda", "1"],
+        "--work-of-adhesion-j-per-m2",
     ),
     "maugis-lambda-subnormal": (
-        ["--work-of-adhesion-j-m2", "0.1", "--maugis-lambda", SUBNORMAL],
+        ["--work-of-adhesion-j-per-m2", "0.1", "--maugis-lambda", SUBNORMAL],
         "--maugis-lambda",
     ),
     "cycle-fraction-subnormal": (
@@ -69,8 +72,8 @@ CONTACT_CASES = {
         "--cycle-amplitude-fractions",
     ),
     "cycle-amplitude-subnormal": (
-        ["--cycle", "--cycle-amplitude-un", SUBNORMAL],
-        "--cycle-amplitude-un",
+        ["--cycle", "--cycle-amplitudes-un", SUBNORMAL],
+        "--cycle-amplitudes-un",
     ),
     "experiment-p0-subnormal": (["--experiment-p0-gpa", SUBNORMAL], "--experiment-p0-gpa"),
 }
@@ -104,7 +107,7 @@ def test_elastic_strain_subnormal(capsys):
         ("elastic: {strain: 1.0e-320}", "elastic.strain"),
         ("contact: {shear_modulus_gpa: 1.0e-320}", "contact.shear_modulus_gpa"),
         ("analysis: {p_gpa: [0.0, 1.0e-320]}", "analysis.p_gpa"),
-        ("contact: {maugis_lambda: 1.0e-320, work_of_adhesion_j_m2: 0.1}", "maugis_lambda"),
+        ("contact: {maugis_lambda: 1.0e-320, work_of_adhesion_j_per_m2: 0.1}", "maugis_lambda"),
     ],
 )
 def test_config_field_at_the_edge_is_one_line(section, field, tmp_path, capsys):
@@ -120,13 +123,20 @@ def test_config_field_at_the_edge_is_one_line(section, field, tmp_path, capsys):
         ["--radius-um", "1e-3", "--contact-modulus-gpa", "1e4", "--shear-modulus-gpa", "0.01"],
         ["--radius-um", "1e4", "--contact-modulus-gpa", "0.01", "--shear-modulus-gpa", "1e4"],
         ["--p0-gpa", "1e-6,1e3", "--tau0-mpa", "1e5", "--sigma0-mpa", "1e5"],
-        ["--work-of-adhesion-j-m2", "100", "--maugis-lambda", "1e-3"],
-        ["--work-of-adhesion-j-m2", "100", "--maugis-lambda", "1e3", "--radius-um", "1e4"],
+        ["--work-of-adhesion-j-per-m2", "100", "--maugis-lambda", "1e-3"],
+        ["--work-of-adhesion-j-per-m2", "100", "--maugis-lambda", "1e3", "--radius-um", "1e4"],
         [
-            *("--work-of-adhesion-j-m2", "1e-6", "--maugis-lambda", "1e-3", "--radius-um", "1e4"),
+            *(
+                "--work-of-adhesion-j-per-m2",
+                "1e-6",
+                "--maugis-lambda",
+                "1e-3",
+                "--radius-um",
+                "1e4",
+            ),
             *("--contact-modulus-gpa", "1e4", "--shear-modulus-gpa", "0.01", "--p0-gpa", "1e3"),
         ],
-        ["--work-of-adhesion-j-m2", "0", "--tau0-mpa", "0", "--sigma0-mpa", "0"],
+        ["--work-of-adhesion-j-per-m2", "0", "--tau0-mpa", "0", "--sigma0-mpa", "0"],
     ],
 )
 def test_contact_at_the_bounds_runs_clean(argv, capsys):
@@ -211,7 +221,7 @@ def _synthetic_rows() -> list[str]:
 
 def _tau0(path: Path, capsys) -> float:
     code, out, err = run_cli(
-        ["contact", "--p0-gpa", "1.77", "--experiment", str(path), "--json"], capsys
+        ["contact", "--p0-gpa", "1.77", "--experiment-csv", str(path), "--json"], capsys
     )
     assert code in (0, None), err
     return json.loads(out)["experiment"]["fitted_tau0_mpa"]
@@ -249,7 +259,7 @@ def test_shuffled_and_repeated_csv_gives_the_sorted_result(tmp_path, capsys):
 def test_impossible_csv_is_one_line_naming_file_and_row(body, line, words, tmp_path, capsys):
     path = tmp_path / "measured.csv"
     path.write_text(HEADER + body)
-    code, _, err = run_cli(["contact", "--p0-gpa", "1.77", "--experiment", str(path)], capsys)
+    code, _, err = run_cli(["contact", "--p0-gpa", "1.77", "--experiment-csv", str(path)], capsys)
     text = _clean_refusal(code, err, "measured.csv", *words)
     if line is not None:
         assert line in text

@@ -33,18 +33,17 @@ CASES: dict[tuple[str, str], tuple[list[str], list[str]]] = {
     ("build", "--gap-angstrom"): (["--out", "{tmp}/b"], [HUGE]),
     ("build", "--lj-cutoff-angstrom"): (["--out", "{tmp}/b"], ["1e6"]),
     ("build", "--fmax-ev-per-angstrom"): (["--out", "{tmp}/b"], [SUBNORMAL]),
-    ("build", "--normal-axis"): (["--out", "{tmp}/b"], ["7"]),
     ("contact", "--radius-um"): (["--out", "{tmp}/c"], [SUBNORMAL]),
     ("contact", "--contact-modulus-gpa"): (["--out", "{tmp}/c"], [HUGE]),
     ("contact", "--shear-modulus-gpa"): (["--out", "{tmp}/c"], [SUBNORMAL]),
     ("contact", "--burgers-angstrom"): (["--out", "{tmp}/c"], [SUBNORMAL]),
     ("contact", "--equilibrium-separation-angstrom"): (["--out", "{tmp}/c"], [HUGE]),
-    ("contact", "--unstable-stacking-mj-m2"): (["--out", "{tmp}/c"], [SUBNORMAL]),
+    ("contact", "--unstable-stacking-mj-per-m2"): (["--out", "{tmp}/c"], [SUBNORMAL]),
     ("contact", "--k-mpa-per-gpa"): (["--out", "{tmp}/c"], [HUGE]),
     ("contact", "--tau0-mpa"): (["--out", "{tmp}/c"], [HUGE]),
     ("contact", "--mu-mpa-per-gpa"): (["--out", "{tmp}/c"], [HUGE]),
     ("contact", "--sigma0-mpa"): (["--out", "{tmp}/c"], [HUGE]),
-    ("contact", "--work-of-adhesion-j-m2"): (["--out", "{tmp}/c"], [HUGE]),
+    ("contact", "--work-of-adhesion-j-per-m2"): (["--out", "{tmp}/c"], [HUGE]),
     ("contact", "--maugis-lambda"): (["--out", "{tmp}/c"], [SUBNORMAL]),
     ("contact", "--knee-fraction"): (["--out", "{tmp}/c"], ["1.5"]),
     ("contact", "--experiment-p0-gpa"): (["--out", "{tmp}/c"], [HUGE]),
@@ -142,7 +141,10 @@ LIST_CASES = {
         ["contact", "--out", "{tmp}/c", "--fit-p0-gpa", "1e-320"],
         "--fit-p0-gpa",
     ),
-    "scan-thickness-huge": (["scan", "--out", "{tmp}/s", "--thickness", "1e300"], "--thickness"),
+    "scan-thickness-huge": (
+        ["scan", "--out", "{tmp}/s", "--thickness-angstrom", "1e300"],
+        "--thickness-angstrom",
+    ),
 }
 
 

@@ -123,7 +123,7 @@ def test_a_link_planted_in_a_scan_out_is_refused(tmp_path, capsys, name):
     bait.write_text("keep\n")
     (out / name).symlink_to(bait)
     argv = ["scan", "--interface", iface, *TOY, "--grid", "2", "2"]
-    argv += ["--thickness", f"{thickness(reference):.4f}"]
+    argv += ["--thickness-angstrom", f"{thickness(reference):.4f}"]
     code, _, err = run_cli([*argv, "--out", out], capsys)
     refused(code, err, str(out / name), "symbolic link")
     assert bait.read_text() == "keep\n"
@@ -211,7 +211,7 @@ def test_a_refused_command_leaves_the_folder_above_out_untouched(tmp_path, monke
     monkeypatch.chdir(tmp_path)
     (tmp_path / "parent").mkdir()
     before = (tmp_path / "parent").stat().st_mtime_ns
-    argv = ["contact", "--experiment", tmp_path / "missing.csv", "--out", "parent/new/run"]
+    argv = ["contact", "--experiment-csv", tmp_path / "missing.csv", "--out", "parent/new/run"]
     assert_refused_cleanly(argv, capsys, tmp_path, ["missing.csv"])
     assert (tmp_path / "parent").stat().st_mtime_ns == before
     assert list((tmp_path / "parent").iterdir()) == []

@@ -202,7 +202,7 @@ def test_a_fifo_measured_csv_is_one_line_not_a_hang(tmp_path):
             "-m",
             "flatcontact",
             "contact",
-            "--experiment",
+            "--experiment-csv",
             str(fifo),
             "--out",
             str(tmp_path / "out"),

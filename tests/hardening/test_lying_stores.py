@@ -38,7 +38,7 @@ def scanned(tmp_path_factory):
     z0 = thickness(reference)
     iface = write_interface(reference, base / "iface.extxyz")
     argv = ["scan", "--interface", str(iface), *TOY, "--grid", "3", "3"]
-    argv += ["--thickness", f"{z0 - 0.1:.4f},{z0 + 0.1:.4f}", "--workers", "1"]
+    argv += ["--thickness-angstrom", f"{z0 - 0.1:.4f},{z0 + 0.1:.4f}", "--workers", "1"]
     with pytest.raises(SystemExit) as info:
         main([*argv, "--out", str(base / "scan")])
     assert info.value.code in (0, None)

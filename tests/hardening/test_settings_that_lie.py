@@ -1,5 +1,5 @@
-"""Settings that do nothing, or too late: the deprecated calculator: beside potential: (it
-replaced the potential silently), a Dask address with an empty host label (a UnicodeError
+"""Settings that do nothing, or too late: a top-level calculator: (an unknown key naming
+potential.calculator), a Dask address with an empty host label (a UnicodeError
 traceback), uncertainty widths that are not normal finite floats within a bound (1e200 went
 into laws.json as Infinity, 5e-324 broke the file contract) are one line at config --check."""
 
@@ -23,32 +23,31 @@ def _check(tmp_path, capsys, text):
     return run_cli(["config", "--check", conf], capsys)
 
 
-def test_the_deprecated_calculator_beside_potential_is_one_line(tmp_path, capsys):
+def test_a_top_level_calculator_beside_potential_is_one_line(tmp_path, capsys):
     text = TOY.replace("potential:", "calculator: {target: x:y}\npotential:")
     code, _, err = _check(tmp_path, capsys, text)
-    refused(code, err, "c.yaml", "calculator", "potential")
+    refused(code, err, "c.yaml", "calculator: unknown field", "potential.calculator")
 
 
-def test_the_deprecated_calculator_alone_still_reads(tmp_path, capsys):
+def test_a_top_level_calculator_alone_is_refused_naming_its_home(tmp_path, capsys):
     text = TOY.replace(
         'potential: {calculator: {target: "flatcontact.ispes.toy:toy_calculator"}}',
         'calculator: {target: "flatcontact.ispes.toy:toy_calculator"}',
     )
     code, _, err = _check(tmp_path, capsys, text)
-    assert code == 0, err
+    refused(code, err, "c.yaml", "calculator: unknown field", "potential.calculator")
 
 
 def test_scan_calculator_flag_over_a_configuration_still_works(tmp_path):
-    """The flag lays calculator: over the file's whole settings (a potential section
-    included): that is not the user's file holding both."""
+    """The flag lays potential.calculator over the file's whole settings (a potential
+    section included): the file's model is replaced, not merged."""
     from flatcontact.cli.settings import resolve_config
 
     conf = tmp_path / "c.yaml"
     conf.write_text(TOY)
     target = "flatcontact.ispes.toy:toy_calculator"
-    cfg = resolve_config(
-        conf, None, {"calculator": {"target": target, "kwargs": {"eps_cross_ev": 0.02}}}, {}
-    )
+    calc = {"target": target, "kwargs": {"eps_cross_ev": 0.02}}
+    cfg = resolve_config(conf, None, {"potential": {"calculator": calc}}, {})
     assert cfg.potential.calculator.kwargs == {"eps_cross_ev": 0.02}
 
 

@@ -32,7 +32,7 @@ from flatcontact import Pipeline, build_config
 
 cfg = build_config({
     "structure": {"kind": "toy-lj", "layers": 3},
-    "calculator": {"target": "flatcontact.ispes.toy:toy_calculator"},
+    "potential": {"calculator": {"target": "flatcontact.ispes.toy:toy_calculator"}},
     "scan": {"grid": [3, 3], "p_range_gpa": {"lo_gpa": -0.2, "hi_gpa": 1.5, "n": 4},
              "executor": "processes", "workers": 2},
     "analysis": {"p_gpa": [0.0, 0.5, 1.0]},

@@ -4,7 +4,7 @@ A calculator factory (a user module, as ``calculator:`` allows) whose calculator
 numpy's overflow warning and a third-party ``UserWarning`` on every call: ``flatcontact run``
 finishes with exit 0 and prints one summary ``warning:`` line for all of them (no
 ``RuntimeWarning: overflow`` line per point); the run's ``run.log`` has each. flatcontact's
-own dated deprecations stay one line each, and a refused command prints only its error line.
+own dated deprecations stay one line each (an old settings key is an error line), and a refused command prints only its error line.
 Outside the command line (library callers, these tests) the warnings are raised as Python
 raises them.
 """
@@ -70,14 +70,14 @@ def test_a_refused_command_prints_only_its_error(noisy_run, tmp_path, capsys):
     assert len(err.strip().splitlines()) == 1 and "scan.max_steps" in err, err
 
 
-def test_flatcontact_deprecations_stay_one_line_each(tmp_path, capsys):
+def test_an_old_key_is_one_error_line_naming_the_setting_it_became(tmp_path, capsys):
     old = tmp_path / "old.yaml"
     old.write_text("contact:\n  experiment_p0_gpa: 1.5\n")
     code, _, err = run_cli(["config", "--check", old], capsys)
-    assert code == 0, err
+    assert code == 2, err
     assert err.strip().splitlines() == [
-        "warning: DeprecationWarning: contact.experiment_p0_gpa is deprecated since "
-        "2026-11-25: use contact.experiment.p0_gpa"
+        f"error: {old}: contact.experiment_p0_gpa: unknown field "
+        "(did you mean contact.experiment.p0_gpa?)"
     ]
 
 

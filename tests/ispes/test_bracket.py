@@ -202,7 +202,7 @@ def test_the_scan_extends_its_grid_until_every_column_brackets(
     from flatcontact.ispes.scan import run_scan
 
     grid = GridSpec(2, 2, p_range_gpa=(0.0, 0.3, 4))
-    settings = RelaxSettings(fmax_ev_per_a=1e-4)
+    settings = RelaxSettings(fmax_ev_per_angstrom=1e-4)
     loads = [-0.01, 0.0, 0.2, 0.4]  # below P = 0 and above HI = 0.3 GPa
     first = run_scan(
         toy_reference,

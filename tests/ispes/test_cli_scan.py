@@ -30,8 +30,9 @@ def test_cli_scan_and_rerun(tmp_path, toy_file, toy_reference, capsys):
     z0 = thickness(toy_reference)
     cfg = tmp_path / "run.yaml"
     cfg.write_text(
-        "calculator:\n"
-        f"  target: {TOY}\n"
+        "potential:\n"
+        "  calculator:\n"
+        f"    target: {TOY}\n"
         "scan:\n"
         "  grid: [2, 2]\n"
         f"  thickness_angstrom: [{z0 - 0.2}, {z0 + 0.2}]\n"
@@ -138,23 +139,39 @@ def test_flags_override_the_file_and_keep_the_rest(tmp_path):
 @pytest.mark.parametrize(
     ("extra", "match"),
     [
-        (["--potential", "nosuchpot", "--thickness", "11"], "unknown potential 'nosuchpot'"),
-        (["--potential", "/nope/X.snapcoeff", "--thickness", "11"], "not found"),
-        (["--potential", "vashishta", "--thickness", "11"], "element"),
-        (["--thickness", "11"], f"potential '{default_potential()['intra']}'"),
+        (
+            ["--potential", "nosuchpot", "--thickness-angstrom", "11"],
+            "unknown potential 'nosuchpot'",
+        ),
+        (["--potential", "/nope/X.snapcoeff", "--thickness-angstrom", "11"], "not found"),
+        (["--potential", "vashishta", "--thickness-angstrom", "11"], "element"),
+        (["--thickness-angstrom", "11"], f"potential '{default_potential()['intra']}'"),
         (["--potential", "/nope/spec.json"], "no such potential spec file"),
         (["--potential", "vashishta", "--calculator", TOY], "not both"),
         (["--calculator", TOY, "--grid", "0", "2"], "--grid: expected two positive integers"),
-        (["--calculator", TOY, "--thickness", "5"], "overlap"),
-        (["--calculator", TOY, "--thickness", "11,x"], "--thickness: 'x' is not a number"),
+        (["--calculator", TOY, "--thickness-angstrom", "5"], "overlap"),
         (
-            ["--calculator", TOY, "--thickness", "-1"],
-            "--thickness (scan.thickness_angstrom.0): expected 0.1 <= value <= 1000 Å",
+            ["--calculator", TOY, "--thickness-angstrom", "11,x"],
+            "--thickness-angstrom: 'x' is not a number",
+        ),
+        (
+            ["--calculator", TOY, "--thickness-angstrom", "-1"],
+            "--thickness-angstrom (scan.thickness_angstrom.0): expected 0.1 <= value <= 1000 Å",
         ),
         (["--calculator", TOY, "--p-range-gpa", "2", "1", "4"], "--p-range-gpa"),
-        (["--calculator", TOY, "--thickness", "11", "--p-range-gpa", "0", "1", "3"], "not both"),
         (
-            ["--calculator", TOY, "--thickness", "11", "--dask-address", "tcp://127.0.0.1:9"],
+            ["--calculator", TOY, "--thickness-angstrom", "11", "--p-range-gpa", "0", "1", "3"],
+            "not both",
+        ),
+        (
+            [
+                "--calculator",
+                TOY,
+                "--thickness-angstrom",
+                "11",
+                "--dask-address",
+                "tcp://127.0.0.1:9",
+            ],
             "no Dask scheduler",
         ),
         (["--calculator", TOY, "--workers", "0"], "--workers: expected a value >= 1, got 0"),

@@ -26,7 +26,7 @@ from flatcontact.ispes.scan import run_scan
 from flatcontact.potentials.engines import calculator_factory
 from flatcontact.potentials.model import InteractionModel
 
-SETTINGS = RelaxSettings(fmax_ev_per_a=1e-4, optimizer="FIRE")
+SETTINGS = RelaxSettings(fmax_ev_per_angstrom=1e-4, optimizer="FIRE")
 
 
 def _rows(db):

@@ -22,7 +22,7 @@ from flatcontact.ispes.store import discard_store
 from flatcontact.layout import PROBE_JSON
 from flatcontact.structures.toy import ToyPairCalculator
 
-SETTINGS = RelaxSettings(fmax_ev_per_a=1e-4, optimizer="FIRE")
+SETTINGS = RelaxSettings(fmax_ev_per_angstrom=1e-4, optimizer="FIRE")
 GRID = GridSpec(3, 3, p_range_gpa=(-0.05, 0.5, 4))
 
 
@@ -190,7 +190,7 @@ def test_a_unit_is_reused_only_under_its_own_inputs(
     _same_ispes(tmp_path / "fresh" / "ispes.nc", out / "ispes.nc")
 
     discard_store(out / "points.db")
-    looser = RelaxSettings(fmax_ev_per_a=2e-4, optimizer="FIRE")
+    looser = RelaxSettings(fmax_ev_per_angstrom=2e-4, optimizer="FIRE")
     with warnings.catch_warnings():
         warnings.simplefilter("error", ProbeUnitsReused)
         run_scan(toy_reference, toy_factory, other, out, looser, executor=SerialExecutor())

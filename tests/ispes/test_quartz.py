@@ -11,7 +11,7 @@ from flatcontact.ispes.geometry import in_plane_vectors, thickness
 from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point
 from flatcontact.units import EV_PER_A3_TO_GPA
 
-TIGHT = RelaxSettings(fmax_ev_per_a=1e-4, optimizer="LBFGS", max_steps=5000)
+TIGHT = RelaxSettings(fmax_ev_per_angstrom=1e-4, optimizer="LBFGS", max_steps=5000)
 
 
 @pytest.fixture(scope="module")

@@ -14,7 +14,7 @@ from flatcontact.structures.construct import build_interface
 from flatcontact.structures.toy import ToyPairCalculator
 from flatcontact.units import EV_PER_A3_TO_GPA
 
-TIGHT = RelaxSettings(fmax_ev_per_a=1e-5, optimizer="BFGS", max_steps=5000)
+TIGHT = RelaxSettings(fmax_ev_per_angstrom=1e-5, optimizer="BFGS", max_steps=5000)
 
 
 def relaxed(ref, a, b, z, settings=TIGHT, calc=None):
@@ -37,7 +37,7 @@ def test_fixed_atoms_stay_fixed_and_free_atoms_converge(toy_reference):
     fixed = fixed_mask(toy_reference)
     np.testing.assert_array_equal(r.positions[fixed], placed.positions[fixed])
     assert np.abs(r.positions[~fixed] - placed.positions[~fixed]).max() > 1e-3  # something relaxed
-    assert r.converged and r.max_force_ev_per_a < TIGHT.fmax_ev_per_a
+    assert r.converged and r.max_force_ev_per_a < TIGHT.fmax_ev_per_angstrom
     assert r.force_calls >= r.steps >= 1
 
 
@@ -59,7 +59,7 @@ def test_load_is_minus_energy_derivative_along_a_column(toy_reference):
 def test_rigid_body_load_is_robust_to_loose_tolerance(toy_reference):
     """At separation the load is zero; the fixed-atom reaction keeps the free atoms' residual."""
     z = thickness(toy_reference) + 8.0  # beyond the 6.25 Å cross cutoff
-    loose = RelaxSettings(fmax_ev_per_a=2e-2, optimizer="FIRE")
+    loose = RelaxSettings(fmax_ev_per_angstrom=2e-2, optimizer="FIRE")
     r = relaxed(toy_reference, 0.2, 0.3, z, settings=loose)
     assert abs(r.normal_stress_gpa) < 1e-12
     assert r.converged
@@ -90,7 +90,7 @@ def test_mirror_symmetric_shifts_give_the_same_point(toy_reference):
 
 def test_warm_start_lands_on_the_same_point_with_fewer_force_calls(toy_reference):
     z0 = thickness(toy_reference)
-    settings = RelaxSettings(fmax_ev_per_a=1e-4, optimizer="FIRE")
+    settings = RelaxSettings(fmax_ev_per_angstrom=1e-4, optimizer="FIRE")
     calc = ToyPairCalculator()
     neighbour = relax_point(
         toy_reference, calc, PointTask((0, 0, 0), 0.25, 0.25, z0 - 0.2), settings
@@ -166,7 +166,7 @@ def test_AB_and_BA_bilayer_are_equal_in_every_mode(mode):
     """Bilayer of monolayers, each held whole: AB (2/3, 1/3) and BA (1/3, 2/3) from AA."""
     ref = _sheets(1)
     z = thickness(ref)
-    settings = RelaxSettings(fmax_ev_per_a=1e-6, optimizer="BFGS", max_steps=5000, mode=mode)
+    settings = RelaxSettings(fmax_ev_per_angstrom=1e-6, optimizer="BFGS", max_steps=5000, mode=mode)
     ab = relaxed(ref, 2 / 3, 1 / 3, z, settings, SheetPairCalculator())
     ba = relaxed(ref, 1 / 3, 2 / 3, z, settings, SheetPairCalculator())
     aa = relaxed(ref, 0.0, 0.0, z, settings, SheetPairCalculator())
@@ -183,7 +183,7 @@ def test_mirror_related_shifts_stay_equal_with_free_layers(mode):
     ref = _sheets(2)
     assert ref.arrays["held"].tolist() == [True, True, False, False, False, False, True, True]
     z = thickness(ref) - 0.3
-    settings = RelaxSettings(fmax_ev_per_a=1e-6, optimizer="BFGS", max_steps=5000, mode=mode)
+    settings = RelaxSettings(fmax_ev_per_angstrom=1e-6, optimizer="BFGS", max_steps=5000, mode=mode)
     for a, b in ((0.23, 0.11), (2 / 3, 1 / 3)):
         plus = relaxed(ref, a, b, z, settings, SheetPairCalculator())
         minus = relaxed(ref, -a, -b, z, settings, SheetPairCalculator())
@@ -203,7 +203,9 @@ def test_modes_are_nested_minimisations():
     free = ~fixed_mask(ref)
     layer = ref.arrays["layer"]
     for mode in ("rigid", "rigid-layers", "normal", "full"):
-        settings = RelaxSettings(fmax_ev_per_a=1e-6, optimizer="BFGS", max_steps=5000, mode=mode)
+        settings = RelaxSettings(
+            fmax_ev_per_angstrom=1e-6, optimizer="BFGS", max_steps=5000, mode=mode
+        )
         r = relaxed(ref, 0.23, 0.11, z, settings, SheetPairCalculator())
         assert r.converged
         energies[mode] = r.energy_ev
@@ -235,7 +237,7 @@ def test_constrained_modes_load_is_minus_energy_derivative(toy_reference, mode):
     a1, a2 = in_plane_vectors(toy_reference)
     area = cell_area(a1, a2)
     z0, h = thickness(toy_reference) - 0.2, 2e-3
-    settings = RelaxSettings(fmax_ev_per_a=1e-6, optimizer="BFGS", max_steps=5000, mode=mode)
+    settings = RelaxSettings(fmax_ev_per_angstrom=1e-6, optimizer="BFGS", max_steps=5000, mode=mode)
     lo, mid, hi = (relaxed(toy_reference, 0.21, 0.43, z0 + d, settings) for d in (-h, 0.0, h))
     fd_gpa = -(hi.energy_ev - lo.energy_ev) / (2 * h) / area * EV_PER_A3_TO_GPA
     assert mid.normal_stress_gpa == pytest.approx(fd_gpa, abs=2e-3)
@@ -274,8 +276,8 @@ def test_warm_start_keeps_the_mode_constraints(mode):
     """A warm start from a fully relaxed neighbour lands on the same constrained minimum."""
     ref = _sheets(2)
     z = thickness(ref) - 0.3
-    tight = RelaxSettings(fmax_ev_per_a=1e-6, optimizer="BFGS", max_steps=5000, mode=mode)
-    full = RelaxSettings(fmax_ev_per_a=1e-6, optimizer="BFGS", max_steps=5000)
+    tight = RelaxSettings(fmax_ev_per_angstrom=1e-6, optimizer="BFGS", max_steps=5000, mode=mode)
+    full = RelaxSettings(fmax_ev_per_angstrom=1e-6, optimizer="BFGS", max_steps=5000)
     calc = SheetPairCalculator()
     neighbour = relax_point(ref, calc, PointTask((0, 0, 0), 0.2, 0.1, z), full)
     cold = relax_point(ref, calc, PointTask((1, 0, 0), 0.3, 0.1, z), tight)

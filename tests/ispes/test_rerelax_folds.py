@@ -114,7 +114,7 @@ def test_a_fold_from_a_point_stopped_above_its_minimum_is_re_relaxed_away(
     fixed, done = rerelax_folds(
         toy_reference, toy_factory, ds, work / POINTS_DB, settings, RELAX, LOADS_GPA
     )
-    assert done.fmax_ev_per_a == pytest.approx(RELAX.fmax_ev_per_a * FMAX_FACTOR)
+    assert done.fmax_ev_per_angstrom == pytest.approx(RELAX.fmax_ev_per_angstrom * FMAX_FACTOR)
     assert done.surviving == [] and [w.column for w in done.remedied] == [(0, 0)]
     assert fold_windows(fixed, LOADS_GPA) == []
     # the load falls with z again along the whole compressed side of the column
@@ -130,7 +130,7 @@ def test_a_fold_from_a_point_stopped_above_its_minimum_is_re_relaxed_away(
     # the scan's own store is left as it was; the re-relaxed points are a store of their own
     # (same row contract, the tighter fmax in its settings), which reopens without repair
     assert _dataset(work, settings, toy_reference)["energy"].values[0, 0, k] == raised
-    tight = {**settings, "relax": {**settings["relax"], "fmax_ev_per_a": done.fmax_ev_per_a}}
+    tight = {**settings, "relax": {**settings["relax"], "fmax_ev_per_a": done.fmax_ev_per_angstrom}}
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         with PointStore(work / RERELAX_DB, tight, toy_reference) as store:
@@ -224,16 +224,17 @@ def test_a_fold_of_the_interaction_survives_and_the_analysis_refuses_it_with_the
         constant_pressure(fixed, LOADS_GPA, form="internal")
     line = str(info.value)
     assert "\n" not in line and "fold" in line
-    assert f"at fmax {done.fmax_ev_per_a:g} eV/Å and the fold survived" in line
+    assert f"at fmax {done.fmax_ev_per_angstrom:g} eV/Å and the fold survived" in line
     assert "scan.relax_mode: normal" in line and "scan.thickness_angstrom" in line
     assert "analysis.p_gpa" in line
 
 
 FOLDED_RUN = """\
 structure: {kind: toy-lj, layers: 3}
-calculator:
-  target: "tests.ispes.fold_toy:folded_toy"
-  kwargs: {z0_angstrom: 11.1, width_angstrom: 0.05, bump_gpa: 1.5}
+potential:
+  calculator:
+    target: "tests.ispes.fold_toy:folded_toy"
+    kwargs: {z0_angstrom: 11.1, width_angstrom: 0.05, bump_gpa: 1.5}
 scan:
   grid: [3, 3]
   thickness_angstrom: [10.95, 11.0, 11.05, 11.1, 11.15, 11.2, 11.25, 11.3, 11.35, 11.4, 11.5, 11.6, 11.7]

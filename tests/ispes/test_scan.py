@@ -19,7 +19,7 @@ from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.relax import RelaxSettings
 from flatcontact.ispes.scan import run_scan
 
-SETTINGS = RelaxSettings(fmax_ev_per_a=1e-4, optimizer="FIRE")
+SETTINGS = RelaxSettings(fmax_ev_per_angstrom=1e-4, optimizer="FIRE")
 
 
 def _grid(ref, n=2):
@@ -71,7 +71,7 @@ def test_store_with_other_settings_is_refused(tmp_path, toy_reference, toy_facto
         SETTINGS,
         executor=SerialExecutor(),
     )
-    other = RelaxSettings(fmax_ev_per_a=1e-3, optimizer="FIRE")
+    other = RelaxSettings(fmax_ev_per_angstrom=1e-3, optimizer="FIRE")
     with pytest.raises(
         InputError, match=r"relax\.fmax_ev_per_a: 0\.0001 in the store vs 0\.001 now"
     ) as err:
@@ -134,7 +134,7 @@ def test_executors_give_the_same_grid(tmp_path, toy_reference, toy_factory, thic
 def test_warm_start_orders_agree_within_tolerance(tmp_path, toy_reference, toy_factory):
     z0 = thickness(toy_reference)
     grid = GridSpec(3, 3, thickness_angstrom=tuple(z0 + np.linspace(-0.15, 0.15, 4)))
-    settings = RelaxSettings(fmax_ev_per_a=1e-4, optimizer="LBFGS")
+    settings = RelaxSettings(fmax_ev_per_angstrom=1e-4, optimizer="LBFGS")
     runs = {
         o: run_scan(
             toy_reference,
@@ -175,7 +175,7 @@ KILLED_RUN = textwrap.dedent(
     toy = InteractionModel(calculator={"target": "flatcontact.ispes.toy:toy_calculator"})
     run_scan(ref, calculator_factory(toy),
              GridSpec(6, 6, thickness_angstrom=(z0 - 0.25, z0 + 0.3)), sys.argv[1],
-             RelaxSettings(fmax_ev_per_a=1e-4, optimizer="FIRE"), executor=SerialExecutor())
+             RelaxSettings(fmax_ev_per_angstrom=1e-4, optimizer="FIRE"), executor=SerialExecutor())
     """
 )
 

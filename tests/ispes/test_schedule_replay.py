@@ -17,7 +17,7 @@ from flatcontact.ispes.scan import run_scan
 from flatcontact.ispes.scan_probe import MANY_WORKERS
 from flatcontact.units import EV_PER_A3_TO_GPA
 
-SETTINGS = RelaxSettings(fmax_ev_per_a=1e-3)
+SETTINGS = RelaxSettings(fmax_ev_per_angstrom=1e-3)
 #: HI high enough that the compression runs over several segments of 3 steps
 GRID = GridSpec(3, 3, p_range_gpa=(-0.05, 3.0, 4))
 
@@ -144,7 +144,7 @@ def test_many_workers_give_the_sequential_grid_to_the_tolerance(
     assert 0 < np.abs(dz).max() < 0.01  # moved, by less than a tenth of the probe's step
     area = float(s.attrs["area"])
     p_s = s.normal_stress.values
-    fmax_gpa = SETTINGS.fmax_ev_per_a / area * EV_PER_A3_TO_GPA
+    fmax_gpa = SETTINGS.fmax_ev_per_angstrom / area * EV_PER_A3_TO_GPA
     first_order_u = s.energy.values - p_s / EV_PER_A3_TO_GPA * area * dz
     np.testing.assert_allclose(m.energy.values, first_order_u, rtol=0, atol=1e-5)
     first_order_p = p_s + np.gradient(p_s, z, axis=-1) * dz

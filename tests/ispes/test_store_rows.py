@@ -188,7 +188,7 @@ KILLED_SCAN = textwrap.dedent(
     try:
         run_scan(ref, calculator_factory(toy),
                  GridSpec(6, 6, thickness_angstrom=(z0 - 0.25, z0 + 0.3)), sys.argv[1],
-                 RelaxSettings(fmax_ev_per_a=1e-4, optimizer="FIRE"), executor=pool,
+                 RelaxSettings(fmax_ev_per_angstrom=1e-4, optimizer="FIRE"), executor=pool,
                  progress=lambda done, total: print(done, flush=True))
     finally:
         pool.close(cancel=True)
@@ -235,7 +235,7 @@ def test_scan_killed_mid_grid_on_workers_resumes_to_the_uninterrupted_grid(
     assert 0 < kept < 72, "the scan was not killed mid-grid"
     if signum == signal.SIGTERM:
         assert kept >= stored, "SIGTERM lost stored points"
-    settings = RelaxSettings(fmax_ev_per_a=1e-4, optimizer="FIRE")
+    settings = RelaxSettings(fmax_ev_per_angstrom=1e-4, optimizer="FIRE")
     z0 = thickness(toy_reference)
     grid = GridSpec(6, 6, thickness_angstrom=(z0 - 0.25, z0 + 0.3))
     resumed = run_scan(toy_reference, toy_factory, grid, out, settings, executor=SerialExecutor())

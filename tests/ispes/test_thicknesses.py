@@ -126,7 +126,7 @@ def test_toy_lj_every_extreme_column_reaches_the_requested_loads(toy_reference, 
     from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point
 
     calc = toy_factory(toy_reference)
-    relax_settings = RelaxSettings(fmax_ev_per_a=1e-4)
+    relax_settings = RelaxSettings(fmax_ev_per_angstrom=1e-4)
 
     def relax(a, b, z, start, start_z):
         task = PointTask((0, 0, 0), a, b, z, start, (a, b) if start is not None else None, start_z)

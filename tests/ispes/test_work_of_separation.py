@@ -59,7 +59,7 @@ def test_cu111_work_of_separation_is_twice_the_surface_energy(mode):
     )
     factory = calculator_factory(InteractionModel(preset="cu-eam"))
     w = ideal_work_of_separation(
-        interface, factory, RelaxSettings(fmax_ev_per_a=1e-4, mode=mode), (0.0, 0.0)
+        interface, factory, RelaxSettings(fmax_ev_per_angstrom=1e-4, mode=mode), (0.0, 0.0)
     )
     assert w.converged
     assert abs(w.zero_load_stress_gpa) < 0.01
@@ -119,7 +119,7 @@ def test_toy_relaxed_work_of_separation_matches_an_ase_relaxation():
     factory = calculator_factory(
         InteractionModel(calculator={"target": "flatcontact.ispes.toy:toy_calculator"})
     )
-    w = ideal_work_of_separation(ref, factory, RelaxSettings(fmax_ev_per_a=1e-5), (0.0, 0.0))
+    w = ideal_work_of_separation(ref, factory, RelaxSettings(fmax_ev_per_angstrom=1e-5), (0.0, 0.0))
 
     def relaxed(atoms, constraints):
         atoms = atoms.copy()
@@ -153,7 +153,7 @@ def test_hand_written_thicknesses_keep_the_work_of_separation(tmp_path):
     factory = calculator_factory(
         InteractionModel(calculator={"target": "flatcontact.ispes.toy:toy_calculator"})
     )
-    relax = RelaxSettings(fmax_ev_per_a=1e-4)
+    relax = RelaxSettings(fmax_ev_per_angstrom=1e-4)
     z0 = thickness(ref)
     auto = run_scan(
         ref,

@@ -49,21 +49,22 @@ def test_default_structure_section_keeps_the_fingerprint_of_runs_before_recipes(
     assert _build_structure_inputs(kept, tmp_path / "kept") == earlier
 
 
-def test_legacy_flat_structure_keys_are_converted(tmp_path):
+@pytest.mark.parametrize("key", ["face_depth_angstrom: 2.0", "normal_axis: 2", "layers: 6"])
+def test_a_key_the_recipe_lacks_is_refused_naming_it(tmp_path, key):
     slab = tmp_path / "slab.extxyz"
     from ase.build import fcc111
 
     fcc111("Cu", (1, 1, 3), vacuum=5.0, a=3.615).write(slab)
     path = tmp_path / "c.yaml"
     path.write_text(
-        "structure: {kind: slab, file: slab.extxyz, face_depth_angstrom: 2.0, normal_axis: 2, "
-        "layers: 6, source: auto}\npotential: {preset: cu-eam}\nelastic: {enabled: false}\n"
-        "contact: {contact_modulus_gpa: 70, shear_modulus_gpa: 55}\n"
+        "structure: {kind: slab, file: slab.extxyz}\npotential: {preset: cu-eam}\n"
+        "elastic: {enabled: false}\ncontact: {contact_modulus_gpa: 70, shear_modulus_gpa: 55}\n"
     )
     cfg = load_config(path)
     assert cfg.structure.kind == "slab" and cfg.structure.file == str(slab.resolve())
-    path.write_text(path.read_text().replace("normal_axis: 2", "normal_axis: 0"))
-    with pytest.raises(InputError, match=r"structure.normal_axis=0"):
+    path.write_text(path.read_text().replace("slab.extxyz}", f"slab.extxyz, {key}}}"))
+    name = key.partition(":")[0]
+    with pytest.raises(InputError, match=rf"c\.yaml: structure\.{name}: unknown field$"):
         load_config(path)
 
 

@@ -156,7 +156,7 @@ def test_contact_uses_the_fitted_laws(tiny_run):
         assert prov[key] == "fitted laws"
         assert params[key] == pytest.approx(laws[key])
     scan = json.loads((root / "02-scan" / "scan.json").read_text())
-    assert params["work_of_adhesion_j_m2"] == pytest.approx(
+    assert params["work_of_adhesion_j_per_m2"] == pytest.approx(
         scan["adhesion"]["work_of_separation_j_per_m2"]
     )
     with xr.open_dataset(root / "06-contact" / "contact.nc", engine="h5netcdf") as ds:
@@ -390,10 +390,11 @@ def _points(db: Path) -> dict:
 
 def test_kill_9_mid_scan_then_rerun_loses_nothing(tiny_run, tmp_path):
     src, _, _ = tiny_run
-    data = _merge(
-        TINY,
-        {"structure": {"kind": "file", "file": str(src / "01-build" / "interface.extxyz")}},
-    )
+    # another recipe kind replaces the structure section whole (the quartz keys do not apply)
+    data = {
+        **TINY,
+        "structure": {"kind": "file", "file": str(src / "01-build" / "interface.extxyz")},
+    }
     cfg_path = tmp_path / "run.yaml"
     cfg_path.write_text(json.dumps(data))  # JSON is YAML
     root = tmp_path / "killed"
@@ -489,7 +490,7 @@ def _range_flags(root) -> list[str]:
         path = path_facts(ds)
     return [
         f"--equilibrium-separation-angstrom={gap!r}",
-        f"--unstable-stacking-mj-m2={1e3 * path['unstable_stacking_j_m2']!r}",
+        f"--unstable-stacking-mj-per-m2={1e3 * path['unstable_stacking_j_per_m2']!r}",
         f"--burgers-angstrom={path['burgers_angstrom']!r}",
     ]
 
@@ -643,7 +644,7 @@ def test_each_stage_through_the_cli_writes_the_files_of_the_run(tiny_run, tmp_pa
     # the run's z0 (the built interface's gap) and its sliding path's γ_us, b as flags
     flags += _range_flags(src)
     _cli(["contact", "--p0-gpa", p0, *flags, "--no-svg", "--out", str(out),
-          f"--work-of-adhesion-j-m2={w['work_of_separation_j_per_m2']!r}"])  # fmt: skip
+          f"--work-of-adhesion-j-per-m2={w['work_of_separation_j_per_m2']!r}"])  # fmt: skip
     _same_netcdf(out / "contact.nc", src / "06-contact" / "contact.nc")
     ours = json.loads((out / "summary.json").read_text())
     run = json.loads((src / "06-contact" / "summary.json").read_text())
@@ -730,7 +731,7 @@ def test_cycle_and_fit_in_a_run_match_the_cli_and_the_fit_file_content_reruns_co
 
     flags = [f"--{k.replace('_', '-')}={v!r}" for k, v in fitted.items()] + _range_flags(root)
     argv = ["contact", "--p0-gpa", ",".join(map(str, TINY["contact"]["p0_gpa"])), *flags]
-    argv += ["--cycle", "--cycle-amplitude-fractions", "0.4,0.8", "--fit", str(csv), "--json"]
+    argv += ["--cycle", "--cycle-amplitude-fractions", "0.4,0.8", "--fit-csv", str(csv), "--json"]
     with pytest.raises(SystemExit) as exc:
         main(argv)
     assert exc.value.code in (0, None)

@@ -3,7 +3,7 @@
 from flatcontact.stages._common import rename
 
 CORE_TO_SETTINGS = {"p_gpa": "analysis.p_gpa", "form": "analysis.energy_form"}
-SETTINGS_TO_FLAG = {"analysis.p_gpa": "--p-gpa", "analysis.energy_form": "--energy"}
+SETTINGS_TO_FLAG = {"analysis.p_gpa": "--p-gpa", "analysis.energy_form": "--energy-form"}
 
 
 def test_a_core_parameter_becomes_the_settings_path_then_the_flag():
@@ -11,7 +11,7 @@ def test_a_core_parameter_becomes_the_settings_path_then_the_flag():
     settings = rename(core, CORE_TO_SETTINGS)
     assert settings == "analysis.energy_form: expected one of internal, enthalpy, got 'gibbs'"
     assert rename(settings, SETTINGS_TO_FLAG) == (
-        "--energy: expected one of internal, enthalpy, got 'gibbs'"
+        "--energy-form: expected one of internal, enthalpy, got 'gibbs'"
     )
     # a message naming no parameter is unchanged by both
     other = "P = 90 GPa is outside the data of ispes.nc"

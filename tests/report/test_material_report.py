@@ -142,9 +142,9 @@ def _stage_folders(tmp_path, atoms, build_record, laws, stackings, elastic=None,
             "tau0_mpa": laws["tau0_mpa"],
             "mu_mpa_per_gpa": laws["mu_mpa_per_gpa"],
             "sigma0_mpa": laws["sigma0_mpa"],
-            "work_of_adhesion_j_m2": 2.48,
+            "work_of_adhesion_j_per_m2": 2.48,
         },
-        "provenance": {"moduli": "elastic stage", "work_of_adhesion_j_m2": "scan"},
+        "provenance": {"moduli": "elastic stage", "work_of_adhesion_j_per_m2": "scan"},
         # Hertz at p0 = 1 GPa, R = 5 µm, E* = 73 GPa: a = pi p0 R / (2 E*), P = 2/3 pi a^2 p0
         "results": [
             {

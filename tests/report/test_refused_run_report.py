@@ -27,7 +27,7 @@ from flatcontact.report.sections.refusal import (
 
 REFUSED_YAML = """\
 structure: {kind: toy-lj, layers: 3}
-calculator: {target: "flatcontact.ispes.toy:toy_calculator"}
+potential: {calculator: {target: "flatcontact.ispes.toy:toy_calculator"}}
 scan:
   grid: [7, 7]
   p_range_gpa: {lo_gpa: -0.2, hi_gpa: 1.5, n: 4}
@@ -193,14 +193,14 @@ def test_after_accept_untrusted_the_box_names_the_numbers_that_flowed_on():
             "sigma0_mpa": 130.2,
             "contact_modulus_gpa": 52.5,
             "shear_modulus_gpa": 29.0,
-            "work_of_adhesion_j_m2": 0.18,
+            "work_of_adhesion_j_per_m2": 0.18,
         },
         "provenance": {
             "k_mpa_per_gpa": "config",
             "tau0_mpa": "fitted laws",
             "mu_mpa_per_gpa": "fitted laws",
             "sigma0_mpa": "fitted laws",
-            "work_of_adhesion_j_m2": "scan work of separation",
+            "work_of_adhesion_j_per_m2": "scan work of separation",
             "moduli": "config",
         },
         "results": [{"p0_gpa": 0.5}, {"p0_gpa": 1.0}],

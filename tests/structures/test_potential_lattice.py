@@ -199,7 +199,7 @@ def test_the_isf_energy_of_the_built_slab_is_the_plain_lammps_one_at_4_0817(tmp_
     cfg = _al_config(tmp_path)
     built = build_stage(cfg, BuildInputs(), None).atoms
     calc = make_calculator(cfg.potential, built)
-    relax = RelaxSettings(fmax_ev_per_a=1e-4, mode="normal")
+    relax = RelaxSettings(fmax_ev_per_angstrom=1e-4, mode="normal")
     a1, a2 = in_plane_vectors(built)
     # the two three-fold sites: (a1 + a2)/3 and 2(a1 + a2)/3 for a 60° cell, else (120°)
     # (a1 + 2 a2)/3 and (2 a1 + a2)/3; one is the fault, the other the on-top stacking

@@ -1,4 +1,4 @@
-"""Issue 13 wiring: ``contact --cycle/--model/--fit`` and the same settings in a run config.
+"""Issue 13 wiring: ``contact --cycle/--cycle-model/--fit-csv`` and the same settings in a run config.
 
 The CLI and the contact stage of ``flatcontact run`` (``contact_stage`` with a config read by
 ``load_config``) must give the same cycle rows and fit results; the cycle rows must obey
@@ -69,7 +69,7 @@ def test_classical_model_is_mindlin_deresiewicz_with_mu_equal_k(capsys):
             "--p0-gpa",
             "1",
             "--cycle",
-            "--model",
+            "--cycle-model",
             "classical",
             "--cycle-amplitude-fractions",
             "0.5,0.9",
@@ -137,11 +137,11 @@ def test_cli_and_run_config_give_the_same_cycle_and_fit(tmp_path, capsys):
             "--p0-gpa",
             "1,2",
             "--cycle",
-            "--model",
+            "--cycle-model",
             "modified",
             "--cycle-amplitude-fractions",
             "0.3,0.7",
-            "--fit",
+            "--fit-csv",
             str(data),
             "--fit-free",
             "tau0_mpa",
@@ -196,17 +196,24 @@ def test_cli_and_run_config_give_the_same_cycle_and_fit(tmp_path, capsys):
 @pytest.mark.parametrize(
     "argv,needle",
     [
-        (["--cycle", "--cycle-amplitude-un", "2", "--p0-gpa", "1"], "--cycle-amplitude-un"),
+        (["--cycle", "--cycle-amplitudes-un", "2", "--p0-gpa", "1"], "--cycle-amplitudes-un"),
         (["--cycle", "--cycle-amplitude-fractions", "1"], "--cycle-amplitude-fractions"),
-        (["--cycle", "--model", "hertz"], "--model"),
+        (["--cycle", "--cycle-model", "hertz"], "--cycle-model"),
         (["--cycle", "--sigma0-mpa", "30"], "--sigma0-mpa"),
         (
-            ["--fit", "A", "--fit-free", "tau0_mpa,k_mpa_per_gpa", "--fit-fixed", "k_mpa_per_gpa"],
+            [
+                "--fit-csv",
+                "A",
+                "--fit-free",
+                "tau0_mpa,k_mpa_per_gpa",
+                "--fit-fixed",
+                "k_mpa_per_gpa",
+            ],
             "--fit-fixed",
         ),
-        (["--fit", "A", "--fit-free", "tau0"], "--fit-free"),
-        (["--fit", "A,B"], "--fit"),
-        (["--fit", "A", "--fit-stiffness", "secant"], "--fit-stiffness"),
+        (["--fit-csv", "A", "--fit-free", "tau0"], "--fit-free"),
+        (["--fit-csv", "A,B"], "--fit-csv"),
+        (["--fit-csv", "A", "--fit-stiffness", "secant"], "--fit-stiffness"),
     ],
 )
 def test_bad_cycle_and_fit_input_is_one_line_naming_the_flag(argv, needle, tmp_path, capsys):
@@ -231,7 +238,7 @@ def test_several_loads_without_a_load_column_name_the_p0_flag(tmp_path, capsys):
     for name in ("a", "b"):
         (tmp_path / f"{name}.csv").write_text(plain)
         files.append(str(tmp_path / f"{name}.csv"))
-    code, _, err = run_cli(["contact", "--fit", ",".join(files)], capsys)
+    code, _, err = run_cli(["contact", "--fit-csv", ",".join(files)], capsys)
     line = one_error_line(code, err)
     assert "no load column" in line and "--fit-p0-gpa" in line and "a.csv" in line
 

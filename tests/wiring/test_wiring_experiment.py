@@ -23,7 +23,7 @@ from flatcontact.report.format import fmt
 
 TOY = {
     "structure": {"kind": "toy-lj", "layers": 3},
-    "calculator": {"target": "flatcontact.ispes.toy:toy_calculator"},
+    "potential": {"calculator": {"target": "flatcontact.ispes.toy:toy_calculator"}},
     "scan": {
         "grid": [3, 3],
         "p_range_gpa": {"lo_gpa": -0.2, "hi_gpa": 1.5, "n": 4},

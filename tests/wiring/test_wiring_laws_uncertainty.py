@@ -397,7 +397,7 @@ def test_validate_potential_ispes_compares_two_classical_models(tmp_path, capsys
     "extra,needle",
     [
         ([], "--reference"),
-        (["--reference", "vashishta", "--energy", "gibbs"], "--energy"),
+        (["--reference", "vashishta", "--energy-form", "gibbs"], "--energy-form"),
         (["--reference", "vashishta", "--grid", "1", "3"], "--grid"),
         (["--reference", "nonsense-model"], "--reference"),
         (["--reference", "vashishta", "--p-range-gpa", "2", "1", "5"], "--p-range-gpa"),

@@ -1,6 +1,7 @@
 """``flatcontact analyze``: ISPES grid → τ, σ_MSS, shear stiffness per load and the load laws.
 
-Thin: maps the flags to run settings (``analysis``, ``report.svg``), runs the analyze and the
+Thin: its flags are the run settings' ``analysis`` section and ``report.svg``, one per
+setting, derived from the settings (:mod:`flatcontact.cli.options`); it runs the analyze and the
 laws stages (:mod:`flatcontact.stages.analyze`, :mod:`flatcontact.stages.laws`, the ones
 ``flatcontact run`` runs), prints a table or JSON and, with ``--out``, the stages write their
 files there: ``friction.csv``, ``friction.nc``, ``analyze.json``, Fig. 2 per load,
@@ -28,21 +29,26 @@ from flatcontact.cli.app import (
     setting_bounds,
     split_list,
 )
+from flatcontact.cli.options import flags_of, setting_options, settings_command
 from flatcontact.config.analysis import AnalysisConfig
 from flatcontact.errors import InputError
 
+#: The settings the command exposes, one flag each (:mod:`flatcontact.cli.options`);
+#: ``analysis.p_gpa`` is ``--p-gpa``, whose values may also follow the ISPES file.
+PATHS = (
+    "analysis.direction_deg",
+    "analysis.energy_form",
+    "analysis.load_source",
+    "analysis.energy_zero",
+    "analysis.threshold_gpa",
+    "analysis.allow_missing",
+    "analysis.with_mep",
+    "report.svg",
+)
+OPTIONS = setting_options(PATHS, {})
 #: Settings paths and core parameters -> the flag that sets them, to name it in errors.
-_FLAG_OF = {
-    "analysis.p_gpa": "--p-gpa",
-    "analysis.direction_deg": "--direction-deg",
-    "analysis.energy_form": "--energy",
-    "analysis.load_source": "--load-source",
-    "analysis.energy_zero": "--energy-zero",
-    "analysis.threshold_gpa": "--threshold-gpa",
-    "analysis.allow_missing": "--allow-missing",
-    "analysis.with_mep": "--mep",
-    "p_gpa": "--p-gpa",
-}
+FLAG_OF = {**flags_of(OPTIONS), "analysis.p_gpa": "--p-gpa", "p_gpa": "--p-gpa"}
+_P_GPA_HELP = setting_options(["analysis.p_gpa"], {"analysis.p_gpa": "none"})[0].help
 
 
 def _split_arguments(items: list[str], p_values: list[str] | None) -> tuple[Path, list[float]]:
@@ -69,7 +75,9 @@ def _split_arguments(items: list[str], p_values: list[str] | None) -> tuple[Path
     "analyze",
     context_settings={"ignore_unknown_options": True, "allow_interspersed_args": True},
 )
+@settings_command(OPTIONS)
 def analyze_command(
+    settings: dict,
     items: Annotated[
         list[str],
         typer.Argument(
@@ -81,87 +89,30 @@ def analyze_command(
         list[str] | None,
         typer.Option(
             "--p-gpa",
-            help="Target normal pressure(s) P in GPa: --p-gpa 0.5 1 2 (or repeat/comma-separate).",
+            metavar="NUMBERS",
+            help=_P_GPA_HELP.removesuffix(" Default: none.")
+            + " Give them as --p-gpa 0.5 1 2 (or repeat/comma-separate); one is enough here.",
         ),
     ] = None,
-    direction_deg: Annotated[
-        str,
-        typer.Option(
-            "--direction-deg",
-            help="Pulling direction, degrees from x (90 = y, the paper's), or 'auto': the "
-            "lowest-barrier direction of the lowest load's landscape (stated in the outputs).",
-        ),
-    ] = "90",
-    energy: Annotated[
-        str,
-        typer.Option("--energy", help="'internal' (paper: U at z*(P)) or 'enthalpy' (U + P·A·z*)."),
-    ] = "internal",
-    load_source: Annotated[
-        str,
-        typer.Option(
-            "--load-source",
-            help="Where P comes from: 'energy' (-(1/A) dU/dz of the spline of U(z); default) "
-            "or 'stress' (the stored normal_stress).",
-        ),
-    ] = "energy",
-    energy_zero: Annotated[
-        str,
-        typer.Option(
-            "--energy-zero",
-            help="Energy zero: 'lowest-p' (global minimum at the lowest P), 'each', 'none'.",
-        ),
-    ] = "lowest-p",
-    threshold_gpa: Annotated[
-        float, typer.Option("--threshold-gpa", help="Fit the load laws on P <= this (GPa).")
-    ] = 3.0,
-    allow_missing: Annotated[
-        bool,
-        typer.Option(
-            "--allow-missing",
-            help="Interpolate columns with missing (NaN) points instead of refusing.",
-        ),
-    ] = False,
-    mep: Annotated[
-        bool, typer.Option("--mep", help="Also compute the string-method minimum-energy path.")
-    ] = False,
     out: Annotated[
         Path | None,
         typer.Option("--out", help="Directory for friction.csv/.nc, laws.json and the figures."),
     ] = None,
-    svg: Annotated[bool, typer.Option("--svg/--no-svg", help="Also write SVG figures.")] = True,
     as_json: Annotated[bool, typer.Option("--json", help="Print the results as JSON.")] = False,
 ) -> None:
     """Constant-pressure ISPES, sliding path, τ, σ_MSS, shear stiffness and load laws."""
-    from flatcontact.analysis.analyze import ENERGY_ZEROS
-    from flatcontact.analysis.constant_pressure import FORMS, LOAD_SOURCES
     from flatcontact.analysis.outputs import per_pressure_rows, summary_json
-    from flatcontact.cli.settings import FLAGS_SOURCE, flag_errors
-    from flatcontact.config import build_config
+    from flatcontact.cli.settings import flag_errors, settings_from_flags
     from flatcontact.layout import FRICTION_CSV, OTHER_FORM_JSON
     from flatcontact.stages.analyze import AnalyzeInputs, analyze_stage
     from flatcontact.stages.laws import LawsInputs, laws_stage
 
-    for flag, value, allowed in (
-        ("--energy", energy, FORMS),
-        ("--load-source", load_source, LOAD_SOURCES),
-        ("--energy-zero", energy_zero, ENERGY_ZEROS),
-    ):  # before the file is opened (analyze_ispes checks them again for library callers)
-        if value not in allowed:
-            raise InputError(f"{flag}: expected one of {', '.join(allowed)}, got {value!r}")
+    # the settings before the file is opened (analyze_ispes checks them again for library callers)
+    cfg = settings_from_flags(settings, FLAG_OF)
     path, pressures = _split_arguments(items, p_gpa)
     if out is not None:
         check_out_dir(out)
-    section = {
-        "direction_deg": _direction(direction_deg),
-        "energy_form": energy,
-        "load_source": load_source,
-        "energy_zero": energy_zero,
-        "threshold_gpa": threshold_gpa,
-        "allow_missing": allow_missing,
-        "with_mep": mep,
-    }
-    with flag_errors(_FLAG_OF):
-        cfg = build_config({"analysis": section, "report": {"svg": svg}}, source=FLAGS_SOURCE)
+    with flag_errors(FLAG_OF):
         # one load is enough here (the run's config asks for two, to fit the laws)
         cfg = cfg.model_copy(
             update={"analysis": cfg.analysis.model_copy(update={"p_gpa": pressures})}
@@ -186,8 +137,8 @@ def analyze_command(
     from rich.table import Table
 
     table = Table(
-        title=f"{path.name}: {energy} energy, {load_source} load, pulling at "
-        + _direction_title(result)
+        title=f"{path.name}: {cfg.analysis.energy_form} energy, {cfg.analysis.load_source} "
+        "load, pulling at " + _direction_title(result)
     )
     for col in (
         "P (GPa)",
@@ -232,18 +183,6 @@ def analyze_command(
 
 def _fmt(v: float | None) -> str:
     return "n/a" if v is None else f"{v:.4g}"
-
-
-def _direction(text: str) -> float | str:
-    """``--direction-deg`` as an angle in degrees or ``'auto'`` (one line naming the flag)."""
-    if text.strip().lower() == "auto":
-        return "auto"
-    try:
-        return float(text)
-    except ValueError:
-        raise InputError(
-            f"--direction-deg: expected an angle in degrees or 'auto', got {text!r}"
-        ) from None
 
 
 def _direction_title(result) -> str:

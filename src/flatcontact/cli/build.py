@@ -16,27 +16,25 @@ from flatcontact import limits
 from flatcontact.cli.app import (
     app,
     bounded,
-    bounded_int,
     check_out_dir,
     console,
     print_warning,
     setting_bounds,
 )
+from flatcontact.cli.options import flags_of, setting_options, settings_command
 from flatcontact.errors import InputError
 from flatcontact.layout import BUILD_JSON
 
-#: Settings path -> the flag that sets it, to name the flag in errors.
-_FLAG_OF = {
-    "structure.file": "--structure",
-    "structure.layers": "--layers",
-    "structure.source": "--source",
-    "structure.gap_angstrom": "--gap-angstrom",
-    "structure.fmax_ev_per_angstrom": "--fmax-ev-per-angstrom",
-    "structure.normal_axis": "--normal-axis",
-    "potential.lj.cutoff_angstrom": "--lj-cutoff-angstrom",
-    "potential.lj": "--lj-cutoff-angstrom",
-    "potential": "--potential",
-}
+#: The settings the command exposes, one flag each (:mod:`flatcontact.cli.options`): the
+#: quartz recipe's (with ``--config``, the file's recipe's: a flag it has no setting for is
+#: refused) and the cutoff of the model's Lennard-Jones coupling.
+PATHS = (
+    "structure.layers",
+    "structure.source",
+    "structure.gap_angstrom",
+    "structure.fmax_ev_per_angstrom",
+    "potential.lj.cutoff_angstrom",
+)
 
 #: The defaults of the quartz flags when no configuration is given (with ``--config`` a flag
 #: left out keeps the file's value).
@@ -46,9 +44,26 @@ _QUARTZ_DEFAULTS = {
     "gap_angstrom": 3.0,
     "fmax_ev_per_angstrom": 0.01,
 }
+OPTIONS = setting_options(
+    PATHS,
+    {
+        **{
+            f"structure.{k}": f"{v} (α-quartz; with --config the file's)"
+            for k, v in _QUARTZ_DEFAULTS.items()
+        },
+        "potential.lj.cutoff_angstrom": "the run's (10; with --config the file's)",
+    },
+)
+#: Settings path -> the flag that sets it, to name the flag in errors.
+FLAG_OF = {
+    **flags_of(OPTIONS),
+    "structure.file": "--structure",
+    "potential.lj": "--lj-cutoff-angstrom",
+    "potential": "--potential",
+}
 
 
-def _check_numbers(gap_angstrom, fmax_ev_per_angstrom, lj_cutoff_angstrom, normal_axis):
+def _check_numbers(gap_angstrom, fmax_ev_per_angstrom, lj_cutoff_angstrom):
     """Every number flag of ``build`` that was given within the bounds of the setting it sets
     (the recipe's gap and force tolerance, the LJ cutoff), before anything is read or built."""
     from flatcontact.potentials.coupling import LJSpec
@@ -66,7 +81,6 @@ def _check_numbers(gap_angstrom, fmax_ev_per_angstrom, lj_cutoff_angstrom, norma
         bounded(
             lj_cutoff_angstrom, "--lj-cutoff-angstrom", setting_bounds(LJSpec, "cutoff_angstrom")
         )
-    bounded_int(normal_axis, "--normal-axis", 0, 2, "a cell axis")
 
 
 def _potential_spec(potential: str | None, lj_cutoff_angstrom: float | None):
@@ -97,18 +111,13 @@ def _potential_spec(potential: str | None, lj_cutoff_angstrom: float | None):
 
 
 @app.command("build")
+@settings_command(OPTIONS)
 def build(
-    layers: int = typer.Option(
-        None,
-        "--layers",
-        help="Layers per slab. α-quartz (0001) (default 6): O–Si–O layers, >= 5: a fixed outer "
-        "and a sliding inner dense face layer of 2 units each and at least one inner layer "
-        "between them. With --config: the recipe's own layers setting.",
-    ),
+    settings: dict,
     potential: str = typer.Option(
         None,
         "--potential",
-        help="vashishta | tersoff | [snap:]NAME | [snap:]path/X.snapcoeff | ase:module:factory "
+        help="vashishta | tersoff | \\[snap:]NAME | \\[snap:]path/X.snapcoeff | ase:module:factory "
         "(default: the run's default, snap:sio2-snap; vashishta if that is not installed).",
     ),
     out: Path = typer.Option(
@@ -116,28 +125,11 @@ def build(
         "--out",
         help="Output directory (default ./build, where 'flatcontact scan' looks by default).",
     ),
-    source: str = typer.Option(
-        None,
-        "--source",
-        help="α-quartz: auto (default) | shipped (CHGNet-relaxed 6-layer slab; 9, 12, ... "
-        "layers: bulk alpha-quartz c-repeats inserted into its interior) | seed",
-    ),
-    gap_angstrom: float = typer.Option(
-        None, "--gap-angstrom", help="Initial gap between the slabs (Å; default 3)."
-    ),
-    lj_cutoff_angstrom: float = typer.Option(
-        None, "--lj-cutoff-angstrom", help="Cross-interface LJ cutoff (Å; default the run's, 10)."
-    ),
-    fmax_ev_per_angstrom: float = typer.Option(
-        None,
-        "--fmax-ev-per-angstrom",
-        help="Relaxation tolerance on the max force (eV/Å; default 0.01).",
-    ),
     structure: Path | None = typer.Option(
-        None, "--structure", help="A slab structure file (any crystal) instead of α-quartz."
-    ),
-    normal_axis: int = typer.Option(
-        2, "--normal-axis", help="With --structure: cell axis (0, 1, 2) along the surface normal."
+        None,
+        "--structure",
+        help="A slab structure file (any crystal, surface normal along cell vector 3) instead "
+        "of α-quartz.",
     ),
     config: Path | None = typer.Option(
         None,
@@ -162,27 +154,21 @@ def build(
     from flatcontact.stages.build import BuildInputs, build_stage
     from flatcontact.structures import build as builder
 
-    _check_numbers(gap_angstrom, fmax_ev_per_angstrom, lj_cutoff_angstrom, normal_axis)
+    given = {k: settings.get("structure", {}).get(k) for k in _QUARTZ_DEFAULTS}
+    layers, source = given["layers"], given["source"]
+    gap_angstrom, fmax_ev_per_angstrom = given["gap_angstrom"], given["fmax_ev_per_angstrom"]
+    lj_cutoff_angstrom = settings.get("potential", {}).get("lj", {}).get("cutoff_angstrom")
+    _check_numbers(gap_angstrom, fmax_ev_per_angstrom, lj_cutoff_angstrom)
     if structure is not None and not structure.is_file():
         raise InputError(f"--structure {structure}: file not found")
-    if structure is None and normal_axis != 2:
-        raise InputError("--normal-axis: the normal of a --structure file; give --structure")
-    given = {
-        "layers": layers,
-        "source": source,
-        "gap_angstrom": gap_angstrom,
-        "fmax_ev_per_angstrom": fmax_ev_per_angstrom,
-    }
     if config is not None:
         if regenerate_dense:
             raise InputError(
                 "--regenerate-dense: not with --config (it rebuilds the shipped quartz slab)"
             )
-        cfg = _config_settings(
-            config, structure, potential, lj_cutoff_angstrom, given, normal_axis, svg
-        )
+        cfg = _config_settings(config, structure, potential, lj_cutoff_angstrom, given, svg)
         check_out_dir(out)
-        with flag_errors(_FLAG_OF):
+        with flag_errors(FLAG_OF):
             result = build_stage(cfg, BuildInputs(), out)
         _print(result, out)
         return
@@ -217,22 +203,20 @@ def build(
         "fmax_ev_per_angstrom": fmax_ev_per_angstrom,
     }
     if structure is not None:
-        # the slab recipe finds the layers from the structure (a monolayer works); a normal
-        # other than cell vector 3 is refused naming --normal-axis
+        # the slab recipe finds the layers from the structure (a monolayer works) and takes
+        # the surface normal along cell vector 3
         section = {
             "kind": "slab",
             "file": str(structure),
             "gap_angstrom": gap_angstrom,
             "fmax_ev_per_angstrom": fmax_ev_per_angstrom,
         }
-        if normal_axis != 2:  # the default is the only axis taken (no deprecation warning)
-            section["normal_axis"] = normal_axis
     data = {
         "structure": section,
         "potential": spec.model_dump(mode="json"),
         "report": {"svg": svg},
     }
-    with flag_errors(_FLAG_OF):
+    with flag_errors(FLAG_OF):
         cfg = build_config(data, source=FLAGS_SOURCE)
         result = build_stage(cfg, BuildInputs(), out)
     _print(result, out)
@@ -244,7 +228,6 @@ def _config_settings(
     potential: str | None,
     lj_cutoff_angstrom: float | None,
     given: dict,
-    normal_axis: int,
     svg: bool,
 ):
     """The run settings of ``--config`` with every flag that was given laid over: ``--structure``
@@ -264,7 +247,7 @@ def _config_settings(
     for key in recipe:
         if key not in fields:
             raise InputError(
-                f"{_FLAG_OF['structure.' + key]}: the structure recipe {kind!r} has no {key} "
+                f"{FLAG_OF['structure.' + key]}: the structure recipe {kind!r} has no {key} "
                 "setting (remove the flag or change the recipe)"
             )
     if kind == "quartz-dense" and "layers" in recipe:
@@ -273,13 +256,11 @@ def _config_settings(
         builder.check_layers(recipe["layers"], "--layers")
     if structure is not None:
         recipe = {**recipe, "kind": "slab", "file": str(structure)}
-        if normal_axis != 2:
-            recipe["normal_axis"] = normal_axis
     if recipe:
         flags["structure"] = recipe
     if potential is not None:
         flags["potential"] = _potential_flag_section(potential)
-    cfg = resolve_config(config, None, flags, _FLAG_OF)
+    cfg = resolve_config(config, None, flags, FLAG_OF)
     if lj_cutoff_angstrom is not None:
         if cfg.potential.coupling != "lj":
             raise InputError(
@@ -287,7 +268,7 @@ def _config_settings(
                 f"{cfg.potential.coupling!r}, not lj: there is no Lennard-Jones cutoff to set"
             )
         lj = {**flags.get("potential", {}), "lj": {"cutoff_angstrom": lj_cutoff_angstrom}}
-        cfg = resolve_config(config, None, {**flags, "potential": lj}, _FLAG_OF)
+        cfg = resolve_config(config, None, {**flags, "potential": lj}, FLAG_OF)
     return cfg
 
 

@@ -24,8 +24,8 @@ def elastic_cmd(
     potential: str = typer.Option(
         "sio2-snap",
         "--potential",
-        help="Without CONFIG: alpha-quartz with vashishta | tersoff | [snap:]NAME | "
-        "[snap:]path/X.snapcoeff | chgnet.",
+        help="Without CONFIG: alpha-quartz with vashishta | tersoff | \\[snap:]NAME | "
+        "\\[snap:]path/X.snapcoeff | chgnet.",
     ),
     strain: float = typer.Option(0.005, "--strain", help="Finite strain amplitude (fraction)."),
     out: Path | None = typer.Option(

@@ -71,7 +71,7 @@ def ispes_check(
     )
     require(
         energy in ("internal", "enthalpy"),
-        f"--energy: expected internal or enthalpy, got {energy!r}",
+        f"--energy-form: expected internal or enthalpy, got {energy!r}",
     )
     for axis in grid:
         bounded_int(axis, "--grid", 2, limits.bound("grid_axis"), "points along one axis")

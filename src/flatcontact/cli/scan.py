@@ -1,8 +1,8 @@
 """``flatcontact scan``: the ISPES grid of an interface (resumable, parallel).
 
 Thin: reads the run configuration (:func:`flatcontact.config.load_config`, the file
-``flatcontact run`` reads; its ``potential``/``calculator`` and ``scan`` sections), lays the
-flags over it, runs the scan stage (:func:`flatcontact.stages.scan.scan_stage`, the one
+``flatcontact run`` reads; its ``potential`` and ``scan`` sections), lays the flags over it
+(one per ``scan`` setting, derived from the settings by :mod:`flatcontact.cli.options`), runs the scan stage (:func:`flatcontact.stages.scan.scan_stage`, the one
 ``flatcontact run`` runs: ``points.db``, ``ispes.nc``, ``scan.json`` and
 ``fig_scan_columns.png``, + ``.svg`` with ``report.svg``) with a progress bar and prints its
 summary and warnings.
@@ -16,36 +16,42 @@ from typing import Annotated, Any
 
 import typer
 
-from flatcontact.cli.app import app, check_out_dir, console, parse_floats, say_interrupted
+from flatcontact.cli.app import (
+    app,
+    check_out_dir,
+    console,
+    say_interrupted,
+)
+from flatcontact.cli.options import flags_of, setting_options, settings_command
 from flatcontact.errors import InputError
 from flatcontact.layout import INTERFACE
 
-#: Config field (dotted path) -> the flag that sets it, to name the flag in errors.
-_FLAG_OF = {
+#: The settings the command exposes, one flag each (:mod:`flatcontact.cli.options`); laid
+#: over CONFIG (the flags not given keep its values).
+PATHS = (
+    "scan.relax_mode",
+    "scan.grid",
+    "scan.thickness_angstrom",
+    "scan.workers",
+    "scan.executor",
+    "scan.dask_address",
+    "scan.fmax_ev_per_angstrom",
+    "scan.optimizer",
+    "scan.max_steps",
+    "scan.order",
+)
+OPTIONS = setting_options(PATHS)
+#: Settings path -> the flag that sets it, to name the flag in errors.
+FLAG_OF = {
+    **flags_of(OPTIONS),
+    "scan.p_range_gpa": "--p-range-gpa",
     "potential": "--potential",
     "potential.intra": "--potential",
-    "calculator": "--calculator",
     "potential.calculator": "--calculator",
-    "scan.grid": "--grid",
-    "scan.thickness_angstrom": "--thickness",
-    "scan.p_range_gpa": "--p-range-gpa",
-    "scan.fmax_ev_per_angstrom": "--fmax-ev-per-angstrom",
-    "scan.optimizer": "--optimizer",
-    "scan.max_steps": "--max-steps",
-    "scan.relax_mode": "--relax-mode",
     "potential.calculator.kwargs": "--calculator-kwarg",
-    "scan.order": "--order",
-    "scan.executor": "--executor",
-    "scan.workers": "--workers",
-    "scan.dask_address": "--dask-address",
 }
 #: Where ``flatcontact build`` writes the interface by default (``--out build``).
 DEFAULT_INTERFACE = f"build/{INTERFACE}"
-
-
-def _floats(values: list[str] | None, flag: str) -> list[float] | None:
-    """The numbers of a list flag, ``None`` when it is not given (empty items refused)."""
-    return parse_floats(values, flag, "Å") if values else None
 
 
 def _potential_section(potential: str) -> dict[str, Any]:
@@ -70,16 +76,18 @@ def resolve_config(config: Path | None, preset: str | None, flags: dict[str, Any
     """The run configuration of ``CONFIG`` with the scan flags laid over (errors name the flag)."""
     from flatcontact.cli.settings import resolve_config as resolve
 
-    return resolve(config, preset, flags, _FLAG_OF)
+    return resolve(config, preset, flags, FLAG_OF)
 
 
 @app.command("scan")
+@settings_command(OPTIONS)
 def scan_command(
+    settings: dict,
     config: Annotated[
         Path | None,
         typer.Argument(
             help="Run configuration (YAML), the same file 'flatcontact run' reads: its "
-            "potential/calculator and scan sections are used, flags override them. "
+            "potential and scan sections are used, flags override them. "
             "Default: the built-in quick preset."
         ),
     ] = None,
@@ -98,7 +106,7 @@ def scan_command(
         str | None,
         typer.Option(
             "--potential",
-            help="potential.intra: vashishta | tersoff | [snap:]NAME | [snap:]path/X.snapcoeff | "
+            help="potential.intra: vashishta | tersoff | \\[snap:]NAME | \\[snap:]path/X.snapcoeff | "
             "ase:module:factory; or a "
             "InteractionModel .json whose fields replace the potential section's (default "
             "snap:sio2-snap, "
@@ -109,80 +117,24 @@ def scan_command(
         str | None,
         typer.Option(
             "--calculator",
-            help="calculator.target: an ASE calculator 'module:callable' instead of --potential.",
+            help="potential.calculator.target: an ASE calculator 'module:callable' instead of --potential.",
         ),
     ] = None,
     calculator_kwarg: Annotated[
         list[str] | None,
         typer.Option(
             "--calculator-kwarg",
-            help="calculator.kwargs: key=value (value read as YAML), repeatable, e.g. "
+            help="potential.calculator.kwargs: key=value (value read as YAML), repeatable, e.g. "
             "--calculator-kwarg model=medium --calculator-kwarg device=cpu.",
-        ),
-    ] = None,
-    relax_mode: Annotated[
-        str | None,
-        typer.Option(
-            "--relax-mode",
-            help="scan.relax_mode: full (default) | normal (generalized-stacking-fault "
-            "convention) | rigid-layers | rigid.",
-        ),
-    ] = None,
-    grid: Annotated[
-        tuple[int, int] | None,
-        typer.Option("--grid", help="scan.grid: lateral points NA NB (default: the preset's)."),
-    ] = None,
-    thickness: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--thickness",
-            help="scan.thickness_angstrom: thicknesses z in Å (surface 1 to 4); repeat or "
-            "comma-separate. Replaces the pressure range.",
         ),
     ] = None,
     p_range_gpa: Annotated[
         tuple[float, float, int] | None,
         typer.Option(
             "--p-range-gpa",
-            help="scan.p_range_gpa: choose N thicknesses spanning loads LO..HI GPa "
-            "(default: the preset's).",
-        ),
-    ] = None,
-    workers: Annotated[
-        int | None,
-        typer.Option("--workers", help="scan.workers: worker processes (default: one per core)."),
-    ] = None,
-    executor: Annotated[
-        str | None,
-        typer.Option("--executor", help="scan.executor: serial | processes (default) | dask."),
-    ] = None,
-    dask_address: Annotated[
-        str | None,
-        typer.Option("--dask-address", help="scan.dask_address: a running Dask scheduler."),
-    ] = None,
-    fmax_ev_per_angstrom: Annotated[
-        float | None,
-        typer.Option(
-            "--fmax-ev-per-angstrom",
-            help="scan.fmax_ev_per_angstrom: force tolerance on free atoms, eV/Å "
-            "(default: the preset's).",
-        ),
-    ] = None,
-    optimizer: Annotated[
-        str | None,
-        typer.Option(
-            "--optimizer",
-            help="scan.optimizer: LBFGS (default), BFGS, FIRE, FIRE2, BFGSLineSearch, lammps-cg (LAMMPS models).",
-        ),
-    ] = None,
-    max_steps: Annotated[
-        int | None,
-        typer.Option("--max-steps", help="scan.max_steps: optimiser step cap (default 2000)."),
-    ] = None,
-    order: Annotated[
-        str | None,
-        typer.Option(
-            "--order", help="scan.order: warm-start tree columns (default), planes, cold."
+            metavar="LO HI N",
+            help="scan.p_range_gpa: choose N thicknesses spanning loads LO..HI GPa at the "
+            "probe stacking; exclusive with --thickness-angstrom. Default: the configuration's.",
         ),
     ] = None,
     out: Annotated[
@@ -203,26 +155,15 @@ def scan_command(
     from flatcontact.rundir import RunLock
     from flatcontact.stages.scan import ScanInputs, scan_stage
 
-    if thickness and p_range_gpa is not None:
-        raise InputError("give either --thickness or --p-range-gpa, not both")
+    if "thickness_angstrom" in settings.get("scan", {}) and p_range_gpa is not None:
+        raise InputError("give either --thickness-angstrom or --p-range-gpa, not both")
     if potential is not None and calculator is not None:
         raise InputError("give either --potential or --calculator, not both")
-    scan_flags = {
-        "grid": list(grid) if grid is not None else None,
-        "thickness_angstrom": _floats(thickness, "--thickness"),
-        "p_range_gpa": dict(zip(("lo_gpa", "hi_gpa", "n"), p_range_gpa, strict=True))
-        if p_range_gpa is not None
-        else None,
-        "fmax_ev_per_angstrom": fmax_ev_per_angstrom,
-        "optimizer": optimizer,
-        "max_steps": max_steps,
-        "relax_mode": relax_mode,
-        "order": order,
-        "executor": executor,
-        "workers": workers,
-        "dask_address": dask_address,
-    }
-    flags: dict[str, Any] = {"scan": {k: v for k, v in scan_flags.items() if v is not None}}
+    flags: dict[str, Any] = {"scan": {}, **settings}
+    if p_range_gpa is not None:
+        flags["scan"]["p_range_gpa"] = dict(
+            zip(("lo_gpa", "hi_gpa", "n"), p_range_gpa, strict=True)
+        )
     if potential is not None:
         # an intra-slab model in place of the configured model's (its LJ kept), not a calculator
         flags["potential"] = {**_potential_section(potential), "calculator": None}
@@ -231,7 +172,9 @@ def scan_command(
     if calculator is not None:
         from flatcontact.potentials.loader import parse_kwargs
 
-        flags["calculator"] = {"target": calculator, "kwargs": parse_kwargs(calculator_kwarg)}
+        flags["potential"] = {
+            "calculator": {"target": calculator, "kwargs": parse_kwargs(calculator_kwarg)}
+        }
     cfg = resolve_config(config, preset, flags)
     out_dir = check_out_dir(out or "ispes")
     where = Path(interface or DEFAULT_INTERFACE)

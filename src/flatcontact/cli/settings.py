@@ -2,8 +2,9 @@
 with the same loader as ``flatcontact run``; errors are translated to the flag the user typed.
 
 A stage's errors name settings paths (``analysis.energy_form``, ``contact.p0_gpa``) or core
-parameters; :func:`flag_errors` renames them to the command's flags (``--energy``,
-``--p0-gpa``), so a YAML user reads the YAML path and a command-line user the flag.
+parameters; :func:`flag_errors` renames them to the command's flags (``--energy-form``,
+``--p0-gpa``), so a YAML user reads the YAML path and a command-line user the flag. The
+table settings path -> flag is derived with the options (:func:`flatcontact.cli.options.flags_of`).
 """
 
 from __future__ import annotations
@@ -23,7 +24,10 @@ def _flag_error(exc: InputError, flag_of: dict[str, str]) -> InputError:
     text = str(exc).removeprefix(f"{FLAGS_SOURCE}: ")
     where, sep, msg = text.partition(": ")
     field, sep2, rest = msg.partition(": ")  # a section validator naming its field first
-    if sep2 and f"{where}.{field}" in flag_of:
+    name, eq, value = field.partition("=")  # ... or the field and its value (layers=5)
+    if sep2 and f"{where}.{name}" in flag_of:
+        if eq:
+            return InputError(f"{flag_of[f'{where}.{name}']}={value}: {rest}")
         where, msg = f"{where}.{field}", rest
     for key in sorted(flag_of, key=len, reverse=True):
         if sep and where == key:

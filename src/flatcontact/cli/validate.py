@@ -27,7 +27,7 @@ from flatcontact.reference import (
 def validate_potential_cmd(
     potential: str = typer.Argument(
         ...,
-        help="vashishta | tersoff | [snap:]NAME (sio2-snap) | [snap:]path/X.snapcoeff | chgnet.",
+        help="vashishta | tersoff | \\[snap:]NAME (sio2-snap) | \\[snap:]path/X.snapcoeff | chgnet.",
     ),
     reference: str = typer.Option(
         None,
@@ -78,7 +78,7 @@ def validate_potential_cmd(
     ),
     energy: str = typer.Option(
         "internal",
-        "--energy",
+        "--energy-form",
         help="With --ispes: energy form, internal (the paper's) or enthalpy.",
     ),
     lj_cutoff_angstrom: float = typer.Option(

@@ -3,7 +3,7 @@ libraries' numerical noise is one summary.
 
 A warning *of flatcontact* — a category defined in the package (``AnalysisWarning``,
 ``PointStoreRepaired``, ...) or a dated deprecation of an old configuration form
-(``"... is deprecated since 2026-11-25: use ..."``, :mod:`flatcontact.config.migration`) — is
+(``"... is deprecated since 2026-11-25: use ..."``) — is
 news for the user: one ``warning:`` line each, without source lines. Everything else (numpy's
 ``RuntimeWarning: overflow encountered ...``, scipy's ``OptimizeWarning``, ASE's notes) is an
 implementation detail of a computation whose result the code checks anyway: it is written to
@@ -26,7 +26,7 @@ import re
 import warnings
 from collections.abc import Iterator
 
-#: The form of flatcontact's dated deprecations (config migration, old factory names).
+#: The form of flatcontact's dated deprecations (old factory names).
 DEPRECATION = re.compile(r".+ is deprecated since \d{4}-\d{2}-\d{2}")
 #: The environment variable that prints every library warning as its own line.
 ENV = "FLATCONTACT_WARNINGS"

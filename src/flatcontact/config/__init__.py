@@ -24,8 +24,8 @@ atomistic quantities in eV and Å, loads in GPa, laws in MPa and MPa/GPa, contac
 The package, one job per module: :mod:`.run` (the root model) and one module per section
 (:mod:`.scan`, :mod:`.analysis`, :mod:`.elastic`, :mod:`.uncertainty`, :mod:`.contact`,
 :mod:`.report`; :mod:`.section` their base), :mod:`.presets`, :mod:`.merge`,
-:mod:`.migration` (old forms, each with a dated deprecation), :mod:`.messages` (error
-wording), :mod:`.yaml_io` (the strict YAML reader, :func:`to_yaml`) and :mod:`.load`. The
+:mod:`.paths` (every dotted settings path and its field), :mod:`.messages` (error
+wording; an unknown key names the setting it probably meant), :mod:`.yaml_io` (the strict YAML reader, :func:`to_yaml`) and :mod:`.load`. The
 settings import no physics beyond the two data models they hold (the structure recipe and
 the interaction model); the checks that need files or the physics cores run before a run in
 :mod:`flatcontact.stages.preflight`.

@@ -6,9 +6,6 @@ At the top: the loads (``p0_gpa``), the tip (``radius_um``), the moduli, the law
 - ``cycle``: the steady load-controlled oscillation cycle per p0;
 - ``fit``: the multi-load least-squares fit of measured stiffness curves;
 - ``experiment``: one measured stiffness curve overlaid on Fig. 6.
-
-The flat keys of the earlier one-level section (``fit_csv``, ``cycle_amplitudes_un``, ...)
-are read through :mod:`flatcontact.config.migration`.
 """
 
 from __future__ import annotations
@@ -168,10 +165,11 @@ class ContactConfig(Section):
         "null: fitted",
     )
     sigma0_mpa: StressMPa | None = Field(None, description="override σ0 (MPa); null: fitted")
-    work_of_adhesion_j_m2: physical(1e-6, 100.0, "J/m²", or_zero=True) | None = Field(
+    work_of_adhesion_j_per_m2: physical(1e-6, 100.0, "J/m²", or_zero=True) | None = Field(
         None,
-        description="work of adhesion w (J/m²) for DMT/JKR radii; null: the work of separation "
-        "measured by the scan",
+        description="work of adhesion w (J/m²) of the contact for DMT/JKR radii (measured or "
+        "chosen); null: the ideal work of separation W of the scan's slabs, a distinct "
+        "quantity taken in its place",
     )
     maugis_lambda: physical(1e-3, 1e3) | None = Field(
         None,

@@ -1,7 +1,6 @@
 """Reading a run configuration: :func:`load_config` (a YAML file) and :func:`build_config` (a mapping).
 
-Both lay the data over a preset (:mod:`.presets`, :mod:`.merge`), read old forms
-(:mod:`.migration`), validate with the section models (:class:`~.run.RunConfig`) and turn
+Both lay the data over a preset (:mod:`.presets`, :mod:`.merge`), validate with the section models (:class:`~.run.RunConfig`) and turn
 every problem into one :class:`~flatcontact.errors.InputError` line naming the source and the
 dotted field path (:mod:`.messages`). :func:`load_config` also resolves the file fields
 against the config file's directory and checks that they exist.
@@ -14,9 +13,9 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from flatcontact.config import migration
 from flatcontact.config.merge import merge_config, replaces_model
 from flatcontact.config.messages import one_line, show
+from flatcontact.config.paths import suggestion
 from flatcontact.config.presets import preset
 from flatcontact.config.run import RunConfig
 from flatcontact.config.yaml_io import MAX_CONFIG_BYTES, parse_yaml
@@ -41,14 +40,13 @@ def build_config(
     Parameters
     ----------
     data
-        Nested mapping as read from YAML (may be empty or ``None``); old forms are read
-        through :mod:`flatcontact.config.migration`.
+        Nested mapping as read from YAML (may be empty or ``None``).
     preset_name
         ``quick`` or ``paper``; overrides ``data['preset']``; default ``quick``.
     source
         Name used in error messages (the file path).
     """
-    data = migration.contact_keys(dict(data or {}), source)
+    data = dict(data or {})
     name = preset_name or data.pop("preset", None) or "quick"
     data.pop("preset", None)
     if name not in ("quick", "paper"):
@@ -66,7 +64,7 @@ def build_config(
     try:
         return RunConfig.model_validate(merged)
     except ValidationError as exc:
-        raise one_line(exc, source) from None
+        raise one_line(exc, source, suggestion) from None
     except InputError as exc:  # InteractionModel's own one-line errors ("potential intra: ...")
         text = str(exc)
         if text.startswith("potential "):
@@ -95,13 +93,6 @@ def load_config(path: str | Path | None = None, preset_name: str | None = None) 
         data = {}
     if not isinstance(data, dict):
         raise InputError(f"{path}: expected a mapping of sections, got {type(data).__name__}")
-    data = migration.contact_keys(data, str(path))
-    if data.get("calculator") is not None and data.get("potential") is not None:
-        # the deprecated section would replace the potential whole, silently
-        raise InputError(
-            f"{path}: calculator: the deprecated top-level section is given beside potential: "
-            "and would replace it; write it as potential.calculator, or remove one of the two"
-        )
     if isinstance(data.get("uncertainty"), str):
         data["uncertainty"] = _uncertainty_file(data["uncertainty"], path)
     for dotted in FILE_FIELDS:

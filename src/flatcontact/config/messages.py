@@ -50,8 +50,18 @@ _MESSAGES = {
 }
 
 
-def one_line(exc: ValidationError, source: str) -> InputError:
-    """The first pydantic error as ``<source>: <dotted.path>: expected ..., got <value>``."""
+def one_line(exc: ValidationError, source: str, meant=None) -> InputError:
+    """The first pydantic error as ``<source>: <dotted.path>: expected ..., got <value>``.
+
+    ``meant``: for an unknown key, a function of its dotted path giving the setting it
+    probably meant (:func:`flatcontact.config.paths.suggestion`), appended as
+    ``(did you mean ...?)``.
+    """
+
+    def _meant(path: str) -> str:
+        near = meant(path) if meant is not None else None
+        return f" (did you mean {near}?)" if near else ""
+
     first = exc.errors()[0]
     # union members (direction_deg: float | 'auto'; refine.settings: 'auto' | list[...]) name
     # their type in the path: drop them
@@ -70,10 +80,16 @@ def one_line(exc: ValidationError, source: str) -> InputError:
             msg = str(first.get("msg", "invalid"))
         if kind not in ("extra_forbidden", "missing"):
             msg += f", got {show(first.get('input'))}"
+        if kind == "extra_forbidden":
+            msg += _meant(where)
     else:
         msg = str(first.get("msg", "invalid")).removeprefix("Value error, ")
         field, sep, rest = msg.partition(": ")
-        if sep and field.isidentifier() and field.islower() and where:
+        if sep and where and (field == where or field.startswith(f"{where}.")):
+            where, msg = field, rest  # a sub-model's own one line naming its whole path
+            if msg == "unknown field":
+                msg += _meant(where)
+        elif sep and field.isidentifier() and field.islower() and where:
             where, msg = f"{where}.{field}", rest  # a model check naming its field
         if where == "potential" and msg.startswith("potential "):  # InteractionModel's InputError
             return InputError(f"{source}: potential.{msg.removeprefix('potential ')}")

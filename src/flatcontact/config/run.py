@@ -13,7 +13,7 @@ from typing import Any, Literal
 
 from pydantic import Field, field_validator, model_validator
 
-from flatcontact.config import migration
+from flatcontact import limits
 from flatcontact.config.analysis import AnalysisConfig
 from flatcontact.config.approximants import ApproximantSettings
 from flatcontact.config.asperity import AsperityConfig
@@ -26,15 +26,12 @@ from flatcontact.config.scan import PressureRange, ScanConfig
 from flatcontact.config.section import Section
 from flatcontact.config.uncertainty import UncertaintyConfig
 from flatcontact.potentials.model import InteractionModel
-from flatcontact.structures.recipe import QuartzDenseRecipe, StructureRecipe
+from flatcontact.structures.recipe import QuartzDenseRecipe, StructureRecipe, parse_recipe
 
 
 class CalculatorConfig(Section):
-    """A whole-interface ASE calculator (the top-level ``calculator:`` section, deprecated 2026-11-22).
-
-    Still read from YAML and turned into ``potential: {calculator: {target, kwargs}}``;
-    ``RunConfig.calculator`` gives this view of such a model.
-    """
+    """A whole-interface ASE calculator: :attr:`RunConfig.calculator`'s view of a model
+    ``potential: {calculator: {target, kwargs, scope: interface}}``."""
 
     target: str = Field(
         description="'module:callable'; callable(atoms, **kwargs) returns an ASE calculator "
@@ -108,17 +105,19 @@ class RunConfig(Section):
     @field_validator("structure", mode="before")
     @classmethod
     def _structure(cls, value: Any) -> Any:
-        return migration.structure_section(value)
-
-    @model_validator(mode="before")
-    @classmethod
-    def _calculator_section(cls, data: Any) -> Any:
-        """The top-level ``calculator: {target, kwargs}`` (deprecated) becomes the model's."""
-        return migration.calculator_section(data)
+        """The ``structure`` mapping as its recipe (``kind`` defaults to ``quartz-dense``);
+        one line naming the first bad field (an unknown key included)."""
+        if not isinstance(value, dict):
+            return value  # a model already, or pydantic's own type error
+        data = {"kind": "quartz-dense", **value}
+        layers = data.get("layers")
+        if isinstance(layers, int | float) and not isinstance(layers, bool):
+            limits.check("layers", layers, "structure.layers", "layers per slab")
+        return parse_recipe(data)
 
     @property
     def calculator(self) -> CalculatorConfig | None:
-        """The whole-interface ASE calculator of the model, if it is one (earlier section)."""
+        """The whole-interface ASE calculator of the model, if it is one."""
         calc = self.potential.calculator
         if calc is None or calc.scope != "interface":
             return None
@@ -128,7 +127,8 @@ class RunConfig(Section):
     def _cross(self) -> RunConfig:
         if self.structure.kind == "toy-lj" and self.calculator is None:
             raise ValueError(
-                "structure.kind 'toy-lj' needs calculator.target: flatcontact.ispes.toy:toy_calculator"
+                "structure.kind 'toy-lj' needs potential.calculator.target: "
+                "flatcontact.ispes.toy:toy_calculator"
             )
         fig = self.report.fig2_p_gpa
         if fig is not None and any(p not in self.analysis.p_gpa for p in fig):

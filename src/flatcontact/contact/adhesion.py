@@ -37,32 +37,32 @@ FloatArray = NDArray[np.float64]
 MODELS = ("hertz", "dmt", "jkr", "maugis-dugdale")
 
 
-def dmt_pull_off_force(work_of_adhesion_j_m2: ArrayLike, radius_m: float) -> FloatArray:
+def dmt_pull_off_force(work_of_adhesion_j_per_m2: ArrayLike, radius_m: float) -> FloatArray:
     """DMT pull-off force 2πwR (N)."""
-    return 2.0 * np.pi * np.asarray(work_of_adhesion_j_m2, dtype=float) * radius_m
+    return 2.0 * np.pi * np.asarray(work_of_adhesion_j_per_m2, dtype=float) * radius_m
 
 
-def jkr_pull_off_force(work_of_adhesion_j_m2: ArrayLike, radius_m: float) -> FloatArray:
+def jkr_pull_off_force(work_of_adhesion_j_per_m2: ArrayLike, radius_m: float) -> FloatArray:
     """JKR pull-off force 1.5πwR (N) under load control."""
-    return 1.5 * np.pi * np.asarray(work_of_adhesion_j_m2, dtype=float) * radius_m
+    return 1.5 * np.pi * np.asarray(work_of_adhesion_j_per_m2, dtype=float) * radius_m
 
 
 def dmt_contact_radius(
-    load_n: ArrayLike, work_of_adhesion_j_m2: float, radius_m: float, contact_modulus_pa: float
+    load_n: ArrayLike, work_of_adhesion_j_per_m2: float, radius_m: float, contact_modulus_pa: float
 ) -> FloatArray:
     """DMT contact radius a = [3R(P + 2πwR)/(4E*)]^(1/3) (m); nan below pull-off."""
-    total = np.asarray(load_n, dtype=float) + 2.0 * np.pi * work_of_adhesion_j_m2 * radius_m
+    total = np.asarray(load_n, dtype=float) + 2.0 * np.pi * work_of_adhesion_j_per_m2 * radius_m
     return np.cbrt(
         np.where(total >= 0.0, 3.0 * radius_m * total / (4.0 * contact_modulus_pa), np.nan)
     )
 
 
 def jkr_contact_radius(
-    load_n: ArrayLike, work_of_adhesion_j_m2: float, radius_m: float, contact_modulus_pa: float
+    load_n: ArrayLike, work_of_adhesion_j_per_m2: float, radius_m: float, contact_modulus_pa: float
 ) -> FloatArray:
     """JKR contact radius (m) on the stable branch; nan below the pull-off load −1.5πwR."""
     p = np.asarray(load_n, dtype=float)
-    x = 3.0 * np.pi * work_of_adhesion_j_m2 * radius_m
+    x = 3.0 * np.pi * work_of_adhesion_j_per_m2 * radius_m
     disc = 2.0 * x * p + x**2
     with np.errstate(invalid="ignore"):
         total = p + x + np.sqrt(np.where(disc >= 0.0, disc, np.nan))
@@ -71,13 +71,13 @@ def jkr_contact_radius(
 
 def maugis_parameter(
     dugdale_stress_pa: float,
-    work_of_adhesion_j_m2: float,
+    work_of_adhesion_j_per_m2: float,
     radius_m: float,
     contact_modulus_pa: float,
 ) -> float:
     """λ = σ_D (9R/(2πwE*²))^(1/3) from the Dugdale (cohesive) stress σ_D (Pa)."""
     return dugdale_stress_pa * (
-        9.0 * radius_m / (2.0 * np.pi * work_of_adhesion_j_m2 * contact_modulus_pa**2)
+        9.0 * radius_m / (2.0 * np.pi * work_of_adhesion_j_per_m2 * contact_modulus_pa**2)
     ) ** (1.0 / 3.0)
 
 
@@ -121,7 +121,7 @@ def _md_pull_off(lam: float) -> tuple[float, float]:
 
 
 def maugis_dugdale_pull_off_force(
-    work_of_adhesion_j_m2: float, radius_m: float, maugis_lambda: float
+    work_of_adhesion_j_per_m2: float, radius_m: float, maugis_lambda: float
 ) -> float:
     """Pull-off force (N, magnitude) of the Maugis–Dugdale model under load control.
 
@@ -129,12 +129,12 @@ def maugis_dugdale_pull_off_force(
     """
     lam = check_positive("maugis_lambda", maugis_lambda)
     _, pbar = _md_pull_off(lam)
-    return -pbar * np.pi * work_of_adhesion_j_m2 * radius_m
+    return -pbar * np.pi * work_of_adhesion_j_per_m2 * radius_m
 
 
 def maugis_dugdale_contact_radius(
     load_n: ArrayLike,
-    work_of_adhesion_j_m2: float,
+    work_of_adhesion_j_per_m2: float,
     radius_m: float,
     contact_modulus_pa: float,
     maugis_lambda: float,
@@ -144,7 +144,7 @@ def maugis_dugdale_contact_radius(
     Solves P̄(Ā) = P/(πwR) for Ā above the pull-off point; nan below pull-off.
     """
     lam = check_positive("maugis_lambda", maugis_lambda)
-    w = check_positive("work_of_adhesion_j_m2", work_of_adhesion_j_m2)
+    w = check_positive("work_of_adhesion_j_per_m2", work_of_adhesion_j_per_m2)
     kmod = 4.0 * contact_modulus_pa / 3.0
     length = (np.pi * w * radius_m**2 / kmod) ** (1.0 / 3.0)  # a = Ā · length
     a_min, p_min = _md_pull_off(lam)
@@ -167,12 +167,12 @@ def contact_radius_at_p0(
     p0_pa: ArrayLike,
     radius_m: float,
     contact_modulus_pa: float,
-    work_of_adhesion_j_m2: float = 0.0,
+    work_of_adhesion_j_per_m2: float = 0.0,
     maugis_lambda: float | None = None,
 ) -> FloatArray:
     """Contact radius (m) of ``model`` at the Hertz load of peak pressure p0 (Pa)."""
     require(model in MODELS, f"adhesion model must be one of {MODELS}, got {model!r}")
-    w = check_non_negative("work_of_adhesion_j_m2", work_of_adhesion_j_m2)
+    w = check_non_negative("work_of_adhesion_j_per_m2", work_of_adhesion_j_per_m2)
     p0 = np.asarray(p0_pa, dtype=float)
     a_h = hertz_contact_radius(p0, radius_m, contact_modulus_pa)
     load = hertz_load(p0, a_h)
@@ -193,13 +193,13 @@ def radius_change_relative_to_hertz(
     p0_pa: ArrayLike,
     radius_m: float,
     contact_modulus_pa: float,
-    work_of_adhesion_j_m2: float,
+    work_of_adhesion_j_per_m2: float,
     maugis_lambda: float | None = None,
 ) -> FloatArray:
     """a_model/a_Hertz − 1 at the Hertz load of p0 (dimensionless, 0.3 = 30% larger)."""
     a_h = hertz_contact_radius(p0_pa, radius_m, contact_modulus_pa)
     a_m = contact_radius_at_p0(
-        model, p0_pa, radius_m, contact_modulus_pa, work_of_adhesion_j_m2, maugis_lambda
+        model, p0_pa, radius_m, contact_modulus_pa, work_of_adhesion_j_per_m2, maugis_lambda
     )
     return a_m / a_h - 1.0
 
@@ -216,12 +216,12 @@ def dmt_work_of_adhesion_for_radius_ratio(
 
 
 def dmt_p0_for_radius_ratio(
-    ratio: float, work_of_adhesion_j_m2: float, radius_m: float, contact_modulus_pa: float
+    ratio: float, work_of_adhesion_j_per_m2: float, radius_m: float, contact_modulus_pa: float
 ) -> float:
     """p0 (Pa) above which a_DMT/a_Hertz < ``ratio`` (closed form; P ∝ p0³)."""
     r = check_positive("ratio", ratio)
     require(r > 1.0, f"ratio must be > 1, got {ratio!r}")
     # P(p0) = (2/3)π a² p0 with a = πRp0/(2E*): P = c p0³
     c = float(hertz_load(1.0, hertz_contact_radius(1.0, radius_m, contact_modulus_pa)))
-    load = 2.0 * np.pi * work_of_adhesion_j_m2 * radius_m / (r**3 - 1.0)
+    load = 2.0 * np.pi * work_of_adhesion_j_per_m2 * radius_m / (r**3 - 1.0)
     return (load / c) ** (1.0 / 3.0)

@@ -71,7 +71,7 @@ MODEL_NAMES = {"dmt": "DMT", "jkr": "JKR", "maugis-dugdale": "Maugis–Dugdale"}
 
 
 def tabor_parameter(
-    work_of_adhesion_j_m2: float,
+    work_of_adhesion_j_per_m2: float,
     radius_m: float,
     contact_modulus_pa: float,
     equilibrium_separation_m: float,
@@ -79,7 +79,7 @@ def tabor_parameter(
     """μ_T = (R w²/(E*² z0³))^(1/3) (dimensionless)."""
     z0 = check_positive("equilibrium_separation_m", equilibrium_separation_m)
     return float(
-        (radius_m * work_of_adhesion_j_m2**2 / (contact_modulus_pa**2 * z0**3)) ** (1.0 / 3.0)
+        (radius_m * work_of_adhesion_j_per_m2**2 / (contact_modulus_pa**2 * z0**3)) ** (1.0 / 3.0)
     )
 
 
@@ -149,7 +149,7 @@ class AdhesiveContact:
 
 def dugdale_zone_force(
     radius_m: float,
-    work_of_adhesion_j_m2: float,
+    work_of_adhesion_j_per_m2: float,
     tip_radius_m: float,
     contact_modulus_pa: float,
     maugis_lambda: float,
@@ -158,7 +158,7 @@ def dugdale_zone_force(
     a < r < c, outside the contact; σ_D = (λ/2)(π w K²/R)^(1/3), m = c/a from Maugis's
     equation at Ā = a (K/(π w R²))^(1/3). The rest of P1 − P acts inside the contact."""
     k = 4.0 * contact_modulus_pa / 3.0
-    w, r = work_of_adhesion_j_m2, tip_radius_m
+    w, r = work_of_adhesion_j_per_m2, tip_radius_m
     abar = radius_m * (k / (np.pi * w * r * r)) ** (1.0 / 3.0)
     m = adhesion._md_m(abar, maugis_lambda)
     sigma_d = 0.5 * maugis_lambda * (np.pi * w * k * k / r) ** (1.0 / 3.0)
@@ -187,7 +187,7 @@ def adhesive_contact(
     """The contact at the Hertz load of ``p0_pa`` under the regime of ``maugis_lambda``
     (None or w = 0: Hertz); ``use_hertz``: the adhesive radius is reported, the model is
     evaluated at p0 (the paper's Hertz contact)."""
-    r, e, w = params.radius_m, params.contact_modulus_pa, params.work_of_adhesion_j_m2
+    r, e, w = params.radius_m, params.contact_modulus_pa, params.work_of_adhesion_j_per_m2
     a_h = float(hertz_contact_radius(p0_pa, r, e))
     load = float(hertz_load(p0_pa, a_h))
     if w == 0.0 or maugis_lambda is None:
@@ -320,7 +320,7 @@ def adhesion_regime(
     contact is Hertz. Raises InputError naming ``p0_name`` where the bound δ exceeds
     :data:`REFUSE_FRACTION` (no model of the tool applies), unless ``use_hertz``.
     """
-    w = params.work_of_adhesion_j_m2
+    w = params.work_of_adhesion_j_per_m2
     p0s = [float(p) for p in p0_gpa]
     tabor = lam = None
     z0 = equilibrium_separation_m

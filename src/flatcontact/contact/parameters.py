@@ -68,9 +68,12 @@ class ContactParameters:
     mu_mpa_per_gpa, sigma0_mpa : float
         Slip-zone ("minimal-scale sliding") friction law σ(p) = μ·p + σ0. σ0 >= 0;
         μ may be negative, then σ0 > 0 and p0 <= σ0/|μ| (σ >= 0 on the contact).
-    work_of_adhesion_j_m2 : float
-        Work of adhesion w (J/m²) for the DMT/JKR/Maugis–Dugdale radii, >= 0
-        (0: no adhesion correction).
+    work_of_adhesion_j_per_m2 : float
+        Work of adhesion w (J/m²) of the tip on the surface, for the DMT/JKR/Maugis–Dugdale
+        radii, >= 0 (0: no adhesion correction). A contact input, measured or chosen; a run
+        without one takes the scan's ideal work of separation W
+        (:class:`flatcontact.ispes.work_of_separation.WorkOfSeparation`), a distinct quantity:
+        W separates two perfect slabs at one stacking, w is what the contact feels.
     """
 
     radius_um: float = PAPER_DEFAULTS["radius_um"]
@@ -80,12 +83,12 @@ class ContactParameters:
     tau0_mpa: float = PAPER_DEFAULTS["tau0_mpa"]
     mu_mpa_per_gpa: float = PAPER_DEFAULTS["mu_mpa_per_gpa"]
     sigma0_mpa: float = PAPER_DEFAULTS["sigma0_mpa"]
-    work_of_adhesion_j_m2: float = 0.0
+    work_of_adhesion_j_per_m2: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("radius_um", "contact_modulus_gpa", "shear_modulus_gpa"):
             object.__setattr__(self, name, check_positive(name, getattr(self, name)))
-        for name in ("tau0_mpa", "sigma0_mpa", "work_of_adhesion_j_m2"):
+        for name in ("tau0_mpa", "sigma0_mpa", "work_of_adhesion_j_per_m2"):
             object.__setattr__(self, name, check_non_negative(name, getattr(self, name)))
         for name in ("k_mpa_per_gpa", "mu_mpa_per_gpa"):
             object.__setattr__(self, name, _finite(name, getattr(self, name)))

@@ -68,20 +68,20 @@ COMMENSURATE, TWISTED, APPROXIMANT = "commensurate", "twisted", "approximant"
 
 
 def dislocation_strength(
-    contact_radius_m: ArrayLike, shear_modulus_pa: float, unstable_stacking_j_m2: float
+    contact_radius_m: ArrayLike, shear_modulus_pa: float, unstable_stacking_j_per_m2: float
 ) -> FloatArray:
     """τ_dis(a) = √(8 G* γ_us/(π a)) (Pa): the mean shear stress at which an interfacial
     dislocation nucleates at the edge of a stuck contact of radius a (paper's G*)."""
     a = np.asarray(contact_radius_m, dtype=float)
-    return np.sqrt(8.0 * shear_modulus_pa * unstable_stacking_j_m2 / (np.pi * a))
+    return np.sqrt(8.0 * shear_modulus_pa * unstable_stacking_j_per_m2 / (np.pi * a))
 
 
 def critical_radius(
-    concurrent_strength_pa: ArrayLike, shear_modulus_pa: float, unstable_stacking_j_m2: float
+    concurrent_strength_pa: ArrayLike, shear_modulus_pa: float, unstable_stacking_j_per_m2: float
 ) -> FloatArray:
     """a_c = 8 G* γ_us/(π τ_c²) (m): above it τ_dis(a) < τ_c (commensurate interfaces)."""
     tau = np.asarray(concurrent_strength_pa, dtype=float)
-    return 8.0 * shear_modulus_pa * unstable_stacking_j_m2 / (np.pi * tau**2)
+    return 8.0 * shear_modulus_pa * unstable_stacking_j_per_m2 / (np.pi * tau**2)
 
 
 def elastic_bound(
@@ -136,14 +136,14 @@ class SlipInterface:
 
     kind: str
     why: str
-    unstable_stacking_j_m2: float | None
+    unstable_stacking_j_per_m2: float | None
     burgers_m: float | None
     tau_max_pa: float | None = None
     source: str = ""
 
     def __post_init__(self) -> None:
-        if self.unstable_stacking_j_m2 is not None:
-            check_positive("unstable_stacking_j_m2", self.unstable_stacking_j_m2)
+        if self.unstable_stacking_j_per_m2 is not None:
+            check_positive("unstable_stacking_j_per_m2", self.unstable_stacking_j_per_m2)
         if self.burgers_m is not None:
             check_positive("burgers_m", self.burgers_m)
 
@@ -184,10 +184,10 @@ def size_limits(
     a = np.atleast_1d(np.asarray(contact_radius_m, dtype=float))
     tau = np.atleast_1d(np.asarray(concurrent_strength_pa, dtype=float))
     if interface.kind == COMMENSURATE:
-        if interface.unstable_stacking_j_m2 is None:
+        if interface.unstable_stacking_j_per_m2 is None:
             return None
-        crit = critical_radius(tau, shear_modulus_pa, interface.unstable_stacking_j_m2)
-        tdis = dislocation_strength(a, shear_modulus_pa, interface.unstable_stacking_j_m2)
+        crit = critical_radius(tau, shear_modulus_pa, interface.unstable_stacking_j_per_m2)
+        tdis = dislocation_strength(a, shear_modulus_pa, interface.unstable_stacking_j_per_m2)
         limited = np.minimum(tau, tdis)
     else:
         if interface.burgers_m is None:

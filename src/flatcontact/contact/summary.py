@@ -60,7 +60,7 @@ class ContactAnalysis:
         a = mindlin.contact_radius(pc, pr)  # the adhesive radius where pc != p0
         area = np.pi * a**2
         load = 2.0 / 3.0 * np.pi * a_h**2 * p0  # the applied load
-        w = pr.work_of_adhesion_j_m2
+        w = pr.work_of_adhesion_j_per_m2
         out = []
         for i, c in enumerate(self.curves):
             rec: dict[str, Any] = {

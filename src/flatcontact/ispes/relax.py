@@ -94,7 +94,7 @@ class RelaxSettings:
 
     Attributes
     ----------
-    fmax_ev_per_a
+    fmax_ev_per_angstrom
         Convergence when max |F| over the free atoms < fmax (eV/Å).
     optimizer
         ``LBFGS`` (the built-in, ASE's steps: :mod:`flatcontact.ispes.lbfgs`), another ASE
@@ -110,15 +110,15 @@ class RelaxSettings:
         module docstring.
     """
 
-    fmax_ev_per_a: float = 0.005
+    fmax_ev_per_angstrom: float = 0.005
     optimizer: str = "LBFGS"
     max_steps: int = 2000
     mode: str = "full"
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.fmax_ev_per_a) and self.fmax_ev_per_a > 0):
+        if not (np.isfinite(self.fmax_ev_per_angstrom) and self.fmax_ev_per_angstrom > 0):
             raise InputError(
-                f"fmax_ev_per_a: expected a positive force tolerance (eV/Å), got {self.fmax_ev_per_a}"
+                f"fmax_ev_per_angstrom: expected a positive force tolerance (eV/Å), got {self.fmax_ev_per_angstrom}"
             )
         if self.optimizer not in OPTIMIZERS:
             raise InputError(f"optimizer: '{self.optimizer}' is not one of {', '.join(OPTIMIZERS)}")
@@ -134,8 +134,13 @@ class RelaxSettings:
 
     def as_dict(self) -> dict[str, Any]:
         """The settings for the store fingerprint; ``mode`` only when it is not the default
-        ``full`` (a store written before the modes existed stays valid: same numbers)."""
-        out = dataclasses.asdict(self)
+        ``full`` (a store written before the modes existed stays valid: same numbers). The
+        force tolerance is stored under its key of the ``points.db`` contract,
+        ``fmax_ev_per_a`` (docs/file-contracts.md), so existing stores resume."""
+        out = {
+            "fmax_ev_per_a" if k == "fmax_ev_per_angstrom" else k: v
+            for k, v in dataclasses.asdict(self).items()
+        }
         if self.mode == "full":
             del out["mode"]
         return out
@@ -265,7 +270,7 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
             point_evaluator(calc, atoms),
             atoms.positions,
             project,
-            settings.fmax_ev_per_a,
+            settings.fmax_ev_per_angstrom,
             settings.max_steps,
         )
         atoms.positions = outcome.positions
@@ -279,7 +284,7 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
             )
         held = project(np.ones_like(atoms.positions)) == 0.0  # the components P removes
         positions, energy, forces, steps, _ = minimize(
-            atoms, held, settings.fmax_ev_per_a, settings.max_steps
+            atoms, held, settings.fmax_ev_per_angstrom, settings.max_steps
         )
         atoms.positions = positions
     elif relaxing:
@@ -310,7 +315,7 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
         reaction_stress_gpa=reaction_stress_gpa(atoms, forces, fixed),
         force_calls=int(calc.force_calls - calls0),
         steps=steps,
-        converged=bool(not relaxing or max_force < settings.fmax_ev_per_a),
+        converged=bool(not relaxing or max_force < settings.fmax_ev_per_angstrom),
         max_force_ev_per_a=max_force,
         seconds=time.perf_counter() - t0,
         positions=atoms.positions.copy(),
@@ -412,7 +417,7 @@ def _relax_with_ase(atoms, calc, fixed, free, groups, settings: RelaxSettings) -
     atoms.set_constraint(constraints)
     atoms.calc = calc
     opt = _optimizer_class(settings.optimizer)(atoms, logfile=None)
-    opt.run(fmax=settings.fmax_ev_per_a, steps=settings.max_steps)
+    opt.run(fmax=settings.fmax_ev_per_angstrom, steps=settings.max_steps)
     return int(opt.nsteps)
 
 

@@ -49,7 +49,7 @@ class RelaxationNoise:
     """The relaxed noise floor and what it cost (see the module docstring)."""
 
     ev_per_a2: float  #: largest spread of one structure's relaxed energies per area (eV/Å²)
-    fmax_ev_per_a: float  #: the relaxation's force tolerance (eV/Å)
+    fmax_ev_per_angstrom: float  #: the relaxation's force tolerance (eV/Å)
     mode: str  #: the relaxation mode
     relaxations: int  #: relaxations done (3 per sample)
     force_calls: int  #: force calls they took
@@ -133,7 +133,7 @@ def relaxation_noise(
         worst = max(worst, max(energies) - min(energies))
     return RelaxationNoise(
         ev_per_a2=worst / area,
-        fmax_ev_per_a=relax.fmax_ev_per_a,
+        fmax_ev_per_angstrom=relax.fmax_ev_per_angstrom,
         mode=relax.mode,
         relaxations=count,
         force_calls=calls,

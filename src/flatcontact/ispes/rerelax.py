@@ -23,7 +23,7 @@ itself) and is left to the analysis to refuse, with the record saying it survive
 
 The re-relaxed points are a point store of their own (``rerelax.db`` beside ``points.db``,
 :class:`~flatcontact.ispes.store.PointStore`: the same row contract, its settings those of
-the scan with the tighter ``relax.fmax_ev_per_a``), so the scan's own store stays what the
+the scan with the tighter force tolerance, stored as ``relax.fmax_ev_per_a``), so the scan's own store stays what the
 scan computed, an interrupted re-relaxation resumes where it stopped, and ``ispes.nc`` is the
 scan's grid with those points replaced (attributes ``fold_rerelaxed_points`` and
 ``fold_rerelaxed_fmax_ev_per_a``). Units: Å, eV, GPa.
@@ -184,7 +184,7 @@ class FoldRerelaxation:
     """What :func:`rerelax_folds` did: the tighter tolerance (eV/Å), the folds found, those
     that survived, the columns left alone and why, and one record per re-relaxed point."""
 
-    fmax_ev_per_a: float
+    fmax_ev_per_angstrom: float
     found: list[FoldWindow]
     surviving: list[FoldWindow]
     left: list[tuple[str, str]]  #: (column name, why it was not re-relaxed)
@@ -203,7 +203,7 @@ class FoldRerelaxation:
     def record(self) -> dict:
         """``scan.json`` ``fold_rerelaxation``."""
         return {
-            "fmax_ev_per_angstrom": self.fmax_ev_per_a,
+            "fmax_ev_per_angstrom": self.fmax_ev_per_angstrom,
             "rounds": MAX_ROUNDS,
             "found": [w.record() for w in self.found],
             "remedied": [w.name for w in self.remedied],
@@ -229,10 +229,12 @@ class FoldRerelaxation:
                 f"{w.name}: load folded from {w.p_below_gpa:.4g} GPa at z = "
                 f"{w.z_below_angstrom:.4g} Å to {w.p_gpa:.4g} GPa at z = {w.z_angstrom:.4g} Å; "
                 f"its window ({len(w.nodes)} thicknesses) re-relaxed at fmax "
-                f"{self.fmax_ev_per_a:g} eV/Å: {verdict}"
+                f"{self.fmax_ev_per_angstrom:g} eV/Å: {verdict}"
             )
         if n:
-            out.append(f"fold re-relaxation: {n} point(s) at fmax {self.fmax_ev_per_a:g} eV/Å")
+            out.append(
+                f"fold re-relaxation: {n} point(s) at fmax {self.fmax_ev_per_angstrom:g} eV/Å"
+            )
         return out + [f"{name}: fold not re-relaxed ({why})" for name, why in self.left]
 
 
@@ -276,7 +278,7 @@ def rerelax_folds(
     rerelax_path: str | Path | None = None,
     recorded: bool = False,
 ) -> tuple[Any, FoldRerelaxation]:
-    """Re-relax the windows of the folds of ``ds`` at ``relax.fmax_ev_per_a`` × FMAX_FACTOR.
+    """Re-relax the windows of the folds of ``ds`` at ``relax.fmax_ev_per_angstrom`` × FMAX_FACTOR.
 
     Parameters
     ----------
@@ -302,9 +304,11 @@ def rerelax_folds(
         ``ds`` with the re-relaxed points' energy, normal stress, convergence and force calls
         (``ds`` itself when nothing folds), and the :class:`FoldRerelaxation`.
     """
-    tight = dataclasses.replace(relax, fmax_ev_per_a=relax.fmax_ev_per_a * FMAX_FACTOR)
+    tight = dataclasses.replace(
+        relax, fmax_ev_per_angstrom=relax.fmax_ev_per_angstrom * FMAX_FACTOR
+    )
     found = fold_windows(ds, loads_gpa, load_source, recorded=recorded)
-    result = FoldRerelaxation(tight.fmax_ev_per_a, found, [], [], [])
+    result = FoldRerelaxation(tight.fmax_ev_per_angstrom, found, [], [], [])
     if not found:
         return ds, result
     if relax.mode == "rigid":
@@ -359,7 +363,7 @@ def rerelax_folds(
                 }
             )
     out.attrs["fold_rerelaxed_points"] = len(result.points)
-    out.attrs["fold_rerelaxed_fmax_ev_per_a"] = tight.fmax_ev_per_a
+    out.attrs["fold_rerelaxed_fmax_ev_per_a"] = tight.fmax_ev_per_angstrom
     columns = {w.column for w in chosen}
     again = fold_windows(out, loads_gpa, load_source, recorded=recorded)
     result.surviving += [w for w in again if w.column in columns]

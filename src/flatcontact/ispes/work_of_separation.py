@@ -79,7 +79,13 @@ def work_shift(reference: Atoms, lowest: tuple[float, float]) -> tuple[tuple[flo
 
 @dataclasses.dataclass(frozen=True)
 class WorkOfSeparation:
-    """The ideal work of separation and the states it compares (energies in eV)."""
+    """The ideal work of separation and the states it compares (energies in eV).
+
+    W = [E(slabs apart) - E(interface at zero load)] / A of two perfect slabs at one stacking
+    (``work_of_separation_j_per_m2``, J/m²). The contact stage takes it as its work of adhesion
+    w (``contact.work_of_adhesion_j_per_m2``) when none is given: a distinct quantity (w is
+    the tip's adhesion on the surface, measured or chosen), of which W is an estimate.
+    """
 
     work_of_separation_j_per_m2: float
     #: distance (Å) added to the reference thickness for the slabs apart
@@ -189,7 +195,7 @@ def slabs_apart(
         raise InputError(
             f"work of separation: the slabs still interact {SEPARATIONS_ANGSTROM[-1]:.4g} Å "
             f"apart (the energy changes by {change / area * EV_PER_A2_TO_J_PER_M2:.3g} J/m² "
-            "when the distance doubles); give contact.work_of_adhesion_j_m2"
+            "when the distance doubles); give contact.work_of_adhesion_j_per_m2"
         )
     r = relax_point(reference, calc, PointTask((0, 0, 0), a, b, z_ref + d), relax)
     return d, r.energy_ev, r.converged, r.force_calls

@@ -24,7 +24,7 @@ def fig_slip_size(doc: dict) -> Figure:
     fig = Figure(figsize=(6.4, 4.4), layout="constrained")
     ax = fig.subplots()
     g = doc["shear_modulus_gpa"] * 1e9
-    gus = doc.get("unstable_stacking_j_m2")
+    gus = doc.get("unstable_stacking_j_per_m2")
     commensurate = doc["structure"] == COMMENSURATE
     x = RADII_M * 1e9
     for row in doc["results"]:

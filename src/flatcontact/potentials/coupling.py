@@ -61,7 +61,9 @@ class LJSpec(BaseModel):
     number_density_per_nm3: dict[str, float] = Field(default_factory=dict)
     #: 1..50 Å: below an atom's size the shift is the potential; beyond, a neighbour list
     #: of every LAMMPS worker grows as rc³ with nothing left to converge (10 Å: 0.1 % of U)
-    cutoff_angstrom: physical(1.0, 50.0, "Å") = 10.0
+    cutoff_angstrom: physical(1.0, 50.0, "Å") = Field(
+        10.0, description="cutoff of the cross-interface Lennard-Jones (Å)"
+    )
 
     @field_validator("c6_ev_a6")
     @classmethod

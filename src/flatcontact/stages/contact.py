@@ -23,12 +23,14 @@ so both the stick and the slip zone show whatever the laws.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from flatcontact.config.contact import ContactConfig
+from flatcontact.contact.parameters import ContactParameters
 from flatcontact.errors import InputError
 from flatcontact.fileio import atomic_path, file_sha256, write_json_atomic
 from flatcontact.layout import (
@@ -55,16 +57,12 @@ from flatcontact.stages.contact_experiment import (  # noqa: F401  (re-exported)
     quartz_reference_laws,
 )
 
-#: ContactParameters fields -> the settings path that sets them.
+#: ContactParameters fields -> the settings path that sets them: the fields the ``contact``
+#: section has under the same name (R, E*, G*, the four law coefficients, w).
 SETTINGS_NAMES = {
-    name: f"contact.{name}"
-    for name in (
-        "radius_um",
-        "contact_modulus_gpa",
-        "shear_modulus_gpa",
-        "work_of_adhesion_j_m2",
-        *PAPER_LAW_KEYS,
-    )
+    f.name: f"contact.{f.name}"
+    for f in fields(ContactParameters)
+    if f.name in ContactConfig.model_fields
 }
 
 
@@ -82,7 +80,7 @@ class ContactInputs:
     """What the contact model takes from upstream stages (all optional).
 
     ``laws``: ``laws.json`` of the laws stage (k, τ0, μ, σ0 where ``contact`` gives none);
-    ``work_of_separation_j_per_m2``: the scan's (w where ``contact.work_of_adhesion_j_m2``
+    ``work_of_separation_j_per_m2``: the scan's (w where ``contact.work_of_adhesion_j_per_m2``
     is null; ``from_scan`` says a scan was read); ``moduli``: ``elastic.json`` of the elastic
     stage (E*, G* replacing ``contact.contact_modulus_gpa``/``shear_modulus_gpa``);
     ``gates``: the validity gates' report (:meth:`flatcontact.analysis.gates.GateReport.to_json`,
@@ -102,7 +100,7 @@ def contact_parameters(settings, inputs: ContactInputs):
     """The :class:`~flatcontact.contact.parameters.ContactParameters` and their provenance.
 
     k, τ0, μ, σ0 come from ``contact`` where given, else from the fitted laws; w is
-    ``contact.work_of_adhesion_j_m2`` or the scan's work of separation; E*, G* come from the
+    ``contact.work_of_adhesion_j_per_m2`` or the scan's work of separation; E*, G* come from the
     elastic stage when it ran. Errors name the settings path (``contact.tau0_mpa``).
     """
     from flatcontact.contact.parameters import ContactParameters
@@ -127,14 +125,14 @@ def contact_parameters(settings, inputs: ContactInputs):
         # negative slopes pass through: the model takes k < 0, μ < 0 wherever τ > 0
         # and σ >= 0 on the contact, and refuses the p0 where they are not
         values[key], provenance[key] = fitted, "fitted laws"
-    w = c.work_of_adhesion_j_m2
-    provenance["work_of_adhesion_j_m2"] = "config"
+    w = c.work_of_adhesion_j_per_m2
+    provenance["work_of_adhesion_j_per_m2"] = "config"
     if w is None:
         w = inputs.work_of_separation_j_per_m2
-        provenance["work_of_adhesion_j_m2"] = "scan work of separation"
+        provenance["work_of_adhesion_j_per_m2"] = "scan work of separation"
         if w is None or not w > 0:
             why = "none (no probe column)" if inputs.from_scan else "none"
-            w, provenance["work_of_adhesion_j_m2"] = 0.0, why
+            w, provenance["work_of_adhesion_j_per_m2"] = 0.0, why
     e_star, g_star = c.contact_modulus_gpa, c.shear_modulus_gpa
     provenance["moduli"] = "config"
     if inputs.moduli is not None:
@@ -146,7 +144,7 @@ def contact_parameters(settings, inputs: ContactInputs):
                 radius_um=c.radius_um,
                 contact_modulus_gpa=e_star,
                 shear_modulus_gpa=g_star,
-                work_of_adhesion_j_m2=float(w),
+                work_of_adhesion_j_per_m2=float(w),
                 **values,
             )
     except InputError as exc:  # e.g. a fitted τ0 < 0, or k < 0 with τ0 = 0
@@ -313,10 +311,10 @@ def check_contact(settings, params) -> None:
     params.check_p0_gpa(c.p0_gpa, "contact.p0_gpa")
     if c.experiment.csv or c.experiment.compare:
         params.check_p0_gpa(c.experiment.p0_gpa, "contact.experiment.p0_gpa")
-    if c.maugis_lambda is not None and not params.work_of_adhesion_j_m2 > 0:
+    if c.maugis_lambda is not None and not params.work_of_adhesion_j_per_m2 > 0:
         raise InputError(
             "contact.maugis_lambda: the Maugis–Dugdale radius needs a work of adhesion > 0 "
-            "(contact.work_of_adhesion_j_m2, or the scan's work of separation)"
+            "(contact.work_of_adhesion_j_per_m2, or the scan's work of separation)"
         )
 
 

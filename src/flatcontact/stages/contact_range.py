@@ -63,7 +63,7 @@ def path_facts(friction) -> dict:
             barrier, source = mep, "the minimum-energy-path barrier along the sliding direction"
     return {
         "p_gpa": float(friction["p_gpa"].values[i]),
-        "unstable_stacking_j_m2": barrier * MEV_PER_A2_TO_J_PER_M2,
+        "unstable_stacking_j_per_m2": barrier * MEV_PER_A2_TO_J_PER_M2,
         "unstable_stacking_source": source,
         "burgers_angstrom": float(np.hypot(x[-1] - x[0], y[-1] - y[0])),
         "tau_max_mpa": float(np.nanmax(np.abs(f))),
@@ -127,7 +127,7 @@ def slip_interface(inputs):
     else:
         kind, why = structure_regime(run.get("recipe"))
     path = run.get("path") or {}
-    gus, b = path.get("unstable_stacking_j_m2"), path.get("burgers_angstrom")
+    gus, b = path.get("unstable_stacking_j_per_m2"), path.get("burgers_angstrom")
     return SlipInterface(
         kind,
         why,
@@ -162,14 +162,14 @@ def slip_of(settings, interface, analysis) -> dict | None:
         "slip_regime": mode,
         "source": interface.source,
         "shear_modulus_gpa": params.shear_modulus_gpa,
-        "unstable_stacking_j_m2": interface.unstable_stacking_j_m2,
+        "unstable_stacking_j_per_m2": interface.unstable_stacking_j_per_m2,
         "burgers_angstrom": None if interface.burgers_m is None else interface.burgers_m * 1e10,
         "estimate": "a_c = 8 G* gamma_us/(pi tau_c^2), tau_dis(a) = sqrt(8 G* gamma_us/(pi a))"
         if interface.kind == COMMENSURATE
         else "a_el = G* b/(pi tau_p); beyond it the concurrent number is a lower bound",
         "results": [],
     }
-    t, b, g = interface.tau_max_pa, interface.burgers_m, interface.unstable_stacking_j_m2
+    t, b, g = interface.tau_max_pa, interface.burgers_m, interface.unstable_stacking_j_per_m2
     if t and b and g and np.isfinite(t):
         doc["shape_factor"] = float(np.pi * g / (t * b))
         doc["core_width_nm"] = core_width(t, params.shear_modulus_pa, b) * 1e9

@@ -143,8 +143,12 @@ def contact(cfg: RunConfig) -> dict:
     experiment, the quick preset's laws the comparison quotes, the curves to fit."""
     from flatcontact.stages.contact import QUARTZ_QUICK_LAWS_FILE
 
+    section = dict(cfg.section("contact"))
+    for sub in ("experiment", "fit"):  # their csv files enter by name and content, not place
+        if isinstance(section.get(sub), dict):
+            section[sub] = portable(section[sub], "csv")
     inputs = {
-        "contact": portable(cfg.section("contact"), "experiment_csv", "fit_csv"),
+        "contact": section,
         **_figures(cfg),
     }
     if cfg.contact.experiment.csv:

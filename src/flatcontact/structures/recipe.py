@@ -71,7 +71,7 @@ TOY_PARAMS: dict[str, Bounds] = {
     "sigma_angstrom": Bounds(0.5, 10.0, "Å"),
     "cutoff_sigma": Bounds(1.2, 5.0),
     "gap_factor": Bounds(0.5, 5.0),
-    "relax_fmax_ev_per_a": Bounds(1e-8, 1.0, "eV/Å"),
+    "relax_fmax_ev_per_angstrom": Bounds(1e-8, 1.0, "eV/Å"),
 }
 
 
@@ -447,6 +447,8 @@ def parse_recipe(data: dict[str, Any], field: str = SECTION) -> Any:
             parts = parts[:1] + parts[2:]
         loc = ".".join(parts)
         msg = str(err["msg"]).removeprefix("Value error, ")  # pydantic's, not the user's
+        if err["type"] == "extra_forbidden":
+            msg = "unknown field"
         raise InputError(f"{field}.{loc}: {msg}" if loc else f"{field}: {msg}") from None
 
 

@@ -122,7 +122,7 @@ class ToyPairCalculator(Calculator):
 def toy_interface(
     layers: int = 3,
     gap_factor: float = 1.0,
-    relax_fmax_ev_per_a: float = 1e-5,
+    relax_fmax_ev_per_angstrom: float = 1e-5,
     **params: float,
 ) -> Atoms:
     """Build the toy two-slab interface and relax it along z (reference structure).
@@ -133,7 +133,7 @@ def toy_interface(
         Atomic layers per slab (>= 3: an outer face, inner atoms, an inner face).
     gap_factor
         Initial interfacial gap in units of the in-slab layer spacing before relaxing.
-    relax_fmax_ev_per_a
+    relax_fmax_ev_per_angstrom
         Force tolerance of the initial relaxation (every atom free along z only), eV/Å.
     params
         Overrides of :class:`ToyPairCalculator` parameters.
@@ -170,7 +170,7 @@ def toy_interface(
     atoms.calc = ToyPairCalculator(**params)
     # initial optimisation: only z may relax (the lateral registry is the reference stacking)
     atoms.set_constraint([FixedLine(list(range(len(atoms))), [0, 0, 1])])
-    BFGS(atoms, logfile=None).run(fmax=relax_fmax_ev_per_a, steps=1000)
+    BFGS(atoms, logfile=None).run(fmax=relax_fmax_ev_per_angstrom, steps=1000)
     atoms.set_constraint()
     atoms.calc = None
     return atoms

@@ -242,7 +242,7 @@ def tolerance_advice(barrier_mev_per_a2: float, noise_mev_per_a2: float, relaxed
         barrier_mev_per_a2 < bound and barrier_mev_per_a2 >= RESOLVED_FACTOR * noise_mev_per_a2
     ):
         return ""
-    fmax = relaxed.fmax_ev_per_a
+    fmax = relaxed.fmax_ev_per_angstrom
     needed = fmax * math.sqrt(barrier_mev_per_a2 / bound)
     # two significant figures, rounded down: never the tolerance the cell already ran at
     # (0.000486 at fmax 0.0005 printed as 0.0005 with one figure)

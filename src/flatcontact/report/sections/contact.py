@@ -99,7 +99,7 @@ def contact_section(cfg, contact: dict, elastic: dict | None, folder: Path) -> S
             f"{params['shear_modulus_gpa']:g} GPa ({prov.get('moduli')}); k = {params['k_mpa_per_gpa']:.3g} "
             f"MPa/GPa, τ0 = {params['tau0_mpa']:.3g} MPa, μ = {params['mu_mpa_per_gpa']:.3g} MPa/GPa, "
             f"σ0 = {params['sigma0_mpa']:.3g} MPa ; "
-            f"w = {params['work_of_adhesion_j_m2']:.3g} J/m² ({prov.get('work_of_adhesion_j_m2')}).",
+            f"w = {params['work_of_adhesion_j_per_m2']:.3g} J/m² ({prov.get('work_of_adhesion_j_per_m2')}).",
         ],
         notes=notes,
         tables=[

@@ -49,8 +49,8 @@ def flowed_on(contact: dict, gates: list[str]) -> str | None:
         for k in keys
         if k in _NAMES and prov.get(k) == "fitted laws" and k in params
     ]
-    if "w" in keys and prov.get("work_of_adhesion_j_m2") == "scan work of separation":
-        used.append(f"w = {params.get('work_of_adhesion_j_m2', float('nan')):.4g} J/m² (scan)")
+    if "w" in keys and prov.get("work_of_adhesion_j_per_m2") == "scan work of separation":
+        used.append(f"w = {params.get('work_of_adhesion_j_per_m2', float('nan')):.4g} J/m² (scan)")
     if not used:
         return None
     p0 = [r.get("p0_gpa") for r in contact.get("results") or [] if r.get("p0_gpa") is not None]
