@@ -12,10 +12,9 @@ a1, a2, the potential label, the probe column and adhesion if the thicknesses we
 chosen from a pressure range). A store whose settings differ from the current ones is
 refused with a line naming the first difference.
 
-Size: a new store has 8 kB pages and none of ``ase.db``'s optional query indexes (ASE's
-``create_indices=False``); its tables, the key-value tables included, are ASE's, so ASE's
-key queries still answer, by a table scan. The default run's 2,160 points of 36 atoms take
-about 5 MB instead of 7.4 MB.
+Size: a new store keeps each key-value pair once, in its row, and none of ``ase.db``'s
+optional indexes; ASE's key tables are views of the rows, so ASE's queries still answer
+(:mod:`flatcontact.ispes.store_schema`).
 
 Crash safety: only the driver process writes, on one connection, into SQLite's write-ahead
 log with ``synchronous=NORMAL``: a commit is a write, not an fsync (an fsync per point cost
@@ -67,7 +66,7 @@ from ase import Atoms
 from flatcontact.errors import InputError
 from flatcontact.fileio import refuse_link
 from flatcontact.interrupts import raise_on_sigterm
-from flatcontact.ispes import contract
+from flatcontact.ispes import contract, store_schema
 from flatcontact.ispes.relax import Index, PointResult
 from flatcontact.ispes.store_checks import (
     quick_check,
@@ -98,24 +97,6 @@ def _acquire_driver_lock(path: Path):
             "or use another --out"
         ) from None
     return handle
-
-
-#: SQLite page size of a new store: a row (36 quartz atoms: ≈ 1.5 kB, positions 864 bytes) left
-#: a quarter of each 4 kB page empty; 8 kB pages hold five rows with 5 % left over.
-PAGE_SIZE = 8192
-
-
-def _create_store_file(path: Path) -> None:
-    """Create an empty ``points.db`` with :data:`PAGE_SIZE` pages in write-ahead-log mode.
-
-    A page size is fixed when the file is first written; ``ase.db`` then creates its tables
-    in it. Called only for a path that does not exist yet or is empty."""
-    con = sqlite3.connect(str(path))
-    try:
-        con.execute(f"PRAGMA page_size={PAGE_SIZE}")
-        con.execute("PRAGMA journal_mode=WAL")  # writes the header: the page size is kept
-    finally:
-        con.close()
 
 
 def interface_hash(atoms: Atoms) -> str:
@@ -207,15 +188,15 @@ class PointStore:
             refuse_link(self.path.with_name(self.path.name + suffix), "a point store file")
         self._driver_lock = _acquire_driver_lock(self.path)
         try:
-            if not self.path.exists() or self.path.stat().st_size == 0:
-                _create_store_file(self.path)
-            # without ase.db's query indexes (on keys, key values, ctime, user, calculator,
-            # species, and unique_id twice): a third of the file, nothing the store reads;
-            # ase.db's key queries still work on the tables (`ase db points.db i_z=3`)
+            new = not self.path.exists() or self.path.stat().st_size == 0
+            if new:  # the layout of a new store: store_schema
+                store_schema.create(self.path)
             self._db = ase.db.connect(
                 str(self.path), type="db", append=True, use_lock_file=False, create_indices=False
             )
             n_rows = self._db.count()  # creates the tables of a new store
+            if new:
+                store_schema.replace_key_tables(self.path)
             if n_rows:
                 quick_check(self.path)
             meta = self._db.metadata
