@@ -15,7 +15,10 @@ eV/Å, the benchmarks' :func:`benchmarks.bench_scan.build`):
 3. what the exact resume costs: each point starts its LAMMPS instance afresh (a full setup,
    ``run 0``, for its first force call, :meth:`LammpsEngine.restart`) instead of one more
    step (``run 1 pre no post no``); CPU ms per point measured on the same cell, and its
-   share of a point (force calls per point × CPU ms per call); the force calls are the same.
+   share of a point (force calls per point × CPU ms per call); the force calls are the same;
+4. the driver's CPU per stored point, 2,160 rows of this cell committed every 0.5 s, in the
+   store's layout (:mod:`flatcontact.ispes.store_schema`) and in ASE's own (key tables and
+   indexes), interleaved, and the two files' sizes.
 
 Targets (issue 33): wall ≤ 0.3 × the native script; 2 workers ≥ 1.8 × 1. On a shared
 machine the wall times are upper bounds and the speed-up reads low (the load average is
@@ -82,6 +85,66 @@ def restart_cost(reference, factory, n: int = 60) -> tuple[float, float]:
     return float(fast), float(full)
 
 
+def store_cost(reference, n: int = 2160, repeats: int = 3) -> dict[str, list]:
+    """CPU ms per stored point and file bytes, the store's layout against ASE's own."""
+    from unittest import mock
+
+    import ase.db
+
+    from flatcontact.ispes import store_schema
+    from flatcontact.ispes.relax import PointResult
+    from flatcontact.ispes.store import PointStore
+
+    rng = np.random.default_rng(1)
+    rows = [
+        PointResult(
+            (k % 12, (k // 12) % 12, k // 144),
+            0.1,
+            0.2,
+            18.0 + k // 144,
+            -355.0 - rng.random(),
+            0.5,
+            0.4,
+            7,
+            6,
+            True,
+            1e-3,
+            0.02,
+            reference.positions + 1e-3 * rng.standard_normal(reference.positions.shape),
+            None,
+        )
+        for k in range(n)
+    ]
+    connect = ase.db.connect
+    ase_layout = (
+        mock.patch.object(store_schema, "create", lambda path: None),
+        mock.patch.object(store_schema, "replace_key_tables", lambda path: False),
+        mock.patch.object(
+            ase.db, "connect", lambda *a, **k: connect(*a, **{**k, "create_indices": True})
+        ),
+    )
+    out: dict[str, list] = {"store": [], "ase": []}
+    for _ in range(repeats):
+        for layout in out:
+            with tempfile.TemporaryDirectory() as tmp:
+                patches = ase_layout if layout == "ase" else ()
+                for patch in patches:
+                    patch.start()
+                try:
+                    path = Path(tmp) / "points.db"
+                    with PointStore(path, {"bench": 1}, reference, commit_interval_s=0.5) as st:
+                        t = time.process_time()
+                        for r in rows:
+                            st.write(r)
+                        st.flush()
+                        cpu = time.process_time() - t
+                finally:
+                    for patch in patches:
+                        patch.stop()
+                out[layout].append((1e3 * cpu / n, path.stat().st_size))
+    return out
+
+
 def main() -> None:
     from benchmarks.bench_scan import build
     from benchmarks.native_lammps import run_script, write_inputs
@@ -136,3 +199,12 @@ def main() -> None:
             f"({per_point:.0f} calls); no extra force call, {_load()}",
             flush=True,
         )
+    cost = store_cost(reference)
+    print(
+        "STORE per point (driver CPU ms, 2160 rows, interleaved): this layout "
+        + ", ".join(f"{ms:.3f}" for ms, _ in cost["store"])
+        + f" ({cost['store'][0][1] / 1e6:.2f} MB); ASE's layout "
+        + ", ".join(f"{ms:.3f}" for ms, _ in cost["ase"])
+        + f" ({cost['ase'][0][1] / 1e6:.2f} MB), {_load()}",
+        flush=True,
+    )
