@@ -90,6 +90,11 @@ def main(argv: list[str] | None = None) -> None:
                 ),
                 flush=True,
             )
+            print(
+                "    driver phases (s; a/b is part of a): "
+                + ", ".join(f"{k} {v:.2f}" for k, v in r.phase_seconds.items()),
+                flush=True,
+            )
         t1 = rows[0][1]
         print(
             "| workers | wall s | speed-up | efficiency | machine ceiling | efficiency / ceiling |"

@@ -2,7 +2,9 @@
 
 Runs the built-in default in a temporary directory twice: the first pass computes
 every stage, the second must skip them all (the cost of a no-op rerun). Prints the per-stage
-table, the run directory's size (every file's bytes; the largest files), report.html's size,
+table, the scan driver's phases (probe, ideal work of separation, symmetry, grid, writing:
+:mod:`flatcontact.ispes.phases`), the run directory's size (its files' bytes, a file under
+two names once, as ``du`` counts; the largest files), report.html's size,
 the scan's force calls and, against the figures before issue 33
 (``benchmarks/run_baseline.json``), the ratio of each. Stores them as the ``"run"`` block of
 ``benchmarks/run_record.json`` (:mod:`benchmarks.record`), from which
@@ -14,6 +16,7 @@ Set ``FLATCONTACT_BENCH_PRESET=paper`` for the paper preset (hours; not stored).
 from __future__ import annotations
 
 import json
+import logging
 import os
 import tempfile
 import time
@@ -26,11 +29,41 @@ LARGEST = 6
 
 
 def sizes(root: Path) -> tuple[int, list[tuple[str, int]]]:
-    """Total bytes of the files under ``root`` and the largest files (relative name, bytes)."""
-    files = [(p.relative_to(root).as_posix(), p.stat().st_size) for p in root.rglob("*")]
-    files = [(name, n) for name, n in files if (root / name).is_file()]
+    """Bytes of the files under ``root``, a file under two names (a hard link: the run's
+    ``report.html``) counted once, as ``du`` does; and the largest files (relative name,
+    bytes), every name listed."""
+    files, inodes = [], {}
+    for p in root.rglob("*"):
+        if p.is_file() and not p.is_symlink():
+            st = p.stat()
+            files.append((p.relative_to(root).as_posix(), st.st_size))
+            inodes[(st.st_dev, st.st_ino)] = st.st_size
     files.sort(key=lambda x: -x[1])
-    return sum(n for _, n in files), files[:LARGEST]
+    return sum(inodes.values()), files[:LARGEST]
+
+
+class PhaseLog(logging.Handler):
+    """The scan driver's phases (:mod:`flatcontact.ispes.phases`), from its DEBUG log."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.DEBUG)
+        self.seconds: dict[str, float] = {}
+
+    def emit(self, record: logging.LogRecord) -> None:
+        name, seconds = record.getMessage().rsplit(" ", 1)
+        self.seconds[name] = self.seconds.get(name, 0.0) + float(seconds)
+
+    def __enter__(self) -> PhaseLog:
+        logger = logging.getLogger("flatcontact.ispes.phases")
+        self._level = logger.level
+        logger.setLevel(logging.DEBUG)
+        logger.addHandler(self)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        logger = logging.getLogger("flatcontact.ispes.phases")
+        logger.removeHandler(self)
+        logger.setLevel(self._level)
 
 
 class ScanClock:
@@ -76,7 +109,10 @@ def measure(preset: str) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp) / "run"
         start = time.perf_counter()
-        with Pipeline(cfg, root, on_event=clock.event, scan_progress=clock.progress) as pipe:
+        with (
+            PhaseLog() as phases,
+            Pipeline(cfg, root, on_event=clock.event, scan_progress=clock.progress) as pipe,
+        ):
             pipe.run()
             first = dict(pipe.results)
         block["total_s"] = round(time.perf_counter() - start, 2)
@@ -96,6 +132,7 @@ def measure(preset: str) -> dict:
         "stages_s": {n: round(r.seconds, 2) for n, r in first.items() if r.action == "ran"},
         "stage_actions": {n: r.action for n, r in first.items()},
         "scan_phases_s": clock.phases(),
+        "scan_driver_phases_s": {k: round(v, 3) for k, v in phases.seconds.items()},
         "rerun_s": round(rerun, 2),
         "rerun_actions": actions,
         "run_dir_bytes": total,
@@ -148,6 +185,12 @@ def table(block: dict, baseline: dict) -> list[str]:
         f"{block['scan']['median_force_calls_per_point']} per point",
         f"  rerun with nothing changed: {block['rerun_s']:.2f} s, actions {block['rerun_actions']}",
     ]
+    if block.get("scan_driver_phases_s"):
+        lines.insert(
+            -1,
+            "  scan driver phases (s; a/b is part of a): "
+            + ", ".join(f"{k} {v:.2f}" for k, v in block["scan_driver_phases_s"].items()),
+        )
     if block.get("scan_phases_s"):
         ph = block["scan_phases_s"]
         lines.insert(

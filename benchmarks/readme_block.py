@@ -67,9 +67,23 @@ def render_run_cell(block: dict) -> str:
     )
 
 
-RENDER = {"run": render_run, "tests": render_tests, "run-cell": render_run_cell}
+def render_install(block: dict) -> str:
+    """The install step of a fresh clone's first ``make run`` / ``make test``."""
+    return (
+        f"{block['seconds'] / 60:.0f} min ({block['seconds']:.0f} s) for the venv and "
+        f'`pip install -e ".[test]"`, {block["packages"]} packages downloaded with pip\'s cache '
+        f"off; `python -m benchmarks install`, {_when(block)}"
+    )
+
+
+RENDER = {
+    "run": render_run,
+    "tests": render_tests,
+    "run-cell": render_run_cell,
+    "install": render_install,
+}
 #: The record's block behind each rendered block.
-SOURCE = {"run": "run", "tests": "tests", "run-cell": "run"}
+SOURCE = {"run": "run", "tests": "tests", "run-cell": "run", "install": "install"}
 
 
 def marker(name: str) -> re.Pattern:

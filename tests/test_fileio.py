@@ -32,3 +32,29 @@ def test_file_sha256_is_the_sha256_of_the_bytes_read_in_blocks(tmp_path):
     assert file_sha256(path) == hashlib.sha256(data).hexdigest()
     (tmp_path / "empty").write_bytes(b"")
     assert file_sha256(tmp_path / "empty") == hashlib.sha256(b"").hexdigest()
+
+
+def test_link_file_atomic_stores_the_bytes_once_and_replaces_a_planted_link(tmp_path, monkeypatch):
+    import os
+
+    from flatcontact.fileio import link_file_atomic, write_text_atomic
+
+    src = write_text_atomic(tmp_path / "stage" / "report.html", "<html>1</html>")
+    elsewhere = tmp_path / "elsewhere.html"
+    elsewhere.write_text("not mine")
+    target = tmp_path / "report.html"
+    target.symlink_to(elsewhere)  # planted: replaced, not written through
+    link_file_atomic(src, target)
+    assert not target.is_symlink() and os.path.samefile(src, target)
+    assert src.stat().st_nlink == 2 and elsewhere.read_text() == "not mine"
+    link_file_atomic(src, target)  # again: the same link, no temporary left behind
+    assert os.path.samefile(src, target)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["elsewhere.html", "report.html", "stage"]
+    # a rewrite of the stage's file (atomic: a new file) leaves the old link's bytes alone
+    write_text_atomic(src, "<html>2</html>")
+    assert target.read_text() == "<html>1</html>"
+    # a filesystem without hard links: a copy
+    monkeypatch.setattr(os, "link", lambda *a, **k: (_ for _ in ()).throw(PermissionError()))
+    link_file_atomic(src, target)
+    assert target.read_text() == "<html>2</html>" and not os.path.samefile(src, target)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["elsewhere.html", "report.html", "stage"]

@@ -218,6 +218,33 @@ def copy_file_atomic(source: str | os.PathLike[str], path: str | os.PathLike[str
     return Path(path)
 
 
+def link_file_atomic(source: str | os.PathLike[str], path: str | os.PathLike[str]) -> Path:
+    """Make ``path`` a second hard link to ``source``'s file, atomically; return ``path``.
+
+    The file's bytes are stored once (``du`` counts them once; ``cp -a``, ``tar`` and
+    ``rsync -H`` keep the link). Where the filesystem has no hard links, or ``source`` is a
+    symbolic link, ``path`` becomes a copy (:func:`copy_file_atomic`). Either way a symbolic
+    link planted at ``path`` is replaced, not written through; later atomic writes to either
+    name replace that name only.
+    """
+    source, target = Path(source), Path(path)
+    if source.is_symlink():
+        return copy_file_atomic(source, target)
+    check_path_length(target.name, str(target.parent))
+    target.parent.mkdir(parents=True, exist_ok=True)
+    refuse_link(target.parent, "a folder flatcontact writes into")
+    tmp = _create_temporary(target)  # reserves a fresh name beside the target
+    try:
+        tmp.unlink()
+        os.link(source, tmp, follow_symlinks=False)
+        os.replace(tmp, target)  # a no-op when target is already a link to the same file
+    except OSError:
+        return copy_file_atomic(source, target)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return target
+
+
 def write_text_atomic(path: str | os.PathLike[str], text: str) -> Path:
     """Write ``text`` to ``path`` atomically and return the path."""
     with atomic_path(path) as tmp:

@@ -54,7 +54,7 @@ from flatcontact import __version__
 from flatcontact.config import RunConfig, to_yaml
 from flatcontact.errors import InputError
 from flatcontact.fileio import (
-    copy_file_atomic,
+    link_file_atomic,
     open_nofollow,
     write_json_atomic,
     write_text_atomic,
@@ -544,7 +544,8 @@ class Pipeline:
         target = self.root / REPORT_HTML
         if self.rundir.read_only is not None:  # a finished run on a read-only mount
             return target if target.is_file() else result.folder / REPORT_HTML
-        return copy_file_atomic(result.folder / REPORT_HTML, target)
+        # one file under two names: the report is stored once
+        return link_file_atomic(result.folder / REPORT_HTML, target)
 
     def asperity(self) -> dict | None:
         """Stage 8 (optional, ``asperity.enabled``): the asperity in atoms against the model

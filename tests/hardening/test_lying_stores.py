@@ -169,7 +169,8 @@ def test_an_identical_duplicate_row_is_collapsed_without_a_warning(store, scanne
 def test_a_garbled_store_is_one_line_naming_it(store, tmp_path, capsys, where):
     argv, _folder, db = store
     data = bytearray(db.read_bytes())
-    start = 20 if where == "header" else 4096 + 8
+    page = int.from_bytes(data[16:18], "big")  # the page size in SQLite's file header
+    start = 20 if where == "header" else page + 8  # inside the second page
     data[start : start + 2000] = b"\xa5" * 2000
     db.write_bytes(bytes(data))
     before = tree(tmp_path)

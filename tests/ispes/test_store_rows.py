@@ -66,6 +66,19 @@ def _assert_same_rows(a, b):
                 assert x == y, (index, key)
 
 
+def _kvp(r):
+    """The key-value pairs of a point as written independently of the store."""
+    return {
+        "i_a": r.index[0], "i_b": r.index[1], "i_z": r.index[2],
+        "shift_a": r.shift_a, "shift_b": r.shift_b, "thickness": r.thickness,
+        "normal_stress_gpa": r.normal_stress_gpa,
+        "reaction_stress_gpa": r.reaction_stress_gpa, "force_calls": r.force_calls,
+        "steps": r.steps, "converged": bool(r.converged),
+        "max_force_ev_per_a": r.max_force_ev_per_a, "seconds": r.seconds,
+        "start": ",".join(map(str, r.start_index)) if r.start_index else "",
+    }  # fmt: skip
+
+
 def test_rows_are_the_ones_ase_writes_from_the_atoms(tmp_path):
     """Independent: the same points written by ase.db from Atoms + SinglePointCalculator."""
     ref = toy_interface(layers=3)
@@ -77,16 +90,7 @@ def test_rows_are_the_ones_ase_writes_from_the_atoms(tmp_path):
         r = _result(ref, k)
         atoms = Atoms(numbers=ref.numbers, positions=r.positions, cell=ref.cell, pbc=ref.pbc)
         atoms.calc = SinglePointCalculator(atoms, energy=r.energy_ev)
-        kvp = {
-            "i_a": r.index[0], "i_b": r.index[1], "i_z": r.index[2],
-            "shift_a": r.shift_a, "shift_b": r.shift_b, "thickness": r.thickness,
-            "normal_stress_gpa": r.normal_stress_gpa,
-            "reaction_stress_gpa": r.reaction_stress_gpa, "force_calls": r.force_calls,
-            "steps": r.steps, "converged": bool(r.converged),
-            "max_force_ev_per_a": r.max_force_ev_per_a, "seconds": r.seconds,
-            "start": ",".join(map(str, r.start_index)) if r.start_index else "",
-        }  # fmt: skip
-        plain.write(atoms, key_value_pairs=kvp)
+        plain.write(atoms, key_value_pairs=_kvp(r))
     ours, theirs = _ase_rows(tmp_path / "points.db"), _ase_rows(tmp_path / "plain.db")
     _assert_same_rows(ours, theirs)
     # the key tables too: ase.db's queries by key find the same rows
@@ -246,3 +250,53 @@ def test_scan_killed_mid_grid_on_workers_resumes_to_the_uninterrupted_grid(
     a, b = open_ispes(out / "ispes.nc"), open_ispes(tmp_path / "whole" / "ispes.nc")
     for name in ("energy", "normal_stress", "converged"):
         np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
+
+
+def test_store_is_compact_and_still_answers_ase_queries(tmp_path):
+    """A new store: 8 kB pages, none of ase.db's optional indexes, ASE's key tables as views of
+    the rows' JSON; under 0.6 of the file ase.db itself makes of the same rows, and ASE's
+    queries (key values, ranges, bare keys, sorting, a row written by ase.db itself, a
+    deletion) answer exactly as on ASE's own file."""
+    from flatcontact.ispes.store_schema import PAGE_SIZE
+
+    ref = toy_interface(layers=3)
+    n = 400
+    with PointStore(tmp_path / "points.db", {"test": "size"}, ref) as store:
+        for k in range(n):
+            store.write(_result(ref, k, n=20))
+    plain = ase.db.connect(str(tmp_path / "plain.db"), use_lock_file=False)
+    with plain:  # one transaction, as ase.db's own bulk write
+        for k in range(n):
+            r = _result(ref, k, n=20)
+            atoms = Atoms(numbers=ref.numbers, positions=r.positions, cell=ref.cell, pbc=ref.pbc)
+            atoms.calc = SinglePointCalculator(atoms, energy=r.energy_ev)
+            plain.write(atoms, key_value_pairs=_kvp(r))
+    path = tmp_path / "points.db"
+    with sqlite3.connect(str(path)) as con:
+        con.execute("PRAGMA wal_checkpoint(TRUNCATE)")
+        assert con.execute("PRAGMA page_size").fetchone()[0] == PAGE_SIZE
+        kinds = dict(con.execute("SELECT name, type FROM sqlite_master"))
+    con.close()
+    assert [k for k, t in kinds.items() if t == "index"] == ["sqlite_autoindex_systems_1"]
+    assert {k: kinds[k] for k in ("keys", "number_key_values", "text_key_values")} == dict.fromkeys(
+        ("keys", "number_key_values", "text_key_values"), "view"
+    )
+    ours, theirs = path.stat().st_size, (tmp_path / "plain.db").stat().st_size
+    assert ours < 0.6 * theirs, (ours, theirs)
+    db = ase.db.connect(str(path), use_lock_file=False)
+    for other in (db, plain):  # the same row written by ase.db itself into each
+        atoms = Atoms(numbers=ref.numbers, positions=ref.positions, cell=ref.cell, pbc=ref.pbc)
+        other.write(atoms, i_a=99, converged=False, start="planted", thickness=1e3)
+    for query in (
+        "", "i_a=3,converged=True", "converged=False", "thickness>11.5", "converged",
+        "start=planted", "i_a=99", "steps<20,i_b=2", "max_force_ev_per_a>=0.02",
+    ):  # fmt: skip
+        assert db.count(query) == plain.count(query), query
+        assert [r.id for r in db.select(query, sort="thickness")] == [
+            r.id for r in plain.select(query, sort="thickness")
+        ], query
+    assert db.get(i_a=4, i_b=1).toatoms() == plain.get(i_a=4, i_b=1).toatoms()
+    assert sorted(db.get(i_a=99).key_value_pairs) == ["converged", "i_a", "start", "thickness"]
+    for other in (db, plain):
+        other.delete([other.get(i_a=99).id])
+    assert db.count("i_a=99") == 0 and db.count() == n

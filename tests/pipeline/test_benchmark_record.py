@@ -23,7 +23,12 @@ def test_readme_blocks_are_rendered_from_the_stored_record():
     (no typed-in figure)."""
     doc = json.loads(record.RECORD.read_text())
     assert "run" in doc
-    for name, file in (("run", "README.md"), ("tests", "README.md"), ("run-cell", "docs/run.md")):
+    for name, file in (
+        ("run", "README.md"),
+        ("tests", "README.md"),
+        ("run-cell", "docs/run.md"),
+        ("install", "README.md"),
+    ):
         source = readme_block.SOURCE[name]
         want = readme_block.RENDER[name](doc[source]) if source in doc else ""
         assert _block(name, file) == want, name
@@ -41,8 +46,12 @@ def test_the_record_states_its_machine_and_the_run_its_stages():
     # the second pass computed nothing
     assert set(run["rerun_actions"]) <= {"skipped", "off"}
     assert run["report_bytes"] < run["run_dir_bytes"]
+    # issue 33's bounds on the default run: a directory a user can keep
+    assert run["run_dir_bytes"] <= 10_000_000 and run["report_bytes"] <= 2_000_000
     if "tests" in doc:
         assert doc["tests"]["exit_status"] == 0 and doc["tests"]["passed"] > 0
+    if "install" in doc:
+        assert doc["install"]["seconds"] > 0 and doc["install"]["packages"] > 0
 
 
 def _made_up_record() -> dict:
@@ -58,6 +67,7 @@ def _made_up_record() -> dict:
             "report_bytes": 1_250_000,
         },
         "tests": machine | {"load_average": 9.0, "seconds": 540.0, "passed": 1600},
+        "install": machine | {"load_average": 0.2, "seconds": 151.4, "packages": 87},
     }
 
 
@@ -71,6 +81,8 @@ def test_rendering_carries_the_records_numbers_and_its_load():
     tests = readme_block.render_tests(doc["tests"])
     assert tests.startswith("9 min for 1600 tests")
     assert "load average 9 on 2 cores): an upper bound" in tests
+    install = readme_block.render_install(doc["install"])
+    assert install.startswith("3 min (151 s) for the venv") and "87 packages" in install
 
 
 def test_rewrite_replaces_only_the_blocks_and_is_idempotent():

@@ -43,6 +43,7 @@ from flatcontact.ispes.executors import Executor
 from flatcontact.ispes.geometry import thickness, validate_interface
 from flatcontact.ispes.grid import GridSpec, check_thicknesses
 from flatcontact.ispes.order import PREFERENCES
+from flatcontact.ispes.phases import phase, recording
 from flatcontact.ispes.probe_units import ProbeUnits, probe_settings
 from flatcontact.ispes.reduction import SymmetrySettings
 from flatcontact.ispes.relax import RelaxSettings, ScanContext
@@ -78,6 +79,11 @@ class ScanResult:
     #: folds of the probed and of the grid's columns and the loads they refuse
     #: (:meth:`flatcontact.ispes.thicknesses.LoadFold.record`; ``scan.json`` ``load_folds``)
     load_folds: list[dict] = dataclasses.field(default_factory=list)
+    #: the driver's wall seconds per phase (:mod:`flatcontact.ispes.phases`): ``open store``,
+    #: ``probe`` (``probe/rigid points``, ``probe/ideal W``), ``overlap check``, ``symmetry``,
+    #: ``grid`` (``grid/verification``), ``assemble``, ``extend``, ``ideal W after grid``,
+    #: ``write``
+    phase_seconds: dict[str, float] = dataclasses.field(default_factory=dict)
 
 
 def check_interface(atoms: Atoms) -> None:
@@ -214,12 +220,16 @@ def run_scan(
     fresh_dir, fresh_store = not out_dir.exists(), not store_path.exists()
     store = None
     try:
-        with PointStore(
-            store_path,
-            scan_settings(reference, factory, grid, relax, symmetry),
-            reference,
-            commit_interval_s=COMMIT_INTERVAL_S,
-        ) as store:
+        with (
+            recording() as clock,
+            PointStore(
+                store_path,
+                scan_settings(reference, factory, grid, relax, symmetry),
+                reference,
+                commit_interval_s=COMMIT_INTERVAL_S,
+            ) as store,
+        ):
+            clock.add("open store", time.perf_counter() - t0)  # with the input checks
             own_executor = executor is None
             if own_executor:
                 executor = executors.make_executor(**(executor_options or {}))
@@ -229,7 +239,9 @@ def run_scan(
             finally:
                 if own_executor:
                     executor.close(cancel=True)
-            result = _assemble(store, scanned, out_dir, t0)
+            with phase("write"):
+                result = _assemble(store, scanned, out_dir, t0)
+            result.phase_seconds = dict(clock.seconds)
     except Exception:
         # a run that failed before storing a point (executor not reachable, probe error)
         # leaves no store behind that would refuse the corrected rerun
@@ -256,7 +268,8 @@ def _drive(
         executor.prestart(factory, reference)  # worker start overlaps the probe
     # the probe's finished units, beside the store (a resumed probe reuses them)
     units = ProbeUnits(out_dir / PROBE_JSON, probe_settings(store.settings))
-    resolved, notes, pending = resolve(store, reference, factory, grid, relax, executor, units)
+    with phase("probe"):
+        resolved, notes, pending = resolve(store, reference, factory, grid, relax, executor, units)
     scheduler = Scheduler(
         store,
         executor,
@@ -269,7 +282,8 @@ def _drive(
     if pending is not None and not scanned.interrupted:
         # the ideal work of separation ran beside the grid (a resumed scan
         # whose store lacks it computed it in the driver, in resolve)
-        store_pending_work(store, pending, executor)
+        with phase("ideal W after grid"):
+            store_pending_work(store, pending, executor)
         scanned.resolved = store.resolved
     kept = list(store.resolved.get("notes", []))
     scanned.notes = kept + [n for n in scanned.notes if n not in kept]
@@ -312,18 +326,24 @@ def _rounds(
         z = np.asarray(resolved["thickness_angstrom"], dtype=float)
         if grid.thickness_angstrom is None:
             new_z = [float(v) for v in z if float(v) not in checked]
-            check_overlaps(scheduler.executor, scheduler.context, grid, new_z)
+            with phase("overlap check"):
+                check_overlaps(scheduler.executor, scheduler.context, grid, new_z)
             checked.update(new_z)
         round_ = ScanRound(z, grid.n_a, grid.n_b, thickness(reference), job.order)
-        plan = SymmetryPlan(reference, grid, relax, job.symmetry, round_)
+        with phase("symmetry"):  # the group's search and the reduction's plan
+            plan = SymmetryPlan(reference, grid, relax, job.symmetry, round_)
         try:
-            plan.run(scheduler, notes)
+            with phase("grid"):
+                plan.run(scheduler, notes)
         except KeyboardInterrupt:
             interrupted = True
             break
-        ds = store.assemble(plan.mapping, plan.record)
+        with phase("assemble"):
+            ds = store.assemble(plan.mapping, plan.record)
         limit = scheduler.max_new_points
-        if not extend_grid(store, reference, grid, relax, limit, job.bracket_loads_gpa, ds):
+        with phase("extend"):
+            extended = extend_grid(store, reference, grid, relax, limit, job.bracket_loads_gpa, ds)
+        if not extended:
             break
         resolved = store.resolved
     return _Scanned(plan, resolved, notes, interrupted, scheduler.computed_calls)

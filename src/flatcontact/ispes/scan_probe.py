@@ -24,6 +24,7 @@ from ase import Atoms
 from flatcontact.ispes.executors import Executor
 from flatcontact.ispes.geometry import in_plane_vectors
 from flatcontact.ispes.grid import GridSpec
+from flatcontact.ispes.phases import phase
 from flatcontact.ispes.probe import (
     CompressionSegments,
     RigidStackings,
@@ -175,9 +176,10 @@ def resolve(
             pending = work
             resolved["adhesion"] = pull_off_record(resolved.get("adhesion"))
         else:
-            resolved["adhesion"] = adhesion_record(
-                reference, factory, grid, relax, resolved.get("adhesion"), work, units
-            )
+            with phase("probe/ideal W"):  # computed here for given thicknesses
+                resolved["adhesion"] = adhesion_record(
+                    reference, factory, grid, relax, resolved.get("adhesion"), work, units
+                )
         units.announce()
         store.set_resolved(resolved)
     resolved = store.resolved
@@ -231,23 +233,26 @@ def probe(
         return probe_many(reference, factory, grid, relax, executor, units)
     calc = worker_calculator(factory, reference)
     relax_one = functools.partial(relax_column_point, reference, calc, relax)
-    rigid = _rigid_serial(reference, calc, grid, units)
+    with phase("probe/rigid points"):
+        rigid = _rigid_serial(reference, calc, grid, units)
     lowest = extreme_stackings(rigid.energy_ev, grid)[0]
     if workers <= 1:
         columns = functools.partial(_probe_columns_here, relax_one, reference, units)
         extra, notes = probe_thicknesses(relax_one, reference, rigid, grid, columns)
-        work = _cached(
-            units,
-            "work",
-            (*lowest,),
-            lambda: ideal_work_of_separation(reference, factory, relax, lowest, calc=calc),
-        )
+        with phase("probe/ideal W"):
+            work = _cached(
+                units,
+                "work",
+                (*lowest,),
+                lambda: ideal_work_of_separation(reference, factory, relax, lowest, calc=calc),
+            )
         return extra, notes, work
     context = ScanContext(reference, factory, relax)
     work: list = []
     columns = functools.partial(_probe_columns_on_workers, executor, units, context, lowest, work)
     extra, notes = probe_thicknesses(relax_one, reference, rigid, grid, columns)
-    w = unit_result(executor, units, "work", (*lowest,), work[0]) if work else None
+    with phase("probe/ideal W"):  # the wait for it: it ran beside the probed columns
+        w = unit_result(executor, units, "work", (*lowest,), work[0]) if work else None
     return extra, notes, w
 
 

@@ -26,6 +26,7 @@ from flatcontact.ispes.contract import cell_area
 from flatcontact.ispes.geometry import in_plane_vectors
 from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.order import tree_in_store_order
+from flatcontact.ispes.phases import phase
 from flatcontact.ispes.reduction import (
     SymmetrySettings,
     choose_verify,
@@ -147,7 +148,8 @@ class SymmetryPlan:
                 total=grid_points + len(self.reduction.verify),
             )
         if all(idx in store for idx in self.reduction.computed):
-            self._verify(scheduler, notes)
+            with phase("grid/verification"):
+                self._verify(scheduler, notes)
 
     def _verify(self, scheduler: Scheduler, notes: list[str]) -> None:
         """Compare the verified points with their representatives; on a broken symmetry

@@ -12,6 +12,10 @@ a1, a2, the potential label, the probe column and adhesion if the thicknesses we
 chosen from a pressure range). A store whose settings differ from the current ones is
 refused with a line naming the first difference.
 
+Size: a new store keeps each key-value pair once, in its row, and none of ``ase.db``'s
+optional indexes; ASE's key tables are views of the rows, so ASE's queries still answer
+(:mod:`flatcontact.ispes.store_schema`).
+
 Crash safety: only the driver process writes, on one connection, into SQLite's write-ahead
 log with ``synchronous=NORMAL``: a commit is a write, not an fsync (an fsync per point cost
 2-16 ms on a shared disk), and it survives the death of the process however it dies; only an
@@ -62,7 +66,7 @@ from ase import Atoms
 from flatcontact.errors import InputError
 from flatcontact.fileio import refuse_link
 from flatcontact.interrupts import raise_on_sigterm
-from flatcontact.ispes import contract
+from flatcontact.ispes import contract, store_schema
 from flatcontact.ispes.relax import Index, PointResult
 from flatcontact.ispes.store_checks import (
     quick_check,
@@ -184,8 +188,15 @@ class PointStore:
             refuse_link(self.path.with_name(self.path.name + suffix), "a point store file")
         self._driver_lock = _acquire_driver_lock(self.path)
         try:
-            self._db = ase.db.connect(str(self.path), type="db", append=True, use_lock_file=False)
+            new = not self.path.exists() or self.path.stat().st_size == 0
+            if new:  # the layout of a new store: store_schema
+                store_schema.create(self.path)
+            self._db = ase.db.connect(
+                str(self.path), type="db", append=True, use_lock_file=False, create_indices=False
+            )
             n_rows = self._db.count()  # creates the tables of a new store
+            if new:
+                store_schema.replace_key_tables(self.path)
             if n_rows:
                 quick_check(self.path)
             meta = self._db.metadata

@@ -1,0 +1,67 @@
+"""The scan driver times its serial phases (issue 33): probe, ideal work of separation,
+symmetry, grid, write; the benchmark prints them. The clock observes: it changes nothing."""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+
+from flatcontact.ispes.executors import SerialExecutor
+from flatcontact.ispes.grid import GridSpec
+from flatcontact.ispes.phases import phase, recording
+from flatcontact.ispes.reduction import SymmetrySettings
+from flatcontact.ispes.relax import RelaxSettings
+from flatcontact.ispes.scan import run_scan
+
+SETTINGS = RelaxSettings(fmax_ev_per_angstrom=1e-4, optimizer="FIRE")
+TOP = ("open store", "probe", "overlap check", "symmetry", "grid", "assemble", "extend", "write")
+
+
+def test_a_probed_scan_reports_each_phase_once_and_they_add_up(
+    tmp_path, toy_reference, toy_factory, caplog
+):
+    grid = GridSpec(3, 3, p_range_gpa=(-0.05, 0.5, 4))
+    with caplog.at_level(logging.DEBUG, logger="flatcontact.ispes.phases"):
+        r = run_scan(
+            toy_reference,
+            toy_factory,
+            grid,
+            tmp_path,
+            SETTINGS,
+            executor=SerialExecutor(),
+            symmetry=SymmetrySettings(enabled=True),
+        )
+    ph = r.phase_seconds
+    assert set(TOP) <= set(ph) and {"probe/rigid points", "probe/ideal W"} <= set(ph)
+    assert all(s >= 0 for s in ph.values())
+    # the parts within their phase, the top-level phases within the scan's wall time
+    assert ph["probe/rigid points"] + ph["probe/ideal W"] <= ph["probe"]
+    assert ph.get("grid/verification", 0.0) <= ph["grid"]
+    assert sum(ph[k] for k in TOP) <= r.seconds
+    # the log carries the same phases, each entry "<name> <seconds>"
+    logged: dict[str, float] = {}
+    for rec in caplog.records:
+        name, seconds = rec.getMessage().rsplit(" ", 1)
+        logged[name] = logged.get(name, 0.0) + float(seconds)
+    assert logged.keys() == ph.keys()
+    np.testing.assert_allclose([logged[k] for k in ph], list(ph.values()), atol=2e-6)
+    # a rerun on the finished store computes nothing: no probe work, a grid of no points
+    again = run_scan(
+        toy_reference, toy_factory, grid, tmp_path, SETTINGS, executor=SerialExecutor(),
+        symmetry=SymmetrySettings(enabled=True),
+    )  # fmt: skip
+    assert "probe/rigid points" not in again.phase_seconds
+    np.testing.assert_array_equal(again.dataset.energy.values, r.dataset.energy.values)
+
+
+def test_phase_outside_a_scan_does_nothing_and_nested_recordings_are_apart():
+    with phase("alone"):
+        pass
+    with recording() as outer:
+        with phase("a"):
+            with recording() as inner, phase("b"):
+                pass
+        with phase("a"):
+            pass
+    assert list(outer.seconds) == ["a"] and list(inner.seconds) == ["b"]
