@@ -100,7 +100,7 @@ class ScanClock:
 def measure(preset: str) -> dict:
     """Run the default twice in a temporary directory; the ``"run"`` block of the record."""
     from flatcontact.config import load_config
-    from flatcontact.layout import REPORT_HTML, SCAN_JSON
+    from flatcontact.foundation.layout import REPORT_HTML, SCAN_JSON
     from flatcontact.pipeline import Pipeline
 
     cfg = load_config(preset_name=preset)

@@ -261,9 +261,9 @@ def subset(intra: str, tmp: Path) -> dict:
     cold, warm = runs["cold", 1], runs["columns", 1]
     d_e = float(np.abs(cold["dataset"].energy - warm["dataset"].energy).max())
     d_p = float(np.abs(cold["dataset"].normal_stress - warm["dataset"].normal_stress).max())
+    from flatcontact.foundation.units import EV_PER_A3_TO_GPA
     from flatcontact.ispes.contract import cell_area
     from flatcontact.structures.interface_contract import fixed_mask
-    from flatcontact.units import EV_PER_A3_TO_GPA
 
     # scale of the load error a relaxation to fmax allows: free atoms of slab 2 x fmax / A
     free2 = int(np.sum(~fixed_mask(reference) & (reference.arrays["slab"] == 2)))

@@ -7,7 +7,7 @@ Usage (no torch; LAMMPS only)::
 Each DIR holds one ``*.snapcoeff`` (with its ``.snapparam``), ``test.extxyz`` and
 ``provenance.json`` (``train-snap`` or ``benchmarks.refit_weights`` output). Writes, per DIR,
 the lattice, the trigonal Cij (±0.5 %, relaxed-ion as ``flatcontact elastic`` and
-clamped-ion), E*, their relative errors against :mod:`flatcontact.reference`, the held-out
+clamped-ion), E*, their relative errors against :mod:`flatcontact.foundation.reference`, the held-out
 RMSEs per group against the labels of ``test.extxyz``, and the group weights and descriptor.
 """
 
@@ -18,8 +18,11 @@ import sys
 from pathlib import Path
 
 from flatcontact.elastic import elastic_tensor, quartz_contact_moduli, trigonal_constants
+from flatcontact.foundation.reference import (
+    QUARTZ_CIJ_EXPERIMENT_GPA,
+    QUARTZ_LATTICE_EXPERIMENT_ANGSTROM,
+)
 from flatcontact.potentials.engines import bulk_calculator
-from flatcontact.reference import QUARTZ_CIJ_EXPERIMENT_GPA, QUARTZ_LATTICE_EXPERIMENT_ANGSTROM
 from flatcontact.training.dataset import read_dataset
 from flatcontact.training.validate import dataset_errors, quartz_lattice
 

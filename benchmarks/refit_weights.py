@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from flatcontact.fileio import write_json_atomic
+from flatcontact.foundation.fileio import write_json_atomic
 from flatcontact.training.dataset import read_dataset, write_dataset
 from flatcontact.training.fit import FitSettings, default_settings, fit_snap, split_indices
 from flatcontact.training.snapfiles import SnapHyper, write_snap_files

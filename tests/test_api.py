@@ -16,7 +16,7 @@ TAUGHT = {
     "build_config": "flatcontact.config.load",
     "RunConfig": "flatcontact.config.run",
     "Pipeline": "flatcontact.pipeline",
-    "InputError": "flatcontact.errors",
+    "InputError": "flatcontact.foundation.errors",
     "InteractionModel": "flatcontact.potentials.model",
     "make_calculator": "flatcontact.potentials.engines",
     "calculator_factory": "flatcontact.potentials.engines",
@@ -67,8 +67,8 @@ def test_the_top_level_scan_is_the_core_and_the_stage_door_has_its_own_name():
     """``flatcontact.run_scan`` is the ISPES core; every stage door is ``<stage>_stage``, so no
     stage door shares a name (and a different signature) with a public function."""
     from flatcontact import stages
+    from flatcontact.foundation.layout import STAGES
     from flatcontact.ispes import scan as ispes_scan
-    from flatcontact.layout import STAGES
     from flatcontact.stages import scan as stage_scan
 
     assert flatcontact.run_scan is ispes_scan.run_scan

@@ -1,6 +1,6 @@
 """The layer contract of docs/architecture.md, checked over the static import graph.
 
-The graph is :func:`flatcontact.codegraph.import_graph`: every ``import`` statement in
+The graph is :func:`flatcontact.foundation.codegraph.import_graph`: every ``import`` statement in
 src/flatcontact, function-level imports and ``TYPE_CHECKING`` blocks included (a
 function-level import is an edge like any other: it runs when the function is called).
 Three rules:
@@ -14,7 +14,7 @@ Imports *from* the top-level package ``flatcontact/__init__.py`` are exempt from
 it is the public API, which reaches every layer lazily; every module may import from it
 (``__version__``). A parent package's ``__init__`` that runs on import is not an edge here
 (re-exporting ``__init__`` files would otherwise all be cycles); the stage fingerprints do
-count it (:func:`flatcontact.codegraph.import_closure`).
+count it (:func:`flatcontact.foundation.codegraph.import_closure`).
 
 :data:`SETTINGS_SCHEMAS` are the one declared door from the settings (foundation) into the
 cores: the section data classes; :data:`SETTINGS_REACH` bounds what they load.
@@ -31,7 +31,7 @@ from pathlib import Path
 
 import pytest
 
-from flatcontact.codegraph import SOURCE_ROOT, ImportGraph, import_closure, import_graph
+from flatcontact.foundation.codegraph import SOURCE_ROOT, ImportGraph, import_closure, import_graph
 
 PACKAGE = "flatcontact"
 
@@ -42,17 +42,7 @@ LAYERS: tuple[tuple[str, frozenset[str]], ...] = (
         frozenset(
             {
                 "config",
-                "reference",
-                "units",
-                "errors",
-                "limits",
-                "fileio",
-                "interrupts",
-                "result_json",
-                "rundir",
-                "codegraph",
-                "layout",
-                "numbers",
+                "foundation",
             }
         ),
     ),
@@ -369,14 +359,15 @@ def tiny_package(tmp_path) -> Path:
         tmp_path,
         {
             "__init__.py": '__version__ = "0"\n',
-            "errors.py": "class InputError(ValueError): ...\n",
-            "units.py": "from flatcontact.errors import InputError\n",
+            "foundation/__init__.py": "",
+            "foundation/errors.py": "class InputError(ValueError): ...\n",
+            "foundation/units.py": "from flatcontact.foundation.errors import InputError\n",
             "potentials/__init__.py": "",
             "potentials/model.py": "from flatcontact import __version__\n",
             "structures/__init__.py": "",
             "structures/build.py": "from ..potentials import model\n",
             "ispes/__init__.py": "",
-            "ispes/contract.py": "from flatcontact import units\n",
+            "ispes/contract.py": "from flatcontact.foundation import units\n",
             "ispes/scan.py": "from flatcontact.structures.build import x\n",
             "analysis/__init__.py": "",
             "analysis/friction.py": "from flatcontact.ispes.contract import read\n",

@@ -16,7 +16,7 @@ from flatcontact.elastic import (
     relax_cell,
     trigonal_constants,
 )
-from flatcontact.units import EV_PER_A3_TO_GPA
+from flatcontact.foundation.units import EV_PER_A3_TO_GPA
 
 
 def energy_hessian(atoms, calc, h=2e-3):

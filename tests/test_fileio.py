@@ -7,7 +7,7 @@ def test_atomic_write_leaves_usual_permissions_and_no_partial_file(tmp_path):
     import os
     import stat
 
-    from flatcontact.fileio import atomic_path, write_text_atomic
+    from flatcontact.foundation.fileio import atomic_path, write_text_atomic
 
     mask = os.umask(0o022)
     try:
@@ -24,7 +24,7 @@ def test_atomic_write_leaves_usual_permissions_and_no_partial_file(tmp_path):
 def test_file_sha256_is_the_sha256_of_the_bytes_read_in_blocks(tmp_path):
     import hashlib
 
-    from flatcontact.fileio import file_sha256
+    from flatcontact.foundation.fileio import file_sha256
 
     data = bytes(range(256)) * 9000  # more than one 1 MiB block
     path = tmp_path / "data.bin"
@@ -37,7 +37,7 @@ def test_file_sha256_is_the_sha256_of_the_bytes_read_in_blocks(tmp_path):
 def test_link_file_atomic_stores_the_bytes_once_and_replaces_a_planted_link(tmp_path, monkeypatch):
     import os
 
-    from flatcontact.fileio import link_file_atomic, write_text_atomic
+    from flatcontact.foundation.fileio import link_file_atomic, write_text_atomic
 
     src = write_text_atomic(tmp_path / "stage" / "report.html", "<html>1</html>")
     elsewhere = tmp_path / "elsewhere.html"

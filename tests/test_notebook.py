@@ -13,7 +13,7 @@ from ase.calculators.emt import EMT
 
 import flatcontact
 from flatcontact import notebook
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.structures.assemble import make_interface
 
 Z = [10.3, 10.45, 10.6]

@@ -4,8 +4,8 @@ import json
 
 import pytest
 
-from flatcontact.errors import InputError
-from flatcontact.rundir import RECORD_NAME, RunDirectory, fingerprint
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.rundir import RECORD_NAME, RunDirectory, fingerprint
 
 
 def _counting_work(calls, name, fail=False):

@@ -2,7 +2,7 @@
 
 import pytest
 
-from flatcontact import units
+from flatcontact.foundation import units
 
 
 def test_unit_constants_against_definitions():

@@ -38,7 +38,7 @@ except PackageNotFoundError:  # running from a source tree without installation
 #: Public name -> the sub-package (or top-level module) that owns it.
 _EXPORTS: dict[str, list[str]] = {
     "config": ["RunConfig", "build_config", "load_config", "preset", "to_yaml"],
-    "errors": ["InputError"],
+    "foundation.errors": ["InputError"],
     "pipeline": ["Pipeline", "StageEvent"],
     "potentials": [
         "InteractionModel",

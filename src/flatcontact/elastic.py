@@ -34,11 +34,11 @@ import numpy as np
 from ase import Atoms
 from ase.optimize import BFGS
 
-from flatcontact.errors import require
+from flatcontact.foundation.errors import require
+from flatcontact.foundation.units import EV_PER_A3_TO_GPA
 from flatcontact.potentials.engines import bulk_calculator
 from flatcontact.potentials.model import InteractionModel
 from flatcontact.structures.lattice import relax_cell  # the build's lattice relaxation
-from flatcontact.units import EV_PER_A3_TO_GPA
 
 _VOIGT_PAIRS = ((0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1))
 

@@ -46,7 +46,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 #: Relaxation modes of :class:`flatcontact.ispes.relax.RelaxSettings` (``scan.relax_mode``).
 RELAX_MODES = ("full", "normal", "rigid-layers", "rigid")
@@ -286,7 +286,7 @@ def contact_from_laws(
 def _law_numbers(laws) -> dict[str, float]:
     """k, τ0, μ, σ0 of a :class:`~flatcontact.analysis.laws.LoadLaws` (through its
     ``laws.json`` form, :meth:`~flatcontact.analysis.laws.LoadLaws.to_json`) or a mapping."""
-    from flatcontact.reference import PAPER_LAW_KEYS
+    from flatcontact.foundation.reference import PAPER_LAW_KEYS
 
     doc = laws if isinstance(laws, dict) else getattr(laws, "to_json", dict)()
     missing = [k for k in PAPER_LAW_KEYS if doc.get(k) is None]

@@ -1,6 +1,6 @@
 """The whole study as stages over a run directory: build → scan → analyze → laws → (elastic) → contact → report.
 
-:class:`Pipeline` runs each stage through :meth:`flatcontact.rundir.RunDirectory.run_stage`
+:class:`Pipeline` runs each stage through :meth:`flatcontact.foundation.rundir.RunDirectory.run_stage`
 with the stage's inputs = its configuration section + the content of the files it reads
 (potential coefficients, structure and measurement files) + the digest of the source code
 that computes it (:func:`stage_code_digest`: the stage module's import closure, figure
@@ -17,7 +17,7 @@ What each stage's fingerprint takes from the settings is :mod:`flatcontact.stage
 (everything the stage reads; settings that do not change numbers, ``scan.executor``,
 ``scan.workers``, ``scan.dask_address``, are not part of any fingerprint).
 
-The run directory's folders and file names are :mod:`flatcontact.layout`.
+The run directory's folders and file names are :mod:`flatcontact.foundation.layout`.
 
 This module keeps only the order of the stages and their fingerprints. What a stage computes
 and writes is :mod:`flatcontact.stages` (``<stage>_stage(settings, inputs, folder)``), which
@@ -52,15 +52,14 @@ import pandas as pd
 
 from flatcontact import __version__
 from flatcontact.config import RunConfig, to_yaml
-from flatcontact.errors import InputError
-from flatcontact.fileio import (
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import (
     link_file_atomic,
     open_nofollow,
     write_json_atomic,
     write_text_atomic,
 )
-from flatcontact.ispes.contract import check_grid, open_ispes
-from flatcontact.layout import (
+from flatcontact.foundation.layout import (
     BUILD_JSON,
     CONFIG_YAML,
     CONTACT_NC,
@@ -79,15 +78,16 @@ from flatcontact.layout import (
     SUMMARY_JSON,
     VERSIONS_JSON,
 )
-from flatcontact.refused import refused_report
-from flatcontact.result_json import read_result_json
-from flatcontact.rundir import (
+from flatcontact.foundation.result_json import read_result_json
+from flatcontact.foundation.rundir import (
     RunDirectory,
     RunLock,
     StageResult,
     package_versions,
     writable,
 )
+from flatcontact.ispes.contract import check_grid, open_ispes
+from flatcontact.refused import refused_report
 from flatcontact.stages import contact_range
 from flatcontact.stages.analyze import AnalyzeInputs, analyze_stage, grid_note
 from flatcontact.stages.build import BuildInputs, build_stage
@@ -150,7 +150,7 @@ class StageEvent:
     wall time; ``message``: the analyze stage's grid verdict when its grid does not resolve τ),
     ``"failed"`` (an exception, ``"interrupted"`` for Ctrl-C, leaves the stage;
     it propagates after the event) or ``"off"`` (a disabled stage; ``message`` says what
-    replaces it). ``index`` is the stage's folder index (:data:`flatcontact.layout.STAGES`).
+    replaces it). ``index`` is the stage's folder index (:data:`flatcontact.foundation.layout.STAGES`).
     """
 
     kind: str
@@ -279,7 +279,7 @@ class Pipeline:
         return self.results[name]
 
     def _json(self, name: str, file: str) -> dict:
-        """A stage's JSON file checked against its contract (:mod:`flatcontact.result_json`)
+        """A stage's JSON file checked against its contract (:mod:`flatcontact.foundation.result_json`)
         and against what this run knows: the scan's grid from its stage record, the energy
         form and the loads p0 from the settings."""
         folder = self._upstream(name).folder
@@ -550,7 +550,7 @@ class Pipeline:
     def asperity(self) -> dict | None:
         """Stage 8 (optional, ``asperity.enabled``): the asperity in atoms against the model
         (``08-asperity/asperity.json``); its saved states resume an interrupted stage."""
-        from flatcontact.layout import ASPERITY_JSON
+        from flatcontact.foundation.layout import ASPERITY_JSON
         from flatcontact.stages.asperity import AsperityInputs, asperity_stage
 
         cfg = self.config

@@ -13,7 +13,7 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-from flatcontact.layout import STAGES
+from flatcontact.foundation.layout import STAGES
 from flatcontact.stages.report import refusal_of
 
 log = logging.getLogger("flatcontact.run")

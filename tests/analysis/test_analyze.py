@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from flatcontact import units
 from flatcontact.analysis import synthetic as syn
 from flatcontact.analysis.analyze import analyze_ispes
 from flatcontact.analysis.options import AnalysisOptions
-from flatcontact.errors import InputError
+from flatcontact.foundation import units
+from flatcontact.foundation.errors import InputError
 
 A = 4.916
 A1, A2 = syn.hexagonal_cell(A)

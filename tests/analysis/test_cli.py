@@ -117,7 +117,7 @@ def test_a_core_error_names_the_flag_for_the_cli_and_the_settings_path_for_the_r
     """The core names its parameter (allow_missing); the analyze stage renames it to the
     settings path a YAML user wrote (analysis.allow_missing), the CLI to the flag it offers."""
     from flatcontact.config import build_config
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
     from flatcontact.ispes.contract import open_ispes
     from flatcontact.stages.analyze import AnalyzeInputs, analyze_stage
 

@@ -8,7 +8,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from flatcontact import units
 from flatcontact.analysis import synthetic as syn
 from flatcontact.analysis.constant_pressure import constant_pressure, invert_columns
 from flatcontact.analysis.diagnostics import (
@@ -16,7 +15,8 @@ from flatcontact.analysis.diagnostics import (
     StressEnergyMismatchWarning,
     UnconvergedPointsWarning,
 )
-from flatcontact.errors import InputError
+from flatcontact.foundation import units
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.contract import branch_run
 
 A1, A2 = syn.hexagonal_cell()

@@ -32,7 +32,7 @@ from flatcontact.analysis.starts import (
     degeneracy_tolerance_ev_per_a2,
     paths_from_near_degenerate_minima,
 )
-from flatcontact.units import EV_PER_A2_TO_MEV_PER_A2, EV_PER_A3_TO_MPA
+from flatcontact.foundation.units import EV_PER_A2_TO_MEV_PER_A2, EV_PER_A3_TO_MPA
 
 V = 1e-3  # eV/Å²
 A, B = 3.0, 4.0  # Å, rectangular cell

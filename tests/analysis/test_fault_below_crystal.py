@@ -13,8 +13,8 @@ import pandas as pd
 import pytest
 
 from flatcontact.config.load import build_config
+from flatcontact.foundation.layout import BUILD_JSON, FRICTION_CSV, SCAN_JSON
 from flatcontact.ispes.work_of_separation import AT_PERFECT_STACKING
-from flatcontact.layout import BUILD_JSON, FRICTION_CSV, SCAN_JSON
 from flatcontact.pipeline import Pipeline
 from flatcontact.report.sections.analysis import stacking_rows
 from flatcontact.report.stacking_names import stacking_family

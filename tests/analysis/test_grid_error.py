@@ -27,7 +27,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from flatcontact import units
 from flatcontact.analysis import gates
 from flatcontact.analysis import synthetic as syn
 from flatcontact.analysis.analyze import analyze_ispes
@@ -41,6 +40,7 @@ from flatcontact.analysis.grid_error import (
 )
 from flatcontact.analysis.options import AnalysisOptions
 from flatcontact.analysis.uncertainty import grid_law_components, law_half_widths
+from flatcontact.foundation import units
 from flatcontact.ispes.contract import open_ispes
 
 MEASURED = Path(__file__).resolve().parents[2] / "docs" / "measured" / "examples"

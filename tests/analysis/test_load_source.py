@@ -3,13 +3,13 @@
 import numpy as np
 import pytest
 
-from flatcontact import units
 from flatcontact.analysis import synthetic as syn
 from flatcontact.analysis.analyze import analyze_ispes
 from flatcontact.analysis.constant_pressure import constant_pressure
 from flatcontact.analysis.friction import merge_shallow_minima
 from flatcontact.analysis.options import AnalysisOptions
-from flatcontact.errors import InputError
+from flatcontact.foundation import units
+from flatcontact.foundation.errors import InputError
 
 A1, A2 = syn.hexagonal_cell()
 MODEL = syn.SyntheticInterface(A1, A2, syn.three_cosine(A1, A2), corrugation_ev_per_a2=-2e-4)

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 
 from flatcontact.analysis import synthetic as syn
 from flatcontact.analysis.periodic import PeriodicSurface, rectangular_supercell
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 A1, A2 = syn.hexagonal_cell()
 

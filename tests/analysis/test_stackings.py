@@ -351,7 +351,7 @@ def test_outputs_carry_the_stackings_barriers_and_rules(tmp_path):
 
 @pytest.mark.parametrize("bad", ["north", "Auto"])
 def test_an_unknown_direction_word_is_a_one_line_error(bad):
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
 
     a1, a2 = syn.hexagonal_cell(2.46)
     ds = syn.SyntheticInterface(a1, a2, syn.three_cosine(a1, a2)).grid(

@@ -73,7 +73,7 @@ def test_config_check_refuses_an_asperity_without_lammps_or_layers(tmp_path):
     import pytest
 
     from flatcontact.config import build_config
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
     from flatcontact.stages.preflight import check_asperity
 
     ase = build_config(

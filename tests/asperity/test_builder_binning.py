@@ -5,7 +5,7 @@ import pytest
 
 from flatcontact.asperity import binning
 from flatcontact.asperity import builder as b
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.structures.construct import build_interface
 from flatcontact.structures.recipe import parse_recipe
 

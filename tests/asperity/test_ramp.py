@@ -13,7 +13,7 @@ from flatcontact.asperity import ramp
 from flatcontact.contact import cycle, mindlin
 from flatcontact.contact import line_contact as lc
 from flatcontact.contact.parameters import ContactParameters
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 
 def _loop(branch_down, u_amp, n=2001):

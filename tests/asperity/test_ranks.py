@@ -26,7 +26,7 @@ from flatcontact.asperity.driver import (
     step_path,
 )
 from flatcontact.asperity.experiment import plan, target_force_ev_per_angstrom
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials.model import InteractionModel
 from flatcontact.structures.recipe import parse_recipe
 

@@ -5,7 +5,7 @@ import pytest
 import yaml
 
 from flatcontact.config import load_config
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.stages.asperity import _executor
 
 

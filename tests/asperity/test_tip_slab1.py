@@ -10,7 +10,7 @@ from ase.calculators.emt import EMT
 
 from flatcontact.asperity import builder
 from flatcontact.cli.settings import resolve_config
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.structures.construct import build_interface
 
 EXAMPLES = Path(__file__).parents[2] / "examples"

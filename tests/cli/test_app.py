@@ -4,7 +4,7 @@ import pytest
 from typer.testing import CliRunner
 
 from flatcontact.cli import app
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 
 def test_cli_version():

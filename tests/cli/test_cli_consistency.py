@@ -47,7 +47,7 @@ _finite = st.floats(allow_nan=False, allow_infinity=False, width=32)
 @given(st.lists(_finite, min_size=1, max_size=6), st.integers(0, 6))
 def test_parse_floats_round_trip_and_refuses_any_empty_item(values, where):
     from flatcontact.cli.app import parse_floats
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
 
     items = [repr(float(v)) for v in values]
     assert parse_floats([",".join(items)], "--x") == [float(v) for v in values]
@@ -102,7 +102,7 @@ def test_min_layers_leaves_one_inner_layer_between_fixed_and_sliding_faces():
     inner face sliding), a slab of MIN_LAYERS units has exactly one untagged (inner, fully
     relaxed) unit; with one unit fewer the two face layers would touch and the interface
     cannot even be tagged."""
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
     from flatcontact.structures.assemble import make_interface
     from flatcontact.structures.build import SYMMETRIC_CUT
     from flatcontact.structures.dense import QUARTZ_ATOMS_PER_LAYER

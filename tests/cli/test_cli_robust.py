@@ -59,7 +59,7 @@ def test_unusable_out_is_one_line_before_work(tmp_path, monkeypatch, capsys, arg
 
 def test_check_out_dir_creates_nothing(tmp_path):
     from flatcontact.cli.app import check_out_dir
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
 
     assert check_out_dir(tmp_path / "a" / "b") == tmp_path / "a" / "b"
     assert list(tmp_path.iterdir()) == []
@@ -108,7 +108,7 @@ def test_build_warns_when_relaxation_does_not_converge(tmp_path, monkeypatch, ca
 
 
 def test_relax_refuses_non_positive_fmax():
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
     from flatcontact.structures.dense import relax
 
     for bad in (0.0, -1.0, float("nan")):
@@ -196,7 +196,7 @@ def test_build_then_scan_chain_with_the_run_model(tmp_path, monkeypatch, capsys)
 
 @pytest.mark.parametrize("existing_dir", [False, True])
 def test_failed_scan_leaves_no_store(tmp_path, monkeypatch, capsys, existing_dir):
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
     from flatcontact.ispes import executors
     from flatcontact.structures.interface_contract import thickness
     from flatcontact.structures.interface_io import write_interface

@@ -15,7 +15,7 @@ from tests.cli.cli_helpers import one_error_line, run_cli
 from flatcontact.cli import analyze, build, contact, scan
 from flatcontact.cli.options import flag_name
 from flatcontact.config.paths import field_at
-from flatcontact.numbers import field_bounds
+from flatcontact.foundation.numbers import field_bounds
 
 COMMANDS = {"contact": contact, "analyze": analyze, "scan": scan, "build": build}
 

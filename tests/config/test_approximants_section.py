@@ -7,7 +7,7 @@ from flatcontact.config.approximants import (
     ApproximantSettings,
     parse_approximants,
 )
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 
 def test_defaults():

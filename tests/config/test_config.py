@@ -8,7 +8,7 @@ from typer.testing import CliRunner
 
 from flatcontact.cli import app
 from flatcontact.config import build_config, load_config, preset, to_yaml
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 
 @pytest.mark.parametrize("name", ["quick", "paper"])

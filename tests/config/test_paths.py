@@ -5,7 +5,7 @@ import pytest
 from flatcontact.config import build_config
 from flatcontact.config.paths import field_at, settings_paths, suggestion
 from flatcontact.config.run import RunConfig
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 
 @pytest.mark.parametrize(

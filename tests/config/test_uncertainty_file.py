@@ -12,7 +12,7 @@ from tests.studies.toy import toy_data, write_yaml
 
 from flatcontact.analysis.uncertainty import LAW_COEFFICIENTS
 from flatcontact.config import build_config, load_config
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.stages.measured_on import check_measured_on, measured_on
 
 

@@ -18,7 +18,7 @@ from flatcontact.contact.adhesion_regime import (
     tabor_parameter,
 )
 from flatcontact.contact.parameters import ContactParameters
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.stages.contact import ContactInputs, contact_stage
 
 #: Cu(111)/Cu(111) with the Mishin EAM (examples/README.md: laws, W, elastic stage's moduli).

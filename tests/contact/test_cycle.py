@@ -6,13 +6,13 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import quad
 
-from flatcontact import units
 from flatcontact.contact import cattaneo_mindlin as cm
 from flatcontact.contact import cycle, cycle_output, mindlin, modified_cycle
 from flatcontact.contact.cycle_reference import time_stepped_cycle
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.contact.summary import analyse
-from flatcontact.errors import InputError
+from flatcontact.foundation import units
+from flatcontact.foundation.errors import InputError
 
 P = ContactParameters()
 

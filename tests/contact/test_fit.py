@@ -6,7 +6,7 @@ import pytest
 from flatcontact.contact import fit, mindlin
 from flatcontact.contact.measured import LoadCurve, load_fit_data
 from flatcontact.contact.parameters import ContactParameters
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 TRUE = ContactParameters(tau0_mpa=40.0)
 LOADS = (1.0, 1.77, 3.0)

@@ -5,11 +5,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from flatcontact import units
 from flatcontact.contact import adhesion as ad
 from flatcontact.contact.hertz import hertz_pressure, solve_hertz
 from flatcontact.contact.parameters import ContactParameters
-from flatcontact.errors import InputError
+from flatcontact.foundation import units
+from flatcontact.foundation.errors import InputError
 
 P = ContactParameters()
 R, E = P.radius_m, P.contact_modulus_pa

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 from scipy.integrate import quad
 
 from flatcontact.contact import line_contact as lc
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 A = 2.0e-9
 P0 = 3.0e9

@@ -6,14 +6,14 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import quad
 
-from flatcontact import units
 from flatcontact.contact import cattaneo_mindlin as cm
 from flatcontact.contact import mindlin as m
 from flatcontact.contact import moduli
 from flatcontact.contact.classical_limit import classical_limit_of_paper_model
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.contact.quadrature import paper_integrals, stick_zone_by_root_finding
-from flatcontact.errors import InputError
+from flatcontact.foundation import units
+from flatcontact.foundation.errors import InputError
 
 P = ContactParameters()
 P0 = 1.0e9

@@ -15,7 +15,7 @@ from flatcontact.contact import oscillation as osc
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.contact.quadrature import paper_integrals
 from flatcontact.contact.summary import analyse
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 #: k = −10 MPa/GPa: τ(centre) > 0 below 2.67 GPa; the centre slips first above 1.335 GPa
 NEG = ContactParameters(k_mpa_per_gpa=-10.0)

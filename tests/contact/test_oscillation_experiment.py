@@ -10,7 +10,7 @@ from flatcontact.contact import mindlin as m
 from flatcontact.contact import oscillation as osc
 from flatcontact.contact.measured import load_stiffness_csv, parse_unit
 from flatcontact.contact.parameters import ContactParameters
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 P = ContactParameters()
 P0 = 1.77e9

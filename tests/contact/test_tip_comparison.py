@@ -19,7 +19,7 @@ from flatcontact.contact.moduli import (
 from flatcontact.contact.oscillation import stiffness_curve
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.contact.tip_comparison import compare_collapse
-from flatcontact.reference import (
+from flatcontact.foundation.reference import (
     DIAMOND_ISOTROPIC,
     FUSED_SILICA_ISOTROPIC,
     PAPER,

@@ -28,7 +28,7 @@ from flatcontact.analysis.laws import fit_load_laws
 from flatcontact.analysis.uncertainty import grid_law_components
 from flatcontact.contact.experiment import model_collapse_stress
 from flatcontact.contact.parameters import ContactParameters
-from flatcontact.units import GPA_TO_PA, MPA_TO_PA
+from flatcontact.foundation.units import GPA_TO_PA, MPA_TO_PA
 
 STORED = sorted(
     p.name

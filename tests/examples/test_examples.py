@@ -25,7 +25,7 @@ import pytest
 from tests.potentials.plain_lammps import lammps_energy
 
 from flatcontact.config import load_config
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials.lammps_runtime import lammps_potential_file
 
 EXAMPLES = Path(__file__).parents[2] / "examples"

@@ -9,7 +9,7 @@ import textwrap
 import pytest
 from tests.hardening.helpers import assert_refused_cleanly
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.toy import toy_calculator
 from flatcontact.potentials.loader import call_factory
 from flatcontact.structures.interface_io import write_interface

@@ -161,7 +161,7 @@ def test_bad_flag_is_one_line_before_work(case, tmp_path, monkeypatch, capsys):
 )
 def test_train_snap_library_refuses_before_reading(tmp_path, kwargs, field):
     """The library door checks the same arguments as the CLI, before reading any data."""
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
     from flatcontact.training.train import train_snap
 
     with pytest.raises(InputError, match=field):

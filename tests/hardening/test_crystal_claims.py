@@ -11,7 +11,7 @@ import pytest
 from ase.build import bulk
 from tests.hardening.helpers import assert_refused_cleanly
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.structures import construct
 from flatcontact.structures.crystal import orient, passivated_crystal_slab, read_bulk
 

@@ -25,8 +25,8 @@ from flatcontact.config.elastic import ElasticConfig
 from flatcontact.config.scan import ScanConfig
 from flatcontact.contact import experiment as ex
 from flatcontact.contact.parameters import ContactParameters
-from flatcontact.errors import InputError
-from flatcontact.numbers import field_bounds
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.numbers import field_bounds
 
 SUBNORMAL = "1e-320"  # nonzero, below the smallest normal double (2.2e-308)
 

@@ -177,7 +177,7 @@ def test_a_failing_write_leaves_no_temporary_file(copy, monkeypatch, capsys):
 
 
 def test_sweep_removes_only_hidden_temporary_files(tmp_path):
-    from flatcontact.fileio import sweep_temporary
+    from flatcontact.foundation.fileio import sweep_temporary
 
     for name in (".a.png.1234.part", "keep.part", ".report.html.tmp", "notes.tmp", "b.png"):
         (tmp_path / name).write_text("x")
@@ -191,7 +191,7 @@ def test_sweep_removes_only_hidden_temporary_files(tmp_path):
 
 
 def test_an_atomic_write_replaces_a_planted_link_instead_of_writing_through(tmp_path):
-    from flatcontact.fileio import write_text_atomic
+    from flatcontact.foundation.fileio import write_text_atomic
 
     bait = tmp_path / "bait.txt"
     bait.write_text("keep\n")

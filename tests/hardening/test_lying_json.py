@@ -1,5 +1,5 @@
 """Result files read back as if true: every JSON file a stage, the report or a study reads
-back goes through its checked reader (flatcontact.result_json): truncated, of the wrong
+back goes through its checked reader (flatcontact.foundation.result_json): truncated, of the wrong
 types, or inconsistent with the stage record and the settings is one line naming it; an
 ispes.nc of another grid beside a record claiming this run's is refused; a file that is not a
 regular file (a FIFO) is refused before it is opened; export-uncertainty's inputs and --out
@@ -19,8 +19,8 @@ import numpy as np
 import pytest
 from tests.hardening.helpers import finished_toy_run, refused, run_cli
 
-from flatcontact.errors import InputError
-from flatcontact.result_json import LAWS, SCAN, SUMMARY, check_document, read_result_json
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.result_json import LAWS, SCAN, SUMMARY, check_document, read_result_json
 
 
 @pytest.fixture(scope="module")

@@ -2,7 +2,7 @@
 checked reader (:mod:`flatcontact.stages.result_files`).
 
 A results file changed after its stage is recomputed (the stage record keeps its SHA-256,
-:mod:`flatcontact.rundir`); these tests make the record lie too (the digest of the damaged
+:mod:`flatcontact.foundation.rundir`); these tests make the record lie too (the digest of the damaged
 file written into ``stage.json``), so the file reaches the reader: it is refused in one
 ``error:`` line naming the file and the defect, never used. An honest rerun still reads the
 same numbers as the first run.
@@ -19,8 +19,8 @@ import xarray as xr
 from tests.hardening.helpers import TOY_YAML, refused, run_cli, tree
 
 from flatcontact.config import build_config
-from flatcontact.errors import InputError
-from flatcontact.fileio import file_sha256
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import file_sha256
 from flatcontact.stages.result_files import CONTACT, FRICTION, open_result
 
 

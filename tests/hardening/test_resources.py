@@ -35,7 +35,7 @@ def test_file_size_limit_is_one_line_naming_the_file(tmp_path, monkeypatch, caps
 
 
 def test_memory_limit_is_one_line(tmp_path, monkeypatch, capsys):
-    from flatcontact import rundir
+    from flatcontact.foundation import rundir
 
     def no_memory(*args, **kwargs):
         return np.empty(1 << 50)  # numpy's _ArrayMemoryError, as under ulimit -v

@@ -202,7 +202,7 @@ def test_a_finished_run_on_a_read_only_mount_reports_its_results(copy, monkeypat
 
 
 def test_a_second_writer_is_refused_while_the_lock_is_held(copy, capsys):
-    from flatcontact.rundir import RunLock
+    from flatcontact.foundation.rundir import RunLock
 
     config, run = copy
     lock = RunLock(run).acquire()

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from tests.hardening.helpers import refused, run_cli
 
-from flatcontact.errors import InputError
-from flatcontact.limits import SearchTimeout
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.limits import SearchTimeout
 from flatcontact.structures.match import coincidence_match, twist_match
 
 #: graphene (2.46 Å) and h-BN (2.504 Å): a 1.8 % mismatch; at 0.01 % strain the search runs

@@ -12,7 +12,7 @@ import pytest
 from tests.hardening.helpers import refused, run_cli, tree
 from tests.studies.toy import toy_data, toy_model, write_yaml
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.studies.study_dir import folder_name, variant_folders
 
 
@@ -47,7 +47,7 @@ def test_a_second_study_on_the_same_out_is_one_line(tmp_path, capsys):
         [
             sys.executable,
             "-c",
-            "import sys, time; from flatcontact.rundir import RunLock; "
+            "import sys, time; from flatcontact.foundation.rundir import RunLock; "
             "lock = RunLock(sys.argv[1]).acquire(); print('held', flush=True); time.sleep(60)",
             str(out),
         ],

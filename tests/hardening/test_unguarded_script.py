@@ -6,7 +6,7 @@ flatcontact at its top level would run the study again in every worker. Such a s
 points serially, with one warning naming the guard (:mod:`flatcontact.ispes.main_guard`), and
 the same script with the guard gets its workers. A lock whose writer was killed while a process
 forked from it still holds the open lock file is recognised as stale and taken over
-(:class:`flatcontact.rundir.RunLock`).
+(:class:`flatcontact.foundation.rundir.RunLock`).
 """
 
 from __future__ import annotations
@@ -21,9 +21,9 @@ from pathlib import Path
 
 import pytest
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.rundir import RunLock, stale_holder
 from flatcontact.ispes.main_guard import guarded_lines
-from flatcontact.rundir import RunLock, stale_holder
 
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux only")
 
@@ -124,7 +124,7 @@ def test_guarded_lines_are_the_bodies_of_main_blocks_in_either_order():
 
 HOLDER = """\
 import os, sys, time
-from flatcontact.rundir import RunLock
+from flatcontact.foundation.rundir import RunLock
 
 lock = RunLock(sys.argv[1]).acquire()
 child = os.fork()

@@ -2,8 +2,8 @@
 
 import numpy as np
 
+from flatcontact.foundation.units import EV_PER_A3_TO_GPA
 from flatcontact.ispes.probe import ColumnProbe
-from flatcontact.units import EV_PER_A3_TO_GPA
 
 
 def lj_wall_probe(w_ev_per_a2=0.02, z0=10.0, area=7.0):

@@ -15,9 +15,9 @@ import math
 import numpy as np
 from ase.calculators.calculator import Calculator, all_changes
 
+from flatcontact.foundation.units import EV_PER_A3_TO_GPA
 from flatcontact.ispes.toy import toy_calculator
 from flatcontact.structures.interface_contract import in_plane_vectors
-from flatcontact.units import EV_PER_A3_TO_GPA
 
 
 class FoldedToy(Calculator):

@@ -9,7 +9,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.units import EV_PER_A3_TO_GPA
 from flatcontact.ispes.grid_bracket import check_grid, node_loads_gpa
 from flatcontact.ispes.probe import ColumnProbe
 from flatcontact.ispes.thicknesses import (
@@ -17,7 +18,6 @@ from flatcontact.ispes.thicknesses import (
     merge_close_thicknesses,
     thicknesses_spanning_columns,
 )
-from flatcontact.units import EV_PER_A3_TO_GPA
 
 DATA = Path(__file__).parent / "data"
 

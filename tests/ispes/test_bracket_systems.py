@@ -37,8 +37,8 @@ def _analysis_brackets(out, loads):
     """Every requested load inside every column's branch, read independently from
     ispes.nc with the analysis's own inversion."""
     from flatcontact.analysis.constant_pressure import invert_columns
+    from flatcontact.foundation.units import EV_PER_A3_TO_GPA
     from flatcontact.ispes.contract import open_ispes
-    from flatcontact.units import EV_PER_A3_TO_GPA
 
     ds = open_ispes(out / "02-scan" / "ispes.nc")
     z = ds.thickness.values

@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from flatcontact.foundation.units import EV_PER_A3_TO_GPA
 from flatcontact.ispes.grid_bracket import check_grid
 from flatcontact.ispes.thicknesses import FOLD_REMEDY
-from flatcontact.units import EV_PER_A3_TO_GPA
 
 AREA_ANGSTROM2 = 20.929284430681143
 SHIFT = (0.8333333333333334, 0.6666666666666666)

@@ -2,7 +2,7 @@
 
 import pytest
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.geometry import thickness
 from flatcontact.ispes.grid import GridSpec, check_thicknesses
 

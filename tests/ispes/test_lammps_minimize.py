@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.geometry import thickness
 from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point
 from flatcontact.potentials import InteractionModel

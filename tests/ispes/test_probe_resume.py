@@ -8,7 +8,8 @@ import warnings
 import numpy as np
 import pytest
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.layout import PROBE_JSON
 from flatcontact.ispes import probe_units as units_module
 from flatcontact.ispes import relax as relax_module
 from flatcontact.ispes.contract import open_ispes
@@ -19,7 +20,6 @@ from flatcontact.ispes.relax import RelaxSettings
 from flatcontact.ispes.scan import run_scan
 from flatcontact.ispes.scan_probe import MANY_WORKERS
 from flatcontact.ispes.store import discard_store
-from flatcontact.layout import PROBE_JSON
 from flatcontact.structures.toy import ToyPairCalculator
 
 SETTINGS = RelaxSettings(fmax_ev_per_angstrom=1e-4, optimizer="FIRE")

@@ -8,7 +8,7 @@ point for point; only the force calls differ (a cold start costs more here, as o
 import numpy as np
 import pytest
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.geometry import thickness
 from flatcontact.ispes.probe import (
     CompressionSegments,

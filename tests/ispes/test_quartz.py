@@ -6,10 +6,10 @@ CHGNet-relaxed slab re-relaxed with Vashishta), the one the default run scans.
 
 import pytest
 
+from flatcontact.foundation.units import EV_PER_A3_TO_GPA
 from flatcontact.ispes.contract import cell_area
 from flatcontact.ispes.geometry import in_plane_vectors, thickness
 from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point
-from flatcontact.units import EV_PER_A3_TO_GPA
 
 TIGHT = RelaxSettings(fmax_ev_per_angstrom=1e-4, optimizer="LBFGS", max_steps=5000)
 

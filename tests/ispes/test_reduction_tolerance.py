@@ -131,7 +131,7 @@ def test_the_round_off_floor_keeps_a_flat_rigid_landscape_reduced():
 
 
 def test_a_bad_fraction_is_refused_in_one_line():
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
 
     with pytest.raises(InputError, match="energy_tolerance_fraction: expected a positive"):
         SymmetrySettings(energy_tolerance_fraction=float("nan"))

@@ -6,13 +6,13 @@ from ase.calculators.calculator import Calculator, all_changes
 from ase.calculators.fd import calculate_numerical_forces
 from ase.neighborlist import neighbor_list
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.units import EV_PER_A3_TO_GPA
 from flatcontact.ispes.contract import cell_area
 from flatcontact.ispes.geometry import fixed_mask, in_plane_vectors, place_slab2, thickness
 from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point
 from flatcontact.structures.construct import build_interface
 from flatcontact.structures.toy import ToyPairCalculator
-from flatcontact.units import EV_PER_A3_TO_GPA
 
 TIGHT = RelaxSettings(fmax_ev_per_angstrom=1e-5, optimizer="BFGS", max_steps=5000)
 

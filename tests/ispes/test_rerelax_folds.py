@@ -21,7 +21,8 @@ import warnings
 import numpy as np
 import pytest
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.layout import POINTS_DB, RERELAX_DB
 from flatcontact.ispes import scan as ispes_scan
 from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.grid_bracket import node_loads_gpa
@@ -29,7 +30,6 @@ from flatcontact.ispes.relax import RelaxSettings, normal_stress_gpa
 from flatcontact.ispes.rerelax import FMAX_FACTOR, fold_windows, rerelax_folds
 from flatcontact.ispes.store import PointStore
 from flatcontact.ispes.toy import toy_calculator
-from flatcontact.layout import POINTS_DB, RERELAX_DB
 
 LOADS_GPA = [0.0, 0.5, 1.0, 1.5]
 GRID = GridSpec(2, 2, p_range_gpa=(-0.2, 1.5, 6))
@@ -212,7 +212,7 @@ def test_a_fold_of_the_interaction_survives_and_the_analysis_refuses_it_with_the
     assert done.remedied == [] and {w.column for w in done.surviving} == {w.column for w in found}
     assert all("the fold survived" in line for line in done.lines()[: len(found)])
     # the analysis refuses the loads above the fold; the scan's record makes it say why
-    record = {  # the required keys of scan.json's contract (flatcontact.result_json)
+    record = {  # the required keys of scan.json's contract (flatcontact.foundation.result_json)
         "points_total": int(fixed["energy"].size),
         "points_done": int(fixed["energy"].size),
         "force_calls_total": 1,

@@ -11,7 +11,7 @@ import time
 import numpy as np
 import pytest
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.contract import open_ispes
 from flatcontact.ispes.executors import DaskExecutor, ProcessExecutor, SerialExecutor
 from flatcontact.ispes.geometry import thickness
@@ -269,9 +269,9 @@ def test_stale_lock_file_of_a_killed_writer_does_not_block_a_rerun(
 
 
 def test_a_second_driver_on_the_same_store_is_refused(tmp_path, toy_reference, toy_factory):
+    from flatcontact.foundation.layout import POINTS_DB
     from flatcontact.ispes.scan import scan_settings
     from flatcontact.ispes.store import PointStore
-    from flatcontact.layout import POINTS_DB
 
     grid = GridSpec(1, 1, thickness_angstrom=(thickness(toy_reference),))
     settings = scan_settings(toy_reference, toy_factory, grid, SETTINGS)

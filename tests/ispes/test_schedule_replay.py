@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 from benchmarks.schedule_replay import VirtualExecutor, task_key
 
+from flatcontact.foundation.units import EV_PER_A3_TO_GPA
 from flatcontact.ispes.executors import ProcessExecutor, SerialExecutor
 from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.relax import RelaxSettings
 from flatcontact.ispes.scan import run_scan
 from flatcontact.ispes.scan_probe import MANY_WORKERS
-from flatcontact.units import EV_PER_A3_TO_GPA
 
 SETTINGS = RelaxSettings(fmax_ev_per_angstrom=1e-3)
 #: HI high enough that the compression runs over several segments of 3 steps

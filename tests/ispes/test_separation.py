@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from tests.ispes.analytic_column import lj_wall_probe
 
+from flatcontact.foundation.units import EV_PER_A2_TO_J_PER_M2, EV_PER_A3_TO_GPA
 from flatcontact.ispes.separation import adhesion
-from flatcontact.units import EV_PER_A2_TO_J_PER_M2, EV_PER_A3_TO_GPA
 
 
 def test_adhesion_of_an_analytic_curve():

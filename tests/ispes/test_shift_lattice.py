@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.contract import fractional_shifts, symmetry_attrs
 from flatcontact.ispes.shift_lattice import (
     grid_size_for,

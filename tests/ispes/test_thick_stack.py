@@ -11,7 +11,7 @@ homogeneously compressed stack and the relaxed point carries the load.
 import pytest
 
 import flatcontact.structures.placement as placement_module
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.relax import RelaxSettings
 from flatcontact.ispes.scan import run_scan

@@ -7,7 +7,8 @@ from hypothesis import strategies as st
 from tests.ispes.analytic_column import lj_wall_probe
 
 from flatcontact.analysis import synthetic as syn
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.units import EV_PER_A3_TO_GPA
 from flatcontact.ispes.geometry import thickness
 from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.probe import (
@@ -21,7 +22,6 @@ from flatcontact.ispes.thicknesses import (
     probe_thicknesses,
     thicknesses_for_pressures,
 )
-from flatcontact.units import EV_PER_A3_TO_GPA
 
 
 def test_thicknesses_span_the_pressure_range():

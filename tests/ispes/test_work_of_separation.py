@@ -14,6 +14,7 @@ from ase.calculators.eam import EAM
 from ase.constraints import FixAtoms, FixCartesian
 from ase.optimize import BFGS
 
+from flatcontact.foundation.units import EV_PER_A2_TO_J_PER_M2
 from flatcontact.ispes.executors import SerialExecutor
 from flatcontact.ispes.geometry import fixed_mask, in_plane_vectors, place_slab2, thickness
 from flatcontact.ispes.grid import GridSpec
@@ -31,7 +32,6 @@ from flatcontact.structures.toy import (
     ToyPairCalculator,
     toy_interface,
 )
-from flatcontact.units import EV_PER_A2_TO_J_PER_M2
 
 A_CU = 3.615  # Mishin Cu1 lattice constant (Å)
 

@@ -7,7 +7,7 @@ import json
 
 import pytest
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.stages.analyze import _folds_named
 
 NOT_MONOTONIC = (
@@ -16,7 +16,7 @@ NOT_MONOTONIC = (
 )
 
 
-#: The required keys of a ``scan.json`` (flatcontact.result_json's contract) around the folds.
+#: The required keys of a ``scan.json`` (flatcontact.foundation.result_json's contract) around the folds.
 SCAN_RECORD = {
     "points_total": 36,
     "points_done": 36,

@@ -11,7 +11,7 @@ import json
 import pytest
 
 from flatcontact.config import build_config
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.pipeline import Pipeline
 
 G33 = {

@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from flatcontact.config import build_config, load_config
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.stages.scan import grid_spec, relax_settings
 
 

@@ -24,9 +24,9 @@ import pytest
 import xarray as xr
 
 from flatcontact.config import build_config
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.layout import STAGES
 from flatcontact.ispes.contract import open_ispes
-from flatcontact.layout import STAGES
 from flatcontact.pipeline import Pipeline
 from flatcontact.stages.fingerprints import settings_inputs
 

@@ -8,7 +8,7 @@ import json
 import pytest
 from tests.cli.cli_helpers import run_cli
 
-from flatcontact.reference import PAPER_LAW_KEYS
+from flatcontact.foundation.reference import PAPER_LAW_KEYS
 from flatcontact.stages.contact import quartz_quick_laws
 
 

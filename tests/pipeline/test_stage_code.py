@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from flatcontact.codegraph import SOURCE_ROOT, closure_digest, import_closure
+from flatcontact.foundation.codegraph import SOURCE_ROOT, closure_digest, import_closure
 from flatcontact.pipeline import (
     FIGURE_MODULES,
     PUBLIC_API_MODULE,

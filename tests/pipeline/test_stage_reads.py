@@ -26,7 +26,7 @@ from pydantic import BaseModel
 from tests.hardening.helpers import finished_toy_run
 
 from flatcontact.config import load_config
-from flatcontact.layout import (
+from flatcontact.foundation.layout import (
     FRICTION_CSV,
     INTERFACE,
     ISPES_NC,
@@ -34,7 +34,7 @@ from flatcontact.layout import (
     STAGES,
     VERSIONS_JSON,
 )
-from flatcontact.rundir import RunDirectory
+from flatcontact.foundation.rundir import RunDirectory
 from flatcontact.stages.analyze import AnalyzeInputs, analyze_stage
 from flatcontact.stages.build import BuildInputs, build_stage
 from flatcontact.stages.contact import contact_stage

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials import InteractionModel, LJSpec, make_calculator
 
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from ase import Atoms
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials import InteractionModel, make_calculator
 from flatcontact.potentials.lj import lj_cross_energy_forces
 from flatcontact.structures.placement import interslab_min_distance

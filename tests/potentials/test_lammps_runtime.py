@@ -2,7 +2,7 @@
 
 import pytest
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials import lammps_runtime
 
 

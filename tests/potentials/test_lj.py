@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials import InteractionModel, LJSpec
 from flatcontact.potentials.lj import (
     BOHR_TO_ANGSTROM,
@@ -159,7 +159,7 @@ def test_hamaker_and_scale_are_validated():
     with pytest.raises(ValidationError, match="either c6_scale or hamaker_zj"):
         LJSpec(hamaker_zj=88.0, c6_scale=0.5, number_density_per_nm3={"Si": 1.0, "O": 2.0})
     with pytest.raises(ValidationError, match=r"expected 0.001 <= value <= 1000, got 0"):
-        LJSpec(c6_scale=0.0)  # the bounded float (flatcontact.numbers): 1e-3..1e3
+        LJSpec(c6_scale=0.0)  # the bounded float (flatcontact.foundation.numbers): 1e-3..1e3
     spec = LJSpec(hamaker_zj=88.0, number_density_per_nm3={"O": 53.0})
     with pytest.raises(InputError, match=r"lacks the elements \['Si'\]"):
         spec.table(["O", "Si"], ["O", "Si"])

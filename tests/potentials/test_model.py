@@ -10,7 +10,7 @@ from ase.build import bulk
 from ase.calculators.lj import LennardJones
 
 from flatcontact.config import build_config, load_config
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials import PRESETS, InteractionModel, make_calculator, parse_kwargs
 from flatcontact.potentials.engines import bulk_calculator, calculator_factory
 from flatcontact.potentials.lj import lj_cross_energy_forces, lj_table

@@ -4,7 +4,7 @@ import shutil
 
 import pytest
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials import InteractionModel
 from flatcontact.potentials.files import BUNDLED_DIR
 from flatcontact.potentials.names import normalize_potential_name, resolve_intra

@@ -15,8 +15,7 @@ import pandas as pd
 import pytest
 
 from flatcontact.config.load import build_config
-from flatcontact.ispes.work_of_separation import AT_PERFECT_STACKING
-from flatcontact.layout import (
+from flatcontact.foundation.layout import (
     ANALYZE_JSON,
     BUILD_FIGURE,
     BUILD_JSON,
@@ -32,7 +31,8 @@ from flatcontact.layout import (
     SUMMARY_JSON,
     png,
 )
-from flatcontact.reference import PAPER, PAPER_LAW_KEYS
+from flatcontact.foundation.reference import PAPER, PAPER_LAW_KEYS
+from flatcontact.ispes.work_of_separation import AT_PERFECT_STACKING
 from flatcontact.report.assemble import build_sections
 from flatcontact.report.html import render_html
 from flatcontact.report.sections.laws import PAPER_COLUMN

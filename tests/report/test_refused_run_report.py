@@ -15,7 +15,7 @@ import re
 
 import pytest
 
-from flatcontact.layout import REFUSAL_JSON, REPORT_HTML
+from flatcontact.foundation.layout import REFUSAL_JSON, REPORT_HTML
 from flatcontact.report.html import render_html
 from flatcontact.report.sections.gates import gates_section
 from flatcontact.report.sections.refusal import (
@@ -51,7 +51,7 @@ def _text(page: str) -> str:
 def refused_run(tmp_path_factory):
     """(config, run directory, the refusal line, the stage records after the first run)."""
     from flatcontact.config.load import load_config
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
     from flatcontact.pipeline import Pipeline
 
     base = tmp_path_factory.mktemp("refused")
@@ -117,7 +117,7 @@ def test_the_report_holds_what_was_computed_the_refusal_its_points_and_the_remed
 
 
 def test_a_rerun_of_the_refused_run_redoes_no_finished_stage(refused_run):
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
     from flatcontact.pipeline import Pipeline
 
     cfg, run, line, records = refused_run
@@ -137,7 +137,7 @@ def test_a_report_of_a_run_refused_in_the_analysis_holds_the_fold_and_its_remedi
     """The same finished build and scan, refused in the analysis (a fold the scan recorded):
     no analysis, laws or contact section; the fold's column, z, p and refused loads; the
     relaxation, the thicknesses (the grid) and lower loads among the remedies."""
-    from flatcontact.layout import STAGES
+    from flatcontact.foundation.layout import STAGES
     from flatcontact.stages.report import ReportInputs, report_stage
 
     cfg, run, _, _ = refused_run

@@ -9,7 +9,7 @@ import pytest
 
 from flatcontact.config.approximants import parse_approximants
 from flatcontact.config.merge import merge_config
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.structures.approximants import approximant_sequence, coprime_twists
 from flatcontact.structures.construct import build_interface
 from flatcontact.structures.sheets import builtin_sheet

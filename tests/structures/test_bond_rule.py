@@ -10,7 +10,7 @@ from ase import Atoms
 from ase.build import diamond111
 from ase.neighborlist import neighbor_list
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.structures.bulk import alpha_quartz
 from flatcontact.structures.layers import bonded_components, sheet_layers
 from flatcontact.structures.sheets import builtin_sheet, check_sheet, stack_sheets

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.structures.assemble import make_interface
 from flatcontact.structures.interface_contract import fixed_mask, thickness
 from flatcontact.structures.interface_io import read_interface, write_interface

@@ -7,7 +7,7 @@ import pytest
 from ase.build import bulk
 from ase.io import write
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.structures.assemble import face_tags, make_interface
 from flatcontact.structures.build import load_shipped_dense_slab
 from flatcontact.structures.construct import build_interface

@@ -15,7 +15,7 @@ from ase import Atoms
 from ase.build import bulk
 from ase.neighborlist import neighbor_list
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.structures.bulk import alpha_quartz
 from flatcontact.structures.construct import build_interface
 from flatcontact.structures.crystal import crystal_slab, orient, passivated_crystal_slab

@@ -14,10 +14,10 @@ import pytest
 from ase.build import bulk, fcc111
 
 from flatcontact.config.load import load_config
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.units import EV_PER_A2_TO_J_PER_M2
 from flatcontact.stages.build import BuildInputs, build_stage
 from flatcontact.structures.lattice import MAX_FILE_MISMATCH_PERCENT
-from flatcontact.units import EV_PER_A2_TO_J_PER_M2
 
 
 def _lammps():

@@ -8,7 +8,7 @@ from ase.build import bulk
 from ase.io import write
 from ase.neighborlist import neighbor_list
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.structures.construct import build_interface
 from flatcontact.structures.interface_contract import thickness
 from flatcontact.structures.match import twist_angle_deg

@@ -5,7 +5,7 @@ import pytest
 from ase.filters import FrechetCellFilter
 from ase.optimize import BFGS
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials.engines import bulk_calculator
 from flatcontact.structures.bulk import QUARTZ_C_ANGSTROM, alpha_quartz
 from flatcontact.structures.dense import face_masks, verify_dense_slab

@@ -12,8 +12,8 @@ import pytest
 from flatcontact.config.load import build_config, load_config
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.contact.tip_comparison import LAW_KEYS
-from flatcontact.errors import InputError
-from flatcontact.reference import PAPER, PAPER_EXPERIMENT_COLLAPSE_MPA
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.reference import PAPER, PAPER_EXPERIMENT_COLLAPSE_MPA
 from flatcontact.stages.contact import experiment_comparison
 from flatcontact.studies.approximant_collapse import approximant_collapse, cell_collapse
 

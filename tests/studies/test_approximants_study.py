@@ -15,7 +15,7 @@ from matplotlib.figure import Figure
 from tests.cli.cli_helpers import one_error_line, run_cli
 
 from flatcontact.config.load import build_config
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.plots.approximants import figure_approximants
 from flatcontact.studies.approximants import RESOLVED_FACTOR, plan, run_approximants
 from flatcontact.studies.output import (

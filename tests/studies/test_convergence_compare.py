@@ -9,7 +9,7 @@ from flatcontact.analysis.convergence import (
     per_load_changes,
     summarize,
 )
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 
 def _rows(p, tau, sigma, noise=None):

@@ -14,7 +14,7 @@ from ase import Atoms
 from tests.potentials.plain_lammps import lammps_energy
 
 from flatcontact.config.load import build_config
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials import make_calculator
 from flatcontact.potentials.lammps_runtime import lammps_potential_file
 from flatcontact.potentials.styles import style_cutoff_angstrom, with_cutoff

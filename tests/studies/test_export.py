@@ -16,7 +16,7 @@ from flatcontact.analysis.uncertainty import LAW_COEFFICIENTS
 from flatcontact.config.load import build_config
 from flatcontact.config.presets import LAW_UNCERTAINTY_FILE
 from flatcontact.config.uncertainty import UncertaintyConfig
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.stages.measured_on import check_measured_on, measured_on
 from flatcontact.studies import convergence as convergence_module
 from flatcontact.studies.export import merge_studies, read_study

@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials import InteractionModel
 from flatcontact.training.ispes_check import (
     QUARTZ_CIJ_EXPERIMENT_GPA,

@@ -11,7 +11,7 @@ import pytest
 from tests.studies.toy import EPS_CROSS, toy_config, toy_data, toy_model, write_yaml
 
 from flatcontact.analysis.uncertainty import LAW_COEFFICIENTS
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.studies import models as models_module
 from flatcontact.studies.output import write_study
 

@@ -26,8 +26,8 @@ from flatcontact.analysis.uncertainty import LAW_COEFFICIENTS
 from flatcontact.config import MEASURED_LAW_UNCERTAINTY, build_config
 from flatcontact.config.presets import LAW_UNCERTAINTY_FILE
 from flatcontact.config.uncertainty import UncertaintyConfig
-from flatcontact.errors import InputError
-from flatcontact.fileio import file_sha256
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import file_sha256
 from flatcontact.stages.measured_on import check_measured_on, measured_on
 from flatcontact.studies.export import merge_studies
 

@@ -14,7 +14,7 @@ from tests.studies.toy import TOY, toy_config, toy_data, toy_model, write_yaml
 
 from flatcontact.analysis.uncertainty import LAW_COEFFICIENTS
 from flatcontact.config.load import build_config
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.stages.measured_on import check_measured_on, measured_on
 from flatcontact.studies.convergence import run_convergence
 from flatcontact.studies.output import write_study

@@ -10,7 +10,7 @@ from flatcontact.analysis.uncertainty import (
     model_spread,
     propagate_box,
 )
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 LAWS = {
     "k_mpa_per_gpa": 16.5,

@@ -2,15 +2,18 @@
 
 Computed here with LAMMPS through flatcontact.elastic (no torch): zero-stress cell, relaxed-ion
 Cij by central ±0.5 % strains, compared with the experimental constants of
-flatcontact.reference (McSkimin et al. 1965) and lattice (Levien et al. 1980).
+flatcontact.foundation.reference (McSkimin et al. 1965) and lattice (Levien et al. 1980).
 """
 
 import json
 
 import pytest
 
+from flatcontact.foundation.reference import (
+    QUARTZ_CIJ_EXPERIMENT_GPA,
+    QUARTZ_LATTICE_EXPERIMENT_ANGSTROM,
+)
 from flatcontact.potentials.files import BUNDLED_DIR
-from flatcontact.reference import QUARTZ_CIJ_EXPERIMENT_GPA, QUARTZ_LATTICE_EXPERIMENT_ANGSTROM
 
 NAME = "sio2-snap-mf0"
 HERE = BUNDLED_DIR / NAME

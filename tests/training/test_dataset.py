@@ -5,7 +5,7 @@ import pytest
 from ase import Atoms
 from ase.io import write
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.training.dataset import labelled, labels, read_dataset, write_dataset
 from flatcontact.training.polymorphs import build_polymorph
 

@@ -1,4 +1,4 @@
-"""Experimental α-quartz constants have one home, flatcontact.reference, and are self-consistent."""
+"""Experimental α-quartz constants have one home, flatcontact.foundation.reference, and are self-consistent."""
 
 import ast
 from pathlib import Path
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import flatcontact
-from flatcontact import reference
+from flatcontact.foundation import reference
 
 SRC = Path(flatcontact.__file__).parent
 ONE_HOME = (
@@ -36,7 +36,7 @@ def test_experimental_constants_are_assigned_only_in_reference_py():
         )
         for name in ONE_HOME
     }
-    assert homes == {name: ["reference.py"] for name in ONE_HOME}
+    assert homes == {name: ["foundation/reference.py"] for name in ONE_HOME}
 
 
 def test_consumers_compare_with_the_same_object():
@@ -79,7 +79,7 @@ def test_experimental_density_follows_from_the_lattice():
 
 @pytest.mark.parametrize("name", ["sio2-snap", "sio2-snap-mf0"])
 def test_bundled_reports_compare_with_the_one_experimental_set(name):
-    """The stored vs_experiment blocks are what flatcontact.reference gives (|C14| compared)."""
+    """The stored vs_experiment blocks are what flatcontact.foundation.reference gives (|C14| compared)."""
     import json
 
     from flatcontact.potentials.files import BUNDLED_DIR

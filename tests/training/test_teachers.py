@@ -5,7 +5,7 @@ import importlib
 import pytest
 from tests.cli.cli_helpers import one_error_line, run_cli
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials import teachers as reg
 
 #: What each registered teacher must say about itself: (package, checkpoint, head, functional).

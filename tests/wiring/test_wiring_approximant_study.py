@@ -18,9 +18,9 @@ from tests.studies.test_approximants_study import _fake_doc
 from tests.wiring.test_wiring_experiment import TOY
 
 from flatcontact.config import build_config
-from flatcontact.errors import InputError
-from flatcontact.fileio import write_json_atomic
-from flatcontact.layout import EXPERIMENT_COLLAPSE_JSON
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import write_json_atomic
+from flatcontact.foundation.layout import EXPERIMENT_COLLAPSE_JSON
 from flatcontact.pipeline import Pipeline
 from flatcontact.report.format import fmt
 from flatcontact.report.sections.approximant_study import this_run_label

@@ -244,7 +244,7 @@ def test_several_loads_without_a_load_column_name_the_p0_flag(tmp_path, capsys):
 
 
 def test_config_file_errors_name_the_field(tmp_path):
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
 
     bad = tmp_path / "bad.yaml"
     bad.write_text("contact:\n  fit: {csv: [missing.csv]}\n")

@@ -15,12 +15,12 @@ import numpy as np
 import pytest
 from tests.cli.cli_helpers import one_error_line, run_cli
 
-from flatcontact import units
 from flatcontact.analysis import synthetic as syn
 from flatcontact.config import MEASURED_LAW_UNCERTAINTY, build_config
 from flatcontact.contact import mindlin
-from flatcontact.errors import InputError
-from flatcontact.layout import FRICTION_CSV, LAWS_JSON, OTHER_FORM_JSON
+from flatcontact.foundation import units
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.layout import FRICTION_CSV, LAWS_JSON, OTHER_FORM_JSON
 from flatcontact.stages.analyze import AnalyzeInputs, analyze_stage
 from flatcontact.stages.contact import ContactInputs, contact_stage
 from flatcontact.stages.laws import LawsInputs, laws_stage
@@ -305,7 +305,7 @@ def test_paper_preset_carries_the_measured_uncertainty():
 
 
 def test_bad_uncertainty_fields_name_the_field():
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
 
     with pytest.raises(InputError, match=r"uncertainty\.convergence_internal"):
         build_config({"uncertainty": {"convergence_internal": {"kappa": 1.0}}})

@@ -33,7 +33,6 @@ from dataclasses import dataclass, field
 import numpy as np
 import xarray as xr
 
-from flatcontact import units
 from flatcontact.analysis.constant_pressure import (
     DEFAULT_LOAD_SOURCE,
     LOAD_SOURCES,  # noqa: F401 (re-exported: the analysis's choices in one place)
@@ -65,7 +64,8 @@ from flatcontact.analysis.starts import (
     warn_if_tau_depends_on_start,
 )
 from flatcontact.analysis.symmetry import SymmetryReport, symmetry_report
-from flatcontact.errors import InputError
+from flatcontact.foundation import units
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes import contract
 
 #: Lateral points per axis: a periodic interpolant needs the first harmonic (k = -1, 0, 1).

@@ -42,14 +42,14 @@ import numpy as np
 import xarray as xr
 from scipy.interpolate import CubicSpline, make_interp_spline
 
-from flatcontact import units
 from flatcontact.analysis.diagnostics import (
     LoadFoldWarning,
     StressEnergyMismatchWarning,
     UnconvergedPointsWarning,
 )
 from flatcontact.analysis.noise import LoadNoise, load_noise
-from flatcontact.errors import InputError
+from flatcontact.foundation import units
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes import contract
 
 FORMS = ("internal", "enthalpy")

@@ -29,7 +29,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-from flatcontact.errors import InputError, require
+from flatcontact.foundation.errors import InputError, require
 
 #: Quantities compared per load, with the column holding their noise estimate (or None).
 QUANTITIES: dict[str, str | None] = {

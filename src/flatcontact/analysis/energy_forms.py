@@ -31,7 +31,7 @@ from flatcontact.analysis.diagnostics import AnalysisWarning
 from flatcontact.analysis.laws import fit_load_laws
 from flatcontact.analysis.options import AnalysisOptions
 from flatcontact.analysis.outputs import friction_csv_text
-from flatcontact.errors import require
+from flatcontact.foundation.errors import require
 
 FORMS = ("internal", "enthalpy")
 #: Per-load columns kept for each form.

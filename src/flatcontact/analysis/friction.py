@@ -35,8 +35,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from flatcontact import units
 from flatcontact.analysis.path import SlidingPath
+from flatcontact.foundation import units
 
 #: stiffness eV/Å⁴ (stress per length) -> GPa/nm
 EV_PER_A4_TO_GPA_PER_NM = units.EV_PER_A3_TO_GPA / units.ANGSTROM_TO_NM

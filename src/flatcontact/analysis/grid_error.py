@@ -62,7 +62,7 @@ from scipy.optimize import brentq
 
 from flatcontact.analysis.periodic import PeriodicSurface
 from flatcontact.analysis.starts import paths_from_near_degenerate_minima
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 #: Points per axis a sub-grid must keep to be used (a 3×3 one is pre-asymptotic: docstring).
 MIN_SUBGRID_POINTS = 4

@@ -30,7 +30,7 @@ import numpy as np
 from scipy import stats
 
 from flatcontact.analysis.diagnostics import LinearFitWarning
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 
 @dataclass(frozen=True)

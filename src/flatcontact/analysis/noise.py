@@ -41,7 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from flatcontact import units
+from flatcontact.foundation import units
 
 #: Barriers below this multiple of the energy noise ε(P) do not count in σ_MSS.
 BARRIER_NOISE_FACTOR = 2.0

@@ -1,7 +1,7 @@
 """How an ISPES grid is analysed: the choices of :func:`flatcontact.analysis.analyze.analyze_ispes`.
 
 :class:`AnalysisOptions` is a frozen dataclass validated on construction (and on
-:func:`dataclasses.replace`): a bad value raises one :class:`~flatcontact.errors.InputError`
+:func:`dataclasses.replace`): a bad value raises one :class:`~flatcontact.foundation.errors.InputError`
 line naming the field (``form: expected one of internal, enthalpy, got 'gibbs'``), which the
 run's analyze stage renames to its settings path (``analysis.energy_form``). The loads are not
 an option: they are the analysis's subject (``analyze_ispes(ds, p_gpa, options)``).
@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from flatcontact.analysis.constant_pressure import DEFAULT_LOAD_SOURCE, FORMS, LOAD_SOURCES
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 #: Where each load's landscape is zeroed (:attr:`AnalysisOptions.energy_zero`).
 ENERGY_ZEROS = ("lowest-p", "each", "none")

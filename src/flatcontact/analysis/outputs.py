@@ -25,11 +25,12 @@ import math
 import numpy as np
 import xarray as xr
 
-from flatcontact import __version__, units
+from flatcontact import __version__
 from flatcontact.analysis.analyze import AnalysisResult
 from flatcontact.analysis.friction import EV_PER_A4_TO_GPA_PER_NM
 from flatcontact.analysis.grid_error import ERROR_COLUMNS
 from flatcontact.analysis.noise import BARRIER_NOISE_FACTOR
+from flatcontact.foundation import units
 
 CSV_COLUMNS = (
     "p_gpa",

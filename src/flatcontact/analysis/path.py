@@ -37,7 +37,7 @@ from scipy.optimize import brentq
 
 from flatcontact.analysis.diagnostics import PathNotPeriodicWarning
 from flatcontact.analysis.periodic import PeriodicSurface, lattice_vectors
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 
 @dataclass(frozen=True)

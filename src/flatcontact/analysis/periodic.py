@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import minimize
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 TWO_PI = 2.0 * np.pi
 

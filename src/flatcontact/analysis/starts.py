@@ -70,12 +70,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from flatcontact import units
 from flatcontact.analysis.diagnostics import DegenerateMinimaWarning
 from flatcontact.analysis.friction import FrictionResult, friction_along_path
 from flatcontact.analysis.path import SlidingPath, zero_perpendicular_force_path
 from flatcontact.analysis.periodic import PeriodicSurface
 from flatcontact.analysis.stackings import SYMMETRY_TOLERANCE, Stackings
+from flatcontact.foundation import units
 
 #: Smallest degeneracy tolerance (meV/Å²), used where the energy noise is unknown or smaller.
 DEGENERACY_FLOOR_MEV_PER_A2 = 1.0e-4

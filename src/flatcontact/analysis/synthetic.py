@@ -41,8 +41,8 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from flatcontact import units
-from flatcontact.errors import require
+from flatcontact.foundation import units
+from flatcontact.foundation.errors import require
 from flatcontact.ispes import contract
 
 Pattern = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]

@@ -39,7 +39,7 @@ from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
-from flatcontact.errors import InputError, require
+from flatcontact.foundation.errors import InputError, require
 
 #: Law coefficients and their standard-error keys in ``laws.json``.
 LAW_COEFFICIENTS: dict[str, str] = {

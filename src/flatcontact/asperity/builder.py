@@ -33,7 +33,7 @@ import numpy as np
 from ase import Atoms
 
 from flatcontact.asperity.binning import contact_coordinate
-from flatcontact.errors import InputError, require
+from flatcontact.foundation.errors import InputError, require
 from flatcontact.structures.layers import atomic_planes
 
 #: Bytes per atom of a LAMMPS run (positions, forces, minimiser vectors, ghosts) besides the

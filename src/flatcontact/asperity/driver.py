@@ -39,7 +39,7 @@ from pathlib import Path
 import numpy as np
 from ase import Atoms
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials.lammps_box import create_box
 from flatcontact.potentials.lammps_runtime import new_lammps
 from flatcontact.potentials.lammps_setup import compile_setup

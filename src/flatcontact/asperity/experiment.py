@@ -24,7 +24,7 @@ from flatcontact.asperity.compare import Laws, compare_load
 from flatcontact.asperity.driver import EV_PER_ANGSTROM_N, Protocol, run_load
 from flatcontact.asperity.ranks import check_ranks, mpiexec
 from flatcontact.asperity.records import Binning, StepRecord, measure_load
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 GPA_ANGSTROM2_TO_EV_PER_ANGSTROM = 1e-11 / EV_PER_ANGSTROM_N
 

@@ -53,7 +53,7 @@ from flatcontact.asperity.driver import (
     save_state,
 )
 from flatcontact.contact import line_contact as lc
-from flatcontact.errors import InputError, require
+from flatcontact.foundation.errors import InputError, require
 
 # ------------------------------------------------------------------------------------------
 # the lock-in reading of a loop

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from flatcontact.asperity.driver import compute_step, save_state, step_path
 from flatcontact.asperity.ranks import PROGRESS
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 
 def _world() -> tuple[int, int]:

@@ -30,7 +30,7 @@ beside the Python interpreter (the environment's ``bin/``), and every rank loads
 ``LD_LIBRARY_PATH``. ``mpiexec`` dies with its parent (``PR_SET_PDEATHSIG``), so a parent
 killed with kill -9 leaves no ranks writing behind it. Any failure (no ``mpiexec``, a rank's
 error, a LAMMPS error, a rank count LAMMPS did not see) is one
-:class:`~flatcontact.errors.InputError` line naming the cause.
+:class:`~flatcontact.foundation.errors.InputError` line naming the cause.
 
 Memory: every rank's Python holds the whole structure (the atoms, the gathered positions and
 forces) besides its share of LAMMPS's (:func:`rank_memory_bytes`).
@@ -53,7 +53,7 @@ from pathlib import Path
 import numpy as np
 
 from flatcontact.config.asperity import MAX_MPI_RANKS as MAX_RANKS
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 #: Resident memory (bytes) of one rank's Python before its atoms: the interpreter, numpy,
 #: ASE, pydantic and the LAMMPS library (measured 83 MB after one LAMMPS instance; rounded up).

@@ -4,7 +4,7 @@
 on stderr with exit status 2 (the status click uses for usage errors), never a traceback
 or a boxed multi-line message:
 
-- :class:`~flatcontact.errors.InputError` raised by a command (bad values, files, configs);
+- :class:`~flatcontact.foundation.errors.InputError` raised by a command (bad values, files, configs);
 - a full disk (``ENOSPC``, ``EDQUOT``) in any stage: one line saying to free space and
   rerun (the rerun resumes: stage records and scan points are written atomically);
 - a resource limit of the process: the file-size limit (``ulimit -f``, ``EFBIG``) and the
@@ -47,7 +47,7 @@ import typer
 from flatcontact import __version__
 from flatcontact.cli import memory_floor  # noqa: F401  (refuses a too low ulimit -v)
 from flatcontact.cli.app import STOPPED, app, check_out_flags, console, print_error
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 try:  # registers the sub-commands; their modules load numpy and the settings
     from flatcontact.cli import commands as _commands  # noqa: F401
@@ -173,7 +173,7 @@ def sigterm_unwinds():
     """While a command runs, SIGTERM raises :class:`Terminated` in the main thread; yields a
     list that holds the signal once it came. A process forked from this one dies of SIGTERM
     as before (a pool's workers); nothing changes where SIGTERM already has a handler."""
-    from flatcontact.interrupts import raise_on_sigterm
+    from flatcontact.foundation.interrupts import raise_on_sigterm
 
     got: list[int] = STOPPED["signals"]
     got.clear()

@@ -19,7 +19,6 @@ from typing import Annotated
 
 import typer
 
-from flatcontact import limits
 from flatcontact.cli.app import (
     app,
     bounded,
@@ -31,7 +30,8 @@ from flatcontact.cli.app import (
 )
 from flatcontact.cli.options import flags_of, setting_options, settings_command
 from flatcontact.config.analysis import AnalysisConfig
-from flatcontact.errors import InputError
+from flatcontact.foundation import limits
+from flatcontact.foundation.errors import InputError
 
 #: The settings the command exposes, one flag each (:mod:`flatcontact.cli.options`);
 #: ``analysis.p_gpa`` is ``--p-gpa``, whose values may also follow the ISPES file.
@@ -103,7 +103,7 @@ def analyze_command(
     """Constant-pressure ISPES, sliding path, τ, σ_MSS, shear stiffness and load laws."""
     from flatcontact.analysis.outputs import per_pressure_rows, summary_json
     from flatcontact.cli.settings import flag_errors, settings_from_flags
-    from flatcontact.layout import FRICTION_CSV, OTHER_FORM_JSON
+    from flatcontact.foundation.layout import FRICTION_CSV, OTHER_FORM_JSON
     from flatcontact.stages.analyze import AnalyzeInputs, analyze_stage
     from flatcontact.stages.laws import LawsInputs, laws_stage
 

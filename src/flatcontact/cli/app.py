@@ -80,8 +80,8 @@ def check_out_dir(path: str | Path, flag: str = "--out") -> Path:
     import os
     import tempfile
 
-    from flatcontact.errors import InputError
-    from flatcontact.fileio import check_path_length
+    from flatcontact.foundation.errors import InputError
+    from flatcontact.foundation.fileio import check_path_length
 
     if not str(path).strip():
         raise InputError(f"{flag} {str(path)!r}: empty path; name a directory (. for this one)")
@@ -127,8 +127,8 @@ def check_out_flags(argv: list[str], flags: tuple[str, ...] = ("--out",)) -> Non
     ``.``), and a name over 255 bytes fails in the first ``stat``. Both are one line naming
     the flag; nothing is touched.
     """
-    from flatcontact.errors import InputError
-    from flatcontact.fileio import check_path_length
+    from flatcontact.foundation.errors import InputError
+    from flatcontact.foundation.fileio import check_path_length
 
     for i, token in enumerate(argv):
         for flag in flags:
@@ -157,7 +157,7 @@ def split_list(values: list[str] | None, flag: str, *, whitespace: bool = True) 
     InputError
         One line naming ``flag`` and the token with the empty item.
     """
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
 
     items: list[str] = []
     for token in values or []:
@@ -174,8 +174,8 @@ def split_list(values: list[str] | None, flag: str, *, whitespace: bool = True) 
 
 def parse_floats(values: list[str] | None, flag: str, unit: str = "", bounds=None) -> list[float]:
     """The numbers of a list flag (see :func:`split_list`); a non-number, or with ``bounds``
-    (:class:`~flatcontact.numbers.Bounds`) a number outside them, is one line naming ``flag``."""
-    from flatcontact.errors import InputError
+    (:class:`~flatcontact.foundation.numbers.Bounds`) a number outside them, is one line naming ``flag``."""
+    from flatcontact.foundation.errors import InputError
 
     out = []
     for item in split_list(values, flag):
@@ -188,12 +188,12 @@ def parse_floats(values: list[str] | None, flag: str, unit: str = "", bounds=Non
 
 
 def bounded(value: float, flag: str, bounds) -> float:
-    """A float flag's value within ``bounds`` (:class:`~flatcontact.numbers.Bounds`: finite,
-    no subnormal, ``lo..hi``), else one :class:`~flatcontact.errors.InputError` line
+    """A float flag's value within ``bounds`` (:class:`~flatcontact.foundation.numbers.Bounds`: finite,
+    no subnormal, ``lo..hi``), else one :class:`~flatcontact.foundation.errors.InputError` line
     naming ``flag``, the bounds and the value. For flags that do not pass through a bounded
     setting; a flag that mirrors a setting takes the setting's bounds
     (:func:`setting_bounds`)."""
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
 
     try:
         return bounds.check(value)
@@ -203,7 +203,7 @@ def bounded(value: float, flag: str, bounds) -> float:
 
 def bounded_int(value: int, flag: str, lo: int, hi: int, what: str = "") -> int:
     """An integer flag's value within ``lo..hi``, else one line naming ``flag``."""
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
 
     if not lo <= value <= hi:
         detail = f" ({what})" if what else ""
@@ -212,10 +212,10 @@ def bounded_int(value: int, flag: str, lo: int, hi: int, what: str = "") -> int:
 
 
 def setting_bounds(model, field: str):
-    """The :class:`~flatcontact.numbers.Bounds` of the bounded float ``field`` of the
+    """The :class:`~flatcontact.foundation.numbers.Bounds` of the bounded float ``field`` of the
     pydantic class ``model`` (a settings section, the recipe, the LJ): a flag that sets the
     same quantity is held to the same bounds."""
-    from flatcontact.numbers import field_bounds
+    from flatcontact.foundation.numbers import field_bounds
 
     found = field_bounds(model.model_fields[field])
     if found is None:

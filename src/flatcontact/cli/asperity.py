@@ -9,7 +9,7 @@ from pathlib import Path
 import typer
 
 from flatcontact.cli.app import app, check_out_dir, console
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 
 @app.command("asperity")
@@ -37,7 +37,7 @@ def asperity_cmd(
     Rerunning into the same --out resumes from the last relaxed step.
     """
     from flatcontact.cli.settings import resolve_config
-    from flatcontact.layout import ELASTIC_JSON, LAWS_JSON, STAGES
+    from flatcontact.foundation.layout import ELASTIC_JSON, LAWS_JSON, STAGES
     from flatcontact.stages.asperity import (
         AsperityInputs,
         asperity_stage,

@@ -12,7 +12,6 @@ from pathlib import Path
 
 import typer
 
-from flatcontact import limits
 from flatcontact.cli.app import (
     app,
     bounded,
@@ -22,8 +21,9 @@ from flatcontact.cli.app import (
     setting_bounds,
 )
 from flatcontact.cli.options import flags_of, setting_options, settings_command
-from flatcontact.errors import InputError
-from flatcontact.layout import BUILD_JSON
+from flatcontact.foundation import limits
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.layout import BUILD_JSON
 
 #: The settings the command exposes, one flag each (:mod:`flatcontact.cli.options`): the
 #: quartz recipe's (with ``--config``, the file's recipe's: a flag it has no setting for is

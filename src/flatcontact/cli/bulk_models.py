@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 
 def bulk_potential(potential: str, flag: str) -> str:

@@ -2,7 +2,7 @@
 
 Thin: its flags are the run settings' ``contact`` section and ``report.svg``, one per
 setting, derived from the settings by :mod:`flatcontact.cli.options` (k, τ0, μ, σ0 default
-to the paper's, :mod:`flatcontact.reference`); it runs
+to the paper's, :mod:`flatcontact.foundation.reference`); it runs
 the contact stage (:func:`flatcontact.stages.contact.contact_stage`, the one ``flatcontact run``
 runs) and prints a rich table or JSON; with ``--out`` the stage writes its figures,
 ``summary.json`` and ``contact.nc`` there.
@@ -18,7 +18,7 @@ import typer
 
 from flatcontact.cli.app import app, check_out_dir, console
 from flatcontact.cli.options import flags_of, setting_options, settings_command
-from flatcontact.reference import DEFAULT_P0_GPA, PAPER, PAPER_LAW_KEYS
+from flatcontact.foundation.reference import DEFAULT_P0_GPA, PAPER, PAPER_LAW_KEYS
 
 #: The settings the command exposes, one flag each (:mod:`flatcontact.cli.options`).
 PATHS = (
@@ -222,13 +222,13 @@ def _given_interface(unstable_stacking_mj_per_m2, burgers_angstrom, structure) -
     """The contact's range facts from the flags (``ContactInputs.interface``); None when
     neither γ_us nor b is given (no size limit is computed)."""
     from flatcontact.contact.slip_size import APPROXIMANT, COMMENSURATE, TWISTED
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
 
     kinds = (COMMENSURATE, TWISTED, APPROXIMANT)
     if structure not in kinds:
         raise InputError(f"--structure: expected one of {', '.join(kinds)}, got {structure!r}")
     from flatcontact.cli.app import bounded
-    from flatcontact.numbers import Bounds
+    from flatcontact.foundation.numbers import Bounds
 
     for flag, value, bounds in (
         ("--unstable-stacking-mj-per-m2", unstable_stacking_mj_per_m2, Bounds(1e-3, 1e4, "mJ/m²")),

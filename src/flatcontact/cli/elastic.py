@@ -11,7 +11,7 @@ import typer
 
 from flatcontact.cli.app import app, check_out_dir, console
 from flatcontact.cli.bulk_models import bulk_potential
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 
 @app.command("elastic")
@@ -40,7 +40,7 @@ def elastic_cmd(
     """
     from flatcontact.config.elastic import ElasticConfig
     from flatcontact.elastic import quartz_contact_moduli
-    from flatcontact.numbers import field_bounds
+    from flatcontact.foundation.numbers import field_bounds
 
     try:  # the run's elastic.strain bounds
         strain = field_bounds(ElasticConfig.model_fields["strain"]).check(strain)

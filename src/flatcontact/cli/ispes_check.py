@@ -20,7 +20,7 @@ from flatcontact.cli.app import (
     print_progress,
     setting_bounds,
 )
-from flatcontact.errors import InputError, require
+from flatcontact.foundation.errors import InputError, require
 
 
 def _ispes_model(name: str, flag: str, lj: dict):
@@ -56,11 +56,11 @@ def ispes_check(
     ispes_dir,
 ) -> dict:
     """``validate-potential --ispes``: checks every argument, then compare_ispes."""
-    from flatcontact import limits
     from flatcontact.analysis.uncertainty import committee_spread
     from flatcontact.config import default_potential
     from flatcontact.config.analysis import AnalysisConfig
     from flatcontact.config.scan import PressureRange, ScanConfig
+    from flatcontact.foundation import limits
     from flatcontact.potentials.coupling import LJSpec
     from flatcontact.training.ispes_check import compare_ispes
 

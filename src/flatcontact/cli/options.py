@@ -32,7 +32,7 @@ from typing import Annotated, Any, Literal
 import typer
 
 from flatcontact.cli.app import parse_floats, split_list
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 #: Kinds of option a field becomes.
 _Kind = Literal["bool", "int", "float", "text", "number-or-text", "floats", "texts", "pair"]
@@ -159,7 +159,7 @@ def setting_options(
     (a command laid over a configuration) and the field's default otherwise.
     """
     from flatcontact.config.paths import field_at
-    from flatcontact.numbers import field_bounds
+    from flatcontact.foundation.numbers import field_bounds
 
     out = []
     for path in paths:

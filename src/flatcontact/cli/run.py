@@ -15,7 +15,7 @@ import typer
 
 from flatcontact.cli.app import app, check_out_dir, console, say_interrupted
 from flatcontact.cli.progress import ScanBar, StageLines
-from flatcontact.layout import RUN_MARKER
+from flatcontact.foundation.layout import RUN_MARKER
 
 _PRESET_HELP = "quick (default: minutes on a 2-core laptop) or paper (the paper's grids and loads)."
 
@@ -89,7 +89,7 @@ def config_command(
 ) -> None:
     """Print the default run configuration (with every field described) or check a file."""
     from flatcontact.config import load_config, to_yaml
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
     from flatcontact.stages.preflight import check_inputs
 
     if not show_default and check is None:

@@ -23,8 +23,8 @@ from flatcontact.cli.app import (
     say_interrupted,
 )
 from flatcontact.cli.options import flags_of, setting_options, settings_command
-from flatcontact.errors import InputError
-from flatcontact.layout import INTERFACE
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.layout import INTERFACE
 
 #: The settings the command exposes, one flag each (:mod:`flatcontact.cli.options`); laid
 #: over CONFIG (the flags not given keep its values).
@@ -151,8 +151,8 @@ def scan_command(
     """
     from flatcontact.cli.app import print_warning
     from flatcontact.cli.progress import ScanBar
+    from flatcontact.foundation.rundir import RunLock
     from flatcontact.ispes.scan import ScanInterrupted
-    from flatcontact.rundir import RunLock
     from flatcontact.stages.scan import ScanInputs, scan_stage
 
     if "thickness_angstrom" in settings.get("scan", {}) and p_range_gpa is not None:

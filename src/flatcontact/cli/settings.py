@@ -14,7 +14,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 FLAGS_SOURCE = "command-line flags"
 

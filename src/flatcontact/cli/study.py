@@ -190,7 +190,7 @@ def _scaling_line(name: str, fit: dict) -> str:
 def _print_experiment_collapse(cfg, doc: dict, out: Path) -> None:
     """Each cell's collapse stress at the experiment's conditions (``contact.experiment``):
     printed and written to ``experiment_collapse.json``."""
-    from flatcontact.fileio import write_json_atomic
+    from flatcontact.foundation.fileio import write_json_atomic
     from flatcontact.studies.approximant_collapse import (
         EXPERIMENT_COLLAPSE_JSON,
         approximant_collapse,
@@ -312,8 +312,8 @@ def export_uncertainty_command(
     ] = None,
 ) -> None:
     """One uncertainty file (the paper preset's data-file format) from the studies' blocks."""
-    from flatcontact.errors import InputError
-    from flatcontact.fileio import write_json_atomic
+    from flatcontact.foundation.errors import InputError
+    from flatcontact.foundation.fileio import write_json_atomic
     from flatcontact.studies.export import export_uncertainty
 
     if out.is_dir() or (out.exists() and not out.is_file()):

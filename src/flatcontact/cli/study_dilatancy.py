@@ -20,7 +20,7 @@ _PRINTED = ("z_range_angstrom", "gap_range_angstrom", "slabs_range_angstrom", "h
 
 def _labelled_folders(items: list[str]) -> dict[str, Path]:
     """``LABEL=DIR`` arguments -> ``{label: Path(dir)}``; one error line per bad item."""
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
 
     folders: dict[str, Path] = {}
     for item in items:
@@ -54,7 +54,7 @@ def dilatancy_command(
     """Dilatancy of stored scans: z* at fixed load split into the interface gap and the slabs."""
     import numpy as np
 
-    from flatcontact.fileio import write_json_atomic
+    from flatcontact.foundation.fileio import write_json_atomic
     from flatcontact.studies.dilatancy import LOADS_GPA, compare_dilatancy
 
     folders = _labelled_folders(scans)

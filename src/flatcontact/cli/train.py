@@ -18,7 +18,7 @@ from flatcontact.cli.app import (
     console,
     print_progress,
 )
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 
 def check_base_name(name: str, flag: str = "--name") -> str:
@@ -61,7 +61,7 @@ def train_snap_cmd(
     ),
 ) -> None:
     """Fit a SNAP (LAMMPS .snapcoeff/.snapparam) to a dataset or a generated recipe."""
-    from flatcontact.numbers import Bounds
+    from flatcontact.foundation.numbers import Bounds
     from flatcontact.potentials.teachers import get_teacher
     from flatcontact.training.train import train_snap
 

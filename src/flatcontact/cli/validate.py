@@ -14,9 +14,9 @@ from rich.table import Table
 from flatcontact.cli.app import app, check_out_dir, console, print_progress
 from flatcontact.cli.bulk_models import bulk_potential
 from flatcontact.cli.ispes_check import ispes_check, print_ispes_check
-from flatcontact.errors import InputError
-from flatcontact.fileio import write_json_atomic
-from flatcontact.reference import (
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import write_json_atomic
+from flatcontact.foundation.reference import (
     QUARTZ_CIJ_EXPERIMENT_GPA,
     QUARTZ_DENSITY_EXPERIMENT_G_CM3,
     QUARTZ_LATTICE_EXPERIMENT_ANGSTROM,

@@ -16,7 +16,7 @@ by default, or ``paper``), so a file only lists what it changes::
 Every field carries its unit in its name (``radius_um``, ``p0_gpa``,
 ``fmax_ev_per_angstrom``) and a description (``flatcontact config --show-default`` prints
 them as comments). Unknown keys are refused. :func:`load_config` turns every problem into one
-:class:`~flatcontact.errors.InputError` line that names the file and the dotted path of the
+:class:`~flatcontact.foundation.errors.InputError` line that names the file and the dotted path of the
 field, e.g. ``config.yaml: scan.grid: expected two positive integers, got [0, 4]``. Units:
 atomistic quantities in eV and Å, loads in GPa, laws in MPa and MPa/GPa, contact geometry in
 µm/nm.

@@ -6,11 +6,11 @@ from typing import Literal
 
 from pydantic import Field, field_validator
 
-from flatcontact import limits
 from flatcontact.config.messages import show
 from flatcontact.config.section import Section
-from flatcontact.numbers import physical
-from flatcontact.reference import PAPER_THRESHOLD_GPA
+from flatcontact.foundation import limits
+from flatcontact.foundation.numbers import physical
+from flatcontact.foundation.reference import PAPER_THRESHOLD_GPA
 
 
 class AnalysisConfig(Section):

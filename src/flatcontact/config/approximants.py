@@ -27,7 +27,7 @@ from pydantic import Field, ValidationError, field_validator
 
 from flatcontact.config.messages import one_line
 from flatcontact.config.section import Section
-from flatcontact.numbers import physical
+from flatcontact.foundation.numbers import physical
 
 #: Strain bounds (%) of the coincidence-lattice ladder of two materials when none is given.
 DEFAULT_STRAIN_LADDER_PERCENT = (3.0, 1.0, 0.3, 0.1)

@@ -11,7 +11,7 @@ from typing import Literal
 from pydantic import Field, field_validator
 
 from flatcontact.config.section import Section
-from flatcontact.numbers import physical
+from flatcontact.foundation.numbers import physical
 
 #: Largest ``asperity.mpi_ranks`` (flatcontact.asperity.ranks checks against it too).
 MAX_MPI_RANKS = 256

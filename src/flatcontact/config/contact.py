@@ -14,11 +14,11 @@ from typing import Literal
 
 from pydantic import Field, field_validator
 
-from flatcontact import limits
 from flatcontact.config.messages import show
 from flatcontact.config.section import Section
-from flatcontact.numbers import physical
-from flatcontact.reference import DEFAULT_P0_GPA, PAPER, PAPER_EXPERIMENT_P0_GPA
+from flatcontact.foundation import limits
+from flatcontact.foundation.numbers import physical
+from flatcontact.foundation.reference import DEFAULT_P0_GPA, PAPER, PAPER_EXPERIMENT_P0_GPA
 
 #: Force amplitudes of the cycle as fractions of the gross-sliding force
 #: (:data:`flatcontact.contact.cycle.DEFAULT_AMPLITUDE_FRACTIONS`; a test keeps them equal).

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pydantic import Field
 
 from flatcontact.config.section import Section
-from flatcontact.numbers import physical
+from flatcontact.foundation.numbers import physical
 
 
 class ElasticConfig(Section):

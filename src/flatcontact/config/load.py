@@ -1,7 +1,7 @@
 """Reading a run configuration: :func:`load_config` (a YAML file) and :func:`build_config` (a mapping).
 
 Both lay the data over a preset (:mod:`.presets`, :mod:`.merge`), validate with the section models (:class:`~.run.RunConfig`) and turn
-every problem into one :class:`~flatcontact.errors.InputError` line naming the source and the
+every problem into one :class:`~flatcontact.foundation.errors.InputError` line naming the source and the
 dotted field path (:mod:`.messages`). :func:`load_config` also resolves the file fields
 against the config file's directory and checks that they exist.
 """
@@ -19,8 +19,8 @@ from flatcontact.config.paths import suggestion
 from flatcontact.config.presets import preset
 from flatcontact.config.run import RunConfig
 from flatcontact.config.yaml_io import MAX_CONFIG_BYTES, parse_yaml
-from flatcontact.errors import InputError
-from flatcontact.fileio import read_text_file
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import read_text_file
 from flatcontact.structures.recipe import FILE_FIELDS as RECIPE_FILE_FIELDS
 
 #: Names of the built-in sheets a recipe's ``sheet`` may give instead of a file
@@ -82,7 +82,7 @@ def load_config(path: str | Path | None = None, preset_name: str | None = None) 
     naming the file and the field path: a file that is missing, a directory, unreadable,
     larger than :data:`~flatcontact.config.yaml_io.MAX_CONFIG_BYTES`, not UTF-8, not YAML,
     nested deeper than :data:`~flatcontact.config.yaml_io.MAX_CONFIG_DEPTH` or with a key
-    given twice; a field out of range or above a size bound (:mod:`flatcontact.limits`); a
+    given twice; a field out of range or above a size bound (:mod:`flatcontact.foundation.limits`); a
     file field naming no readable file.
     """
     if path is None:

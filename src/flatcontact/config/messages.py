@@ -11,7 +11,7 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 
 def show(value: Any) -> str:

@@ -23,8 +23,8 @@ import json
 import math
 from pathlib import Path
 
-from flatcontact.errors import InputError
-from flatcontact.reference import QUARTZ_HAMAKER_ZJ, QUARTZ_LATTICE_EXPERIMENT_ANGSTROM
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.reference import QUARTZ_HAMAKER_ZJ, QUARTZ_LATTICE_EXPERIMENT_ANGSTROM
 
 _PACKAGE = Path(__file__).resolve().parent.parent
 #: The bundled SNAP the default run uses when it is present.
@@ -56,7 +56,7 @@ MEASURED_LAW_UNCERTAINTY: dict = _law_uncertainty()
 
 def quartz_number_density_per_nm3() -> dict[str, float]:
     """Number densities of Si and O in α-quartz (nm⁻³) from the experimental lattice
-    (:data:`flatcontact.reference.QUARTZ_LATTICE_EXPERIMENT_ANGSTROM`; 3 SiO₂ per cell)."""
+    (:data:`flatcontact.foundation.reference.QUARTZ_LATTICE_EXPERIMENT_ANGSTROM`; 3 SiO₂ per cell)."""
     a, c = QUARTZ_LATTICE_EXPERIMENT_ANGSTROM["a"], QUARTZ_LATTICE_EXPERIMENT_ANGSTROM["c"]
     volume_angstrom3 = math.sqrt(3.0) / 2.0 * a**2 * c
     return {"Si": 3.0 / volume_angstrom3 * 1.0e3, "O": 6.0 / volume_angstrom3 * 1.0e3}

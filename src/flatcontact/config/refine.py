@@ -26,7 +26,7 @@ from typing import Literal
 from pydantic import Field, field_validator
 
 from flatcontact.config.section import Section
-from flatcontact.numbers import physical
+from flatcontact.foundation.numbers import physical
 
 #: The settings a refinement study can refine, in the order they are reported.
 REFINABLE = ("grid", "thicknesses", "layers", "fmax", "cutoff")

@@ -13,7 +13,6 @@ from typing import Any, Literal
 
 from pydantic import Field, field_validator, model_validator
 
-from flatcontact import limits
 from flatcontact.config.analysis import AnalysisConfig
 from flatcontact.config.approximants import ApproximantSettings
 from flatcontact.config.asperity import AsperityConfig
@@ -25,6 +24,7 @@ from flatcontact.config.report import ReportConfig
 from flatcontact.config.scan import PressureRange, ScanConfig
 from flatcontact.config.section import Section
 from flatcontact.config.uncertainty import UncertaintyConfig
+from flatcontact.foundation import limits
 from flatcontact.potentials.model import InteractionModel
 from flatcontact.structures.recipe import QuartzDenseRecipe, StructureRecipe, parse_recipe
 

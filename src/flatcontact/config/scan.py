@@ -12,10 +12,10 @@ from typing import Any, Literal
 
 from pydantic import Field, field_validator, model_validator
 
-from flatcontact import limits
 from flatcontact.config.messages import show
 from flatcontact.config.section import Section, positive_pair
-from flatcontact.numbers import physical
+from flatcontact.foundation import limits
+from flatcontact.foundation.numbers import physical
 
 #: Optimisers a scan point may use (:data:`flatcontact.ispes.relax.OPTIMIZERS`): ASE's, and
 #: ``lammps-cg`` (LAMMPS's own minimiser, LAMMPS models only).

@@ -7,9 +7,9 @@ from typing import Any
 
 from pydantic import BaseModel, ConfigDict
 
-from flatcontact import limits
 from flatcontact.config.messages import show
-from flatcontact.numbers import state_bounds
+from flatcontact.foundation import limits
+from flatcontact.foundation.numbers import state_bounds
 
 
 class Section(BaseModel):
@@ -18,7 +18,7 @@ class Section(BaseModel):
     Frozen, so a validated configuration cannot drift; ``extra="forbid"``, so a misspelt key
     is an error naming its path; ``allow_inf_nan=False``, so NaN or inf in the YAML is
     refused naming its path. A float field typed with
-    :func:`~flatcontact.numbers.physical` is also refused when subnormal or out of
+    :func:`~flatcontact.foundation.numbers.physical` is also refused when subnormal or out of
     its bounds, and the bounds are appended to its description.
     """
 
@@ -26,14 +26,14 @@ class Section(BaseModel):
 
     @classmethod
     def __pydantic_init_subclass__(cls, **kwargs: Any) -> None:
-        """State the bounds of every :func:`~flatcontact.numbers.physical` field in its
+        """State the bounds of every :func:`~flatcontact.foundation.numbers.physical` field in its
         description (printed by ``flatcontact config --show-default``)."""
         super().__pydantic_init_subclass__(**kwargs)
         state_bounds(cls)
 
 
 def positive_pair(value: Any, what: str) -> tuple[int, int]:
-    """``value`` as two positive integers within the ``grid_axis`` bound (:mod:`flatcontact.limits`)."""
+    """``value`` as two positive integers within the ``grid_axis`` bound (:mod:`flatcontact.foundation.limits`)."""
     ok = (
         isinstance(value, list | tuple)
         and len(value) == 2

@@ -8,7 +8,7 @@ from pydantic import Field, field_validator
 
 from flatcontact.config.messages import show
 from flatcontact.config.section import Section
-from flatcontact.numbers import Bounds, physical
+from flatcontact.foundation.numbers import Bounds, physical
 
 #: The law coefficients an uncertainty block may name (τ = k·P + τ0, σ = μ·P + σ0).
 LAW_KEYS = ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa")

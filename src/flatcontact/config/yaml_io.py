@@ -2,7 +2,7 @@
 
 In: :func:`parse_yaml` reads with ``yaml.SafeLoader`` (no Python objects), refuses a key
 given twice in one mapping and nesting deeper than :data:`MAX_CONFIG_DEPTH`; the file itself
-is read within :data:`MAX_CONFIG_BYTES` (:func:`flatcontact.fileio.read_text_file`).
+is read within :data:`MAX_CONFIG_BYTES` (:func:`flatcontact.foundation.fileio.read_text_file`).
 
 Anchors and aliases (``&name`` / ``*name``) are allowed, but the document they expand to is
 bounded: before anything is constructed, the composed node graph is counted as the tree the
@@ -33,7 +33,7 @@ from flatcontact.config.report import ReportConfig
 from flatcontact.config.run import RunConfig
 from flatcontact.config.scan import ScanConfig
 from flatcontact.config.section import Section
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials.model import InteractionModel
 
 #: Largest configuration file read (bytes): a run configuration is a few kB.

@@ -30,7 +30,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from flatcontact.contact.hertz import hertz_contact_radius, hertz_load
 from flatcontact.contact.parameters import check_non_negative, check_positive
-from flatcontact.errors import require
+from flatcontact.foundation.errors import require
 
 FloatArray = NDArray[np.float64]
 

@@ -53,7 +53,7 @@ import numpy as np
 from flatcontact.contact import adhesion
 from flatcontact.contact.hertz import hertz_contact_radius, hertz_load
 from flatcontact.contact.parameters import ContactParameters, check_positive
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 #: λ per μ_T for the Dugdale stress of a Lennard-Jones law, σ_th = 1.03 w/z0 (J&G 1997).
 LAMBDA_PER_TABOR = 2.0 * 1.03 * (9.0 / (16.0 * np.pi)) ** (1.0 / 3.0)

@@ -47,11 +47,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from flatcontact import units
 from flatcontact.contact import cattaneo_mindlin as cm
 from flatcontact.contact import mindlin, modified_cycle, oscillation
 from flatcontact.contact.parameters import ContactParameters
-from flatcontact.errors import require
+from flatcontact.foundation import units
+from flatcontact.foundation.errors import require
 
 FloatArray = NDArray[np.float64]
 

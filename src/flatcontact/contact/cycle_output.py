@@ -15,10 +15,10 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from flatcontact import units
 from flatcontact.contact import cycle
 from flatcontact.contact.cycle import SteadyCycle
 from flatcontact.contact.parameters import ContactParameters
+from flatcontact.foundation import units
 
 
 def cycle_records(cyc: Sequence[SteadyCycle]) -> list[dict[str, Any]]:

@@ -31,7 +31,6 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import brentq
 
-from flatcontact import units
 from flatcontact.contact import mindlin
 from flatcontact.contact.measured import MeasuredStiffness
 from flatcontact.contact.oscillation import (
@@ -40,7 +39,8 @@ from flatcontact.contact.oscillation import (
     lateral_stiffness,
 )
 from flatcontact.contact.parameters import ContactParameters, check_positive
-from flatcontact.errors import require
+from flatcontact.foundation import units
+from flatcontact.foundation.errors import require
 
 FloatArray = NDArray[np.float64]
 

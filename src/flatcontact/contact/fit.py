@@ -44,11 +44,11 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
-from flatcontact import units
 from flatcontact.contact import cycle, experiment, mindlin
 from flatcontact.contact.measured import LoadCurve
 from flatcontact.contact.parameters import ContactParameters
-from flatcontact.errors import InputError, require
+from flatcontact.foundation import units
+from flatcontact.foundation.errors import InputError, require
 
 FloatArray = NDArray[np.float64]
 

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from flatcontact.errors import require
+from flatcontact.foundation.errors import require
 
 FloatArray = NDArray[np.float64]
 

@@ -50,7 +50,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import brentq
 
-from flatcontact.errors import require
+from flatcontact.foundation.errors import require
 
 FloatArray = NDArray[np.float64]
 

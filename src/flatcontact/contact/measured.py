@@ -48,10 +48,10 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from flatcontact import units
 from flatcontact.contact.parameters import ContactParameters
-from flatcontact.errors import InputError, require
-from flatcontact.fileio import read_text_file
+from flatcontact.foundation import units
+from flatcontact.foundation.errors import InputError, require
+from flatcontact.foundation.fileio import read_text_file
 
 FloatArray = NDArray[np.float64]
 

@@ -41,7 +41,7 @@ from scipy.optimize import brentq
 
 from flatcontact.contact import mindlin
 from flatcontact.contact.parameters import ContactParameters, check_positive
-from flatcontact.errors import require
+from flatcontact.foundation.errors import require
 
 FloatArray = NDArray[np.float64]
 

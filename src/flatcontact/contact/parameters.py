@@ -19,9 +19,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from flatcontact import units
-from flatcontact.errors import require
-from flatcontact.reference import PAPER as PAPER_DEFAULTS
+from flatcontact.foundation import units
+from flatcontact.foundation.errors import require
+from flatcontact.foundation.reference import PAPER as PAPER_DEFAULTS
 
 
 def _finite(name: str, value: Any) -> float:

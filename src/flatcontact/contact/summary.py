@@ -14,10 +14,11 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
-from flatcontact import __version__, units
+from flatcontact import __version__
 from flatcontact.contact import adhesion, mindlin
 from flatcontact.contact.oscillation import StiffnessCurve, stiffness_curve
 from flatcontact.contact.parameters import ContactParameters
+from flatcontact.foundation import units
 
 #: Points of each Q(u) curve, on u in [0, 1.5·u_fs].
 N_DISPLACEMENT = 301

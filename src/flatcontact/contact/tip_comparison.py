@@ -20,10 +20,10 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from flatcontact import units
 from flatcontact.contact import mindlin
 from flatcontact.contact.experiment import model_collapse_stress
 from flatcontact.contact.parameters import ContactParameters
+from flatcontact.foundation import units
 
 #: The law coefficients a reference law set carries.
 LAW_KEYS = ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa")

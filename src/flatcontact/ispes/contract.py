@@ -35,11 +35,11 @@ attrs
 Points not computed yet are NaN with ``converged = False``.
 
 Reading (:func:`open_ispes`, the one reader of the file) checks, in this order, each failure
-one :class:`~flatcontact.errors.InputError` line naming the file and the defect, never a
+one :class:`~flatcontact.foundation.errors.InputError` line naming the file and the defect, never a
 warning line: the file opens as netCDF4/HDF5 (anything h5netcdf cannot read, including
 plain HDF5 without dimensions, is "not a readable netCDF file" or a missing dimension);
 the three dimensions exist and their sizes are within the run bounds of
-:mod:`flatcontact.limits` (``grid_axis`` per lateral axis, ``thicknesses``, ``scan_points``
+:mod:`flatcontact.foundation.limits` (``grid_axis`` per lateral axis, ``thicknesses``, ``scan_points``
 for the product) before any variable is read into memory; then :func:`validate_ispes`:
 the required variables exist on exactly the three dimensions with numeric values;
 ``a1``, ``a2`` are vectors of at least two finite numbers, ``area`` one finite number equal
@@ -56,9 +56,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from flatcontact import __version__, limits
-from flatcontact.errors import InputError
-from flatcontact.fileio import atomic_path
+from flatcontact import __version__
+from flatcontact.foundation import limits
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import atomic_path
 
 if TYPE_CHECKING:  # xarray is imported where a dataset is made: scan workers never need it
     import xarray as xr

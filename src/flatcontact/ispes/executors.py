@@ -29,7 +29,7 @@ import sys
 from collections.abc import Callable, Iterable
 from typing import Any, Protocol, runtime_checkable
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.main_guard import serial_instead
 from flatcontact.ispes.relax import worker_calculator
 

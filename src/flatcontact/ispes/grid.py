@@ -19,7 +19,7 @@ from collections.abc import Sequence
 import numpy as np
 from ase import Atoms
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.contract import fractional_shifts
 from flatcontact.ispes.geometry import place_slab2
 

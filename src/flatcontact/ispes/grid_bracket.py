@@ -23,8 +23,8 @@ from collections.abc import Sequence
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from flatcontact.foundation.units import EV_PER_A3_TO_GPA
 from flatcontact.ispes.thicknesses import MIN_THICKNESS_SPACING_ANGSTROM, LoadFold
-from flatcontact.units import EV_PER_A3_TO_GPA
 
 #: Grid extensions a scan makes at most before it names the columns still short.
 MAX_EXTENSIONS = 3

@@ -18,7 +18,7 @@ from collections.abc import Callable
 import numpy as np
 from ase import Atoms
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.contract import cell_area
 from flatcontact.ispes.geometry import in_plane_vectors, place_slab2, thickness
 from flatcontact.ispes.grid import GridSpec

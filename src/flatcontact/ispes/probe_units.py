@@ -17,7 +17,7 @@ and its own inputs only:
   (:func:`~flatcontact.ispes.work_of_separation.ideal_work_of_separation`), keyed by the shift.
 
 Each unit is written to ``probe.json`` as soon as the driver has it (the whole file replaced
-atomically, :func:`flatcontact.fileio.write_json_atomic`), beside ``points.db`` and not in
+atomically, :func:`flatcontact.foundation.fileio.write_json_atomic`), beside ``points.db`` and not in
 it. The file's ``settings`` are the scan fingerprint without the grid (the interface hash,
 the potential, the relaxation settings): a file made with other settings is set aside and
 its units recomputed; within it a unit is reused only under exactly its key, so a unit whose
@@ -39,8 +39,8 @@ from typing import Any
 
 import numpy as np
 
-from flatcontact.errors import InputError
-from flatcontact.fileio import refuse_link, write_json_atomic
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import refuse_link, write_json_atomic
 from flatcontact.ispes.probe import ColumnChain
 from flatcontact.ispes.work_of_separation import WorkOfSeparation
 

@@ -39,7 +39,7 @@ import dataclasses
 
 import numpy as np
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.shift_symmetry import ShiftGroup
 
 Index = tuple[int, int, int]

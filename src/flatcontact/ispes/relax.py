@@ -68,7 +68,8 @@ from typing import Any, Literal
 import numpy as np
 from ase import Atoms
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.units import EV_PER_A3_TO_GPA
 from flatcontact.ispes.calculators import count_force_calls
 from flatcontact.ispes.contract import cell_area
 from flatcontact.ispes.geometry import (
@@ -78,7 +79,6 @@ from flatcontact.ispes.geometry import (
     warm_start_positions,
 )
 from flatcontact.ispes.lbfgs import largest_atomic_norm, lbfgs_relax
-from flatcontact.units import EV_PER_A3_TO_GPA
 
 Optimizer = Literal["FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch", "lammps-cg"]
 OPTIMIZERS: tuple[str, ...] = ("FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch", "lammps-cg")

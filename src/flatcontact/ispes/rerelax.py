@@ -40,11 +40,11 @@ from typing import Any
 import numpy as np
 from ase import Atoms
 
+from flatcontact.foundation.layout import RERELAX_DB
 from flatcontact.ispes import contract
 from flatcontact.ispes.grid_bracket import node_loads_gpa
 from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point, worker_calculator
 from flatcontact.ispes.store import PointStore
-from flatcontact.layout import RERELAX_DB
 
 log = logging.getLogger("flatcontact.scan")
 

@@ -37,7 +37,8 @@ from typing import Any
 import numpy as np
 from ase import Atoms
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.layout import ISPES_NC, POINTS_DB, PROBE_JSON
 from flatcontact.ispes import contract, executors
 from flatcontact.ispes.executors import Executor
 from flatcontact.ispes.geometry import thickness, validate_interface
@@ -52,7 +53,6 @@ from flatcontact.ispes.scan_probe import resolve, store_pending_work
 from flatcontact.ispes.scan_scheduler import COMMIT_INTERVAL_S, Scheduler
 from flatcontact.ispes.scan_symmetry import ScanRound, SymmetryPlan
 from flatcontact.ispes.store import PointStore, discard_store, interface_hash
-from flatcontact.layout import ISPES_NC, POINTS_DB, PROBE_JSON
 
 
 @dataclasses.dataclass

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from ase import Atoms
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.contract import DIM_A, DIM_B, DIM_Z, VAR_ENERGY, VAR_STRESS
 from flatcontact.ispes.executors import Executor
 from flatcontact.ispes.grid import GridSpec, check_thicknesses

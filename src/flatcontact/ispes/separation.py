@@ -18,9 +18,9 @@ import dataclasses
 
 import numpy as np
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.units import EV_PER_A2_TO_J_PER_M2, EV_PER_A3_TO_GPA
 from flatcontact.ispes.probe import ColumnProbe
-from flatcontact.units import EV_PER_A2_TO_J_PER_M2, EV_PER_A3_TO_GPA
 
 
 @dataclasses.dataclass(frozen=True)

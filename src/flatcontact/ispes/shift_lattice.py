@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 _ROUND_TOL = 1e-6
 

@@ -63,9 +63,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 from ase import Atoms
 
-from flatcontact.errors import InputError
-from flatcontact.fileio import refuse_link
-from flatcontact.interrupts import raise_on_sigterm
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import refuse_link
+from flatcontact.foundation.interrupts import raise_on_sigterm
 from flatcontact.ispes import contract, store_schema
 from flatcontact.ispes.relax import Index, PointResult
 from flatcontact.ispes.store_checks import (

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.relax import Index
 
 #: Keys every row must hold (the index and the record :meth:`PointStore._record` reads).

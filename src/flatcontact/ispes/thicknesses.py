@@ -17,7 +17,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 from ase import Atoms
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.contract import branch_run
 from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.probe import ColumnProbe, RigidStackings, probe_column, probed_stackings

@@ -41,12 +41,12 @@ from typing import Any
 import numpy as np
 from ase import Atoms
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.units import EV_PER_A2_TO_J_PER_M2
 from flatcontact.ispes.contract import cell_area
 from flatcontact.ispes.geometry import in_plane_vectors, place_slab2, thickness
 from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point, start_afresh
 from flatcontact.structures.interface_contract import continues_crystal, recipe_record
-from flatcontact.units import EV_PER_A2_TO_J_PER_M2
 
 #: first step (Å) away from the reference thickness when bracketing p = 0; doubled each time
 FIRST_STEP_ANGSTROM = 0.05

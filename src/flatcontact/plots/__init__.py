@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-from flatcontact.fileio import atomic_path
+from flatcontact.foundation.fileio import atomic_path
 
 __all__ = ["save_figure"]
 

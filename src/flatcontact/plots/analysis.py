@@ -13,10 +13,10 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from flatcontact import units
 from flatcontact.analysis.analyze import AnalysisResult, PressureAnalysis
 from flatcontact.analysis.laws import LoadLaws
 from flatcontact.analysis.uncertainty import propagate_box
+from flatcontact.foundation import units
 
 MEV = units.EV_PER_A2_TO_MEV_PER_A2
 

@@ -12,12 +12,12 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from flatcontact import units
 from flatcontact.contact import fit, mindlin
 from flatcontact.contact.experiment import model_stiffness_at_stress
 from flatcontact.contact.measured import LoadCurve, MeasuredStiffness
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.contact.summary import ContactAnalysis
+from flatcontact.foundation import units
 
 #: Fig. 4's default displacement as a fraction of the displacement at the peak force.
 FIG4_FRACTION_OF_PEAK = 0.6

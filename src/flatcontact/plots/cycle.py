@@ -13,10 +13,10 @@ from collections.abc import Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
-from flatcontact import units
 from flatcontact.contact import cycle, fit
 from flatcontact.contact.measured import LoadCurve
 from flatcontact.contact.parameters import ContactParameters
+from flatcontact.foundation import units
 
 _MPA = units.MPA_TO_PA
 

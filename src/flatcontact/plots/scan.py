@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from flatcontact import units
+from flatcontact.foundation import units
 
 
 def figure_scan_columns(ds, adhesion: dict | None = None):

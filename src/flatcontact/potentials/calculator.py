@@ -19,7 +19,7 @@ import numpy as np
 from ase import Atoms
 from ase.calculators.calculator import Calculator, all_changes
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials.lammps_engine import LammpsEngine
 from flatcontact.potentials.lammps_setup import compile_setup
 from flatcontact.potentials.lj import lj_cross_energy_forces

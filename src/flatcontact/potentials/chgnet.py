@@ -10,7 +10,7 @@ from __future__ import annotations
 import contextlib
 import sys
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 
 def chgnet_available() -> bool:

@@ -13,8 +13,8 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from flatcontact.errors import InputError
-from flatcontact.numbers import physical
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.numbers import physical
 from flatcontact.potentials.lj import hamaker_c6_scale, lj_table, pair_key
 from flatcontact.potentials.styles import check_element
 

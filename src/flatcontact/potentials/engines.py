@@ -21,7 +21,7 @@ from functools import cached_property
 
 from ase import Atoms
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials.calculator import AseInterfaceCalculator, LammpsInterfaceCalculator
 from flatcontact.potentials.loader import call_factory
 from flatcontact.potentials.model import InteractionModel

@@ -22,7 +22,7 @@ from pathlib import Path
 
 from ase.data import chemical_symbols
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials.lammps_runtime import lammps_potentials_dir
 
 #: Directory of flatcontact's bundled potentials (package data).

@@ -27,7 +27,7 @@ from ase.calculators.lammps import Prism
 from ase.data import atomic_masses, atomic_numbers
 from ase.units import bar
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 #: Voigt pairs in ASE order (xx, yy, zz, yz, xz, xy).
 VOIGT_PAIRS = ((0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1))

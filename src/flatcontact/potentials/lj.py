@@ -43,8 +43,8 @@ from dataclasses import dataclass
 import numpy as np
 from ase import Atoms, units
 
-from flatcontact import units as units_conv
-from flatcontact.errors import InputError
+from flatcontact.foundation import units as units_conv
+from flatcontact.foundation.errors import InputError
 
 #: Hartree·bohr⁶ → eV·Å⁶.
 HARTREE_BOHR6_TO_EV_A6 = units.Hartree * units.Bohr**6

@@ -17,7 +17,7 @@ from typing import Any
 
 import yaml
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 
 def load_callable(target: str, what: str = "calculator") -> Any:

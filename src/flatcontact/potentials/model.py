@@ -44,8 +44,8 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from flatcontact.errors import InputError
-from flatcontact.fileio import file_sha256
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import file_sha256
 from flatcontact.potentials.coupling import Coupling, LJSpec
 from flatcontact.potentials.lj import ts_elements
 from flatcontact.potentials.names import (

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from pydantic import BaseModel, ConfigDict
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials.files import BUNDLED_DIR, bundled_snap_names, snap_elements
 from flatcontact.potentials.lammps_runtime import lammps_potential_file
 from flatcontact.potentials.presets import PRESETS

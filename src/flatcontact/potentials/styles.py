@@ -16,7 +16,7 @@ from typing import Any, Literal
 from ase.data import chemical_symbols
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials.files import file_elements, require_potential_file
 from flatcontact.potentials.loader import check_finite_data, load_callable
 

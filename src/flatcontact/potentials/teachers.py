@@ -28,7 +28,7 @@ import importlib.metadata as md
 from dataclasses import asdict, dataclass
 from types import MappingProxyType
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials.chgnet import chgnet_calculator
 from flatcontact.potentials.loader import load_callable
 

@@ -1,7 +1,7 @@
 """The report's sections in order, from the stage folders of a run.
 
 :func:`build_sections` reads each stage's files once (the names are
-:mod:`flatcontact.layout`'s) and hands them to the section of that stage
+:mod:`flatcontact.foundation.layout`'s) and hands them to the section of that stage
 (:mod:`flatcontact.report.sections`); the report stage (:mod:`flatcontact.stages.report`)
 renders the result (:mod:`flatcontact.report.html`). Editing the report's wording reruns
 the report and nothing else.
@@ -14,9 +14,9 @@ from pathlib import Path
 import pandas as pd
 from ase.io import read
 
-from flatcontact.errors import InputError
-from flatcontact.fileio import read_json_file
-from flatcontact.layout import (
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import read_json_file
+from flatcontact.foundation.layout import (
     ANALYZE_JSON,
     ASPERITY_JSON,
     BUILD_JSON,
@@ -27,7 +27,8 @@ from flatcontact.layout import (
     SCAN_JSON,
     SUMMARY_JSON,
 )
-from flatcontact.reference import is_paper_material
+from flatcontact.foundation.reference import is_paper_material
+from flatcontact.foundation.result_json import CONTRACTS, MAX_BYTES, read_result_json
 from flatcontact.report.html import Section
 from flatcontact.report.sections.analysis import analysis_section
 from flatcontact.report.sections.approximant_study import (
@@ -45,12 +46,11 @@ from flatcontact.report.sections.refusal import refusal_section
 from flatcontact.report.sections.scan import scan_section
 from flatcontact.report.sections.summary import summary_section
 from flatcontact.report.stacking_names import stacking_family
-from flatcontact.result_json import CONTRACTS, MAX_BYTES, read_result_json
 
 
 def _json(path: Path, **expect) -> dict:
     """A stage's JSON file, checked against its contract where it has one
-    (:mod:`flatcontact.result_json`; ``expect``: what the settings say it holds);
+    (:mod:`flatcontact.foundation.result_json`; ``expect``: what the settings say it holds);
     ``build.json`` as a complete JSON mapping."""
     if path.name in CONTRACTS:
         return read_result_json(path, **expect)
@@ -77,7 +77,7 @@ def build_sections(
 
     ``stage_rows``: (stage, state, seconds, finished) of the summary table. The section
     next to the summary compares the run with the paper when its slabs are the paper's
-    α-quartz (:func:`flatcontact.reference.is_paper_material`), else shows its results alone;
+    α-quartz (:func:`flatcontact.foundation.reference.is_paper_material`), else shows its results alone;
     only then does any section show a value of the paper, except the experiment section
     (:mod:`flatcontact.report.sections.experiment`), which a run asks for with
     ``contact.experiment.compare`` and which sets its collapse stress against the paper's

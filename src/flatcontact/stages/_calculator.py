@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 #: The elements the elastic stage's crystal (α-quartz) needs.
 QUARTZ_ELEMENTS = frozenset({"Si", "O"})

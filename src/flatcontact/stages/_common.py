@@ -58,9 +58,9 @@ def rename(message: str, names: dict[str, str]) -> str:
 
 @contextlib.contextmanager
 def renamed_errors(names: dict[str, str]) -> Iterator[None]:
-    """Re-raise an :class:`~flatcontact.errors.InputError` of the block with the parameter
+    """Re-raise an :class:`~flatcontact.foundation.errors.InputError` of the block with the parameter
     names of ``names`` translated (core parameter -> settings path, or settings path -> flag)."""
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
 
     try:
         yield

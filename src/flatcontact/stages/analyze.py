@@ -18,9 +18,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from flatcontact.errors import InputError
-from flatcontact.fileio import atomic_path, read_json_file, write_json_atomic, write_text_atomic
-from flatcontact.layout import (
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import (
+    atomic_path,
+    read_json_file,
+    write_json_atomic,
+    write_text_atomic,
+)
+from flatcontact.foundation.layout import (
     ANALYZE_JSON,
     FRICTION_CSV,
     FRICTION_NC,

@@ -20,9 +20,9 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from flatcontact.errors import InputError
-from flatcontact.fileio import write_json_atomic
-from flatcontact.layout import (
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import write_json_atomic
+from flatcontact.foundation.layout import (
     ASPERITY_JSON,
     ASPERITY_NC,
     ASPERITY_STATE,
@@ -322,7 +322,7 @@ def asperity_stage(
             from flatcontact.asperity.records import ramp_dataset
 
             ds = ds.merge(ramp_dataset(exp.ramps))
-        from flatcontact.fileio import atomic_path
+        from flatcontact.foundation.fileio import atomic_path
 
         with atomic_path(folder / ASPERITY_NC) as tmp_nc:
             ds.to_netcdf(tmp_nc, engine="h5netcdf")

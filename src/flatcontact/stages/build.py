@@ -11,8 +11,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from flatcontact.fileio import write_json_atomic
-from flatcontact.layout import BUILD_FIGURE, BUILD_JSON, INTERFACE
+from flatcontact.foundation.fileio import write_json_atomic
+from flatcontact.foundation.layout import BUILD_FIGURE, BUILD_JSON, INTERFACE
 from flatcontact.stages import _calculator
 from flatcontact.stages._common import save
 

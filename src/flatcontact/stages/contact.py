@@ -31,9 +31,9 @@ import numpy as np
 
 from flatcontact.config.contact import ContactConfig
 from flatcontact.contact.parameters import ContactParameters
-from flatcontact.errors import InputError
-from flatcontact.fileio import atomic_path, file_sha256, write_json_atomic
-from flatcontact.layout import (
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import atomic_path, file_sha256, write_json_atomic
+from flatcontact.foundation.layout import (
     CONTACT_NC,
     FIG4_TRACTION,
     FIG5_FORCE_STIFFNESS,
@@ -46,7 +46,7 @@ from flatcontact.layout import (
     FIT_JSON,
     SUMMARY_JSON,
 )
-from flatcontact.reference import PAPER, PAPER_LAW_KEYS, is_paper_material
+from flatcontact.foundation.reference import PAPER, PAPER_LAW_KEYS, is_paper_material
 from flatcontact.stages._common import renamed_errors, save
 from flatcontact.stages.contact_experiment import (  # noqa: F401  (re-exported)
     QUARTZ_QUICK_LAWS_FILE,
@@ -248,9 +248,9 @@ def contact_intervals(
     document ``component_half_widths``. ``p0c``: the peak pressures the model is evaluated
     at (the adhesive contact, :func:`flatcontact.stages.contact_range.contact_p0_gpa`).
     """
-    from flatcontact import units
     from flatcontact.analysis.uncertainty import propagate_box
     from flatcontact.contact import experiment, mindlin, oscillation
+    from flatcontact.foundation import units
 
     c = settings.contact
     p0s = [float(p) for p in c.p0_gpa]

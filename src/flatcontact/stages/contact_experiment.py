@@ -7,8 +7,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from flatcontact.errors import InputError
-from flatcontact.reference import PAPER, PAPER_EXPERIMENT_COLLAPSE_MPA, PAPER_LAW_KEYS
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.reference import PAPER, PAPER_EXPERIMENT_COLLAPSE_MPA, PAPER_LAW_KEYS
 from flatcontact.stages._common import rename
 
 #: flatcontact's own α-quartz laws, a data file with its provenance: ``flatcontact run`` on
@@ -21,7 +21,7 @@ QUARTZ_QUICK_LAWS_FILE = (
 
 def quartz_quick_laws() -> dict:
     """The quick preset's quartz laws of :data:`QUARTZ_QUICK_LAWS_FILE` (``label``, the four
-    numbers of :data:`~flatcontact.reference.PAPER_LAW_KEYS`, ``source``).
+    numbers of :data:`~flatcontact.foundation.reference.PAPER_LAW_KEYS`, ``source``).
 
     Raises
     ------
@@ -31,7 +31,7 @@ def quartz_quick_laws() -> dict:
     """
     import json
 
-    from flatcontact.result_json import ContractError, check_keys
+    from flatcontact.foundation.result_json import ContractError, check_keys
 
     doc = json.loads(QUARTZ_QUICK_LAWS_FILE.read_text(encoding="utf-8"))
     try:
@@ -43,7 +43,7 @@ def quartz_quick_laws() -> dict:
 
 def quartz_reference_laws() -> dict[str, dict[str, float]]:
     """The quartz law sets the experiment comparison sets a run against: the paper's
-    (:data:`flatcontact.reference.PAPER`) and flatcontact's quick preset
+    (:data:`flatcontact.foundation.reference.PAPER`) and flatcontact's quick preset
     (:func:`quartz_quick_laws`)."""
     quick = quartz_quick_laws()
     return {
@@ -55,7 +55,7 @@ def quartz_reference_laws() -> dict[str, dict[str, float]]:
 def experiment_comparison(settings, params) -> dict:
     """``summary.json["experiment_comparison"]`` for ``contact.experiment.compare``: the run's
     collapse stress at ``contact.experiment.p0_gpa`` against the measured collapses
-    (:data:`flatcontact.reference.PAPER_EXPERIMENT_COLLAPSE_MPA`) and the quartz laws'
+    (:data:`flatcontact.foundation.reference.PAPER_EXPERIMENT_COLLAPSE_MPA`) and the quartz laws'
     (:func:`flatcontact.contact.tip_comparison.compare_collapse`)."""
     from flatcontact.contact.tip_comparison import compare_collapse
 

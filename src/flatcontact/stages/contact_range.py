@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from flatcontact import units
+from flatcontact.foundation import units
 
 #: 1 meV/Å² in J/m².
 MEV_PER_A2_TO_J_PER_M2 = 1e-3 * units.EV_PER_A2_TO_J_PER_M2
@@ -188,7 +188,7 @@ def slip_of(settings, interface, analysis) -> dict | None:
 def foreign_moduli_note(settings, provenance: dict, params) -> str | None:
     """A sentence when the configured E*, G* are the paper's α-quartz values (52.5, 29 GPa,
     DFT and its SNAP) but the run's material or interaction model is another; else None."""
-    from flatcontact.reference import PAPER, is_paper_material
+    from flatcontact.foundation.reference import PAPER, is_paper_material
 
     if provenance.get("moduli") != "config":
         return None

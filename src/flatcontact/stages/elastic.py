@@ -26,9 +26,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from flatcontact.errors import InputError
-from flatcontact.fileio import write_json_atomic
-from flatcontact.layout import ELASTIC_JSON
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import write_json_atomic
+from flatcontact.foundation.layout import ELASTIC_JSON
 from flatcontact.stages import _calculator
 
 #: The convention of the layered crystals' moduli (elastic.json ``crystal.convention``).

@@ -17,7 +17,7 @@ The code part is here too: :func:`stage_code`, the stage module's import closure
 :func:`stage_code_digest` (``code_sha256``), re-exported by :mod:`flatcontact.pipeline`.
 
 A file a setting names enters by its name and content (``*_sha256``), never by its path
-(:func:`flatcontact.rundir.portable`), so moving a configuration folder reruns nothing.
+(:func:`flatcontact.foundation.rundir.portable`), so moving a configuration folder reruns nothing.
 """
 
 from __future__ import annotations
@@ -25,15 +25,15 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
-from flatcontact.codegraph import SOURCE_ROOT, closure_digest, import_closure
 from flatcontact.config import RunConfig, recipe_files
-from flatcontact.fileio import file_sha256
-from flatcontact.layout import STAGES
-from flatcontact.rundir import portable
+from flatcontact.foundation.codegraph import SOURCE_ROOT, closure_digest, import_closure
+from flatcontact.foundation.fileio import file_sha256
+from flatcontact.foundation.layout import STAGES
+from flatcontact.foundation.rundir import portable
 from flatcontact.stages import _calculator
 
 #: The module of each stage; the flatcontact code a stage runs is that module's import
-#: closure (:func:`flatcontact.codegraph.import_closure`): every flatcontact module it imports,
+#: closure (:func:`flatcontact.foundation.codegraph.import_closure`): every flatcontact module it imports,
 #: directly or not, at module or function level, with their parent packages' ``__init__``.
 #: Editing any of them reruns the stage and, through the fingerprints, every stage that reads
 #: it. ``pipeline.py`` itself is in no closure (it orders the stages, it computes nothing).

@@ -14,9 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.result_json import read_result_json
 from flatcontact.ispes.shift_symmetry import DEFAULT_TOLERANCE_ANGSTROM
-from flatcontact.result_json import read_result_json
 
 
 @dataclass(frozen=True)
@@ -136,7 +136,7 @@ def _landscape_gates(inputs: GateInputs, ds, not_checked: list[str]) -> list:
 
 
 def check_gates(settings, report) -> None:
-    """Stop (:class:`~flatcontact.errors.InputError`, one line per gate) on every finding of
+    """Stop (:class:`~flatcontact.foundation.errors.InputError`, one line per gate) on every finding of
     ``report`` whose gate is not in ``settings.contact.accept_untrusted``."""
     refused = report.refused(settings.contact.accept_untrusted)
     if not refused:

@@ -23,8 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from flatcontact.fileio import write_json_atomic
-from flatcontact.layout import LAWS_FIGURE, LAWS_JSON
+from flatcontact.foundation.fileio import write_json_atomic
+from flatcontact.foundation.layout import LAWS_FIGURE, LAWS_JSON
 from flatcontact.stages._common import captured, save
 
 _COLUMNS = ("p_gpa", "tau_mpa", "sigma_mss_mpa")
@@ -236,7 +236,7 @@ def _other_form(settings, other_form_json: Path) -> dict:
     import json
 
     from flatcontact.analysis.energy_forms import form_laws
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
 
     stored = json.loads(Path(other_form_json).read_text())
     form = other_form(settings.analysis.energy_form)

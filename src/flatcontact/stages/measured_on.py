@@ -6,7 +6,7 @@ measured. :func:`check_measured_on` refuses, in one line, a run whose structure 
 interaction model differs: the numbers say nothing about another interface or potential.
 
 * ``structure_sha256``: SHA-256 of the structure recipe as the build stage fingerprints it
-  (files by name and content, :func:`flatcontact.rundir.portable`); the layer count is part
+  (files by name and content, :func:`flatcontact.foundation.rundir.portable`); the layer count is part
   of it, so a block measured at 9 layers does not apply at 12.
 * ``model_sha256``: SHA-256 of :meth:`flatcontact.potentials.model.InteractionModel.fingerprint`
   (the model's canonical data, its files by name and SHA-256).
@@ -18,9 +18,9 @@ is the (lower-bound) uncertainty of a run at those or coarser settings of the sa
 from __future__ import annotations
 
 from flatcontact.config import RunConfig, recipe_files
-from flatcontact.errors import InputError
-from flatcontact.fileio import file_sha256
-from flatcontact.rundir import fingerprint, portable
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import file_sha256
+from flatcontact.foundation.rundir import fingerprint, portable
 from flatcontact.stages import _calculator
 
 

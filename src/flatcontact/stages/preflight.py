@@ -14,11 +14,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from flatcontact import limits
 from flatcontact.analysis.analyze import MIN_LATERAL_POINTS
 from flatcontact.config import RunConfig
 from flatcontact.contact.measured import load_stiffness_csv
-from flatcontact.errors import InputError
+from flatcontact.foundation import limits
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.executors import check_scheduler_address
 from flatcontact.potentials.engines import calculator_factory
 from flatcontact.potentials.loader import load_callable

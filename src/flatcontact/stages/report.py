@@ -9,14 +9,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from flatcontact.fileio import file_sha256, write_json_atomic
-from flatcontact.layout import EXPERIMENT_COLLAPSE_JSON, REFUSAL_JSON, REPORT_HTML
+from flatcontact.foundation.fileio import file_sha256, write_json_atomic
+from flatcontact.foundation.layout import EXPERIMENT_COLLAPSE_JSON, REFUSAL_JSON, REPORT_HTML
 
 
 @dataclass(frozen=True)
 class ReportInputs:
     """The folders of the stages to report (``folders[name]``, name as in
-    :data:`flatcontact.layout.STAGES`; ``elastic`` optional), the package versions, and for a
+    :data:`flatcontact.foundation.layout.STAGES`; ``elastic`` optional), the package versions, and for a
     run refused after the scan its refusal
     (:func:`flatcontact.report.sections.refusal.refusal_record`: only the stages it lists as
     finished are reported)."""
@@ -72,8 +72,8 @@ def refusal_of(settings, stage: str, error, gates, finished: list[str], scan: di
 def _stage_rows(
     folders: dict[str, Path], refusal: dict | None = None
 ) -> list[tuple[str, str, str, str]]:
+    from flatcontact.foundation.rundir import RunDirectory
     from flatcontact.report.format import fmt
-    from flatcontact.rundir import RunDirectory
 
     rows = []
     for name, folder in folders.items():

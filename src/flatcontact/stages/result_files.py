@@ -1,13 +1,13 @@
 """Checked readers of the stages' netCDF results, ``friction.nc`` and ``contact.nc``.
 
-A stage writes these files and records their SHA-256 (:mod:`flatcontact.rundir`), so a file
+A stage writes these files and records their SHA-256 (:mod:`flatcontact.foundation.rundir`), so a file
 changed after the stage is recomputed on the next run. What is read back must still follow
 the file's contract, whatever put it there (a bug, a disk fault, an edited record): the
 reader checks, before a value is used,
 
 - the file: a regular file (not a link), at most :data:`MAX_BYTES`, readable as netCDF4;
 - the sizes, before anything is loaded: the load dimension within the ``loads`` bound
-  (:mod:`flatcontact.limits`), every other dimension within :data:`MAX_SAMPLES`;
+  (:mod:`flatcontact.foundation.limits`), every other dimension within :data:`MAX_SAMPLES`;
 - the load coordinate (``p_gpa``, ``p0``): numbers, finite, no load twice and, when the
   caller knows them, exactly the loads the settings asked for (in any order);
 - the required variables: present, numbers, along the load dimension, finite (the per-load
@@ -16,7 +16,7 @@ reader checks, before a value is used,
 - the required attributes: present, finite numbers (the cell ``a1``, ``a2``, ``area`` of
   ``friction.nc``; the contact parameters ``param_*`` of ``contact.nc``).
 
-A file that fails is refused in one :class:`~flatcontact.errors.InputError` line naming it
+A file that fails is refused in one :class:`~flatcontact.foundation.errors.InputError` line naming it
 and the first defect, with the way to recompute it (remove the stage folder and rerun).
 """
 
@@ -29,8 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from flatcontact import limits
-from flatcontact.errors import InputError
+from flatcontact.foundation import limits
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.contract import finite_attribute, numeric_dtype
 
 #: Largest results file read (bytes): the paper's study writes ~1 MB.

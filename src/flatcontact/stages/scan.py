@@ -28,13 +28,13 @@ from typing import Any
 
 import numpy as np
 
-from flatcontact.errors import InputError
-from flatcontact.fileio import write_json_atomic
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import write_json_atomic
+from flatcontact.foundation.layout import SCAN_FIGURE, SCAN_JSON
 from flatcontact.ispes import scan as ispes_scan
 from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.reduction import SymmetrySettings
 from flatcontact.ispes.relax import RelaxSettings
-from flatcontact.layout import SCAN_FIGURE, SCAN_JSON
 from flatcontact.stages import _calculator
 from flatcontact.stages._common import save
 from flatcontact.stages.fold_remedy import remedy_folds

@@ -53,8 +53,8 @@ from typing import Any
 import numpy as np
 
 from flatcontact.config.approximants import DEFAULT_STRAIN_LADDER_PERCENT, ApproximantSettings
-from flatcontact.errors import InputError, require
-from flatcontact.limits import SearchTimeout
+from flatcontact.foundation.errors import InputError, require
+from flatcontact.foundation.limits import SearchTimeout
 from flatcontact.structures.cell2d import is_hexagonal
 from flatcontact.structures.construct import slab_sources
 from flatcontact.structures.match import (

@@ -17,7 +17,7 @@ import json
 import numpy as np
 from ase import Atoms
 
-from flatcontact.errors import InputError, require
+from flatcontact.foundation.errors import InputError, require
 from flatcontact.structures.cell2d import standard_slab
 from flatcontact.structures.interface_contract import (
     DEFAULT_VACUUM_ANGSTROM,

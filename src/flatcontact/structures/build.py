@@ -33,8 +33,8 @@ import numpy as np
 from ase import Atoms
 from ase.io import read, write
 
-from flatcontact.errors import InputError, require
-from flatcontact.fileio import atomic_path, write_json_atomic
+from flatcontact.foundation.errors import InputError, require
+from flatcontact.foundation.fileio import atomic_path, write_json_atomic
 from flatcontact.potentials.engines import bulk_calculator, make_calculator
 from flatcontact.potentials.factories import chgnet_r2scan
 from flatcontact.potentials.model import InteractionModel

@@ -13,7 +13,7 @@ import numpy as np
 from ase import Atoms
 from ase.spacegroup import crystal
 
-from flatcontact.errors import require
+from flatcontact.foundation.errors import require
 
 #: Experimental α-quartz lattice constants (Å), Levien et al. 1980.
 QUARTZ_A_ANGSTROM = 4.916

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from ase import Atoms
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 #: Relative tolerance for "same length" / "integer" tests of lattice vectors.
 LATTICE_RTOL = 1e-6

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 from ase import Atoms
 
-from flatcontact.errors import InputError, require
+from flatcontact.foundation.errors import InputError, require
 from flatcontact.structures.assemble import finish_interface, layer_plane, split_stack, stack_pair
 from flatcontact.structures.build import build_quartz_interface
 from flatcontact.structures.cell2d import lattice_is_invariant, standard_slab

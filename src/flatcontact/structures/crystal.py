@@ -31,8 +31,8 @@ from ase.build import fcc111
 from ase.build import surface as ase_surface
 from ase.data import atomic_numbers, reference_states
 
-from flatcontact.errors import InputError, require
-from flatcontact.fileio import file_sha256
+from flatcontact.foundation.errors import InputError, require
+from flatcontact.foundation.fileio import file_sha256
 from flatcontact.structures.cell2d import standard_slab
 from flatcontact.structures.layers import repeat_layers
 from flatcontact.structures.passivate import passivate_window

@@ -23,7 +23,7 @@ import numpy as np
 from ase import Atoms
 from ase.optimize import FIRE
 
-from flatcontact.errors import require
+from flatcontact.foundation.errors import require
 from flatcontact.structures.quartz_layers import DENSE_FACE_LAYERS
 from flatcontact.structures.topology import bonds, coordination_defects, height_spread, ring_sizes
 

@@ -38,7 +38,7 @@ from __future__ import annotations
 import numpy as np
 from ase import Atoms
 
-from flatcontact.errors import InputError, require
+from flatcontact.foundation.errors import InputError, require
 
 #: Vacuum (Å) kept above and below the interface along z in the stored cell.
 DEFAULT_VACUUM_ANGSTROM = 10.0

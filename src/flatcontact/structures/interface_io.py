@@ -13,8 +13,8 @@ import numpy as np
 from ase import Atoms
 from ase.io import write
 
-from flatcontact.errors import require
-from flatcontact.fileio import atomic_path
+from flatcontact.foundation.errors import require
+from flatcontact.foundation.fileio import atomic_path
 from flatcontact.structures.interface_contract import (
     fixed_mask,
     in_plane_vectors,

@@ -36,8 +36,8 @@ from ase import Atoms
 from ase.filters import FrechetCellFilter
 from ase.optimize import BFGS
 
-from flatcontact.errors import InputError
-from flatcontact.units import EV_PER_A3_TO_GPA
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.units import EV_PER_A3_TO_GPA
 
 #: Largest in-plane mismatch (%) between the file's lattice and the potential's that
 #: ``structure.lattice: file`` accepts. At 2 % a crystal with biaxial modulus

@@ -26,7 +26,7 @@ from ase.neighborlist import neighbor_list
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.structures.interface_contract import fixed_mask
 from flatcontact.structures.topology import BOND_TOLERANCE, bond_radii
 

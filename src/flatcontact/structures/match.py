@@ -27,9 +27,9 @@ import numpy as np
 from ase import Atoms
 from ase.build import make_supercell
 
-from flatcontact import limits
-from flatcontact.errors import InputError
-from flatcontact.limits import Deadline
+from flatcontact.foundation import limits
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.limits import Deadline
 from flatcontact.structures.cell2d import (
     integer_matrix,
     is_hexagonal,
@@ -123,7 +123,7 @@ def twist_match(a: np.ndarray, m: int, n: int, field: str = "twist") -> tuple[Ma
 
 
 def check_search_size(max_atoms: int, field: str) -> None:
-    """Refuse a search for cells above the ``atoms`` bound (:mod:`flatcontact.limits`) before
+    """Refuse a search for cells above the ``atoms`` bound (:mod:`flatcontact.foundation.limits`) before
     it starts: its candidates grow with the square of the largest cell."""
     if max_atoms > limits.bound("atoms"):
         raise InputError(

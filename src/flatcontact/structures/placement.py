@@ -12,7 +12,7 @@ import numpy as np
 from ase import Atoms
 from scipy.spatial import cKDTree
 
-from flatcontact.errors import InputError, require
+from flatcontact.foundation.errors import InputError, require
 from flatcontact.structures.interface_contract import (
     DEFAULT_VACUUM_ANGSTROM,
     fixed_mask,

@@ -7,7 +7,7 @@ the builders (:mod:`.dense`, :mod:`.thicken`, :mod:`.build`) use the same number
 
 from __future__ import annotations
 
-from flatcontact.errors import require
+from flatcontact.foundation.errors import require
 
 #: Dense face layer = the two outermost O–Si–O units.
 DENSE_FACE_LAYERS = 2

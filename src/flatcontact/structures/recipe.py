@@ -39,9 +39,9 @@ from pydantic import (
     model_validator,
 )
 
-from flatcontact import limits
-from flatcontact.errors import InputError
-from flatcontact.numbers import Bounds, physical, state_bounds
+from flatcontact.foundation import limits
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.numbers import Bounds, physical, state_bounds
 from flatcontact.structures.quartz_layers import MIN_LAYERS, check_shipped_layers
 from flatcontact.structures.sheet_catalog import BUILTIN_SHEETS
 
@@ -49,7 +49,7 @@ from flatcontact.structures.sheet_catalog import BUILTIN_SHEETS
 SECTION = "structure"
 
 
-#: Bounds of the recipe's floats (:func:`~flatcontact.numbers.physical`: finite, no
+#: Bounds of the recipe's floats (:func:`~flatcontact.foundation.numbers.physical`: finite, no
 #: subnormals, printed by ``flatcontact config --show-default``). A gap or spacing from
 #: touching cores (0.5 Å, below any bond) to twice the longest vdW cutoff (20 Å); an fcc
 #: lattice constant from 1 to 10 Å (Cu 3.61, Pb 4.95, Ca 5.58 Å); a relaxation's force

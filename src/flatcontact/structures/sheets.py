@@ -34,7 +34,7 @@ from ase import Atoms
 from ase.build import graphene, mx2
 from ase.neighborlist import neighbor_list
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.structures.cell2d import (
     is_hexagonal,
     lattice_is_invariant,

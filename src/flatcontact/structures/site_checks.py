@@ -27,7 +27,7 @@ from ase import Atoms
 from ase.data import atomic_numbers, covalent_radii
 from ase.neighborlist import neighbor_list
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 #: Occupancy within this of 1 is a full site (CIFs round to 2-4 digits).
 OCCUPANCY_TOLERANCE = 0.01

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from ase import Atoms
 
-from flatcontact.errors import InputError, require
+from flatcontact.foundation.errors import InputError, require
 from flatcontact.structures.bulk import QUARTZ_A_ANGSTROM, QUARTZ_C_ANGSTROM, alpha_quartz
 
 #: Heights closer than this (Å) count as one atomic plane when listing cleavage planes.

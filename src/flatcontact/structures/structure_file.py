@@ -2,11 +2,11 @@
 training set).
 
 :func:`read_structure` reads a file (:func:`read_structures` every frame of it) with ASE between two sets of checks, each refusal one
-:class:`~flatcontact.errors.InputError` naming the field, the file and the defect:
+:class:`~flatcontact.foundation.errors.InputError` naming the field, the file and the defect:
 
 Before parsing (nothing allocated from what the file claims):
 
-- the file is at most ``structure_mb`` MB (:mod:`flatcontact.limits`,
+- the file is at most ``structure_mb`` MB (:mod:`flatcontact.foundation.limits`,
   ``FLATCONTACT_MAX_STRUCTURE_MB``);
 - an XYZ / extended XYZ file (by the format ASE detects) is walked frame by frame: each
   frame's first line is an atom count between 0 and the ``atoms`` bound
@@ -45,8 +45,8 @@ from ase.io import read
 from ase.io.formats import filetype
 from ase.neighborlist import neighbor_list
 
-from flatcontact import limits
-from flatcontact.errors import InputError
+from flatcontact.foundation import limits
+from flatcontact.foundation.errors import InputError
 
 #: Closest two atoms may be (Å), periodic images included.
 MIN_DISTANCE_ANGSTROM = 0.5

@@ -31,7 +31,7 @@ from ase.filters import UnitCellFilter
 from ase.optimize import BFGS
 from ase.units import GPa
 
-from flatcontact.errors import InputError, require
+from flatcontact.foundation.errors import InputError, require
 from flatcontact.structures.bulk import QUARTZ_C_ANGSTROM, alpha_quartz
 from flatcontact.structures.dense import QUARTZ_ATOMS_PER_LAYER, face_masks
 from flatcontact.structures.quartz_layers import DENSE_FACE_LAYERS, UNITS_PER_REPEAT

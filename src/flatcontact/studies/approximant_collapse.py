@@ -9,7 +9,7 @@ resolved cell's laws go through the contact model at the experiment's conditions
 (:func:`flatcontact.stages.contact.experiment_comparison`, whose criterion this is: the
 amplitude stress Q_max/(π a²) where the load-controlled d⟨Q⟩/d⟨u⟩ first falls to
 ``contact.collapse_fraction`` of its initial value), set against the measured collapses
-(:data:`flatcontact.reference.PAPER_EXPERIMENT_COLLAPSE_MPA`).
+(:data:`flatcontact.foundation.reference.PAPER_EXPERIMENT_COLLAPSE_MPA`).
 
 A cell whose corrugation is not resolved above its noise floor has no laws (NaN): its row
 has no collapse stress and says why; a cell whose laws the contact model refuses (e.g.
@@ -25,9 +25,9 @@ import math
 from flatcontact.config.run import RunConfig
 from flatcontact.contact.parameters import ContactParameters
 from flatcontact.contact.tip_comparison import LAW_KEYS, compare_collapse
-from flatcontact.errors import InputError
-from flatcontact.layout import EXPERIMENT_COLLAPSE_JSON  # noqa: F401 (the file these rows go to)
-from flatcontact.reference import PAPER_EXPERIMENT_COLLAPSE_MPA, is_paper_material
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.layout import EXPERIMENT_COLLAPSE_JSON  # noqa: F401 (the file these rows go to)
+from flatcontact.foundation.reference import PAPER_EXPERIMENT_COLLAPSE_MPA, is_paper_material
 from flatcontact.stages.build import structure_elements
 from flatcontact.stages.contact import quartz_reference_laws
 

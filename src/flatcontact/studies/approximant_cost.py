@@ -44,12 +44,12 @@ from pathlib import Path
 import numpy as np
 
 from flatcontact.config.run import RunConfig
-from flatcontact.errors import InputError
-from flatcontact.fileio import read_json_file
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import read_json_file
+from flatcontact.foundation.layout import SCAN_JSON, STAGES
+from flatcontact.foundation.result_json import read_result_json
+from flatcontact.foundation.rundir import RECORD_NAME
 from flatcontact.ispes.executors import default_workers
-from flatcontact.layout import SCAN_JSON, STAGES
-from flatcontact.result_json import read_result_json
-from flatcontact.rundir import RECORD_NAME
 from flatcontact.studies.study_dir import RUNS, folder_name
 
 #: Force calls per grid point when no finished cell measured them and something relaxes:

@@ -60,11 +60,9 @@ from pathlib import Path
 import numpy as np
 
 from flatcontact.config.run import RunConfig
-from flatcontact.errors import InputError
-from flatcontact.fileio import refuse_link
-from flatcontact.ispes.executors import make_executor
-from flatcontact.ispes.shift_lattice import scan_grid
-from flatcontact.layout import (
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import refuse_link
+from flatcontact.foundation.layout import (
     FRICTION_CSV,
     FRICTION_NC,
     INTERFACE,
@@ -73,7 +71,9 @@ from flatcontact.layout import (
     OTHER_FORM_JSON,
     SCAN_JSON,
 )
-from flatcontact.result_json import read_result_json
+from flatcontact.foundation.result_json import read_result_json
+from flatcontact.ispes.executors import make_executor
+from flatcontact.ispes.shift_lattice import scan_grid
 from flatcontact.studies.runner import run_jobs
 from flatcontact.studies.scaling import fit_scaling
 from flatcontact.studies.study_dir import RUNS, folder_name, refuse_study_links

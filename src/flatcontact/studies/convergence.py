@@ -34,7 +34,7 @@ from pathlib import Path
 
 from flatcontact.analysis.uncertainty import LAW_COEFFICIENTS
 from flatcontact.config.run import RunConfig
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.executors import make_executor
 from flatcontact.studies.compare import (
     NOISIER_FACTOR,

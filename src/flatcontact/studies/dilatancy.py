@@ -126,7 +126,7 @@ def compare_dilatancy(folders: dict[str, Path], loads_gpa=LOADS_GPA) -> dict:
     InputError
         ``folders``: empty.
     """
-    from flatcontact.errors import InputError
+    from flatcontact.foundation.errors import InputError
 
     if not folders:
         raise InputError("folders: give at least one LABEL=DIR scan folder")

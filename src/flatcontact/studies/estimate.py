@@ -46,11 +46,11 @@ import math
 from pathlib import Path
 
 from flatcontact.config.run import RunConfig
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.layout import SCAN_JSON, STAGES
+from flatcontact.foundation.result_json import read_result_json
+from flatcontact.foundation.rundir import RECORD_NAME, RunDirectory
 from flatcontact.ispes.thicknesses import MIN_THICKNESS_SPACING_ANGSTROM
-from flatcontact.layout import SCAN_JSON, STAGES
-from flatcontact.result_json import read_result_json
-from flatcontact.rundir import RECORD_NAME, RunDirectory
 from flatcontact.studies.approximant_cost import duration, time_force_call
 from flatcontact.studies.variants import Variant, base_value, shares_build
 

@@ -27,9 +27,9 @@ from pydantic import ValidationError
 from flatcontact import __version__
 from flatcontact.config.messages import one_line
 from flatcontact.config.uncertainty import MEASURED_ON_KEYS, UncertaintyConfig
-from flatcontact.errors import InputError
-from flatcontact.fileio import file_sha256, quoted, read_json_file
-from flatcontact.result_json import KINDS, ContractError, check_keys
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import file_sha256, quoted, read_json_file
+from flatcontact.foundation.result_json import KINDS, ContractError, check_keys
 
 #: The number blocks an uncertainty file may carry (per energy form).
 NUMBER_BLOCKS = (

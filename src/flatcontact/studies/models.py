@@ -20,7 +20,7 @@ from flatcontact.analysis.uncertainty import model_spread
 from flatcontact.config.load import load_config
 from flatcontact.config.messages import one_line
 from flatcontact.config.run import RunConfig
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.executors import make_executor
 from flatcontact.potentials.presets import PRESETS
 from flatcontact.stages.preflight import check_inputs

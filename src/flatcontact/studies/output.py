@@ -23,8 +23,8 @@ import yaml
 
 from flatcontact import __version__
 from flatcontact.config.run import RunConfig
-from flatcontact.fileio import write_json_atomic, write_text_atomic
-from flatcontact.layout import STUDY_JSON
+from flatcontact.foundation.fileio import write_json_atomic, write_text_atomic
+from flatcontact.foundation.layout import STUDY_JSON
 from flatcontact.plots import save_figure
 from flatcontact.plots.study import QUANTITY_LABELS, figure_study
 from flatcontact.stages.measured_on import measured_on

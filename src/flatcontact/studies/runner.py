@@ -24,9 +24,9 @@ from pathlib import Path
 import pandas as pd
 
 from flatcontact.config.run import RunConfig
-from flatcontact.errors import InputError
-from flatcontact.fileio import refuse_link
-from flatcontact.layout import FRICTION_CSV, RUN_MARKER, STAGES
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import refuse_link
+from flatcontact.foundation.layout import FRICTION_CSV, RUN_MARKER, STAGES
 from flatcontact.pipeline import Pipeline
 
 
@@ -103,7 +103,7 @@ def run_variant(config: dict, folder: str, share_build_from: str | None = None) 
 def run_jobs(executor, task: Callable, jobs: list[tuple], on_done: Callable | None = None) -> dict:
     """Run ``jobs`` = [(key, *arguments of task)] through ``executor``; ``{key: result}``.
 
-    A job that ``task`` refuses (:class:`~flatcontact.errors.InputError`: a variant or cell the
+    A job that ``task`` refuses (:class:`~flatcontact.foundation.errors.InputError`: a variant or cell the
     builder, model or analysis refuses) gives ``{"error": message}`` and the others go on; a
     job that fails otherwise (an engine error, a defect) gives ``{"error": "Type: first
     line", "unexpected": True}``: one variant must not take hours of the others' results

@@ -3,13 +3,13 @@
 A study (``flatcontact study convergence|models|approximants --out DIR``) writes its own files
 (``study.json``, ``study.csv``, figures, ``uncertainty.yaml``) into ``DIR`` and one ordinary
 run directory per variant into ``DIR/runs/<folder>``. The rules are a run's
-(:mod:`flatcontact.rundir`, :mod:`flatcontact.fileio`):
+(:mod:`flatcontact.foundation.rundir`, :mod:`flatcontact.foundation.fileio`):
 
 - nothing is written through a symbolic link: ``DIR/runs`` or one of its entries planted as
   a link is refused in one line naming it, before any variant runs (a run directory may
   itself be a link the user made, a variant's folder may not: the study made it);
 - one study writer per ``DIR``: :func:`study_directory` holds the run lock
-  (:class:`flatcontact.rundir.RunLock`) on ``DIR`` while the study runs and writes its
+  (:class:`flatcontact.foundation.rundir.RunLock`) on ``DIR`` while the study runs and writes its
   files, so a second study on the same ``--out`` is refused in one line instead of failing
   its variants one by one;
 - one folder per variant, whose name can neither collide with another's nor leave ``runs``
@@ -25,9 +25,9 @@ import re
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
-from flatcontact.errors import InputError
-from flatcontact.fileio import refuse_link
-from flatcontact.rundir import RunLock
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import refuse_link
+from flatcontact.foundation.rundir import RunLock
 
 #: The folder of a study's run directories.
 RUNS = "runs"

@@ -17,7 +17,7 @@ from pydantic import ValidationError
 from flatcontact.config.merge import merge_config
 from flatcontact.config.refine import REFINABLE
 from flatcontact.config.run import RunConfig
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials.styles import CUTOFF_FIRST_STYLES, style_cutoff_angstrom, with_cutoff
 
 #: Recipe kinds whose ``layers`` field is a slab thickness a study may refine (``slab`` and

@@ -6,7 +6,7 @@ stress in eV/Å³, Voigt order (xx, yy, zz, yz, xz, xy), positive = tensile
 ``info["config_type"]`` (a group name used for weights, splits and reports).
 
 :func:`read_dataset` validates everything before any work starts and raises a
-one-line :class:`~flatcontact.errors.InputError` that names the file and frame: first the
+one-line :class:`~flatcontact.foundation.errors.InputError` that names the file and frame: first the
 checked structure reader (:func:`flatcontact.structures.structure_file.read_structures`:
 file size and claimed atom counts before parsing; atom count, finite positions and cell,
 cell shape and minimum distance per frame), then the labels (:func:`validate_frame`).
@@ -23,8 +23,8 @@ from ase.calculators.singlepoint import SinglePointCalculator
 from ase.io import write
 from ase.neighborlist import neighbor_list
 
-from flatcontact.errors import InputError
-from flatcontact.fileio import atomic_path
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import atomic_path
 from flatcontact.structures.structure_file import read_structures
 
 #: Two atoms closer than this (Å) make a frame unphysical.

@@ -31,11 +31,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from ase import Atoms
 
-from flatcontact.errors import require
+from flatcontact.foundation.errors import require
+from flatcontact.foundation.units import EV_PER_A3_TO_GPA
 from flatcontact.training.dataset import labels
 from flatcontact.training.descriptors import DesignBlock, SnapDescriptors
 from flatcontact.training.snapfiles import SnapCoefficients, SnapHyper
-from flatcontact.units import EV_PER_A3_TO_GPA
 
 #: Targets that normalise the selection score (meV/atom, meV/Å, GPa).
 TARGET_ENERGY_MEV = 10.0

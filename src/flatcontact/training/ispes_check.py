@@ -5,7 +5,7 @@ Two measurements for any SiO₂ model that has an ASE calculator:
 * :func:`quartz_elastic_vs_experiment`: zero-stress α-quartz lattice and relaxed-ion
   Cij (:func:`flatcontact.training.validate.quartz_lattice`,
   :func:`~flatcontact.training.validate.quartz_elastic`: central finite strains ±0.5 %,
-  ions relaxed) against experiment (:mod:`flatcontact.reference`, |C14|);
+  ions relaxed) against experiment (:mod:`flatcontact.foundation.reference`, |C14|);
 * :func:`compare_ispes`: the ISPES of ONE interface (the same reference geometry and
   lateral cell) scanned with each model on the same lateral grid and load range, then
   analysed identically (constant-pressure ISPES, zero-perpendicular-force path, τ and
@@ -34,11 +34,14 @@ import numpy as np
 import pandas as pd
 from ase import Atoms
 
-from flatcontact.errors import InputError, require
+from flatcontact.foundation.errors import InputError, require
+from flatcontact.foundation.reference import (
+    QUARTZ_CIJ_EXPERIMENT_GPA,
+    QUARTZ_LATTICE_EXPERIMENT_ANGSTROM,
+)
 from flatcontact.potentials.teachers import TEACHERS, get_teacher, teacher_calculator  # noqa: F401
-from flatcontact.reference import QUARTZ_CIJ_EXPERIMENT_GPA, QUARTZ_LATTICE_EXPERIMENT_ANGSTROM
 
-#: Experimental α-quartz Cij (GPa) as compared here: :data:`flatcontact.reference.QUARTZ_CIJ_EXPERIMENT_GPA`
+#: Experimental α-quartz Cij (GPa) as compared here: :data:`flatcontact.foundation.reference.QUARTZ_CIJ_EXPERIMENT_GPA`
 #: with |C14| (a model's C14 sign depends on its axes).
 QUARTZ_CIJ_ABS_EXPERIMENT_GPA = {k: abs(v) for k, v in QUARTZ_CIJ_EXPERIMENT_GPA.items()}
 #: Per-load quantities compared between models.

@@ -21,7 +21,7 @@ from ase import Atoms
 from ase.calculators.calculator import Calculator, all_changes
 from ase.calculators.lammps import Prism
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 from flatcontact.potentials.engines import bulk_calculator
 from flatcontact.potentials.lammps_box import (  # noqa: F401 - re-exported for training modules
     VOIGT_PAIRS,

@@ -28,7 +28,7 @@ from ase import Atoms
 from ase.neighborlist import neighbor_list
 from ase.spacegroup import crystal
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 #: Si-O bond cutoff used to count coordination (Å).
 SI_O_BOND_CUTOFF = 2.0

@@ -15,8 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from flatcontact.errors import InputError, require
-from flatcontact.fileio import write_text_atomic
+from flatcontact.foundation.errors import InputError, require
+from flatcontact.foundation.fileio import write_text_atomic
 
 
 def n_bispectrum(twojmax: int) -> int:

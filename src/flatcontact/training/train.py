@@ -21,12 +21,12 @@ from pathlib import Path
 
 import numpy as np
 
-from flatcontact.errors import InputError
-from flatcontact.fileio import atomic_path, write_json_atomic
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import atomic_path, write_json_atomic
+from flatcontact.foundation.units import EV_PER_A3_TO_GPA
 from flatcontact.training.dataset import labels, read_dataset, write_dataset
 from flatcontact.training.fit import FitResult, default_hypers, default_settings, fit_snap
 from flatcontact.training.snapfiles import write_snap_files
-from flatcontact.units import EV_PER_A3_TO_GPA
 
 ELEMENTS = ("Si", "O")
 #: Active-learning frames whose teacher forces exceed this (eV/Å) are dropped: the

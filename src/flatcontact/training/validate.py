@@ -10,7 +10,7 @@ Checks (each a pure function of a calculator; :func:`validate_potential` runs al
   (topology criteria of :mod:`flatcontact.structures.dense`), and its surface energy.
 
 Experimental references (lattice, density, adiabatic elastic constants at 25 °C) come from
-their one home, :mod:`flatcontact.reference`; C14 is compared by magnitude (its sign is a
+their one home, :mod:`flatcontact.foundation.reference`; C14 is compared by magnitude (its sign is a
 choice of axes).
 """
 
@@ -26,14 +26,14 @@ from ase.optimize import BFGS
 from ase.units import GPa
 
 from flatcontact.elastic import elastic_tensor, isotropic_moduli, relax_cell, trigonal_constants
-from flatcontact.reference import (
+from flatcontact.foundation.reference import (
     QUARTZ_CIJ_EXPERIMENT_GPA,
     QUARTZ_DENSITY_EXPERIMENT_G_CM3,
     QUARTZ_LATTICE_EXPERIMENT_ANGSTROM,
 )
+from flatcontact.foundation.units import EV_PER_A2_TO_J_PER_M2, EV_PER_A3_TO_GPA
 from flatcontact.training.dataset import labels
 from flatcontact.training.polymorphs import density_g_cm3
-from flatcontact.units import EV_PER_A2_TO_J_PER_M2, EV_PER_A3_TO_GPA
 
 #: Targets of the bundled potential vs the reference model.
 TARGETS = {
@@ -260,7 +260,7 @@ def compare(value: float | None, reference: float | None) -> float | None:
 
 def vs_experiment(entry: dict) -> dict:
     """Relative and absolute deviations of a report entry (``lattice``, ``elastic``) from the
-    experimental α-quartz of :mod:`flatcontact.reference`; C14 compared by magnitude."""
+    experimental α-quartz of :mod:`flatcontact.foundation.reference`; C14 compared by magnitude."""
     cij = {k: abs(v) if k == "C14" else v for k, v in entry["elastic"]["cij_gpa"].items()}
     exp_cij = {k: abs(v) if k == "C14" else v for k, v in QUARTZ_CIJ_EXPERIMENT_GPA.items()}
     lat = entry["lattice"]

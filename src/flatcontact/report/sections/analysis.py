@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from flatcontact.analysis.convergence import monotonic_violations
-from flatcontact.layout import analyze_figure, png
+from flatcontact.foundation.layout import analyze_figure, png
 from flatcontact.report.format import fmt, grouped_warnings
 from flatcontact.report.html import Figure, Section, Table
 from flatcontact.report.stacking_names import display_names

@@ -17,12 +17,12 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from flatcontact.errors import InputError
-from flatcontact.fileio import quoted, read_json_file
-from flatcontact.layout import EXPERIMENT_COLLAPSE_JSON
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import quoted, read_json_file
+from flatcontact.foundation.layout import EXPERIMENT_COLLAPSE_JSON
+from flatcontact.foundation.result_json import KINDS, ContractError, check_keys
 from flatcontact.report.format import fmt
 from flatcontact.report.html import Section, Table
-from flatcontact.result_json import KINDS, ContractError, check_keys
 
 #: Largest study.json read (a study of thousands of cells is a few MB).
 MAX_STUDY_BYTES = 64 * 1024 * 1024

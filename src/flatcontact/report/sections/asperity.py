@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from flatcontact.layout import (
+from flatcontact.foundation.layout import (
     FIG_ASPERITY_FORCE,
     FIG_ASPERITY_RAMP,
     FIG_ASPERITY_SLIP,

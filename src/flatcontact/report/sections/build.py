@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 from ase import Atoms
 
-from flatcontact.layout import BUILD_FIGURE, png
+from flatcontact.foundation.layout import BUILD_FIGURE, png
 from flatcontact.report.format import fmt
 from flatcontact.report.html import Figure, Section
 

@@ -1,7 +1,7 @@
 """The report's section next to the summary: this run beside the paper (its α-quartz), or the
 results of another material on their own.
 
-The paper's numbers come from :mod:`flatcontact.reference`; the set-up differences read the
+The paper's numbers come from :mod:`flatcontact.foundation.reference`; the set-up differences read the
 run's interaction model (``cfg.potential``, a :class:`flatcontact.potentials.InteractionModel`).
 """
 
@@ -11,17 +11,17 @@ import json
 from typing import Any
 
 from flatcontact.config import BUNDLED_SNAP
-from flatcontact.errors import InputError
-from flatcontact.potentials.files import BUNDLED_DIR
-from flatcontact.potentials.lj import (
-    ALPHA_QUARTZ_NUMBER_DENSITY_PER_NM3,
-    pairwise_hamaker_constant_zj,
-)
-from flatcontact.reference import (
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.reference import (
     PAPER,
     PAPER_THRESHOLD_GPA,
     QUARTZ_HAMAKER_ZJ,
     QUARTZ_LATTICE_EXPERIMENT_ANGSTROM,
+)
+from flatcontact.potentials.files import BUNDLED_DIR
+from flatcontact.potentials.lj import (
+    ALPHA_QUARTZ_NUMBER_DENSITY_PER_NM3,
+    pairwise_hamaker_constant_zj,
 )
 from flatcontact.report.format import LAW_COEFFICIENTS, fmt, pm
 from flatcontact.report.html import Section, Table

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from flatcontact.layout import (
+from flatcontact.foundation.layout import (
     FIG4_TRACTION,
     FIG5_FORCE_STIFFNESS,
     FIG5C_CYCLE_LOOPS,

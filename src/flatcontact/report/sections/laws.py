@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from flatcontact.layout import LAWS_FIGURE, png
-from flatcontact.reference import PAPER
+from flatcontact.foundation.layout import LAWS_FIGURE, png
+from flatcontact.foundation.reference import PAPER
 from flatcontact.report.format import LAW_COEFFICIENTS, fmt, grouped_warnings, pm
 from flatcontact.report.html import Figure, Section, Table
 

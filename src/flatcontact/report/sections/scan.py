@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from flatcontact.layout import SCAN_FIGURE, png
+from flatcontact.foundation.layout import SCAN_FIGURE, png
 from flatcontact.report.format import fmt, grouped_warnings
 from flatcontact.report.html import Figure, Section, Table
 

@@ -26,11 +26,11 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
-from flatcontact.fileio import file_sha256
+from flatcontact.foundation.fileio import file_sha256
 
 PACKAGE = "flatcontact"
 #: The installed source tree: the folder that holds the ``flatcontact`` package.
-SOURCE_ROOT = Path(__file__).resolve().parent.parent
+SOURCE_ROOT = Path(__file__).resolve().parents[2]
 #: Folder name of package data (shipped files beside a sub-package's modules).
 DATA_DIR = "data"
 

@@ -19,7 +19,7 @@ A run directory::
     07-report/   report.html  (refusal.json: a run refused after the scan)
     08-asperity/ asperity.nc  asperity.json  fig_asperity_*  state/   (only with asperity.enabled)
 
-and every stage folder holds its record ``stage.json`` (:data:`flatcontact.rundir.RECORD_NAME`).
+and every stage folder holds its record ``stage.json`` (:data:`flatcontact.foundation.rundir.RECORD_NAME`).
 """
 
 from __future__ import annotations

@@ -63,8 +63,8 @@ from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 from typing import Any
 
-from flatcontact.errors import InputError
-from flatcontact.fileio import (
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import (
     file_sha256,
     open_nofollow,
     refuse_link,
@@ -251,7 +251,7 @@ class RunLock:
 
         The lock file is opened without following a link (a link planted there is refused in
         one line). Once the lock is held, temporary files that a killed writer left directly
-        in the directory are removed (:func:`~flatcontact.fileio.sweep_temporary`).
+        in the directory are removed (:func:`~flatcontact.foundation.fileio.sweep_temporary`).
         """
         for _ in range(5):  # a takeover another writer won is retried, a few times at most
             handle = open(open_nofollow(self.path, append=True, readable=True), "a+", closefd=True)

@@ -2,7 +2,7 @@
 reads back: ``scan.json``, ``analyze.json``, ``laws.json``, ``elastic.json``,
 ``summary.json``.
 
-A stage records the SHA-256 of each output (:mod:`flatcontact.rundir`), so a file changed
+A stage records the SHA-256 of each output (:mod:`flatcontact.foundation.rundir`), so a file changed
 after its stage is recomputed. What is read back must still follow the file's contract,
 whatever put it there (a truncated write beside an edited record, a bug, a file copied from
 another run), the way ``ispes.nc`` (:mod:`flatcontact.ispes.contract`) and the netCDF
@@ -10,7 +10,7 @@ results (:mod:`flatcontact.stages.result_files`) are checked. :func:`read_result
 checks, before a value is used:
 
 - the file: a regular file (a FIFO is refused before it is opened), at most
-  :data:`MAX_BYTES`, UTF-8, one complete JSON document (:func:`flatcontact.fileio.
+  :data:`MAX_BYTES`, UTF-8, one complete JSON document (:func:`flatcontact.foundation.fileio.
   read_json_file`);
 - the document: a mapping holding the contract's required keys, each of its kind
   (:data:`KINDS`: finite numbers, counts, text, mappings, lists of finite numbers); keys the
@@ -19,7 +19,7 @@ checks, before a value is used:
   points are the record's grid times its thicknesses) and the run's settings (``laws.json``'s
   energy form, ``summary.json``'s loads p0).
 
-A file that fails is one :class:`~flatcontact.errors.InputError` line naming it and the
+A file that fails is one :class:`~flatcontact.foundation.errors.InputError` line naming it and the
 first defect, with the way to recompute it.
 """
 
@@ -32,8 +32,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from flatcontact.errors import InputError
-from flatcontact.fileio import quoted, read_json_file
+from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import quoted, read_json_file
 
 #: Largest JSON result read (bytes): the paper's run writes < 200 kB per file.
 MAX_BYTES = 64_000_000

@@ -24,7 +24,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 #: Longest file or folder name in bytes (``NAME_MAX`` of Linux and macOS file systems).
 NAME_MAX = 255
@@ -330,7 +330,7 @@ def read_json_file(path: str | os.PathLike[str], what: str, max_bytes: int) -> A
     The file must be a regular file (:func:`refuse_special`, checked before it is opened), at
     most ``max_bytes``, UTF-8 and one complete JSON document (a truncated write, a foreign
     file: refused, never a ``JSONDecodeError`` traceback). What the document must hold is its
-    reader's business (:mod:`flatcontact.result_json`).
+    reader's business (:mod:`flatcontact.foundation.result_json`).
     """
     text = read_text_file(refuse_special(path, what), what, max_bytes)
     try:

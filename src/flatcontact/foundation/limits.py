@@ -35,7 +35,7 @@ from __future__ import annotations
 import os
 import time
 
-from flatcontact.errors import InputError
+from flatcontact.foundation.errors import InputError
 
 #: Default bounds (``workers`` is per core, see :func:`bound`).
 DEFAULTS: dict[str, int] = {
