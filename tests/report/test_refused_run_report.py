@@ -3,9 +3,7 @@ refusal with its points and the remedies, the grid among them where the refusal 
 grid's; a rerun redoes no finished stage. And after ``contact.accept_untrusted`` the report
 names the untrusted numbers that flowed on.
 
-The refused run is the toy Lennard-Jones interface on a 7 × 7 grid relaxed with ASE's BFGS (the
-toy's free layer is bistable in tension: with the scan's L-BFGS it takes other wells and the
-case is gone): its σ_MSS falls with the
+The refused run is the toy Lennard-Jones interface on a 7 × 7 grid: its σ_MSS falls with the
 load in the internal form (μ = −7.0, interval −8.7 .. −5.4 MPa/GPa over 0, 0.5, 1 GPa, measured
 with this code) and the ``negative_slope`` gate stops it before the contact stage.
 """
@@ -34,7 +32,6 @@ scan:
   grid: [7, 7]
   p_range_gpa: {lo_gpa: -0.2, hi_gpa: 1.5, n: 4}
   executor: serial
-  optimizer: BFGS
 analysis: {p_gpa: [0.0, 0.5, 1.0]}
 contact: {p0_gpa: [0.5, 1.0]}
 report: {svg: false}

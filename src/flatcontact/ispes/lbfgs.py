@@ -19,8 +19,8 @@ zeroed; see :mod:`flatcontact.ispes.relax`) and gradient g = -f:
 2. from the second step on, store s = x - x_prev, y = g - g_prev, ρ = 1/(y·s) (the oldest
    pair dropped beyond ``memory`` pairs; no curvature test, as in ASE);
 3. direction p = -H g by the two-loop recursion with H0 = I/α (ASE: α fixed; with
-   ``scaled=True`` H0 = γ I from the newest pair, γ = s·y/y·y, Nocedal & Wright eq. 7.20,
-   once a pair of positive curvature is stored: "Initial Hessian scaling" below);
+   ``scaled=True``, not ASE's, H0 = γ I from the newest pair, γ = s·y/y·y, Nocedal & Wright
+   eq. 7.20, once a pair of positive curvature is stored: "Initial Hessian scaling" below);
 4. step dr = p, scaled by ``maxstep``/max_i |p_i| if the longest atomic step exceeds
    ``maxstep`` (Å), times ``damping``; x ← x + P(dr).
 
@@ -56,17 +56,19 @@ step, where the loops took six, equal to the loops to round-off
 (``tests/ispes/test_lbfgs.py``); fewer cannot do, as S g needs the new gradient and the
 step needs S g.
 
-Initial Hessian scaling (``scaled=True``, the scan's choice)
------------------------------------------------------------
+Initial Hessian scaling (``scaled=True``)
+-----------------------------------------
 ASE keeps H0 = I/α with α = 70 eV/Å² at every step. The textbook L-BFGS (Nocedal & Wright,
 Algorithm 7.5 with eq. 7.20; Liu & Nocedal, Math. Prog. 45, 503 (1989)) rescales it at every
 step to γ_k I, γ_k = s_{k-1}·y_{k-1}/y_{k-1}·y_{k-1}, the inverse curvature measured along the
 last step (kept at 1/α until a pair with s·y > 0 and y·y > 0 arrives; the first step is
-ASE's). The recursion is unchanged, H0 enters only as the scalar it multiplies. The scan
-(:func:`flatcontact.ispes.relax.relax_point`) uses it: on the 6 × 6 × 8 quartz SNAP + LJ grid
-of ``benchmarks/bench_scanspeed.py`` (fmax 0.005 eV/Å, warm-start tree ``columns``) it took
-17.8 force calls per point against ASE's 21.8 (``docs/performance.md``), every point within
-the same max-norm tolerance. Without it (the default here) the iterates are ASE's.
+ASE's). The recursion is unchanged, H0 enters only as the scalar it multiplies. On
+the 6 × 6 × 8 quartz SNAP + LJ grid of ``benchmarks/bench_scanspeed.py`` (fmax 0.005 eV/Å,
+warm-start tree ``columns``) it took 17.8 force calls per point against ASE's 21.8
+(``docs/performance.md``, "Fewer force calls per point"), every point within the same
+max-norm tolerance. The scan does not use it yet: with it the quick preset's default run
+fires its ``degenerate_minima`` gate (the high-load τ move within the relaxation tolerance).
+Without it (the default) the iterates are ASE's.
 
 The memory
 ----------

@@ -272,7 +272,6 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
             project,
             settings.fmax_ev_per_angstrom,
             settings.max_steps,
-            scaled=True,  # H0 = γ I (lbfgs module docstring): fewer calls per point
         )
         atoms.positions = outcome.positions
         energy, forces, steps = outcome.energy_ev, outcome.forces, outcome.steps
