@@ -369,3 +369,57 @@ def test_converges_on_rosenbrock_pairs():
         out = lbfgs_relax(evaluate, start, lambda v: v.copy(), 1e-6, 2000, memory=memory)
         assert out.converged and out.steps < 2000
         np.testing.assert_allclose(out.positions, np.tile([1.0, 1.0, 0.0], (50, 1)), atol=1e-5)
+
+
+def scaled_lbfgs_path(atoms, calc, held, fmax, steps, alpha=70.0, maxstep=0.2):
+    """The textbook L-BFGS with H0 = γ_k I, γ_k = s·y/y·y of the newest pair (Nocedal &
+    Wright, Algorithm 7.5, eq. 7.20; 1/α before the first pair), ASE's step-length rule,
+    written out with the explicit loops: the positions before every evaluation."""
+    probe = atoms.copy()
+    probe.calc = calc
+
+    def gradient(x):
+        probe.positions = x.reshape(-1, 3)
+        f = probe.get_forces().copy()
+        f[held] = 0.0
+        return -f.ravel()
+
+    x = atoms.positions.ravel().copy()
+    g = gradient(x)
+    path, pairs, h0 = [x.copy()], [], 1.0 / alpha
+    for _ in range(steps):
+        if np.sqrt((g.reshape(-1, 3) ** 2).sum(axis=1).max()) < fmax:
+            break
+        p = -explicit_loops(pairs, g, 1.0 / h0)
+        longest = np.sqrt((p.reshape(-1, 3) ** 2).sum(axis=1).max())
+        if longest >= maxstep:
+            p *= maxstep / longest
+        x_new = x + p
+        g_new = gradient(x_new)
+        s, y = x_new - x, g_new - g
+        pairs = [*pairs, (s, y)][-100:]
+        if s @ y > 0.0:
+            h0 = (s @ y) / (y @ y)
+        x, g = x_new, g_new
+        path.append(x.copy())
+    return [v.reshape(-1, 3) for v in path]
+
+
+def test_scaled_steps_equal_the_textbook_iteration():
+    """``scaled=True`` (H0 = γ I) takes the steps of the written-out textbook L-BFGS to
+    round-off, converges to ASE's minimum (same tolerance) and holds the held atoms."""
+    atoms, held = cu_slab()
+
+    def project(v):
+        out = v.copy()
+        out[held] = 0.0
+        return out
+
+    path, out = own_trajectory(atoms, EMT(), project, 1e-4, 300, scaled=True)
+    expected = scaled_lbfgs_path(atoms, EMT(), held, 1e-4, 300)
+    assert out.converged and out.force_calls == len(path) == len(expected) > 10
+    assert max(np.abs(a - b).max() for a, b in zip(expected, path, strict=True)) < 1e-9
+    assert np.array_equal(out.positions[held], atoms.positions[held])
+    _, ase_out = own_trajectory(atoms, EMT(), project, 1e-4, 300)
+    assert ase_out.converged and np.abs(out.positions - ase_out.positions).max() < 1e-3
+    assert abs(out.energy_ev - ase_out.energy_ev) < 1e-6

@@ -97,7 +97,7 @@ def _toy_factory():
     )
 
 
-def _scan(tmp_path, name, symmetry, mode="normal", **kwargs):
+def _scan(tmp_path, name, symmetry, mode="normal", optimizer="LBFGS", **kwargs):
     ref = toy_interface_3()
     z0 = thickness(ref)
     return run_scan(
@@ -105,7 +105,7 @@ def _scan(tmp_path, name, symmetry, mode="normal", **kwargs):
         _toy_factory(),
         GridSpec(6, 6, thickness_angstrom=(z0 - 0.2, z0 + 0.3)),
         tmp_path / name,
-        RelaxSettings(mode=mode),
+        RelaxSettings(mode=mode, optimizer=optimizer),
         executor=SerialExecutor(),
         symmetry=symmetry,
         **kwargs,
@@ -134,14 +134,24 @@ def test_reduced_toy_scan_equals_the_full_scan(tmp_path):
 
 def test_a_relaxation_that_breaks_the_symmetry_is_computed_in_full(tmp_path):
     """Full 3-D relaxation of the toy: at its unstable high-energy registries the free layer
-    slides sideways (the full scan itself is not symmetric there, by up to 0.03 eV), though
-    the structure has order 6. The verification at the highest orbits must see it."""
-    full = _scan(tmp_path, "full", SymmetrySettings(enabled=False), mode="full")
+    slides sideways (the full scan itself is not symmetric there, by up to 0.05 eV), though
+    the structure has order 6. The verification at the highest orbits must see it. Where the
+    layer slides depends on the relaxation's path (from cold starts no registry breaks the
+    group): the construction is ASE's BFGS along the ``planes`` warm-start tree, whose full
+    scan breaks the group by 0.053 eV (measured; the scan's own L-BFGS and ``columns`` tree
+    break it elsewhere or not beyond 2e-4 eV)."""
+    full = _scan(
+        tmp_path, "full", SymmetrySettings(enabled=False), mode="full", optimizer="BFGS",
+        order="planes",
+    )  # fmt: skip
     e = full.dataset["energy"].values
     group = shift_space_group(toy_interface_3()).for_grid(6, 6)
     spread = max(np.ptp([e[a, b] for a, b in orbit], axis=0).max() for orbit in group.orbits(6, 6))
     assert spread > 1e-3  # the constructed case: the relaxed landscape breaks the group
-    red = _scan(tmp_path, "reduced", SymmetrySettings(verify_points=24), mode="full")
+    red = _scan(
+        tmp_path, "reduced", SymmetrySettings(verify_points=24), mode="full", optimizer="BFGS",
+        order="planes",
+    )  # fmt: skip
     sym = red.symmetry
     assert sym["computed_in_full"]
     assert sym["verification"]["max_energy_difference_mev_per_a2"] > 0.01

@@ -41,7 +41,7 @@ from flatcontact.foundation.errors import InputError
 from flatcontact.foundation.layout import ISPES_NC, POINTS_DB, PROBE_JSON
 from flatcontact.ispes import contract, executors
 from flatcontact.ispes.executors import Executor
-from flatcontact.ispes.geometry import thickness, validate_interface
+from flatcontact.ispes.geometry import validate_interface
 from flatcontact.ispes.grid import GridSpec, check_thicknesses
 from flatcontact.ispes.order import PREFERENCES
 from flatcontact.ispes.phases import phase, recording
@@ -329,7 +329,7 @@ def _rounds(
             with phase("overlap check"):
                 check_overlaps(scheduler.executor, scheduler.context, grid, new_z)
             checked.update(new_z)
-        round_ = ScanRound(z, grid.n_a, grid.n_b, thickness(reference), job.order)
+        round_ = ScanRound(z, grid.n_a, grid.n_b, job.order)
         with phase("symmetry"):  # the group's search and the reduction's plan
             plan = SymmetryPlan(reference, grid, relax, job.symmetry, round_)
         try:
