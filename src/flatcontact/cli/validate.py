@@ -99,10 +99,6 @@ def validate_potential_cmd(
     W per load) against a reference model on the same interface
     (:func:`flatcontact.training.ispes_check.compare_ispes`).
     """
-    from flatcontact.potentials.engines import bulk_calculator
-    from flatcontact.training.dataset import read_dataset
-    from flatcontact.training.validate import validate_potential
-
     if out is not None:
         if out.is_dir():
             raise InputError(f"--out {str(out)!r}: is a directory, expected a JSON file path")
@@ -122,13 +118,28 @@ def validate_potential_cmd(
             lj_cutoff_angstrom=lj_cutoff_angstrom,
             ispes_dir=ispes_dir,
         )
-        if out is not None:
-            write_json_atomic(out, report)
-        if json_out:
-            print(json.dumps(report, indent=2))
-            return
-        print_ispes_check(report)
+        _emit(report, out, json_out, print_ispes_check)
         return
+    _emit(_validate_bulk(potential, reference, heldout, surface), out, json_out, _print_validation)
+
+
+def _emit(report: dict, out: Path | None, json_out: bool, show) -> None:
+    """Write ``report`` to ``--out`` (atomically), then print it as JSON or through ``show``."""
+    if out is not None:
+        write_json_atomic(out, report)
+    if json_out:
+        print(json.dumps(report, indent=2))
+        return
+    show(report)
+
+
+def _validate_bulk(potential: str, reference: str | None, heldout, surface) -> dict:
+    """The bulk checks of POTENTIAL (:func:`flatcontact.training.validate.validate_potential`)
+    against a reference model or held-out frames (``--reference`` FILE.extxyz or ``--heldout``)."""
+    from flatcontact.potentials.engines import bulk_calculator
+    from flatcontact.training.dataset import read_dataset
+    from flatcontact.training.validate import validate_potential
+
     calc = bulk_calculator(bulk_potential(potential, "POTENTIAL"))
     ref_calc, frames, ref_label = None, None, None
     if heldout is not None:
@@ -144,7 +155,7 @@ def validate_potential_cmd(
         else:
             ref_calc = bulk_calculator(bulk_potential(reference, "--reference"))
             ref_label = reference
-    report = validate_potential(
+    return validate_potential(
         calc,
         potential,
         ref_calc,
@@ -153,12 +164,6 @@ def validate_potential_cmd(
         surface=surface,
         progress=print_progress,
     )
-    if out is not None:
-        write_json_atomic(out, report)
-    if json_out:
-        print(json.dumps(report, indent=2))
-        return
-    _print_validation(report)
 
 
 def _print_validation(report: dict) -> None:
