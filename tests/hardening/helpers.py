@@ -4,6 +4,11 @@ that a refused command wrote nothing (no stage started, nothing outside --out)."
 from __future__ import annotations
 
 import os
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -80,3 +85,36 @@ def finished_toy_run(base: Path) -> tuple[Path, Path]:
         main(["run", str(conf / "run.yaml"), "--out", str(base / "run")])
     assert info.value.code == 0
     return conf, base / "run"
+
+
+def stored_rows(db: Path) -> int:
+    """Rows of a point store (``points.db``) as a concurrent reader sees them; 0 before it
+    exists or while it is locked."""
+    try:
+        with sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=0.1) as con:
+            return con.execute("SELECT count(*) FROM systems").fetchone()[0]
+    except sqlite3.Error:
+        return 0
+
+
+def kill_9_when(argv: list[str], ready, poll_seconds: float = 0.005) -> None:
+    """Start ``python -m flatcontact argv`` in its own process group, SIGKILL the group once
+    ``ready()`` holds; assert the command was still running then and died of the signal."""
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    driver = subprocess.Popen(
+        [sys.executable, "-m", "flatcontact", *map(str, argv)],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        env=env,
+        start_new_session=True,
+    )
+    try:
+        end = time.monotonic() + 300
+        while driver.poll() is None and time.monotonic() < end and not ready():
+            time.sleep(poll_seconds)
+        assert driver.poll() is None, "the command ended before the kill: make it longer"
+        os.killpg(driver.pid, signal.SIGKILL)
+        assert driver.wait(timeout=30) == -signal.SIGKILL
+    finally:
+        if driver.poll() is None:
+            os.killpg(driver.pid, signal.SIGKILL)

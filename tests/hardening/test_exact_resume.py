@@ -12,16 +12,14 @@ symmetry reduction is on; the kill is a real SIGKILL of the process group mid-sc
 from __future__ import annotations
 
 import os
-import signal
-import sqlite3
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 import xarray as xr
+from tests.hardening.helpers import kill_9_when, stored_rows
 
 from flatcontact.ispes.geometry import thickness
 from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point
@@ -78,37 +76,6 @@ def _scan_here(argv: list[str]) -> None:
     assert info.value.code in (0, None)
 
 
-def _rows(db: Path) -> int:
-    try:
-        with sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=0.1) as con:
-            return con.execute("SELECT count(*) FROM systems").fetchone()[0]
-    except sqlite3.Error:
-        return 0
-
-
-def _kill_9_when(argv: list[str], ready) -> None:
-    """Start ``flatcontact argv``, SIGKILL its process group once ``ready()`` holds; assert the
-    kill came before the scan ended."""
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
-    driver = subprocess.Popen(
-        [sys.executable, "-m", "flatcontact", *argv],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-        env=env,
-        start_new_session=True,
-    )
-    try:
-        end = time.monotonic() + 300
-        while driver.poll() is None and time.monotonic() < end and not ready():
-            time.sleep(0.005)
-        assert driver.poll() is None, "the scan ended before the kill: make it longer"
-        os.killpg(driver.pid, signal.SIGKILL)
-        assert driver.wait(timeout=30) == -signal.SIGKILL
-    finally:
-        if driver.poll() is None:
-            os.killpg(driver.pid, signal.SIGKILL)
-
-
 def _identical(a: Path, b: Path) -> None:
     """Every variable, coordinate and result attribute of two ``ispes.nc`` files, bit for bit."""
     with (
@@ -157,7 +124,7 @@ def test_kill_9_mid_grid_then_resume_equals_an_uninterrupted_scan(cu_interface, 
     config = _config(tmp_path, f"  grid: [6, 6]\n  thickness_angstrom: [{zs}]\n")
     whole, resumed = tmp_path / "whole", tmp_path / "resumed"
     _scan_here(_argv(config, interface, whole))
-    _kill_9_when(_argv(config, interface, resumed), lambda: _rows(resumed / "points.db") >= 6)
+    kill_9_when(_argv(config, interface, resumed), lambda: stored_rows(resumed / "points.db") >= 6)
     _scan_here(_argv(config, interface, resumed))
     _identical(whole, resumed)
 
@@ -174,8 +141,8 @@ def test_kill_9_in_the_probe_and_in_the_grid_and_two_workers_equal_one_serial_sc
     whole = tmp_path / "whole"
     _scan(_argv(config, interface, whole))
     in_probe, in_grid = tmp_path / "in_probe", tmp_path / "in_grid"
-    _kill_9_when(_argv(config, interface, in_probe), lambda: (in_probe / "probe.json").exists())
-    _kill_9_when(_argv(config, interface, in_grid), lambda: _rows(in_grid / "points.db") >= 20)
+    kill_9_when(_argv(config, interface, in_probe), lambda: (in_probe / "probe.json").exists())
+    kill_9_when(_argv(config, interface, in_grid), lambda: stored_rows(in_grid / "points.db") >= 20)
     for out in (in_probe, in_grid):
         _scan(_argv(config, interface, out))
         _identical(whole, out)

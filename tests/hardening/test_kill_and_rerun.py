@@ -10,13 +10,12 @@ from __future__ import annotations
 
 import os
 import signal
-import sqlite3
 import subprocess
 import sys
 import time
 
 import pytest
-from tests.hardening.helpers import TOY_YAML, run_cli
+from tests.hardening.helpers import TOY_YAML, run_cli, stored_rows
 from tests.hardening.test_run_directory import _same_content
 
 pytestmark = [
@@ -41,14 +40,6 @@ def uninterrupted(tmp_path_factory):
     return base / "run"
 
 
-def _rows(db) -> int:
-    try:
-        with sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=0.1) as con:
-            return con.execute("SELECT count(*) FROM systems").fetchone()[0]
-    except sqlite3.Error:
-        return 0
-
-
 @pytest.mark.parametrize("stage", ["02-scan", "06-contact"])
 def test_kill_9_then_rerun_equals_an_uninterrupted_run(uninterrupted, tmp_path, capsys, stage):
     config = tmp_path / "run.yaml"
@@ -66,7 +57,7 @@ def test_kill_9_then_rerun_equals_an_uninterrupted_run(uninterrupted, tmp_path, 
     try:
         end = time.monotonic() + 300
         while driver.poll() is None and time.monotonic() < end:
-            if stage == "02-scan" and _rows(run / "02-scan" / "points.db") >= 5:
+            if stage == "02-scan" and stored_rows(run / "02-scan" / "points.db") >= 5:
                 break
             if stage == "06-contact" and (run / stage).is_dir():
                 break

@@ -11,17 +11,17 @@ rtol = 1e-9 comparison of ``test_kill_and_rerun.py`` would not all see.
 from __future__ import annotations
 
 import json
-import os
-import signal
-import sqlite3
-import subprocess
-import sys
-import time
 
 import numpy as np
 import pytest
 import xarray as xr
-from tests.hardening.helpers import TOY_YAML, assert_refused_cleanly, run_cli
+from tests.hardening.helpers import (
+    TOY_YAML,
+    assert_refused_cleanly,
+    kill_9_when,
+    run_cli,
+    stored_rows,
+)
 
 
 @pytest.mark.parametrize("grid", ["[2, 2]", "[2, 5]"])
@@ -95,14 +95,6 @@ def _bitwise(a, b, roots=()) -> None:
         assert differ == [], (a.name, [(k, la[k], lb[k]) for k in differ[:5]])
 
 
-def _rows(db) -> int:
-    try:
-        with sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=0.1) as con:
-            return con.execute("SELECT count(*) FROM systems").fetchone()[0]
-    except sqlite3.Error:
-        return 0
-
-
 @pytest.mark.slow
 def test_kill_9_in_a_reduced_scan_then_rerun_equals_an_uninterrupted_run_bit_for_bit(
     tmp_path, capsys
@@ -117,26 +109,11 @@ def test_kill_9_in_a_reduced_scan_then_rerun_equals_an_uninterrupted_run_bit_for
     assert code == 0, err
     scan = json.loads((whole / "02-scan" / "scan.json").read_text())
     assert scan["symmetry"]["order"] == 6 and not scan["symmetry"]["computed_in_full"]
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
-    driver = subprocess.Popen(
-        [sys.executable, "-m", "flatcontact", "run", str(config), "--out", str(run)],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-        env=env,
-        start_new_session=True,
+    kill_9_when(
+        ["run", config, "--out", run],
+        lambda: stored_rows(run / "02-scan" / "points.db") >= 5,
+        poll_seconds=0.002,
     )
-    try:
-        end = time.monotonic() + 300
-        while driver.poll() is None and time.monotonic() < end:
-            if _rows(run / "02-scan" / "points.db") >= 5:
-                break
-            time.sleep(0.002)
-        assert driver.poll() is None, "the run ended before the kill"
-        os.killpg(driver.pid, signal.SIGKILL)
-        driver.wait(timeout=30)
-    finally:
-        if driver.poll() is None:
-            os.killpg(driver.pid, signal.SIGKILL)
     assert not (run / "02-scan" / "ispes.nc").exists(), "the kill came after the scan"
     code, _, err = run_cli(["run", config, "--out", run], capsys)
     assert code == 0, err
