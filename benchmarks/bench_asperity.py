@@ -82,28 +82,55 @@ def _native(model, atoms, positions, protocol, folder: Path) -> tuple[float, int
     return seconds, iterations
 
 
-def main() -> None:
-    from flatcontact.asperity.builder import build_asperity
-    from flatcontact.asperity.driver import Protocol, relax
-    from flatcontact.asperity.experiment import GPA_ANGSTROM2_TO_EV_PER_ANGSTROM
+def cu_model():
+    """The benchmarks' interaction model: Cu EAM (Mishin) inside each body, LJ (10 Å) across."""
     from flatcontact.potentials.model import InteractionModel
-    from flatcontact.structures.recipe import parse_recipe
 
-    radius = float(os.environ.get("ASPERITY_BENCH_RADIUS_ANGSTROM", "800"))
-    recipe = parse_recipe(
-        {"kind": "fcc111", "element": "Cu", "a_angstrom": 3.615, "layers": 3, "gap_angstrom": 3.0}
-    )
-    model = InteractionModel.model_validate(
+    return InteractionModel.model_validate(
         {
             "intra": [{"pair_style": "eam/alloy", "pair_coeff": ["Cu_mishin1.eam.alloy"]}],
             "coupling": "lj",
             "lj": {"cutoff_angstrom": 10.0},
         }
     )
-    atoms, sizes = build_asperity(recipe, "cylinder", radius, 1.0, 73.0, depth_factor=3.0)
+
+
+def cu_recipe(layers: int = 3):
+    """The benchmarks' interface recipe: Cu(111) on Cu(111), 3 Å gap."""
+    from flatcontact.structures.recipe import parse_recipe
+
+    return parse_recipe(
+        {
+            "kind": "fcc111",
+            "element": "Cu",
+            "a_angstrom": 3.615,
+            "layers": layers,
+            "gap_angstrom": 3.0,
+        }
+    )
+
+
+def cu_cylinder(radius_angstrom: float):
+    """The Cu(111) LJ cylinder of radius R at p0 = 1 GPa (E* 73 GPa, bodies 3 Hertz half-widths
+    deep) and the normal force (eV/Å) of that p0 over the cell's axis length: (atoms, force)."""
+    from flatcontact.asperity.builder import build_asperity
+    from flatcontact.asperity.experiment import GPA_ANGSTROM2_TO_EV_PER_ANGSTROM
+
+    atoms, sizes = build_asperity(
+        cu_recipe(), "cylinder", radius_angstrom, 1.0, 73.0, depth_factor=3.0
+    )
     a = sizes.hertz_half_width_angstrom
     axis = float(np.linalg.norm(atoms.cell.array[0]))
-    force = np.pi * a * 1.0 / 2.0 * axis * GPA_ANGSTROM2_TO_EV_PER_ANGSTROM
+    # the line contact's load per length P' = pi a p0 / 2 (Johnson eq. 4.46) times the axis
+    return atoms, np.pi * a * 1.0 / 2.0 * axis * GPA_ANGSTROM2_TO_EV_PER_ANGSTROM
+
+
+def main() -> None:
+    from flatcontact.asperity.driver import Protocol, relax
+
+    radius = float(os.environ.get("ASPERITY_BENCH_RADIUS_ANGSTROM", "800"))
+    model = cu_model()
+    atoms, force = cu_cylinder(radius)
     protocol = Protocol(force, 0.05, 1)
     # alternated twice, the faster of each kept (the machine is shared: its load drifts)
     tools, natives = [], []

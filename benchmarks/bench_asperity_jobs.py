@@ -19,22 +19,13 @@ import numpy as np
 
 
 def main() -> None:
+    from benchmarks.bench_asperity import cu_model, cu_recipe
     from flatcontact.asperity.driver import load_state
     from flatcontact.asperity.experiment import ExperimentSpec, run_experiment
     from flatcontact.ispes.executors import ProcessExecutor
-    from flatcontact.potentials.model import InteractionModel
-    from flatcontact.structures.recipe import parse_recipe
 
-    recipe = parse_recipe(
-        {"kind": "fcc111", "element": "Cu", "a_angstrom": 3.615, "layers": 4, "gap_angstrom": 3.0}
-    )
-    model = InteractionModel.model_validate(
-        {
-            "intra": [{"pair_style": "eam/alloy", "pair_coeff": ["Cu_mishin1.eam.alloy"]}],
-            "coupling": "lj",
-            "lj": {"cutoff_angstrom": 10.0},
-        }
-    )
+    recipe = cu_recipe(layers=4)
+    model = cu_model()
     steps = int(os.environ.get("ASPERITY_JOBS_STEPS", "4"))
     spec = ExperimentSpec(
         "cylinder",

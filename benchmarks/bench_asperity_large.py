@@ -35,8 +35,6 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
-
 
 def _load() -> float:
     return os.getloadavg()[0]
@@ -94,28 +92,13 @@ def _driver(model, atoms, protocol, ranks: int, folder: Path) -> tuple[float, in
 
 
 def _setup():
-    from flatcontact.asperity.builder import build_asperity
+    from benchmarks.bench_asperity import cu_cylinder, cu_model
     from flatcontact.asperity.driver import Protocol
-    from flatcontact.asperity.experiment import GPA_ANGSTROM2_TO_EV_PER_ANGSTROM
-    from flatcontact.potentials.model import InteractionModel
-    from flatcontact.structures.recipe import parse_recipe
 
     radius = float(os.environ.get("ASPERITY_LARGE_RADIUS_ANGSTROM", "2600"))
     iterations = int(os.environ.get("ASPERITY_LARGE_ITERATIONS", "200"))
-    recipe = parse_recipe(
-        {"kind": "fcc111", "element": "Cu", "a_angstrom": 3.615, "layers": 3, "gap_angstrom": 3.0}
-    )
-    model = InteractionModel.model_validate(
-        {
-            "intra": [{"pair_style": "eam/alloy", "pair_coeff": ["Cu_mishin1.eam.alloy"]}],
-            "coupling": "lj",
-            "lj": {"cutoff_angstrom": 10.0},
-        }
-    )
-    atoms, sizes = build_asperity(recipe, "cylinder", radius, 1.0, 73.0, depth_factor=3.0)
-    a = sizes.hertz_half_width_angstrom
-    axis = float(np.linalg.norm(atoms.cell.array[0]))
-    force = np.pi * a * 1.0 / 2.0 * axis * GPA_ANGSTROM2_TO_EV_PER_ANGSTROM
+    model = cu_model()
+    atoms, force = cu_cylinder(radius)
     # steps 0: the press alone; the cap makes every run the same number of force calls
     protocol = Protocol(force, 0.05, 0, 1e-3, max_iterations=iterations)
     return radius, model, atoms, protocol
