@@ -121,7 +121,8 @@ def cu_cylinder(radius_angstrom: float):
     )
     a = sizes.hertz_half_width_angstrom
     axis = float(np.linalg.norm(atoms.cell.array[0]))
-    # the line contact's load per length P' = pi a p0 / 2 (Johnson eq. 4.46) times the axis
+    # the 2D Hertz load per length P' = pi a p0 / 2 (Johnson, Contact Mechanics, section 7.2;
+    # contact/line_contact.py) times the axis length
     return atoms, np.pi * a * 1.0 / 2.0 * axis * GPA_ANGSTROM2_TO_EV_PER_ANGSTROM
 
 

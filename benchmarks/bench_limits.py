@@ -39,21 +39,12 @@ import tempfile
 import time
 from pathlib import Path
 
+from tests.hardening.helpers import TOY_YAML  # the toy study the hardening tests run
+
 HERE = Path(__file__).resolve().parent
 RECORD = HERE / "limits_measured.json"
 MIB = 1024 * 1024
 
-TOY_YAML = """\
-structure: {kind: toy-lj, layers: 3}
-calculator: {target: "flatcontact.ispes.toy:toy_calculator"}
-scan:
-  grid: [3, 3]
-  p_range_gpa: {lo_gpa: -0.2, hi_gpa: 1.5, n: 4}
-  executor: serial
-analysis: {p_gpa: [0.0, 0.5, 1.0]}
-contact: {p0_gpa: [0.5, 1.0], accept_untrusted: [broken_symmetry, negative_slope, in_slab_slip, degenerate_minima]}
-report: {svg: false}
-"""
 LAMMPS_YAML = """\
 structure: {kind: fcc111, element: Cu, layers: 3}
 potential: {preset: cu-eam}
