@@ -14,7 +14,7 @@ import sys
 import time
 
 import pytest
-from tests.hardening.helpers import refused, run_cli
+from tests.hardening.helpers import refused, run_cli, stored_rows
 
 from flatcontact.cli.app import one_line
 
@@ -156,16 +156,6 @@ def _signal_once(argv, cwd, ready, sig, seconds=240.0):
     return code, proc.stderr.read(), sent
 
 
-def _rows(db) -> int:
-    import sqlite3
-
-    try:
-        with sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=0.05) as con:
-            return con.execute("SELECT count(*) FROM systems").fetchone()[0]
-    except sqlite3.Error:
-        return 0
-
-
 @pytest.mark.parametrize("command", ["run", "scan"])
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
 def test_a_signal_in_the_scan_is_one_error_line(tmp_path, finished_toy, command, sig):
@@ -181,7 +171,7 @@ def test_a_signal_in_the_scan_is_one_error_line(tmp_path, finished_toy, command,
         interface = run / "01-build" / "interface.extxyz"
         argv = ["scan", conf / "run.yaml", "--interface", interface, "--out", out]
         db = out / "points.db"
-    code, err, sent = _signal_once(argv, tmp_path, lambda: db.exists() and _rows(db) > 0, sig)
+    code, err, sent = _signal_once(argv, tmp_path, lambda: db.exists() and stored_rows(db) > 0, sig)
     if not sent:
         pytest.skip("the scan finished before a point was seen")
     lines = err.strip().splitlines()
