@@ -1,5 +1,7 @@
 """fileio.py: atomic writes, the file hash."""
 
+import os
+
 import pytest
 
 
@@ -58,3 +60,33 @@ def test_link_file_atomic_stores_the_bytes_once_and_replaces_a_planted_link(tmp_
     link_file_atomic(src, target)
     assert target.read_text() == "<html>2</html>" and not os.path.samefile(src, target)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["elsewhere.html", "report.html", "stage"]
+
+
+def test_an_interruption_between_creating_a_temporary_file_and_guarding_it_leaves_none(
+    tmp_path, monkeypatch
+):
+    """SIGTERM (raised as an exception) or Ctrl-C can arrive between the temporary file's
+    creation and the ``try`` that would remove it; the file is registered before it exists, so
+    ``remove_live_temporaries`` (run by the command line on an interruption) removes it."""
+    from flatcontact.foundation import fileio
+
+    real = fileio._open_checked
+
+    def created_then_interrupted(path, flags, mode):
+        os.close(real(path, flags, mode))
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(fileio, "_open_checked", created_then_interrupted)
+    with pytest.raises(KeyboardInterrupt), fileio.atomic_path(tmp_path / "out.txt"):
+        pass
+    left = sorted(p.name for p in tmp_path.iterdir())
+    assert len(left) == 1 and left[0].startswith(".out.txt.") and left[0].endswith(".part")
+    monkeypatch.setattr(fileio, "_open_checked", real)
+    assert fileio.remove_live_temporaries() == [tmp_path / left[0]]
+    assert list(tmp_path.iterdir()) == []
+    # a completed and a failed write leave nothing registered
+    fileio.write_text_atomic(tmp_path / "done.txt", "x")
+    with pytest.raises(ValueError), fileio.atomic_path(tmp_path / "failed.txt"):
+        raise ValueError("the writer failed")
+    assert fileio._LIVE_TEMPORARIES == set()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["done.txt"]

@@ -48,6 +48,7 @@ from flatcontact import __version__
 from flatcontact.cli import memory_floor  # noqa: F401  (refuses a too low ulimit -v)
 from flatcontact.cli.app import STOPPED, app, check_out_flags, console, print_error
 from flatcontact.foundation.errors import InputError
+from flatcontact.foundation.fileio import remove_live_temporaries
 
 try:  # registers the sub-commands; their modules load numpy and the settings
     from flatcontact.cli import commands as _commands  # noqa: F401
@@ -212,6 +213,8 @@ def _run(argv: list[str] | None) -> int:
             code = _command(argv)
         except KeyboardInterrupt:
             code = 130
+        if code == 130 or got:  # what the unwinding could not reach (fileio's registry)
+            remove_live_temporaries()
         # typer turns a KeyboardInterrupt it sees into exit status 130 without a word
         if code == 130 and not got and not STOPPED["kept"]:
             # Ctrl-C in a command that does not say it itself

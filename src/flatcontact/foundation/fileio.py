@@ -7,8 +7,9 @@ created with ``O_CREAT | O_EXCL | O_NOFOLLOW`` in the target's own folder (a fol
 link is refused), ``os.replace`` swaps the directory entry (a link planted at the target is
 replaced, its target never written) and files appended to in place are opened with
 ``O_NOFOLLOW`` (:func:`open_nofollow`). Temporary files are named ``.<name>.<random>.part``;
-they are removed on every exit path that Python sees and swept by :func:`sweep_temporary`
-on the next run after a ``kill -9``.
+they are removed on every exit path that Python sees (an interruption between a file's
+creation and its guard included: :func:`remove_live_temporaries`) and swept by
+:func:`sweep_temporary` on the next run after a ``kill -9``.
 """
 
 from __future__ import annotations
@@ -176,8 +177,7 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
             os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, target)
     finally:
-        if tmp.exists():
-            tmp.unlink()
+        _drop_temporary(tmp)
 
 
 def file_sha256(path: str | os.PathLike[str]) -> str:
@@ -195,19 +195,49 @@ def file_sha256(path: str | os.PathLike[str]) -> str:
     return digest.hexdigest()
 
 
+#: The temporary files of this process not yet moved onto their target or removed. A name is
+#: registered before its file is created and dropped after the file is gone, so an
+#: interruption (SIGTERM or Ctrl-C raised between any two bytecodes, even between the file's
+#: creation and the ``try`` that would remove it) never leaves a file nobody knows of:
+#: :func:`remove_live_temporaries` removes what the unwinding missed.
+_LIVE_TEMPORARIES: set[Path] = set()
+
+
+def remove_live_temporaries() -> list[Path]:
+    """Remove this process's temporary files that an interruption left; return them."""
+    removed = []
+    for tmp in list(_LIVE_TEMPORARIES):
+        with contextlib.suppress(FileNotFoundError):
+            tmp.unlink()
+            removed.append(tmp)
+        _LIVE_TEMPORARIES.discard(tmp)
+    return removed
+
+
 def _create_temporary(target: Path) -> Path:
-    """A new empty hidden file ``.<name>.<random>.part`` beside ``target`` (name <= NAME_MAX)."""
+    """A new empty hidden file ``.<name>.<random>.part`` beside ``target`` (name <= NAME_MAX),
+    registered in :data:`_LIVE_TEMPORARIES` until :func:`_drop_temporary`."""
     room = NAME_MAX - len(_PART_SUFFIX) - _RANDOM_CHARS - 2
     stem = os.fsdecode(os.fsencode(target.name)[:room])
     for _ in range(100):
         tmp = target.parent / f".{stem}.{secrets.token_hex(_RANDOM_CHARS // 2)}{_PART_SUFFIX}"
+        _LIVE_TEMPORARIES.add(tmp)
         try:
             fd = _open_checked(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
-        except FileExistsError:
-            continue
+        except OSError as error:  # not created (an interruption is no OSError: it stays)
+            _LIVE_TEMPORARIES.discard(tmp)
+            if isinstance(error, FileExistsError):
+                continue
+            raise
         os.close(fd)
         return tmp
     raise FileExistsError(errno.EEXIST, "no free temporary name", str(target))
+
+
+def _drop_temporary(tmp: Path) -> None:
+    """Remove ``tmp`` if it is still there (not moved onto its target) and forget it."""
+    tmp.unlink(missing_ok=True)
+    _LIVE_TEMPORARIES.discard(tmp)
 
 
 def copy_file_atomic(source: str | os.PathLike[str], path: str | os.PathLike[str]) -> Path:
@@ -241,7 +271,7 @@ def link_file_atomic(source: str | os.PathLike[str], path: str | os.PathLike[str
     except OSError:
         return copy_file_atomic(source, target)
     finally:
-        tmp.unlink(missing_ok=True)
+        _drop_temporary(tmp)
     return target
 
 
