@@ -79,6 +79,36 @@ def resolve_config(config: Path | None, preset: str | None, flags: dict[str, Any
     return resolve(config, preset, flags, FLAG_OF)
 
 
+def _given(flags: dict[str, Any], prefix: str = "") -> set[str]:
+    """The settings paths (and their sections) that ``flags`` sets."""
+    out = set()
+    for key, value in flags.items():
+        path = f"{prefix}{key}"
+        out.add(path)
+        if isinstance(value, dict):
+            out |= _given(value, f"{path}.")
+    return out
+
+
+def check_settings(cfg, config: Path | None, flags: dict[str, Any]) -> None:
+    """The pre-run checks of the scan's settings (:func:`~flatcontact.stages.preflight.check_scan_settings`),
+    refused in the line ``flatcontact run CONFIG`` and ``config --check CONFIG`` give: it names
+    CONFIG and the settings path, or the flag when a flag set that path."""
+    from flatcontact.cli.settings import config_source
+    from flatcontact.stages._common import rename
+    from flatcontact.stages.preflight import check_scan_settings
+
+    source = config_source(config)
+    try:
+        check_scan_settings(cfg, source)
+    except InputError as exc:
+        text = str(exc).removeprefix(f"{source}: ")
+        path = text.partition(": ")[0]
+        if path in _given(flags) and path in FLAG_OF:
+            raise InputError(rename(text, {path: FLAG_OF[path]})) from None
+        raise
+
+
 @app.command("scan")
 @settings_command(OPTIONS)
 def scan_command(
@@ -176,6 +206,7 @@ def scan_command(
             "calculator": {"target": calculator, "kwargs": parse_kwargs(calculator_kwarg)}
         }
     cfg = resolve_config(config, preset, flags)
+    check_settings(cfg, config, flags)
     out_dir = check_out_dir(out or "ispes")
     where = Path(interface or DEFAULT_INTERFACE)
     created = not out_dir.exists()
