@@ -1,0 +1,96 @@
+"""A SIGTERM while the command line is still importing ends it with the one line a terminated
+command prints and status 143, never a silent death by the signal (status -15).
+
+A real process and a real signal from outside: the child runs the ``flatcontact`` entry point
+(the console script's, from pyproject's ``[project.scripts]``, or ``python -m flatcontact``)
+and, at the first import of a heavy library (typer, rich, click, numpy: the start-up's slow
+part), tells the parent through a pipe and waits; the parent then sends SIGTERM. Ordered by
+the pipe, not by timing, so a loaded machine only makes it slower.
+"""
+
+import os
+import signal
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+#: The child: a meta-path finder that stops at the first heavy import, then the entry point.
+CHILD = r"""
+import importlib, os, runpy, sys, time
+
+fd = int(sys.argv[1])
+HEAVY = {"typer", "rich", "click", "numpy"}
+
+
+class WaitForSignal:
+    def find_spec(self, name, path=None, target=None):
+        if name.partition(".")[0] in HEAVY:
+            sys.meta_path.remove(self)
+            os.write(fd, name.encode() + b"\n")
+            os.close(fd)
+            time.sleep(300)  # the parent's SIGTERM comes in here
+        return None
+
+
+entry, sys.argv = sys.argv[2], ["flatcontact", *sys.argv[3:]]
+sys.meta_path.insert(0, WaitForSignal())
+if entry == "-m":
+    runpy.run_module("flatcontact", run_name="__main__", alter_sys=True)
+else:
+    module, _, function = entry.partition(":")
+    getattr(importlib.import_module(module), function)()
+"""
+
+LINE = (
+    "error: terminated (SIGTERM); temporary files removed, finished work kept: rerun the same "
+    "command to resume"
+)
+
+
+def console_script() -> str:
+    """``module:function`` of the ``flatcontact`` console script, as pyproject declares it."""
+    with open(ROOT / "pyproject.toml", "rb") as fh:
+        return tomllib.load(fh)["project"]["scripts"]["flatcontact"]
+
+
+@pytest.mark.parametrize("entry", ["console script", "-m"])
+def test_sigterm_during_start_up_prints_one_line_and_exits_143(tmp_path, entry):
+    read, write = os.pipe()
+    out = tmp_path / "run"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "src"), str(ROOT)])}
+    target = console_script() if entry == "console script" else "-m"
+    child = subprocess.Popen(
+        [sys.executable, "-c", CHILD, str(write), target, "run", "--out", str(out)],
+        pass_fds=(write,),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+        cwd=tmp_path,
+    )
+    os.close(write)
+    try:
+        with os.fdopen(read, "rb") as pipe:
+            reached = pipe.readline().decode().strip()
+        assert reached, "the child never reached a heavy import"
+        child.send_signal(signal.SIGTERM)
+        stdout, stderr = child.communicate(timeout=240)
+    finally:
+        if child.poll() is None:
+            child.kill()
+            child.wait()
+    assert "Traceback" not in stderr + stdout
+    assert stderr.splitlines() == [LINE], (reached, child.returncode, stderr)
+    assert child.returncode == 143, (reached, stderr)
+    assert not out.exists()
+
+
+def test_the_console_script_is_the_entry_that_installs_the_handler_first():
+    """The script's function is the one that installs the start-up handler before it imports
+    the command line (a script pointing at ``flatcontact.cli:main`` imports typer first)."""
+    assert console_script() == "flatcontact.__main__:main"
