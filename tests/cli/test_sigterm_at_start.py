@@ -94,3 +94,33 @@ def test_the_console_script_is_the_entry_that_installs_the_handler_first():
     """The script's function is the one that installs the start-up handler before it imports
     the command line (a script pointing at ``flatcontact.cli:main`` imports typer first)."""
     assert console_script() == "flatcontact.__main__:main"
+
+
+def test_the_entry_module_installs_the_handler_before_any_slow_import():
+    """What runs before the start-up handler is the window in which SIGTERM still kills
+    silently: importing the entry module loads no slow library (the command line's typer, rich,
+    numpy; importlib.metadata, ~40 ms, which the package once read its version with)."""
+    program = (
+        "import signal, sys; import flatcontact.__main__ as entry; "
+        "slow = ('typer', 'rich', 'click', 'numpy', 'importlib.metadata', 'flatcontact.cli'); "
+        "print(sorted(m for m in slow if m in sys.modules))"
+    )
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    done = subprocess.run(
+        [sys.executable, "-c", program], capture_output=True, text=True, env=env, timeout=120
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "[]", done.stdout
+
+
+def test_the_version_read_on_first_use_is_the_installed_one():
+    from importlib.metadata import PackageNotFoundError, version
+
+    import flatcontact
+
+    try:
+        installed = version("flatcontact")
+    except PackageNotFoundError:
+        installed = "0.0.0+unknown"
+    assert flatcontact.__version__ == installed
+    assert "__version__" in dir(flatcontact) and "__version__" in flatcontact.__all__
