@@ -32,6 +32,7 @@ PATHS = (
     "scan.relax_mode",
     "scan.grid",
     "scan.thickness_angstrom",
+    "scan.p_range_gpa",
     "scan.workers",
     "scan.executor",
     "scan.dask_address",
@@ -44,7 +45,6 @@ OPTIONS = setting_options(PATHS)
 #: Settings path -> the flag that sets it, to name the flag in errors.
 FLAG_OF = {
     **flags_of(OPTIONS),
-    "scan.p_range_gpa": "--p-range-gpa",
     "potential": "--potential",
     "potential.intra": "--potential",
     "potential.calculator": "--calculator",
@@ -158,15 +158,6 @@ def scan_command(
             "--calculator-kwarg model=medium --calculator-kwarg device=cpu.",
         ),
     ] = None,
-    p_range_gpa: Annotated[
-        tuple[float, float, int] | None,
-        typer.Option(
-            "--p-range-gpa",
-            metavar="LO HI N",
-            help="scan.p_range_gpa: choose N thicknesses spanning loads LO..HI GPa at the "
-            "probe stacking; exclusive with --thickness-angstrom. Default: the configuration's.",
-        ),
-    ] = None,
     out: Annotated[
         str | None, typer.Option("--out", help="Output directory (default ./ispes).")
     ] = None,
@@ -185,15 +176,11 @@ def scan_command(
     from flatcontact.ispes.scan import ScanInterrupted
     from flatcontact.stages.scan import ScanInputs, scan_stage
 
-    if "thickness_angstrom" in settings.get("scan", {}) and p_range_gpa is not None:
+    if {"thickness_angstrom", "p_range_gpa"} <= settings.get("scan", {}).keys():
         raise InputError("give either --thickness-angstrom or --p-range-gpa, not both")
     if potential is not None and calculator is not None:
         raise InputError("give either --potential or --calculator, not both")
     flags: dict[str, Any] = {"scan": {}, **settings}
-    if p_range_gpa is not None:
-        flags["scan"]["p_range_gpa"] = dict(
-            zip(("lo_gpa", "hi_gpa", "n"), p_range_gpa, strict=True)
-        )
     if potential is not None:
         # an intra-slab model in place of the configured model's (its LJ kept), not a calculator
         flags["potential"] = {**_potential_section(potential), "calculator": None}
