@@ -55,3 +55,14 @@ def test_scan_names_the_flag_that_set_the_refused_setting(tmp_path, monkeypatch,
     line = one_error_line(*run_cli(argv, capsys)[::2])
     assert line.startswith("error: --optimizer: 'lammps-cg' relaxes atoms"), line
     assert not Path("o").exists()
+
+
+def test_study_convergence_refuses_its_base_as_config_check_does(tmp_path, monkeypatch, capsys):
+    """The study's base run is CONFIG: its refusal is config --check's line, before the study
+    starts (it was "the base configuration failed: config: ...", after the study began)."""
+    config = _config(tmp_path, monkeypatch, COARSE_GRID)
+    check = one_error_line(*run_cli(["config", "--check", config], capsys)[::2])
+    code, out, err = run_cli(["study", "convergence", config, "--out", "study"], capsys)
+    assert one_error_line(code, err) == check
+    assert out == ""  # nothing started
+    assert sorted(p.name for p in Path().iterdir()) == ["configs"]
