@@ -1,10 +1,12 @@
 """A SIGTERM while the command line is still importing ends it with the one line a terminated
-command prints and status 143, never a silent death by the signal (status -15).
+command prints and status 143, never a silent death by the signal (status -15); a Ctrl-C
+(SIGINT) with the one line of an interrupted command and status 130, never a
+``KeyboardInterrupt`` traceback.
 
 A real process and a real signal from outside: the child runs the ``flatcontact`` entry point
 (the console script's, from pyproject's ``[project.scripts]``, or ``python -m flatcontact``)
 and, at the first import of a heavy library (typer, rich, click, numpy: the start-up's slow
-part), tells the parent through a pipe and waits; the parent then sends SIGTERM. Ordered by
+part), tells the parent through a pipe and waits; the parent then sends the signal. Ordered by
 the pipe, not by timing, so a loaded machine only makes it slower.
 """
 
@@ -46,10 +48,19 @@ else:
     getattr(importlib.import_module(module), function)()
 """
 
-LINE = (
-    "error: terminated (SIGTERM); temporary files removed, finished work kept: rerun the same "
-    "command to resume"
-)
+#: signal -> (the one stderr line, the exit status)
+EXPECTED = {
+    signal.SIGTERM: (
+        "error: terminated (SIGTERM); temporary files removed, finished work kept: rerun the "
+        "same command to resume",
+        143,
+    ),
+    signal.SIGINT: (
+        "error: interrupted; temporary files removed, finished work kept: rerun the same "
+        "command to resume",
+        130,
+    ),
+}
 
 
 def console_script() -> str:
@@ -58,8 +69,9 @@ def console_script() -> str:
         return tomllib.load(fh)["project"]["scripts"]["flatcontact"]
 
 
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
 @pytest.mark.parametrize("entry", ["console script", "-m"])
-def test_sigterm_during_start_up_prints_one_line_and_exits_143(tmp_path, entry):
+def test_a_signal_during_start_up_prints_one_line(tmp_path, entry, sig):
     read, write = os.pipe()
     out = tmp_path / "run"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "src"), str(ROOT)])}
@@ -78,15 +90,16 @@ def test_sigterm_during_start_up_prints_one_line_and_exits_143(tmp_path, entry):
         with os.fdopen(read, "rb") as pipe:
             reached = pipe.readline().decode().strip()
         assert reached, "the child never reached a heavy import"
-        child.send_signal(signal.SIGTERM)
+        child.send_signal(sig)
         stdout, stderr = child.communicate(timeout=240)
     finally:
         if child.poll() is None:
             child.kill()
             child.wait()
+    line, status = EXPECTED[sig]
     assert "Traceback" not in stderr + stdout
-    assert stderr.splitlines() == [LINE], (reached, child.returncode, stderr)
-    assert child.returncode == 143, (reached, stderr)
+    assert stderr.splitlines() == [line], (reached, child.returncode, stderr)
+    assert child.returncode == status, (reached, stderr)
     assert not out.exists()
 
 

@@ -51,7 +51,11 @@ from flatcontact.cli import memory_floor  # noqa: F401  (refuses a too low ulimi
 from flatcontact.cli.app import STOPPED, app, check_out_flags, console, print_error
 from flatcontact.foundation.errors import InputError
 from flatcontact.foundation.fileio import remove_live_temporaries
-from flatcontact.foundation.interrupts import TERMINATED_LINE, TERMINATED_STATUS
+from flatcontact.foundation.interrupts import (
+    INTERRUPTED_LINE,
+    TERMINATED_LINE,
+    TERMINATED_STATUS,
+)
 
 try:  # registers the sub-commands; their modules load numpy and the settings
     from flatcontact.cli import commands as _commands  # noqa: F401
@@ -221,10 +225,7 @@ def _run(argv: list[str] | None) -> int:
         # typer turns a KeyboardInterrupt it sees into exit status 130 without a word
         if code == 130 and not got and not STOPPED["kept"]:
             # Ctrl-C in a command that does not say it itself
-            print_error(
-                "interrupted; temporary files removed, finished work kept: rerun the same "
-                "command to resume"
-            )
+            print_error(INTERRUPTED_LINE)
             return 130
         if got:  # the one line: what the command kept (say_interrupted) and the status
             kept = "; ".join(STOPPED["kept"]) or "finished work kept"

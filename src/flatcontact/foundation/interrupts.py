@@ -23,6 +23,12 @@ TERMINATED_LINE = (
 )
 #: The exit status of a command stopped by SIGTERM (the shell's 128 + signal number).
 TERMINATED_STATUS = 128 + signal.SIGTERM
+#: The line (after ``error: ``) of a command stopped by Ctrl-C that does not say it itself.
+INTERRUPTED_LINE = (
+    "interrupted; temporary files removed, finished work kept: rerun the same command to resume"
+)
+#: The exit status of a command stopped by Ctrl-C (128 + SIGINT).
+INTERRUPTED_STATUS = 128 + signal.SIGINT
 
 
 def _in_charge() -> bool:
