@@ -26,14 +26,7 @@ Each sub-package exports what it owns the same way (``flatcontact.contact.latera
 ``flatcontact.ispes.GridSpec``, ...): see ``__all__`` of each and docs/architecture.md.
 """
 
-from importlib.metadata import PackageNotFoundError, version
-
 import lazy_loader
-
-try:
-    __version__ = version("flatcontact")
-except PackageNotFoundError:  # running from a source tree without installation
-    __version__ = "0.0.0+unknown"
 
 #: Public name -> the sub-package (or top-level module) that owns it.
 _EXPORTS: dict[str, list[str]] = {
@@ -62,7 +55,7 @@ _EXPORTS: dict[str, list[str]] = {
     "notebook": ["contact_from_laws", "scan_interface"],
 }
 
-__getattr__, _lazy_dir, _lazy_all = lazy_loader.attach(
+_lazy_getattr, _lazy_dir, _lazy_all = lazy_loader.attach(
     __name__,
     submodules=[
         "analysis",
@@ -82,6 +75,24 @@ __getattr__, _lazy_dir, _lazy_all = lazy_loader.attach(
     submod_attrs=_EXPORTS,
 )
 __all__ = ["__version__", *sorted(name for names in _EXPORTS.values() for name in names)]
+
+
+def _version() -> str:
+    """The installed distribution's version (importlib.metadata: ~40 ms, so read on first use,
+    not while the command line starts: :mod:`flatcontact.__main__`)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("flatcontact")
+    except PackageNotFoundError:  # running from a source tree without installation
+        return "0.0.0+unknown"
+
+
+def __getattr__(name: str):
+    if name == "__version__":
+        globals()["__version__"] = found = _version()
+        return found
+    return _lazy_getattr(name)
 
 
 def __dir__() -> list[str]:

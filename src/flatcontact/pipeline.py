@@ -177,6 +177,9 @@ class Pipeline:
     scan_progress
         Observer of the scan, called as ``scan_progress(done, total)``; if it is a context
         manager the scan stage runs inside it (the CLI's progress bar).
+    source
+        What the configuration came from, named first in a refusal of the pre-run checks
+        (:func:`flatcontact.stages.preflight.check_inputs`): the file the user gave.
     """
 
     def __init__(
@@ -185,8 +188,10 @@ class Pipeline:
         root: str | Path,
         on_event: Callable[[StageEvent], None] | None = None,
         scan_progress: Callable[[int, int], None] | None = None,
+        source: str = "config",
     ):
         self.config = config
+        self.source = source
         self.root = Path(root)
         self.on_event = on_event
         self.scan_progress = scan_progress
@@ -235,7 +240,7 @@ class Pipeline:
 
     def _check_config(self) -> None:
         """Checks that need the file system or optional modules, before any work."""
-        check_inputs(self.config)
+        check_inputs(self.config, self.source)
 
     def _open_log(self) -> None:
         handler = _NoFollowFileHandler(self.root / RUN_LOG, encoding="utf-8")

@@ -6,6 +6,9 @@ own), the command is run up to its stage with the stage replaced by a recorder: 
 it would run with hold the flag's value where the file says something else, or the command
 refused the flag in one ``error:`` line naming it. A table below gives each flag a value;
 a flag added to a command without one fails :func:`test_every_flag_has_a_case`.
+``flatcontact analyze`` (no configuration: its flags over the preset) likewise, with its
+one hand-declared setting option, ``--p-gpa`` (why: :mod:`flatcontact.cli.options`), in
+each form it takes.
 """
 
 from pathlib import Path
@@ -13,8 +16,10 @@ from pathlib import Path
 import pytest
 from tests.cli.cli_helpers import one_error_line, run_cli
 
+from flatcontact.cli import analyze as analyze_cli
 from flatcontact.cli import build as build_cli
 from flatcontact.cli import scan as scan_cli
+from flatcontact.config.paths import field_at
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 CU = EXAMPLES / "cu111-eam.yaml"  # fcc111 recipe, EAM preset (no LJ), p_range_gpa, 6x6
@@ -95,19 +100,76 @@ BUILD_CASES = {
 BUILD_NOT_SETTINGS = {"--out", "--config", "--structure", "--regenerate-dense"}
 
 
-def _flags(command) -> set[str]:
+#: analyze flag -> (arguments after the ISPES file, settings path, the value it must then hold)
+ANALYZE_CASES = {
+    "--direction-deg": (["--direction-deg", "30"], "analysis.direction_deg", 30.0),
+    "--energy-form": (["--energy-form", "enthalpy"], "analysis.energy_form", "enthalpy"),
+    "--load-source": (["--load-source", "stress"], "analysis.load_source", "stress"),
+    "--energy-zero": (["--energy-zero", "each"], "analysis.energy_zero", "each"),
+    "--threshold-gpa": (["--threshold-gpa", "1.5"], "analysis.threshold_gpa", 1.5),
+    "--allow-missing": (["--allow-missing"], "analysis.allow_missing", True),
+    "--with-mep": (["--with-mep"], "analysis.with_mep", True),
+    "--svg": (["--no-svg"], "report.svg", False),
+    "--p-gpa": (["--p-gpa", "0.25", "1.75"], "analysis.p_gpa", [0.25, 1.75]),
+}
+#: Options of analyze that set no setting.
+ANALYZE_NOT_SETTINGS = {"--out", "--json"}
+
+
+def _click(command):
     import typer.main
 
-    click = typer.main.get_command(scan_cli.app).commands[command]
-    return {opt for p in click.params for opt in p.opts if opt.startswith("--")}
+    return typer.main.get_command(scan_cli.app).commands[command]
+
+
+def _flags(command) -> set[str]:
+    return {opt for p in _click(command).params for opt in p.opts if opt.startswith("--")}
 
 
 def test_every_flag_has_a_case():
     assert _flags("scan") == set(SCAN_CASES) | SCAN_NOT_SETTINGS
     assert _flags("build") == set(BUILD_CASES) | BUILD_NOT_SETTINGS
+    assert _flags("analyze") == set(ANALYZE_CASES) | ANALYZE_NOT_SETTINGS
     # the derived ones are the settings' own names
     assert {o.flag for o in scan_cli.OPTIONS} <= set(SCAN_CASES)
     assert {o.flag for o in build_cli.OPTIONS} <= set(BUILD_CASES)
+    assert {o.flag for o in analyze_cli.OPTIONS} <= set(ANALYZE_CASES)
+    # every setting option is derived, but analyze's --p-gpa (cli/options.py says why)
+    assert {o.flag for o in analyze_cli.OPTIONS} == set(ANALYZE_CASES) - {"--p-gpa"}
+
+
+def test_p_range_gpa_is_derived_from_its_field():
+    """``--p-range-gpa LO HI N`` is the sub-section ``scan.p_range_gpa``: one value per field,
+    in the field order, typed as the fields are, help from the description."""
+    (option,) = [o for o in scan_cli.OPTIONS if o.path == "scan.p_range_gpa"]
+    assert option.flag == "--p-range-gpa" and scan_cli.FLAG_OF["scan.p_range_gpa"] == option.flag
+    assert option.metavar == "LO HI N"
+    model = field_at("scan.p_range_gpa.n")[0]
+    assert (
+        [name for name, _ in option.parts] == list(model.model_fields) == ["lo_gpa", "hi_gpa", "n"]
+    )
+    (param,) = [p for p in _click("scan").params if "--p-range-gpa" in p.opts]
+    assert param.nargs == 3 and param.metavar == "LO HI N"
+    assert [kind for _, kind in option.parts] == [float, float, int]
+    assert option.value((0.5, 3.0, 5)) == {"lo_gpa": 0.5, "hi_gpa": 3.0, "n": 5}
+    described = field_at("scan.p_range_gpa")[1].description
+    assert option.help.startswith(f"scan.p_range_gpa: {described}. Default: ")
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["--p-range-gpa", "3", "0.5", "5"],  # lo >= hi
+        ["--p-range-gpa", "0.5", "3", "1"],  # n < 2
+        ["--p-range-gpa", "abc", "3", "5"],  # not a number
+        ["--p-range-gpa", "0.5", "3", "2.5"],  # n not an integer
+        ["--p-range-gpa", "0.5", "3", "5", "--thickness-angstrom", "9"],  # both
+    ],
+)
+def test_a_bad_p_range_gpa_is_one_line_naming_it(argv, tmp_path, capsys):
+    line = one_error_line(*run_cli(["scan", *argv, "--out", str(tmp_path / "s")], capsys)[::2])
+    assert "--p-range-gpa" in line, line
+    assert not (tmp_path / "s").exists()
 
 
 def _applied_or_refused(argv, flag, path, expected, monkeypatch, capsys, stage):
@@ -160,3 +222,69 @@ def test_build_flag_over_a_configuration(flag, config, tmp_path, monkeypatch, ca
     refused = config == CU and flag in ("--source", "--lj-cutoff-angstrom")
     assert got == ("refused" if refused else "applied"), (flag, config.name)
     assert not (tmp_path / "b").exists() or got == "applied"
+
+
+def _analyzed_with(argv, monkeypatch, capsys):
+    """The settings ``flatcontact analyze`` would run its stage with (the stage a recorder)."""
+
+    def record(settings, *args, **kwargs):
+        raise Ran(settings)
+
+    monkeypatch.setattr("flatcontact.stages.analyze.analyze_stage", record)
+    with pytest.raises(Ran) as ran:
+        run_cli(["analyze", *map(str, argv)], capsys)
+    return ran.value.settings
+
+
+@pytest.mark.parametrize("flag", sorted(ANALYZE_CASES))
+def test_analyze_flag_lands_at_its_setting(flag, tmp_path, monkeypatch, capsys):
+    from flatcontact.config import load_config
+
+    args, path, expected = ANALYZE_CASES[flag]
+    assert _setting(load_config(None), path) != expected  # the flag changes it
+    loads = [] if flag == "--p-gpa" else ["--p-gpa", "1"]  # analyze needs a load
+    settings = _analyzed_with([tmp_path / "ispes.nc", *loads, *args], monkeypatch, capsys)
+    assert _setting(settings, path) == expected
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["{nc}", "--p-gpa", "0.5", "1", "2"],
+        ["--p-gpa", "0.5", "1", "2", "{nc}"],
+        ["--p-gpa", "0.5", "{nc}", "1", "2"],
+        ["{nc}", "--p-gpa", "0.5,1", "--p-gpa", "2"],
+        ["{nc}", "--p-gpa=0.5,1,2"],
+        ["--p-gpa", "{nc}", "0.5", "1,2"],  # the file where a load was expected: still read
+    ],
+)
+def test_every_form_of_p_gpa_gives_the_same_loads(argv, tmp_path, monkeypatch, capsys):
+    nc = tmp_path / "ispes.nc"
+    settings = _analyzed_with([a.format(nc=nc) for a in argv], monkeypatch, capsys)
+    assert settings.analysis.p_gpa == [0.5, 1.0, 2.0]
+
+
+def test_one_load_is_enough_for_analyze(tmp_path, monkeypatch, capsys):
+    """The run's settings ask for two loads (to fit the laws); analyze takes one."""
+    settings = _analyzed_with([tmp_path / "ispes.nc", "--p-gpa", "-0.5"], monkeypatch, capsys)
+    assert settings.analysis.p_gpa == [-0.5]
+
+
+@pytest.mark.parametrize(
+    ("argv", "said"),
+    [
+        (["--p-gpa", "2e3"], "--p-gpa"),  # outside the setting's bounds
+        (["--p-gpa", "nan"], "--p-gpa"),
+        ([], "--p-gpa"),  # no load
+        (["--p-gpa", "1,,2"], "--p-gpa"),
+    ],
+)
+def test_a_bad_p_gpa_is_one_line_naming_it(argv, said, tmp_path, capsys):
+    code, _, err = run_cli(["analyze", str(tmp_path / "ispes.nc"), *argv], capsys)
+    assert said in one_error_line(code, err)
+
+
+def test_p_gpa_help_is_the_field_description():
+    (param,) = [p for p in _click("analyze").params if "--p-gpa" in p.opts]
+    described = field_at("analysis.p_gpa")[1].description.replace("[", "(").replace("]", ")")
+    assert param.help.startswith(f"analysis.p_gpa: {described}"), param.help

@@ -11,7 +11,9 @@ or a boxed multi-line message:
   memory limit (``ulimit -v``, ``MemoryError``), one line naming the limit and the file;
 - SIGTERM: raised as :class:`Terminated` (a ``KeyboardInterrupt``) in the main thread, so
   every stage and standalone command unwinds as on Ctrl-C: temporary files are removed
-  (``.<name>.<random>.part``), the point store commits; one line, exit status 143;
+  (``.<name>.<random>.part``), the point store commits; one line, exit status 143 (the
+  console script's entry, :func:`flatcontact.__main__.main`, says the same line while this
+  module is still being imported);
 - Python warnings: flatcontact's own (analysis diagnostics, dated deprecations) as one
   ``warning:`` line each; the libraries' numerical warnings (numpy, scipy, ASE) into the
   run log and one summary line after a successful command
@@ -49,6 +51,11 @@ from flatcontact.cli import memory_floor  # noqa: F401  (refuses a too low ulimi
 from flatcontact.cli.app import STOPPED, app, check_out_flags, console, print_error
 from flatcontact.foundation.errors import InputError
 from flatcontact.foundation.fileio import remove_live_temporaries
+from flatcontact.foundation.interrupts import (
+    INTERRUPTED_LINE,
+    TERMINATED_LINE,
+    TERMINATED_STATUS,
+)
 
 try:  # registers the sub-commands; their modules load numpy and the settings
     from flatcontact.cli import commands as _commands  # noqa: F401
@@ -218,18 +225,12 @@ def _run(argv: list[str] | None) -> int:
         # typer turns a KeyboardInterrupt it sees into exit status 130 without a word
         if code == 130 and not got and not STOPPED["kept"]:
             # Ctrl-C in a command that does not say it itself
-            print_error(
-                "interrupted; temporary files removed, finished work kept: rerun the same "
-                "command to resume"
-            )
+            print_error(INTERRUPTED_LINE)
             return 130
         if got:  # the one line: what the command kept (say_interrupted) and the status
             kept = "; ".join(STOPPED["kept"]) or "finished work kept"
-            print_error(
-                f"terminated (SIGTERM); temporary files removed, {kept}: rerun the same "
-                "command to resume"
-            )
-            return 128 + signal.SIGTERM
+            print_error(TERMINATED_LINE.format(kept=kept))
+            return TERMINATED_STATUS
         return code
 
 

@@ -14,9 +14,22 @@ sub-section's ``enabled`` is the sub-section's name (``contact.cycle.enabled`` -
 
 Types: a number is a number flag (click refuses ``abc`` in one line); a list is given by
 repeating the flag or comma-separating (:func:`~flatcontact.cli.app.split_list`); a fixed
-pair is ``--grid 8 8``; a choice or a union (``direction_deg``: an angle or ``auto``) is
-text that the settings check. Bounds, choices and defaults are the field's: a value is
-validated by the settings model, and an error names the flag.
+pair is ``--grid 8 8``; a sub-section of numbers is its fields' values in order after one
+flag, each shown by its name without the unit (``scan.p_range_gpa``, fields ``lo_gpa``,
+``hi_gpa``, ``n``: ``--p-range-gpa LO HI N``, ``--p-range-gpa -0.5 3 6``); a choice or a
+union (``direction_deg``: an angle or ``auto``) is text that the settings check. Bounds,
+choices and defaults are the field's: a value is validated by the settings model, and an
+error names the flag.
+
+One option sets a setting and is declared by its command, not derived: ``analyze
+--p-gpa`` (``analysis.p_gpa``, its help text is the field's). Its values may follow the flag
+as separate words (``--p-gpa 0.5 1 2``): click gives an option one word, so the others
+arrive among ``analyze``'s positional arguments, beside the ISPES file, and the command
+sorts numbers from the file (:func:`flatcontact.cli.analyze._split_arguments`). A derived
+list option would read only the words given to the flag itself (refusing ``--p-gpa
+ispes.nc 1``, which ``analyze`` accepts) and hand the loads to the settings' validation,
+which asks for two loads where ``analyze`` needs one. tests/cli/test_config_flags.py holds
+it to the setting: what it parses is what the analysis runs with.
 """
 
 from __future__ import annotations
@@ -35,7 +48,9 @@ from flatcontact.cli.app import parse_floats, split_list
 from flatcontact.foundation.errors import InputError
 
 #: Kinds of option a field becomes.
-_Kind = Literal["bool", "int", "float", "text", "number-or-text", "floats", "texts", "pair"]
+_Kind = Literal[
+    "bool", "int", "float", "text", "number-or-text", "floats", "texts", "pair", "record"
+]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -48,6 +63,8 @@ class SettingOption:
     help: str
     unit: str = ""
     metavar: str | None = None
+    #: a ``record``'s fields in order: (name, ``int`` or ``float``)
+    parts: tuple[tuple[str, type], ...] = ()
 
     @property
     def name(self) -> str:
@@ -62,6 +79,8 @@ class SettingOption:
             return split_list(given, self.flag, whitespace=not self.path.endswith("csv"))
         if self.kind == "pair":
             return list(given)
+        if self.kind == "record":
+            return {name: value for (name, _), value in zip(self.parts, given, strict=True)}
         if self.kind == "number-or-text":
             value = _number_or_text(given)
             words = (self.metavar or "").split("|")[1:]
@@ -102,9 +121,23 @@ def _strip(annotation: Any) -> Any:
     return annotation
 
 
+def _record(annotation: Any) -> tuple[tuple[str, type], ...]:
+    """The fields (name, ``int`` or ``float``) of a sub-section whose fields are all numbers
+    (``scan.p_range_gpa``), else ``()``."""
+    from pydantic import BaseModel
+
+    ann = _strip(annotation)
+    if not (isinstance(ann, type) and issubclass(ann, BaseModel)):
+        return ()
+    parts = tuple((name, _strip(f.annotation)) for name, f in ann.model_fields.items())
+    return parts if parts and all(t in (int, float) for _, t in parts) else ()
+
+
 def _kind(annotation: Any) -> _Kind:
     ann = _strip(annotation)
     origin = typing.get_origin(ann)
+    if _record(annotation):
+        return "record"
     if ann is bool:
         return "bool"
     if ann is int:
@@ -129,6 +162,8 @@ def _metavar(annotation: Any) -> str | None:
     if kind == "number-or-text":
         words = [w for a in typing.get_args(ann) for w in typing.get_args(_strip(a))]
         return "|".join(["NUMBER", *map(str, words)])
+    if kind == "record":
+        return " ".join(_part_name(name, ann.model_fields[name]) for name, _ in _record(ann))
     return {
         "floats": "NUMBERS",
         "texts": "TEXTS",
@@ -137,6 +172,15 @@ def _metavar(annotation: Any) -> str | None:
         "text": "TEXT",
         "pair": "INTEGER INTEGER",
     }.get(kind)
+
+
+def _part_name(name: str, info: Any) -> str:
+    """A record field as the help shows it: its name without the unit (``lo_gpa`` -> ``LO``)."""
+    from flatcontact.foundation.numbers import field_bounds
+
+    if field_bounds(info) is not None and "_" in name:
+        name = name.rpartition("_")[0]
+    return name.upper()
 
 
 def _default_text(default: Any) -> str:
@@ -179,6 +223,7 @@ def setting_options(
                 text.replace("[", "(").replace("]", ")"),  # no rich markup in the help
                 bounds.unit if bounds is not None else "",
                 _metavar(info.annotation),
+                _record(info.annotation),
             )
         )
     return out
@@ -199,6 +244,7 @@ def _parameter(option: SettingOption) -> inspect.Parameter:
         "floats": list[str] | None,
         "texts": list[str] | None,
         "pair": tuple[int, int] | None,
+        "record": tuple[tuple(t for _, t in option.parts)] | None,
     }[option.kind]
     decls = (
         [f"{option.flag}/--no-{option.flag.removeprefix('--')}"]

@@ -15,6 +15,7 @@ import typer
 
 from flatcontact.cli.app import app, check_out_dir, console, say_interrupted
 from flatcontact.cli.progress import ScanBar, StageLines
+from flatcontact.cli.settings import config_source
 from flatcontact.foundation.layout import RUN_MARKER
 
 _PRESET_HELP = "quick (default: minutes on a 2-core laptop) or paper (the paper's grids and loads)."
@@ -44,7 +45,9 @@ def run_command(
         check_out_dir(out)
     with (
         StageLines(console) as lines,
-        Pipeline(cfg, out, on_event=lines, scan_progress=ScanBar(console)) as pipe,
+        Pipeline(
+            cfg, out, on_event=lines, scan_progress=ScanBar(console), source=config_source(config)
+        ) as pipe,
     ):
         console.print(
             f"flatcontact run: preset {cfg.preset}, {cfg.structure.kind}, "

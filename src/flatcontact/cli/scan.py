@@ -32,6 +32,7 @@ PATHS = (
     "scan.relax_mode",
     "scan.grid",
     "scan.thickness_angstrom",
+    "scan.p_range_gpa",
     "scan.workers",
     "scan.executor",
     "scan.dask_address",
@@ -44,7 +45,6 @@ OPTIONS = setting_options(PATHS)
 #: Settings path -> the flag that sets it, to name the flag in errors.
 FLAG_OF = {
     **flags_of(OPTIONS),
-    "scan.p_range_gpa": "--p-range-gpa",
     "potential": "--potential",
     "potential.intra": "--potential",
     "potential.calculator": "--calculator",
@@ -77,6 +77,36 @@ def resolve_config(config: Path | None, preset: str | None, flags: dict[str, Any
     from flatcontact.cli.settings import resolve_config as resolve
 
     return resolve(config, preset, flags, FLAG_OF)
+
+
+def _given(flags: dict[str, Any], prefix: str = "") -> set[str]:
+    """The settings paths (and their sections) that ``flags`` sets."""
+    out = set()
+    for key, value in flags.items():
+        path = f"{prefix}{key}"
+        out.add(path)
+        if isinstance(value, dict):
+            out |= _given(value, f"{path}.")
+    return out
+
+
+def check_settings(cfg, config: Path | None, flags: dict[str, Any]) -> None:
+    """The pre-run checks of the scan's settings (:func:`~flatcontact.stages.preflight.check_scan_settings`),
+    refused in the line ``flatcontact run CONFIG`` and ``config --check CONFIG`` give: it names
+    CONFIG and the settings path, or the flag when a flag set that path."""
+    from flatcontact.cli.settings import config_source
+    from flatcontact.stages._common import rename
+    from flatcontact.stages.preflight import check_scan_settings
+
+    source = config_source(config)
+    try:
+        check_scan_settings(cfg, source)
+    except InputError as exc:
+        text = str(exc).removeprefix(f"{source}: ")
+        path = text.partition(": ")[0]
+        if path in _given(flags) and path in FLAG_OF:
+            raise InputError(rename(text, {path: FLAG_OF[path]})) from None
+        raise
 
 
 @app.command("scan")
@@ -128,15 +158,6 @@ def scan_command(
             "--calculator-kwarg model=medium --calculator-kwarg device=cpu.",
         ),
     ] = None,
-    p_range_gpa: Annotated[
-        tuple[float, float, int] | None,
-        typer.Option(
-            "--p-range-gpa",
-            metavar="LO HI N",
-            help="scan.p_range_gpa: choose N thicknesses spanning loads LO..HI GPa at the "
-            "probe stacking; exclusive with --thickness-angstrom. Default: the configuration's.",
-        ),
-    ] = None,
     out: Annotated[
         str | None, typer.Option("--out", help="Output directory (default ./ispes).")
     ] = None,
@@ -155,15 +176,11 @@ def scan_command(
     from flatcontact.ispes.scan import ScanInterrupted
     from flatcontact.stages.scan import ScanInputs, scan_stage
 
-    if "thickness_angstrom" in settings.get("scan", {}) and p_range_gpa is not None:
+    if {"thickness_angstrom", "p_range_gpa"} <= settings.get("scan", {}).keys():
         raise InputError("give either --thickness-angstrom or --p-range-gpa, not both")
     if potential is not None and calculator is not None:
         raise InputError("give either --potential or --calculator, not both")
     flags: dict[str, Any] = {"scan": {}, **settings}
-    if p_range_gpa is not None:
-        flags["scan"]["p_range_gpa"] = dict(
-            zip(("lo_gpa", "hi_gpa", "n"), p_range_gpa, strict=True)
-        )
     if potential is not None:
         # an intra-slab model in place of the configured model's (its LJ kept), not a calculator
         flags["potential"] = {**_potential_section(potential), "calculator": None}
@@ -176,6 +193,7 @@ def scan_command(
             "calculator": {"target": calculator, "kwargs": parse_kwargs(calculator_kwarg)}
         }
     cfg = resolve_config(config, preset, flags)
+    check_settings(cfg, config, flags)
     out_dir = check_out_dir(out or "ispes")
     where = Path(interface or DEFAULT_INTERFACE)
     created = not out_dir.exists()

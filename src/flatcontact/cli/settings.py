@@ -37,6 +37,12 @@ def _flag_error(exc: InputError, flag_of: dict[str, str]) -> InputError:
     return InputError(f"{FLAGS_SOURCE}: {text}")
 
 
+def config_source(config: Path | None) -> str:
+    """What a refusal of ``config``'s settings names first: the file as the user gave it, or
+    ``default config`` (the preset alone), as :func:`flatcontact.config.load_config` does."""
+    return "default config" if config is None else str(config)
+
+
 def resolve_config(
     config: Path | None, preset: str | None, flags: dict[str, Any], flag_of: dict[str, str]
 ):

@@ -59,6 +59,7 @@ def convergence_command(
 ) -> None:
     """Refine grid, thicknesses, layers, fmax, cutoff one at a time until τ and σ_MSS stop moving."""
     from flatcontact.config.load import load_config
+    from flatcontact.stages.preflight import check_inputs
     from flatcontact.studies.convergence import run_convergence
     from flatcontact.studies.estimate import estimate_lines
     from flatcontact.studies.output import cost_line, write_study
@@ -68,6 +69,7 @@ def convergence_command(
             console.print(line, highlight=False)
 
     cfg = load_config(config)
+    check_inputs(cfg, str(config))  # what the base run would refuse, named by CONFIG
     check_out_dir(out)
     console.print(f"flatcontact study convergence: {config} -> {out}", highlight=False)
     with study_directory(out):

@@ -69,6 +69,32 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
         check_fit_settings(cfg)
     if cfg.report.approximant_study is not None:
         read_approximant_study(cfg.report.approximant_study, f"{source}: report.approximant_study")
+    check_scan_settings(cfg, source)
+    _check_structure(cfg, source)
+    check_measured_on(cfg, source)
+    check_moduli_source(cfg, structure_elements(cfg.structure))
+    if cfg.asperity.enabled:
+        check_asperity(cfg, source)
+    if cfg.elastic.enabled:
+        bulk, _ = bulk_crystal(cfg.structure)
+        if bulk is None:
+            _calculator.check(cfg)
+        else:
+            _calculator.check_atoms(cfg, bulk)
+
+
+def check_scan_settings(cfg: RunConfig, source: str = "config") -> None:
+    """The checks of :func:`check_inputs` that concern the scan alone (the optimiser against
+    the model and the relaxation mode, the calculator's import, the Dask address), so
+    ``flatcontact scan CONFIG`` refuses them in the same line as ``flatcontact run CONFIG``
+    and ``flatcontact config --check CONFIG``. The analysis's minimum lateral grid is not
+    one of them: a scan alone may be coarser.
+
+    Raises
+    ------
+    InputError
+        One line ``<source>: <settings path>: <what was expected>``.
+    """
     calc = cfg.potential.calculator
     if calc is not None and cfg.scan.optimizer == "lammps-cg":
         raise InputError(
@@ -88,17 +114,6 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
             raise InputError(f"{source}: potential.calculator.target: {exc}") from None
     if cfg.scan.dask_address is not None:
         check_scheduler_address(cfg.scan.dask_address, field=f"{source}: scan.dask_address")
-    _check_structure(cfg, source)
-    check_measured_on(cfg, source)
-    check_moduli_source(cfg, structure_elements(cfg.structure))
-    if cfg.asperity.enabled:
-        check_asperity(cfg, source)
-    if cfg.elastic.enabled:
-        bulk, _ = bulk_crystal(cfg.structure)
-        if bulk is None:
-            _calculator.check(cfg)
-        else:
-            _calculator.check_atoms(cfg, bulk)
 
 
 def check_asperity(cfg: RunConfig, source: str = "config") -> None:
