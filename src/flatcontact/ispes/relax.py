@@ -80,9 +80,7 @@ from flatcontact.ispes.geometry import (
 )
 from flatcontact.ispes.lbfgs import largest_atomic_norm, lbfgs_relax
 
-Optimizer = Literal[
-    "LBFGS-scaled", "LBFGS", "FIRE", "FIRE2", "BFGS", "BFGSLineSearch", "lammps-cg"
-]
+Optimizer = Literal["LBFGS-scaled", "LBFGS", "FIRE", "FIRE2", "BFGS", "BFGSLineSearch", "lammps-cg"]
 OPTIMIZERS: tuple[str, ...] = (
     "LBFGS-scaled",
     "LBFGS",
