@@ -338,6 +338,48 @@ def test_the_rest_position_that_changes_with_load_is_gated():
     assert both is not None and "give τ = 50 and 80 MPa" in both.message
 
 
+def test_a_choice_between_degenerate_sites_of_equal_tau_is_not_a_move():
+    """The previous rest site is still a degenerate start at the next load and gives the
+    reported τ: the analysis's choice of the other start (its tie rule) mixes no stackings.
+    With τ apart by more than the spread it is gated, as a move or as the pair."""
+    a1, a2 = np.array([3.0, 0.0]), np.array([0.0, 3.0])
+    site_a, site_b = np.array([0.75, 0.75]), np.array([2.25, 1.8])
+    maps = np.array([_two_site_map(1.0, 0.6), _two_site_map(1.0, 1.0)])
+    nan = np.full(2, np.nan)
+
+    def run(tau_b_mpa, selected_b=True):
+        return gates.degenerate_minima(
+            [0.0, 1.0],
+            maps,
+            a1,
+            a2,
+            np.array([[site_a, nan], [site_a, site_b]]),
+            [0, 1 if selected_b else 0],
+            np.array([[50.0, np.nan], [50.0, tau_b_mpa]]),
+            np.array([[0.0, np.nan], [1e-5, 0.0]]),
+            [1e-4, 1e-4],
+        )
+
+    assert run(50.0) is None
+    assert run(51.0) is None  # 2 % apart: inside DEGENERATE_TAU_SPREAD
+    moved = run(80.0)
+    assert moved is not None and "moves between P = 0 and 1 GPa" in moved.message
+    assert "give τ = 50 and 80 MPa" in moved.message
+    # the previous site no longer within the tolerance: a real move, whatever τ says
+    far = gates.degenerate_minima(
+        [0.0, 1.0],
+        maps,
+        a1,
+        a2,
+        np.array([[site_a, nan], [site_a, site_b]]),
+        [0, 1],
+        np.array([[50.0, np.nan], [50.0, 50.0]]),
+        np.array([[0.0, np.nan], [2e-4, 0.0]]),
+        [1e-4, 1e-4],
+    )
+    assert far is not None and "moves between P = 0 and 1 GPa" in far.message
+
+
 def test_the_report_lists_refused_and_overridden_gates():
     found = [gates.Finding("negative_slope", "x"), gates.Finding("load_fold", "y")]
     report = gates.GateReport(found, ["a note"], [])

@@ -17,11 +17,20 @@ from flatcontact.config.section import Section, positive_pair
 from flatcontact.foundation import limits
 from flatcontact.foundation.numbers import physical
 
-#: Optimisers a scan point may use (:data:`flatcontact.ispes.relax.OPTIMIZERS`): ASE's, and
+#: Optimisers a scan point may use (:data:`flatcontact.ispes.relax.OPTIMIZERS`): the built-in
+#: L-BFGS rescaled (``LBFGS-scaled``) or with ASE's steps (``LBFGS``), ASE's others, and
 #: ``lammps-cg`` (LAMMPS's own minimiser, LAMMPS models only).
-OPTIMIZERS: tuple[str, ...] = ("FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch", "lammps-cg")
+OPTIMIZERS: tuple[str, ...] = (
+    "LBFGS-scaled",
+    "LBFGS",
+    "FIRE",
+    "FIRE2",
+    "BFGS",
+    "BFGSLineSearch",
+    "lammps-cg",
+)
 #: The default optimiser (:class:`flatcontact.ispes.relax.RelaxSettings`' default).
-DEFAULT_OPTIMIZER = "LBFGS"
+DEFAULT_OPTIMIZER = "LBFGS-scaled"
 #: Warm-start orders of the scan (:data:`flatcontact.ispes.order.PREFERENCES`).
 PREFERENCES: tuple[str, ...] = ("columns", "planes", "cold")
 

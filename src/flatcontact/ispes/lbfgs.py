@@ -66,9 +66,10 @@ ASE's). The recursion is unchanged, H0 enters only as the scalar it multiplies. 
 the 6 × 6 × 8 quartz SNAP + LJ grid of ``benchmarks/bench_scanspeed.py`` (fmax 0.005 eV/Å,
 warm-start tree ``columns``) it took 17.8 force calls per point against ASE's 21.8
 (``docs/performance.md``, "Fewer force calls per point"), every point within the same
-max-norm tolerance. The scan does not use it yet: with it the quick preset's default run
-fires its ``degenerate_minima`` gate (the high-load τ move within the relaxation tolerance).
-Without it (the default) the iterates are ASE's.
+max-norm tolerance. The scan uses it by default (optimiser ``LBFGS-scaled``,
+:data:`flatcontact.ispes.relax.BUILT_IN_LBFGS`); ``LBFGS`` keeps ASE's iterates. (It waited
+for the ``degenerate_minima`` gate to stop counting a tie-rule choice between degenerate
+sites of equal τ as a move: :mod:`flatcontact.analysis.gates`.)
 
 The memory
 ----------

@@ -80,8 +80,21 @@ from flatcontact.ispes.geometry import (
 )
 from flatcontact.ispes.lbfgs import largest_atomic_norm, lbfgs_relax
 
-Optimizer = Literal["FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch", "lammps-cg"]
-OPTIMIZERS: tuple[str, ...] = ("FIRE", "FIRE2", "BFGS", "LBFGS", "BFGSLineSearch", "lammps-cg")
+Optimizer = Literal["LBFGS-scaled", "LBFGS", "FIRE", "FIRE2", "BFGS", "BFGSLineSearch", "lammps-cg"]
+OPTIMIZERS: tuple[str, ...] = (
+    "LBFGS-scaled",
+    "LBFGS",
+    "FIRE",
+    "FIRE2",
+    "BFGS",
+    "BFGSLineSearch",
+    "lammps-cg",
+)
+#: The built-in L-BFGS (:mod:`flatcontact.ispes.lbfgs`) under its two names: ``LBFGS`` takes
+#: ASE's steps (H0 = I/70 eV/Å² at every step), ``LBFGS-scaled`` rescales H0 at every step
+#: (Nocedal & Wright eq. 7.20; the scan's default: fewer force calls, measured in
+#: ``docs/performance.md``, "Fewer force calls per point").
+BUILT_IN_LBFGS: dict[str, bool] = {"LBFGS": False, "LBFGS-scaled": True}
 RelaxMode = Literal["full", "normal", "rigid-layers", "rigid"]
 RELAX_MODES: tuple[str, ...] = ("full", "normal", "rigid-layers", "rigid")
 
@@ -97,11 +110,13 @@ class RelaxSettings:
     fmax_ev_per_angstrom
         Convergence when max |F| over the free atoms < fmax (eV/Å).
     optimizer
-        ``LBFGS`` (the built-in, ASE's steps: :mod:`flatcontact.ispes.lbfgs`), another ASE
-        optimiser name, or ``lammps-cg``: LAMMPS's own ``minimize`` (``min_style cg``, the
-        same max-norm tolerance; LAMMPS models, modes ``full`` and ``normal`` only). On large
-        cells of cheap potentials it takes fewer force calls than L-BFGS (measured in
-        ``docs/performance.md``); its iterates are not ASE's.
+        ``LBFGS-scaled`` (the default: the built-in L-BFGS with the textbook rescaled initial
+        inverse Hessian, :mod:`flatcontact.ispes.lbfgs`, "Initial Hessian scaling"),
+        ``LBFGS`` (the built-in with ASE's steps, iterates equal to ASE's ``LBFGS``),
+        another ASE optimiser name, or ``lammps-cg``: LAMMPS's own ``minimize``
+        (``min_style cg``, the same max-norm tolerance; LAMMPS models, modes ``full`` and
+        ``normal`` only). On large cells of cheap potentials it takes fewer force calls
+        than L-BFGS (measured in ``docs/performance.md``); its iterates are not ASE's.
     max_steps
         Optimiser step cap; a point that hits it is stored with ``converged=False``.
     mode
@@ -111,7 +126,7 @@ class RelaxSettings:
     """
 
     fmax_ev_per_angstrom: float = 0.005
-    optimizer: str = "LBFGS"
+    optimizer: str = "LBFGS-scaled"
     max_steps: int = 2000
     mode: str = "full"
 
@@ -208,7 +223,7 @@ def reaction_stress_gpa(atoms: Atoms, forces: np.ndarray, fixed: np.ndarray) -> 
 
 
 def _optimizer_class(name: str):
-    # ASE's optimisers (≈0.4 s of scipy imports) only for optimizer != "LBFGS": kept out of
+    # ASE's optimisers (≈0.4 s of scipy imports) only for the other names: kept out of
     # the scan workers that run the built-in L-BFGS
     import ase.optimize
 
@@ -265,13 +280,14 @@ def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings
     steps = 0
     groups = free_layer_groups(atoms, free) if settings.mode == "rigid-layers" else []
     project = constraint_projector(fixed, settings.mode, groups)
-    if relaxing and settings.optimizer == "LBFGS":
+    if relaxing and settings.optimizer in BUILT_IN_LBFGS:
         outcome = lbfgs_relax(
             point_evaluator(calc, atoms),
             atoms.positions,
             project,
             settings.fmax_ev_per_angstrom,
             settings.max_steps,
+            scaled=BUILT_IN_LBFGS[settings.optimizer],
         )
         atoms.positions = outcome.positions
         energy, forces, steps = outcome.energy_ev, outcome.forces, outcome.steps
