@@ -144,7 +144,7 @@ class RelaxSettings:
         if self.optimizer == "lammps-cg" and self.mode == "rigid-layers":
             raise InputError(
                 "optimizer: 'lammps-cg' relaxes atoms (modes full, normal), not rigid layers; "
-                "use LBFGS with mode rigid-layers"
+                "use LBFGS-scaled (the default) with mode rigid-layers"
             )
 
     def as_dict(self) -> dict[str, Any]:

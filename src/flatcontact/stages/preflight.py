@@ -99,12 +99,12 @@ def check_scan_settings(cfg: RunConfig, source: str = "config") -> None:
     if calc is not None and cfg.scan.optimizer == "lammps-cg":
         raise InputError(
             f"{source}: scan.optimizer: 'lammps-cg' is LAMMPS's own minimiser and needs a "
-            f"LAMMPS interaction model, not the ASE calculator {calc.target!r}; use LBFGS"
+            f"LAMMPS interaction model, not the ASE calculator {calc.target!r}; use LBFGS-scaled (the default)"
         )
     if cfg.scan.optimizer == "lammps-cg" and cfg.scan.relax_mode == "rigid-layers":
         raise InputError(
             f"{source}: scan.optimizer: 'lammps-cg' relaxes atoms (relax_mode full or normal), "
-            "not rigid layers; use LBFGS"
+            "not rigid layers; use LBFGS-scaled (the default)"
         )
     if calc is not None:
         try:
