@@ -7,6 +7,8 @@ its engines (:mod:`flatcontact.potentials.engines`); nothing here branches on th
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
 from flatcontact.foundation.errors import InputError
@@ -63,6 +65,47 @@ def check_setup(settings, atoms) -> None:
     from flatcontact.potentials.engines import check_setup as check_model_setup
 
     check_model_setup(settings.potential, atoms)
+
+
+def check_evaluation(settings, atoms) -> None:
+    """:func:`check_setup` and one energy and forces of ``atoms`` with the model's calculator
+    (:func:`flatcontact.potentials.engines.check_evaluation`; a calculator that raises or
+    returns NaN is a :class:`~flatcontact.potentials.guarded.CalculatorFailure`)."""
+    from flatcontact.potentials.engines import check_evaluation as check_model_evaluation
+
+    check_model_evaluation(settings.potential, atoms)
+
+
+def evaluation_refusal(settings, failure, source: str, what: str):
+    """The one line of a pre-run evaluation that failed (``failure``: a
+    :class:`~flatcontact.potentials.guarded.CalculatorFailure`) as an InputError:
+    ``<source>: <settings path>: <calculator> cannot evaluate the elements Si, O of <what>
+    (<reason>)``. The settings path is the one naming the calculator:
+    ``potential.calculator.target``, ``potential.intra`` (``ase:...``) or ``potential``."""
+    m = settings.potential
+    if m.calculator is not None:
+        field, name = "potential.calculator.target", m.calculator.target
+    elif m.engine == "ase-slab":
+        field, name = "potential.intra", m.intra
+    else:
+        field, name = "potential", m.label
+    elements = ", ".join(failure.elements)
+    return InputError(
+        f"{source}: {field}: {name} cannot evaluate the elements {elements} of {what} "
+        f"({failure.reason})"
+    )
+
+
+@contextmanager
+def failing_at(stage: str) -> Iterator[None]:
+    """A user's calculator that fails inside the block (an exception, a NaN:
+    :class:`~flatcontact.potentials.guarded.CalculatorFailure`) names ``stage`` first:
+    ``scan: point at shift (0.5, 0), thickness 11.2 Å: calculator '...' failed on ...``."""
+    # imported here for the same reason as in :func:`factory`
+    from flatcontact.potentials.guarded import failing_at as name_the_place
+
+    with name_the_place(stage):
+        yield
 
 
 def toy_kwargs(settings) -> dict:
