@@ -204,7 +204,8 @@ def scan_command(
     check_settings(cfg, config, flags)
     out_dir = check_out_dir(out or "ispes")
     where = Path(interface or DEFAULT_INTERFACE)
-    check_settings(cfg, config, flags, where)  # the model on the interface: nothing written yet
+    if where.is_file():  # the model on the interface, before anything is written (a missing
+        check_settings(cfg, config, flags, where)  # file is the scan stage's own refusal)
     created = not out_dir.exists()
     out_dir.mkdir(parents=True, exist_ok=True)
     lock = RunLock(out_dir).acquire()  # one writer per --out (a run or another scan)
