@@ -72,6 +72,27 @@ def test_config_check_refuses_emt_on_quartz(emt_config, tmp_path, capsys):
     _emt_line(line, str(emt_config))
 
 
+@pytest.mark.parametrize(
+    ("section", "field", "named"),
+    [
+        (f'{{calculator: {{target: "{EMT}", scope: slab}}, coupling: none}}', None, EMT),
+        (f'{{intra: "ase:{EMT}"}}', "potential.intra", f"ase:{EMT}"),
+    ],
+    ids=["per-slab", "intra"],
+)
+def test_config_check_refuses_emt_per_slab_and_as_intra(
+    section, field, named, tmp_path, capsys, monkeypatch
+):
+    monkeypatch.chdir(tmp_path)
+    config = _config(tmp_path, f"potential: {section}\n")
+    line = assert_refused_cleanly(["config", "--check", config], capsys, tmp_path, [])
+    field = field or "potential.calculator.target"
+    assert line == (
+        f"error: {config}: {field}: {named} cannot evaluate the elements Si, O of this "
+        f"interface's alpha-quartz {EMT_SAYS}"
+    )
+
+
 def test_run_refuses_emt_on_quartz_before_the_run_directory(emt_config, tmp_path, capsys):
     out = tmp_path / "run"
     line = assert_refused_cleanly(["run", emt_config, "--out", out], capsys, tmp_path, [])
@@ -128,6 +149,49 @@ def test_scan_refuses_nan_forces_before_writing(toy, tmp_path, capsys, monkeypat
 
 
 # ---- a calculator that fails at one point in the middle of a scan ----------------------
+
+
+def _scan(toy, out, executor, *extra, capsys):
+    argv = ["scan", "--interface", toy, "--calculator", f"{HERE}:FailsWhenPressed", *extra]
+    argv += ["--p-range-gpa", "0", "1", "3", "--grid", "2", "2", "--executor", executor]
+    argv += ["--workers", "2", "--out", out, "--json"]
+    return run_cli(argv, capsys)
+
+
+def test_a_calculator_class_scans_on_worker_processes_as_in_one_process(
+    toy, tmp_path, capsys, monkeypatch
+):
+    """An ASE Calculator class as the target (``ase.calculators.emt:EMT`` style) attaches
+    itself to the atoms it is built with; built on the driver's reference, it made every
+    task sent to the workers unpicklable (``Can't pickle local object``, a traceback). The
+    pressure-range scan on two worker processes now gives the serial scan's numbers."""
+    import xarray as xr
+
+    monkeypatch.chdir(tmp_path)
+    energies = {}
+    # processes first: the driver's calculator (cached per thread and model) is then built
+    # on this run's reference, as in a fresh command
+    for executor in ("processes", "serial"):
+        code, _, err = _scan(toy, tmp_path / executor, executor, capsys=capsys)
+        assert code == 0, err
+        with xr.open_dataset(tmp_path / executor / "ispes.nc") as ds:
+            energies[executor] = ds["energy"].values.copy()
+    assert np.all(np.isfinite(energies["serial"]))
+    np.testing.assert_allclose(energies["processes"], energies["serial"], rtol=0, atol=1e-9)
+
+
+def test_a_failure_in_the_probe_on_workers_names_the_probe_point(toy, tmp_path, capsys):
+    """The pressure-range probe's compression reaches the gap the model refuses, in a worker
+    process: one line naming the scan's probe and the point (not a pickling traceback)."""
+    reference = toy_interface(layers=3)
+    z = reference.positions[:, 2]
+    slab = reference.arrays["slab"]
+    gap = float(z[slab == 2].min() - z[slab == 1].max())
+    kwarg = ["--calculator-kwarg", f"fail_gap_angstrom={gap - 0.15:.4f}"]
+    code, _, err = _scan(toy, tmp_path / "p", "processes", *kwarg, capsys=capsys)
+    line = refused(code, err, f"calculator '{HERE}:FailsWhenPressed' failed on the elements Ar")
+    assert line.startswith("error: scan: probe: point at shift (0, 0), thickness ")
+    assert line.endswith("outside the fitted range)")
 
 
 @pytest.mark.parametrize("executor", ["serial", "processes"])
@@ -233,6 +297,15 @@ def test_a_duck_typed_calculator_is_guarded_at_its_getters():
     assert atoms.get_potential_energy() == 0.0
     with pytest.raises(CalculatorFailure, match=r"\(IndexError: index 11 is out of bounds"):
         atoms.get_forces()
+
+
+def test_a_calculator_class_given_atoms_leaves_them_alone():
+    from flatcontact.potentials.loader import call_factory
+
+    atoms = toy_interface(layers=3)
+    calc = call_factory(f"{HERE}:FailsWhenPressed", atoms, {})
+    assert atoms.calc is None and calc.atoms is not atoms
+    pickle.dumps(atoms)  # what the scan sends to its workers
 
 
 def test_flatcontacts_own_errors_are_not_renamed():
