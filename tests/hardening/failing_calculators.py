@@ -70,3 +70,14 @@ class FailsAfter(EMT):
         if self.calls >= self.after:
             raise RuntimeError(f"evaluation {self.calls}: the model diverged")
         super().calculate(atoms, properties, system_changes)
+
+
+class NanStress(ToyPairCalculator):
+    """The toy model that also returns a stress, NaN, whether asked for or not (as a
+    calculator may for a cell that is not periodic along z)."""
+
+    implemented_properties = ("energy", "free_energy", "forces", "stress")
+
+    def calculate(self, atoms=None, properties=("energy",), system_changes=all_changes):
+        super().calculate(atoms, properties, system_changes)
+        self.results["stress"] = np.full(6, np.nan)

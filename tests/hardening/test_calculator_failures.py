@@ -289,6 +289,22 @@ def test_nan_and_exceptions_become_one_line_and_cross_processes():
     assert back.reason == "non-finite forces on 1 of 6 atoms" and back.elements == ("Ar",)
 
 
+def test_a_nan_stress_is_refused_only_when_asked_for():
+    """A scan asks for energy and forces: a NaN stress beside them is dropped, the forces are
+    the toy's; the elastic stage asks for the stress: refused in one line."""
+    from tests.hardening.failing_calculators import NanStress
+
+    atoms = toy_interface(layers=3)
+    atoms.calc = guard_calculator(NanStress(), "calculator 'nan-stress'")
+    plain = atoms.copy()
+    plain.calc = toy_calculator()
+    np.testing.assert_array_equal(atoms.get_forces(), plain.get_forces())
+    with pytest.raises(
+        CalculatorFailure, match=r"failed on the elements Ar \(non-finite stress \(nan"
+    ):
+        atoms.get_stress()
+
+
 def test_a_duck_typed_calculator_is_guarded_at_its_getters():
     from tests.hardening.failing_calculators import broken
 

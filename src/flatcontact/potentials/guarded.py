@@ -113,12 +113,21 @@ def non_finite(name: str, value: Any) -> str | None:
     return f"non-finite {name} ({shown} {unit})".replace(" )", ")")
 
 
-def _check_results(results: dict, name: str, atoms: Any) -> None:
+def _check_results(results: dict, name: str, atoms: Any, asked=()) -> None:
+    """Refuse a non-finite energy, forces or stress in ``results`` (cached: ASE hands them
+    out later without a new calculation). A non-finite stress that was not ``asked`` for is
+    dropped instead (a calculator may fill one nobody uses for a cell that is not 3-D
+    periodic); asked for later, it is computed again and checked then."""
     for key, _ in _CHECKED:
-        if key in results:
-            reason = non_finite(key, results[key])
-            if reason is not None:
-                raise CalculatorFailure(name, elements_of(atoms), reason)
+        if key not in results:
+            continue
+        reason = non_finite(key, results[key])
+        if reason is None:
+            continue
+        if key == "stress" and key not in asked:
+            del results[key]
+            continue
+        raise CalculatorFailure(name, elements_of(atoms), reason)
 
 
 def guard_calculator(calc: Any, name: str) -> Any:
@@ -149,7 +158,8 @@ def guard_calculator(calc: Any, name: str) -> Any:
                 if _passed_on(exc):
                     raise
                 raise CalculatorFailure(name, elements_of(structure), first_line(exc)) from None
-            _check_results(calc.results, name, structure)
+            asked = args[0] if args else kwargs.get("properties", ())
+            _check_results(calc.results, name, structure, asked or ())
             return out
 
         calc.calculate = calculate
@@ -175,7 +185,7 @@ def _guarded_getter(calc: Any, inner, key: str, name: str):
             if _passed_on(exc):
                 raise
             raise CalculatorFailure(name, elements_of(structure), first_line(exc)) from None
-        _check_results({key: value}, name, structure)
+        _check_results({key: value}, name, structure, (key,))
         return value
 
     return getter
