@@ -134,7 +134,7 @@ def test_nan_forces_are_refused_before_any_work(command, tmp_path, capsys, monke
     line = assert_refused_cleanly(argv, capsys, tmp_path, [])
     assert line == (
         f"error: {config}: potential.calculator.target: {HERE}:NanForces cannot evaluate the "
-        "elements Ar of this interface (non-finite forces on 1 of 6 atoms)"
+        "element Ar of this interface (non-finite forces on 1 of 6 atoms)"
     )
     assert not out.exists()
 
@@ -189,7 +189,7 @@ def test_a_failure_in_the_probe_on_workers_names_the_probe_point(toy, tmp_path, 
     gap = float(z[slab == 2].min() - z[slab == 1].max())
     kwarg = ["--calculator-kwarg", f"fail_gap_angstrom={gap - 0.15:.4f}"]
     code, _, err = _scan(toy, tmp_path / "p", "processes", *kwarg, capsys=capsys)
-    line = refused(code, err, f"calculator '{HERE}:FailsWhenPressed' failed on the elements Ar")
+    line = refused(code, err, f"calculator '{HERE}:FailsWhenPressed' failed on the element Ar")
     assert line.startswith("error: scan: probe: point at shift (0, 0), thickness ")
     assert line.endswith("outside the fitted range)")
 
@@ -218,7 +218,7 @@ def test_a_failure_mid_scan_names_the_calculator_and_the_point(
     if executor == "processes":
         argv += ["--workers", "1"]
     code, _, err = run_cli(argv, capsys)
-    line = refused(code, err, target, "failed on the elements Ar (RuntimeError: gap ")
+    line = refused(code, err, target, "failed on the element Ar (RuntimeError: gap ")
     assert line.startswith("error: scan: point at shift (")
     assert f"thickness {pressed:.4g} Å: calculator '{target}'" in line
     assert line.endswith("outside the fitted range)")
@@ -247,7 +247,7 @@ def test_a_failure_in_the_build_relaxation_names_the_stage(command, tmp_path, ca
     code, _, err = run_cli([*argv, "--out", out], capsys)
     line = refused(code, err)
     assert line == (
-        f"error: build: calculator '{target}' failed on the elements Cu "
+        f"error: build: calculator '{target}' failed on the element Cu "
         "(RuntimeError: evaluation 3: the model diverged)"
     )
     assert not (out / "interface.extxyz").exists() and not any(out.glob("01-build/*.extxyz"))
@@ -280,7 +280,7 @@ def test_nan_and_exceptions_become_one_line_and_cross_processes():
     failure = info.value
     assert (
         str(failure)
-        == "calculator 'nan' failed on the elements Ar (non-finite forces on 1 of 6 atoms)"
+        == "calculator 'nan' failed on the element Ar (non-finite forces on 1 of 6 atoms)"
     )
     placed = failure.at("point at shift (0.5, 0), thickness 11 Å").at("scan")
     back = pickle.loads(pickle.dumps(placed))
@@ -300,7 +300,7 @@ def test_a_nan_stress_is_refused_only_when_asked_for():
     plain.calc = toy_calculator()
     np.testing.assert_array_equal(atoms.get_forces(), plain.get_forces())
     with pytest.raises(
-        CalculatorFailure, match=r"failed on the elements Ar \(non-finite stress \(nan"
+        CalculatorFailure, match=r"failed on the element Ar \(non-finite stress \(nan"
     ):
         atoms.get_stress()
 

@@ -53,7 +53,7 @@ class CalculatorFailure(InputError):
         self.elements = tuple(elements)
         self.reason = reason
         self.where = where
-        text = f"{calculator} failed on the elements {', '.join(self.elements)} ({reason})"
+        text = f"{calculator} failed on {the_elements(self.elements)} ({reason})"
         super().__init__(f"{where}: {text}" if where else text)
 
     def __reduce__(self):  # crosses process boundaries (scan workers) with its fields
@@ -72,6 +72,12 @@ def failing_at(where: str) -> Iterator[None]:
         yield
     except CalculatorFailure as exc:
         raise exc.at(where) from None
+
+
+def the_elements(elements: tuple[str, ...]) -> str:
+    """``"the elements Si, O"``, ``"the element Ar"``."""
+    noun = "element" if len(elements) == 1 else "elements"
+    return f"the {noun} {', '.join(elements)}"
 
 
 def elements_of(atoms: Any) -> tuple[str, ...]:

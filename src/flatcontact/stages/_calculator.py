@@ -89,9 +89,11 @@ def evaluation_refusal(settings, failure, source: str, what: str):
         field, name = "potential.intra", m.intra
     else:
         field, name = "potential", m.label
-    elements = ", ".join(failure.elements)
+    # imported here for the same reason as in :func:`factory`
+    from flatcontact.potentials.guarded import the_elements
+
     return InputError(
-        f"{source}: {field}: {name} cannot evaluate the elements {elements} of {what} "
+        f"{source}: {field}: {name} cannot evaluate {the_elements(failure.elements)} of {what} "
         f"({failure.reason})"
     )
 
