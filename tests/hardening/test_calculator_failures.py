@@ -251,6 +251,10 @@ def test_a_failure_in_the_build_relaxation_names_the_stage(command, tmp_path, ca
         "(RuntimeError: evaluation 3: the model diverged)"
     )
     assert not (out / "interface.extxyz").exists() and not any(out.glob("01-build/*.extxyz"))
+    if command == "run":  # the console has one line; the run log keeps the traceback
+        log = (out / "run.log").read_text()
+        assert "the calculator's traceback:\nTraceback (most recent call last):" in log
+        assert "in calculate\n" in log and "RuntimeError: evaluation 3: the model diverged" in log
 
 
 # ---- the guard itself ---------------------------------------------------------------------
@@ -313,6 +317,16 @@ def test_a_duck_typed_calculator_is_guarded_at_its_getters():
     assert atoms.get_potential_energy() == 0.0
     with pytest.raises(CalculatorFailure, match=r"\(IndexError: index 11 is out of bounds"):
         atoms.get_forces()
+    detail = pickle.loads(pickle.dumps(info_of(atoms.get_forces))).detail
+    assert detail.startswith("Traceback (most recent call last):")
+    assert "in get_forces\n" in detail and detail.rstrip().endswith("with size 7")
+
+
+def info_of(call) -> CalculatorFailure:
+    """The CalculatorFailure ``call()`` raises."""
+    with pytest.raises(CalculatorFailure) as info:
+        call()
+    return info.value
 
 
 def test_a_calculator_class_given_atoms_leaves_them_alone():

@@ -18,6 +18,7 @@ flatcontact's code around it keeps its traceback.
 from __future__ import annotations
 
 import errno
+import traceback
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
@@ -28,6 +29,8 @@ from flatcontact.foundation.errors import InputError
 
 #: Operating-system faults passed on unchanged (the command line names the limit).
 _RESOURCE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG})
+#: The characters of the calculator's traceback a failure keeps (:attr:`CalculatorFailure.detail`).
+TRACEBACK_CHARS = 4000
 #: The properties whose values are checked finite, with their units for the message.
 _CHECKED = (("energy", "eV"), ("forces", "eV/Å"), ("stress", "eV/Å³"))
 
@@ -46,23 +49,35 @@ class CalculatorFailure(InputError):
         27 atoms"``.
     where
         Where it happened (``"scan: point at shift (0.5, 0), thickness 11.2 Å"``), or ``""``.
+    detail
+        The calculator's own traceback (text, its last ``TRACEBACK_CHARS`` characters), for
+        the run log; never printed on the console.
     """
 
-    def __init__(self, calculator: str, elements: tuple[str, ...], reason: str, where: str = ""):
+    def __init__(
+        self,
+        calculator: str,
+        elements: tuple[str, ...],
+        reason: str,
+        where: str = "",
+        detail: str = "",
+    ):
         self.calculator = calculator
         self.elements = tuple(elements)
         self.reason = reason
         self.where = where
+        self.detail = detail
         text = f"{calculator} failed on {the_elements(self.elements)} ({reason})"
         super().__init__(f"{where}: {text}" if where else text)
 
     def __reduce__(self):  # crosses process boundaries (scan workers) with its fields
-        return (type(self), (self.calculator, self.elements, self.reason, self.where))
+        fields = (self.calculator, self.elements, self.reason, self.where, self.detail)
+        return (type(self), fields)
 
     def at(self, where: str) -> CalculatorFailure:
         """The same failure, ``where`` named before the places already named."""
         inner = f"{where}: {self.where}" if self.where else where
-        return CalculatorFailure(self.calculator, self.elements, self.reason, inner)
+        return CalculatorFailure(self.calculator, self.elements, self.reason, inner, self.detail)
 
 
 @contextmanager
@@ -92,6 +107,12 @@ def first_line(exc: BaseException) -> str:
     lines = [ln.strip() for ln in str(exc).splitlines() if ln.strip()]
     said = lines[0][:200] if lines else ""
     return f"{type(exc).__name__}: {said}" if said else type(exc).__name__
+
+
+def _raised(name: str, atoms: Any, exc: Exception) -> CalculatorFailure:
+    """The :class:`CalculatorFailure` of ``exc``, raised by the calculator ``name`` on ``atoms``."""
+    detail = "".join(traceback.format_exception(exc))[-TRACEBACK_CHARS:]
+    return CalculatorFailure(name, elements_of(atoms), first_line(exc), detail=detail)
 
 
 def _passed_on(exc: BaseException) -> bool:
@@ -163,7 +184,7 @@ def guard_calculator(calc: Any, name: str) -> Any:
             except Exception as exc:
                 if _passed_on(exc):
                     raise
-                raise CalculatorFailure(name, elements_of(structure), first_line(exc)) from None
+                raise _raised(name, structure, exc) from None
             asked = args[0] if args else kwargs.get("properties", ())
             _check_results(calc.results, name, structure, asked or ())
             return out
@@ -190,7 +211,7 @@ def _guarded_getter(calc: Any, inner, key: str, name: str):
         except Exception as exc:
             if _passed_on(exc):
                 raise
-            raise CalculatorFailure(name, elements_of(structure), first_line(exc)) from None
+            raise _raised(name, structure, exc) from None
         _check_results({key: value}, name, structure, (key,))
         return value
 
@@ -216,7 +237,7 @@ def evaluate_once(calc: Any, atoms: Any, name: str) -> tuple[float, np.ndarray]:
     except Exception as exc:
         if _passed_on(exc):
             raise
-        raise CalculatorFailure(name, elements, first_line(exc)) from None
+        raise _raised(name, atoms, exc) from None
     finally:
         work.calc = None
     for key, value in (("energy", energy), ("forces", forces)):

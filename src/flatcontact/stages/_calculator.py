@@ -7,11 +7,14 @@ its engines (:mod:`flatcontact.potentials.engines`); nothing here branches on th
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
 from flatcontact.foundation.errors import InputError
+
+log = logging.getLogger("flatcontact.run")
 
 #: The elements the elastic stage's crystal (α-quartz) needs.
 QUARTZ_ELEMENTS = frozenset({"Si", "O"})
@@ -102,12 +105,19 @@ def evaluation_refusal(settings, failure, source: str, what: str):
 def failing_at(stage: str) -> Iterator[None]:
     """A user's calculator that fails inside the block (an exception, a NaN:
     :class:`~flatcontact.potentials.guarded.CalculatorFailure`) names ``stage`` first:
-    ``scan: point at shift (0.5, 0), thickness 11.2 Å: calculator '...' failed on ...``."""
+    ``scan: point at shift (0.5, 0), thickness 11.2 Å: calculator '...' failed on ...``;
+    its own traceback goes to the run log (INFO: nowhere without one, not the console)."""
     # imported here for the same reason as in :func:`factory`
+    from flatcontact.potentials.guarded import CalculatorFailure
     from flatcontact.potentials.guarded import failing_at as name_the_place
 
-    with name_the_place(stage):
-        yield
+    try:
+        with name_the_place(stage):
+            yield
+    except CalculatorFailure as exc:
+        if exc.detail:  # the run log (``flatcontact run``) keeps the calculator's traceback
+            log.info("%s; the calculator's traceback:\n%s", exc, exc.detail)
+        raise
 
 
 def toy_kwargs(settings) -> dict:
