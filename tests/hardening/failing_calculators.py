@@ -81,3 +81,8 @@ class NanStress(ToyPairCalculator):
     def calculate(self, atoms=None, properties=("energy",), system_changes=all_changes):
         super().calculate(atoms, properties, system_changes)
         self.results["stress"] = np.full(6, np.nan)
+
+
+def boom(**kwargs):
+    """A factory that refuses to build its calculator."""
+    raise ValueError("sigma must be positive\nsee the manual")

@@ -120,6 +120,24 @@ def test_scan_names_the_calculator_flag_that_set_emt(quartz, tmp_path, capsys, m
     assert line.endswith(EMT_SAYS) and not out.exists()
 
 
+def test_a_factory_that_fails_is_refused_naming_the_field_or_the_flag(
+    toy, tmp_path, capsys, monkeypatch
+):
+    """The pre-run evaluation builds the calculator: a factory that raises is refused by
+    ``config --check`` (which only imported it before) under ``potential.calculator.target``
+    and by ``scan`` under ``--calculator``, the flag that set it."""
+    monkeypatch.chdir(tmp_path)
+    config = _config(
+        tmp_path, TOY_STRUCTURE + f"potential: {{calculator: {{target: '{HERE}:boom'}}}}\n"
+    )
+    said = f"calculator '{HERE}:boom' failed: ValueError: sigma must be positive see the manual"
+    line = assert_refused_cleanly(["config", "--check", config], capsys, tmp_path, [])
+    assert line == f"error: {config}: potential.calculator.target: {said}"
+    argv = ["scan", "--interface", toy, "--calculator", f"{HERE}:boom", "--out", tmp_path / "s"]
+    line = assert_refused_cleanly([*argv, "--thickness-angstrom", "11"], capsys, tmp_path, [])
+    assert line == f"error: --calculator: {said}"
+
+
 # ---- a calculator that returns NaN forces -----------------------------------------------
 
 

@@ -79,26 +79,40 @@ def check_evaluation(settings, atoms) -> None:
     check_model_evaluation(settings.potential, atoms)
 
 
-def evaluation_refusal(settings, failure, source: str, what: str):
-    """The one line of a pre-run evaluation that failed (``failure``: a
-    :class:`~flatcontact.potentials.guarded.CalculatorFailure`) as an InputError:
-    ``<source>: <settings path>: <calculator> cannot evaluate the elements Si, O of <what>
-    (<reason>)``. The settings path is the one naming the calculator:
+def _field(settings) -> tuple[str, str]:
+    """The settings path naming the model's calculator and how it is written there:
     ``potential.calculator.target``, ``potential.intra`` (``ase:...``) or ``potential``."""
     m = settings.potential
     if m.calculator is not None:
-        field, name = "potential.calculator.target", m.calculator.target
-    elif m.engine == "ase-slab":
-        field, name = "potential.intra", m.intra
-    else:
-        field, name = "potential", m.label
-    # imported here for the same reason as in :func:`factory`
-    from flatcontact.potentials.guarded import the_elements
+        return "potential.calculator.target", m.calculator.target
+    if m.engine == "ase-slab":
+        return "potential.intra", m.intra
+    return "potential", m.label
 
-    return InputError(
-        f"{source}: {field}: {name} cannot evaluate {the_elements(failure.elements)} of {what} "
-        f"({failure.reason})"
-    )
+
+def evaluation_refusal(settings, failure, source: str, what: str) -> InputError:
+    """The one line of a pre-run evaluation that failed as an InputError.
+
+    ``failure`` a :class:`~flatcontact.potentials.guarded.CalculatorFailure`: ``<source>:
+    <settings path>: <calculator> cannot evaluate the elements Si, O of <what> (<reason>)``;
+    any other InputError of the model's setup keeps its text after ``<source>:`` and the
+    settings path it concerns (``potential.calculator.target`` for a calculator factory that
+    failed, ``potential`` for the rest, unless it names one itself)."""
+    # imported here for the same reason as in :func:`factory`
+    from flatcontact.potentials.guarded import CalculatorFailure, the_elements
+
+    field, name = _field(settings)
+    if isinstance(failure, CalculatorFailure):
+        return InputError(
+            f"{source}: {field}: {name} cannot evaluate {the_elements(failure.elements)} of "
+            f"{what} ({failure.reason})"
+        )
+    text = str(failure)
+    if text.startswith("potential"):
+        return InputError(f"{source}: {text}")
+    if not text.startswith(("calculator ", "ASE calculator factory ")):
+        field = "potential"
+    return InputError(f"{source}: {field}: {text}")
 
 
 @contextmanager

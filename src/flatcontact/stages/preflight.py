@@ -22,7 +22,6 @@ from flatcontact.foundation import limits
 from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.executors import check_scheduler_address
 from flatcontact.potentials.engines import calculator_factory
-from flatcontact.potentials.guarded import CalculatorFailure
 from flatcontact.potentials.loader import load_callable
 from flatcontact.report.sections.approximant_study import read_approximant_study
 from flatcontact.stages import _calculator
@@ -181,12 +180,8 @@ def check_scan_interface(cfg: RunConfig, interface: str | Path, source: str = "c
     atoms = read_interface(interface)
     try:
         _calculator.check_evaluation(cfg, atoms)
-    except CalculatorFailure as exc:
-        raise _calculator.evaluation_refusal(cfg, exc, source, str(interface)) from None
     except InputError as exc:
-        text = str(exc)
-        where = "" if text.startswith("potential") else "potential: "
-        raise InputError(f"{source}: {where}{text}") from None
+        raise _calculator.evaluation_refusal(cfg, exc, source, str(interface)) from None
     return atoms
 
 
@@ -209,9 +204,5 @@ def _check_structure(cfg: RunConfig, source: str) -> None:
             raise InputError(f"{source}: {exc}") from None
     try:
         _calculator.check_evaluation(cfg, atoms)
-    except CalculatorFailure as exc:
-        raise _calculator.evaluation_refusal(cfg, exc, source, what) from None
     except InputError as exc:
-        text = str(exc)
-        where = "" if text.startswith("potential") else "potential: "
-        raise InputError(f"{source}: {where}{text}") from None
+        raise _calculator.evaluation_refusal(cfg, exc, source, what) from None
