@@ -198,6 +198,23 @@ def test_a_calculator_class_scans_on_worker_processes_as_in_one_process(
     np.testing.assert_allclose(energies["processes"], energies["serial"], rtol=0, atol=1e-9)
 
 
+def test_a_failure_in_a_rigid_single_point_names_its_stacking():
+    """The probe's single points (one per lateral shift at the reference thickness)."""
+    from flatcontact.ispes.grid import GridSpec
+    from flatcontact.ispes.probe import rigid_rows
+
+    reference = toy_interface(layers=3)
+    calc = guard_calculator(NanForces(), "calculator 'nan'")
+    grid = GridSpec(2, 2, thickness_angstrom=(11.0,))
+    with pytest.raises(CalculatorFailure) as info:
+        rigid_rows(reference, calc, grid, [1])
+    z = thickness(reference)
+    assert str(info.value) == (
+        f"rigid single point at shift (0.5, 0), thickness {z:.4g} Å: calculator 'nan' failed "
+        "on the element Ar (non-finite forces on 1 of 6 atoms)"
+    )
+
+
 def test_a_failure_in_the_probe_on_workers_names_the_probe_point(toy, tmp_path, capsys):
     """The pressure-range probe's compression reaches the gap the model refuses, in a worker
     process: one line naming the scan's probe and the point (not a pickling traceback)."""

@@ -96,7 +96,8 @@ def rigid_rows(reference: Atoms, calc, grid: GridSpec, rows) -> tuple[np.ndarray
                 continue
             start_afresh(calc)  # a function of the stacking alone, whatever ran before
             atoms.calc = calc
-            with failing_at(f"rigid single point at shift ({a:.4g}, {b:.4g}), {z_ref:.4g} Å"):
+            where = f"rigid single point at shift ({a:.4g}, {b:.4g}), thickness {z_ref:.4g} Å"
+            with failing_at(where):
                 energy[i, j] = atoms.get_potential_energy()
                 load[i, j] = normal_stress_gpa(atoms, atoms.get_forces(apply_constraint=False))
             atoms.calc = None

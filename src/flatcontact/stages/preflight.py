@@ -4,11 +4,13 @@ The settings (:mod:`flatcontact.config`) check values alone; :func:`check_inputs
 what they name (the interface file, the measured CSVs, the calculator's module), builds the
 recipe's interface as the build stage does but without its relaxation (milliseconds: the
 relaxation is the build's only expensive part), sets the model up for it (for LAMMPS: the
-``pair_style``/``pair_coeff`` commands, files read and element map checked) and computes
-one energy and forces of it (a calculator that raises, as ASE's EMT does for Si, or returns
-NaN is refused here, not in the build's relaxation), and asks the stages' own checks (the contact moduli's material, the elastic
-crystal), so ``flatcontact config --check`` and :class:`flatcontact.pipeline.Pipeline`
-refuse a run before its first stage, with one line naming the field and the file.
+``pair_style``/``pair_coeff`` commands, files read and element map checked), computes one
+energy and forces of it (a calculator that raises, as ASE's EMT does for Si, or returns NaN
+is refused here, not in the build's relaxation) and asks the stages' own checks (the
+contact moduli's material, the elastic crystal), so ``flatcontact config --check`` and
+:class:`flatcontact.pipeline.Pipeline` refuse a run before its first stage, with one line
+naming the field and the file. ``flatcontact scan`` asks :func:`check_scan_interface` for
+the interface it is given.
 """
 
 from __future__ import annotations
