@@ -48,6 +48,7 @@ FLAG_OF = {
     "potential": "--potential",
     "potential.intra": "--potential",
     "potential.calculator": "--calculator",
+    "potential.calculator.target": "--calculator",
     "potential.calculator.kwargs": "--calculator-kwarg",
 }
 #: Where ``flatcontact build`` writes the interface by default (``--out build``).
@@ -90,17 +91,24 @@ def _given(flags: dict[str, Any], prefix: str = "") -> set[str]:
     return out
 
 
-def check_settings(cfg, config: Path | None, flags: dict[str, Any]) -> None:
+def check_settings(
+    cfg, config: Path | None, flags: dict[str, Any], interface: Path | None = None
+) -> None:
     """The pre-run checks of the scan's settings (:func:`~flatcontact.stages.preflight.check_scan_settings`),
     refused in the line ``flatcontact run CONFIG`` and ``config --check CONFIG`` give: it names
-    CONFIG and the settings path, or the flag when a flag set that path."""
+    CONFIG and the settings path, or the flag when a flag set that path. With ``interface``,
+    the model on that interface instead (:func:`~flatcontact.stages.preflight.check_scan_interface`:
+    one energy and forces), before the scan writes anything."""
     from flatcontact.cli.settings import config_source
     from flatcontact.stages._common import rename
-    from flatcontact.stages.preflight import check_scan_settings
+    from flatcontact.stages.preflight import check_scan_interface, check_scan_settings
 
     source = config_source(config)
     try:
-        check_scan_settings(cfg, source)
+        if interface is None:
+            check_scan_settings(cfg, source)
+        else:
+            check_scan_interface(cfg, interface, source)
     except InputError as exc:
         text = str(exc).removeprefix(f"{source}: ")
         path = text.partition(": ")[0]
@@ -196,6 +204,8 @@ def scan_command(
     check_settings(cfg, config, flags)
     out_dir = check_out_dir(out or "ispes")
     where = Path(interface or DEFAULT_INTERFACE)
+    if where.is_file():  # the model on the interface, before anything is written (a missing
+        check_settings(cfg, config, flags, where)  # file is the scan stage's own refusal)
     created = not out_dir.exists()
     out_dir.mkdir(parents=True, exist_ok=True)
     lock = RunLock(out_dir).acquire()  # one writer per --out (a run or another scan)

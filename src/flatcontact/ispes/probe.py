@@ -23,6 +23,7 @@ from flatcontact.ispes.contract import cell_area
 from flatcontact.ispes.geometry import in_plane_vectors, place_slab2, thickness
 from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.relax import normal_stress_gpa, start_afresh
+from flatcontact.potentials.guarded import CalculatorFailure, failing_at
 
 
 @dataclasses.dataclass(frozen=True)
@@ -95,8 +96,10 @@ def rigid_rows(reference: Atoms, calc, grid: GridSpec, rows) -> tuple[np.ndarray
                 continue
             start_afresh(calc)  # a function of the stacking alone, whatever ran before
             atoms.calc = calc
-            energy[i, j] = atoms.get_potential_energy()
-            load[i, j] = normal_stress_gpa(atoms, atoms.get_forces(apply_constraint=False))
+            where = f"rigid single point at shift ({a:.4g}, {b:.4g}), thickness {z_ref:.4g} Å"
+            with failing_at(where):
+                energy[i, j] = atoms.get_potential_energy()
+                load[i, j] = normal_stress_gpa(atoms, atoms.get_forces(apply_constraint=False))
             atoms.calc = None
     return energy, load
 
@@ -197,6 +200,8 @@ def compress_chain(
         z = z_ref - k * dz_down_angstrom
         try:
             e, p, n, pos = relax(a, b, z, start, start_z)
+        except CalculatorFailure:
+            raise  # the user's calculator failed: not an overlap
         except InputError as exc:
             raise InputError(_overlap_message(p_hi_gpa, exc)) from None
         out.append((z, e, p, n))
@@ -253,6 +258,8 @@ def compress_segment(
         z = z_ref - k * dz_down_angstrom
         try:
             e, p, n, pos = relax(a, b, z, start, start_z)
+        except CalculatorFailure:
+            raise  # the user's calculator failed: not an overlap
         except InputError as exc:
             if k == 0:
                 raise

@@ -79,6 +79,7 @@ from flatcontact.ispes.geometry import (
     warm_start_positions,
 )
 from flatcontact.ispes.lbfgs import largest_atomic_norm, lbfgs_relax
+from flatcontact.potentials.guarded import failing_at
 
 Optimizer = Literal["LBFGS-scaled", "LBFGS", "FIRE", "FIRE2", "BFGS", "BFGSLineSearch", "lammps-cg"]
 OPTIMIZERS: tuple[str, ...] = (
@@ -231,6 +232,18 @@ def _optimizer_class(name: str):
 
 
 def relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings) -> PointResult:
+    """Relax one grid point with ``calc`` (reused across calls) and measure it
+    (:func:`_relax_point`). A user's calculator that fails there
+    (:class:`~flatcontact.potentials.guarded.CalculatorFailure`) names the point: ``point at
+    shift (0.5, 0), thickness 11.2 Å: calculator '...' failed on ...``."""
+    where = (
+        f"point at shift ({task.shift_a:.4g}, {task.shift_b:.4g}), thickness {task.thickness:.4g} Å"
+    )
+    with failing_at(where):
+        return _relax_point(reference, calc, task, settings)
+
+
+def _relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSettings) -> PointResult:
     """Relax one grid point with ``calc`` (reused across calls) and measure it.
 
     The structure is ``place_slab2(reference, task.shift_a, task.shift_b,

@@ -53,6 +53,7 @@ from flatcontact.ispes.scan_probe import resolve, store_pending_work
 from flatcontact.ispes.scan_scheduler import COMMIT_INTERVAL_S, Scheduler
 from flatcontact.ispes.scan_symmetry import ScanRound, SymmetryPlan
 from flatcontact.ispes.store import PointStore, discard_store, interface_hash
+from flatcontact.potentials.guarded import failing_at
 
 
 @dataclasses.dataclass
@@ -268,7 +269,7 @@ def _drive(
         executor.prestart(factory, reference)  # worker start overlaps the probe
     # the probe's finished units, beside the store (a resumed probe reuses them)
     units = ProbeUnits(out_dir / PROBE_JSON, probe_settings(store.settings))
-    with phase("probe"):
+    with phase("probe"), failing_at("probe"):
         resolved, notes, pending = resolve(store, reference, factory, grid, relax, executor, units)
     scheduler = Scheduler(
         store,

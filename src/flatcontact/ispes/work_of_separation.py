@@ -46,6 +46,7 @@ from flatcontact.foundation.units import EV_PER_A2_TO_J_PER_M2
 from flatcontact.ispes.contract import cell_area
 from flatcontact.ispes.geometry import in_plane_vectors, place_slab2, thickness
 from flatcontact.ispes.relax import PointTask, RelaxSettings, relax_point, start_afresh
+from flatcontact.potentials.guarded import CalculatorFailure, failing_at
 from flatcontact.structures.interface_contract import continues_crystal, recipe_record
 
 #: first step (Å) away from the reference thickness when bracketing p = 0; doubled each time
@@ -146,8 +147,9 @@ def ideal_work_of_separation(
     a1, a2 = in_plane_vectors(reference)
     area = cell_area(a1, a2)
     calc = factory(reference) if calc is None else calc
-    z_eq, e_int, p_eq, ok, calls = zero_load_interface(reference, calc, relax, shift)
-    d, e_apart, converged, n = slabs_apart(reference, calc, relax, shift, area)
+    with failing_at("ideal work of separation"):  # a user's calculator that fails: one line
+        z_eq, e_int, p_eq, ok, calls = zero_load_interface(reference, calc, relax, shift)
+        d, e_apart, converged, n = slabs_apart(reference, calc, relax, shift, area)
     w = (e_apart - e_int) / area * EV_PER_A2_TO_J_PER_M2
     return WorkOfSeparation(
         work_of_separation_j_per_m2=float(w),
@@ -235,6 +237,8 @@ def zero_load_interface(
         )
         try:
             r = relax_point(reference, calc, task, relax)
+        except CalculatorFailure:
+            raise  # the user's calculator failed: not an overlap
         except InputError as exc:
             raise InputError(
                 f"work of separation: the slabs overlap at z = {z:.4g} Å before the load "

@@ -20,11 +20,23 @@ from ase import Atoms
 from ase.calculators.calculator import Calculator, all_changes
 
 from flatcontact.foundation.errors import InputError
+from flatcontact.potentials.guarded import guard_calculator
 from flatcontact.potentials.lammps_engine import LammpsEngine
 from flatcontact.potentials.lammps_setup import compile_setup
 from flatcontact.potentials.lj import lj_cross_energy_forces
 from flatcontact.potentials.loader import call_factory
 from flatcontact.potentials.model import InteractionModel, slab_ids
+
+
+def calculator_name(spec: InteractionModel) -> str:
+    """How a refusal names the model's calculator: ``calculator 'module:callable'`` for a
+    user's ASE calculator, ``ASE calculator factory '...'`` for ``intra: ase:...``, else
+    ``potential <label>``."""
+    if spec.calculator is not None:
+        return f"calculator '{spec.calculator.target}'"
+    if spec.engine == "ase-slab":
+        return f"ASE calculator factory '{spec.intra.removeprefix('ase:')}'"
+    return f"potential {spec.label}"
 
 
 def _signature(atoms: Atoms) -> tuple:
@@ -223,11 +235,16 @@ class AseInterfaceCalculator(InterfaceCalculator):
     """
 
     def _factory(self):
-        spec = self.spec
+        """``make()`` -> one slab's calculator, guarded
+        (:func:`~flatcontact.potentials.guarded.guard_calculator`: the user's code)."""
+        spec, name = self.spec, calculator_name(self.spec)
         if spec.calculator is not None:
-            return lambda: call_factory(spec.calculator.target, None, spec.calculator.kwargs)
+            c = spec.calculator
+            return lambda: guard_calculator(call_factory(c.target, None, c.kwargs), name)
         target = spec.intra.removeprefix("ase:")
-        return lambda: call_factory(target, None, {}, what="ASE calculator factory")
+        return lambda: guard_calculator(
+            call_factory(target, None, {}, what="ASE calculator factory"), name
+        )
 
     def _build(self, atoms: Atoms) -> None:
         make = self._factory()

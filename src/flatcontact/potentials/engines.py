@@ -5,6 +5,9 @@
   calculator for the whole interface);
 - :func:`check_setup`: the model set up for a structure without computing anything, so a
   setup its engine refuses (LAMMPS pair commands) is one line before any work;
+- :func:`check_evaluation`: the same and one energy and forces of the structure, so a
+  calculator that cannot evaluate its elements (it raises, or returns NaN) is one line
+  before any work;
 - :func:`calculator_factory`: the same as a picklable factory (:class:`ModelFactory`) for scan
   workers and Dask;
 - :func:`bulk_calculator`: energy, forces and stress of a single crystal, from a model or from a
@@ -22,7 +25,12 @@ from functools import cached_property
 from ase import Atoms
 
 from flatcontact.foundation.errors import InputError
-from flatcontact.potentials.calculator import AseInterfaceCalculator, LammpsInterfaceCalculator
+from flatcontact.potentials.calculator import (
+    AseInterfaceCalculator,
+    LammpsInterfaceCalculator,
+    calculator_name,
+)
+from flatcontact.potentials.guarded import evaluate_once, guard_calculator
 from flatcontact.potentials.loader import call_factory
 from flatcontact.potentials.model import InteractionModel
 from flatcontact.potentials.names import CLASSICAL, snapcoeff_path
@@ -34,11 +42,14 @@ def make_calculator(model: InteractionModel, atoms: Atoms):
     """The calculator of ``model`` for ``atoms`` (an interface, a slab or a bulk crystal).
 
     Raises :class:`InputError` on an element mismatch before any LAMMPS instance is created.
+    A user's ASE calculator is guarded (:func:`~flatcontact.potentials.guarded.guard_calculator`:
+    an exception it raises or a NaN it returns is a one-line
+    :class:`~flatcontact.potentials.guarded.CalculatorFailure` naming it).
     """
     if model.engine == "ase-interface":
         model.check_atoms(atoms)
         c = model.calculator
-        return call_factory(c.target, atoms, c.kwargs)
+        return guard_calculator(call_factory(c.target, atoms, c.kwargs), calculator_name(model))
     if model.engine == "ase-slab":
         return AseInterfaceCalculator(model, atoms)
     return LammpsInterfaceCalculator(model, atoms)
@@ -53,15 +64,45 @@ def check_setup(model: InteractionModel, atoms: Atoms) -> None:
     calculators are not instantiated (some load models for seconds).
     """
     model.check_atoms(atoms)
-    if model.engine != "lammps":
-        return
+    if model.engine == "lammps":
+        _lammps_setup(model, atoms).close()
+
+
+def _lammps_setup(model: InteractionModel, atoms: Atoms) -> LammpsInterfaceCalculator:
+    """The LAMMPS calculator of ``model`` set up for ``atoms``; LAMMPS's refusal in one line."""
     try:
-        calc = LammpsInterfaceCalculator(model, atoms)
+        return LammpsInterfaceCalculator(model, atoms)
     except InputError as exc:
         lines = [ln.strip() for ln in str(exc).splitlines() if ln.strip()]
         kept = [ln for ln in lines if not ln.startswith("For more information")]
         raise InputError("; ".join(kept)) from None
-    calc.close()
+
+
+def check_evaluation(model: InteractionModel, atoms: Atoms) -> None:
+    """:func:`check_setup`, then one energy and forces of ``atoms`` with the model's calculator.
+
+    The user's ASE calculator is instantiated (a machine-learned model loads its weights:
+    seconds) and evaluated once; LAMMPS computes once on the setup :func:`check_setup` makes
+    (milliseconds for a reference interface).
+
+    Raises
+    ------
+    InputError
+        :func:`check_setup`'s refusals, and a
+        :class:`~flatcontact.potentials.guarded.CalculatorFailure` when the calculator raises
+        (``NotImplementedError: No EMT-potential for Si``) or returns a non-finite energy or
+        forces.
+    """
+    model.check_atoms(atoms)
+    calc = (
+        _lammps_setup(model, atoms) if model.engine == "lammps" else make_calculator(model, atoms)
+    )
+    try:
+        evaluate_once(calc, atoms, calculator_name(model))
+    finally:
+        close = getattr(calc, "close", None)
+        if model.engine != "ase-interface" and close is not None:
+            close()
 
 
 @dataclasses.dataclass(frozen=True)
@@ -144,9 +185,10 @@ def bulk_calculator(model: InteractionModel | str, atoms: Atoms | None = None):
         model = _named_model(model)
     if model.calculator is not None:
         c = model.calculator
-        return call_factory(c.target, atoms, c.kwargs)
+        return guard_calculator(call_factory(c.target, atoms, c.kwargs), calculator_name(model))
     if model.engine == "ase-slab":
-        return call_factory(model.intra.removeprefix("ase:"), None, {})
+        target = model.intra.removeprefix("ase:")
+        return guard_calculator(call_factory(target, None, {}), calculator_name(model))
     if not model.intra_styles:
         raise InputError(f"potential {model.label}: no intra model to compute a bulk crystal with")
     return LammpsInterfaceCalculator(model, atoms, bulk=True)

@@ -61,7 +61,9 @@ def is_calculator(obj: Any) -> bool:
 
 
 def call_factory(target: str, atoms=None, kwargs: dict | None = None, what: str = "calculator"):
-    """``callable(**kwargs)`` (with ``atoms=atoms`` when it takes ``atoms``): an ASE calculator.
+    """``callable(**kwargs)`` (with ``atoms=`` a copy of ``atoms`` when it takes ``atoms``): an
+    ASE calculator. ``atoms`` itself is not modified (an ASE ``Calculator`` class given atoms
+    sets their ``calc``; here it sets the copy's).
 
     Raises
     ------
@@ -75,7 +77,10 @@ def call_factory(target: str, atoms=None, kwargs: dict | None = None, what: str 
     kwargs = dict(kwargs or {})
     check_finite_data(kwargs, f"{what} '{target}' keyword argument")
     if atoms is not None and "atoms" not in kwargs and accepts_atoms(fn):
-        kwargs["atoms"] = atoms
+        # a copy: an ASE Calculator class attaches itself to the atoms it is given
+        # (``atoms.calc = self``), and the caller's atoms (the scan's reference, pickled to
+        # every worker task) must not carry the calculator
+        kwargs["atoms"] = atoms.copy()
     try:
         made = fn(**kwargs)
     except TypeError as exc:

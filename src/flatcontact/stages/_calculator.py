@@ -7,9 +7,14 @@ its engines (:mod:`flatcontact.potentials.engines`); nothing here branches on th
 
 from __future__ import annotations
 
+import logging
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
 from flatcontact.foundation.errors import InputError
+
+log = logging.getLogger("flatcontact.run")
 
 #: The elements the elastic stage's crystal (α-quartz) needs.
 QUARTZ_ELEMENTS = frozenset({"Si", "O"})
@@ -63,6 +68,70 @@ def check_setup(settings, atoms) -> None:
     from flatcontact.potentials.engines import check_setup as check_model_setup
 
     check_model_setup(settings.potential, atoms)
+
+
+def check_evaluation(settings, atoms) -> None:
+    """:func:`check_setup` and one energy and forces of ``atoms`` with the model's calculator
+    (:func:`flatcontact.potentials.engines.check_evaluation`; a calculator that raises or
+    returns NaN is a :class:`~flatcontact.potentials.guarded.CalculatorFailure`)."""
+    from flatcontact.potentials.engines import check_evaluation as check_model_evaluation
+
+    check_model_evaluation(settings.potential, atoms)
+
+
+def _field(settings) -> tuple[str, str]:
+    """The settings path naming the model's calculator and how it is written there:
+    ``potential.calculator.target``, ``potential.intra`` (``ase:...``) or ``potential``."""
+    m = settings.potential
+    if m.calculator is not None:
+        return "potential.calculator.target", m.calculator.target
+    if m.engine == "ase-slab":
+        return "potential.intra", m.intra
+    return "potential", m.label
+
+
+def evaluation_refusal(settings, failure, source: str, what: str) -> InputError:
+    """The one line of a pre-run evaluation that failed as an InputError.
+
+    ``failure`` a :class:`~flatcontact.potentials.guarded.CalculatorFailure`: ``<source>:
+    <settings path>: <calculator> cannot evaluate the elements Si, O of <what> (<reason>)``;
+    any other InputError of the model's setup keeps its text after ``<source>:`` and the
+    settings path it concerns (``potential.calculator.target`` for a calculator factory that
+    failed, ``potential`` for the rest, unless it names one itself)."""
+    # imported here for the same reason as in :func:`factory`
+    from flatcontact.potentials.guarded import CalculatorFailure, the_elements
+
+    field, name = _field(settings)
+    if isinstance(failure, CalculatorFailure):
+        return InputError(
+            f"{source}: {field}: {name} cannot evaluate {the_elements(failure.elements)} of "
+            f"{what} ({failure.reason})"
+        )
+    text = str(failure)
+    if text.startswith("potential"):
+        return InputError(f"{source}: {text}")
+    if not text.startswith(("calculator ", "ASE calculator factory ")):
+        field = "potential"
+    return InputError(f"{source}: {field}: {text}")
+
+
+@contextmanager
+def failing_at(stage: str) -> Iterator[None]:
+    """A user's calculator that fails inside the block (an exception, a NaN:
+    :class:`~flatcontact.potentials.guarded.CalculatorFailure`) names ``stage`` first:
+    ``scan: point at shift (0.5, 0), thickness 11.2 Å: calculator '...' failed on ...``;
+    its own traceback goes to the run log (INFO: nowhere without one, not the console)."""
+    # imported here for the same reason as in :func:`factory`
+    from flatcontact.potentials.guarded import CalculatorFailure
+    from flatcontact.potentials.guarded import failing_at as name_the_place
+
+    try:
+        with name_the_place(stage):
+            yield
+    except CalculatorFailure as exc:
+        if exc.detail:  # the run log (``flatcontact run``) keeps the calculator's traceback
+            log.info("%s; the calculator's traceback:\n%s", exc, exc.detail)
+        raise
 
 
 def toy_kwargs(settings) -> dict:

@@ -97,17 +97,21 @@ def build_stage(settings, inputs: BuildInputs, folder: Path | None, progress=Non
         # the toy's geometry follows its calculator's LJ (calculator.kwargs), as before recipes
         s = s.model_copy(update={"params": _calculator.toy_kwargs(settings)})
     lattice = {"lattice_calculator": _calculator.bulk_factory(settings)}
-    if isinstance(s, QuartzDenseRecipe):
-        atoms, report = build_interface(s, potential=_calculator.model(settings))
-    elif s.kind in RELAXED_KINDS:
-        atoms, report = build_interface(s, relax_calculator=_relax_calculator(settings), **lattice)
-    elif s.kind in IDEAL_KINDS:
-        atoms, report = build_interface(s, **lattice)
-    else:
-        atoms, report = build_interface(s)
-        if s.kind in IDEAL_KINDS:
-            report["interface_relaxation"] = None
-            report["reference_geometry"] = IDEAL_GEOMETRY
+    # a user's calculator that fails in a relaxation: one line naming the stage
+    with _calculator.failing_at("build"):
+        if isinstance(s, QuartzDenseRecipe):
+            atoms, report = build_interface(s, potential=_calculator.model(settings))
+        elif s.kind in RELAXED_KINDS:
+            atoms, report = build_interface(
+                s, relax_calculator=_relax_calculator(settings), **lattice
+            )
+        elif s.kind in IDEAL_KINDS:
+            atoms, report = build_interface(s, **lattice)
+        else:
+            atoms, report = build_interface(s)
+            if s.kind in IDEAL_KINDS:
+                report["interface_relaxation"] = None
+                report["reference_geometry"] = IDEAL_GEOMETRY
     _calculator.check_atoms(settings, atoms)
     fmax = getattr(s, "fmax_ev_per_angstrom", 0.0)
     warnings = unconverged_warnings(report, fmax) + list(

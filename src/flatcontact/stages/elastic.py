@@ -139,10 +139,12 @@ def elastic_stage(
     model = _calculator.model(settings)
     if atoms is None:
         _calculator.check_elastic(settings)
-        doc = quartz_contact_moduli(model, strain=settings.elastic.strain)
+        with _calculator.failing_at("elastic"):  # a user's calculator that fails: one line
+            doc = quartz_contact_moduli(model, strain=settings.elastic.strain)
     else:
         _calculator.check_atoms(settings, atoms)
-        doc = crystal_contact_moduli(atoms, model, strain=settings.elastic.strain)
+        with _calculator.failing_at("elastic"):
+            doc = crystal_contact_moduli(atoms, model, strain=settings.elastic.strain)
         doc["potential"] = model.label
     result = ElasticResult({**doc, "crystal": record})
     if folder is not None:

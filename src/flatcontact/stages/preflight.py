@@ -4,10 +4,13 @@ The settings (:mod:`flatcontact.config`) check values alone; :func:`check_inputs
 what they name (the interface file, the measured CSVs, the calculator's module), builds the
 recipe's interface as the build stage does but without its relaxation (milliseconds: the
 relaxation is the build's only expensive part), sets the model up for it (for LAMMPS: the
-``pair_style``/``pair_coeff`` commands, files read and element map checked, nothing
-computed) and asks the stages' own checks (the contact moduli's material, the elastic
-crystal), so ``flatcontact config --check`` and :class:`flatcontact.pipeline.Pipeline`
-refuse a run before its first stage, with one line naming the field and the file.
+``pair_style``/``pair_coeff`` commands, files read and element map checked), computes one
+energy and forces of it (a calculator that raises, as ASE's EMT does for Si, or returns NaN
+is refused here, not in the build's relaxation) and asks the stages' own checks (the
+contact moduli's material, the elastic crystal), so ``flatcontact config --check`` and
+:class:`flatcontact.pipeline.Pipeline` refuse a run before its first stage, with one line
+naming the field and the file. ``flatcontact scan`` asks :func:`check_scan_interface` for
+the interface it is given.
 """
 
 from __future__ import annotations
@@ -164,11 +167,34 @@ def _check_structure_file(cfg: RunConfig, source: str) -> None:
         raise InputError(f"{field}: {limits.message('atoms', n, f'atoms in {file.name}')}")
 
 
+def check_scan_interface(cfg: RunConfig, interface: str | Path, source: str = "config"):
+    """The interface ``flatcontact scan`` would scan: read (the interface contract), the
+    model's elements, and one energy and forces with the model's calculator, before the
+    scan writes anything. Returns the interface.
+
+    Raises
+    ------
+    InputError
+        The interface file's refusal, or one line
+        ``<source>: potential.calculator.target: <target> cannot evaluate the elements Si, O
+        of <interface> (<exception type>: <first line>)``.
+    """
+    atoms = read_interface(interface)
+    try:
+        _calculator.check_evaluation(cfg, atoms)
+    except InputError as exc:
+        raise _calculator.evaluation_refusal(cfg, exc, source, str(interface)) from None
+    return atoms
+
+
 def _check_structure(cfg: RunConfig, source: str) -> None:
-    """The recipe's interface, built unrelaxed, and the model set up for it (one line)."""
+    """The recipe's interface, built unrelaxed, the model set up for it and one energy and
+    forces computed on it (one line)."""
     recipe = cfg.structure
+    what = "this interface"
     if isinstance(recipe, QuartzDenseRecipe):  # its builder relaxes; the material is fixed
         atoms = alpha_quartz()
+        what = "this interface's alpha-quartz"
     elif isinstance(recipe, FileRecipe):
         atoms = read_interface(recipe.file)
     else:
@@ -179,8 +205,6 @@ def _check_structure(cfg: RunConfig, source: str) -> None:
         except InputError as exc:
             raise InputError(f"{source}: {exc}") from None
     try:
-        _calculator.check_setup(cfg, atoms)
+        _calculator.check_evaluation(cfg, atoms)
     except InputError as exc:
-        text = str(exc)
-        where = "" if text.startswith("potential") else "potential: "
-        raise InputError(f"{source}: {where}{text}") from None
+        raise _calculator.evaluation_refusal(cfg, exc, source, what) from None

@@ -219,19 +219,21 @@ def scan_stage(
         )
         log.warning("scan: %s", warnings[-1])
     grid, relax, symmetry = grid_spec(s, lateral), relax_settings(s), symmetry_settings(s)
-    scan = ispes_scan.run_scan(
-        reference,
-        factory,
-        grid,
-        folder,
-        relax,
-        order=s.order,
-        executor_options=s.executor_options(),
-        progress=progress,
-        symmetry=symmetry,
-        bracket_loads_gpa=list(settings.analysis.p_gpa),
-    )
-    scan, folds, lines = remedy_folds(settings, reference, factory, scan, grid, relax, symmetry)
+    # a user's calculator that fails at a point: one line naming the stage and the point
+    with _calculator.failing_at("scan"):
+        scan = ispes_scan.run_scan(
+            reference,
+            factory,
+            grid,
+            folder,
+            relax,
+            order=s.order,
+            executor_options=s.executor_options(),
+            progress=progress,
+            symmetry=symmetry,
+            bracket_loads_gpa=list(settings.analysis.p_gpa),
+        )
+        scan, folds, lines = remedy_folds(settings, reference, factory, scan, grid, relax, symmetry)
     warnings += lines
     if lattice.index > 1:
         from flatcontact.ispes.contract import write_ispes

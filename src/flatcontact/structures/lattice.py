@@ -38,6 +38,7 @@ from ase.optimize import BFGS
 
 from flatcontact.foundation.errors import InputError
 from flatcontact.foundation.units import EV_PER_A3_TO_GPA
+from flatcontact.potentials.guarded import CalculatorFailure
 
 #: Largest in-plane mismatch (%) between the file's lattice and the potential's that
 #: ``structure.lattice: file`` accepts. At 2 % a crystal with biaxial modulus
@@ -288,18 +289,21 @@ class LatticeChoice:
     def _fit(compute, atoms: Atoms, material: str, kind: str) -> LatticeFit:
         """``compute()``, or, when the model's engine cannot compute the material alone (a
         LAMMPS hybrid whose sub-style has no atom of it, e.g. h-BN's ``coul/shield`` on a
-        graphene sheet), the file's lattice recorded as not computed. A one-line
-        :class:`InputError` (an element the model lacks) propagates."""
+        graphene sheet, or a user's ASE calculator that fails on it:
+        :class:`~flatcontact.potentials.guarded.CalculatorFailure`), the file's lattice
+        recorded as not computed. Any other one-line :class:`InputError` (an element the model
+        lacks) propagates."""
         try:
             return compute()
+        except CalculatorFailure as exc:
+            failed: Exception = exc
         except InputError:
             raise
         except Exception as exc:  # the engine's own error, kept as the reason
-            reason = next((ln.strip() for ln in str(exc).splitlines() if ln.strip()), repr(exc))
-            cell = np.asarray(atoms.cell.array, float).copy()
-            return LatticeFit(
-                material, kind, cell, cell, False, float("nan"), {"not_computed": reason}
-            )
+            failed = exc
+        reason = next((ln.strip() for ln in str(failed).splitlines() if ln.strip()), repr(failed))
+        cell = np.asarray(atoms.cell.array, float).copy()
+        return LatticeFit(material, kind, cell, cell, False, float("nan"), {"not_computed": reason})
 
     def note(self, slab: str, fit: LatticeFit, file_cell2, potential_cell2) -> dict:
         """Record slab ``slab``'s lattice: ``fit`` and the in-plane strain the file's puts on it."""
