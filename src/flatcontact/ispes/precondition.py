@@ -39,6 +39,7 @@ stored and not sent with the tasks (an n × n matrix per task).
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Callable
 
 import numpy as np
@@ -123,10 +124,14 @@ def inverse_hessian_root(
 _CACHE: dict = {}
 
 
-def cached_root(key, compute: Callable[[], np.ndarray | None]) -> np.ndarray | None:
-    """``compute()`` once per ``key`` in this process (the last two keys kept)."""
-    if key not in _CACHE:
+def cached_root(calc, key, compute: Callable[[], np.ndarray | None]) -> np.ndarray | None:
+    """``compute()`` once per calculator ``calc`` and ``key`` in this process (the last two
+    kept). The entry holds a weak reference to ``calc``: a new calculator that reuses a
+    freed one's ``id`` computes its own."""
+    full_key = (id(calc), key)
+    entry = _CACHE.get(full_key)
+    if entry is None or entry[0]() is not calc:
         while len(_CACHE) >= 2:
             del _CACHE[next(iter(_CACHE))]
-        _CACHE[key] = compute()
-    return _CACHE[key]
+        entry = _CACHE[full_key] = (weakref.ref(calc), compute())
+    return entry[1]

@@ -416,8 +416,6 @@ def reference_root(
     if coordinates.size > precondition.MAX_COORDINATES:
         return None
     key = (
-        id(calc),
-        getattr(calc, "fingerprint", None),
         mode,
         reference.positions.tobytes(),
         reference.numbers.tobytes(),
@@ -433,7 +431,7 @@ def reference_root(
             hessian, coordinates, 3 * len(reference), ASE_ALPHA_EV_PER_A2
         )
 
-    return precondition.cached_root(key, compute)
+    return precondition.cached_root(calc, key, compute)
 
 
 def start_afresh(calc) -> None:
