@@ -14,6 +14,8 @@ and Vashishta + LJ:
   by tree-edge kind (root; lateral: the root plane; z-first: a column's first step off it,
   a rigid start; z-extrap: the rest, extrapolated in z), unconverged points; the Hessian's
   own calls (once per process, in no point's count) apart;
+- the reference Hessian's eigenvalue floor (``precondition.FLOOR_FRACTION``, 0.01) at
+  0.001 … 0.05 of the largest eigenvalue;
 - the largest energy and load differences against the γ-scaled scan (two relaxations to the
   same tolerance);
 - sio2-snap only: the preconditioned scan's wall time (Hessian included) against the
@@ -45,6 +47,8 @@ VARIANTS = {
     "reference Hessian, scaled": (True, True),
 }
 BASELINE = "L-BFGS, H0 = γI (scaled)"
+#: the eigenvalue floor of the reference Hessian (fraction of the largest), beside the default
+FLOORS = (0.001, 0.005, 0.02, 0.05)
 
 
 def _load() -> str:
@@ -77,19 +81,26 @@ def edge_kind(parent: dict, idx) -> str:
     return "z-extrap" if grand is not None and grand[:2] == idx[:2] else "z-first"
 
 
-def scan(reference, factory, grid, out: Path, scaled: bool, precondition: bool):
-    """(wall s, dataset) of a serial scan from scratch (the Hessian cache emptied first)."""
+def scan(reference, factory, grid, out: Path, scaled: bool, precondition: bool, floor=None):
+    """(wall s, dataset) of a serial scan from scratch (the Hessian cache emptied first;
+    ``floor``: another ``precondition.FLOOR_FRACTION`` for this scan)."""
     from flatcontact.ispes import precondition as pre
     from flatcontact.ispes.executors import SerialExecutor
     from flatcontact.ispes.relax import RelaxSettings
     from flatcontact.ispes.scan import run_scan
 
     pre._CACHE.clear()
+    default = pre.FLOOR_FRACTION
+    pre.FLOOR_FRACTION = default if floor is None else floor
     settings = RelaxSettings(FMAX, precondition=precondition)
-    with _scaled(scaled):
-        t0 = time.perf_counter()
-        r = run_scan(reference, factory, grid, out, settings, executor=SerialExecutor())
-        return time.perf_counter() - t0, r.dataset
+    try:
+        with _scaled(scaled):
+            t0 = time.perf_counter()
+            r = run_scan(reference, factory, grid, out, settings, executor=SerialExecutor())
+            return time.perf_counter() - t0, r.dataset
+    finally:
+        pre.FLOOR_FRACTION = default
+        pre._CACHE.clear()
 
 
 def summary(ds) -> dict:
@@ -133,8 +144,10 @@ def potential(intra: str, tmp: Path) -> None:
     )
     print("| variant | mean | median | max | unconverged | by kind (points: mean) | wall s |")
     data, walls = {}, {}
-    for name, (scaled, pre) in VARIANTS.items():
-        walls[name], data[name] = scan(reference, factory, grid, tmp / name, scaled, pre)
+    runs = {name: (scaled, pre, None) for name, (scaled, pre) in VARIANTS.items()}
+    runs.update({f"reference Hessian, floor {f:g}": (False, True, f) for f in FLOORS})
+    for name, (scaled, pre, floor) in runs.items():
+        walls[name], data[name] = scan(reference, factory, grid, tmp / name, scaled, pre, floor)
         s = summary(data[name])
         kinds = ", ".join(f"{k} ({n}): {m:.2f}" for k, (n, m) in s["kinds"].items())
         print(

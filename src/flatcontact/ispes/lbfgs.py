@@ -79,7 +79,8 @@ where H0 is the identity: the memory keeps s_u = L⁻¹ s (the last step in u, k
 inverse is ever formed) and y_u = L y, the gradient row holds L g, and the direction -H_u g_u
 becomes the atoms' step L(-H_u g_u), capped at ``maxstep`` in x as before. The two passes
 and the memory are unchanged; a step adds two dense n × n products (L g, L d). The scan
-uses the reference interface's Hessian (:mod:`flatcontact.ispes.precondition`); with the
+takes the reference interface's Hessian (``RelaxSettings.precondition``,
+:mod:`flatcontact.ispes.precondition`); with the
 identity L = I/√α the iterates are ASE's to round-off (``tests/ispes/test_lbfgs_precondition.py``).
 
 The memory

@@ -48,7 +48,7 @@ import numpy as np
 #: round-off O(ε·|F|/h) both far below a force tolerance of 1e-3 eV/Å on quartz
 FD_STEP_ANGSTROM = 2e-3
 #: eigenvalues of the reference Hessian below this fraction of the largest are raised to it
-#: (measured: 0.005-0.02 equally good on quartz sio2-snap and Vashishta, 0.001 worse)
+#: (``python -m benchmarks precondition`` measures 0.001 … 0.05 on quartz)
 FLOOR_FRACTION = 0.01
 #: no preconditioner on cells with more relaxed coordinates than this: the Hessian costs two
 #: force calls per coordinate once, and each step two dense n × n products
@@ -91,13 +91,13 @@ def inverse_hessian_root(
     coordinates: np.ndarray,
     n: int,
     alpha: float,
-    floor_fraction: float = FLOOR_FRACTION,
+    floor_fraction: float | None = None,
 ) -> np.ndarray:
     """L = H0^{1/2} (n × n, symmetric) for H0 = K_floored⁻¹ on ``coordinates``, I/α elsewhere.
 
     K (``hessian``, k × k over the flat indices ``coordinates``) = V diag(λ) Vᵀ; each λ is
-    raised to at least ``floor_fraction`` · max λ (eV/Å²; a K with no positive eigenvalue
-    is refused), and L = V diag(λ^{-1/2}) Vᵀ on those coordinates. L is block diagonal
+    raised to at least ``floor_fraction`` (default ``FLOOR_FRACTION``) · max λ (eV/Å²; a K
+    with no positive eigenvalue is refused), and L = V diag(λ^{-1/2}) Vᵀ on those coordinates. L is block diagonal
     between them and the rest, so it commutes with a projector that keeps exactly them.
     """
     hessian = np.asarray(hessian, dtype=float)
@@ -116,7 +116,8 @@ def inverse_hessian_root(
         raise ValueError(
             f"hessian: expected a positive curvature, got eigenvalues {lam.min():.3g}…{lam.max():.3g}"
         )
-    lam = np.maximum(lam, floor_fraction * lam.max())
+    fraction = FLOOR_FRACTION if floor_fraction is None else floor_fraction
+    lam = np.maximum(lam, fraction * lam.max())
     root[np.ix_(coordinates, coordinates)] = (vec / np.sqrt(lam)) @ vec.T
     return root
 
