@@ -178,3 +178,35 @@ def test_settings_refuse_a_preconditioner_it_cannot_apply():
         RelaxSettings(precondition=True, optimizer="FIRE")
     with pytest.raises(InputError, match=r"^precondition: .*rigid-layers"):
         RelaxSettings(precondition=True, mode="rigid-layers")
+
+
+def test_the_cache_computes_once_per_calculator_and_key():
+    """Per calculator and key once; other calculators (threads) do not evict it; a
+    calculator's entries go with it."""
+    import gc
+
+    from flatcontact.ispes import precondition
+
+    class Calc:
+        pass
+
+    computed = []
+
+    def compute(tag):
+        return lambda: computed.append(tag) or np.full((1, 1), float(len(computed)))
+
+    precondition._CACHE.clear()
+    a, others = Calc(), [Calc() for _ in range(4)]
+    first = precondition.cached_root(a, "k", compute("a"))
+    for i, other in enumerate(others):
+        precondition.cached_root(other, "k", compute(i))
+    assert precondition.cached_root(a, "k", compute("again")) is first
+    assert computed == ["a", 0, 1, 2, 3]
+    precondition.cached_root(a, "k2", compute("a2"))
+    precondition.cached_root(a, "k3", compute("a3"))  # a keeps its last two keys
+    precondition.cached_root(a, "k", compute("a again"))
+    assert computed[-3:] == ["a2", "a3", "a again"]
+    del others, other
+    gc.collect()
+    precondition.cached_root(a, "k", compute("no"))
+    assert all(ref() is a for ref, _ in precondition._CACHE.values())

@@ -123,16 +123,25 @@ def inverse_hessian_root(
 
 
 _CACHE: dict = {}
+#: keys kept per calculator (a scan asks for one: its reference and mode)
+KEYS_PER_CALCULATOR = 2
 
 
 def cached_root(calc, key, compute: Callable[[], np.ndarray | None]) -> np.ndarray | None:
-    """``compute()`` once per calculator ``calc`` and ``key`` in this process (the last two
-    kept). The entry holds a weak reference to ``calc``: a new calculator that reuses a
-    freed one's ``id`` computes its own."""
+    """``compute()`` once per calculator ``calc`` and ``key`` in this process.
+
+    Each entry holds a weak reference to its calculator and goes with it (a new calculator
+    that reuses a freed one's ``id`` computes its own); a calculator keeps its last
+    ``KEYS_PER_CALCULATOR`` keys, so the calculators of several threads in one process
+    (Dask) do not evict each other's.
+    """
+    for stale in [k for k, (ref, _) in _CACHE.items() if ref() is None]:
+        del _CACHE[stale]
     full_key = (id(calc), key)
     entry = _CACHE.get(full_key)
     if entry is None or entry[0]() is not calc:
-        while len(_CACHE) >= 2:
-            del _CACHE[next(iter(_CACHE))]
+        mine = [k for k in _CACHE if k[0] == id(calc)]
+        while len(mine) >= KEYS_PER_CALCULATOR:
+            del _CACHE[mine.pop(0)]
         entry = _CACHE[full_key] = (weakref.ref(calc), compute())
     return entry[1]
