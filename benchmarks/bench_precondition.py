@@ -6,10 +6,10 @@ grid at the thicknesses the probe chooses for -0.5 … 5 GPa (6 loads; 8 thickne
 ``fmax`` 0.005 eV/Å, warm-start tree ``columns`` (root at the largest z), for sio2-snap + LJ
 and Vashishta + LJ:
 
-- the built-in L-BFGS as ASE's (H0 = I/70), with γ-scaling (H0 = γ I, Nocedal & Wright eq.
-  7.20: ``lbfgs_relax(scaled=True)``, patched in here until the scan's optimiser names it),
-  with the reference's Hessian (``RelaxSettings(precondition=True)``,
-  :mod:`flatcontact.ispes.precondition`), and with both;
+- the built-in L-BFGS as ASE's (``LBFGS``: H0 = I/70), with γ-scaling (``LBFGS-scaled``, the
+  scan's default: H0 = γ I, Nocedal & Wright eq. 7.20), each with and without the
+  reference's Hessian (``RelaxSettings(precondition=True)``,
+  :mod:`flatcontact.ispes.precondition`);
 - force calls per point (the store's counts: exact, load-independent): mean, median, max,
   by tree-edge kind (root; lateral: the root plane; z-first: a column's first step off it,
   a rigid start; z-extrap: the rest, extrapolated in z), unconverged points; the Hessian's
@@ -26,8 +26,6 @@ and Vashishta + LJ:
 
 from __future__ import annotations
 
-import contextlib
-import functools
 import os
 import tempfile
 import time
@@ -39,34 +37,21 @@ GRID = (6, 6)
 P_RANGE_GPA = (-0.5, 5.0, 6)
 FMAX = 0.005
 POTENTIALS = ("snap:sio2-snap", "vashishta")
-#: name: (lbfgs_relax(scaled=...), RelaxSettings(precondition=...))
+#: name: (RelaxSettings.optimizer, RelaxSettings.precondition)
 VARIANTS = {
-    "L-BFGS, H0 = I/70 (ASE)": (False, False),
-    "L-BFGS, H0 = γI (scaled)": (True, False),
-    "reference Hessian": (False, True),
-    "reference Hessian, scaled": (True, True),
+    "L-BFGS, H0 = I/70 (ASE: LBFGS)": ("LBFGS", False),
+    "L-BFGS, H0 = γI (LBFGS-scaled)": ("LBFGS-scaled", False),
+    "reference Hessian (LBFGS)": ("LBFGS", True),
+    "reference Hessian and γ (LBFGS-scaled)": ("LBFGS-scaled", True),
 }
-BASELINE = "L-BFGS, H0 = γI (scaled)"
+BASELINE = "L-BFGS, H0 = γI (LBFGS-scaled)"
+BEST = "reference Hessian (LBFGS)"
 #: the eigenvalue floor of the reference Hessian (fraction of the largest), beside the default
 FLOORS = (0.001, 0.005, 0.02, 0.05)
 
 
 def _load() -> str:
     return f"load {os.getloadavg()[0]:.1f}"
-
-
-@contextlib.contextmanager
-def _scaled(on: bool):
-    """The scan's built-in L-BFGS with ``scaled=on`` (this process only: serial scans)."""
-    from flatcontact.ispes import relax
-
-    plain = relax.lbfgs_relax
-    if on:
-        relax.lbfgs_relax = functools.partial(plain, scaled=True)
-    try:
-        yield
-    finally:
-        relax.lbfgs_relax = plain
 
 
 def edge_kind(parent: dict, idx) -> str:
@@ -81,7 +66,7 @@ def edge_kind(parent: dict, idx) -> str:
     return "z-extrap" if grand is not None and grand[:2] == idx[:2] else "z-first"
 
 
-def scan(reference, factory, grid, out: Path, scaled: bool, precondition: bool, floor=None):
+def scan(reference, factory, grid, out: Path, optimizer: str, precondition: bool, floor=None):
     """(wall s, dataset) of a serial scan from scratch (the Hessian cache emptied first;
     ``floor``: another ``precondition.FLOOR_FRACTION`` for this scan)."""
     from flatcontact.ispes import precondition as pre
@@ -92,12 +77,11 @@ def scan(reference, factory, grid, out: Path, scaled: bool, precondition: bool, 
     pre._CACHE.clear()
     default = pre.FLOOR_FRACTION
     pre.FLOOR_FRACTION = default if floor is None else floor
-    settings = RelaxSettings(FMAX, precondition=precondition)
+    settings = RelaxSettings(FMAX, optimizer, precondition=precondition)
     try:
-        with _scaled(scaled):
-            t0 = time.perf_counter()
-            r = run_scan(reference, factory, grid, out, settings, executor=SerialExecutor())
-            return time.perf_counter() - t0, r.dataset
+        t0 = time.perf_counter()
+        r = run_scan(reference, factory, grid, out, settings, executor=SerialExecutor())
+        return time.perf_counter() - t0, r.dataset
     finally:
         pre.FLOOR_FRACTION = default
         pre._CACHE.clear()
@@ -144,10 +128,10 @@ def potential(intra: str, tmp: Path) -> None:
     )
     print("| variant | mean | median | max | unconverged | by kind (points: mean) | wall s |")
     data, walls = {}, {}
-    runs = {name: (scaled, pre, None) for name, (scaled, pre) in VARIANTS.items()}
-    runs.update({f"reference Hessian, floor {f:g}": (False, True, f) for f in FLOORS})
-    for name, (scaled, pre, floor) in runs.items():
-        walls[name], data[name] = scan(reference, factory, grid, tmp / name, scaled, pre, floor)
+    runs = {name: (opt, pre, None) for name, (opt, pre) in VARIANTS.items()}
+    runs.update({f"{BEST}, floor {f:g}": ("LBFGS", True, f) for f in FLOORS})
+    for name, (opt, pre, floor) in runs.items():
+        walls[name], data[name] = scan(reference, factory, grid, tmp / name, opt, pre, floor)
         s = summary(data[name])
         kinds = ", ".join(f"{k} ({n}): {m:.2f}" for k, (n, m) in s["kinds"].items())
         print(
@@ -170,7 +154,7 @@ def potential(intra: str, tmp: Path) -> None:
     native = run_script(script)
     n_points = GRID[0] * GRID[1] * len(zs)
     per_point = native["force_evaluations"] / n_points
-    for name in ("reference Hessian", BASELINE):
+    for name in (BEST, BASELINE):
         calls = float(data[name].force_calls.values.mean())
         print(
             f"NATIVE LAMMPS script {native['wall']:.1f} s, {per_point:.1f} force evaluations/"

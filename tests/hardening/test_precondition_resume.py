@@ -33,15 +33,18 @@ def cu_reference():
     return atoms
 
 
+@pytest.mark.parametrize("optimizer", ["LBFGS", "LBFGS-scaled"])
 @pytest.mark.parametrize("mode", ["full", "normal"])
-def test_a_preconditioned_point_does_not_depend_on_the_engine_or_the_cache(cu_reference, mode):
+def test_a_preconditioned_point_does_not_depend_on_the_engine_or_the_cache(
+    cu_reference, mode, optimizer
+):
     """The same task on a fresh calculator (which computes the Hessian first: 2 force calls
     per relaxed coordinate, not counted in the point) and on one that relaxed other points
     with the Hessian cached: the same bits, and fewer force calls than without it (the
     same energy in ``normal`` mode)."""
     ref = cu_reference
     z0 = thickness(ref)
-    settings = RelaxSettings(0.005, mode=mode, precondition=True)
+    settings = RelaxSettings(0.005, optimizer, mode=mode, precondition=True)
     task = PointTask((0, 0, 0), 1 / 6, 1 / 3, z0 - 0.15)
     precondition._CACHE.clear()
     calc = LammpsInterfaceCalculator(MODEL, ref)
@@ -56,10 +59,10 @@ def test_a_preconditioned_point_does_not_depend_on_the_engine_or_the_cache(cu_re
     assert again.normal_stress_gpa == fresh.normal_stress_gpa
     assert np.array_equal(again.positions, fresh.positions)
     assert fresh.converged and fresh.max_force_ev_per_a < 0.005
-    plain = relax_point(ref, used, task, RelaxSettings(0.005, mode=mode))
+    plain = relax_point(ref, used, task, RelaxSettings(0.005, optimizer, mode=mode))
     assert fresh.force_calls < plain.force_calls
     if mode == "normal":  # one minimum along z; in 3D the free layers have two wells here:
-        # ASE's steps slide into the lower (-27.4175 eV), the preconditioned ones stay in
+        # the unpreconditioned steps slide into the lower (-27.4175 eV), the preconditioned stay in
         # the nearer (-27.3840 eV), each a minimum to 1e-4 eV/Å (docs/performance.md)
         assert abs(plain.energy_ev - fresh.energy_ev) < 1e-4
 
@@ -70,7 +73,7 @@ def test_interrupted_preconditioned_scan_resumes_to_the_same_bits(cu_reference, 
     ref = cu_reference
     z0 = thickness(ref)
     grid = GridSpec(4, 4, thickness_angstrom=(z0 - 0.2, z0, z0 + 0.3))
-    settings = RelaxSettings(0.005, precondition=True)
+    settings = RelaxSettings(0.005, "LBFGS", precondition=True)
     factory = calculator_factory(MODEL)
     whole, resumed = tmp_path / "whole", tmp_path / "resumed"
 
