@@ -24,7 +24,7 @@ projected out of every step anyway).
 What the relaxation needs is L = H0^{1/2} (symmetric): :func:`flatcontact.ispes.lbfgs.lbfgs_relax`
 runs the iteration in u = L⁻¹ x, where H0 is the identity (``preconditioner``).
 
-Measured (``python -m benchmarks precondition``; ``docs/performance.md``, "The reference's
+Measured (``python -m benchmarks precondition``; ``docs/performance.md``, "The reference interface's
 Hessian as H0"): 6 × 6 × 8 quartz grid, fmax 0.005 eV/Å, sio2-snap 15.4 force calls per
 point with γ-scaling (``LBFGS-scaled``) → 3.15; Vashishta 12.6 → 2.6; every point converged.
 
