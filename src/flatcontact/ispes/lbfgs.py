@@ -71,6 +71,18 @@ max-norm tolerance. The scan uses it by default (optimiser ``LBFGS-scaled``,
 for the ``degenerate_minima`` gate to stop counting a tie-rule choice between degenerate
 sites of equal τ as a move: :mod:`flatcontact.analysis.gates`.)
 
+A fixed initial inverse Hessian (``preconditioner``)
+---------------------------------------------------
+Any fixed symmetric positive definite H0 may stand in Algorithm 7.4 (Nocedal & Wright,
+§7.2). With H0 = L L (L symmetric, commuting with P) the iteration is run in u = L⁻¹ x,
+where H0 is the identity: the memory keeps s_u = L⁻¹ s (the last step in u, kept: no
+inverse is ever formed) and y_u = L y, the gradient row holds L g, and the direction -H_u g_u
+becomes the atoms' step L(-H_u g_u), capped at ``maxstep`` in x as before. The two passes
+and the memory are unchanged; a step adds two dense n × n products (L g, L d). The scan
+takes the reference interface's Hessian (``RelaxSettings.precondition``,
+:mod:`flatcontact.ispes.precondition`); with the
+identity L = I/√α the iterates are ASE's to round-off (``tests/ispes/test_lbfgs_precondition.py``).
+
 The memory
 ----------
 ASE's 100 pairs on cells up to 1,000 atoms; beyond, :func:`memory_for` keeps m·n ≤ 300,000
@@ -403,6 +415,32 @@ def largest_atomic_norm(vectors: np.ndarray, scratch: np.ndarray | None = None) 
     return float(np.sqrt(norms.max()))
 
 
+def _checked_root(preconditioner: np.ndarray | None, n: int) -> np.ndarray | None:
+    """``preconditioner`` as a float (n, n) array, or None."""
+    if preconditioner is None:
+        return None
+    root = np.asarray(preconditioner, dtype=float)
+    if root.shape != (n, n):
+        raise ValueError(f"preconditioner: expected a ({n}, {n}) matrix, got {root.shape}")
+    return root
+
+
+def _projector_into(
+    project: Callable, shape: tuple
+) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
+    """``into(v, out)``: P(v) written to ``out`` (any array of v's size, possibly v itself),
+    returned as ``shape``; through ``project``'s ``out`` argument if it has one (no copy)."""
+    if "out" in inspect.signature(project).parameters:
+        return lambda v, out: project(v.reshape(shape), out=out.reshape(shape))
+
+    def into(v: np.ndarray, out: np.ndarray) -> np.ndarray:
+        view = out.reshape(shape)
+        view[...] = project(v.reshape(shape))
+        return view
+
+    return into
+
+
 def lbfgs_relax(
     evaluate: Callable[[np.ndarray], tuple[float, np.ndarray]],
     positions: np.ndarray,
@@ -414,6 +452,7 @@ def lbfgs_relax(
     maxstep: float = ASE_MAXSTEP_A,
     damping: float = 1.0,
     scaled: bool = False,
+    preconditioner: np.ndarray | None = None,
 ) -> LbfgsOutcome:
     """Relax ``positions`` with ASE's L-BFGS iteration, one ``evaluate`` per step.
 
@@ -451,6 +490,10 @@ def lbfgs_relax(
     scaled
         Rescale H0 to γ I at every step (module docstring, "Initial Hessian scaling"); the
         default ``False`` takes ASE's steps.
+    preconditioner
+        L = H0^{1/2}, symmetric (3n, 3n), commuting with ``project`` (module docstring, "A
+        fixed initial inverse Hessian"; :func:`flatcontact.ispes.precondition.inverse_hessian_root`):
+        H0 = L L (Å²/eV) replaces I/α (``scaled`` rescales it by γ). None: I/α (ASE).
 
     Returns
     -------
@@ -458,20 +501,22 @@ def lbfgs_relax(
     """
     x = np.array(positions, dtype=float)
     shape = x.shape
+    root = _checked_root(preconditioner, x.size)
     # the memory first: its gradient rows take -P(F) straight away (np.zeros: pages untouched
-    # until used, nothing spent on a start that is already converged)
-    history = TwoLoopMemory(x.size, memory_for(x.size) if memory is None else memory, alpha, scaled)
+    # until used, nothing spent on a start that is already converged); H0 = I in u
+    size = memory_for(x.size) if memory is None else memory
+    history = TwoLoopMemory(x.size, size, alpha if root is None else 1.0, scaled)
     g, g_prev = history.gradients  # -H g then takes one product (TwoLoopMemory._apply)
-    in_place = "out" in inspect.signature(project).parameters
+    project_into = _projector_into(project, shape)
+    g_x = None if root is None else np.empty(x.size)  # -P(F) before L (its norm: the test)
 
     def gradient(forces: np.ndarray, out: np.ndarray) -> np.ndarray:
-        """-P(F) into the gradient row ``out``; as (n, 3) (its norm is P(F)'s)."""
-        if in_place:
-            project(forces, out=out.reshape(shape))
-            np.negative(out, out=out)
-        else:
-            np.negative(project(forces).ravel(), out=out)
-        return out.reshape(shape)
+        """-P(F) into the row ``out`` (times L if preconditioned); -P(F) as (n, 3)."""
+        target = out if root is None else g_x
+        np.negative(project_into(forces, target), out=target.reshape(shape))
+        if root is not None:
+            np.dot(root, target, out=out)
+        return target.reshape(shape)
 
     energy, forces = evaluate(x)
     calls = 1
@@ -482,16 +527,22 @@ def lbfgs_relax(
         return LbfgsOutcome(x, float(energy), np.array(forces), steps, calls, bool(converged))
     x_prev = np.empty_like(x)
     direction = np.empty(x.size)
-    dr = direction.reshape(shape)  # the step -H g: a view of the direction's buffer
+    # the step in x: -H g itself (a view of the direction's buffer), or L·(-H g) in u
+    dr = (direction if root is None else np.empty(x.size)).reshape(shape)
     scale = 1.0  # s = scale · P(H g_prev): the factor of the last step
     while not converged and steps < max_steps:
         if steps == 0:
             history.inverse_hessian_times(g, out=direction, factor=-1.0)
         else:
             s, y = history.next_pair()
-            np.subtract(x.ravel(), x_prev.ravel(), out=s)
+            if root is None:
+                np.subtract(x.ravel(), x_prev.ravel(), out=s)
+            else:  # u - u_prev: the last step in u, kept in the direction's buffer
+                s[...] = direction
             np.subtract(g, g_prev, out=y)
             history.push_stored(g, scale, out=direction, factor=-1.0)
+        if root is not None:
+            np.dot(root, direction, out=dr.reshape(-1))
         scale = -damping
         longest = largest_atomic_norm(dr, scratch)
         if longest >= maxstep:
@@ -499,8 +550,11 @@ def lbfgs_relax(
             scale *= maxstep / longest
         if damping != 1.0:
             dr *= damping
+        if root is not None:  # the step in u, P(scale'·(-H g)), for the next pair's s
+            direction *= -scale
+            project_into(direction, direction)
         x, x_prev = x_prev, x
-        np.add(x_prev, project(dr, out=dr) if in_place else project(dr), out=x)
+        np.add(x_prev, project_into(dr, dr), out=x)
         g, g_prev = g_prev, g
         steps += 1
         energy, forces = evaluate(x)

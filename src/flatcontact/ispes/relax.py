@@ -124,12 +124,19 @@ class RelaxSettings:
         ``full`` (free atoms relax in 3D), ``normal`` (along z only), ``rigid-layers``
         (each free layer a rigid body moving along z) or ``rigid`` (no relaxation); see the
         module docstring.
+    precondition
+        The built-in L-BFGS starts every point with the reference interface's inverse
+        Hessian as H0 (:mod:`flatcontact.ispes.precondition`: computed once per process,
+        2 force calls per relaxed coordinate, not counted in any point's force calls;
+        cells with more than ``precondition.MAX_COORDINATES`` relaxed coordinates keep
+        H0 = I/α). Modes ``full`` and ``normal``.
     """
 
     fmax_ev_per_angstrom: float = 0.005
     optimizer: str = "LBFGS-scaled"
     max_steps: int = 2000
     mode: str = "full"
+    precondition: bool = False
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.fmax_ev_per_angstrom) and self.fmax_ev_per_angstrom > 0):
@@ -142,6 +149,14 @@ class RelaxSettings:
             raise InputError(f"max_steps: expected at least 1 optimiser step, got {self.max_steps}")
         if self.mode not in RELAX_MODES:
             raise InputError(f"mode: '{self.mode}' is not one of {', '.join(RELAX_MODES)}")
+        if self.precondition and (
+            self.optimizer not in BUILT_IN_LBFGS or self.mode == "rigid-layers"
+        ):
+            raise InputError(
+                f"precondition: the reference Hessian preconditions the built-in L-BFGS "
+                f"({', '.join(BUILT_IN_LBFGS)}) in modes full and normal, not optimizer "
+                f"'{self.optimizer}' in mode '{self.mode}'"
+            )
         if self.optimizer == "lammps-cg" and self.mode == "rigid-layers":
             raise InputError(
                 "optimizer: 'lammps-cg' relaxes atoms (modes full, normal), not rigid layers; "
@@ -159,6 +174,8 @@ class RelaxSettings:
         }
         if self.mode == "full":
             del out["mode"]
+        if not self.precondition:  # stores written before the option resume
+            del out["precondition"]
         return out
 
 
@@ -289,10 +306,13 @@ def _relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSetting
     fixed_positions = atoms.positions[fixed].copy()
     lateral_positions = atoms.positions[:, :2].copy()
     calc = count_force_calls(calc)
-    calls0 = calc.force_calls
-    steps = 0
     groups = free_layer_groups(atoms, free) if settings.mode == "rigid-layers" else []
     project = constraint_projector(fixed, settings.mode, groups)
+    root = None
+    if relaxing and settings.optimizer in BUILT_IN_LBFGS and settings.precondition:
+        root = reference_root(reference, calc, fixed, settings.mode, project)
+    calls0 = calc.force_calls
+    steps = 0
     if relaxing and settings.optimizer in BUILT_IN_LBFGS:
         outcome = lbfgs_relax(
             point_evaluator(calc, atoms),
@@ -301,6 +321,7 @@ def _relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSetting
             settings.fmax_ev_per_angstrom,
             settings.max_steps,
             scaled=BUILT_IN_LBFGS[settings.optimizer],
+            preconditioner=root,
         )
         atoms.positions = outcome.positions
         energy, forces, steps = outcome.energy_ev, outcome.forces, outcome.steps
@@ -393,6 +414,37 @@ def constraint_projector(fixed: np.ndarray, mode: str, groups: list[np.ndarray])
         return np.multiply(v, factor, out=out)
 
     return project
+
+
+def reference_root(
+    reference: Atoms, calc, fixed: np.ndarray, mode: str, project
+) -> np.ndarray | None:
+    """L = H0^{1/2} from the Hessian of ``reference`` over the coordinates ``project`` keeps
+    (:mod:`flatcontact.ispes.precondition`), computed once per process and key (calculator,
+    reference, mode); None beyond ``precondition.MAX_COORDINATES`` relaxed coordinates."""
+    from flatcontact.ispes import precondition
+    from flatcontact.ispes.lbfgs import ASE_ALPHA_EV_PER_A2
+
+    coordinates = np.flatnonzero(project(np.ones((len(reference), 3))).ravel() != 0.0)
+    if coordinates.size > precondition.MAX_COORDINATES:
+        return None
+    key = (
+        mode,
+        reference.positions.tobytes(),
+        reference.numbers.tobytes(),
+        reference.cell.array.tobytes(),
+        np.asarray(fixed).tobytes(),
+    )
+
+    def compute() -> np.ndarray:
+        hessian = precondition.finite_difference_hessian(
+            point_evaluator(calc, reference), reference.positions, coordinates
+        )
+        return precondition.inverse_hessian_root(
+            hessian, coordinates, 3 * len(reference), ASE_ALPHA_EV_PER_A2
+        )
+
+    return precondition.cached_root(calc, key, compute)
 
 
 def start_afresh(calc) -> None:

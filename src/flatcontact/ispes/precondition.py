@@ -1,0 +1,147 @@
+"""A fixed initial inverse Hessian for every point of a scan: the reference interface's own.
+
+The scan's L-BFGS starts each point with H0 = I/α (ASE) or γ I (Nocedal & Wright eq. 7.20)
+and spends most of its force calls learning the curvature of the stiff Si-O (or C-C, Cu-Cu)
+bonds beside the soft interface, anew at every point. Every point of a scan is the same
+interface, slab 2 shifted laterally and in z, so the curvature of the reference interface
+is a good model of every point's: preconditioned L-BFGS (Nocedal & Wright, *Numerical
+Optimization*, §7.2, any fixed symmetric positive definite H0 in Algorithm 7.4) with
+H0 = (the reference's Hessian)⁻¹ takes a near-Newton step from the first one on, and the
+stored pairs correct it where the point's curvature differs.
+
+The Hessian
+-----------
+K_ij = -∂F_i/∂x_j of the relaxed coordinates (those the relaxation mode's projector keeps:
+every component of the free atoms in ``full``, their z in ``normal``) by central differences
+of the forces, step ``FD_STEP_ANGSTROM``, symmetrised: 2 force calls per relaxed coordinate,
+once per scan (:func:`reference_hessian`, 180 calls on the 36-atom quartz cell). Its
+eigenvalues are floored at ``FLOOR_FRACTION`` of the largest (:func:`inverse_hessian_root`):
+the softest interface modes (0.13 eV/Å² against 94 on sio2-snap quartz) would otherwise ask
+for steps the next point's curvature does not support, and a floor also makes a reference
+that is not an exact minimum positive definite. The removed coordinates get I/α (they are
+projected out of every step anyway).
+
+What the relaxation needs is L = H0^{1/2} (symmetric): :func:`flatcontact.ispes.lbfgs.lbfgs_relax`
+runs the iteration in u = L⁻¹ x, where H0 is the identity (``preconditioner``).
+
+Measured (``python -m benchmarks precondition``; ``docs/performance.md``, "The reference interface's
+Hessian as H0"): 6 × 6 × 8 quartz grid, fmax 0.005 eV/Å, sio2-snap 15.4 force calls per
+point with γ-scaling (``LBFGS-scaled``) → 3.15; Vashishta 12.6 → 2.6; every point converged.
+
+Determinism
+-----------
+The Hessian is a function of the reference, the calculator and the mode: its force calls
+run on a calculator started afresh (:func:`flatcontact.ispes.relax.point_evaluator`), in a
+fixed order, so every worker and every resumed run computes the same bits, and the next
+point starts its engine afresh again. It is kept per worker (:func:`cached_root`), not
+stored and not sent with the tasks (an n × n matrix per task).
+"""
+
+from __future__ import annotations
+
+import weakref
+from collections.abc import Callable
+
+import numpy as np
+
+#: central-difference step of the Hessian (Å): the truncation error O(h²·F''') and the
+#: round-off O(ε·|F|/h) both far below a force tolerance of 1e-3 eV/Å on quartz
+FD_STEP_ANGSTROM = 2e-3
+#: eigenvalues of the reference Hessian below this fraction of the largest are raised to it
+#: (``python -m benchmarks precondition`` measures 0.001 … 0.05 on quartz)
+FLOOR_FRACTION = 0.01
+#: no preconditioner on cells with more relaxed coordinates than this: the Hessian costs two
+#: force calls per coordinate once, and each step two dense n × n products
+#: (≈ 2 n² flops: 2 µs at n = 108, ≈ 1 ms at n = 1,000, beside a force call of ≈ 3 ms)
+MAX_COORDINATES = 1000
+
+
+def finite_difference_hessian(
+    evaluate: Callable[[np.ndarray], tuple[float, np.ndarray]],
+    positions: np.ndarray,
+    coordinates: np.ndarray,
+    step_angstrom: float = FD_STEP_ANGSTROM,
+) -> np.ndarray:
+    """K = -∂F/∂x over the flat indices ``coordinates`` (k,) of ``positions`` (n, 3), (k, k).
+
+    Central differences, column j from the forces at x ± h e_j (2k calls of
+    ``evaluate(positions) -> (energy_ev, forces)``, in the order of ``coordinates``),
+    symmetrised (K + Kᵀ)/2. Exact to round-off for a quadratic energy.
+    """
+    coordinates = np.asarray(coordinates, dtype=np.intp)
+    if step_angstrom <= 0:
+        raise ValueError(f"step_angstrom: expected a positive step, got {step_angstrom}")
+    x0 = np.array(positions, dtype=float)
+    k = coordinates.size
+    hessian = np.empty((k, k))
+    work = x0.copy()
+    flat = work.reshape(-1)
+    for col, i in enumerate(coordinates):
+        flat[i] = x0.flat[i] + step_angstrom
+        plus = np.array(evaluate(work)[1], dtype=float).reshape(-1)[coordinates]
+        flat[i] = x0.flat[i] - step_angstrom
+        minus = np.array(evaluate(work)[1], dtype=float).reshape(-1)[coordinates]
+        flat[i] = x0.flat[i]
+        hessian[:, col] = (minus - plus) / (2.0 * step_angstrom)
+    return 0.5 * (hessian + hessian.T)
+
+
+def inverse_hessian_root(
+    hessian: np.ndarray,
+    coordinates: np.ndarray,
+    n: int,
+    alpha: float,
+    floor_fraction: float | None = None,
+) -> np.ndarray:
+    """L = H0^{1/2} (n × n, symmetric) for H0 = K_floored⁻¹ on ``coordinates``, I/α elsewhere.
+
+    K (``hessian``, k × k over the flat indices ``coordinates``) = V diag(λ) Vᵀ; each λ is
+    raised to at least ``floor_fraction`` (default ``FLOOR_FRACTION``) · max λ (eV/Å²; a K
+    with no positive eigenvalue is refused), and L = V diag(λ^{-1/2}) Vᵀ on those coordinates. L is block diagonal
+    between them and the rest, so it commutes with a projector that keeps exactly them.
+    """
+    hessian = np.asarray(hessian, dtype=float)
+    coordinates = np.asarray(coordinates, dtype=np.intp)
+    if hessian.shape != (coordinates.size, coordinates.size):
+        raise ValueError(
+            f"hessian: expected ({coordinates.size}, {coordinates.size}) for the coordinates, "
+            f"got {hessian.shape}"
+        )
+    root = np.zeros((n, n))
+    root[np.diag_indices(n)] = 1.0 / np.sqrt(alpha)
+    if coordinates.size == 0:
+        return root
+    lam, vec = np.linalg.eigh(hessian)
+    if not np.isfinite(lam).all() or lam.max() <= 0.0:
+        raise ValueError(
+            f"hessian: expected a positive curvature, got eigenvalues {lam.min():.3g}…{lam.max():.3g}"
+        )
+    fraction = FLOOR_FRACTION if floor_fraction is None else floor_fraction
+    lam = np.maximum(lam, fraction * lam.max())
+    root[np.ix_(coordinates, coordinates)] = (vec / np.sqrt(lam)) @ vec.T
+    return root
+
+
+_CACHE: dict = {}
+#: keys kept per calculator (a scan asks for one: its reference and mode)
+KEYS_PER_CALCULATOR = 2
+
+
+def cached_root(calc, key, compute: Callable[[], np.ndarray | None]) -> np.ndarray | None:
+    """``compute()`` once per calculator ``calc`` and ``key`` in this process.
+
+    Each entry holds a weak reference to its calculator and goes with it (a new calculator
+    that reuses a freed one's ``id`` computes its own); a calculator keeps its last
+    ``KEYS_PER_CALCULATOR`` keys, so the calculators of several threads in one process
+    (Dask) do not evict each other's.
+    """
+    for stale in [k for k, (ref, _) in _CACHE.items() if ref() is None]:
+        del _CACHE[stale]
+    full_key = (id(calc), key)
+    entry = _CACHE.get(full_key)
+    if entry is None or entry[0]() is not calc:
+        mine = [k for k in _CACHE if k[0] == id(calc)]
+        while len(mine) >= KEYS_PER_CALCULATOR:
+            del _CACHE[mine.pop(0)]
+        entry = _CACHE[full_key] = (weakref.ref(calc), compute())
+    return entry[1]
