@@ -8,8 +8,9 @@ Q_max/(π a²) at which d⟨Q⟩/d⟨u⟩ first falls to ``fraction`` (0.2) of i
 
 With adhesion the contact stage evaluates the model at the adhesive contact's peak pressure
 p1 (:mod:`flatcontact.contact.adhesion_regime`: the Hertzian part over the adhesive radius,
-what ``contact.nc`` stores at the given p0); ``contact_p0_gpa`` puts the comparison at that
-same p1, so its collapse stress is the one read off the run's own stiffness curve.
+what ``contact.nc`` stores at the given p0); ``contact_p0_gpa`` puts the run's row at that
+same p1, so its collapse stress is the one read off the run's own stiffness curve; the
+quartz references stay in the paper's adhesion-free contact at p0.
 
 That stress depends on p0 and the load laws (k, τ0, μ, σ0) alone: the Hertz pressure
 p(r) = p0 √(1 − r²/a²) and the full-stick traction q0/√(1 − r²/a²) are functions of r/a, so
@@ -73,9 +74,11 @@ def compare_collapse(
     references : law sets (k, τ0, μ, σ0 in MPa/GPa and MPa) by label, evaluated with the
         run's R, E*, G* (which cancel out of the collapse stress)
     fraction : the collapse criterion, k < fraction·k0
-    contact_p0_gpa : the peak pressure (GPa) the model is evaluated at for ``p0_gpa``: the
-        adhesive contact's p1 (:func:`flatcontact.stages.contact_range.contact_p0_gpa`), the
-        same for every law set (it depends on w, R and E* only); None: ``p0_gpa`` (Hertz)
+    contact_p0_gpa : the peak pressure (GPa) the run's row is evaluated at for ``p0_gpa``:
+        its adhesive contact's p1 (:func:`flatcontact.stages.contact_range.contact_p0_gpa`),
+        as in its ``contact.nc``; None: ``p0_gpa`` (Hertz). The reference rows stay at the
+        Hertz ``p0_gpa``: the quartz laws in the paper's adhesion-free model, where R, E*
+        and G* cancel out, the same for every run (the run's adhesion is its interface's)
 
     Returns
     -------
@@ -104,7 +107,7 @@ def compare_collapse(
         "references": [
             with_ratios(
                 collapse_row(
-                    name, p1_gpa, params.replace(**{k: laws[k] for k in LAW_KEYS}), fraction
+                    name, p0_gpa, params.replace(**{k: laws[k] for k in LAW_KEYS}), fraction
                 )
             )
             for name, laws in references.items()
