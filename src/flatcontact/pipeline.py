@@ -87,6 +87,7 @@ from flatcontact.foundation.rundir import (
     writable,
 )
 from flatcontact.ispes.contract import check_grid, open_ispes
+from flatcontact.ispes.shift_lattice import scanned_grid
 from flatcontact.refused import refused_report
 from flatcontact.stages import contact_range
 from flatcontact.stages.analyze import AnalyzeInputs, analyze_stage, grid_note
@@ -372,7 +373,7 @@ class Pipeline:
 
         result = self._run("scan", inputs, work)
         ds = open_ispes(result.folder / ISPES_NC)
-        check_grid(ds, self.config.scan.grid, str(result.folder / ISPES_NC))
+        check_grid(ds, scanned_grid(ds, self.config.scan.grid), str(result.folder / ISPES_NC))
         return ds
 
     def scan_summary(self) -> dict:

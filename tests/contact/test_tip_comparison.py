@@ -130,6 +130,27 @@ def test_reference_rows_carry_their_own_laws():
     assert double["collapse_stress_mpa"] > 1.5 * same["collapse_stress_mpa"]
 
 
+def test_an_adhesive_run_row_is_its_contact_at_p1_and_the_references_stay_at_p0():
+    """With adhesion the contact stage evaluates the model at p1 (the Hertzian part over the
+    adhesive radius) and stores that curve in contact.nc; the run's row is that contact's:
+    the row at p1, its radius the closed-form Hertz radius at p1 (the slow example test reads
+    the collapse off contact.nc). The references keep the adhesion-free p0 (the same as
+    without contact_p0_gpa)."""
+    run = ContactParameters(radius_um=5.0, contact_modulus_gpa=70.0, shear_modulus_gpa=60.0, **LAWS)
+    p0, p1 = 1.77, 1.98
+    plain = compare_collapse("run", run, p0, PAPER_EXPERIMENT_COLLAPSE_MPA, {"q": LAWS})
+    doc = compare_collapse(
+        "run", run, p0, PAPER_EXPERIMENT_COLLAPSE_MPA, {"q": LAWS}, contact_p0_gpa=p1
+    )
+    assert doc["p0_gpa"] == p0 and doc["contact_p0_gpa"] == p1 and plain["contact_p0_gpa"] == p0
+    assert doc["references"] == plain["references"]
+    at_p1 = compare_collapse("run", run, p1, PAPER_EXPERIMENT_COLLAPSE_MPA, {})["run"]
+    assert doc["run"] == at_p1
+    assert doc["run"]["collapse_stress_mpa"] > 1.01 * plain["run"]["collapse_stress_mpa"]
+    a_m = 2.0 * p1 * 1e9 * 5e-6 / (4.0 * 70e9 / math.pi)  # Hertz: p1 = 2 E* a / (π R)
+    assert doc["run"]["contact_radius_nm"] == pytest.approx(a_m * 1e9, rel=1e-9)
+
+
 def test_the_report_section_states_the_lock_and_every_row():
     """The section reads build.json's coincidence match (strain per slab) and tables the run,
     each reference and each measurement, with the ratios from the document."""

@@ -4,7 +4,10 @@
 records (graphene strained +2.53 % onto diamond's 1×1 cell: the ratio of the two lattice
 constants, computed here from the CIF and the sheet's a) is stated in the report's experiment
 section, and the section's collapse stress at 1.77 GPa is the one read off the run's own
-contact.nc stiffness curve (interpolated here: no root finding).
+contact.nc stiffness curve (interpolated here: no root finding). The interface adheres
+(Maugis–Dugdale, radius 1.12 × Hertz at 1.77 GPa): contact.nc stores the model at the adhesive
+contact's peak pressure p1, and so must the comparison (it used the Hertz p0: 263.3 MPa
+against the curve's 274.8).
 """
 
 from __future__ import annotations

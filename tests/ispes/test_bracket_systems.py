@@ -74,13 +74,20 @@ def test_au111_from_a_cif_with_au_u3_runs_with_automatic_thicknesses(tmp_path, c
     assert (out / "report.html").is_file()
 
 
-def _diamond_graphite(tmp_path, mode):
+def _diamond_graphite(tmp_path, mode, structure="lattice: file"):
+    """Diamond(111) on graphite(0001) at the files' lattices (``lattice: file``): the 1×1 lock
+    (graphite +2.53 %) the tests were written for. At AIREBO's own lattices (the default since
+    ``structure.lattice: potential``) the pair is a 152-atom coincidence cell (12 diamond
+    cells on 13 graphite cells): its build relaxation breaks the shift-lattice periodicity and
+    the scan refuses it (as it should: :func:`test_the_coincidence_cell_built_unrelaxed_runs`),
+    and built unrelaxed it is near-incommensurate (no fold in ``full``)."""
     write(tmp_path / "diamond.cif", bulk("C", "diamond", a=3.567, cubic=True))
     write(tmp_path / "graphite.cif", Graphite("C", latticeconstant={"a": 2.46, "c": 6.70}))
     return (
         "structure: {kind: crystal, "
         f"bulk: {tmp_path / 'diamond.cif'}, miller: [1, 1, 1], layers: 2, "
-        f"slab2: {{bulk: {tmp_path / 'graphite.cif'}, miller: [0, 0, 1], layers: 2}}}}\n"
+        f"slab2: {{bulk: {tmp_path / 'graphite.cif'}, miller: [0, 0, 1], layers: 2}}, "
+        f"{structure}}}\n"
         "potential: {intra: {pair_style: airebo 3.0 1 1, pair_coeff: [CH.airebo, C], "
         "map_elements: false}, coupling: same}\n"
         f"scan: {{grid: [6, 6], p_range_gpa: {{lo_gpa: 0, hi_gpa: 2, n: 4}}, relax_mode: {mode}}}\n"
@@ -108,4 +115,54 @@ def test_diamond_graphite_full_names_the_fold_and_refuses_the_loads_beyond(tmp_p
         assert set(fold) == {"column", "z_angstrom", "p_gpa", "loads_refused_gpa"}
         assert "column at shift" in fold["column"]
         assert all(p > fold["p_gpa"] for p in fold["loads_refused_gpa"])
-    assert any("folds: p =" in n and "z =" in n for n in scan["notes"])
+    # the notes say it too: a fold's own line (column, p and z), or, after the scan stage
+    # re-relaxed some folding columns (stages/fold_remedy.py), how many remain where
+    grid = sum("grid column" in f["column"] for f in folds)
+    assert any(
+        ("folds: p =" in n and "z =" in n)
+        or f"re-relaxed away; {grid} remain (scan.json load_folds" in n
+        for n in scan["notes"]
+    ), scan["notes"]
+
+
+def test_the_coincidence_cell_built_unrelaxed_runs(tmp_path, capsys):
+    """At AIREBO's lattices the pair is a coincidence cell whose landscape repeats on a shift
+    lattice of index 156 (= 12 × 13); 156 shares factors with 6, so the scan takes the
+    coprime 7 × 7 grid over the cell and re-indexes it onto one period. Built relaxed, the
+    scan refuses the cell before any point (its slabs repeat only to within 0.25 Å); built
+    unrelaxed, as that refusal advises, it runs through the analysis (the run's own grid
+    checks expected 6 × 6 and refused the 7 × 7 landscape before). The near-incommensurate
+    landscape is flat enough that the slider's rest site wanders with load, so the
+    degenerate_minima gate is let through, and its laws are so small that the adhesive
+    tension would dominate them (the Hertz radius is used): this test is about the grid."""
+    relaxed = tmp_path / "relaxed"
+    relaxed.mkdir()
+    code, _, err = run_cli(
+        ["run", str(_config(relaxed, "lattice: potential")), "--out", str(relaxed / "out")],
+        capsys,
+    )
+    assert code not in (0, None)
+    assert "repeats 12 times in the supercell to within 0.25 Å but 1 times" in err
+    assert "build the cell unrelaxed" in err
+    unrelaxed = tmp_path / "unrelaxed"
+    unrelaxed.mkdir()
+    code, err, out, scan = _run(
+        unrelaxed,
+        capsys,
+        _diamond_graphite(unrelaxed, "normal", "fmax_ev_per_angstrom: 10.0"),
+        "contact: {contact_modulus_gpa: 50, shear_modulus_gpa: 30, contact_radius: hertz, "
+        "accept_untrusted: [degenerate_minima]}\n",
+    )
+    assert code in (0, None), err
+    record = scan["shift_lattice"]
+    assert record["index"] == 156 and record["grid_requested"] == [6, 6]
+    assert record["grid"] == [7, 7]
+    assert scan["points_total"] == 49 * len(scan["thickness_angstrom"])
+    _analysis_brackets(out, [0.0, 0.5, 1.0, 1.5])
+    assert (out / "report.html").is_file()
+
+
+def _config(folder, structure):
+    config = folder / "run.yaml"
+    config.write_text(_diamond_graphite(folder, "normal", structure) + MODULI)
+    return config

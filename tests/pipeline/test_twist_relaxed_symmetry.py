@@ -8,9 +8,15 @@ meV/Å² and 5 % of the range at the verified point's thickness, not below round
 - (2, 3), 152 atoms: its landscape is at the relaxation's force tolerance (range 1.2e-3
   meV/Å² at the smallest thickness, 1.8e-4 to 7.5e-4 at the others; the approximant study's
   relaxation floor of this cell is of that size) and relaxes into states that break its
-  group: the verified points differ from their representatives by 4.1e-4 and 4.7e-4 meV/Å²
-  (measured), 40 % of the range, far below the old absolute 0.01. It is computed in full,
-  so the broken-symmetry gate sees the landscape as it relaxed.
+  group: the verified points differ from their representatives by a sizeable fraction of the
+  range, far below the old absolute 0.01. It is computed in full, so the broken-symmetry
+  gate sees the landscape as it relaxed. How much each verified point differs is relaxation
+  noise and follows the iterates: 4.1e-4 and 4.7e-4 meV/Å² (~40 %) with ASE's L-BFGS and
+  the first warm-start order; 3.5e-5 (4.8 %) for one of them after the warm-start tree
+  (3497b3d); 7.5e-4 (49 %) and 9.2e-5 (6 %, range 1.5e-3) with the rescaled L-BFGS, the
+  default since f2f74b5 (measured). So the test asserts the breaking the verification found
+  (one point beyond its tolerance, the largest a sizeable fraction of the range), not a
+  size at every verified point.
 - (1, 2), 56 atoms: corrugation 1.3e-2 to 2.1e-2 meV/Å²; the verified points differ by
   2.9e-4 and 3.1e-4 (1.5 % of the range, measured): reduced (6 × 6 × 4 grid, order 6).
 
@@ -68,13 +74,20 @@ def test_the_relaxed_2_3_twist_breaks_its_group_and_is_computed_in_full(tmp_path
     if "mapped" in ds:
         assert not ds["mapped"].values.any()
     assert int(ds.attrs.get("symmetry_order", 1)) == 1  # the analysis must not symmetrise
-    for c in sym["verification"]["checked"]:
+    checked = sym["verification"]["checked"]
+    assert checked
+    for c in checked:
         d, spread = c["energy_difference_mev_per_a2"], c["range_mev_per_a2"]
         assert c["energy_tolerance_mev_per_a2"] == pytest.approx(0.05 * spread)
         # the computed points are grid points: their range is within the full grid's
         assert spread <= _range_at(ds, c["point"][2]) * (1 + 1e-9)
         assert d < 0.01  # the absolute tolerance alone accepted it
-        assert d > 0.1 * spread  # a sizeable fraction of the corrugation
+    # the relative tolerance does not: a verified point differs beyond it, and the largest
+    # difference is a sizeable fraction of the corrugation (49 % measured), not round-off
+    assert any(
+        c["energy_difference_mev_per_a2"] > c["energy_tolerance_mev_per_a2"] for c in checked
+    )
+    assert max(c["energy_difference_mev_per_a2"] / c["range_mev_per_a2"] for c in checked) > 0.1
     assert "breaks the interface's shift-space symmetry" in sym["computed_in_full_reason"]
 
 

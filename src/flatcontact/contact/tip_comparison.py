@@ -6,6 +6,12 @@ stress (force amplitude over the Hertz area). The model side uses the same crite
 :func:`flatcontact.contact.experiment.model_collapse_stress`: the amplitude stress
 Q_max/(π a²) at which d⟨Q⟩/d⟨u⟩ first falls to ``fraction`` (0.2) of its initial value.
 
+With adhesion the contact stage evaluates the model at the adhesive contact's peak pressure
+p1 (:mod:`flatcontact.contact.adhesion_regime`: the Hertzian part over the adhesive radius,
+what ``contact.nc`` stores at the given p0); ``contact_p0_gpa`` puts the run's row at that
+same p1, so its collapse stress is the one read off the run's own stiffness curve; the
+quartz references stay in the paper's adhesion-free contact at p0.
+
 That stress depends on p0 and the load laws (k, τ0, μ, σ0) alone: the Hertz pressure
 p(r) = p0 √(1 − r²/a²) and the full-stick traction q0/√(1 − r²/a²) are functions of r/a, so
 E*, G* and R fix the scale of a and u but cancel out of Q/(π a²) and of k/k0.
@@ -31,7 +37,8 @@ LAW_KEYS = ("k_mpa_per_gpa", "tau0_mpa", "mu_mpa_per_gpa", "sigma0_mpa")
 
 def collapse_row(label: str, p0_gpa: float, params: ContactParameters, fraction: float) -> dict:
     """One model row: the laws, the collapse stress (amplitude, MPa) and the effective shear
-    strength Q_peak/(π a²) (MPa) at ``p0_gpa`` with ``params``."""
+    strength Q_peak/(π a²) (MPa) at the peak pressure ``p0_gpa`` the model is evaluated at
+    (the adhesive contact's p1 where there is adhesion) with ``params``."""
     p0_pa = params.check_p0_gpa(p0_gpa, "contact.experiment.p0_gpa")[0] * units.GPA_TO_PA
     radius_m = float(mindlin.contact_radius(p0_pa, params))
     area = np.pi * radius_m**2
@@ -54,6 +61,7 @@ def compare_collapse(
     references: Mapping[str, Mapping[str, float]],
     *,
     fraction: float = 0.2,
+    contact_p0_gpa: float | None = None,
 ) -> dict:
     """The run's collapse stress at ``p0_gpa`` next to the measured ones and reference laws.
 
@@ -66,15 +74,22 @@ def compare_collapse(
     references : law sets (k, τ0, μ, σ0 in MPa/GPa and MPa) by label, evaluated with the
         run's R, E*, G* (which cancel out of the collapse stress)
     fraction : the collapse criterion, k < fraction·k0
+    contact_p0_gpa : the peak pressure (GPa) the run's row is evaluated at for ``p0_gpa``:
+        its adhesive contact's p1 (:func:`flatcontact.stages.contact_range.contact_p0_gpa`),
+        as in its ``contact.nc``; None: ``p0_gpa`` (Hertz). The reference rows stay at the
+        Hertz ``p0_gpa``: the quartz laws in the paper's adhesion-free model, where R, E*
+        and G* cancel out, the same for every run (the run's adhesion is its interface's)
 
     Returns
     -------
     dict
-        ``p0_gpa``, ``collapse_fraction``, ``stress_measure`` ("amplitude"), ``run`` (the
+        ``p0_gpa``, ``contact_p0_gpa`` (the p1 evaluated at), ``collapse_fraction``,
+        ``stress_measure`` ("amplitude"), ``run`` (the
         row of :func:`collapse_row` with ``ratio_to_measured``: run/measured per contact),
         ``references`` (rows, same keys), ``measured_mpa``.
     """
     measured = {k: float(v) for k, v in measured_mpa.items()}
+    p1_gpa = float(p0_gpa if contact_p0_gpa is None else contact_p0_gpa)
 
     def with_ratios(row: dict) -> dict:
         row["ratio_to_measured"] = {k: row["collapse_stress_mpa"] / v for k, v in measured.items()}
@@ -82,12 +97,13 @@ def compare_collapse(
 
     return {
         "p0_gpa": float(p0_gpa),
+        "contact_p0_gpa": p1_gpa,
         "collapse_fraction": float(fraction),
         "stress_measure": "amplitude",
         "criterion": f"amplitude stress Q_max/(pi a^2) where d<Q>/d<u> first falls to "
         f"{fraction:g} x its initial value (load control)",
         "measured_mpa": measured,
-        "run": with_ratios(collapse_row(label, p0_gpa, params, fraction)),
+        "run": with_ratios(collapse_row(label, p1_gpa, params, fraction)),
         "references": [
             with_ratios(
                 collapse_row(

@@ -154,6 +154,16 @@ def _check_scan(doc: dict, expect: Mapping[str, Any]) -> None:
             f"'points_done' {doc['points_done']} exceeds 'points_total' {doc['points_total']}"
         )
     grid = expect.get("grid")
+    lattice = doc.get("shift_lattice")
+    if grid is not None and isinstance(lattice, dict) and isinstance(lattice.get("grid"), list):
+        # a coincidence cell scans scan.grid's coprime n x n (the scan stage's shift_lattice
+        # record states both); the record's request must still be the stage record's grid
+        if lattice.get("grid_requested") != [int(v) for v in grid]:
+            raise ContractError(
+                f"'shift_lattice.grid_requested' {lattice.get('grid_requested')} is not the "
+                f"stage record's grid {list(grid)}"
+            )
+        grid = lattice["grid"]
     if grid is not None and "thickness_angstrom" in doc:
         want = int(grid[0]) * int(grid[1]) * len(doc["thickness_angstrom"])
         if doc["points_total"] != want:

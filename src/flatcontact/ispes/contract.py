@@ -375,17 +375,21 @@ def write_ispes(ds: xr.Dataset, path: str | os.PathLike[str]) -> Path:
 def check_grid(ds: xr.Dataset, grid, source: str = "ISPES grid") -> None:
     """Refuse an ISPES whose lateral grid is not ``grid`` (n_a, n_b): a landscape of another
     run or another grid beside a stage record that claims this run's (one line naming it).
+    On a coincidence or twist cell ``grid`` is the one the scan uses for ``scan.grid``
+    (:func:`flatcontact.ispes.shift_lattice.scanned_grid`: n × n coprime to the index).
 
     Raises
     ------
     InputError
         ``source``, both grids and how to recompute it.
     """
+    index = int(ds.attrs.get("shift_lattice_index", 1))
     have = (int(ds.sizes[DIMS[0]]), int(ds.sizes[DIMS[1]]))
     want = (int(grid[0]), int(grid[1]))
     if have != want:
+        on = f" on a shift lattice of index {index}" if index > 1 else ""
         raise InputError(
             f"{source}: a {have[0]}x{have[1]} landscape, the settings scan a {want[0]}x{want[1]} "
-            "grid (scan.grid); the file is not this run's: remove its stage folder and rerun "
-            "to recompute it"
+            f"grid (scan.grid{on}); the file is not this run's: remove its stage folder and "
+            "rerun to recompute it"
         )

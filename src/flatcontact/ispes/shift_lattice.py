@@ -207,6 +207,12 @@ def scan_grid(grid: tuple[int, int] | list[int], index: int) -> tuple[int, int]:
     return n, n
 
 
+def scanned_grid(ds, grid: tuple[int, int] | list[int]) -> tuple[int, int]:
+    """The lateral grid a scan of ``scan.grid`` = ``grid`` wrote ``ds`` (an ``ispes.nc``) on:
+    :func:`scan_grid` at the file's ``shift_lattice_index`` (1 when absent)."""
+    return scan_grid(grid, int(ds.attrs.get("shift_lattice_index", 1)))
+
+
 def reindex(lattice: ShiftLattice, n_a: int, n_b: int) -> tuple[np.ndarray, np.ndarray]:
     """Target indices ``(ia', ib')`` (each ``n_a × n_b``) of every supercell grid point.
 

@@ -461,7 +461,14 @@ def contact_stage(
         )
         result.experiment = comparison.to_json()
     if c.experiment.compare:
-        result.experiment_comparison = experiment_comparison(settings, params)
+        at = rng.contact_p0_gpa(  # the adhesive contact of the experiment's p0, as contact.nc
+            rng.adhesion_of(
+                settings, inputs, params, [c.experiment.p0_gpa], "contact.experiment.p0_gpa"
+            )
+        )
+        result.experiment_comparison = experiment_comparison(
+            settings, params, None if at is None else at[0]
+        )
     if c.cycle.enabled:
         from flatcontact.contact import cycle
 

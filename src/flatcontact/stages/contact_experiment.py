@@ -52,11 +52,12 @@ def quartz_reference_laws() -> dict[str, dict[str, float]]:
     }
 
 
-def experiment_comparison(settings, params) -> dict:
+def experiment_comparison(settings, params, contact_p0_gpa: float | None = None) -> dict:
     """``summary.json["experiment_comparison"]`` for ``contact.experiment.compare``: the run's
     collapse stress at ``contact.experiment.p0_gpa`` against the measured collapses
     (:data:`flatcontact.foundation.reference.PAPER_EXPERIMENT_COLLAPSE_MPA`) and the quartz laws'
-    (:func:`flatcontact.contact.tip_comparison.compare_collapse`)."""
+    (:func:`flatcontact.contact.tip_comparison.compare_collapse`), the model evaluated at
+    ``contact_p0_gpa`` (the adhesive contact's p1 of that p0, as ``contact.nc``; None: Hertz)."""
     from flatcontact.contact.tip_comparison import compare_collapse
 
     c = settings.contact
@@ -67,6 +68,7 @@ def experiment_comparison(settings, params) -> dict:
         PAPER_EXPERIMENT_COLLAPSE_MPA,
         quartz_reference_laws(),
         fraction=c.collapse_fraction,
+        contact_p0_gpa=contact_p0_gpa,
     )
     doc["experiment"] = c.experiment.compare
     return doc

@@ -84,9 +84,10 @@ def facts(interface_path: Path, build_json: Path, friction) -> dict:
     }
 
 
-def adhesion_of(settings, inputs, params):
+def adhesion_of(settings, inputs, params, p0_gpa=None, p0_name: str = "contact.p0_gpa"):
     """The adhesion regime of the run (:mod:`flatcontact.contact.adhesion_regime`): z0 from
-    ``contact.equilibrium_separation_angstrom`` or the built interface's gap."""
+    ``contact.equilibrium_separation_angstrom`` or the built interface's gap; at
+    ``contact.p0_gpa`` or at the peak pressures ``p0_gpa`` (named ``p0_name``)."""
     from flatcontact.contact.adhesion_regime import adhesion_regime
 
     c = settings.contact
@@ -97,13 +98,13 @@ def adhesion_of(settings, inputs, params):
     elif gap:
         z0, source = gap, "gap between the facing atomic planes of the built interface"
     return adhesion_regime(
-        c.p0_gpa,
+        c.p0_gpa if p0_gpa is None else p0_gpa,
         params,
         equilibrium_separation_m=None if z0 is None else z0 * 1e-10,
         z0_source=source,
         maugis_lambda=c.maugis_lambda,
         use_hertz=c.contact_radius == "hertz",
-        p0_name="contact.p0_gpa",
+        p0_name=p0_name,
     )
 
 

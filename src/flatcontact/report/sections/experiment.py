@@ -81,6 +81,13 @@ def experiment_section(contact: dict, build: dict | None = None) -> Section | No
         return None
     measured = comparison["measured_mpa"]
     run = comparison["run"]
+    p0, p1 = comparison["p0_gpa"], comparison.get("contact_p0_gpa", comparison["p0_gpa"])
+    radius = (
+        f"the Hertz radius is {fmt(run['contact_radius_nm'])} nm"
+        if p1 == p0
+        else f"the adhesive contact radius is {fmt(run['contact_radius_nm'])} nm (the model at "
+        f"its peak pressure p1 = {p1:.4g} GPa, as in the contact section)"
+    )
     return Section(
         "The experiment's interface: collapse stress against the measurement",
         paragraphs=[
@@ -88,8 +95,8 @@ def experiment_section(contact: dict, build: dict | None = None) -> Section | No
             f"{comparison['p0_gpa']:g} GPa, lateral stiffness collapsing near "
             + " and ".join(f"{v:g} MPa ({k})" for k, v in measured.items())
             + f". Model criterion: {comparison['criterion']}. This run's interface: "
-            f"{run['label']}; {lock_text(build)}. At p0 = {comparison['p0_gpa']:g} GPa the "
-            f"Hertz radius is {fmt(run['contact_radius_nm'])} nm with the run's E*, G*, R.",
+            f"{run['label']}; {lock_text(build)}. At p0 = {p0:g} GPa {radius} with the run's "
+            "E*, G*, R.",
         ],
         notes=["Why the numbers can differ: " + " ".join(READINGS)],
         tables=[
