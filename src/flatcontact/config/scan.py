@@ -146,6 +146,13 @@ class ScanConfig(Section):
         DEFAULT_OPTIMIZER,
         description="Optimiser of each point: " + ", ".join(OPTIMIZERS),
     )
+    precondition: bool = Field(
+        True,
+        description="start the built-in L-BFGS of every point from the reference interface's "
+        "inverse Hessian (computed once per process: 2 force calls per relaxed coordinate) "
+        "where it applies: optimizers LBFGS-scaled and LBFGS, modes full and normal, at most "
+        "1,000 relaxed coordinates; elsewhere the optimizer's own start",
+    )
     max_steps: int = Field(2000, ge=1, le=1_000_000, description="optimiser step cap per point")
     relax_mode: Literal["full", "normal", "rigid-layers", "rigid"] = Field(
         "full",
