@@ -172,16 +172,17 @@ def test_root_is_the_floored_inverse_and_commutes_with_the_projector():
 
 
 def test_the_preconditioner_applies_where_it_can_and_enters_the_store_only_there():
-    """On by default for the built-in L-BFGS in modes full and normal (the store fingerprint
-    says so); elsewhere the iterates do not depend on it, so it is not in the fingerprint and
-    a store of that optimizer or mode resumes whatever the setting."""
-    assert RelaxSettings().as_dict()["precondition"] is True
-    assert RelaxSettings(mode="normal", optimizer="LBFGS").uses_reference_hessian
-    assert "precondition" not in RelaxSettings(precondition=False).as_dict()
+    """Off by default (old stores keep their fingerprint); on, for the built-in L-BFGS in
+    modes full and normal the store fingerprint says so; elsewhere the iterates do not depend
+    on it, so it is not in the fingerprint and a store of that optimizer or mode resumes
+    whatever the setting."""
+    assert "precondition" not in RelaxSettings().as_dict()
+    assert RelaxSettings(precondition=True).as_dict()["precondition"] is True
+    assert RelaxSettings(mode="normal", optimizer="LBFGS", precondition=True).uses_reference_hessian
     for other in (
-        RelaxSettings(optimizer="FIRE"),
-        RelaxSettings(mode="rigid-layers"),
-        RelaxSettings(optimizer="lammps-cg"),
+        RelaxSettings(optimizer="FIRE", precondition=True),
+        RelaxSettings(mode="rigid-layers", precondition=True),
+        RelaxSettings(optimizer="lammps-cg", precondition=True),
     ):
         assert not other.uses_reference_hessian
         assert "precondition" not in other.as_dict()

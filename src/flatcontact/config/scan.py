@@ -147,11 +147,14 @@ class ScanConfig(Section):
         description="Optimiser of each point: " + ", ".join(OPTIMIZERS),
     )
     precondition: bool = Field(
-        True,
+        False,
+        # left out of the dumped config while off, so existing run fingerprints are unchanged
+        exclude_if=lambda value: value is False,
         description="start the built-in L-BFGS of every point from the reference interface's "
         "inverse Hessian (computed once per process: 2 force calls per relaxed coordinate) "
         "where it applies: optimizers LBFGS-scaled and LBFGS, modes full and normal, at most "
-        "1,000 relaxed coordinates; elsewhere the optimizer's own start",
+        "1,000 relaxed coordinates; about 5x fewer force calls on quartz, but in mode full "
+        "a point at an unstable registry can relax off it (docs/performance.md)",
     )
     max_steps: int = Field(2000, ge=1, le=1_000_000, description="optimiser step cap per point")
     relax_mode: Literal["full", "normal", "rigid-layers", "rigid"] = Field(
