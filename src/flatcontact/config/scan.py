@@ -154,7 +154,7 @@ class ScanConfig(Section):
         "inverse Hessian (computed once per process: 2 force calls per relaxed coordinate) "
         "where it applies: optimizers LBFGS-scaled and LBFGS, modes full and normal, at most "
         "1,000 relaxed coordinates; about 5x fewer force calls on quartz, but in mode full "
-        "a point at an unstable registry can relax off it (docs/performance.md)",
+        "a column can change relaxation branch (docs/performance.md)",
     )
     max_steps: int = Field(2000, ge=1, le=1_000_000, description="optimiser step cap per point")
     relax_mode: Literal["full", "normal", "rigid-layers", "rigid"] = Field(

@@ -133,11 +133,10 @@ class RelaxSettings:
         relaxed coordinates. There H0 stays that matrix at every step (no γ-rescaling:
         it would replace the measured curvature by one scalar, 3.74 against 3.15 force
         calls per point on the quartz benchmark grid); elsewhere the optimizer's own H0
-        (ASE's I/α, or γ I with ``LBFGS-scaled``). Default off: in mode ``full`` the
-        reference's Hessian couples directions that a point's symmetry keeps apart, so a
-        point resting on an unstable registry can relax off it (measured on the notebook's
-        Cu EMT cell: one column changes branch, a fold in its energy-derived load); see
-        ``docs/performance.md``, "The reference interface's Hessian as H0".
+        (ASE's I/α, or γ I with ``LBFGS-scaled``). Default off: in mode ``full`` it made
+        one column of the notebook's Cu EMT example change relaxation branch (a fold in
+        its energy-derived load); see ``docs/performance.md``, "The reference interface's
+        Hessian as H0".
     """
 
     fmax_ev_per_angstrom: float = 0.005
