@@ -69,6 +69,14 @@ def console_script() -> str:
         return tomllib.load(fh)["project"]["scripts"]["flatcontact"]
 
 
+def _signals_as_in_a_terminal() -> None:
+    """SIGINT at its default in the child, as a terminal's foreground command has it: a suite
+    started in the background by a non-interactive shell (``make test &``, ``nohup``) runs
+    with SIGINT ignored, which the child inherits, and Python then installs no handler (the
+    SIGINT cases hung until their timeout that way)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
 @pytest.mark.parametrize("entry", ["console script", "-m"])
 def test_a_signal_during_start_up_prints_one_line(tmp_path, entry, sig):
@@ -79,6 +87,7 @@ def test_a_signal_during_start_up_prints_one_line(tmp_path, entry, sig):
     child = subprocess.Popen(
         [sys.executable, "-c", CHILD, str(write), target, "run", "--out", str(out)],
         pass_fds=(write,),
+        preexec_fn=_signals_as_in_a_terminal,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,

@@ -8,6 +8,8 @@ iteration for L = I/√α, and exact central differences of a quadratic energy.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from ase.calculators.emt import EMT
@@ -15,7 +17,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from tests.ispes.test_lbfgs import cu_slab, own_trajectory
 
-from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.lbfgs import lbfgs_relax
 from flatcontact.ispes.precondition import finite_difference_hessian, inverse_hessian_root
 from flatcontact.ispes.relax import RelaxSettings, constraint_projector
@@ -170,14 +171,23 @@ def test_root_is_the_floored_inverse_and_commutes_with_the_projector():
         inverse_hessian_root(-hessian, free, 12, 70.0)
 
 
-def test_settings_refuse_a_preconditioner_it_cannot_apply():
-    assert "precondition" not in RelaxSettings().as_dict()  # old stores keep their fingerprint
+def test_the_preconditioner_applies_where_it_can_and_enters_the_store_only_there():
+    """Off by default (old stores keep their fingerprint); on, for the built-in L-BFGS in
+    modes full and normal the store fingerprint says so; elsewhere the iterates do not depend
+    on it, so it is not in the fingerprint and a store of that optimizer or mode resumes
+    whatever the setting."""
+    assert "precondition" not in RelaxSettings().as_dict()
     assert RelaxSettings(precondition=True).as_dict()["precondition"] is True
-    RelaxSettings(precondition=True, mode="normal")
-    with pytest.raises(InputError, match=r"^precondition: .*'FIRE'"):
-        RelaxSettings(precondition=True, optimizer="FIRE")
-    with pytest.raises(InputError, match=r"^precondition: .*rigid-layers"):
-        RelaxSettings(precondition=True, mode="rigid-layers")
+    assert RelaxSettings(mode="normal", optimizer="LBFGS", precondition=True).uses_reference_hessian
+    for other in (
+        RelaxSettings(optimizer="FIRE", precondition=True),
+        RelaxSettings(mode="rigid-layers", precondition=True),
+        RelaxSettings(optimizer="lammps-cg", precondition=True),
+    ):
+        assert not other.uses_reference_hessian
+        assert "precondition" not in other.as_dict()
+        off = dataclasses.replace(other, precondition=False)
+        assert off.as_dict() == other.as_dict()
 
 
 def test_the_cache_computes_once_per_calculator_and_key():

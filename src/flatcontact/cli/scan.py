@@ -38,6 +38,7 @@ PATHS = (
     "scan.dask_address",
     "scan.fmax_ev_per_angstrom",
     "scan.optimizer",
+    "scan.precondition",
     "scan.max_steps",
     "scan.order",
 )

@@ -127,9 +127,16 @@ class RelaxSettings:
     precondition
         The built-in L-BFGS starts every point with the reference interface's inverse
         Hessian as H0 (:mod:`flatcontact.ispes.precondition`: computed once per process,
-        2 force calls per relaxed coordinate, not counted in any point's force calls;
-        cells with more than ``precondition.MAX_COORDINATES`` relaxed coordinates keep
-        H0 = I/α). Modes ``full`` and ``normal``.
+        2 force calls per relaxed coordinate, not counted in any point's force calls),
+        where it applies (:func:`preconditioned`): optimizers ``LBFGS-scaled`` and
+        ``LBFGS``, modes ``full`` and ``normal``, at most ``precondition.MAX_COORDINATES``
+        relaxed coordinates. There H0 stays that matrix at every step (no γ-rescaling:
+        it would replace the measured curvature by one scalar, 3.74 against 3.15 force
+        calls per point on the quartz benchmark grid); elsewhere the optimizer's own H0
+        (ASE's I/α, or γ I with ``LBFGS-scaled``). Default off: in mode ``full`` it made
+        one column of the notebook's Cu EMT example change relaxation branch (a fold in
+        its energy-derived load); see ``docs/performance.md``, "The reference interface's
+        Hessian as H0".
     """
 
     fmax_ev_per_angstrom: float = 0.005
@@ -149,19 +156,21 @@ class RelaxSettings:
             raise InputError(f"max_steps: expected at least 1 optimiser step, got {self.max_steps}")
         if self.mode not in RELAX_MODES:
             raise InputError(f"mode: '{self.mode}' is not one of {', '.join(RELAX_MODES)}")
-        if self.precondition and (
-            self.optimizer not in BUILT_IN_LBFGS or self.mode == "rigid-layers"
-        ):
-            raise InputError(
-                f"precondition: the reference Hessian preconditions the built-in L-BFGS "
-                f"({', '.join(BUILT_IN_LBFGS)}) in modes full and normal, not optimizer "
-                f"'{self.optimizer}' in mode '{self.mode}'"
-            )
         if self.optimizer == "lammps-cg" and self.mode == "rigid-layers":
             raise InputError(
                 "optimizer: 'lammps-cg' relaxes atoms (modes full, normal), not rigid layers; "
                 "use LBFGS-scaled (the default) with mode rigid-layers"
             )
+
+    @property
+    def uses_reference_hessian(self) -> bool:
+        """Whether ``precondition`` applies to this optimizer and mode (the cell's size is
+        checked per reference: :func:`reference_root`)."""
+        return (
+            self.precondition
+            and self.optimizer in BUILT_IN_LBFGS
+            and self.mode in ("full", "normal")
+        )
 
     def as_dict(self) -> dict[str, Any]:
         """The settings for the store fingerprint; ``mode`` only when it is not the default
@@ -174,7 +183,7 @@ class RelaxSettings:
         }
         if self.mode == "full":
             del out["mode"]
-        if not self.precondition:  # stores written before the option resume
+        if not self.uses_reference_hessian:  # the iterates do not depend on it: one store
             del out["precondition"]
         return out
 
@@ -309,7 +318,7 @@ def _relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSetting
     groups = free_layer_groups(atoms, free) if settings.mode == "rigid-layers" else []
     project = constraint_projector(fixed, settings.mode, groups)
     root = None
-    if relaxing and settings.optimizer in BUILT_IN_LBFGS and settings.precondition:
+    if relaxing and settings.uses_reference_hessian:
         root = reference_root(reference, calc, fixed, settings.mode, project)
     calls0 = calc.force_calls
     steps = 0
@@ -320,7 +329,7 @@ def _relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSetting
             project,
             settings.fmax_ev_per_angstrom,
             settings.max_steps,
-            scaled=BUILT_IN_LBFGS[settings.optimizer],
+            scaled=BUILT_IN_LBFGS[settings.optimizer] and root is None,
             preconditioner=root,
         )
         atoms.positions = outcome.positions

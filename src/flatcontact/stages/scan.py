@@ -126,7 +126,11 @@ def symmetry_settings(scan) -> SymmetrySettings:
 def relax_settings(scan) -> RelaxSettings:
     """The per-point relaxation of the ``scan`` settings (:class:`flatcontact.ispes.relax.RelaxSettings`)."""
     return RelaxSettings(
-        scan.fmax_ev_per_angstrom, scan.optimizer, scan.max_steps, mode=scan.relax_mode
+        scan.fmax_ev_per_angstrom,
+        scan.optimizer,
+        scan.max_steps,
+        mode=scan.relax_mode,
+        precondition=scan.precondition,
     )
 
 
