@@ -56,16 +56,16 @@ def _load() -> str:
     return f"load {os.getloadavg()[0]:.1f}"
 
 
+#: :func:`benchmarks.scale_report.start_kind`'s names, as this table calls them
+_EDGE_NAMES = {"cold": "root", "lateral": "lateral", "z": "z-first", "z-extrapolated": "z-extrap"}
+
+
 def edge_kind(parent: dict, idx) -> str:
     """root, lateral (parent in the same plane), z-first (parent in the column, no
     grandparent there: a rigid start) or z-extrap (extrapolated in z)."""
-    par = parent[idx]
-    if par is None:
-        return "root"
-    if par[:2] != idx[:2]:
-        return "lateral"
-    grand = parent[par]
-    return "z-extrap" if grand is not None and grand[:2] == idx[:2] else "z-first"
+    from benchmarks.scale_report import start_kind
+
+    return _EDGE_NAMES[start_kind(parent, idx)]
 
 
 def scan(reference, factory, grid, out: Path, optimizer: str, precondition: bool, floor=None):
