@@ -335,3 +335,24 @@ def test_a_two_load_fit_stays_without_interval_whatever_its_grid_part():
     laws["k_stderr_mpa_per_gpa"] = None
     assert gates.negative_slope(laws) is None
     assert any("without an interval" in n for n in gates.negative_slope_notes(laws))
+
+
+def test_a_load_the_chosen_estimator_lost_takes_the_largest_other_estimate():
+    """One abandoned path (a NaN of the estimator used) must not take the grid part out of the
+    laws' intervals: the load takes the largest-magnitude estimate the others have there, and
+    says which; where none has one it stays NaN; the chosen one's own values are kept."""
+    from flatcontact.analysis.grid_error import fill_missing
+
+    nan = float("nan")
+    estimates = {
+        "last shell": np.array([33.2, 38.4, nan, 34.5, nan]),
+        "interpolant": np.array([6.8, 1.5, -3.4, -2.0, nan]),
+        "sub-grid": np.array([nan, nan, 2.1, nan, nan]),
+    }
+    filled, used = fill_missing("last shell", estimates)
+    np.testing.assert_array_equal(filled[[0, 1, 3]], [33.2, 38.4, 34.5])
+    assert filled[2] == -3.4 and used == [None, None, "interpolant", None, None]
+    assert np.isnan(filled[4])
+    whole, none_used = fill_missing("interpolant", estimates)
+    np.testing.assert_array_equal(whole[:4], estimates["interpolant"][:4])
+    assert none_used == [None] * 5

@@ -361,8 +361,9 @@ def _warn_grid(grid: GridEstimate, source: str) -> None:
         warnings.warn(f"{source}: {text}", GridResolutionWarning, stacklevel=3)
     if grid.unavailable is not None:
         warnings.warn(
-            f"{source}: grid error estimate incomplete: {grid.unavailable}; where neither "
-            "estimate exists the laws' intervals carry no grid part",
+            f"{source}: grid error estimate incomplete: {grid.unavailable}; at such a load "
+            "the other estimator's value is used (analyze.json grid fallback); where none "
+            "exists the laws' intervals carry no grid part",
             GridResolutionWarning,
             stacklevel=3,
         )

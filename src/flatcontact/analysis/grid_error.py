@@ -34,7 +34,10 @@ estimators, each a signed per-load series per quantity:
   between 6×6 and 12×12; Al(111) 6×6, 4.5 % against 6 % between 6×6 and 9×9).
 
 For each quantity the estimator with the largest rms over the loads is used (one estimator per
-quantity, so the per-load series the laws are fitted to is consistent). Measured on the docs'
+quantity, so the per-load series the laws are fitted to is consistent); at a load where it has
+no value (its path abandoned there) the largest in magnitude of the others' at that load is
+used (:func:`fill_missing`, recorded as ``fallback``), so one failed path does not take the
+grid part out of the laws' intervals. Measured on the docs'
 Al(111) example (Zhou EAM, at the CIF's 4.05 Å): 6×6, τ(0) = 2059 MPa, interpolant 170, last shell 333 MPa
 (used: 16 %, "does not resolve"), against τ(9×9) − τ(6×6) = −122 MPa; 9×9: interpolant 15,
 last shell 9 MPa (0.75 %). Cu(111) 6×6: interpolant 15, last shell 40 MPa (1 %) against 6–11 MPa
@@ -247,6 +250,26 @@ def other_interpolant(values: np.ndarray, a1: np.ndarray, a2: np.ndarray, group:
     return surf if len(group) > 1 else surf.zone_folded()
 
 
+def fill_missing(
+    chosen: str, estimates: dict[str, np.ndarray]
+) -> tuple[np.ndarray, list[str | None]]:
+    """``estimates[chosen]`` with each non-finite load filled by the largest-magnitude finite
+    estimate of another estimator at that load (NaN where none has one), and per load the
+    estimator filled from (None where the chosen one's own value is kept or none exists)."""
+    out = np.array(estimates[chosen], dtype=float)
+    used: list[str | None] = [None] * out.size
+    for i in np.flatnonzero(~np.isfinite(out)):
+        others = [
+            (abs(float(v[i])), name)
+            for name, v in estimates.items()
+            if name != chosen and np.isfinite(v[i])
+        ]
+        if others:
+            _, name = max(others)
+            out[i], used[i] = float(estimates[name][i]), name
+    return out, used
+
+
 def _rms(values: np.ndarray) -> float:
     v = np.asarray(values, float)
     v = v[np.isfinite(v)]
@@ -279,6 +302,7 @@ class GridEstimate:
     coarsest: dict[str, np.ndarray] = field(default_factory=dict)
     unavailable: str | None = None
     fraction: float = UNRESOLVED_FRACTION
+    fallback: dict[str, list[str | None]] = field(default_factory=dict)
 
     @property
     def relative_tau_error(self) -> np.ndarray:
@@ -353,8 +377,11 @@ class GridEstimate:
                 "last shell": "full - (full without its outermost harmonic shell)",
                 "interpolant": "full (symmetrised, zone-folded) - (the grid's own square set)",
             },
-            "rule": "per quantity the estimator with the largest rms over the loads; signed",
+            "rule": "per quantity the estimator with the largest rms over the loads; signed; "
+            "at a load where it has no value, the largest in magnitude of the others' there "
+            "(fallback: the estimator used per load, null where the rule's own)",
             "source": dict(self.source),
+            "fallback": {ERROR_COLUMNS[q]: list(v) for q, v in self.fallback.items()},
             "unresolved_fraction": self.fraction,
             "p_gpa": clean(self.p_gpa),
             "order": clean(self.order),
@@ -473,13 +500,14 @@ def estimate_grid_error(
             )
             for q in QUANTITIES
         }
-    error, source = {}, {}
+    error, source, fallback = {}, {}, {}
     for q in QUANTITIES:
         best = max(
             (e for e in ESTIMATORS if e in estimates),
             key=lambda e: (_rms(estimates[e][q]), -ESTIMATORS.index(e)),
         )
-        error[q], source[q] = estimates[best][q], best
+        source[q] = best
+        error[q], fallback[q] = fill_missing(best, {e: estimates[e][q] for e in estimates})
     return GridEstimate(
         shape,
         grid,
@@ -494,4 +522,5 @@ def estimate_grid_error(
         coarsest_grid=third,
         coarsest=coarsest,
         unavailable="; ".join(failed) if failed else None,
+        fallback=fallback,
     )
