@@ -128,7 +128,7 @@ class RelaxSettings:
         The built-in L-BFGS starts every point with the reference interface's inverse
         Hessian as H0 (:mod:`flatcontact.ispes.precondition`: computed once per process,
         2 force calls per relaxed coordinate, not counted in any point's force calls),
-        where it applies (:func:`preconditioned`): optimizers ``LBFGS-scaled`` and
+        where it applies (:attr:`uses_reference_hessian`): optimizers ``LBFGS-scaled`` and
         ``LBFGS``, modes ``full`` and ``normal``, at most ``precondition.MAX_COORDINATES``
         relaxed coordinates. There H0 stays that matrix at every step (no γ-rescaling:
         it would replace the measured curvature by one scalar, 3.74 against 3.15 force

@@ -157,6 +157,17 @@ def _check_results(results: dict, name: str, atoms: Any, asked=()) -> None:
         raise CalculatorFailure(name, elements_of(atoms), reason)
 
 
+def _called(method, name: str, structure: Any, *args, **kwargs):
+    """``method(*args, **kwargs)``; an exception it raises (other than those passed on) as
+    the :class:`CalculatorFailure` of ``name`` on ``structure``."""
+    try:
+        return method(*args, **kwargs)
+    except Exception as exc:
+        if _passed_on(exc):
+            raise
+        raise _raised(name, structure, exc) from None
+
+
 def guard_calculator(calc: Any, name: str) -> Any:
     """Make ``calc`` fail in one line: its exceptions and non-finite results become
     :class:`CalculatorFailure` naming ``name``; returns ``calc`` itself.
@@ -179,12 +190,7 @@ def guard_calculator(calc: Any, name: str) -> Any:
 
         def calculate(atoms=None, *args, **kwargs):
             structure = atoms if atoms is not None else getattr(calc, "atoms", None)
-            try:
-                out = inner(atoms, *args, **kwargs)
-            except Exception as exc:
-                if _passed_on(exc):
-                    raise
-                raise _raised(name, structure, exc) from None
+            out = _called(inner, name, structure, atoms, *args, **kwargs)
             asked = args[0] if args else kwargs.get("properties", ())
             _check_results(calc.results, name, structure, asked or ())
             return out
@@ -206,12 +212,7 @@ def _guarded_getter(calc: Any, inner, key: str, name: str):
 
     def getter(atoms=None, *args, **kwargs):
         structure = atoms if atoms is not None else getattr(calc, "atoms", None)
-        try:
-            value = inner(atoms, *args, **kwargs)
-        except Exception as exc:
-            if _passed_on(exc):
-                raise
-            raise _raised(name, structure, exc) from None
+        value = _called(inner, name, structure, atoms, *args, **kwargs)
         _check_results({key: value}, name, structure, (key,))
         return value
 
