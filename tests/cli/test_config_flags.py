@@ -64,7 +64,7 @@ SCAN_CASES = {
         0.002,
     ),
     "--optimizer": (["--optimizer", "FIRE"], "scan.optimizer", "FIRE"),
-    "--precondition": (["--precondition"], "scan.precondition", True),
+    "--precondition": (["--no-precondition"], "scan.precondition", False),
     "--max-steps": (["--max-steps", "17"], "scan.max_steps", 17),
     "--order": (["--order", "planes"], "scan.order", "planes"),
     "--p-range-gpa": (["--p-range-gpa", "0.5", "3", "5"], "scan.p_range_gpa.n", 5),

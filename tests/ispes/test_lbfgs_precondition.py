@@ -172,12 +172,16 @@ def test_root_is_the_floored_inverse_and_commutes_with_the_projector():
 
 
 def test_the_preconditioner_applies_where_it_can_and_enters_the_store_only_there():
-    """Off by default (old stores keep their fingerprint); on, for the built-in L-BFGS in
-    modes full and normal the store fingerprint says so; elsewhere the iterates do not depend
+    """On by default; for the built-in L-BFGS in modes full and normal the store fingerprint
+    says so, with the slip guard (a store written by the unguarded preconditioner, whose
+    fingerprint said ``True``, is not resumed into); off, it is not in the fingerprint (a store
+    of the plain iteration resumes); for other optimizers and modes the iterates do not depend
     on it, so it is not in the fingerprint and a store of that optimizer or mode resumes
     whatever the setting."""
-    assert "precondition" not in RelaxSettings().as_dict()
-    assert RelaxSettings(precondition=True).as_dict()["precondition"] is True
+    assert RelaxSettings().precondition and RelaxSettings().uses_reference_hessian
+    guarded = "reference-hessian, slip-guarded"
+    assert RelaxSettings().as_dict()["precondition"] == guarded
+    assert "precondition" not in RelaxSettings(precondition=False).as_dict()
     assert RelaxSettings(mode="normal", optimizer="LBFGS", precondition=True).uses_reference_hessian
     for other in (
         RelaxSettings(optimizer="FIRE", precondition=True),

@@ -97,7 +97,7 @@ def _toy_factory():
     )
 
 
-def _scan(tmp_path, name, symmetry, mode="normal", optimizer="LBFGS", **kwargs):
+def _scan(tmp_path, name, symmetry, mode="normal", optimizer="LBFGS", fmax=0.005, **kwargs):
     ref = toy_interface_3()
     z0 = thickness(ref)
     return run_scan(
@@ -105,7 +105,7 @@ def _scan(tmp_path, name, symmetry, mode="normal", optimizer="LBFGS", **kwargs):
         _toy_factory(),
         GridSpec(6, 6, thickness_angstrom=(z0 - 0.2, z0 + 0.3)),
         tmp_path / name,
-        RelaxSettings(mode=mode, optimizer=optimizer),
+        RelaxSettings(fmax, mode=mode, optimizer=optimizer),
         executor=SerialExecutor(),
         symmetry=symmetry,
         **kwargs,
@@ -113,9 +113,11 @@ def _scan(tmp_path, name, symmetry, mode="normal", optimizer="LBFGS", **kwargs):
 
 
 def test_reduced_toy_scan_equals_the_full_scan(tmp_path):
-    """Relaxation along z only keeps the symmetry: the reduced grid is the full one."""
-    full = _scan(tmp_path, "full", SymmetrySettings(enabled=False))
-    red = _scan(tmp_path, "reduced", SymmetrySettings(verify_points=3))
+    """Relaxation along z only keeps the symmetry: the reduced grid is the full one, to what
+    the relaxation tolerance leaves (an energy error of order fmax²/k: at fmax 0.005 eV/Å the
+    two scans differ by up to 1.5e-3 meV/Å², at 5e-4 by 1.0e-5 to 1.7e-5)."""
+    full = _scan(tmp_path, "full", SymmetrySettings(enabled=False), fmax=5e-4)
+    red = _scan(tmp_path, "reduced", SymmetrySettings(verify_points=3), fmax=5e-4)
     assert full.symmetry is None and full.points_stored == 72
     sym = red.symmetry
     assert sym["order"] == 6 and not sym["computed_in_full"]
@@ -127,7 +129,7 @@ def test_reduced_toy_scan_equals_the_full_scan(tmp_path):
     assert ds.attrs["computed_points"] == red.points_stored and ds.attrs["grid_points"] == 72
     area = float(ds.attrs["area"])
     de = np.abs(ds["energy"].values - df["energy"].values).max() / area * 1e3
-    assert de < 1e-3  # meV/Å²: the relaxation tolerance's scale, not the symmetry's
+    assert de < 1e-4  # meV/Å²: the relaxation tolerance's scale, not the symmetry's
     assert bool(ds["converged"].all())
     assert int(ds.attrs["symmetry_order"]) == 6
 

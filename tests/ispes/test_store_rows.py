@@ -159,6 +159,9 @@ def test_a_kill_loses_only_the_uncommitted_points(tmp_path, signum, kept):
         stdout=subprocess.PIPE,
         stderr=subprocess.DEVNULL,
         text=True,
+        # SIGINT at its default in the child, as a terminal gives it (a suite started in the
+        # background inherits it ignored, and the child would never see the signal)
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     try:
         assert proc.stdout.readline().split() == ["written", "5"]

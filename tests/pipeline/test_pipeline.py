@@ -39,7 +39,9 @@ TINY = {
         "fmax_ev_per_angstrom": 0.01,  # pinned: this file must not follow the quick preset
         # pinned too: with two loads (threshold 0.6 GPa) μ's sign is the relaxation's noise,
         # and a negative μ rightly refuses p0 = 2 GPa before the stale-warning check is reached
+        # (ASE's iterates: no preconditioner, whose iterates give μ < 0 here)
         "optimizer": "LBFGS",
+        "precondition": False,
         "executor": "serial",
     },
     "analysis": {"p_gpa": [0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0]},

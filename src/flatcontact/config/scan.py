@@ -147,14 +147,12 @@ class ScanConfig(Section):
         description="Optimiser of each point: " + ", ".join(OPTIMIZERS),
     )
     precondition: bool = Field(
-        False,
-        # left out of the dumped config while off, so existing run fingerprints are unchanged
-        exclude_if=lambda value: value is False,
+        True,
         description="start the built-in L-BFGS of every point from the reference interface's "
         "inverse Hessian (computed once per process: 2 force calls per relaxed coordinate) "
         "where it applies: optimizers LBFGS-scaled and LBFGS, modes full and normal, at most "
-        "1,000 relaxed coordinates; about 5x fewer force calls on quartz, but in mode full "
-        "a column can change relaxation branch (docs/performance.md)",
+        "1,000 relaxed coordinates; about 5x fewer force calls on quartz. In mode full a point "
+        "where it slid a plane inside a slab is relaxed again without it (docs/performance.md)",
     )
     max_steps: int = Field(2000, ge=1, le=1_000_000, description="optimiser step cap per point")
     relax_mode: Literal["full", "normal", "rigid-layers", "rigid"] = Field(

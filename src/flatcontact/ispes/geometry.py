@@ -98,3 +98,29 @@ def warm_start_positions(
     pos[slab2] += d
     pos[fixed] = placed.positions[fixed]
     return pos
+
+
+def extrapolated_positions(
+    placed: Atoms,
+    parent: tuple[float, np.ndarray],
+    grandparent: tuple[float, np.ndarray],
+    thickness_angstrom: float,
+    fixed: np.ndarray,
+) -> np.ndarray:
+    """Linear extrapolation in z of two relaxed points of the same column.
+
+    x_start = x1 + (z - z1)/(z1 - z0) (x1 - x0), with ``parent`` = (z1, x1) and
+    ``grandparent`` = (z0, x0) the thicknesses (Å) and relaxed positions of two points at
+    the same lateral shift; the difference is taken with the lateral minimum image of
+    ``placed``'s cell. The ``fixed`` atoms are then placed exactly as in ``placed``.
+    """
+    z1, x1 = float(parent[0]), np.asarray(parent[1], dtype=float)
+    z0, x0 = float(grandparent[0]), np.asarray(grandparent[1], dtype=float)
+    d = x1 - x0
+    cell = placed.cell.array
+    frac = np.linalg.solve(cell.T, d.T).T
+    frac[:, :2] -= np.round(frac[:, :2])
+    d = frac @ cell
+    pos = x1 + (thickness_angstrom - z1) / (z1 - z0) * d
+    pos[fixed] = placed.positions[fixed]
+    return pos

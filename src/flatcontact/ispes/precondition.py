@@ -145,3 +145,23 @@ def cached_root(calc, key, compute: Callable[[], np.ndarray | None]) -> np.ndarr
             del _CACHE[mine.pop(0)]
         entry = _CACHE[full_key] = (weakref.ref(calc), compute())
     return entry[1]
+
+
+def slips_inside_slab(reference, positions: np.ndarray, shift: tuple[float, float]) -> bool:
+    """Whether a plane inside a slab of the relaxed ``positions`` at lateral ``shift`` slid
+    against its neighbour by more than :data:`flatcontact.ispes.slip.SLIP_THRESHOLD_ANGSTROM`
+    (:mod:`flatcontact.ispes.slip`'s definition; layers from ``arrays["layer"]``, found from
+    the structure if the interface has none)."""
+    from flatcontact.ispes import slip
+
+    if "layer" not in reference.arrays:
+        from flatcontact.structures.layers import interface_layers
+
+        reference = reference.copy()
+        reference.arrays["layer"] = interface_layers(reference)
+    gaps = slip.in_slab_gaps(reference)
+    moved = slip.layer_displacements(reference, positions, shift)
+    return any(
+        np.linalg.norm(moved[g.upper] - moved[g.lower]) > slip.SLIP_THRESHOLD_ANGSTROM
+        for g in gaps
+    )

@@ -73,12 +73,14 @@ from flatcontact.foundation.units import EV_PER_A3_TO_GPA
 from flatcontact.ispes.calculators import count_force_calls
 from flatcontact.ispes.contract import cell_area
 from flatcontact.ispes.geometry import (
+    extrapolated_positions,
     fixed_mask,
     in_plane_vectors,
     place_slab2,
     warm_start_positions,
 )
 from flatcontact.ispes.lbfgs import largest_atomic_norm, lbfgs_relax
+from flatcontact.ispes.precondition import slips_inside_slab
 from flatcontact.potentials.guarded import failing_at
 
 Optimizer = Literal["LBFGS-scaled", "LBFGS", "FIRE", "FIRE2", "BFGS", "BFGSLineSearch", "lammps-cg"]
@@ -143,7 +145,7 @@ class RelaxSettings:
     optimizer: str = "LBFGS-scaled"
     max_steps: int = 2000
     mode: str = "full"
-    precondition: bool = False
+    precondition: bool = True
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.fmax_ev_per_angstrom) and self.fmax_ev_per_angstrom > 0):
@@ -183,7 +185,9 @@ class RelaxSettings:
         }
         if self.mode == "full":
             del out["mode"]
-        if not self.uses_reference_hessian:  # the iterates do not depend on it: one store
+        if self.uses_reference_hessian:  # with the slip guard (_relax_point): its iterates
+            out["precondition"] = "reference-hessian, slip-guarded"
+        else:  # the iterates do not depend on it: one store
             del out["precondition"]
         return out
 
@@ -225,6 +229,10 @@ class PointResult:
     seconds: float
     positions: np.ndarray
     start_index: Index | None
+    #: force calls of the reference's Hessian (:func:`reference_root`) spent before this point
+    #: by the process that relaxed it (its first preconditioned point; 0 for the others): not
+    #: in ``force_calls``, which counts the point's own relaxation
+    hessian_force_calls: int = 0
 
 
 def normal_stress_gpa(atoms: Atoms, forces: np.ndarray) -> float:
@@ -303,7 +311,13 @@ def _relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSetting
             fixed,
         )
         if task.previous_positions is not None:
-            atoms.positions = extrapolated_start(atoms, task, fixed)
+            atoms.positions = extrapolated_positions(
+                atoms,
+                (task.start_thickness, task.start_positions),
+                (task.previous_thickness, task.previous_positions),
+                task.thickness,
+                fixed,
+            )
         if settings.mode in ("normal", "rigid-layers"):
             pos = atoms.positions
             pos[:, :2] = placed[:, :2]
@@ -317,21 +331,13 @@ def _relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSetting
     calc = count_force_calls(calc)
     groups = free_layer_groups(atoms, free) if settings.mode == "rigid-layers" else []
     project = constraint_projector(fixed, settings.mode, groups)
-    root = None
+    root, before_hessian = None, calc.force_calls
     if relaxing and settings.uses_reference_hessian:
         root = reference_root(reference, calc, fixed, settings.mode, project)
     calls0 = calc.force_calls
     steps = 0
     if relaxing and settings.optimizer in BUILT_IN_LBFGS:
-        outcome = lbfgs_relax(
-            point_evaluator(calc, atoms),
-            atoms.positions,
-            project,
-            settings.fmax_ev_per_angstrom,
-            settings.max_steps,
-            scaled=BUILT_IN_LBFGS[settings.optimizer] and root is None,
-            preconditioner=root,
-        )
+        outcome = _relax_built_in(reference, calc, atoms, task, settings, project, root)
         atoms.positions = outcome.positions
         energy, forces, steps = outcome.energy_ev, outcome.forces, outcome.steps
     elif relaxing and settings.optimizer == "lammps-cg":
@@ -373,6 +379,7 @@ def _relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSetting
         normal_stress_gpa=normal_stress_gpa(atoms, forces),
         reaction_stress_gpa=reaction_stress_gpa(atoms, forces, fixed),
         force_calls=int(calc.force_calls - calls0),
+        hessian_force_calls=int(calls0 - before_hessian),
         steps=steps,
         converged=bool(not relaxing or max_force < settings.fmax_ev_per_angstrom),
         max_force_ev_per_a=max_force,
@@ -381,6 +388,39 @@ def _relax_point(reference: Atoms, calc, task: PointTask, settings: RelaxSetting
         start_index=task.start_index,
     )
     return result
+
+
+def _relax_built_in(reference: Atoms, calc, atoms: Atoms, task: PointTask, settings, project, root):
+    """The built-in L-BFGS from ``atoms.positions`` (:func:`lbfgs_relax`), with the reference's
+    H0 where ``root`` is given. In mode ``full`` a preconditioned relaxation that slid a plane
+    inside a slab (:func:`flatcontact.ispes.precondition.slips_inside_slab`) is done again
+    from the same start with the optimizer's own H0, and that outcome is the point's (both
+    relaxations' force calls count): on a soft in-slab mode the reference's curvature, raised
+    to its eigenvalue floor, asks for long steps that can carry a plane over a barrier the
+    plain iteration never approaches, and a column whose points switch between such
+    branches is not a landscape (``docs/performance.md``, "The reference interface's
+    Hessian as H0")."""
+    outcome = lbfgs_relax(
+        point_evaluator(calc, atoms),
+        atoms.positions,
+        project,
+        settings.fmax_ev_per_angstrom,
+        settings.max_steps,
+        scaled=BUILT_IN_LBFGS[settings.optimizer] and root is None,
+        preconditioner=root,
+    )
+    if root is None or settings.mode != "full":
+        return outcome
+    if not slips_inside_slab(reference, outcome.positions, (task.shift_a, task.shift_b)):
+        return outcome
+    return lbfgs_relax(
+        point_evaluator(calc, atoms),
+        atoms.positions,
+        project,
+        settings.fmax_ev_per_angstrom,
+        settings.max_steps,
+        scaled=BUILT_IN_LBFGS[settings.optimizer],
+    )
 
 
 def constraint_projector(fixed: np.ndarray, mode: str, groups: list[np.ndarray]):
@@ -523,26 +563,6 @@ def free_layer_groups(atoms: Atoms, free: np.ndarray) -> list[np.ndarray]:
 
         layer = interface_layers(atoms)
     return [np.flatnonzero(free & (layer == k)) for k in np.unique(layer[free])]
-
-
-def extrapolated_start(placed: Atoms, task: PointTask, fixed: np.ndarray) -> np.ndarray:
-    """Linear extrapolation in z of two relaxed points of the same column.
-
-    x_start = x1 + (z - z1)/(z1 - z0) (x1 - x0), with x1, x0 the relaxed positions at
-    z1 (the parent) and z0 (its parent) at the same lateral shift; the difference is
-    taken with the lateral minimum image. Fixed atoms are then placed exactly.
-    """
-    x1 = np.asarray(task.start_positions, dtype=float)
-    x0 = np.asarray(task.previous_positions, dtype=float)
-    z1, z0 = float(task.start_thickness), float(task.previous_thickness)
-    d = x1 - x0
-    cell = placed.cell.array
-    frac = np.linalg.solve(cell.T, d.T).T
-    frac[:, :2] -= np.round(frac[:, :2])
-    d = frac @ cell
-    pos = x1 + (task.thickness - z1) / (z1 - z0) * d
-    pos[fixed] = placed.positions[fixed]
-    return pos
 
 
 @dataclasses.dataclass(frozen=True)

@@ -85,6 +85,10 @@ class ScanResult:
     #: ``grid`` (``grid/verification``), ``assemble``, ``extend``, ``ideal W after grid``,
     #: ``write``
     phase_seconds: dict[str, float] = dataclasses.field(default_factory=dict)
+    #: force calls of the reference interface's Hessian (``RelaxSettings.precondition``)
+    #: spent by the processes that relaxed the grid's points, once each; not in any point's
+    #: ``force_calls`` (a Hessian computed by the probe is in the probe's counts)
+    hessian_force_calls: int = 0
 
 
 def check_interface(atoms: Atoms) -> None:
@@ -141,6 +145,7 @@ class _Scanned:
     notes: list[str]
     interrupted: bool
     computed_calls: list[int]
+    hessian_calls: int = 0
 
     @property
     def mapping(self) -> dict | None:
@@ -347,7 +352,9 @@ def _rounds(
         if not extended:
             break
         resolved = store.resolved
-    return _Scanned(plan, resolved, notes, interrupted, scheduler.computed_calls)
+    return _Scanned(
+        plan, resolved, notes, interrupted, scheduler.computed_calls, scheduler.hessian_calls
+    )
 
 
 def _assemble(store: PointStore, scanned: _Scanned, out_dir: Path, t0: float) -> ScanResult:
@@ -366,6 +373,7 @@ def _assemble(store: PointStore, scanned: _Scanned, out_dir: Path, t0: float) ->
         points_computed=len(scanned.computed_calls),
         seconds=time.perf_counter() - t0,
         force_calls_computed=scanned.computed_calls,
+        hessian_force_calls=scanned.hessian_calls,
         adhesion=scanned.resolved.get("adhesion"),
         notes=scanned.notes,
         interrupted=scanned.interrupted,

@@ -59,7 +59,8 @@ class Scheduler:
     max_new_points
         Stop after this many new points (benchmarks), or None.
 
-    ``computed_calls`` lists the force calls of every point this scheduler computed.
+    ``computed_calls`` lists the force calls of every point this scheduler computed,
+    ``hessian_calls`` those of the reference's Hessian its points' processes computed first.
     """
 
     def __init__(
@@ -77,6 +78,9 @@ class Scheduler:
         self.max_new_points = max_new_points
         self.recent = PositionsCache()
         self.computed_calls: list[int] = []
+        #: force calls of the reference's Hessian the processes relaxing the points spent
+        #: (:attr:`flatcontact.ispes.relax.PointResult.hessian_force_calls`)
+        self.hessian_calls = 0
 
     def run(
         self,
@@ -125,6 +129,7 @@ class Scheduler:
                 self.recent.put(idx, result.positions)
                 queue.stored(idx)
                 self.computed_calls.append(result.force_calls)
+                self.hessian_calls += result.hessian_force_calls
                 stored += weight.get(idx, 1)
                 self._report(stored, total)
         store.flush()  # before the assembly and the checks that follow

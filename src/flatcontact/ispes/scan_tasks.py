@@ -24,10 +24,11 @@ from flatcontact.ispes.work_of_separation import ideal_work_of_separation
 
 
 def relax_column_point(reference, calc, relax, a, b, z, start, start_z) -> tuple:
-    """One probe point: ``(energy_ev, normal_stress_gpa, force_calls, positions)``."""
+    """One probe point: ``(energy_ev, normal_stress_gpa, force_calls, positions)``; the force
+    calls include the reference's Hessian when this point computed it (the probe's cost)."""
     task = PointTask((0, 0, 0), a, b, z, start, (a, b) if start is not None else None, start_z)
     r = relax_point(reference, calc, task, relax)
-    return r.energy_ev, r.normal_stress_gpa, r.force_calls, r.positions
+    return r.energy_ev, r.normal_stress_gpa, r.force_calls + r.hessian_force_calls, r.positions
 
 
 def _relax_one(context: ScanContext):

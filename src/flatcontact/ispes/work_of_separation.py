@@ -200,7 +200,7 @@ def slabs_apart(
             "when the distance doubles); give contact.work_of_adhesion_j_per_m2"
         )
     r = relax_point(reference, calc, PointTask((0, 0, 0), a, b, z_ref + d), relax)
-    return d, r.energy_ev, r.converged, r.force_calls
+    return d, r.energy_ev, r.converged, r.force_calls + r.hessian_force_calls
 
 
 def zero_load_interface(
@@ -244,7 +244,7 @@ def zero_load_interface(
                 f"work of separation: the slabs overlap at z = {z:.4g} Å before the load "
                 f"at shift ({a:.4g}, {b:.4g}) changes sign ({exc})"
             ) from None
-        calls += r.force_calls
+        calls += r.force_calls + r.hessian_force_calls
         done[z] = (r.energy_ev, r.normal_stress_gpa, r.positions, r.converged)
         return r.normal_stress_gpa
 

@@ -81,6 +81,7 @@ class ScanStageResult:
             or {"order": 1, "operations": [], "note": "every grid point relaxed"},
             "converged": int(ds["converged"].sum()),
             "force_calls_total": int(np.nansum(ds["force_calls"].values)),
+            "hessian_force_calls": int(r.hessian_force_calls),
             "median_force_calls_per_point": float(np.median(calls)) if calls else None,
             "thickness_angstrom": [float(z) for z in ds["thickness"].values],
             "area_angstrom2": float(ds.attrs["area"]),
