@@ -28,6 +28,18 @@ Measured (``python -m benchmarks precondition``; ``docs/performance.md``, "The r
 Hessian as H0"): 6 × 6 × 8 quartz grid, fmax 0.005 eV/Å, sio2-snap 15.4 force calls per
 point with γ-scaling (``LBFGS-scaled``) → 3.15; Vashishta 12.6 → 2.6; every point converged.
 
+Where it is not used as it is
+-----------------------------
+In mode ``full`` a soft in-slab mode (a plane of a slab sliding on the next: Cu(111) with one
+atom per plane) gets the floored curvature, so the preconditioned steps along it are long and
+can carry a plane over a barrier the plain iteration never approaches, to a point that passes
+``fmax`` on another branch (the notebook's Cu EMT example, unguarded: a column whose energy
+jumped by 0.010 eV between two thicknesses). A point whose relaxed planes slid against each
+other (:func:`slips_inside_slab`) is therefore relaxed again from the same start with the
+optimizer's own H0 (:func:`flatcontact.ispes.relax._relax_built_in`); both relaxations'
+force calls count. Where the plain iteration slides the plane too, the scan's
+``in_slab_slip`` gate reports it as before.
+
 Determinism
 -----------
 The Hessian is a function of the reference, the calculator and the mode: its force calls

@@ -135,10 +135,12 @@ class RelaxSettings:
         relaxed coordinates. There H0 stays that matrix at every step (no γ-rescaling:
         it would replace the measured curvature by one scalar, 3.74 against 3.15 force
         calls per point on the quartz benchmark grid); elsewhere the optimizer's own H0
-        (ASE's I/α, or γ I with ``LBFGS-scaled``). Default off: in mode ``full`` it made
-        one column of the notebook's Cu EMT example change relaxation branch (a fold in
-        its energy-derived load); see ``docs/performance.md``, "The reference interface's
-        Hessian as H0".
+        (ASE's I/α, or γ I with ``LBFGS-scaled``). Default on. In mode ``full`` a point
+        whose preconditioned relaxation slid a plane inside a slab is relaxed again from the
+        same start with the optimizer's own H0 (:func:`_relax_built_in`): unguarded, one
+        column of the notebook's Cu EMT example changed relaxation branch that way (a fold
+        in its energy-derived load); see ``docs/performance.md``, "The reference
+        interface's Hessian as H0".
     """
 
     fmax_ev_per_angstrom: float = 0.005
