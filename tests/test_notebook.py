@@ -113,6 +113,19 @@ def test_contact_from_laws_takes_a_fit_or_laws_json_alike():
         notebook.contact_from_laws({"k_mpa_per_gpa": 1.0}, [1.0], **moduli)
 
 
+def test_contact_from_laws_takes_one_p0_and_refuses_a_law_that_is_no_number():
+    as_json = {"k_mpa_per_gpa": 4.52, "tau0_mpa": 26.7, "mu_mpa_per_gpa": 0.21, "sigma0_mpa": 11.1}
+    moduli = {"radius_um": 5.0, "contact_modulus_gpa": 52.5, "shear_modulus_gpa": 29.0}
+    one = notebook.contact_from_laws(as_json, 1.0, **moduli).records()
+    assert len(one) == 1
+    assert one[0] == notebook.contact_from_laws(as_json, [1.0], **moduli).records()[0]
+    assert one[0]["contact_radius_nm"] == pytest.approx(np.pi * 5000.0 / (2 * 52.5), rel=1e-9)
+    for bad in ("fast", [1.0, 2.0]):
+        with pytest.raises(InputError) as info:
+            notebook.contact_from_laws({**as_json, "tau0_mpa": bad}, [1.0], **moduli)
+        assert str(info.value) == f"laws: tau0_mpa: expected a number, got {bad!r}"
+
+
 def test_the_public_names_and_the_module_examples():
     assert flatcontact.scan_interface is notebook.scan_interface
     assert flatcontact.contact_from_laws is notebook.contact_from_laws

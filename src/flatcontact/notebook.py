@@ -51,7 +51,7 @@ from __future__ import annotations
 
 import json
 import tempfile
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -330,7 +330,7 @@ def contact_from_laws(
         :func:`flatcontact.analysis.laws.fit_load_laws`'s result, or a mapping with
         ``k_mpa_per_gpa``, ``tau0_mpa``, ``mu_mpa_per_gpa``, ``sigma0_mpa`` (``laws.json``).
     p0_gpa
-        Hertz peak pressures (GPa).
+        Hertz peak pressures (GPa): a sequence, or one number.
     radius_um, contact_modulus_gpa, shear_modulus_gpa
         Tip radius R (µm), Hertz contact modulus E* (GPa) and the paper's shear modulus G*
         (GPa, = 4 G*_J of Johnson; :mod:`flatcontact.contact.moduli`).
@@ -354,7 +354,8 @@ def contact_from_laws(
         work_of_adhesion_j_per_m2=work_of_separation_j_per_m2,
         **numbers,
     )
-    return analyse(list(p0_gpa), params)
+    single = isinstance(p0_gpa, str) or not isinstance(p0_gpa, Iterable)
+    return analyse([p0_gpa] if single else list(p0_gpa), params)
 
 
 def _law_numbers(laws) -> dict[str, float]:
@@ -369,4 +370,10 @@ def _law_numbers(laws) -> dict[str, float]:
             f"laws: missing {', '.join(missing)} (a mapping as laws.json, or "
             "fit_load_laws(...)'s result with both τ and σ laws fitted)"
         )
-    return {k: float(doc[k]) for k in PAPER_LAW_KEYS}
+    numbers = {}
+    for key in PAPER_LAW_KEYS:
+        try:
+            numbers[key] = float(doc[key])
+        except (TypeError, ValueError):
+            raise InputError(f"laws: {key}: expected a number, got {doc[key]!r}") from None
+    return numbers
