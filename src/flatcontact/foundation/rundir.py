@@ -39,10 +39,10 @@ One writer per run directory: :class:`RunLock` holds an advisory ``flock`` on
 ``.flatcontact.lock`` (with the writer's pid in it) for as long as the run lives; a second
 writer is refused in one line. The writer removes the file, the lock still held, when it
 stops (finished, failed, interrupted), so a run directory at rest holds no lock file naming
-a process that is gone; a writer killed outright (``kill -9``) leaves it, and the kernel drops
-the lock when it dies, so the next run takes over. A run directory that cannot be written (a read-only
-mount) is opened read-only: finished stages are reported, a stage that would need to run
-is one line.
+a process that is gone; a writer killed outright (``kill -9``) leaves it, and the kernel
+drops the lock when it dies, so the next run takes over. A run directory that cannot be
+written (a read-only mount) is opened read-only: finished stages are reported, a stage that
+would need to run is one line.
 """
 
 from __future__ import annotations
