@@ -1,6 +1,7 @@
 """Run directory: stages are skipped, resumed or rerun exactly when their inputs say so."""
 
 import json
+import os
 
 import pytest
 
@@ -80,3 +81,88 @@ def test_corrupt_or_foreign_record_is_refused(tmp_path):
     )
     with pytest.raises(InputError, match="belongs to stage 'build'"):
         run.run_stage(1, "scan", {}, lambda f: None)
+
+
+# ---- the lock file: removed by its writer, never another's ------------------------------
+
+
+def test_the_writer_removes_its_lock_file_however_it_stops(tmp_path):
+    """Done, an exception, Ctrl-C: the lock file goes with the lock (the lock is still held
+    while it is removed: a writer that opened it meanwhile retries on a fresh file)."""
+    from flatcontact.foundation.rundir import LOCK_NAME, RunLock
+
+    lock = RunLock(tmp_path).acquire()
+    assert (tmp_path / LOCK_NAME).read_text().split()[0] == str(os.getpid())
+    lock.release()
+    assert not (tmp_path / LOCK_NAME).exists()
+    lock.release()  # idempotent
+    for stop in (RuntimeError("the calculator failed"), KeyboardInterrupt()):
+        with pytest.raises(type(stop)), RunLock(tmp_path):
+            assert (tmp_path / LOCK_NAME).is_file()
+            raise stop
+        assert os.listdir(tmp_path) == []
+    # a writer that follows takes a real lock: a second one is refused while it is held
+    with RunLock(tmp_path):
+        with pytest.raises(InputError, match=f"pid {os.getpid()}"):
+            RunLock(tmp_path).acquire()
+    assert os.listdir(tmp_path) == []
+
+
+def test_tidy_removes_only_an_empty_directory_the_writer_created(tmp_path):
+    from flatcontact.foundation.rundir import RunLock
+
+    made, kept = tmp_path / "made", tmp_path / "kept"
+    made.mkdir()
+    RunLock(made).acquire().release(tidy="created")
+    assert not made.exists()
+    made.mkdir()
+    lock = RunLock(made).acquire()
+    (made / "points.db").write_bytes(b"work")
+    lock.release(tidy="created")
+    assert os.listdir(made) == ["points.db"]
+    kept.mkdir()
+    RunLock(kept).acquire().release(tidy=True)
+    assert kept.is_dir() and os.listdir(kept) == []
+
+
+def test_release_never_removes_a_lock_file_another_writer_made(tmp_path):
+    """The lock file replaced under a writer (a later writer took the lock over as stale):
+    the first writer's release leaves the new file, and the new writer's lock holds."""
+    from flatcontact.foundation.rundir import LOCK_NAME, RunLock
+
+    first = RunLock(tmp_path).acquire()
+    fresh = tmp_path / "fresh"
+    fresh.write_text("")
+    os.replace(fresh, tmp_path / LOCK_NAME)  # as _take_over_or_refuse does
+    second = RunLock(tmp_path).acquire()
+    try:
+        first.release()
+        assert (tmp_path / LOCK_NAME).read_text().split()[0] == str(os.getpid())
+        with pytest.raises(InputError, match="another flatcontact process"):
+            RunLock(tmp_path).acquire()
+    finally:
+        second.release()
+    assert not (tmp_path / LOCK_NAME).exists()
+
+
+def test_a_process_forked_from_the_writer_does_not_remove_its_lock_file(tmp_path):
+    """A forked copy of the writer (a worker started by fork) that releases its copy of the
+    lock leaves the writer's lock file and lock in place."""
+    from flatcontact.foundation.rundir import LOCK_NAME, RunLock
+
+    lock = RunLock(tmp_path).acquire()
+    try:
+        child = os.fork()
+        if child == 0:  # pragma: no cover (the child)
+            try:
+                lock.release(tidy="created")
+            finally:
+                os._exit(0)
+        _, status = os.waitpid(child, 0)
+        assert os.waitstatus_to_exitcode(status) == 0
+        assert (tmp_path / LOCK_NAME).read_text().split()[0] == str(os.getpid())
+        with pytest.raises(InputError, match=f"pid {os.getpid()}"):
+            RunLock(tmp_path).acquire()
+    finally:
+        lock.release()
+    assert not (tmp_path / LOCK_NAME).exists()

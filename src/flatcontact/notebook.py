@@ -36,13 +36,22 @@ The three doors and their conventions:
   zones) at peak pressures ``p0_gpa`` with the fitted laws.
 
 Nothing here prints; progress goes to a callback ``progress(done, total)``.
+
+A calculator is code flatcontact does not control, so :func:`scan_interface` evaluates it
+once (energy and forces of the interface) before any work, and guards it
+(:func:`flatcontact.potentials.guarded.guard_calculator`, in place): one that raises or
+returns a non-finite number is a one-line
+:class:`~flatcontact.potentials.guarded.CalculatorFailure` (an ``InputError``) naming the
+calculator, the elements and its exception, and, mid-scan, the point
+(``point at shift (0.5, 0), thickness 10.75 Å: calculator 'EMT' failed on ...``); its own
+traceback is kept in the failure's ``detail``.
 """
 
 from __future__ import annotations
 
 import json
 import tempfile
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -78,6 +87,8 @@ class CalculatorInHand:
             )
         self.calculator = calculator
         self.label = label or type(calculator).__name__
+        #: how a failure names it (:class:`~flatcontact.potentials.guarded.CalculatorFailure`)
+        self.name = f"calculator {self.label!r}"
         kind = type(calculator)
         parameters = calculator.todict() if hasattr(calculator, "todict") else {}
         self.fingerprint = json.dumps(
@@ -90,7 +101,9 @@ class CalculatorInHand:
         )
 
     def __call__(self, atoms=None):
-        return self.calculator
+        from flatcontact.potentials.guarded import guard_calculator
+
+        return guard_calculator(self.calculator, self.name)
 
     def __reduce__(self):
         raise InputError(
@@ -112,12 +125,31 @@ class FactoryInHand:
         module = getattr(factory, "__module__", type(factory).__module__)
         self.factory = factory
         self.label = label or name
+        self.name = f"calculator {self.label!r}"
         self.fingerprint = json.dumps(
             {"factory": f"{module}.{name}", "label": self.label}, sort_keys=True
         )
 
     def __call__(self, atoms=None):
-        return self.factory(atoms)
+        """The factory's calculator for ``atoms``, guarded; a factory that raises or returns
+        no calculator is one line naming it."""
+        from flatcontact.potentials.guarded import first_line, guard_calculator
+        from flatcontact.potentials.loader import is_calculator
+
+        try:
+            made = self.factory(atoms)
+        except (InputError, MemoryError, OSError):
+            raise
+        except Exception as exc:
+            raise InputError(
+                f"calculator: factory {self.label!r} failed: {first_line(exc)}"
+            ) from None
+        if not is_calculator(made):
+            raise InputError(
+                f"calculator: factory {self.label!r} returned {type(made).__name__}, expected "
+                "an ASE calculator (with get_potential_energy and get_forces)"
+            )
+        return guard_calculator(made, self.name)
 
 
 def _scan_factory(calculator: Any, workers: int, label: str | None):
@@ -142,6 +174,36 @@ def _scan_factory(calculator: Any, workers: int, label: str | None):
         "calculator: expected an ASE calculator, a factory callable(atoms) -> calculator, an "
         f"InteractionModel or a potential's name, got {type(calculator).__name__}"
     )
+
+
+def _fresh(failure):
+    """A copy of the :class:`~flatcontact.potentials.guarded.CalculatorFailure` ``failure``,
+    to raise here: the notebook's traceback ends in this module, not deep in the scan."""
+    f = failure
+    return type(f)(f.calculator, f.elements, f.reason, f.where, f.detail)
+
+
+def _evaluate_once(interface, factory) -> None:
+    """One energy and forces of ``interface`` with ``factory``'s calculator, before any work
+    (the command line's pre-run evaluation): the interface contract first, then a
+    :class:`~flatcontact.potentials.guarded.CalculatorFailure` or an InputError naming
+    ``calculator`` when the calculator cannot evaluate it."""
+    from flatcontact.potentials.engines import ModelFactory, check_evaluation
+    from flatcontact.potentials.guarded import CalculatorFailure, evaluate_once
+    from flatcontact.structures.interface_contract import validate_interface
+
+    validate_interface(interface, "interface")
+    try:
+        if isinstance(factory, ModelFactory):  # a potential's name or an InteractionModel
+            check_evaluation(factory.model, interface)
+        else:
+            evaluate_once(factory(interface), interface, factory.name)
+    except CalculatorFailure as exc:
+        raise (_fresh(exc) if str(exc).startswith("calculator") else exc.at("calculator")) from None
+    except InputError as exc:
+        if str(exc).startswith("calculator"):
+            raise
+        raise InputError(f"calculator: {exc}") from None
 
 
 def scan_interface(
@@ -203,11 +265,19 @@ def scan_interface(
     InputError
         One line naming the parameter: a bad grid, both or neither of the thickness
         choices, an interface that breaks the contract, a calculator that is none.
+    flatcontact.potentials.guarded.CalculatorFailure
+        An ``InputError``, one line: the calculator raised or returned a non-finite energy or
+        forces, before the scan (its one evaluation of ``interface``: ``calculator 'EMT'
+        failed on the elements Si, O (NotImplementedError: No EMT-potential for Si)``) or at
+        a grid point (named first: ``point at shift (0.5, 0), thickness 10.75 Å: ...``; the
+        points relaxed before it stay in ``out``). ``.elements``, ``.reason`` and ``.detail``
+        (the calculator's traceback) hold the parts.
     """
     from flatcontact.ispes.contract import open_ispes
     from flatcontact.ispes.grid import GridSpec
     from flatcontact.ispes.relax import RelaxSettings
     from flatcontact.ispes.scan import run_scan
+    from flatcontact.potentials.guarded import CalculatorFailure
 
     if len(grid) != 2:
         raise InputError(f"grid: expected two lateral counts (n_a, n_b), got {list(grid)}")
@@ -226,11 +296,15 @@ def scan_interface(
     )
     relax = RelaxSettings(fmax_ev_per_angstrom=fmax_ev_per_angstrom, mode=relax_mode)
     options = {"kind": "serial"} if workers == 1 else {"kind": "processes", "workers": workers}
+    _evaluate_once(interface, factory)
 
     def scan(folder: Path):
-        result = run_scan(
-            interface, factory, spec, folder, relax, executor_options=options, progress=progress
-        )
+        try:
+            result = run_scan(
+                interface, factory, spec, folder, relax, executor_options=options, progress=progress
+            )
+        except CalculatorFailure as exc:  # named where it happened (the point), raised here
+            raise _fresh(exc) from None
         return open_ispes(result.ispes_path).load()
 
     if out is not None:
@@ -256,7 +330,7 @@ def contact_from_laws(
         :func:`flatcontact.analysis.laws.fit_load_laws`'s result, or a mapping with
         ``k_mpa_per_gpa``, ``tau0_mpa``, ``mu_mpa_per_gpa``, ``sigma0_mpa`` (``laws.json``).
     p0_gpa
-        Hertz peak pressures (GPa).
+        Hertz peak pressures (GPa): a sequence, or one number.
     radius_um, contact_modulus_gpa, shear_modulus_gpa
         Tip radius R (µm), Hertz contact modulus E* (GPa) and the paper's shear modulus G*
         (GPa, = 4 G*_J of Johnson; :mod:`flatcontact.contact.moduli`).
@@ -280,7 +354,8 @@ def contact_from_laws(
         work_of_adhesion_j_per_m2=work_of_separation_j_per_m2,
         **numbers,
     )
-    return analyse(list(p0_gpa), params)
+    single = isinstance(p0_gpa, str) or not isinstance(p0_gpa, Iterable)
+    return analyse([p0_gpa] if single else list(p0_gpa), params)
 
 
 def _law_numbers(laws) -> dict[str, float]:
@@ -295,4 +370,10 @@ def _law_numbers(laws) -> dict[str, float]:
             f"laws: missing {', '.join(missing)} (a mapping as laws.json, or "
             "fit_load_laws(...)'s result with both τ and σ laws fitted)"
         )
-    return {k: float(doc[k]) for k in PAPER_LAW_KEYS}
+    numbers = {}
+    for key in PAPER_LAW_KEYS:
+        try:
+            numbers[key] = float(doc[key])
+        except (TypeError, ValueError):
+            raise InputError(f"laws: {key}: expected a number, got {doc[key]!r}") from None
+    return numbers

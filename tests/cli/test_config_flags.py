@@ -219,8 +219,9 @@ def test_build_flag_over_a_configuration(flag, config, tmp_path, monkeypatch, ca
     got = _applied_or_refused(
         argv, flag, path, expected, monkeypatch, capsys, "flatcontact.stages.build.build_stage"
     )
-    # the fcc111 recipe has no source, the EAM preset no LJ: those two are refused there
-    refused = config == CU and flag in ("--source", "--lj-cutoff-angstrom")
+    # the fcc111 recipe has no source, the EAM preset no LJ: those two are refused there; nor
+    # has Vashishta parameters for Cu: the pre-run evaluation refuses it naming --potential
+    refused = config == CU and flag in ("--source", "--lj-cutoff-angstrom", "--potential")
     assert got == ("refused" if refused else "applied"), (flag, config.name)
     assert not (tmp_path / "b").exists() or got == "applied"
 

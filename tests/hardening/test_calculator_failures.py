@@ -100,6 +100,48 @@ def test_run_refuses_emt_on_quartz_before_the_run_directory(emt_config, tmp_path
     assert not out.exists()
 
 
+@pytest.mark.parametrize("structure", ["quartz", "toy"])
+def test_build_config_refuses_in_the_line_of_config_check(
+    structure, emt_config, tmp_path, capsys, monkeypatch
+):
+    """``build --config`` evaluates the model once before building, as ``config --check``,
+    ``run`` and ``scan`` do: EMT on quartz (which the build relaxes with it) and NaN forces
+    on the toy interface (which the build does not relax) are refused in the same line,
+    naming the file and the settings path, with nothing written and no relaxation run."""
+    from flatcontact.stages import build as build_module
+
+    config = emt_config
+    if structure == "toy":
+        config.write_text(
+            TOY_STRUCTURE + f"potential: {{calculator: {{target: '{HERE}:NanForces'}}}}\n"
+        )
+    expected = assert_refused_cleanly(["config", "--check", config], capsys, tmp_path, [])
+    monkeypatch.setattr(build_module, "build_stage", _must_not_run)
+    out = tmp_path / "b"
+    line = assert_refused_cleanly(["build", "--config", config, "--out", out], capsys, tmp_path, [])
+    assert line == expected
+    assert line.startswith(f"error: {config}: potential.calculator.target: ")
+    assert not out.exists()
+
+
+def test_build_names_the_potential_flag_that_set_emt(tmp_path, capsys, monkeypatch):
+    from flatcontact.stages import build as build_module
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(build_module, "build_stage", _must_not_run)
+    out = tmp_path / "b"
+    argv = ["build", "--potential", f"ase:{EMT}", "--out", out]
+    line = assert_refused_cleanly(argv, capsys, tmp_path, [])
+    assert line == (
+        f"error: --potential: ase:{EMT} cannot evaluate the elements Si, O of this "
+        f"interface's alpha-quartz {EMT_SAYS}"
+    )
+
+
+def _must_not_run(*args, **kwargs):
+    raise AssertionError("the build stage ran: the pre-run check did not refuse")
+
+
 def test_scan_refuses_emt_on_a_quartz_interface_before_writing(
     emt_config, quartz, tmp_path, capsys
 ):

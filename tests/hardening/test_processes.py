@@ -99,5 +99,5 @@ def test_second_writer_refused_then_parent_kill_takes_workers_and_rerun_takes_ov
     code, out, err = run_cli(["run", config, "--out", run], capsys)
     assert code == 0, err
     assert "resumed" in out.split("2. scan", 1)[1].split("3. analyze", 1)[0]
-    assert (run / ".flatcontact.lock").read_text().split()[0] == str(os.getpid())
+    assert not (run / ".flatcontact.lock").exists()  # taken over, removed by its new writer
     assert (run / "report.html").is_file()

@@ -149,7 +149,7 @@ def build(
 
     The same files as the build stage of 'flatcontact run' (its 01-build/ folder).
     """
-    from flatcontact.cli.settings import FLAGS_SOURCE, flag_errors
+    from flatcontact.cli.settings import FLAGS_SOURCE, config_source, flag_errors
     from flatcontact.config import build_config
     from flatcontact.stages.build import BuildInputs, build_stage
     from flatcontact.structures import build as builder
@@ -167,6 +167,9 @@ def build(
                 "--regenerate-dense: not with --config (it rebuilds the shipped quartz slab)"
             )
         cfg = _config_settings(config, structure, potential, lj_cutoff_angstrom, given, svg)
+        _check_build_inputs(
+            cfg, config_source(config), potential is not None, structure is not None
+        )
         check_out_dir(out)
         with flag_errors(FLAG_OF):
             result = build_stage(cfg, BuildInputs(), out)
@@ -218,6 +221,8 @@ def build(
     }
     with flag_errors(FLAG_OF):
         cfg = build_config(data, source=FLAGS_SOURCE)
+    _check_build_inputs(cfg, FLAGS_SOURCE, potential is not None, structure is not None)
+    with flag_errors(FLAG_OF):
         result = build_stage(cfg, BuildInputs(), out)
     _print(result, out)
 
@@ -270,6 +275,32 @@ def _config_settings(
         lj = {**flags.get("potential", {}), "lj": {"cutoff_angstrom": lj_cutoff_angstrom}}
         cfg = resolve_config(config, None, {**flags, "potential": lj}, FLAG_OF)
     return cfg
+
+
+def _check_build_inputs(cfg, source: str, potential_given: bool, structure_given: bool):
+    """The pre-run checks of the build (:func:`~flatcontact.stages.preflight.check_build_inputs`:
+    the structure file, the model set up on the recipe's interface and one energy and forces
+    of it), before anything is written, in the line ``config --check CONFIG`` gives:
+    ``<source>: <settings path>: ...`` (``source`` the ``--config`` file, or the flags), or
+    ``--potential: ...`` / ``--structure: ...`` when that flag set the part refused."""
+    from flatcontact.stages.preflight import check_build_inputs
+
+    try:
+        check_build_inputs(cfg, source)
+    except InputError as exc:
+        text = str(exc).removeprefix(f"{source}: ")
+        field, _, said = text.partition(": ")
+        for given, section, flag in (
+            (potential_given, "potential", "--potential"),
+            (structure_given, "structure", "--structure"),
+        ):
+            if not given or not text.startswith(section):
+                continue
+            if said and (field == section or field.startswith(section + ".")):
+                raise InputError(f"{flag}: {said}") from None
+            if text[len(section) : len(section) + 1] == " ":  # "potential 'x' has no ..."
+                raise InputError(f"{flag}{text[len(section) :]}") from None
+        raise
 
 
 def _recipe_fields(kind: str) -> set[str]:

@@ -37,10 +37,12 @@ after each stage runs (the stage's folder).
 
 One writer per run directory: :class:`RunLock` holds an advisory ``flock`` on
 ``.flatcontact.lock`` (with the writer's pid in it) for as long as the run lives; a second
-writer is refused in one line, and the kernel drops the lock when the first dies, however
-it dies, so the next run takes over. A run directory that cannot be written (a read-only
-mount) is opened read-only: finished stages are reported, a stage that would need to run
-is one line.
+writer is refused in one line. The writer removes the file, the lock still held, when it
+stops (finished, failed, interrupted), so a run directory at rest holds no lock file naming
+a process that is gone; a writer killed outright (``kill -9``) leaves it, and the kernel
+drops the lock when it dies, so the next run takes over. A run directory that cannot be
+written (a read-only mount) is opened read-only: finished stages are reported, a stage that
+would need to run is one line.
 """
 
 from __future__ import annotations
@@ -225,9 +227,12 @@ class RunLock:
     """One writer per directory: an exclusive advisory ``flock`` on ``<root>/.flatcontact.lock``.
 
     The file holds the writer's pid, host and process start time (:func:`lock_holder_line`),
-    for the refusal message and to recognise a stale lock. The lock belongs to the open
-    file, so it ends with :meth:`release` or with the process, however it ends (``kill -9``
-    included): a later writer takes over without anyone removing a stale file. A lock can
+    for the refusal message and to recognise a stale lock. :meth:`release` removes it while
+    the lock is still held (a writer that opened it meanwhile finds it gone once it has the
+    lock, and retries on a fresh file), so a writer that stops however Python lets it stop
+    (done, an exception, Ctrl-C, SIGTERM) leaves none. The lock belongs to the open file, so
+    it also ends with the process, however it ends (``kill -9`` included): a later writer
+    takes the file such a writer left over without anyone removing it. A lock can
     outlive its writer where another process inherited the open file (a process forked
     from the writer, a launcher that kept its descriptors); a lock whose recorded writer is
     gone (:func:`stale_holder`: this host, pid not running, or reused) is taken over, with a
@@ -245,6 +250,7 @@ class RunLock:
         self.path = Path(root) / LOCK_NAME
         self.flag = flag
         self._handle = None
+        self._pid: int | None = None  # the process that took the lock (not a forked copy)
 
     def acquire(self) -> RunLock:
         """Take the lock or raise a one-line :class:`InputError` naming the live writer.
@@ -271,6 +277,7 @@ class RunLock:
             handle.write(lock_holder_line() + "\n")
             handle.flush()
             self._handle = handle
+            self._pid = os.getpid()
             sweep_temporary(self.path.parent)
             return self
         raise InputError(
@@ -318,23 +325,27 @@ class RunLock:
         os.replace(tmp, self.path)
 
     def release(self, tidy: bool | str = False) -> None:
-        """Give the lock up (idempotent).
+        """Give the lock up and remove the lock file (idempotent).
 
-        With ``tidy``, a directory that holds nothing but the lock file is left as it was
-        found: the lock file is removed (and the directory too when ``tidy`` is the
-        directory this writer created), so a command that failed before writing leaves
-        nothing behind.
+        The file is removed before the lock is let go, and only by the process that took the
+        lock and only while the path still names the file it locked: never a lock file that
+        another writer has since made (a stale lock taken over), nor from a process forked
+        from the writer. With ``tidy="created"`` (the directory this writer created) a
+        directory left empty is removed too, so a command that failed before writing leaves
+        nothing behind (``tidy=True``, a directory that existed, is kept).
         """
         if self._handle is None:
             return
         root = self.path.parent
-        if tidy and [p.name for p in root.iterdir()] == [LOCK_NAME]:
-            self.path.unlink(missing_ok=True)
-            if tidy == "created":
-                with contextlib.suppress(OSError):
-                    root.rmdir()
+        if self._pid == os.getpid():
+            with contextlib.suppress(OSError):  # a directory gone read-only: the file stays
+                if self._still_the_lock_file(self._handle):
+                    self.path.unlink()
         self._handle.close()
         self._handle = None
+        if tidy == "created" and self._pid == os.getpid():
+            with contextlib.suppress(OSError):  # not empty: kept
+                root.rmdir()
 
     def __enter__(self) -> RunLock:
         return self.acquire()

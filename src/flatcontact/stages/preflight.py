@@ -10,7 +10,7 @@ is refused here, not in the build's relaxation) and asks the stages' own checks 
 contact moduli's material, the elastic crystal), so ``flatcontact config --check`` and
 :class:`flatcontact.pipeline.Pipeline` refuse a run before its first stage, with one line
 naming the field and the file. ``flatcontact scan`` asks :func:`check_scan_interface` for
-the interface it is given.
+the interface it is given, ``flatcontact build --config`` :func:`check_build_inputs`.
 """
 
 from __future__ import annotations
@@ -84,6 +84,25 @@ def check_inputs(cfg: RunConfig, source: str = "config") -> None:
             _calculator.check(cfg)
         else:
             _calculator.check_atoms(cfg, bulk)
+
+
+def check_build_inputs(cfg: RunConfig, source: str = "config") -> None:
+    """The checks of :func:`check_inputs` that concern the build stage alone: the structure
+    file (readable, within the ``atoms`` bound, an interface for ``kind: file``) and the
+    model on the recipe's interface, built unrelaxed (set up, one energy and forces), so
+    ``flatcontact build --config CONFIG`` refuses them in the line ``flatcontact run CONFIG``
+    and ``config --check CONFIG`` give, before the build writes anything.
+
+    Raises
+    ------
+    InputError
+        One line ``<source>: <settings path>: ...``; for a calculator that cannot evaluate
+        the interface ``<source>: potential.calculator.target: <target> cannot evaluate the
+        elements Si, O of this interface's alpha-quartz (<exception type>: <first line>)``.
+    """
+    if cfg.structure.kind in ("file", "slab") and getattr(cfg.structure, "file", None) is not None:
+        _check_structure_file(cfg, source)
+    _check_structure(cfg, source)
 
 
 def check_scan_settings(cfg: RunConfig, source: str = "config") -> None:
