@@ -74,6 +74,14 @@ def _potential_section(potential: str) -> dict[str, Any]:
     return {"intra": potential}  # any spelling: InteractionModel normalizes it
 
 
+def potential_flag(potential: str) -> dict[str, Any]:
+    """``--potential`` as laid over the config's ``potential`` section: an intra-slab model in
+    place of the configured model's (its coupling kept; an ASE calculator over the whole
+    interface replaced whole, :func:`flatcontact.config.merge.kept_for_intra`), not a
+    calculator; or a spec's model (a calculator in it kept)."""
+    return {"calculator": None, **_potential_section(potential)}
+
+
 def resolve_config(config: Path | None, preset: str | None, flags: dict[str, Any]):
     """The run configuration of ``CONFIG`` with the scan flags laid over (errors name the flag)."""
     from flatcontact.cli.settings import resolve_config as resolve
@@ -191,8 +199,7 @@ def scan_command(
         raise InputError("give either --potential or --calculator, not both")
     flags: dict[str, Any] = {"scan": {}, **settings}
     if potential is not None:
-        # an intra-slab model in place of the configured model's (its LJ kept), not a calculator
-        flags["potential"] = {**_potential_section(potential), "calculator": None}
+        flags["potential"] = potential_flag(potential)
     if calculator_kwarg and calculator is None:
         raise InputError("--calculator-kwarg: give --calculator module:callable with it")
     if calculator is not None:
