@@ -28,7 +28,9 @@ def merge_config(base: dict, over: dict) -> dict:
 
     Top-level sections that start afresh instead of merging: a ``structure`` of another
     ``kind`` (none of the old recipe's fields apply) and a ``potential`` that defines a whole
-    model (:func:`replaces_model`: a preset, a calculator, a coupling, LAMMPS styles).
+    model (:func:`replaces_model`: a preset, a calculator, a coupling, LAMMPS styles). A
+    ``potential`` naming a new intra-slab model is laid over what :func:`kept_for_intra`
+    keeps of the old one.
     """
     out = copy.deepcopy(base)
     for key, value in over.items():
