@@ -123,6 +123,9 @@ def check_settings(
         path = text.partition(": ")[0]
         if path in _given(flags) and path in FLAG_OF:
             raise InputError(rename(text, {path: FLAG_OF[path]})) from None
+        if text.startswith("potential '") and "potential" in flags:  # the flag's model refused
+            flag = "--calculator" if flags["potential"].get("calculator") else "--potential"
+            raise InputError(flag + text.removeprefix("potential")) from None
         raise
 
 
