@@ -100,3 +100,25 @@ def test_repair_keeps_sound_rows_and_drops_the_rest():
         kept = repair_rows(db, rows, SETTINGS, RESOLVED, 2, "points.db")
     assert list(kept) == [(0, 0, 0)] and kept[(0, 0, 0)].id == 1
     assert sorted(db.deleted) == [2, 3, 4, 5]
+
+
+def test_settings_difference_names_the_model_field_as_the_run_settings_do():
+    """The store keeps the model's fingerprint nested (``potential.potential.model...``); a
+    difference names the setting the user wrote (``potential.calculator.kwargs.x``)."""
+    import json
+
+    from flatcontact.potentials.engines import calculator_factory
+    from flatcontact.potentials.model import InteractionModel
+
+    def settings(**kwargs):
+        model = InteractionModel(calculator={"target": "ase.calculators.emt:EMT", "kwargs": kwargs})
+        return {"potential": json.loads(calculator_factory(model).fingerprint)}
+
+    said = settings_difference(settings(asap_cutoff=False), settings(asap_cutoff=True))
+    assert said == "potential.calculator.kwargs.asap_cutoff: false in the store vs true now"
+    old, new = settings(), settings()
+    old["potential"]["potential"]["files_sha256"] = {"Cu.eam": "a" * 8}
+    new["potential"]["potential"]["files_sha256"] = {"Cu.eam": "b" * 8}
+    said = settings_difference(old, new)
+    assert said.startswith("the content (SHA-256) of potential file Cu.eam: ")
+    assert "potential.potential" not in said

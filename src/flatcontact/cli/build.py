@@ -171,7 +171,12 @@ def build(
             cfg, config_source(config), potential is not None, structure is not None
         )
         check_out_dir(out)
-        with flag_errors(FLAG_OF):
+        given_paths = [f"structure.{k}" for k, v in given.items() if v is not None]
+        given_paths += ["potential"] * (potential is not None)
+        given_paths += ["structure.file"] * (structure is not None)
+        given_paths += ["potential.lj"] * (lj_cutoff_angstrom is not None)
+        # the flags given only: a setting of the file is named as the file names it
+        with flag_errors({k: v for k, v in FLAG_OF.items() if k in given_paths}):
             result = build_stage(cfg, BuildInputs(), out)
         _print(result, out)
         return

@@ -74,6 +74,14 @@ def _potential_section(potential: str) -> dict[str, Any]:
     return {"intra": potential}  # any spelling: InteractionModel normalizes it
 
 
+def potential_flag(potential: str) -> dict[str, Any]:
+    """``--potential`` as laid over the config's ``potential`` section: an intra-slab model in
+    place of the configured model's (its coupling kept; an ASE calculator over the whole
+    interface replaced whole, :func:`flatcontact.config.merge.kept_for_intra`), not a
+    calculator; or a spec's model (a calculator in it kept)."""
+    return {"calculator": None, **_potential_section(potential)}
+
+
 def resolve_config(config: Path | None, preset: str | None, flags: dict[str, Any]):
     """The run configuration of ``CONFIG`` with the scan flags laid over (errors name the flag)."""
     from flatcontact.cli.settings import resolve_config as resolve
@@ -115,6 +123,9 @@ def check_settings(
         path = text.partition(": ")[0]
         if path in _given(flags) and path in FLAG_OF:
             raise InputError(rename(text, {path: FLAG_OF[path]})) from None
+        if text.startswith("potential '") and "potential" in flags:  # the flag's model refused
+            flag = "--calculator" if flags["potential"].get("calculator") else "--potential"
+            raise InputError(flag + text.removeprefix("potential")) from None
         raise
 
 
@@ -191,8 +202,7 @@ def scan_command(
         raise InputError("give either --potential or --calculator, not both")
     flags: dict[str, Any] = {"scan": {}, **settings}
     if potential is not None:
-        # an intra-slab model in place of the configured model's (its LJ kept), not a calculator
-        flags["potential"] = {**_potential_section(potential), "calculator": None}
+        flags["potential"] = potential_flag(potential)
     if calculator_kwarg and calculator is None:
         raise InputError("--calculator-kwarg: give --calculator module:callable with it")
     if calculator is not None:

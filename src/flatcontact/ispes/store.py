@@ -30,8 +30,10 @@ point it was warm-started from (one connection, rows in order), so a resumed gri
 uninterrupted one. ASE's own lock file is disabled: after a
 ``kill -9`` inside a write it would stay behind and block every later run forever.
 Instead the driver holds an advisory ``flock`` on ``points.db.driver`` for as long as
-the store is open; the kernel releases it when the process dies, however it dies, and
-a second driver on the same store is refused with one line.
+the store is open, and removes the file, the lock still held, when it closes the store
+(:class:`_DriverLock`); the kernel releases the lock when the process dies, however it
+dies (``kill -9`` leaves the file, which the next driver takes over), and a second driver
+on the same store is refused with one line.
 
 Validation when a store is opened (a store is never used unchecked):
 
@@ -48,6 +50,7 @@ Validation when a store is opened (a store is never used unchecked):
 
 from __future__ import annotations
 
+import contextlib
 import fcntl
 import hashlib
 import json
@@ -64,7 +67,7 @@ import numpy as np
 from ase import Atoms
 
 from flatcontact.foundation.errors import InputError
-from flatcontact.foundation.fileio import refuse_link
+from flatcontact.foundation.fileio import open_nofollow, refuse_link
 from flatcontact.foundation.interrupts import raise_on_sigterm
 from flatcontact.ispes import contract, store_schema
 from flatcontact.ispes.relax import Index, PointResult
@@ -83,20 +86,56 @@ FORMAT = "flatcontact.points/1"
 SIDE_SUFFIXES = ("-wal", "-shm", "-journal", ".driver")
 
 
-def _acquire_driver_lock(path: Path):
-    """Hold an exclusive advisory lock on ``<path>.driver``; InputError if another driver has it."""
-    handle = open(
-        path.with_name(path.name + ".driver"), "a"
-    )  # the lock lives as long as the handle
+class _DriverLock:
+    """The driver's exclusive advisory ``flock`` on ``<store>.driver`` (module docstring).
+
+    Taken when the store opens, or an InputError if another live driver holds it. Given up
+    by :meth:`release`, which removes the file first, the lock still held, and only in the
+    process that took it and while the path still names the file it locked. A driver that
+    opened the file before it was removed gets the lock of a removed file: it sees the path
+    name another file (or none), lets go and opens the path again, so there is one driver. A
+    driver killed outright leaves the file; the kernel dropped its lock, so the next takes it.
+    """
+
+    def __init__(self, store: Path):
+        self.path = store.with_name(store.name + ".driver")
+        self._pid = os.getpid()
+        for _ in range(5):  # a file removed by the driver that just stopped: open it again
+            handle = open(open_nofollow(self.path, append=True), "a", closefd=True)
+            try:
+                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                handle.close()
+                raise InputError(
+                    f"{store}: another flatcontact scan is writing to this store; wait for it "
+                    "to finish or use another --out"
+                ) from None
+            if _names(self.path, handle):
+                self._handle = handle
+                return
+            handle.close()
+        raise InputError(f"{store}: could not take the lock {self.path.name}; retry")
+
+    def release(self) -> None:
+        """Remove the lock file (as the class says) and let the lock go; idempotent."""
+        if self._handle is None:
+            return
+        if self._pid == os.getpid():
+            with contextlib.suppress(OSError):  # a directory gone read-only: the file stays
+                if _names(self.path, self._handle):
+                    self.path.unlink()
+        self._handle.close()
+        self._handle = None
+
+
+def _names(path: Path, handle) -> bool:
+    """Whether ``path`` is (still) the file open as ``handle``."""
     try:
-        fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        handle.close()
-        raise InputError(
-            f"{path}: another flatcontact scan is writing to this store; wait for it to finish "
-            "or use another --out"
-        ) from None
-    return handle
+        now = os.stat(path, follow_symlinks=False)
+    except FileNotFoundError:
+        return False
+    mine = os.fstat(handle.fileno())
+    return (now.st_dev, now.st_ino) == (mine.st_dev, mine.st_ino)
 
 
 def interface_hash(atoms: Atoms) -> str:
@@ -186,7 +225,7 @@ class PointStore:
         self.path.parent.mkdir(parents=True, exist_ok=True)
         for suffix in ("", *SIDE_SUFFIXES):
             refuse_link(self.path.with_name(self.path.name + suffix), "a point store file")
-        self._driver_lock = _acquire_driver_lock(self.path)
+        self._driver_lock: _DriverLock | None = _DriverLock(self.path)
         try:
             new = not self.path.exists() or self.path.stat().st_size == 0
             if new:  # the layout of a new store: store_schema
@@ -296,12 +335,13 @@ class PointStore:
         return self._uncommitted
 
     def close(self) -> None:
-        """Commit, close the database connection and release the driver lock."""
+        """Commit, close the database connection and release the driver lock (its file
+        removed: :class:`_DriverLock`)."""
         db = getattr(self, "_db", None)
         if db is not None and db.connection is not None:
             db.__exit__(None, None, None)
         if self._driver_lock is not None:
-            self._driver_lock.close()
+            self._driver_lock.release()
             self._driver_lock = None
         if getattr(self, "_old_sigterm", None) is not None:
             signal.signal(signal.SIGTERM, self._old_sigterm)

@@ -79,8 +79,30 @@ def _flatten(d: Any, prefix: str = "") -> dict[str, Any]:
     return {prefix: d}
 
 
+#: The model's part of the store's settings (the scan's ``potential`` key holds
+#: :meth:`flatcontact.potentials.engines.ModelFactory.fingerprint`, ``{"potential": {"model":
+#: ..., "files_sha256": ...}}``) -> how a difference names it: the model's fields as the run
+#: settings name them (``potential.calculator.kwargs.x``), a potential file by its name.
+_FINGERPRINT_NAMES = (
+    ("potential.potential.model.", "potential."),
+    ("potential.potential.files_sha256.", "the content (SHA-256) of potential file "),
+)
+
+
+def _setting_name(key: str) -> str:
+    """The flattened settings key ``key`` as the run settings name it (:data:`_FINGERPRINT_NAMES`)."""
+    for inner, shown in _FINGERPRINT_NAMES:
+        if key.startswith(inner):
+            return shown + key.removeprefix(inner)
+    return key
+
+
 def settings_difference(stored: dict, current: dict) -> str | None:
-    """The first difference between two settings dicts as ``key: stored vs current``, or None."""
+    """The first difference between two settings dicts as ``key: stored vs current``, or None.
+
+    The key is the flattened path (``grid.n_a``), the model's part named as the run settings
+    name it (``potential.calculator.kwargs.x``, not the fingerprint's nesting).
+    """
     a, b = _flatten(json.loads(json.dumps(stored))), _flatten(json.loads(json.dumps(current)))
     for key in sorted(set(a) | set(b)):
         if a.get(key, "<absent>") != b.get(key, "<absent>"):
@@ -89,7 +111,7 @@ def settings_difference(stored: dict, current: dict) -> str | None:
                 sa = sa[:57] + "..."
             if len(sb) > 60:
                 sb = sb[:57] + "..."
-            return f"{key}: {sa} in the store vs {sb} now"
+            return f"{_setting_name(key)}: {sa} in the store vs {sb} now"
     return None
 
 

@@ -37,6 +37,7 @@ exactly the sum of the groups' energies plus the coupling (tested).
 
 from __future__ import annotations
 
+import functools
 import json
 from pathlib import Path
 from typing import Any, Literal
@@ -275,7 +276,7 @@ class InteractionModel(BaseModel):
             intra = " + ".join(s.label for s in self.intra) + (
                 " per layer" if self.intra_scope == "layer" else ""
             )
-        prefix = f"{self.preset}: " if self.preset else ""
+        prefix = f"{self.preset}: " if self._preset_intra else ""
         if self.coupling == "lj":
             return prefix + intra + self._lj_label()
         if self.coupling == "same":
@@ -286,9 +287,16 @@ class InteractionModel(BaseModel):
         return prefix + intra + " (no coupling across the interface)"
 
     @property
+    def _preset_intra(self) -> bool:
+        """Whether the model has a preset and the preset's own intra model (a preset whose
+        ``intra`` was given beside it is named by that intra model, not by the preset)."""
+        return bool(self.preset) and self.intra == _preset_model(self.preset).intra
+
+    @property
     def name(self) -> str:
-        """The shortest name: the preset, the named intra model, the styles or the calculator."""
-        if self.preset:
+        """The shortest name: the preset (with its own intra model), the named intra model,
+        the styles or the calculator."""
+        if self._preset_intra:
             return self.preset
         if self.calculator is not None:
             return self.calculator.target
@@ -360,6 +368,12 @@ class InteractionModel(BaseModel):
                 self.lj.table(sorted(set(sym[groups == 1])), sorted(set(sym[groups != 1])))
         if self.engine == "lammps" and not self.intra_styles and self.coupling != "lj":
             raise InputError(f"potential {self.label}: nothing to compute (no intra model, no LJ)")
+
+
+@functools.cache
+def _preset_model(name: str) -> InteractionModel:
+    """The model of the preset ``name`` as it ships (no field overridden)."""
+    return InteractionModel(preset=name)
 
 
 def slab_ids(atoms) -> np.ndarray:
