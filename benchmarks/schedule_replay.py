@@ -144,10 +144,13 @@ class VirtualExecutor:
         self.log.append(("submit", key, self.clock, start, start + seconds))
         return handle
 
-    def wait_first(self, handles) -> tuple[set, set]:
+    def wait_first(self, handles, timeout: float | None = None) -> tuple[set, set]:
         self._tick()
         handles = set(handles)
         first = min(handles, key=lambda h: (h.end, h.seq))
+        if timeout is not None and first.end > self.clock + timeout:
+            self.clock += timeout  # nothing finished in time: the driver commits, waits again
+            return set(), handles
         self.clock = max(self.clock, first.end)
         return {first}, handles - {first}
 

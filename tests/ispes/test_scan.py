@@ -311,3 +311,61 @@ def test_jobqueue_cluster_from_config_builds_the_batch_job():
         jobqueue_cluster({"kind": "cloud"})
     with pytest.raises(InputError, match="cannot build a SLURMCluster"):
         jobqueue_cluster({"kind": "slurm", "jobs": 0, "cores": 1, "memory": "1GB", "bogus": 1})
+
+
+class _LateResults(SerialExecutor):
+    """Tasks run on submission; each result is handed over ``delay_s`` after the driver starts
+    waiting for it (simulated: a wait whose time limit is shorter sees nothing finished)."""
+
+    inline = False
+
+    def __init__(self, delay_s: float):
+        self.delay_s = delay_s
+        self.timed_out = []  # (timeout, uncommitted points at that moment)
+        self.waits = 0
+
+    def wait_first(self, handles, timeout=None):
+        handles = list(handles)
+        if timeout is not None and timeout < self.delay_s:
+            self.timed_out.append((timeout, self.store.uncommitted))
+            return set(), set(handles)
+        self.waits += 1
+        return {handles[0]}, set(handles[1:])
+
+
+@pytest.mark.parametrize("delay_s", [1e-3, 10.0])
+def test_points_stored_are_committed_when_due_also_while_the_driver_waits(
+    tmp_path, toy_reference, toy_factory, monkeypatch, delay_s
+):
+    """The driver waits for a result at most until the stored points are due
+    (COMMIT_INTERVAL_S after the last commit), commits them then and waits on: with results
+    slower than that every point is committed before the next wait goes on; with fast results
+    the points that arrive within the interval share a commit instead of one commit each."""
+    from flatcontact.ispes import store as store_module
+
+    commits = []
+    original = store_module.PointStore._commit
+
+    def counted(self):
+        commits.append(self._uncommitted)
+        original(self)
+
+    monkeypatch.setattr(store_module.PointStore, "_commit", counted)
+    late = _LateResults(delay_s)
+    opened = store_module.PointStore.__init__
+
+    def remember(self, *args, **kwargs):
+        opened(self, *args, **kwargs)
+        late.store = self
+
+    monkeypatch.setattr(store_module.PointStore, "__init__", remember)
+    z0 = thickness(toy_reference)
+    grid = GridSpec(3, 3, thickness_angstrom=(z0 - 0.2, z0))
+    run_scan(toy_reference, toy_factory, grid, tmp_path / "s", SETTINGS, executor=late)
+    assert late.waits == 18  # every point's result came out of a wait
+    assert sum(commits) == 18  # every point committed once
+    assert all(0 <= t <= 0.5 and n > 0 for t, n in late.timed_out)  # only with points due
+    if delay_s > 0.5:  # each wait outlasts the deadline: a commit before each goes on
+        assert len(late.timed_out) == 17 and max(commits) == 1
+    else:  # the results arrive in time: commits only when due, far fewer than points
+        assert len([n for n in commits if n]) < 6

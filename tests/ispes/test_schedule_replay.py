@@ -58,8 +58,8 @@ class Recording:
         self.events.append(("submit", self.keys[handle]))
         return handle
 
-    def wait_first(self, handles):
-        return self.inner.wait_first(handles)
+    def wait_first(self, handles, timeout=None):
+        return self.inner.wait_first(handles, timeout)
 
     def done(self, handle):
         return self.inner.done(handle)

@@ -49,8 +49,10 @@ class Executor(Protocol):
     ``workers``: how many tasks run at once (the driver keeps twice as many in flight and
     from :data:`flatcontact.ispes.scan_probe.MANY_WORKERS` on probes in parallel chains).
     ``inline``: tasks run at submission in the driver's process (the driver commits its
-    store before each submission). ``prestart``: start the workers and build their
-    calculators without waiting (a no-op where there is nothing to start).
+    store before a submission that would leave points uncommitted past their deadline).
+    ``wait_first``: the finished handles, waiting at most ``timeout`` seconds (None: until
+    one finishes; nothing finished: an empty first set). ``prestart``: start the workers
+    and build their calculators without waiting (a no-op where there is nothing to start).
     """
 
     name: str
@@ -61,7 +63,9 @@ class Executor(Protocol):
 
     def submit(self, fn: Callable, *args: Any) -> Any: ...
 
-    def wait_first(self, handles: Iterable[Any]) -> tuple[set, set]: ...
+    def wait_first(
+        self, handles: Iterable[Any], timeout: float | None = None
+    ) -> tuple[set, set]: ...
 
     def done(self, handle: Any) -> bool: ...
 
@@ -89,8 +93,11 @@ class SerialExecutor:
             fut.set_exception(exc)
         return fut
 
-    def wait_first(self, handles: Iterable[cf.Future]) -> tuple[set, set]:
-        return cf.wait(list(handles), return_when=cf.FIRST_COMPLETED)
+    def wait_first(
+        self, handles: Iterable[cf.Future], timeout: float | None = None
+    ) -> tuple[set, set]:
+        timeout = None if timeout is None or timeout == float("inf") else timeout
+        return cf.wait(list(handles), timeout=timeout, return_when=cf.FIRST_COMPLETED)
 
     @staticmethod
     def done(handle: Any) -> bool:
@@ -336,11 +343,16 @@ class DaskExecutor(SerialExecutor):
     def submit(self, fn: Callable, *args: Any):
         return self._client.submit(fn, *args, pure=False)
 
-    def wait_first(self, handles):
+    def wait_first(self, handles, timeout: float | None = None):
         from distributed import wait
 
+        handles = list(handles)
+        timeout = None if timeout is None or timeout == float("inf") else timeout
         with self._client.as_current():
-            done, not_done = wait(list(handles), return_when="FIRST_COMPLETED")
+            try:
+                done, not_done = wait(handles, timeout=timeout, return_when="FIRST_COMPLETED")
+            except TimeoutError:  # distributed raises it when nothing finished in time
+                return set(), set(handles)
         return set(done), set(not_done)
 
     def close(self, cancel: bool = False) -> None:

@@ -21,10 +21,13 @@ log with ``synchronous=NORMAL``: a commit is a write, not an fsync (an fsync per
 2-16 ms on a shared disk), and it survives the death of the process however it dies; only an
 operating-system crash or power loss can lose the last commits. With ``commit_interval_s = 0``
 (the default) each point is committed at once; the scan opens its store with
-``scan.COMMIT_INTERVAL_S`` (0.5 s) and calls :meth:`PointStore.flush` before the driver waits
-for a result, so the results that arrive together are one transaction and a ``kill -9`` loses
-at most the points stored in the last 0.5 s of uninterrupted storing, besides the points in
-flight. Ctrl-C, SIGTERM (raised as :class:`StoreTerminated` while a store is open) and a
+``scan.COMMIT_INTERVAL_S`` (0.5 s) and commits (:meth:`PointStore.flush`) as soon as a point
+written has waited that long, also while the driver waits for results
+(:meth:`PointStore.commit_due_in_s`, :class:`flatcontact.ispes.scan_scheduler.Scheduler`), so
+the results that arrive within 0.5 s are one transaction and a ``kill -9`` loses at most the
+points stored in the last 0.5 s, besides the points in flight (in a serial scan, where the
+driver relaxes the points itself: the points stored within 0.5 s before the relaxation it
+was killed in, if the one before took less than the time left). Ctrl-C, SIGTERM (raised as :class:`StoreTerminated` while a store is open) and a
 normal end commit everything when the store closes. A point is never committed before the
 point it was warm-started from (one connection, rows in order), so a resumed grid equals an
 uninterrupted one. ASE's own lock file is disabled: after a
@@ -333,6 +336,13 @@ class PointStore:
     def uncommitted(self) -> int:
         """Points written but not yet committed."""
         return self._uncommitted
+
+    def commit_due_in_s(self) -> float:
+        """Seconds until the points written but not committed are due (``commit_interval_s``
+        after the last commit; 0 if overdue); ``inf`` with none uncommitted."""
+        if not self._uncommitted:
+            return float("inf")
+        return max(0.0, self._last_commit + self.commit_interval_s - time.monotonic())
 
     def close(self) -> None:
         """Commit, close the database connection and release the driver lock (its file
