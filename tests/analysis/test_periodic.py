@@ -99,3 +99,42 @@ def test_nan_samples_are_refused():
     values[1, 2] = np.nan
     with pytest.raises(InputError, match="NaN"):
         PeriodicSurface(values, A1, A2)
+
+
+def _well_with_tilt(tilt):
+    """A well at the origin, e = 1e-3 (2 - cos 2πs_a - cos 2πs_b) + tilt · sin 2πs_b, on 4 × 4."""
+    sa, sb = np.moveaxis(_grid(4, 4), -1, 0)
+    return PeriodicSurface(
+        1e-3 * (2 - np.cos(2 * np.pi * sa) - np.cos(2 * np.pi * sb))
+        + tilt * np.sin(2 * np.pi * sb),
+        A1,
+        A2,
+    )
+
+
+@pytest.mark.parametrize("tilt", [0.0, 1e-12, 5e-12, 1e-11, 1e-9, 1e-6])
+def test_a_start_at_or_next_to_the_minimum_is_refined_without_error(tilt):
+    """Scipy's exact trust-region step turned gradients of 1e-12 … 2e-11 at the start (a
+    minimum on a grid point, as a toy scan gave) into a NaN and a ValueError. The minimum of
+    the tilted well is at s_b ≈ -tilt/(1e-3 · 2π) · … : within |∇e|/λ_min of the origin."""
+    surf = _well_with_tilt(tilt)
+    start = surf.evaluate(np.zeros(2))
+    xy, value = surf.local_minimum(np.zeros(2))
+    lam = float(np.linalg.eigvalsh(start.hessian).min())
+    assert np.linalg.norm(xy) <= 2 * np.linalg.norm(start.gradient) / lam + 1e-12
+    assert value <= float(start.value) + 1e-18
+    (found,) = surf.local_minima()  # reduced into the cell: compare modulo the lattice
+    ds = surf.fractional(found[0]) - surf.fractional(xy)
+    assert np.linalg.norm(surf.cartesian(ds - np.round(ds))) < 1e-6
+
+
+def test_where_scipy_fails_the_start_is_polished_by_newton_steps(monkeypatch):
+    from flatcontact.analysis import periodic
+
+    def fails(*args, **kwargs):
+        raise ValueError("array must not contain infs or NaNs")
+
+    monkeypatch.setattr(periodic, "minimize", fails)
+    surf = _well_with_tilt(0.0)
+    xy, value = surf.local_minimum(np.array([0.3, -0.2]))  # 0.36 Å away: not stationary
+    assert np.linalg.norm(xy) < 1e-9 and value == pytest.approx(0.0, abs=1e-15)

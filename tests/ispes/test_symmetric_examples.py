@@ -66,11 +66,19 @@ def test_reduced_scan_equals_the_full_scan(
     assert sym["verification"]["points"] == 2
     assert red.points_stored < full.points_stored / 3
     a, b = red.dataset, full.dataset
-    # the same thickness list to round-off: the engine's nearest-image cache carries over from
-    # the first scan of the process to the second (measured 2e-14 Å, not bit for bit)
-    np.testing.assert_allclose(a["thickness"].values, b["thickness"].values, rtol=0, atol=1e-9)
+    # the probe's thicknesses are the same to round-off (the engine's nearest-image cache
+    # carries over from the first scan of the process to the second: 2e-14 Å); the grid's
+    # bracket check may add one more at an end in either scan, where a column's load lies
+    # within the relaxation's noise of the range's end (0.14 GPa here, above): the full
+    # scan relaxes the mapped columns itself, to the same tolerance, not to the same bits
+    za, zb = a["thickness"].values, b["thickness"].values
+    ia = [i for i, z in enumerate(za) if np.abs(zb - z).min() <= 1e-9]
+    ib = [int(np.abs(zb - za[i]).argmin()) for i in ia]
+    extra = [z for z in (*np.delete(za, ia), *np.delete(zb, ib))]
+    assert len(extra) <= 1 and all(z < za[ia].min() or z > za[ia].max() for z in extra)
     assert bool(a["converged"].all()) and bool(b["converged"].all())
     area = float(a.attrs["area"])
+    a, b = a.isel(thickness=ia), b.isel(thickness=ib)
     de = np.abs(a["energy"].values - b["energy"].values).max() / area * 1e3
     dp = np.abs(a["normal_stress"].values - b["normal_stress"].values).max()
     assert de < energy_tol_mev_per_a2
