@@ -355,6 +355,19 @@ class DaskExecutor(SerialExecutor):
                 return set(), set(handles)
         return set(done), set(not_done)
 
+    def setup_workers(self, name: str, setup: Callable, *args: Any) -> None:
+        """Run ``setup(*args)`` once in every worker process, now and in each that joins later
+        (a worker plugin named ``name``: :class:`flatcontact.ispes.worker_plugin.SetupPlugin`):
+        the arguments travel once per worker, also to workers on other machines, not with
+        every task."""
+        from flatcontact.ispes.worker_plugin import SetupPlugin
+
+        self._client.register_plugin(SetupPlugin(setup, args), name=name)
+
+    def withdraw_setup(self, name: str) -> None:
+        """Stop giving :meth:`setup_workers`'s ``name`` to the workers that join from now on."""
+        self._client.unregister_worker_plugin(name)
+
     def close(self, cancel: bool = False) -> None:
         self._client.close()
         if self._own_cluster is not None:
