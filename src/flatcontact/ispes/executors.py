@@ -4,7 +4,9 @@ Every executor follows the :class:`Executor` protocol: ``submit(fn, *args)`` ret
 handle; ``wait_first`` blocks until at least one handle is finished, ``done`` says whether a
 handle already is, ``result`` gives its value. Workers build their calculator once
 (:func:`flatcontact.ispes.relax.worker_calculator`, cached per worker thread) and
-reuse it for every point they receive. Workers never write files: results come back
+reuse it for every point they receive, with the root of the reference's Hessian the driver
+computed (:mod:`flatcontact.ispes.shared_hessian`: a file local workers read, a worker plugin
+on Dask, :meth:`DaskExecutor.setup_workers`). Workers never write files: results come back
 to the driver, which alone writes the point store.
 
 - :class:`SerialExecutor`: in the driver process (debugging, tests, 1 core).

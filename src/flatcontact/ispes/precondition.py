@@ -16,9 +16,9 @@ every component of the free atoms in ``full``, their z in ``normal``) by central
 of the forces, step ``FD_STEP_ANGSTROM``, symmetrised: 2 force calls per relaxed coordinate,
 once per scan, in its driver (:func:`finite_difference_hessian`, 144 calls on the 36-atom
 quartz cell with 24 free atoms). Its eigenvalues are floored at ``FLOOR_FRACTION`` of the
-largest (:func:`inverse_hessian_root`): the softest interface modes (0.13 eV/Å² against 94 on sio2-snap quartz) would otherwise ask
-for steps the next point's curvature does not support, and a floor also makes a reference
-that is not an exact minimum positive definite. The removed coordinates get I/α (they are
+largest (:func:`inverse_hessian_root`): the softest interface modes (0.13 eV/Å² against 94
+on sio2-snap quartz) would otherwise ask for steps the next point's curvature does not
+support, and a floor also makes a reference that is not an exact minimum positive definite. The removed coordinates get I/α (they are
 projected out of every step anyway).
 
 What the relaxation needs is L = H0^{1/2} (symmetric): :func:`flatcontact.ispes.lbfgs.lbfgs_relax`
