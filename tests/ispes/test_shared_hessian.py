@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 from flatcontact.ispes import precondition
-from flatcontact.ispes.geometry import fixed_mask
+from flatcontact.ispes.executors import SerialExecutor
+from flatcontact.ispes.geometry import fixed_mask, thickness
+from flatcontact.ispes.grid import GridSpec
 from flatcontact.ispes.relax import (
     RelaxSettings,
     constraint_projector,
@@ -16,6 +18,7 @@ from flatcontact.ispes.relax import (
     reference_root,
     worker_calculator,
 )
+from flatcontact.ispes.scan import ScanInterrupted, run_scan
 from flatcontact.ispes.shared_hessian import FILE_PREFIX, HessianSharing, shared_key
 
 SETTINGS = RelaxSettings(1e-3, "LBFGS", precondition=True)
@@ -128,3 +131,35 @@ def test_nothing_is_written_where_nothing_travels(tmp_path, toy_reference, toy_f
         assert sharing.context(_LocalProcesses()).hessian is None
         assert sharing.hessian_force_calls == 0
     assert not list(tmp_path.iterdir())
+
+
+class _NotInline(SerialExecutor):
+    """Runs each task at submission, but tells the scan it does not (as local processes do):
+    the scan writes the file for it."""
+
+    inline = False
+    name = "not-inline"
+
+
+@pytest.mark.parametrize("stop", [RuntimeError, KeyboardInterrupt])
+def test_the_file_lives_while_the_scan_relaxes_and_goes_with_an_error_or_ctrl_c(
+    tmp_path, toy_reference, toy_factory, stop
+):
+    """During the grid the folder holds one ``.reference-hessian-*.npy`` (the driver's root);
+    an error or a Ctrl-C in the middle removes it, and the store keeps the points."""
+    z0 = thickness(toy_reference)
+    grid = GridSpec(3, 3, thickness_angstrom=(z0 - 0.1, z0, z0 + 0.2))
+    seen = []
+
+    def progress(done, total):
+        seen.append(sorted(p.name for p in tmp_path.glob(f"{FILE_PREFIX}*")))
+        if done >= 5:
+            raise stop("stop here")
+
+    with pytest.raises(ScanInterrupted if stop is KeyboardInterrupt else RuntimeError):
+        run_scan(toy_reference, toy_factory, grid, tmp_path, SETTINGS, executor=_NotInline(),
+                 progress=progress)  # fmt: skip
+    key = shared_key(toy_reference, toy_factory, "full")
+    assert seen[-1] == [f"{FILE_PREFIX}{key[:16]}.npy"]
+    assert not [p.name for p in tmp_path.iterdir() if p.name.startswith(".")]
+    assert (tmp_path / "points.db").exists()
