@@ -463,12 +463,10 @@ def constraint_projector(fixed: np.ndarray, mode: str, groups: list[np.ndarray])
     return project
 
 
-def reference_root(
-    reference: Atoms, calc, fixed: np.ndarray, mode: str, project
-) -> np.ndarray | None:
+def reference_root(reference: Atoms, calc, fixed, mode: str, project) -> np.ndarray | None:
     """L = H0^{1/2} from the Hessian of ``reference`` over the coordinates ``project`` keeps
     (:mod:`flatcontact.ispes.precondition`), kept per calculator and key (reference, mode):
-    computed at the first call, unless the scan's driver handed its own (:func:`context_calculator`);
+    computed at the first call unless a scan's driver handed its own (:func:`context_calculator`);
     None beyond ``precondition.MAX_COORDINATES`` relaxed coordinates."""
     coordinates = np.flatnonzero(project(np.ones((len(reference), 3))).ravel() != 0.0)
     if coordinates.size > precondition.MAX_COORDINATES:

@@ -14,6 +14,8 @@ one bit for bit, as do the grids of any number of workers below
 
 The rooms of the driver, in the order :func:`run_scan` goes through them:
 
+- :mod:`~flatcontact.ispes.shared_hessian`: the reference interface's Hessian of the
+  preconditioner, computed once here and handed to every process that relaxes;
 - :mod:`~flatcontact.ispes.scan_probe`: resolve the thicknesses and the adhesion record
   (the probe of a pressure-range grid);
 - :mod:`~flatcontact.ispes.scan_symmetry`: the plan of a round (every point, or the
