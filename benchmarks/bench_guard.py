@@ -78,7 +78,7 @@ def main() -> None:
             table = slip_table(reference, store_points(r.store_path))
             print(
                 f"  {name:10s} force calls {int(np.nansum(ds['force_calls'].values)):5d}"
-                + (" (the Hessian's in the probe's count)" if precondition else "")
+                + (f" (+ the driver's Hessian, {r.hessian_force_calls})" if precondition else "")
                 + ", largest in-slab slip "
                 f"{float(table.max_by_gap().max()):.3f} A at {len(table.slipped())} points, "
                 f"largest |d2U| along a column {largest_second_difference_ev(ds):.4f} eV",

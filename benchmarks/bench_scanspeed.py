@@ -173,7 +173,7 @@ def main() -> None:
                 f"  {GRID[0]}x{GRID[1]}x{r.dataset.sizes['thickness']}, {workers} worker(s): "
                 f"{wall:.1f} s wall, {r.points_computed} points, {calls.sum()} force calls "
                 f"(median {np.median(calls):.0f}/point; the reference's Hessian "
-                f"{r.hessian_force_calls} more on the workers), {before} -> {_load()}\n"
+                f"{r.hessian_force_calls} more in the driver), {before} -> {_load()}\n"
                 f"    phases (s; a/b is part of a): {_phases(r)}",
                 flush=True,
             )

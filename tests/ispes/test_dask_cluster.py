@@ -154,3 +154,61 @@ def test_scan_on_a_separate_scheduler_survives_a_killed_worker(cluster, tmp_path
         np.testing.assert_allclose(
             scanned[name].values, serial.dataset[name].values, rtol=0, atol=1e-10
         )
+
+
+def test_separate_dask_workers_relax_with_the_drivers_reference_hessian(
+    cluster, tmp_path, toy_reference, monkeypatch
+):
+    """With the preconditioner, the workers of a separate ``dask worker`` (processes the driver
+    did not start, as on another machine) get the driver's root of the reference's Hessian
+    through a worker plugin, also the worker the nanny starts after one is killed mid-scan:
+    the scan equals the serial one bit for bit although the driver's eigenvalue floor differs
+    from the one a worker would use (``precondition.FLOOR_FRACTION``, changed here only), and
+    the Hessian's force calls are the driver's alone."""
+    from flatcontact.ispes import precondition
+    from flatcontact.ispes.geometry import fixed_mask
+
+    monkeypatch.setattr(precondition, "FLOOR_FRACTION", 0.02)
+    settings = RelaxSettings(fmax_ev_per_angstrom=1e-4, optimizer="LBFGS", precondition=True)
+    address, worker_cmd = cluster
+    z0 = thickness(toy_reference)
+    grid = GridSpec(3, 3, thickness_angstrom=(z0 - 0.2, z0, z0 + 0.3))
+    total = grid.n_a * grid.n_b * len(grid.thickness_angstrom)
+    hessian_calls = 2 * 3 * int((~fixed_mask(toy_reference)).sum())
+    slow = calculator_factory(
+        InteractionModel(calculator={"target": "tests.ispes.slow_toy:slow_toy"})
+    )
+    executor = DaskExecutor(address=address, timeout_s=30)
+    _wait_for(lambda: len(executor._client.scheduler_info()["workers"]) >= 2, 60, "two workers")
+    out, result = tmp_path / "dask", {}
+
+    def scan():
+        precondition._CACHE.clear()
+        result["scan"] = run_scan(toy_reference, slow, grid, out, settings, executor=executor)
+
+    driver = threading.Thread(target=scan)
+    driver.start()
+    _wait_for(lambda: _rows(out / "points.db") >= 4, 120, "the first stored points")
+    victims = [
+        p for p in psutil.Process(worker_cmd.pid).children(recursive=True) if not p.children()
+    ]
+    before = _rows(out / "points.db")
+    os.kill(victims[0].pid, signal.SIGKILL)
+    driver.join(timeout=300)
+    executor.close()
+    assert not driver.is_alive() and before < total
+    assert result["scan"].hessian_force_calls == hessian_calls
+    assert not [p.name for p in out.iterdir() if p.name.startswith(".")]
+
+    precondition._CACHE.clear()
+    plain = calculator_factory(
+        InteractionModel(calculator={"target": "flatcontact.ispes.toy:toy_calculator"})
+    )
+    serial = run_scan(
+        toy_reference, plain, grid, tmp_path / "serial", settings, executor=SerialExecutor()
+    )
+    assert serial.hessian_force_calls == hessian_calls
+    for name in ("energy", "normal_stress"):
+        np.testing.assert_array_equal(
+            result["scan"].dataset[name].values, serial.dataset[name].values
+        )

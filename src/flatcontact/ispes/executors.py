@@ -4,7 +4,9 @@ Every executor follows the :class:`Executor` protocol: ``submit(fn, *args)`` ret
 handle; ``wait_first`` blocks until at least one handle is finished, ``done`` says whether a
 handle already is, ``result`` gives its value. Workers build their calculator once
 (:func:`flatcontact.ispes.relax.worker_calculator`, cached per worker thread) and
-reuse it for every point they receive. Workers never write files: results come back
+reuse it for every point they receive, with the root of the reference's Hessian the driver
+computed (:mod:`flatcontact.ispes.shared_hessian`: a file local workers read, a worker plugin
+on Dask, :meth:`DaskExecutor.setup_workers`). Workers never write files: results come back
 to the driver, which alone writes the point store.
 
 - :class:`SerialExecutor`: in the driver process (debugging, tests, 1 core).
@@ -354,6 +356,19 @@ class DaskExecutor(SerialExecutor):
             except TimeoutError:  # distributed raises it when nothing finished in time
                 return set(), set(handles)
         return set(done), set(not_done)
+
+    def setup_workers(self, name: str, setup: Callable, *args: Any) -> None:
+        """Run ``setup(*args)`` once in every worker process, now and in each that joins later
+        (a worker plugin named ``name``: :class:`flatcontact.ispes.worker_plugin.SetupPlugin`):
+        the arguments travel once per worker, also to workers on other machines, not with
+        every task."""
+        from flatcontact.ispes.worker_plugin import SetupPlugin
+
+        self._client.register_plugin(SetupPlugin(setup, args), name=name)
+
+    def withdraw_setup(self, name: str) -> None:
+        """Stop giving :meth:`setup_workers`'s ``name`` to the workers that join from now on."""
+        self._client.unregister_worker_plugin(name)
 
     def close(self, cancel: bool = False) -> None:
         self._client.close()

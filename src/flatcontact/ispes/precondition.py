@@ -14,11 +14,11 @@ The Hessian
 K_ij = -∂F_i/∂x_j of the relaxed coordinates (those the relaxation mode's projector keeps:
 every component of the free atoms in ``full``, their z in ``normal``) by central differences
 of the forces, step ``FD_STEP_ANGSTROM``, symmetrised: 2 force calls per relaxed coordinate,
-once per scan (:func:`reference_hessian`, 180 calls on the 36-atom quartz cell). Its
-eigenvalues are floored at ``FLOOR_FRACTION`` of the largest (:func:`inverse_hessian_root`):
-the softest interface modes (0.13 eV/Å² against 94 on sio2-snap quartz) would otherwise ask
-for steps the next point's curvature does not support, and a floor also makes a reference
-that is not an exact minimum positive definite. The removed coordinates get I/α (they are
+once per scan, in its driver (:func:`finite_difference_hessian`, 144 calls on the 36-atom
+quartz cell with 24 free atoms). Its eigenvalues are floored at ``FLOOR_FRACTION`` of the
+largest (:func:`inverse_hessian_root`): the softest interface modes (0.13 eV/Å² against 94
+on sio2-snap quartz) would otherwise ask for steps the next point's curvature does not
+support, and a floor also makes a reference that is not an exact minimum positive definite. The removed coordinates get I/α (they are
 projected out of every step anyway).
 
 What the relaxation needs is L = H0^{1/2} (symmetric): :func:`flatcontact.ispes.lbfgs.lbfgs_relax`
@@ -44,13 +44,22 @@ Determinism
 -----------
 The Hessian is a function of the reference, the calculator and the mode: its force calls
 run on a calculator started afresh (:func:`flatcontact.ispes.relax.point_evaluator`), in a
-fixed order, so every worker and every resumed run computes the same bits, and the next
-point starts its engine afresh again. It is kept per worker (:func:`cached_root`), not
-stored and not sent with the tasks (an n × n matrix per task).
+fixed order, so any process computes the same K. Its root L is not quite: ``numpy.linalg.eigh``
+and the product after it may round differently with another number of BLAS threads (the
+scan's driver runs with the default, its local workers with one:
+:func:`flatcontact.ispes.executors.one_blas_thread_in_workers`). A scan therefore computes L
+once, in its driver (:mod:`flatcontact.ispes.shared_hessian`), and every process that relaxes
+its points uses those bits (:class:`SharedRoot`, :func:`shared_root`, :func:`keep_root`): the
+same numbers with the serial executor, local processes or Dask, and no Hessian per worker.
+Outside a scan (a single :func:`flatcontact.ispes.relax.relax_point`) L is computed once per
+process and calculator (:func:`cached_root`). It is never stored with the points nor sent
+with each task (an n × n matrix per task).
 """
 
 from __future__ import annotations
 
+import dataclasses
+import hashlib
 import weakref
 from collections.abc import Callable
 
@@ -159,6 +168,101 @@ def cached_root(calc, key, compute: Callable[[], np.ndarray | None]) -> np.ndarr
     return entry[1]
 
 
+def root_key(reference, fixed: np.ndarray, mode: str) -> tuple:
+    """The key of the reference's root in :func:`cached_root` (with the calculator): what it is a
+    function of besides the calculator, the relaxation ``mode`` and the reference interface with
+    its held atoms ``fixed``."""
+    return (
+        mode,
+        reference.positions.tobytes(),
+        reference.numbers.tobytes(),
+        reference.cell.array.tobytes(),
+        np.asarray(fixed).tobytes(),
+    )
+
+
+def keep_root(calc, key, root: np.ndarray) -> None:
+    """Make ``root`` the one :func:`cached_root` gives for ``calc`` and ``key`` (a root received
+    from the scan's driver, :func:`shared_root`), replacing any other kept there."""
+    entry = _CACHE.get((id(calc), key))
+    if entry is None or entry[0]() is not calc or entry[1] is not root:
+        _CACHE.pop((id(calc), key), None)
+        cached_root(calc, key, lambda: root)
+
+
+@dataclasses.dataclass(frozen=True)
+class SharedRoot:
+    """Where the processes of a scan find the root its driver computed (picklable, small).
+
+    ``key``: SHA-256 of what the root is a function of (the model's fingerprint, the mode,
+    the reference and its held atoms; names the file); ``sha256``: of the root's bytes
+    (float64, C order), which every process checks before it uses them; ``size``: n (the root
+    is n × n); ``path``: the hidden file in the scan's folder that local worker processes
+    read, or None where the root reaches the processes otherwise (the driver's own: in
+    memory; Dask workers: a worker plugin, :func:`receive_root`).
+    """
+
+    key: str
+    sha256: str
+    size: int
+    path: str | None = None
+
+
+def root_sha256(root: np.ndarray) -> str:
+    """SHA-256 (hex) of ``root``'s float64 bytes in C order."""
+    return hashlib.sha256(np.ascontiguousarray(root, dtype=float).tobytes()).hexdigest()
+
+
+#: the roots this process received from scans' drivers, by their SHA-256 (the last
+#: ``KEPT_RECEIVED``: a Dask worker may serve two scans at once)
+_RECEIVED: dict[str, np.ndarray] = {}
+KEPT_RECEIVED = 2
+
+
+def receive_root(root: np.ndarray, sha256: str) -> np.ndarray:
+    """Keep ``root`` as this process's root of digest ``sha256`` (checked; read-only from now
+    on; the oldest of more than ``KEPT_RECEIVED`` goes) and return it."""
+    root = np.ascontiguousarray(root, dtype=float)
+    if root.ndim != 2 or root.shape[0] != root.shape[1] or root_sha256(root) != sha256:
+        raise RuntimeError(
+            f"the scan's reference Hessian: the root received ({root.shape}) is not the "
+            f"driver's (SHA-256 {sha256[:12]}…)"
+        )
+    root.flags.writeable = False
+    _RECEIVED.pop(sha256, None)
+    _RECEIVED[sha256] = root
+    while len(_RECEIVED) > KEPT_RECEIVED:
+        del _RECEIVED[next(iter(_RECEIVED))]
+    return root
+
+
+def shared_root(shared: SharedRoot) -> np.ndarray:
+    """The driver's root that ``shared`` names, in this process: received before
+    (:func:`receive_root`), else read from ``shared.path`` and checked against its size and
+    digest. A root that cannot be had so is an error, never computed here instead: the
+    scan's points would then depend on the process that relaxed them."""
+    root = _RECEIVED.get(shared.sha256)
+    if root is not None:
+        return root
+    if shared.path is None:
+        raise RuntimeError(
+            "the scan's reference Hessian: this process received none from the driver "
+            f"(SHA-256 {shared.sha256[:12]}…)"
+        )
+    try:
+        root = np.load(shared.path, allow_pickle=False)
+    except (OSError, ValueError) as exc:
+        raise RuntimeError(
+            f"the scan's reference Hessian: cannot read the driver's {shared.path} ({exc})"
+        ) from None
+    if root.shape != (shared.size, shared.size):
+        raise RuntimeError(
+            f"the scan's reference Hessian: {shared.path} holds a {root.shape} matrix, "
+            f"expected ({shared.size}, {shared.size})"
+        )
+    return receive_root(root, shared.sha256)
+
+
 def slips_inside_slab(reference, positions: np.ndarray, shift: tuple[float, float]) -> bool:
     """Whether a plane inside a slab of the relaxed ``positions`` at lateral ``shift`` slid
     against its neighbour by more than :data:`flatcontact.ispes.slip.SLIP_THRESHOLD_ANGSTROM`
@@ -174,6 +278,5 @@ def slips_inside_slab(reference, positions: np.ndarray, shift: tuple[float, floa
     gaps = slip.in_slab_gaps(reference)
     moved = slip.layer_displacements(reference, positions, shift)
     return any(
-        np.linalg.norm(moved[g.upper] - moved[g.lower]) > slip.SLIP_THRESHOLD_ANGSTROM
-        for g in gaps
+        np.linalg.norm(moved[g.upper] - moved[g.lower]) > slip.SLIP_THRESHOLD_ANGSTROM for g in gaps
     )

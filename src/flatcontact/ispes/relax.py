@@ -70,6 +70,7 @@ from ase import Atoms
 
 from flatcontact.foundation.errors import InputError
 from flatcontact.foundation.units import EV_PER_A3_TO_GPA
+from flatcontact.ispes import precondition
 from flatcontact.ispes.calculators import count_force_calls
 from flatcontact.ispes.contract import cell_area
 from flatcontact.ispes.geometry import (
@@ -79,7 +80,7 @@ from flatcontact.ispes.geometry import (
     place_slab2,
     warm_start_positions,
 )
-from flatcontact.ispes.lbfgs import largest_atomic_norm, lbfgs_relax
+from flatcontact.ispes.lbfgs import ASE_ALPHA_EV_PER_A2, largest_atomic_norm, lbfgs_relax
 from flatcontact.ispes.precondition import slips_inside_slab
 from flatcontact.potentials.guarded import failing_at
 
@@ -128,19 +129,14 @@ class RelaxSettings:
         module docstring.
     precondition
         The built-in L-BFGS starts every point with the reference interface's inverse
-        Hessian as H0 (:mod:`flatcontact.ispes.precondition`: computed once per process,
-        2 force calls per relaxed coordinate, not counted in any point's force calls),
-        where it applies (:attr:`uses_reference_hessian`): optimizers ``LBFGS-scaled`` and
-        ``LBFGS``, modes ``full`` and ``normal``, at most ``precondition.MAX_COORDINATES``
-        relaxed coordinates. There H0 stays that matrix at every step (no γ-rescaling:
-        it would replace the measured curvature by one scalar, 3.74 against 3.15 force
-        calls per point on the quartz benchmark grid); elsewhere the optimizer's own H0
-        (ASE's I/α, or γ I with ``LBFGS-scaled``). Default on. In mode ``full`` a point
-        whose preconditioned relaxation slid a plane inside a slab is relaxed again from the
-        same start with the optimizer's own H0 (:func:`_relax_built_in`): unguarded, one
-        column of the notebook's Cu EMT example changed relaxation branch that way (a fold
-        in its energy-derived load); see ``docs/performance.md``, "The reference
-        interface's Hessian as H0".
+        Hessian as H0, kept at every step (:mod:`flatcontact.ispes.precondition`: 2 force
+        calls per relaxed coordinate, once per scan in its driver, in no point's calls),
+        where it applies (:attr:`uses_reference_hessian`: ``LBFGS-scaled`` and ``LBFGS``,
+        modes ``full`` and ``normal``, at most ``precondition.MAX_COORDINATES`` relaxed
+        coordinates); elsewhere the optimizer's own H0. Default on. In mode ``full`` a point
+        whose preconditioned relaxation slid a plane inside a slab is relaxed again with the
+        optimizer's own H0 (:func:`_relax_built_in`; ``docs/performance.md``, "The reference
+        interface's Hessian as H0").
     """
 
     fmax_ev_per_angstrom: float = 0.005
@@ -231,9 +227,9 @@ class PointResult:
     seconds: float
     positions: np.ndarray
     start_index: Index | None
-    #: force calls of the reference's Hessian (:func:`reference_root`) spent before this point
-    #: by the process that relaxed it (its first preconditioned point; 0 for the others): not
-    #: in ``force_calls``, which counts the point's own relaxation
+    #: force calls of the reference's Hessian (:func:`reference_root`) computed before this
+    #: point by its process (0 in a scan: its driver computed it, :mod:`~flatcontact.ispes.shared_hessian`;
+    #: else the process's first preconditioned point): not in ``force_calls``
     hessian_force_calls: int = 0
 
 
@@ -467,25 +463,15 @@ def constraint_projector(fixed: np.ndarray, mode: str, groups: list[np.ndarray])
     return project
 
 
-def reference_root(
-    reference: Atoms, calc, fixed: np.ndarray, mode: str, project
-) -> np.ndarray | None:
+def reference_root(reference: Atoms, calc, fixed, mode: str, project) -> np.ndarray | None:
     """L = H0^{1/2} from the Hessian of ``reference`` over the coordinates ``project`` keeps
-    (:mod:`flatcontact.ispes.precondition`), computed once per process and key (calculator,
-    reference, mode); None beyond ``precondition.MAX_COORDINATES`` relaxed coordinates."""
-    from flatcontact.ispes import precondition
-    from flatcontact.ispes.lbfgs import ASE_ALPHA_EV_PER_A2
-
+    (:mod:`flatcontact.ispes.precondition`), kept per calculator and key (reference, mode):
+    computed at the first call unless a scan's driver handed its own (:func:`context_calculator`);
+    None beyond ``precondition.MAX_COORDINATES`` relaxed coordinates."""
     coordinates = np.flatnonzero(project(np.ones((len(reference), 3))).ravel() != 0.0)
     if coordinates.size > precondition.MAX_COORDINATES:
         return None
-    key = (
-        mode,
-        reference.positions.tobytes(),
-        reference.numbers.tobytes(),
-        reference.cell.array.tobytes(),
-        np.asarray(fixed).tobytes(),
-    )
+    key = precondition.root_key(reference, fixed, mode)
 
     def compute() -> np.ndarray:
         hessian = precondition.finite_difference_hessian(
@@ -574,6 +560,9 @@ class ScanContext:
     reference: Atoms
     factory: Any
     settings: RelaxSettings
+    #: the root of the reference's Hessian the scan's driver computed
+    #: (:class:`~flatcontact.ispes.precondition.SharedRoot`), or None
+    hessian: Any = None
 
 
 _local = threading.local()
@@ -585,16 +574,25 @@ def worker_calculator(factory, reference: Atoms) -> Any:
     ``reference`` is the interface the calculator is built for (species, order,
     slab membership); every grid point has the same atoms in the same order.
     """
-    cache = getattr(_local, "calculators", None)
-    if cache is None:
-        cache = _local.calculators = {}
+    cache = _local.__dict__.setdefault("calculators", {})
     key = factory.fingerprint
     if key not in cache:
         cache[key] = count_force_calls(factory(reference))
     return cache[key]
 
 
+def context_calculator(context: ScanContext) -> Any:
+    """:func:`worker_calculator` for ``context``, holding the root of the reference's Hessian the
+    scan's driver computed (``context.hessian``, :func:`flatcontact.ispes.precondition.shared_root`)
+    for :func:`reference_root`: a scan's process never computes its own."""
+    reference, shared = context.reference, context.hessian
+    calc = worker_calculator(context.factory, reference)
+    if shared is not None:
+        key = precondition.root_key(reference, fixed_mask(reference), context.settings.mode)
+        precondition.keep_root(calc, key, precondition.shared_root(shared))
+    return calc
+
+
 def run_task(context: ScanContext, task: PointTask) -> PointResult:
     """Worker entry point: relax ``task`` with this worker's cached calculator."""
-    calc = worker_calculator(context.factory, context.reference)
-    return relax_point(context.reference, calc, task, context.settings)
+    return relax_point(context.reference, context_calculator(context), task, context.settings)

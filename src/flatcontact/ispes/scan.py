@@ -14,6 +14,8 @@ one bit for bit, as do the grids of any number of workers below
 
 The rooms of the driver, in the order :func:`run_scan` goes through them:
 
+- :mod:`~flatcontact.ispes.shared_hessian`: the reference interface's Hessian of the
+  preconditioner, computed once here and handed to every process that relaxes;
 - :mod:`~flatcontact.ispes.scan_probe`: resolve the thicknesses and the adhesion record
   (the probe of a pressure-range grid);
 - :mod:`~flatcontact.ispes.scan_symmetry`: the plan of a round (every point, or the
@@ -47,11 +49,12 @@ from flatcontact.ispes.order import PREFERENCES
 from flatcontact.ispes.phases import phase, recording
 from flatcontact.ispes.probe_units import ProbeUnits, probe_settings
 from flatcontact.ispes.reduction import SymmetrySettings
-from flatcontact.ispes.relax import RelaxSettings, ScanContext
+from flatcontact.ispes.relax import RelaxSettings
 from flatcontact.ispes.scan_extend import check_overlaps, extend_grid
 from flatcontact.ispes.scan_probe import resolve, store_pending_work
 from flatcontact.ispes.scan_scheduler import COMMIT_INTERVAL_S, Scheduler
 from flatcontact.ispes.scan_symmetry import ScanRound, SymmetryPlan
+from flatcontact.ispes.shared_hessian import HessianSharing
 from flatcontact.ispes.store import PointStore, discard_store, interface_hash
 from flatcontact.potentials.guarded import failing_at
 
@@ -81,13 +84,14 @@ class ScanResult:
     #: (:meth:`flatcontact.ispes.thicknesses.LoadFold.record`; ``scan.json`` ``load_folds``)
     load_folds: list[dict] = dataclasses.field(default_factory=list)
     #: the driver's wall seconds per phase (:mod:`flatcontact.ispes.phases`): ``open store``,
+    #: ``reference Hessian`` (:mod:`~flatcontact.ispes.shared_hessian`),
     #: ``probe`` (``probe/rigid points``, ``probe/ideal W``), ``overlap check``, ``symmetry``,
     #: ``grid`` (``grid/verification``), ``assemble``, ``extend``, ``ideal W after grid``,
     #: ``write``
     phase_seconds: dict[str, float] = dataclasses.field(default_factory=dict)
-    #: force calls of the reference interface's Hessian (``RelaxSettings.precondition``)
-    #: spent by the processes that relaxed the grid's points, once each; not in any point's
-    #: ``force_calls`` (a Hessian computed by the probe is in the probe's counts)
+    #: force calls of the reference interface's Hessian (``RelaxSettings.precondition``): the
+    #: driver's one computation of this attempt (:mod:`flatcontact.ispes.shared_hessian`; 0
+    #: when nothing relaxed, or the process had it for the same model); in no point's count
     hessian_force_calls: int = 0
 
 
@@ -237,14 +241,18 @@ def run_scan(
         ):
             clock.add("open store", time.perf_counter() - t0)  # with the input checks
             own_executor = executor is None
-            if own_executor:
-                executor = executors.make_executor(**(executor_options or {}))
-            try:
-                job = _Job(reference, factory, grid, relax, order, symmetry, bracket_loads_gpa)
-                scanned = _drive(store, executor, job, out_dir, progress, max_new_points)
-            finally:
+            with HessianSharing(out_dir, reference, factory, relax) as sharing:
                 if own_executor:
-                    executor.close(cancel=True)
+                    executor = executors.make_executor(**(executor_options or {}))
+                try:
+                    job = _Job(reference, factory, grid, relax, order, symmetry, bracket_loads_gpa)
+                    scanned = _drive(
+                        store, executor, job, out_dir, progress, max_new_points, sharing
+                    )
+                finally:
+                    if own_executor:
+                        executor.close(cancel=True)
+            scanned.hessian_calls += sharing.hessian_force_calls
             with phase("write"):
                 result = _assemble(store, scanned, out_dir, t0)
             result.phase_seconds = dict(clock.seconds)
@@ -267,24 +275,23 @@ def _drive(
     out_dir: Path,
     progress: Callable[[int, int], None] | None,
     max_new_points: int | None,
+    sharing: HessianSharing,
 ) -> _Scanned:
     """Resolve, then the rounds of the grid, then the work of separation left running."""
     reference, factory, grid, relax = job.reference, job.factory, job.grid, job.relax
+    context = sharing.plain_context()
     if _points_missing(store, grid):
         executor.prestart(factory, reference)  # worker start overlaps the probe
+        with phase("reference Hessian"):  # computed once, here; overlaps the workers' start
+            context = sharing.context(executor)
     # the probe's finished units, beside the store (a resumed probe reuses them)
     units = ProbeUnits(out_dir / PROBE_JSON, probe_settings(store.settings))
     with phase("probe"), failing_at("probe"):
-        resolved, notes, pending = resolve(store, reference, factory, grid, relax, executor, units)
-    scheduler = Scheduler(
-        store,
-        executor,
-        ScanContext(reference, factory, relax),
-        grid.shifts(),
-        progress,
-        max_new_points,
-    )
-    scanned = _rounds(store, scheduler, job, resolved, notes)
+        resolved, notes, pending = resolve(
+            store, reference, factory, grid, relax, executor, units, context.hessian
+        )
+    scheduler = Scheduler(store, executor, context, grid.shifts(), progress, max_new_points)
+    scanned = _rounds(store, scheduler, job, resolved, notes, sharing)
     if pending is not None and not scanned.interrupted:
         # the ideal work of separation ran beside the grid (a resumed scan
         # whose store lacks it computed it in the driver, in resolve)
@@ -320,10 +327,12 @@ def _rounds(
     job: _Job,
     resolved: dict,
     notes: list[str],
+    sharing: HessianSharing,
 ) -> _Scanned:
     """The rounds of the grid: check the round's new thicknesses, plan, relax (and verify),
     then extend the grid if a column ends short of the loads, until none is added or a
-    Ctrl-C stops a round (``interrupted``)."""
+    Ctrl-C stops a round (``interrupted``). The points an extension adds relax with the
+    driver's reference Hessian (computed then if the store held every point before)."""
     reference, grid, relax = job.reference, job.grid, job.relax
     checked: set[float] = set()  # thicknesses whose overlap check passed
     plan, interrupted = None, False
@@ -351,6 +360,7 @@ def _rounds(
             extended = extend_grid(store, reference, grid, relax, limit, job.bracket_loads_gpa, ds)
         if not extended:
             break
+        scheduler.context = sharing.context(scheduler.executor)
         resolved = store.resolved
     return _Scanned(
         plan, resolved, notes, interrupted, scheduler.computed_calls, scheduler.hessian_calls

@@ -150,6 +150,7 @@ def resolve(
     relax: RelaxSettings,
     executor: Executor,
     units: ProbeUnits,
+    hessian: Any = None,
 ) -> tuple[dict, list[str], PendingWork | None]:
     """The store's ``resolved`` entry, computed and stored if the store has none yet.
 
@@ -159,7 +160,8 @@ def resolve(
     ``pending`` the ideal work of separation still running on a worker (many workers: the
     driver stores it after the grid, :func:`store_pending_work`), else None. A store
     resolved before the ideal work of separation existed gets it here (in the returned
-    entry, not in the store).
+    entry, not in the store). ``hessian``: the driver's root of the reference's Hessian
+    (:class:`~flatcontact.ispes.precondition.SharedRoot`) for the probe's tasks.
     """
     notes: list[str] = []
     pending = None
@@ -170,7 +172,7 @@ def resolve(
         if grid.thickness_angstrom is not None:
             resolved["thickness_angstrom"] = list(grid.thickness_angstrom)
         else:
-            extra, notes, work = probe(reference, factory, grid, relax, executor, units)
+            extra, notes, work = probe(reference, factory, grid, relax, executor, units, hessian)
             resolved.update(extra)
         if isinstance(work, PendingWork):  # stored once the grid is done
             pending = work
@@ -208,6 +210,7 @@ def probe(
     relax: RelaxSettings,
     executor: Executor | None = None,
     units: ProbeUnits | None = None,
+    hessian: Any = None,
 ) -> tuple[dict, list[str], Any]:
     """Resolve the thicknesses of a pressure-range grid
     (:func:`flatcontact.ispes.thicknesses.probe_thicknesses`) and, with more than one
@@ -226,11 +229,11 @@ def probe(
     ``units`` (``probe.json``, :mod:`flatcontact.ispes.probe_units`) records every finished
     unit (a row of single points, a chain, a segment, the work of separation) as the driver
     gets it, and gives back those a resumed probe finished before: the same values, so the
-    same thicknesses.
+    same thicknesses. ``hessian`` (the driver's reference Hessian) goes with the tasks.
     """
     workers = 1 if executor is None else executor.workers
     if workers >= MANY_WORKERS:
-        return probe_many(reference, factory, grid, relax, executor, units)
+        return probe_many(reference, factory, grid, relax, executor, units, hessian)
     calc = worker_calculator(factory, reference)
     relax_one = functools.partial(relax_column_point, reference, calc, relax)
     with phase("probe/rigid points"):
@@ -247,7 +250,7 @@ def probe(
                 lambda: ideal_work_of_separation(reference, factory, relax, lowest, calc=calc),
             )
         return extra, notes, work
-    context = ScanContext(reference, factory, relax)
+    context = ScanContext(reference, factory, relax, hessian)
     work: list = []
     columns = functools.partial(_probe_columns_on_workers, executor, units, context, lowest, work)
     extra, notes = probe_thicknesses(relax_one, reference, rigid, grid, columns)
@@ -327,6 +330,7 @@ def probe_many(
     relax: RelaxSettings,
     executor: Executor,
     units: ProbeUnits | None = None,
+    hessian: Any = None,
 ) -> tuple[dict, list[str], PendingWork]:
     """:func:`probe` with many workers: nothing relaxes in the driver.
 
@@ -347,7 +351,7 @@ def probe_many(
     ``probe.json``) are not submitted: a row block holds only the rows still missing, a
     finished segment is added to its column at once without taking a worker.
     """
-    context = ScanContext(reference, factory, relax)
+    context = ScanContext(reference, factory, relax, hessian)
     rigid = _rigid_on_workers(executor, units, context, grid)
     work: list = []
     columns = functools.partial(

@@ -2,8 +2,9 @@
 
 Each function takes a picklable :class:`~flatcontact.ispes.relax.ScanContext` (the reference
 interface, the calculator factory, the relaxation settings), builds or reuses the worker's
-calculator (:func:`~flatcontact.ispes.relax.worker_calculator`, cached per worker thread) and
-returns plain data to the driver, which alone writes files. The grid's points run through
+calculator (:func:`~flatcontact.ispes.relax.worker_calculator`, cached per worker thread; with the
+root of the reference's Hessian the driver computed: :func:`~flatcontact.ispes.relax.context_calculator`)
+and returns plain data to the driver, which alone writes files. The grid's points run through
 :func:`flatcontact.ispes.relax.run_task`; the probe's units and checks run here.
 """
 
@@ -19,7 +20,13 @@ from flatcontact.ispes.probe import (
     rigid_rows,
     stretch_chain,
 )
-from flatcontact.ispes.relax import PointTask, ScanContext, relax_point, worker_calculator
+from flatcontact.ispes.relax import (
+    PointTask,
+    ScanContext,
+    context_calculator,
+    relax_point,
+    worker_calculator,
+)
 from flatcontact.ispes.work_of_separation import ideal_work_of_separation
 
 
@@ -32,8 +39,9 @@ def relax_column_point(reference, calc, relax, a, b, z, start, start_z) -> tuple
 
 
 def _relax_one(context: ScanContext):
-    """:func:`relax_column_point` with this worker's cached calculator."""
-    calc = worker_calculator(context.factory, context.reference)
+    """:func:`relax_column_point` with this worker's cached calculator (holding the driver's
+    root of the reference's Hessian, :func:`~flatcontact.ispes.relax.context_calculator`)."""
+    calc = context_calculator(context)
     return functools.partial(relax_column_point, context.reference, calc, context.settings)
 
 
@@ -72,7 +80,7 @@ def rigid_rows_task(context: ScanContext, grid: GridSpec, rows: list[int]):
 def work_of_separation_task(context: ScanContext, shift):
     """Worker entry point: the ideal work of separation at ``shift``
     (:func:`flatcontact.ispes.work_of_separation.ideal_work_of_separation`)."""
-    calc = worker_calculator(context.factory, context.reference)
+    calc = context_calculator(context)
     return ideal_work_of_separation(
         context.reference, context.factory, context.settings, shift, calc=calc
     )
