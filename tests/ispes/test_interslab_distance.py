@@ -3,10 +3,19 @@
 import numpy as np
 import pytest
 from ase.neighborlist import neighbor_list
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra import numpy as hnp
+from scipy.spatial import cKDTree
 
+from flatcontact.structures import placement
 from flatcontact.structures.assemble import make_interface
 from flatcontact.structures.interface_contract import thickness
-from flatcontact.structures.placement import interslab_min_distance, place_slab2
+from flatcontact.structures.placement import (
+    _closest_pair_distance,
+    interslab_min_distance,
+    place_slab2,
+)
 from flatcontact.structures.slab import quartz_0001_slab
 
 
@@ -50,3 +59,42 @@ def test_tilted_small_cell_needs_several_images(reference):
     assert interslab_min_distance(atoms, cutoff) == pytest.approx(
         all_pairs_min_distance(atoms, cutoff), abs=1e-9
     )
+
+
+#: clouds of 1-40 points, coordinates in ±30 Å (ties and repeated points included)
+clouds = hnp.arrays(
+    np.float64,
+    st.tuples(st.integers(1, 40), st.just(3)),
+    elements=st.floats(-30.0, 30.0, allow_nan=False, allow_infinity=False),
+)
+
+
+@settings(max_examples=300, deadline=None)
+@given(points=clouds, queries=clouds)
+def test_brute_force_distance_is_the_k_d_trees_bit_for_bit(points, queries):
+    """The all-pairs minimum (numpy, small cells) is scipy's k-d tree's number exactly, so the
+    overlap guard decides as before the brute force replaced the tree there."""
+    d, _ = cKDTree(points).query(queries, k=1)
+    assert _closest_pair_distance(points, queries) == float(d.min())
+
+
+@pytest.mark.parametrize("cutoff", [2.0, 4.0, 7.0])
+def test_brute_force_and_tree_agree_over_shifts_thicknesses_and_tilted_images(
+    reference, cutoff, monkeypatch
+):
+    """interslab_min_distance with every pair compared (the default on these cells) and with
+    the k-d tree forced (BRUTE_FORCE_MAX_PAIRS below every count) on periodic placements:
+    the same float, inf included."""
+    rng = np.random.default_rng(5)
+    z0 = thickness(reference)
+    cases = [
+        place_slab2(
+            reference, *rng.random(2), z0 + rng.uniform(-2.5, 4.0), min_distance_angstrom=0.0
+        )
+        for _ in range(40)
+    ]
+    brute = [interslab_min_distance(atoms, cutoff) for atoms in cases]
+    monkeypatch.setattr(placement, "BRUTE_FORCE_MAX_PAIRS", -1)
+    tree = [interslab_min_distance(atoms, cutoff) for atoms in cases]
+    assert brute == tree
+    assert any(np.isfinite(brute))
