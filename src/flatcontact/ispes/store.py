@@ -415,7 +415,9 @@ class PointStore:
 
     def _row(self, result: PointResult, kvp: dict):
         """The ASE row of one point, built directly (what ``ase.db`` would make of
-        ``Atoms(numbers, positions, cell, pbc)`` with a ``SinglePointCalculator(energy=...)``).
+        ``Atoms(numbers, positions, cell, pbc)`` with a ``SinglePointCalculator(energy=...)``),
+        for ``ase.db``'s own writer: used where :class:`~flatcontact.ispes.store_rows.RowWriter`
+        does not know the store's layout.
 
         Building an ``Atoms`` and a calculator only for ``ase.db`` to take them apart again
         (``atoms2dict``: a state check comparing the atoms with ``allclose``, a formula per
