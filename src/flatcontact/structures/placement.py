@@ -145,6 +145,29 @@ def place_slab2(
         inter-slab distance below ``min_distance_angstrom``) with the allowed placement.
     """
     validate_interface(reference, "reference interface")
+    return place_validated(
+        reference,
+        shift_a,
+        shift_b,
+        thickness_angstrom,
+        min_distance_angstrom=min_distance_angstrom,
+        spread_compression=spread_compression,
+    )
+
+
+def place_validated(
+    reference: Atoms,
+    shift_a: float,
+    shift_b: float,
+    thickness_angstrom: float,
+    *,
+    min_distance_angstrom: float = MIN_INTERSLAB_DISTANCE_ANGSTROM,
+    spread_compression: bool = True,
+) -> Atoms:
+    """:func:`place_slab2` of a ``reference`` that already passed ``validate_interface``: the
+    same atoms and errors, without validating the reference again (the overlap check places
+    every point of a round from one reference; the validation was 0.07 of a placement's
+    0.17 ms on the 36-atom quartz cell)."""
     for name, value in (
         ("shift_a", shift_a),
         ("shift_b", shift_b),
