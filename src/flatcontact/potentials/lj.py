@@ -53,7 +53,7 @@ BOHR_TO_ANGSTROM = units.Bohr
 
 #: Tkatchenko–Scheffler free-atom reference data per element, (α in bohr³, C6 in
 #: Hartree·bohr⁶, R0 in bohr): α and C6 from Chu & Dalgarno, J. Chem. Phys. 121, 4083 (2004)
-#: (TS 2009 reference table, the values of ASE's ``vdWDB_alphaC6`` where it has them), R0 from
+#: (TS 2009 reference table; ASE's ``vdWDB_alphaC6`` differs in 13: :data:`ASE_ALPHA_C6`), R0 from
 #: TS, PRL 102, 073005 (2009); 4d/5d metals from the extended TS table used by FHI-aims,
 #: VASP (IVDW=2) and libmbd. H–Ba and Hf–Rn (no lanthanides); others: give ``c6_ev_a6`` and
 #: ``r0_angstrom``.
@@ -86,7 +86,7 @@ TS_FREE_ATOM: dict[str, tuple[float, float, float]] = {
 }  # fmt: skip
 
 #: (α in bohr³, C6 in Hartree·bohr⁶) of ASE's ``vdWDB_alphaC6`` (Chu & Dalgarno 2004, as ASE
-#: rounds them) for the 13 of its 40 elements where they differ from :data:`TS_FREE_ATOM`;
+#: tabulates them) for the 13 of its 40 elements where they differ from :data:`TS_FREE_ATOM`;
 #: for its other 27 elements ASE's values are TS_FREE_ATOM's. :func:`ts_free_atom` takes
 #: ASE's values where it has them; holding the differences here spares every scan worker
 #: the import of ``ase.calculators.vdwcorrection`` (scipy.special, scipy.sparse,

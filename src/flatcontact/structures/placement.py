@@ -32,8 +32,8 @@ MAX_SPREAD_STRAIN = 0.10
 #: Most (facing atom of slab 2) × (image of an atom of slab 1) pairs that
 #: :func:`interslab_min_distance` compares all at once with numpy; beyond, a k-d tree
 #: (``scipy.spatial``, imported only then). A scan's cell is usually far below it (the
-#: 36-atom quartz interface: 25 pairs at the scan's 2 Å), and importing scipy.spatial cost every worker
-#: process ≈ 0.07 s of CPU at start, more than the whole grid's overlap checks.
+#: 36-atom quartz interface: 25 pairs at the scan's 2 Å), and importing scipy.spatial cost
+#: every worker process ≈ 0.07 s of CPU at start, more than all its overlap checks.
 BRUTE_FORCE_MAX_PAIRS = 200_000
 
 
