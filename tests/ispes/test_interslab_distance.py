@@ -3,10 +3,19 @@
 import numpy as np
 import pytest
 from ase.neighborlist import neighbor_list
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra import numpy as hnp
+from scipy.spatial import cKDTree
 
+from flatcontact.structures import placement
 from flatcontact.structures.assemble import make_interface
 from flatcontact.structures.interface_contract import thickness
-from flatcontact.structures.placement import interslab_min_distance, place_slab2
+from flatcontact.structures.placement import (
+    _closest_pair_distance,
+    interslab_min_distance,
+    place_slab2,
+)
 from flatcontact.structures.slab import quartz_0001_slab
 
 
@@ -50,3 +59,68 @@ def test_tilted_small_cell_needs_several_images(reference):
     assert interslab_min_distance(atoms, cutoff) == pytest.approx(
         all_pairs_min_distance(atoms, cutoff), abs=1e-9
     )
+
+
+#: clouds of 1-40 points, coordinates in ±30 Å (ties and repeated points included)
+clouds = hnp.arrays(
+    np.float64,
+    st.tuples(st.integers(1, 40), st.just(3)),
+    elements=st.floats(-30.0, 30.0, allow_nan=False, allow_infinity=False),
+)
+
+
+@settings(max_examples=300, deadline=None)
+@given(points=clouds, queries=clouds)
+def test_brute_force_distance_is_the_k_d_trees_bit_for_bit(points, queries):
+    """The all-pairs minimum (numpy, small cells) is scipy's k-d tree's number exactly, so the
+    overlap guard decides as before the brute force replaced the tree there."""
+    d, _ = cKDTree(points).query(queries, k=1)
+    assert _closest_pair_distance(points, queries) == float(d.min())
+
+
+@pytest.mark.parametrize("cutoff", [2.0, 4.0, 7.0])
+def test_brute_force_and_tree_agree_over_shifts_thicknesses_and_tilted_images(
+    reference, cutoff, monkeypatch
+):
+    """interslab_min_distance with every pair compared (the default on these cells) and with
+    the k-d tree forced (BRUTE_FORCE_MAX_PAIRS below every count) on periodic placements:
+    the same float, inf included."""
+    rng = np.random.default_rng(5)
+    z0 = thickness(reference)
+    cases = [
+        place_slab2(
+            reference, *rng.random(2), z0 + rng.uniform(-2.5, 4.0), min_distance_angstrom=0.0
+        )
+        for _ in range(40)
+    ]
+    brute = [interslab_min_distance(atoms, cutoff) for atoms in cases]
+    monkeypatch.setattr(placement, "BRUTE_FORCE_MAX_PAIRS", -1)
+    tree = [interslab_min_distance(atoms, cutoff) for atoms in cases]
+    assert brute == tree
+    assert any(np.isfinite(brute))
+
+
+def test_overlap_check_validates_the_reference_once_and_places_as_place_slab2(
+    reference, monkeypatch
+):
+    """The grid's overlap check validates the reference once, not at each of its points, and
+    place_validated gives place_slab2's atoms exactly (and its overlap error)."""
+    from flatcontact.foundation.errors import InputError
+    from flatcontact.ispes import grid as grid_module
+    from flatcontact.ispes.grid import GridSpec, check_thicknesses
+
+    rng = np.random.default_rng(3)
+    z0 = thickness(reference)
+    for _ in range(10):
+        a, b, z = *rng.random(2), z0 + rng.uniform(-0.5, 2.0)
+        want = place_slab2(reference, a, b, z)
+        got = placement.place_validated(reference, a, b, z)
+        np.testing.assert_array_equal(got.positions, want.positions)
+        np.testing.assert_array_equal(got.cell.array, want.cell.array)
+    with pytest.raises(InputError, match="overlap"):
+        placement.place_validated(reference, 0.0, 0.0, z0 - 4.0)
+    calls = []
+    real = grid_module.validate_interface
+    monkeypatch.setattr(grid_module, "validate_interface", lambda *a: calls.append(1) or real(*a))
+    check_thicknesses(reference, GridSpec(4, 4, thickness_angstrom=(z0,)), [z0, z0 + 1.0])
+    assert len(calls) == 1

@@ -6,11 +6,13 @@ the ones ASE itself writes from the atoms, the batched store must hold the same 
 unbatched one, and a kill loses only what was not yet committed.
 """
 
+import json
 import signal
 import sqlite3
 import subprocess
 import sys
 import textwrap
+import uuid
 
 import ase.db
 import numpy as np
@@ -98,6 +100,94 @@ def test_rows_are_the_ones_ase_writes_from_the_atoms(tmp_path):
     assert db.count("i_a=3,converged=True") == plain.count("i_a=3,converged=True") > 0
     assert db.count("thickness>11.5") == plain.count("thickness>11.5") > 0
     assert db.get(i_a=4, i_b=1).toatoms() == plain.get(i_a=4, i_b=1).toatoms()
+
+
+#: columns that differ between any two writes (a random id, the time of writing)
+VOLATILE = ("id", "unique_id", "ctime", "mtime")
+
+
+def _raw(path):
+    """Every column of every row of ``systems`` (raw SQLite values, by grid index) and the
+    ``species`` rows, as stored: what any reader of the file sees."""
+    with sqlite3.connect(str(path)) as con:
+        con.row_factory = sqlite3.Row
+        rows = {}
+        for row in con.execute("SELECT * FROM systems"):
+            kvp = json.loads(row["key_value_pairs"])
+            rows[(kvp["i_a"], kvp["i_b"], kvp["i_z"])] = dict(row)
+        species = {}
+        for z, n, row_id in con.execute("SELECT Z, n, id FROM species ORDER BY rowid"):
+            species.setdefault(row_id, []).append((z, n))
+    con.close()
+    return rows, species
+
+
+@pytest.mark.parametrize("layout", ["store", "ase"])
+def test_every_column_and_species_row_is_the_one_ase_writes(tmp_path, layout, monkeypatch):
+    """Column for column (raw SQLite values: blobs, JSON text, the derived natoms, volume,
+    mass, charge, data) and species row for species row, the store's rows are those ase.db
+    writes from Atoms + SinglePointCalculator, except the random id and the write time; in
+    the store's layout and in ASE's own (key tables as tables, filled as ASE fills them)."""
+    from flatcontact.ispes import store_schema
+
+    if layout == "ase":  # a store of the older layout: ASE's key tables are tables
+        monkeypatch.setattr(store_schema, "replace_key_tables", lambda path: False)
+    ref = toy_interface(layers=3)
+    ref.set_tags(np.arange(len(ref)) % 3)  # the reference's own arrays stay out of the rows
+    with PointStore(tmp_path / "points.db", {"test": "raw"}, ref) as store:
+        assert store._rows is not None  # the prepared writer, not ase.db's
+        for k in range(12):
+            store.write(_result(ref, k))
+    plain = ase.db.connect(str(tmp_path / "plain.db"))
+    for k in range(12):
+        r = _result(ref, k)
+        atoms = Atoms(numbers=ref.numbers, positions=r.positions, cell=ref.cell, pbc=ref.pbc)
+        atoms.calc = SinglePointCalculator(atoms, energy=r.energy_ev)
+        plain.write(atoms, key_value_pairs=_kvp(r))
+    (ours, our_species), (theirs, their_species) = (
+        _raw(tmp_path / "points.db"),
+        _raw(tmp_path / "plain.db"),
+    )
+    assert ours.keys() == theirs.keys()
+    for index in ours:
+        a, b = ours[index], theirs[index]
+        assert a.keys() == b.keys()
+        for column in a:
+            if column not in VOLATILE:
+                assert a[column] == b[column], (index, column)
+        assert a["ctime"] == a["mtime"] and len(a["unique_id"]) == 32
+        assert uuid.UUID(a["unique_id"]).version == 4
+        assert our_species[a["id"]] == their_species[b["id"]]
+    if layout == "ase":  # ASE's key tables hold what ASE puts there
+        for table in ("keys", "number_key_values", "text_key_values"):
+            with (
+                sqlite3.connect(str(tmp_path / "points.db")) as x,
+                sqlite3.connect(str(tmp_path / "plain.db")) as y,
+            ):
+                query = f"SELECT * FROM {table} ORDER BY id, rowid"
+                assert x.execute(query).fetchall() == y.execute(query).fetchall(), table
+            x.close()
+            y.close()
+
+
+def test_a_layout_the_writer_does_not_know_is_written_through_ase(tmp_path, monkeypatch):
+    """Another ASE format version (or other columns): the store writes through ase.db, and the
+    rows are still ASE's own."""
+    from flatcontact.ispes import store_rows
+
+    monkeypatch.setattr(store_rows, "FORMAT_VERSION", store_rows.FORMAT_VERSION + 1)
+    ref = toy_interface(layers=3)
+    with PointStore(tmp_path / "points.db", {"test": "fallback"}, ref) as store:
+        assert store._rows is None
+        for k in range(6):
+            store.write(_result(ref, k))
+    plain = ase.db.connect(str(tmp_path / "plain.db"))
+    for k in range(6):
+        r = _result(ref, k)
+        atoms = Atoms(numbers=ref.numbers, positions=r.positions, cell=ref.cell, pbc=ref.pbc)
+        atoms.calc = SinglePointCalculator(atoms, energy=r.energy_ev)
+        plain.write(atoms, key_value_pairs=_kvp(r))
+    _assert_same_rows(_ase_rows(tmp_path / "points.db"), _ase_rows(tmp_path / "plain.db"))
 
 
 def _commits(store):

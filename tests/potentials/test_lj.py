@@ -12,10 +12,12 @@ from flatcontact.potentials import InteractionModel, LJSpec
 from flatcontact.potentials.lj import (
     BOHR_TO_ANGSTROM,
     HARTREE_BOHR6_TO_EV_A6,
+    TS_FREE_ATOM,
     lj_energy,
     lj_from_c6,
     lj_table,
     ts_combined_c6,
+    ts_free_atom,
 )
 
 
@@ -31,6 +33,18 @@ def test_ts_free_atom_values_and_units():
     # σ from the vdW radii: LJ minimum at R0(O) + R0(Si) = (3.19 + 4.20) bohr
     rmin = 2 ** (1 / 6) * table["O-Si"].sigma_angstrom
     assert rmin == pytest.approx((3.19 + 4.20) * BOHR_TO_ANGSTROM)
+
+
+def test_free_atom_values_are_ases_table_where_ase_has_the_element():
+    """ts_free_atom holds ASE's vdWDB_alphaC6 differences itself (no import of
+    ase.calculators.vdwcorrection in a scan worker): for every element the values, bit for
+    bit, that a lookup in ASE's own table gives, and TS_FREE_ATOM's for the others."""
+    from ase.calculators.vdwcorrection import vdWDB_alphaC6
+
+    assert set(vdWDB_alphaC6) <= set(TS_FREE_ATOM)
+    for symbol in TS_FREE_ATOM:
+        alpha, c6 = vdWDB_alphaC6.get(symbol, TS_FREE_ATOM[symbol][:2])
+        assert ts_free_atom(symbol) == (c6 * HARTREE_BOHR6_TO_EV_A6, float(alpha)), symbol
 
 
 @given(

@@ -56,7 +56,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from flatcontact import __version__
 from flatcontact.foundation import limits
 from flatcontact.foundation.errors import InputError
 from flatcontact.foundation.fileio import atomic_path
@@ -197,6 +196,10 @@ def empty_grid(
         },
         coords=coords,
     )
+    # the version here, not at import: reading it (importlib.metadata) cost every scan
+    # worker, which imports this module for cell_area, ≈ 0.02 s of CPU at start
+    from flatcontact import __version__
+
     a1 = np.asarray(a1, dtype=float)[:2]
     a2 = np.asarray(a2, dtype=float)[:2]
     ds.attrs.update(

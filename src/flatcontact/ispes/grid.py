@@ -21,7 +21,8 @@ from ase import Atoms
 
 from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.contract import fractional_shifts
-from flatcontact.ispes.geometry import place_slab2
+from flatcontact.ispes.geometry import validate_interface
+from flatcontact.structures.placement import place_validated
 
 
 @dataclasses.dataclass(frozen=True)
@@ -118,9 +119,11 @@ def check_rows(
     ``shift_b`` of row ``i_a`` at thickness z (Å), in that order (the scan with many
     workers splits the check into blocks of pairs on its workers)."""
     sa, sb = grid.shifts()
+    if items:  # once, place_slab2's first check, not at every point
+        validate_interface(reference, "reference interface")
     for z, row in items:
         for b in sb:
-            place_slab2(
+            place_validated(
                 reference,
                 float(sa[row]),
                 float(b),

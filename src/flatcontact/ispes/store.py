@@ -80,6 +80,7 @@ from flatcontact.ispes.store_checks import (
     resolved_defect,
     settings_difference,
 )
+from flatcontact.ispes.store_rows import RowWriter
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -303,6 +304,9 @@ class PointStore:
         self._db.connection.commit()
         self._db.connection.execute("PRAGMA journal_mode=WAL")
         self._db.connection.execute("PRAGMA synchronous=NORMAL")
+        # the rows with one prepared INSERT, the columns that never change computed once
+        # (store_rows); None for a layout it does not know: ase.db writes them
+        self._rows = RowWriter.for_database(self._db, reference)
         self._catch_sigterm()
 
     def _catch_sigterm(self) -> None:
@@ -411,7 +415,9 @@ class PointStore:
 
     def _row(self, result: PointResult, kvp: dict):
         """The ASE row of one point, built directly (what ``ase.db`` would make of
-        ``Atoms(numbers, positions, cell, pbc)`` with a ``SinglePointCalculator(energy=...)``).
+        ``Atoms(numbers, positions, cell, pbc)`` with a ``SinglePointCalculator(energy=...)``),
+        for ``ase.db``'s own writer: used where :class:`~flatcontact.ispes.store_rows.RowWriter`
+        does not know the store's layout.
 
         Building an ``Atoms`` and a calculator only for ``ase.db`` to take them apart again
         (``atoms2dict``: a state check comparing the atoms with ``allclose``, a formula per
@@ -468,10 +474,13 @@ class PointStore:
         if not self._checked_keys:  # ase.db's key check, once: the keys and types never change
             ase.db.core.check(kvp)
             self._checked_keys = True
-        # the database's own row writer; the key-value pairs travel in the row (ase.db's
-        # rule for a row written without pairs: it keeps its own), so that ase.db's key
-        # check, a formula parse per key (a quarter of the write), runs once, above
-        row_id = self._db._write(self._row(result, kvp), {}, {}, None)
+        if self._rows is not None:
+            row_id = self._rows.write(self._db.connection, result.positions, result.energy_ev, kvp)
+        else:
+            # the database's own row writer; the key-value pairs travel in the row (ase.db's
+            # rule for a row written without pairs: it keeps its own), so that ase.db's key
+            # check, a formula parse per key (a quarter of the write), runs once, above
+            row_id = self._db._write(self._row(result, kvp), {}, {}, None)
         self._uncommitted += 1
         if time.monotonic() - self._last_commit >= self.commit_interval_s:
             self._commit()  # everything written so far, in order

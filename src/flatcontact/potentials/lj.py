@@ -53,7 +53,7 @@ BOHR_TO_ANGSTROM = units.Bohr
 
 #: Tkatchenko–Scheffler free-atom reference data per element, (α in bohr³, C6 in
 #: Hartree·bohr⁶, R0 in bohr): α and C6 from Chu & Dalgarno, J. Chem. Phys. 121, 4083 (2004)
-#: (TS 2009 reference table, the values of ASE's ``vdWDB_alphaC6`` where it has them), R0 from
+#: (TS 2009 reference table; ASE's ``vdWDB_alphaC6`` differs in 13: :data:`ASE_ALPHA_C6`), R0 from
 #: TS, PRL 102, 073005 (2009); 4d/5d metals from the extended TS table used by FHI-aims,
 #: VASP (IVDW=2) and libmbd. H–Ba and Hf–Rn (no lanthanides); others: give ``c6_ev_a6`` and
 #: ``r0_angstrom``.
@@ -85,6 +85,20 @@ TS_FREE_ATOM: dict[str, tuple[float, float, float]] = {
     "Rn": (33.54, 390.63, 4.23),
 }  # fmt: skip
 
+#: (α in bohr³, C6 in Hartree·bohr⁶) of ASE's ``vdWDB_alphaC6`` (Chu & Dalgarno 2004, as ASE
+#: tabulates them) for the 13 of its 40 elements where they differ from :data:`TS_FREE_ATOM`;
+#: for its other 27 elements ASE's values are TS_FREE_ATOM's. :func:`ts_free_atom` takes
+#: ASE's values where it has them; holding the differences here spares every scan worker
+#: the import of ``ase.calculators.vdwcorrection`` (scipy.special, scipy.sparse,
+#: scipy.spatial, ase.neighborlist: ≈ 0.2 s of CPU at start) for a table lookup.
+#: ``tests/potentials/test_lj.py`` checks both statements against ASE's table.
+ASE_ALPHA_C6: dict[str, tuple[float, float]] = {
+    "He": (1.38, 1.42), "Li": (164, 1392), "Be": (38, 227), "Ne": (2.67, 6.2),
+    "Na": (163, 1518), "Mg": (71, 626), "Ar": (11.1, 64.2), "Ca": (160, 2163),
+    "Kr": (16.7, 130), "Sr": (199, 3175), "Te": (40, 445), "Pd": (23.7, 158),
+    "Pt": (39.7, 347),
+}  # fmt: skip
+
 #: TS 2009 free-atom vdW radii R0 (bohr), from :data:`TS_FREE_ATOM`.
 TS_R0_BOHR: dict[str, float] = {k: v[2] for k, v in TS_FREE_ATOM.items()}
 
@@ -109,13 +123,11 @@ def pair_key(a: str, b: str) -> str:
 
 
 def ts_free_atom(symbol: str) -> tuple[float, float]:
-    """Free-atom (C6 in eV·Å⁶, α in bohr³) of ``symbol`` from the TS/Chu–Dalgarno table."""
-    # imported here: ase.calculators.vdwcorrection pulls scipy.special and ase.neighborlist
-    # (about 0.5 s), which a scan worker on a LAMMPS model never needs
-    from ase.calculators.vdwcorrection import vdWDB_alphaC6
-
-    if symbol in vdWDB_alphaC6:
-        alpha, c6 = vdWDB_alphaC6[symbol]
+    """Free-atom (C6 in eV·Å⁶, α in bohr³) of ``symbol`` from the TS/Chu–Dalgarno table:
+    ASE's ``vdWDB_alphaC6`` values where ASE has the element (:data:`ASE_ALPHA_C6`), else
+    :data:`TS_FREE_ATOM`'s."""
+    if symbol in ASE_ALPHA_C6:
+        alpha, c6 = ASE_ALPHA_C6[symbol]
     elif symbol in TS_FREE_ATOM:
         alpha, c6, _ = TS_FREE_ATOM[symbol]
     else:
