@@ -268,21 +268,14 @@ class PeriodicSurface:
     def local_minimum(self, xy0: np.ndarray) -> tuple[np.ndarray, float]:
         """Refine a minimum from ``xy0`` with a trust-region Newton method (analytic derivatives).
 
-        A start that already passes :meth:`local_minima`'s stationarity test
-        (``|∇e| · a_min <= 1e-7 · ptp(e)``; the minimum is then within |∇e|/λ_min of it) is
-        returned as it is: near a stationary point scipy's exact trust-region subproblem
-        turned gradients of 1e-12 … 2e-11 (just above its absolute tolerance) into a NaN
-        and an error (a toy landscape with its minimum on a grid point;
-        ``tests/analysis/test_periodic.py``). Where scipy fails so anyway, the start is
-        polished by Newton steps instead (:meth:`_newton_polish`), and the caller's tests
-        (stationary, positive definite) decide as for any other candidate.
+        Near a stationary start scipy's exact trust-region subproblem turned gradients of
+        1e-12 … 2e-11 (just above its absolute tolerance) into a NaN and an error (a toy
+        landscape with its minimum on a grid point; ``tests/analysis/test_periodic.py``).
+        There the start is polished by Newton steps instead (:meth:`_newton_polish`), and the
+        caller's tests (stationary, positive definite) decide as for any other candidate;
+        wherever scipy succeeds its result is kept, bit for bit as before.
         """
         x0 = np.asarray(xy0, float)
-        start = self.evaluate(x0)
-        spread = max(float(np.ptp(self.values)), 1e-300)
-        scale = float(np.min(np.linalg.norm(self.lattice, axis=0)))
-        if np.linalg.norm(start.gradient) * scale <= 1e-7 * spread:
-            return x0, float(start.value)
 
         def fun(x: np.ndarray) -> float:
             return float(self(x))
