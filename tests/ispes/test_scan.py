@@ -369,3 +369,21 @@ def test_points_stored_are_committed_when_due_also_while_the_driver_waits(
         assert len(late.timed_out) == 17 and max(commits) == 1
     else:  # the results arrive in time: commits only when due, far fewer than points
         assert len([n for n in commits if n]) < 6
+
+
+@pytest.mark.parametrize(
+    ("raw", "expected"),
+    [(None, 0.5), ("", 0.5), ("0", 0.0), ("2.5", 2.5), ("-1", None), ("x", None)],
+)
+def test_the_commit_interval_comes_from_the_environment_or_is_one_line(raw, expected, monkeypatch):
+    from flatcontact.ispes.scan_scheduler import COMMIT_INTERVAL_ENV, commit_interval_s
+
+    if raw is None:
+        monkeypatch.delenv(COMMIT_INTERVAL_ENV, raising=False)
+    else:
+        monkeypatch.setenv(COMMIT_INTERVAL_ENV, raw)
+    if expected is None:
+        with pytest.raises(InputError, match=COMMIT_INTERVAL_ENV):
+            commit_interval_s()
+    else:
+        assert commit_interval_s() == expected

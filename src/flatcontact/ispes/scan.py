@@ -52,7 +52,7 @@ from flatcontact.ispes.reduction import SymmetrySettings
 from flatcontact.ispes.relax import RelaxSettings
 from flatcontact.ispes.scan_extend import check_overlaps, extend_grid
 from flatcontact.ispes.scan_probe import resolve, store_pending_work
-from flatcontact.ispes.scan_scheduler import COMMIT_INTERVAL_S, Scheduler
+from flatcontact.ispes.scan_scheduler import Scheduler, commit_interval_s
 from flatcontact.ispes.scan_symmetry import ScanRound, SymmetryPlan
 from flatcontact.ispes.shared_hessian import HessianSharing
 from flatcontact.ispes.store import PointStore, discard_store, interface_hash
@@ -236,7 +236,7 @@ def run_scan(
                 store_path,
                 scan_settings(reference, factory, grid, relax, symmetry),
                 reference,
-                commit_interval_s=COMMIT_INTERVAL_S,
+                commit_interval_s=commit_interval_s(),
             ) as store,
         ):
             clock.add("open store", time.perf_counter() - t0)  # with the input checks

@@ -17,10 +17,13 @@ from __future__ import annotations
 
 import collections
 import heapq
+import math
+import os
 from collections.abc import Callable
 
 import numpy as np
 
+from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.executors import Executor
 from flatcontact.ispes.relax import PointTask, ScanContext, run_task
 from flatcontact.ispes.scan_probe import MANY_WORKERS
@@ -37,6 +40,24 @@ from flatcontact.ispes.store import PointStore
 #: commit after almost every point (1,242 commits for 1,296 points, 0.7 s of the driver's
 #: 2.5 s on a 2-worker quartz scan; docs/performance.md).
 COMMIT_INTERVAL_S = 0.5
+#: The environment variable that sets another interval (s, ≥ 0; 0 commits every point as it
+#: is stored: what a test that kills the driver mid-scan and reads the store needs)
+COMMIT_INTERVAL_ENV = "FLATCONTACT_COMMIT_INTERVAL_S"
+
+
+def commit_interval_s() -> float:
+    """The store's commit interval: ``FLATCONTACT_COMMIT_INTERVAL_S`` if set, else
+    :data:`COMMIT_INTERVAL_S`; a value that is no number ≥ 0 is one InputError naming it."""
+    raw = os.environ.get(COMMIT_INTERVAL_ENV)
+    if raw is None or raw.strip() == "":
+        return COMMIT_INTERVAL_S
+    try:
+        value = float(raw)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value >= 0):
+        raise InputError(f"{COMMIT_INTERVAL_ENV}={raw!r}: expected seconds >= 0 (e.g. 0.5)")
+    return value
 
 
 #: From this many workers on, the ready points are ranked deepest branch first

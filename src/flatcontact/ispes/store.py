@@ -24,7 +24,8 @@ operating-system crash or power loss can lose the last commits. With ``commit_in
 ``scan.COMMIT_INTERVAL_S`` (0.5 s) and commits (:meth:`PointStore.flush`) as soon as a point
 written has waited that long, also while the driver waits for results
 (:meth:`PointStore.commit_due_in_s`, :class:`flatcontact.ispes.scan_scheduler.Scheduler`), so
-the results that arrive within 0.5 s are one transaction and a ``kill -9`` loses at most the
+the results that arrive within 0.5 s are one transaction (``FLATCONTACT_COMMIT_INTERVAL_S`` sets
+another interval; 0 commits every point) and a ``kill -9`` loses at most the
 points stored in the last 0.5 s, besides the points in flight (in a serial scan, where the
 driver relaxes the points itself: the points stored within 0.5 s before the relaxation it
 was killed in, if the one before took less than the time left). Ctrl-C, SIGTERM (raised as :class:`StoreTerminated` while a store is open) and a
