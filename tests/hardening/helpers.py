@@ -100,7 +100,13 @@ def stored_rows(db: Path) -> int:
 def kill_9_when(argv: list[str], ready, poll_seconds: float = 0.005) -> None:
     """Start ``python -m flatcontact argv`` in its own process group, SIGKILL the group once
     ``ready()`` holds; assert the command was still running then and died of the signal."""
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    # every point committed as it is stored, so that ``ready`` reading the store sees the
+    # scan's progress (in 0.5 s batches a short grid can end before its first commit)
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join(sys.path),
+        "FLATCONTACT_COMMIT_INTERVAL_S": "0",
+    }
     driver = subprocess.Popen(
         [sys.executable, "-m", "flatcontact", *map(str, argv)],
         stdout=subprocess.DEVNULL,

@@ -193,7 +193,9 @@ def _rows(db):
 def test_resume_after_kill_9_gives_the_uninterrupted_grid(tmp_path, toy_reference, toy_factory):
     out = tmp_path / "killed"
     proc = subprocess.Popen(
-        [sys.executable, "-c", KILLED_RUN, str(out)], env={**os.environ, "OMP_NUM_THREADS": "1"}
+        [sys.executable, "-c", KILLED_RUN, str(out)],
+        # every point committed as stored: the rows read below show where the scan is
+        env={**os.environ, "OMP_NUM_THREADS": "1", "FLATCONTACT_COMMIT_INTERVAL_S": "0"},
     )
     deadline = time.monotonic() + 120
     while _rows(out / "points.db") < 4 and time.monotonic() < deadline and proc.poll() is None:
