@@ -104,7 +104,7 @@ def test_overlap_check_validates_the_reference_once_and_places_as_place_slab2(
     reference, monkeypatch
 ):
     """The grid's overlap check validates the reference once, not at each of its points, and
-    place_validated gives place_slab2's atoms exactly (and its overlap error)."""
+    place_slab2 without validating gives the validated atoms exactly (and its overlap error)."""
     from flatcontact.foundation.errors import InputError
     from flatcontact.ispes import grid as grid_module
     from flatcontact.ispes.grid import GridSpec, check_thicknesses
@@ -114,11 +114,11 @@ def test_overlap_check_validates_the_reference_once_and_places_as_place_slab2(
     for _ in range(10):
         a, b, z = *rng.random(2), z0 + rng.uniform(-0.5, 2.0)
         want = place_slab2(reference, a, b, z)
-        got = placement.place_validated(reference, a, b, z)
+        got = place_slab2(reference, a, b, z, validate_reference=False)
         np.testing.assert_array_equal(got.positions, want.positions)
         np.testing.assert_array_equal(got.cell.array, want.cell.array)
     with pytest.raises(InputError, match="overlap"):
-        placement.place_validated(reference, 0.0, 0.0, z0 - 4.0)
+        place_slab2(reference, 0.0, 0.0, z0 - 4.0, validate_reference=False)
     calls = []
     real = grid_module.validate_interface
     monkeypatch.setattr(grid_module, "validate_interface", lambda *a: calls.append(1) or real(*a))

@@ -81,18 +81,25 @@ def _kvp(r):
     }  # fmt: skip
 
 
+def _written_by_ase(path, ref, n: int):
+    """The first ``n`` points of :func:`_result` written by ase.db itself, from Atoms and a
+    SinglePointCalculator, into ``path``; the database."""
+    plain = ase.db.connect(str(path))
+    for k in range(n):
+        r = _result(ref, k)
+        atoms = Atoms(numbers=ref.numbers, positions=r.positions, cell=ref.cell, pbc=ref.pbc)
+        atoms.calc = SinglePointCalculator(atoms, energy=r.energy_ev)
+        plain.write(atoms, key_value_pairs=_kvp(r))
+    return plain
+
+
 def test_rows_are_the_ones_ase_writes_from_the_atoms(tmp_path):
     """Independent: the same points written by ase.db from Atoms + SinglePointCalculator."""
     ref = toy_interface(layers=3)
     with PointStore(tmp_path / "points.db", {"test": "rows"}, ref) as store:
         for k in range(30):
             store.write(_result(ref, k))
-    plain = ase.db.connect(str(tmp_path / "plain.db"))
-    for k in range(30):
-        r = _result(ref, k)
-        atoms = Atoms(numbers=ref.numbers, positions=r.positions, cell=ref.cell, pbc=ref.pbc)
-        atoms.calc = SinglePointCalculator(atoms, energy=r.energy_ev)
-        plain.write(atoms, key_value_pairs=_kvp(r))
+    plain = _written_by_ase(tmp_path / "plain.db", ref, 30)
     ours, theirs = _ase_rows(tmp_path / "points.db"), _ase_rows(tmp_path / "plain.db")
     _assert_same_rows(ours, theirs)
     # the key tables too: ase.db's queries by key find the same rows
@@ -138,12 +145,7 @@ def test_every_column_and_species_row_is_the_one_ase_writes(tmp_path, layout, mo
         assert store._rows is not None  # the prepared writer, not ase.db's
         for k in range(12):
             store.write(_result(ref, k))
-    plain = ase.db.connect(str(tmp_path / "plain.db"))
-    for k in range(12):
-        r = _result(ref, k)
-        atoms = Atoms(numbers=ref.numbers, positions=r.positions, cell=ref.cell, pbc=ref.pbc)
-        atoms.calc = SinglePointCalculator(atoms, energy=r.energy_ev)
-        plain.write(atoms, key_value_pairs=_kvp(r))
+    _written_by_ase(tmp_path / "plain.db", ref, 12)
     (ours, our_species), (theirs, their_species) = (
         _raw(tmp_path / "points.db"),
         _raw(tmp_path / "plain.db"),

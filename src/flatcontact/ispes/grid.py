@@ -22,7 +22,7 @@ from ase import Atoms
 from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.contract import fractional_shifts
 from flatcontact.ispes.geometry import validate_interface
-from flatcontact.structures.placement import place_validated
+from flatcontact.structures.placement import place_slab2
 
 
 @dataclasses.dataclass(frozen=True)
@@ -123,10 +123,11 @@ def check_rows(
         validate_interface(reference, "reference interface")
     for z, row in items:
         for b in sb:
-            place_validated(
+            place_slab2(
                 reference,
                 float(sa[row]),
                 float(b),
                 float(z),
                 spread_compression=spread_compression,
+                validate_reference=False,
             )
