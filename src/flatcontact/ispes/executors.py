@@ -78,6 +78,11 @@ class Executor(Protocol):
     def close(self, cancel: bool = False) -> None: ...
 
 
+def _finite(timeout: float | None) -> float | None:
+    """``wait_first``'s time limit as the waits take it: None (no limit) for None or inf."""
+    return None if timeout is None or timeout == float("inf") else timeout
+
+
 class SerialExecutor:
     """Runs each task at submission, in the driver process."""
 
@@ -98,8 +103,7 @@ class SerialExecutor:
     def wait_first(
         self, handles: Iterable[cf.Future], timeout: float | None = None
     ) -> tuple[set, set]:
-        timeout = None if timeout is None or timeout == float("inf") else timeout
-        return cf.wait(list(handles), timeout=timeout, return_when=cf.FIRST_COMPLETED)
+        return cf.wait(list(handles), timeout=_finite(timeout), return_when=cf.FIRST_COMPLETED)
 
     @staticmethod
     def done(handle: Any) -> bool:
@@ -349,10 +353,11 @@ class DaskExecutor(SerialExecutor):
         from distributed import wait
 
         handles = list(handles)
-        timeout = None if timeout is None or timeout == float("inf") else timeout
         with self._client.as_current():
             try:
-                done, not_done = wait(handles, timeout=timeout, return_when="FIRST_COMPLETED")
+                done, not_done = wait(
+                    handles, timeout=_finite(timeout), return_when="FIRST_COMPLETED"
+                )
             except TimeoutError:  # distributed raises it when nothing finished in time
                 return set(), set(handles)
         return set(done), set(not_done)

@@ -149,6 +149,8 @@ class _Scanned:
     notes: list[str]
     interrupted: bool
     computed_calls: list[int]
+    #: the force calls of the driver's reference Hessian (:class:`HessianSharing`): the
+    #: scan's processes are handed its root and compute none of their own
     hessian_calls: int = 0
 
     @property
@@ -252,7 +254,7 @@ def run_scan(
                 finally:
                     if own_executor:
                         executor.close(cancel=True)
-            scanned.hessian_calls += sharing.hessian_force_calls
+            scanned.hessian_calls = sharing.hessian_force_calls
             with phase("write"):
                 result = _assemble(store, scanned, out_dir, t0)
             result.phase_seconds = dict(clock.seconds)
@@ -362,9 +364,7 @@ def _rounds(
             break
         scheduler.context = sharing.context(scheduler.executor)
         resolved = store.resolved
-    return _Scanned(
-        plan, resolved, notes, interrupted, scheduler.computed_calls, scheduler.hessian_calls
-    )
+    return _Scanned(plan, resolved, notes, interrupted, scheduler.computed_calls)
 
 
 def _assemble(store: PointStore, scanned: _Scanned, out_dir: Path, t0: float) -> ScanResult:

@@ -83,8 +83,7 @@ class Scheduler:
     max_new_points
         Stop after this many new points (benchmarks), or None.
 
-    ``computed_calls`` lists the force calls of every point this scheduler computed,
-    ``hessian_calls`` those of the reference's Hessian its points' processes computed first.
+    ``computed_calls`` lists the force calls of every point this scheduler computed.
     """
 
     def __init__(
@@ -102,9 +101,6 @@ class Scheduler:
         self.max_new_points = max_new_points
         self.recent = PositionsCache()
         self.computed_calls: list[int] = []
-        #: force calls of the reference's Hessian the processes relaxing the points spent
-        #: (:attr:`flatcontact.ispes.relax.PointResult.hessian_force_calls`)
-        self.hessian_calls = 0
         #: wall seconds of the last point relaxed (a serial scan commits before relaxing the
         #: next one if it would take the store past its commit deadline)
         self.last_point_s = 0.0
@@ -158,7 +154,6 @@ class Scheduler:
                 self.recent.put(idx, result.positions)
                 queue.stored(idx)
                 self.computed_calls.append(result.force_calls)
-                self.hessian_calls += result.hessian_force_calls
                 stored += weight.get(idx, 1)
                 self._report(stored, total)
         store.flush()  # before the assembly and the checks that follow
