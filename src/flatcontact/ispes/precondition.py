@@ -270,13 +270,34 @@ def slips_inside_slab(reference, positions: np.ndarray, shift: tuple[float, floa
     the structure if the interface has none)."""
     from flatcontact.ispes import slip
 
-    if "layer" not in reference.arrays:
-        from flatcontact.structures.layers import interface_layers
-
-        reference = reference.copy()
-        reference.arrays["layer"] = interface_layers(reference)
+    reference = _with_layers(reference)
     gaps = slip.in_slab_gaps(reference)
     moved = slip.layer_displacements(reference, positions, shift)
     return any(
         np.linalg.norm(moved[g.upper] - moved[g.lower]) > slip.SLIP_THRESHOLD_ANGSTROM for g in gaps
     )
+
+
+#: the last references given layers by :func:`_with_layers` (a scan asks for one)
+_LAYERED: dict[tuple, object] = {}
+
+
+def _with_layers(reference):
+    """``reference`` if it has ``arrays["layer"]``; else a copy with the layers found from the
+    structure, found once per reference (the guard asks for them at every point)."""
+    if "layer" in reference.arrays:
+        return reference
+    key = (
+        reference.positions.tobytes(),
+        reference.numbers.tobytes(),
+        reference.cell.array.tobytes(),
+        np.asarray(reference.arrays["slab"]).tobytes(),
+    )
+    if key not in _LAYERED:
+        from flatcontact.structures.layers import interface_layers
+
+        layered = reference.copy()
+        layered.arrays["layer"] = interface_layers(reference)
+        _LAYERED.clear()
+        _LAYERED[key] = layered
+    return _LAYERED[key]
