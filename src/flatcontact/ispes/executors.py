@@ -10,9 +10,9 @@ on Dask, :meth:`DaskExecutor.setup_workers`). Workers never write files: results
 to the driver, which alone writes the point store.
 
 - :class:`SerialExecutor`: in the driver process (debugging, tests, 1 core).
-- :class:`ProcessExecutor`: ``concurrent.futures.ProcessPoolExecutor`` with the
-  ``spawn`` start method (no fork of a process that holds a LAMMPS instance or MPI),
-  one worker per core by default; workers ignore SIGINT so Ctrl-C reaches only the
+- :class:`ProcessExecutor`: worker processes fed over pipes by the driver's own thread
+  (:mod:`flatcontact.ispes.worker_pool`), started with the ``spawn`` start method (no
+  fork of a process that holds a LAMMPS instance or MPI), one worker per core by default; workers ignore SIGINT so Ctrl-C reaches only the
   driver, and die with the driver (``kill -9`` of the driver alone leaves no worker).
 - :class:`DaskExecutor`: a ``distributed.Client`` on a running scheduler
   (``--dask-address tcp://host:8786``), a ``LocalCluster``, or a dask-jobqueue
@@ -34,6 +34,7 @@ from typing import Any, Protocol, runtime_checkable
 from flatcontact.foundation.errors import InputError
 from flatcontact.ispes.main_guard import serial_instead
 from flatcontact.ispes.relax import worker_calculator
+from flatcontact.ispes.worker_pool import PoolHandle, WorkerPool
 
 
 def default_workers() -> int:
@@ -158,7 +159,8 @@ def _init_worker(parent_pid: int) -> None:
 
 
 class ProcessExecutor(SerialExecutor):
-    """Local worker processes (``spawn``), ``workers`` of them (default: one per core)."""
+    """Local worker processes (``spawn``), ``workers`` of them (default: one per core), fed
+    by the driver's own thread (:class:`~flatcontact.ispes.worker_pool.WorkerPool`)."""
 
     name = "processes"
     inline = False
@@ -171,29 +173,32 @@ class ProcessExecutor(SerialExecutor):
             )
         self.workers = int(workers)
         one_blas_thread_in_workers()
-        self._pool = cf.ProcessPoolExecutor(
-            max_workers=self.workers,
-            mp_context=multiprocessing.get_context("spawn"),
+        self._pool = WorkerPool(
+            self.workers,
+            multiprocessing.get_context("spawn"),
             initializer=_init_worker,
             initargs=(os.getpid(),),
         )
 
-    def submit(self, fn: Callable, *args: Any) -> cf.Future:
+    def submit(self, fn: Callable, *args: Any) -> PoolHandle:
         return self._pool.submit(fn, *args)
+
+    def wait_first(
+        self, handles: Iterable[PoolHandle], timeout: float | None = None
+    ) -> tuple[set, set]:
+        return self._pool.wait(handles, _finite(timeout))
 
     def prestart(self, factory: Any, reference: Any) -> None:
         """Start every worker now and build its calculator, without waiting.
 
-        The driver calls this before its own serial work (the probe column, the overlap
-        check): the workers' start (spawn, imports, LAMMPS setup: seconds) then overlaps it
-        instead of delaying the first grid points. One task per worker; a worker that gets
-        two builds once (the calculator is cached per worker).
+        The driver calls this before its own serial work (the reference Hessian, the probe):
+        the workers' start (spawn, imports, the model's set-up) then overlaps it instead of
+        delaying the first points. One task per worker.
         """
-        for _ in range(self.workers):
-            self._pool.submit(warm_worker, factory, reference)
+        self._pool.submit_to_each(warm_worker, factory, reference)
 
     def close(self, cancel: bool = False) -> None:
-        self._pool.shutdown(wait=not cancel, cancel_futures=cancel)
+        self._pool.shutdown(cancel=cancel)
 
 
 def one_blas_thread_in_workers() -> None:
