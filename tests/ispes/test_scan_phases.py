@@ -65,3 +65,54 @@ def test_phase_outside_a_scan_does_nothing_and_nested_recordings_are_apart():
         with phase("a"):
             pass
     assert list(outer.seconds) == ["a"] and list(inner.seconds) == ["b"]
+
+
+def test_with_workers_the_probes_single_points_run_while_the_driver_computes_the_hessian(
+    tmp_path, toy_reference, toy_factory, monkeypatch
+):
+    """The rigid single points need no Hessian: with worker processes they are submitted
+    before the driver computes it, and their values (``probe.json``'s rigid units) are the
+    serial scan's bit for bit, so are the thicknesses and the grid."""
+    import json
+
+    from benchmarks.schedule_replay import task_key
+
+    from flatcontact.ispes import shared_hessian
+    from flatcontact.ispes.executors import ProcessExecutor
+
+    events: list[str] = []
+    computing = shared_hessian.HessianSharing.context
+
+    def logged(self, executor):
+        events.append("hessian")
+        return computing(self, executor)
+
+    monkeypatch.setattr(shared_hessian.HessianSharing, "context", logged)
+
+    class Logging(ProcessExecutor):
+        def submit(self, fn, *args):
+            events.append(task_key(fn, args)[0])
+            return super().submit(fn, *args)
+
+    grid = GridSpec(3, 3, p_range_gpa=(-0.05, 0.5, 4))
+    settings = RelaxSettings(fmax_ev_per_angstrom=1e-4)
+    pool = Logging(2)
+    try:
+        two = run_scan(toy_reference, toy_factory, grid, tmp_path / "two", settings, executor=pool)
+    finally:
+        pool.close()
+    first_hessian = events.index("hessian")
+    assert "rigid_rows_task" in events[:first_hessian]
+    assert "rigid_rows_task" not in events[first_hessian:]
+    serial = run_scan(
+        toy_reference, toy_factory, grid, tmp_path / "one", settings, executor=SerialExecutor()
+    )
+
+    def rigid_units(folder):
+        units = json.loads((folder / "probe.json").read_text())["units"]
+        return {key: value for key, value in units.items() if key.startswith('["rigid"')}
+
+    assert len(rigid_units(tmp_path / "two")) == grid.n_a  # one unit per lateral row
+    assert rigid_units(tmp_path / "two") == rigid_units(tmp_path / "one")
+    np.testing.assert_array_equal(two.dataset.thickness.values, serial.dataset.thickness.values)
+    np.testing.assert_array_equal(two.dataset.energy.values, serial.dataset.energy.values)

@@ -51,7 +51,7 @@ from flatcontact.ispes.probe_units import ProbeUnits, probe_settings
 from flatcontact.ispes.reduction import SymmetrySettings
 from flatcontact.ispes.relax import RelaxSettings
 from flatcontact.ispes.scan_extend import check_overlaps, extend_grid
-from flatcontact.ispes.scan_probe import resolve, store_pending_work
+from flatcontact.ispes.scan_probe import early_rigid_rows, resolve, store_pending_work
 from flatcontact.ispes.scan_scheduler import Scheduler, commit_interval_s
 from flatcontact.ispes.scan_symmetry import ScanRound, SymmetryPlan
 from flatcontact.ispes.shared_hessian import HessianSharing
@@ -282,15 +282,18 @@ def _drive(
     """Resolve, then the rounds of the grid, then the work of separation left running."""
     reference, factory, grid, relax = job.reference, job.factory, job.grid, job.relax
     context = sharing.plain_context()
-    if _points_missing(store, grid):
-        executor.prestart(factory, reference)  # worker start overlaps the probe
-        with phase("reference Hessian"):  # computed once, here; overlaps the workers' start
-            context = sharing.context(executor)
     # the probe's finished units, beside the store (a resumed probe reuses them)
     units = ProbeUnits(out_dir / PROBE_JSON, probe_settings(store.settings))
+    rigid = None
+    if _points_missing(store, grid):
+        executor.prestart(factory, reference)  # worker start overlaps the probe
+        # the probe's single points need no Hessian: on the workers while it is computed
+        rigid = early_rigid_rows(store, executor, units, context, grid)
+        with phase("reference Hessian"):  # computed once, here; overlaps the workers' start
+            context = sharing.context(executor)
     with phase("probe"), failing_at("probe"):
         resolved, notes, pending = resolve(
-            store, reference, factory, grid, relax, executor, units, context.hessian
+            store, reference, factory, grid, relax, executor, units, context.hessian, rigid
         )
     scheduler = Scheduler(store, executor, context, grid.shifts(), progress, max_new_points)
     scanned = _rounds(store, scheduler, job, resolved, notes, sharing)

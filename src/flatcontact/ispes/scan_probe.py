@@ -142,6 +142,22 @@ def _submit_stretchings(executor, units, context, specs) -> list:
     ]
 
 
+def early_rigid_rows(
+    store: PointStore,
+    executor: Executor,
+    units: ProbeUnits,
+    context: ScanContext,
+    grid: GridSpec,
+) -> RigidRows | None:
+    """The probe's rigid single points submitted now, if the probe will run and has workers
+    (:class:`RigidRows`): the store is not resolved yet, the grid is given by a pressure
+    range and the executor is not the driver itself. Two blocks per worker: the workers
+    start one after the other and the first takes more. None otherwise."""
+    if executor.inline or store.resolved is not None or grid.thickness_angstrom is not None:
+        return None
+    return RigidRows(executor, units, context, grid, blocks=2 * executor.workers)
+
+
 def resolve(
     store: PointStore,
     reference: Atoms,
@@ -151,6 +167,7 @@ def resolve(
     executor: Executor,
     units: ProbeUnits,
     hessian: Any = None,
+    rigid: RigidRows | None = None,
 ) -> tuple[dict, list[str], PendingWork | None]:
     """The store's ``resolved`` entry, computed and stored if the store has none yet.
 
@@ -161,7 +178,8 @@ def resolve(
     driver stores it after the grid, :func:`store_pending_work`), else None. A store
     resolved before the ideal work of separation existed gets it here (in the returned
     entry, not in the store). ``hessian``: the driver's root of the reference's Hessian
-    (:class:`~flatcontact.ispes.precondition.SharedRoot`) for the probe's tasks.
+    (:class:`~flatcontact.ispes.precondition.SharedRoot`) for the probe's tasks; ``rigid``
+    the probe's single points already on the workers (:func:`early_rigid_rows`).
     """
     notes: list[str] = []
     pending = None
@@ -172,7 +190,9 @@ def resolve(
         if grid.thickness_angstrom is not None:
             resolved["thickness_angstrom"] = list(grid.thickness_angstrom)
         else:
-            extra, notes, work = probe(reference, factory, grid, relax, executor, units, hessian)
+            extra, notes, work = probe(
+                reference, factory, grid, relax, executor, units, hessian, rigid
+            )
             resolved.update(extra)
         if isinstance(work, PendingWork):  # stored once the grid is done
             pending = work
@@ -211,6 +231,7 @@ def probe(
     executor: Executor | None = None,
     units: ProbeUnits | None = None,
     hessian: Any = None,
+    rigid: RigidRows | None = None,
 ) -> tuple[dict, list[str], Any]:
     """Resolve the thicknesses of a pressure-range grid
     (:func:`flatcontact.ispes.thicknesses.probe_thicknesses`) and, with more than one
@@ -230,14 +251,19 @@ def probe(
     unit (a row of single points, a chain, a segment, the work of separation) as the driver
     gets it, and gives back those a resumed probe finished before: the same values, so the
     same thicknesses. ``hessian`` (the driver's reference Hessian) goes with the tasks.
+    ``rigid``: the single points already submitted to the workers (:class:`RigidRows`), else
+    they run here (one or two or three workers) or on the workers (many).
     """
     workers = 1 if executor is None else executor.workers
     if workers >= MANY_WORKERS:
-        return probe_many(reference, factory, grid, relax, executor, units, hessian)
+        return probe_many(reference, factory, grid, relax, executor, units, hessian, rigid)
     calc = worker_calculator(factory, reference)
     relax_one = functools.partial(relax_column_point, reference, calc, relax)
     with phase("probe/rigid points"):
-        rigid = _rigid_serial(reference, calc, grid, units)
+        if rigid is not None:  # on the workers, since they were asked to start
+            rigid = rigid.stackings()
+        else:
+            rigid = _rigid_serial(reference, calc, grid, units)
     lowest = extreme_stackings(rigid.energy_ev, grid)[0]
     if workers <= 1:
         columns = functools.partial(_probe_columns_here, relax_one, reference, units)
@@ -331,11 +357,13 @@ def probe_many(
     executor: Executor,
     units: ProbeUnits | None = None,
     hessian: Any = None,
+    rigid: RigidRows | None = None,
 ) -> tuple[dict, list[str], PendingWork]:
     """:func:`probe` with many workers: nothing relaxes in the driver.
 
     1. The rigid single points, a block of rows of the lateral grid per worker
-       (:func:`~flatcontact.ispes.scan_tasks.rigid_rows_task`).
+       (:func:`~flatcontact.ispes.scan_tasks.rigid_rows_task`; ``rigid``: submitted
+       before, :class:`RigidRows`).
     2. At once: each probed column's stretching (one chain), the compressions as segments
        of :data:`~flatcontact.ispes.probe.COMPRESS_SEGMENT_STEPS` steps
        (:func:`~flatcontact.ispes.scan_tasks.probe_segment_task`), as many as there are free
@@ -352,7 +380,9 @@ def probe_many(
     finished segment is added to its column at once without taking a worker.
     """
     context = ScanContext(reference, factory, relax, hessian)
-    rigid = _rigid_on_workers(executor, units, context, grid)
+    with phase("probe/rigid points"):
+        early = rigid or RigidRows(executor, units, context, grid)
+        rigid = early.stackings()
     work: list = []
     columns = functools.partial(
         _SegmentedColumns.probe, executor, units, context, rigid, grid, work
@@ -361,33 +391,58 @@ def probe_many(
     return extra, notes, work[0]
 
 
-def _rigid_on_workers(
-    executor: Executor, units: ProbeUnits | None, context: ScanContext, grid: GridSpec
-) -> RigidStackings:
-    """The rigid single points of the lateral grid, a block of the rows still missing from
-    ``probe.json`` per worker."""
-    sa, sb = grid.shifts()
-    rows: dict[int, tuple] = {}
-    if units is not None:
-        for row in range(grid.n_a):
-            known = units.get("rigid", *_rigid_inputs(sa, sb, row))
-            if known is not None:
-                rows[row] = known
-    missing = np.array([row for row in range(grid.n_a) if row not in rows], dtype=int)
-    workers = executor.workers
-    blocks = [b for b in np.array_split(missing, min(workers, max(missing.size, 1))) if b.size]
-    handles = [executor.submit(rigid_rows_task, context, grid, b.tolist()) for b in blocks]
-    for block, handle in zip(blocks, handles, strict=True):
-        energy, load = executor.result(handle)
-        for k, row in enumerate(block.tolist()):
-            part = (energy[k : k + 1], load[k : k + 1])
-            rows[row] = (
-                part if units is None else units.put("rigid", _rigid_inputs(sa, sb, row), part)
-            )
-    parts = [rows[row] for row in range(grid.n_a)]
-    return RigidStackings(
-        np.concatenate([e for e, _ in parts]), np.concatenate([p for _, p in parts])
-    )
+class RigidRows:
+    """The rigid single points of the lateral grid on the workers, submitted as soon as the
+    workers are asked to start (:func:`flatcontact.ispes.scan._drive`, before the driver
+    computes the reference Hessian, which they do not need), collected by the probe.
+
+    The rows still missing from ``probe.json`` (``units``) go out in ``blocks`` tasks of
+    whole rows (:func:`~flatcontact.ispes.scan_tasks.rigid_rows_task`); each row is a
+    ``probe.json`` unit once collected. A single point is a function of its stacking alone
+    (:func:`flatcontact.ispes.probe.rigid_rows` starts the calculator afresh), so the values
+    are those of the driver's own evaluation (:func:`_rigid_serial`), wherever they ran.
+    """
+
+    def __init__(
+        self,
+        executor: Executor,
+        units: ProbeUnits | None,
+        context: ScanContext,
+        grid: GridSpec,
+        blocks: int | None = None,
+    ):
+        self.executor, self.units, self.grid = executor, units, grid
+        sa, sb = grid.shifts()
+        self.inputs = [_rigid_inputs(sa, sb, row) for row in range(grid.n_a)]
+        self.rows: dict[int, tuple] = {}
+        if units is not None:
+            for row, inputs in enumerate(self.inputs):
+                known = units.get("rigid", *inputs)
+                if known is not None:
+                    self.rows[row] = known
+        missing = np.array([r for r in range(grid.n_a) if r not in self.rows], dtype=int)
+        blocks = executor.workers if blocks is None else blocks
+        self.blocks = [
+            b for b in np.array_split(missing, min(blocks, max(missing.size, 1))) if b.size
+        ]
+        self.handles = [
+            executor.submit(rigid_rows_task, context, grid, b.tolist()) for b in self.blocks
+        ]
+
+    def stackings(self) -> RigidStackings:
+        """Every row's energies and loads (waiting for the blocks still running)."""
+        for block, handle in zip(self.blocks, self.handles, strict=True):
+            energy, load = self.executor.result(handle)
+            for k, row in enumerate(block.tolist()):
+                part = (energy[k : k + 1], load[k : k + 1])
+                if self.units is not None:
+                    part = self.units.put("rigid", self.inputs[row], part)
+                self.rows[row] = part
+        self.blocks, self.handles = [], []
+        parts = [self.rows[row] for row in range(self.grid.n_a)]
+        return RigidStackings(
+            np.concatenate([e for e, _ in parts]), np.concatenate([p for _, p in parts])
+        )
 
 
 class _SegmentedColumns:
