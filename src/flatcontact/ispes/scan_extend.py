@@ -19,7 +19,6 @@ from flatcontact.ispes.executors import Executor
 from flatcontact.ispes.grid import GridSpec, check_thicknesses
 from flatcontact.ispes.grid_bracket import MAX_EXTENSIONS, bracket_targets_gpa, check_grid
 from flatcontact.ispes.relax import RelaxSettings, ScanContext
-from flatcontact.ispes.scan_probe import MANY_WORKERS
 from flatcontact.ispes.scan_tasks import overlap_check_task
 from flatcontact.ispes.store import PointStore
 
@@ -29,12 +28,14 @@ def check_overlaps(
 ) -> None:
     """The overlap check of every lateral shift at the thicknesses ``z`` before they are
     scanned (:func:`flatcontact.ispes.grid.check_thicknesses`: one InputError naming the
-    first overlap). With :data:`MANY_WORKERS` or more workers the ``(z, row)`` pairs are
-    split into a block per worker (:func:`~flatcontact.ispes.scan_tasks.overlap_check_task`; at the paper preset's
-    3,168 points the check is seconds of the driver's time); else in the driver."""
+    first overlap). With worker processes the ``(z, row)`` pairs are split into a block per
+    worker (:func:`~flatcontact.ispes.scan_tasks.overlap_check_task`): the workers are idle
+    between the probe and the grid, and at the paper preset's 3,168 points the check is
+    seconds of the driver's time (0.14 s of the 12×12 quartz grid's 1,296); serially in the
+    driver."""
     spread = context.settings.mode != "rigid"
     workers = executor.workers
-    if workers < MANY_WORKERS:
+    if executor.inline or workers < 2:
         check_thicknesses(context.reference, grid, z, spread_compression=spread)
         return
     items = [(v, row) for v in z for row in range(grid.n_a)]
