@@ -160,6 +160,7 @@ def _scan_factory(calculator: Any, workers: int, label: str | None):
     if isinstance(calculator, str):
         return calculator_factory(InteractionModel(intra=calculator))
     if isinstance(calculator, InteractionModel):
+        calculator.check_couples_slabs("calculator.coupling")  # per slab, nothing across: flat
         return calculator_factory(calculator)
     if hasattr(calculator, "get_forces"):
         if workers != 1:
