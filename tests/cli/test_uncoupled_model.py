@@ -135,3 +135,23 @@ def test_the_notebook_door_refuses_such_a_model(interface, tmp_path):
         )
     assert str(info.value).startswith("calculator.coupling: 'none' with the per-slab model ")
     assert not (tmp_path / "nb").exists()
+
+
+def test_build_with_an_intra_flag_names_the_files_coupling(tmp_path, capsys, monkeypatch):
+    """``--potential vashishta`` replaces the intra model and keeps the file's coupling: the
+    refusal names the file's potential.coupling, not the flag; a preset's own coupling
+    (cu-eam: the same EAM across) replaces it and the build goes on."""
+    monkeypatch.chdir(tmp_path)
+    config = tmp_path / "flat.yaml"
+    config.write_text(CU + f"potential: {PER_SLAB_EMT}\n".replace("'", '"'))
+    out = tmp_path / "out"
+    argv = ["build", "--config", str(config), "--potential", "vashishta", "--out", str(out)]
+    line = one_error_line(*run_cli(argv, capsys)[::2])
+    assert line.startswith(
+        f"error: {config}: potential.coupling: 'none' with the per-slab model vashishta: "
+    )
+    assert not out.exists()
+    argv[4] = "cu-eam"
+    code, _, err = run_cli([*argv, "--no-svg"], capsys)
+    assert code in (0, None), err
+    assert (out / "interface.extxyz").is_file()
