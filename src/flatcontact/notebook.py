@@ -160,6 +160,7 @@ def _scan_factory(calculator: Any, workers: int, label: str | None):
     if isinstance(calculator, str):
         return calculator_factory(InteractionModel(intra=calculator))
     if isinstance(calculator, InteractionModel):
+        calculator.check_couples_slabs("calculator.coupling")  # per slab, nothing across: flat
         return calculator_factory(calculator)
     if hasattr(calculator, "get_forces"):
         if workers != 1:
@@ -264,7 +265,9 @@ def scan_interface(
     ------
     InputError
         One line naming the parameter: a bad grid, both or neither of the thickness
-        choices, an interface that breaks the contract, a calculator that is none.
+        choices, an interface that breaks the contract, a calculator that is none, an
+        InteractionModel under which the slabs do not interact (per slab, ``coupling:
+        none``: ``calculator.coupling``, a flat ISPES).
     flatcontact.potentials.guarded.CalculatorFailure
         An ``InputError``, one line: the calculator raised or returned a non-finite energy or
         forces, before the scan (its one evaluation of ``interface``: ``calculator 'EMT'

@@ -75,7 +75,7 @@ def test_config_check_refuses_emt_on_quartz(emt_config, tmp_path, capsys):
 @pytest.mark.parametrize(
     ("section", "field", "named"),
     [
-        (f'{{calculator: {{target: "{EMT}", scope: slab}}, coupling: none}}', None, EMT),
+        (f'{{calculator: {{target: "{EMT}", scope: slab}}, coupling: lj}}', None, EMT),
         (f'{{intra: "ase:{EMT}"}}', "potential.intra", f"ase:{EMT}"),
     ],
     ids=["per-slab", "intra"],

@@ -57,9 +57,15 @@ def _displace(store_path, reference, index, shift_angstrom=0.05):
     store the displaced atoms' real energy and load: a point above its minimum. Returns
     (energy before, energy after) in eV."""
     import ase.db
-    from ase.calculators.singlepoint import SinglePointCalculator
 
     db = ase.db.connect(str(store_path), type="db", use_lock_file=False)
+    with db:  # one connection, closed: no -wal, -shm left beside the store
+        return _displace_in(db, reference, index, shift_angstrom)
+
+
+def _displace_in(db, reference, index, shift_angstrom):
+    from ase.calculators.singlepoint import SinglePointCalculator
+
     row = db.get(i_a=index[0], i_b=index[1], i_z=index[2])
     atoms = row.toatoms()
     for key in ("slab", "surface"):
@@ -115,6 +121,8 @@ def test_a_fold_from_a_point_stopped_above_its_minimum_is_re_relaxed_away(
         toy_reference, toy_factory, ds, work / POINTS_DB, settings, RELAX, LOADS_GPA
     )
     assert done.fmax_ev_per_angstrom == pytest.approx(RELAX.fmax_ev_per_angstrom * FMAX_FACTOR)
+    # both stores closed, each one file (a run directory is copied and kept): no -wal, -shm
+    assert sorted(p.name for p in work.glob("*.db*")) == [POINTS_DB, RERELAX_DB]
     assert done.surviving == [] and [w.column for w in done.remedied] == [(0, 0)]
     assert fold_windows(fixed, LOADS_GPA) == []
     # the load falls with z again along the whole compressed side of the column

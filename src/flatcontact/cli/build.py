@@ -295,6 +295,8 @@ def _check_build_inputs(cfg, source: str, potential_given: bool, structure_given
     except InputError as exc:
         text = str(exc).removeprefix(f"{source}: ")
         field, _, said = text.partition(": ")
+        if field == "potential.coupling":  # --potential names an intra model, never the coupling
+            raise
         for given, section, flag in (
             (potential_given, "potential", "--potential"),
             (structure_given, "structure", "--structure"),

@@ -33,6 +33,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from flatcontact.ispes.store_schema import stored_rows
+
 #: A gap whose slip exceeds this at some point is reported (Å).
 SLIP_THRESHOLD_ANGSTROM = 0.25
 #: At most this many slipped points are listed in ``scan.json`` (the count is always given).
@@ -162,8 +164,5 @@ def slip_table(reference, points, threshold_angstrom: float = SLIP_THRESHOLD_ANG
 def store_points(path):
     """``(index, shift, thickness, positions)`` of every point of a closed point store
     (``points.db``, :mod:`flatcontact.ispes.store`), read only."""
-    import ase.db
-
-    db = ase.db.connect(str(path), type="db", use_lock_file=False)
-    for row in db.select():
+    for row in stored_rows(path):
         yield (row.i_a, row.i_b, row.i_z), (row.shift_a, row.shift_b), row.thickness, row.positions

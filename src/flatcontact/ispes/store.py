@@ -238,6 +238,11 @@ class PointStore:
             self._db = ase.db.connect(
                 str(self.path), type="db", append=True, use_lock_file=False, create_indices=False
             )
+            # one connection for the store's lifetime, closed by close(): a query of ase.db
+            # outside its `with` leaves its connection to the garbage collector (a sqlite3
+            # connection is a reference cycle), and an open one keeps -wal and -shm beside
+            # the store; also one commit per point (ASE commits, an fsync each, in every write)
+            self._db.__enter__()
             n_rows = self._db.count()  # creates the tables of a new store
             if new:
                 store_schema.replace_key_tables(self.path)
@@ -293,9 +298,6 @@ class PointStore:
                 "to recompute the scan"
             ) from None
         self._done: dict[Index, dict] = {index: self._record(row) for index, row in kept.items()}
-        # one connection for the store's lifetime, one commit per point: ASE otherwise opens
-        # a connection and commits (an fsync each) several times inside every write
-        self._db.__enter__()
         # ase.db looks the database's external tables up (a query) for every row written as
         # a row; the store creates none, so the list read once at opening stays exact
         external = list(self._db._get_external_table_names())
@@ -352,9 +354,13 @@ class PointStore:
     def close(self) -> None:
         """Commit, close the database connection and release the driver lock (its file
         removed: :class:`_DriverLock`)."""
-        db = getattr(self, "_db", None)
-        if db is not None and db.connection is not None:
-            db.__exit__(None, None, None)
+        con = getattr(getattr(self, "_db", None), "connection", None)
+        if con is not None:
+            self._db.connection = None
+            try:
+                con.commit()
+            finally:  # the last connection closed: SQLite removes -wal and -shm
+                con.close()
         if self._driver_lock is not None:
             self._driver_lock.release()
             self._driver_lock = None

@@ -21,12 +21,20 @@ made its tables):
   functions the tables stay as ASE made them (a bigger file, the same behaviour).
 
 A store made before keeps its layout; both are ASE databases, row for row.
+
+A store is read (:func:`stored_rows`) on one connection, closed when the rows are read: a
+query of ``ase.db`` outside its ``with`` leaves its connection to the garbage collector (a
+``sqlite3`` connection is a reference cycle), and while one is open SQLite keeps
+``points.db-wal`` and ``-shm`` beside the store; closing the last one folds the log into
+the file and removes both.
 """
 
 from __future__ import annotations
 
 import sqlite3
+from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 #: SQLite page size of a new store (bytes).
 PAGE_SIZE = 8192
@@ -91,3 +99,14 @@ def replace_key_tables(path: Path) -> bool:
     finally:
         con.close()
     return True
+
+
+def stored_rows(path: str | Path) -> Iterator[Any]:
+    """Every row of the point store at ``path`` (``ase.db`` rows, in id order), read on one
+    connection that is closed when the rows are read or the iteration is given up (module
+    docstring): no ``-wal``, ``-shm`` left by the reader."""
+    import ase.db
+
+    db = ase.db.connect(str(path), type="db", use_lock_file=False)
+    with db:
+        yield from db.select()

@@ -350,7 +350,36 @@ class InteractionModel(BaseModel):
             text = text.replace(str(path), path.name)
         return {"model": json.loads(text), "files_sha256": {p.name: file_sha256(p) for p in files}}
 
+    @property
+    def couples_slabs(self) -> bool:
+        """Whether anything acts across the interface: a coupling (``lj``, ``same``,
+        ``interlayer``) or an ASE calculator over the whole interface (its ``coupling: none``
+        only says the calculator itself sees both slabs). A per-slab model (LAMMPS styles per
+        slab or layer, an ASE calculator per slab) with ``coupling: none`` computes each slab
+        alone: the energy of two slabs is then the same at every stacking and no load acts
+        between them (a flat ISPES, τ = 0)."""
+        return self.coupling != "none" or self.engine == "ase-interface"
+
     # ---------------------------------------------------------------- checks
+    def check_couples_slabs(self, field: str = "potential.coupling") -> None:
+        """Refuse, in one line naming ``field``, a model with nothing across the interface
+        (:attr:`couples_slabs`): scanning two slabs with it can only give a flat ISPES.
+
+        Raises
+        ------
+        InputError
+            ``<field>: 'none' with the per-slab model <name>: ...; expected lj, same or
+            interlayer, or an ASE calculator over the whole interface``.
+        """
+        if self.couples_slabs:
+            return
+        raise InputError(
+            f"{field}: 'none' with the per-slab model {self.name}: nothing acts across the "
+            "interface, so every stacking of the two slabs has the same energy and no normal "
+            "load (a flat ISPES, τ = 0); expected lj, same or interlayer, or an ASE calculator "
+            "over the whole interface (calculator.scope: interface)"
+        )
+
     def check_atoms(self, atoms) -> None:
         """Refuse, in one line naming element and model, a structure the model cannot compute."""
         symbols = set(atoms.get_chemical_symbols())

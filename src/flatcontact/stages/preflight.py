@@ -98,8 +98,10 @@ def check_build_inputs(cfg: RunConfig, source: str = "config") -> None:
     InputError
         One line ``<source>: <settings path>: ...``; for a calculator that cannot evaluate
         the interface ``<source>: potential.calculator.target: <target> cannot evaluate the
-        elements Si, O of this interface's alpha-quartz (<exception type>: <first line>)``.
+        elements Si, O of this interface's alpha-quartz (<exception type>: <first line>)``;
+        a per-slab model with nothing across the interface (:func:`check_coupling`).
     """
+    check_coupling(cfg, source)
     if cfg.structure.kind in ("file", "slab") and getattr(cfg.structure, "file", None) is not None:
         _check_structure_file(cfg, source)
     _check_structure(cfg, source)
@@ -115,8 +117,10 @@ def check_scan_settings(cfg: RunConfig, source: str = "config") -> None:
     Raises
     ------
     InputError
-        One line ``<source>: <settings path>: <what was expected>``.
+        One line ``<source>: <settings path>: <what was expected>``; a per-slab model with
+        nothing across the interface (:func:`check_coupling`).
     """
+    check_coupling(cfg, source)
     calc = cfg.potential.calculator
     if calc is not None and cfg.scan.optimizer == "lammps-cg":
         raise InputError(
@@ -136,6 +140,23 @@ def check_scan_settings(cfg: RunConfig, source: str = "config") -> None:
             raise InputError(f"{source}: potential.calculator.target: {exc}") from None
     if cfg.scan.dask_address is not None:
         check_scheduler_address(cfg.scan.dask_address, field=f"{source}: scan.dask_address")
+
+
+def check_coupling(cfg: RunConfig, source: str = "config") -> None:
+    """Refuse a model under which the two slabs do not interact: a per-slab model (LAMMPS
+    styles per slab or layer, an ASE calculator per slab) with ``coupling: none``. Every
+    stacking would have the same energy and no load between the slabs, a flat ISPES with
+    τ = 0 for no physical reason of the interface; an ASE calculator over the whole interface
+    (``coupling: none`` there only says it sees both slabs) passes
+    (:meth:`~flatcontact.potentials.model.InteractionModel.check_couples_slabs`).
+
+    Raises
+    ------
+    InputError
+        One line ``<source>: potential.coupling: 'none' with the per-slab model <name>: ...;
+        expected lj, same or interlayer, or an ASE calculator over the whole interface``.
+    """
+    cfg.potential.check_couples_slabs(f"{source}: potential.coupling")
 
 
 def check_asperity(cfg: RunConfig, source: str = "config") -> None:
@@ -196,8 +217,10 @@ def check_scan_interface(cfg: RunConfig, interface: str | Path, source: str = "c
     InputError
         The interface file's refusal, or one line
         ``<source>: potential.calculator.target: <target> cannot evaluate the elements Si, O
-        of <interface> (<exception type>: <first line>)``.
+        of <interface> (<exception type>: <first line>)``; a per-slab model with nothing
+        across the interface (:func:`check_coupling`).
     """
+    check_coupling(cfg, source)
     atoms = read_interface(interface)
     try:
         _calculator.check_evaluation(cfg, atoms)

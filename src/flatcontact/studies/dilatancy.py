@@ -46,10 +46,11 @@ def _lateral_range(x: np.ndarray) -> np.ndarray:
 
 def gap_and_slabs(folder: Path, shape: tuple[int, int, int]) -> tuple[np.ndarray, np.ndarray]:
     """Gap and summed slab extents (Å) of every stored point, arrays ``[a, b, thickness]``."""
-    from ase.db import connect
+    from flatcontact.foundation.layout import POINTS_DB
+    from flatcontact.ispes.store_schema import stored_rows
 
     gap, slabs = np.full(shape, np.nan), np.full(shape, np.nan)
-    for row in connect(folder / "points.db").select():
+    for row in stored_rows(folder / POINTS_DB):
         z = row.toatoms().positions[:, 2]
         half = len(z) // 2
         lower, upper = z[:half], z[half:]
