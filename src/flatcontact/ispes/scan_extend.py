@@ -22,6 +22,10 @@ from flatcontact.ispes.relax import RelaxSettings, ScanContext
 from flatcontact.ispes.scan_tasks import overlap_check_task
 from flatcontact.ispes.store import PointStore
 
+#: blocks of (thickness, row) pairs per worker in the overlap check (one block each left a
+#: worker idle for half the check: 0.079 against 0.040 s on the 12×12 quartz grid)
+OVERLAP_BLOCKS_PER_WORKER = 4
+
 
 def check_overlaps(
     executor: Executor, context: ScanContext, grid: GridSpec, z: list[float]
@@ -39,7 +43,12 @@ def check_overlaps(
         check_thicknesses(context.reference, grid, z, spread_compression=spread)
         return
     items = [(v, row) for v in z for row in range(grid.n_a)]
-    blocks = [b for b in np.array_split(np.arange(len(items)), workers) if b.size]
+    # blocks in grid order, several per worker: their costs differ with the thickness
+    blocks = [
+        b
+        for b in np.array_split(np.arange(len(items)), OVERLAP_BLOCKS_PER_WORKER * workers)
+        if b.size
+    ]
     handles = [
         executor.submit(overlap_check_task, context, grid, [items[k] for k in b]) for b in blocks
     ]

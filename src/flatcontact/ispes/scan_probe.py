@@ -8,9 +8,11 @@ row of single points, a chain, a segment, the work of separation) is recorded in
 ``probe.json`` (:mod:`flatcontact.ispes.probe_units`) as the driver gets it, so an
 interrupted probe resumes with the same values, hence the same thicknesses.
 
-With one worker everything runs in the driver; with two or three the columns' chains run on
-the workers exactly as in sequence; from :data:`MANY_WORKERS` on the compressions run as
-cold-started segments (:func:`probe_many`).
+With one worker everything runs in the driver. With workers, the rigid single points run
+on them while the driver computes the reference Hessian (:class:`RigidRows`) and the ideal
+work of separation beside the grid (:class:`PendingWork`); with two or three the columns'
+chains run on the workers exactly as in sequence; from :data:`MANY_WORKERS` on the
+compressions run as cold-started segments (:func:`probe_many`).
 """
 
 from __future__ import annotations
@@ -48,17 +50,16 @@ from flatcontact.ispes.store import PointStore
 from flatcontact.ispes.thicknesses import probe_thicknesses
 from flatcontact.ispes.work_of_separation import ideal_work_of_separation
 
-#: From this many workers on, the probe runs as many short chains (:func:`_probe_many`):
-#: the rigid single points on the workers, each column's compression in segments started
-#: cold (:class:`~flatcontact.ispes.probe.CompressionSegments`), the ideal work of
-#: separation beside the grid. Below, the columns are relaxed exactly as in sequence (a
-#: 1-2 worker run keeps its numbers); a segment's cold start moves the probe's loads, and
+#: From this many workers on, the probe runs as many short chains (:func:`probe_many`):
+#: each column's compression in segments started cold
+#: (:class:`~flatcontact.ispes.probe.CompressionSegments`). Below, the columns are relaxed
+#: exactly as in sequence (a 1-3 worker run keeps its numbers); a segment's cold start moves the probe's loads, and
 #: the thicknesses with them, within the force tolerance.
 MANY_WORKERS = 4
 
 
 class PendingWork:
-    """The ideal work of separation still running on a worker (:func:`_probe_many`): the
+    """The ideal work of separation still running on a worker (any scan with workers): the
     scan stores it once the grid is done (``handle``: the executor's, or a :class:`Known`
     unit of ``probe.json``)."""
 
@@ -244,8 +245,9 @@ def probe(
     by :func:`~flatcontact.ispes.probe.join_column`) and the ideal work of separation at the
     lowest rigid stacking (a chain of its own, independent of the thicknesses). Returns
     ``(resolved, notes, work)``: ``work`` the
-    :class:`~flatcontact.ispes.work_of_separation.WorkOfSeparation` (serial: computed here
-    after the probe, from the same single points of every stacking).
+    :class:`~flatcontact.ispes.work_of_separation.WorkOfSeparation` computed here after the
+    probe, from the same single points of every stacking (one worker), or with workers a
+    :class:`PendingWork` still running beside the grid (stored after it).
 
     ``units`` (``probe.json``, :mod:`flatcontact.ispes.probe_units`) records every finished
     unit (a row of single points, a chain, a segment, the work of separation) as the driver
@@ -280,9 +282,7 @@ def probe(
     work: list = []
     columns = functools.partial(_probe_columns_on_workers, executor, units, context, lowest, work)
     extra, notes = probe_thicknesses(relax_one, reference, rigid, grid, columns)
-    with phase("probe/ideal W"):  # the wait for it: it ran beside the probed columns
-        w = unit_result(executor, units, "work", (*lowest,), work[0]) if work else None
-    return extra, notes, w
+    return extra, notes, PendingWork(work[0], units, lowest) if work else None
 
 
 def _probe_columns_here(relax_one, reference: Atoms, units: ProbeUnits | None, specs) -> list:
@@ -313,15 +313,14 @@ def _probe_columns_here(relax_one, reference: Atoms, units: ProbeUnits | None, s
 def _probe_columns_on_workers(
     executor: Executor, units, context: ScanContext, lowest, work: list, specs
 ) -> list:
-    """The probed columns ``specs`` as chains on two or three workers: the stretchings, the
-    work of separation (appended to ``work``), then the compressions (on quartz the
-    compressions are the long chains, 19-21 points of ~30 force calls; past its first point
-    a stretching costs ~1 call per point: benchmarks/schedule_model.py)."""
+    """The probed columns ``specs`` as chains on two or three workers: the stretchings,
+    the compressions (on quartz the compressions are the long chains, 19-21 points of ~30
+    force calls; past its first point a stretching costs ~1 call per point:
+    benchmarks/schedule_model.py), then the work of separation (its handle appended to
+    ``work``: the driver does not wait for it, it runs on the first free worker, beside the
+    last chains or the grid's first points)."""
     reference = context.reference
     up = _submit_stretchings(executor, units, context, specs)
-    work.append(
-        unit_submit(executor, units, "work", (*lowest,), work_of_separation_task, context, lowest)
-    )
     down = [
         unit_submit(
             executor,
@@ -337,6 +336,9 @@ def _probe_columns_on_workers(
         )
         for shift, p_hi, stop in specs
     ]
+    work.append(
+        unit_submit(executor, units, "work", (*lowest,), work_of_separation_task, context, lowest)
+    )
     return [
         join_column(
             reference,
