@@ -82,6 +82,7 @@ from flatcontact.ispes.geometry import (
 )
 from flatcontact.ispes.lbfgs import ASE_ALPHA_EV_PER_A2, largest_atomic_norm, lbfgs_relax
 from flatcontact.ispes.precondition import slips_inside_slab
+from flatcontact.ispes.scan_context import ScanContext
 from flatcontact.potentials.guarded import failing_at
 
 Optimizer = Literal["LBFGS-scaled", "LBFGS", "FIRE", "FIRE2", "BFGS", "BFGSLineSearch", "lammps-cg"]
@@ -551,18 +552,6 @@ def free_layer_groups(atoms: Atoms, free: np.ndarray) -> list[np.ndarray]:
 
         layer = interface_layers(atoms)
     return [np.flatnonzero(free & (layer == k)) for k in np.unique(layer[free])]
-
-
-@dataclasses.dataclass(frozen=True)
-class ScanContext:
-    """Everything a worker needs besides the task; picklable."""
-
-    reference: Atoms
-    factory: Any
-    settings: RelaxSettings
-    #: the root of the reference's Hessian the scan's driver computed
-    #: (:class:`~flatcontact.ispes.precondition.SharedRoot`), or None
-    hessian: Any = None
 
 
 _local = threading.local()

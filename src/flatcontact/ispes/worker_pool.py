@@ -11,11 +11,15 @@ and reads the results when it waits for them (:meth:`WorkerPool.wait`, or a hand
 
 Protocol
 --------
-A worker holds at most one task: the driver sends a worker its next task only after it has
-read that worker's previous result. Neither side can then block on a full pipe while the
-other blocks too, whatever the size of a task or a result. The tasks waiting for a worker
-queue in the driver (first in, first out) and go to the first worker that is free, at the
-moment its result is read.
+A worker holds one task, or two when both are small and short: the driver sends a worker
+that is computing a second task only if both tasks pickle to at most
+:data:`SMALL_TASK_BYTES` (together far below a pipe's buffer, so the driver's write never
+blocks) and the last runs of both tasks' functions took less than :data:`PREFETCH_BELOW_S`
+(a long task never waits behind another while a worker is free). A worker with its next task in its
+pipe goes on without sleeping between tasks; the driver reads a worker's results before it
+gives that worker more, so neither side can block on a full pipe while the other blocks
+too, whatever the size of a task or a result. The tasks no worker can take queue in the
+driver (first in, first out) and go to the first worker that can, when its result is read.
 
 Failures
 --------
@@ -51,6 +55,13 @@ __all__ = ["BrokenProcessPool", "PoolHandle", "RemoteTraceback", "WorkerPool"]
 
 #: seconds a worker gets to exit after the pool is shut down before it is killed
 STOP_GRACE_S = 5.0
+#: a task pickled to at most this many bytes may wait in a busy worker's pipe (two of them
+#: stay far below the pipe's buffer, 64 KiB and more: the driver's write never blocks)
+SMALL_TASK_BYTES = 16 * 1024
+#: a task may wait behind another in a worker's pipe if the last run of both tasks'
+#: functions took less than this (s): a scan's point (~10 ms) does, a study's or an
+#: asperity's job (minutes) never, nor anything not run yet
+PREFETCH_BELOW_S = 0.05
 
 
 class RemoteTraceback(Exception):
@@ -100,6 +111,8 @@ class PoolHandle(cf.Future):
     def __init__(self, pool: WorkerPool, fn: Callable, args: tuple):
         super().__init__()
         self._pool, self.fn, self.args = pool, fn, args
+        #: the pickled task until it is sent, and its size in bytes
+        self.data, self.size = b"", 0
 
     def done(self) -> bool:
         if not super().done():
@@ -120,11 +133,14 @@ class PoolHandle(cf.Future):
 
 
 class _Worker:
-    """One worker process, its end of the pipe and the handle of the task it runs."""
+    """One worker process, its end of the pipe and the handles of the tasks sent to it
+    (in the order it runs them)."""
 
     def __init__(self, process: Any, conn: Connection):
         self.process, self.conn = process, conn
-        self.handle: PoolHandle | None = None
+        self.handles: collections.deque[PoolHandle] = collections.deque()
+        #: when its current task started (or, prefetched, its previous one ended)
+        self.since = 0.0
 
 
 class WorkerPool:
@@ -154,6 +170,8 @@ class WorkerPool:
         self._queued: collections.deque[PoolHandle] = collections.deque()
         self._broken: str | None = None
         self._closed = False
+        #: wall seconds of the last run of each task function (by name)
+        self._seconds: dict[str, float] = {}
 
     # -- starting and feeding -----------------------------------------------------------
     def _start(self) -> None:
@@ -170,7 +188,7 @@ class WorkerPool:
             self._workers.append(_Worker(process, ours))
 
     def submit(self, fn: Callable, *args: Any) -> PoolHandle:
-        """Queue ``fn(*args)``; it starts at once if a worker is free."""
+        """Queue ``fn(*args)`` (pickled now); it starts at once if a worker is free."""
         if self._broken is not None:
             raise BrokenProcessPool(self._broken)
         if self._closed:
@@ -178,11 +196,19 @@ class WorkerPool:
         if not self._workers:
             self._start()
         handle = PoolHandle(self, fn, args)
-        idle = next((w for w in self._workers if w.handle is None), None)
-        if idle is None:
-            self._queued.append(handle)
+        try:
+            handle.data = pickle.dumps((fn, args), protocol=pickle.HIGHEST_PROTOCOL)
+            handle.size = len(handle.data)
+        except Exception as exc:  # fails this task only
+            handle.set_running_or_notify_cancel()
+            handle.set_exception(exc)
+            return handle
+        idle = [w for w in self._workers if not w.handles]
+        ready = idle or [w for w in self._workers if self._can_take(w, handle)]
+        if ready and not self._queued:
+            self._send(ready[0], handle)
         else:
-            self._send(idle, handle)
+            self._queued.append(handle)
         return handle
 
     def submit_to_each(self, fn: Callable, *args: Any) -> list[PoolHandle]:
@@ -190,51 +216,66 @@ class WorkerPool:
         return [self.submit(fn, *args) for _ in range(self.size)]
 
     def _send(self, worker: _Worker, handle: PoolHandle) -> None:
-        """Give ``handle``'s task to the free ``worker`` (a task that cannot be pickled
-        fails its handle and leaves the worker free)."""
+        """Give ``handle``'s pickled task to ``worker``."""
         if not handle.set_running_or_notify_cancel():
             return
+        if not worker.handles:
+            worker.since = time.monotonic()
+        worker.handles.append(handle)
         try:
-            data = pickle.dumps((handle.fn, handle.args), protocol=pickle.HIGHEST_PROTOCOL)
-        except Exception as exc:
-            handle.set_exception(exc)
-            return
-        worker.handle = handle
-        try:
-            worker.conn.send_bytes(data)
+            worker.conn.send_bytes(handle.data)
         except OSError:
             self._break(worker)
+        handle.data, handle.args = b"", ()  # the worker has them
+
+    def _can_take(self, worker: _Worker, handle: PoolHandle) -> bool:
+        """Whether ``worker`` may be sent ``handle`` now: it is free, or it runs one task
+        and both are small and short (:data:`SMALL_TASK_BYTES`, :data:`PREFETCH_BELOW_S`)."""
+        if not worker.handles:
+            return True
+        if len(worker.handles) > 1:
+            return False
+        running = worker.handles[0]
+        return all(
+            h.size <= SMALL_TASK_BYTES
+            and self._seconds.get(_task_name(h.fn), PREFETCH_BELOW_S) < PREFETCH_BELOW_S
+            for h in (running, handle)
+        )
 
     def _feed(self, worker: _Worker) -> None:
-        """Give the free ``worker`` the oldest queued task that is still wanted."""
-        while worker.handle is None and self._queued:
+        """Give ``worker`` the oldest queued tasks it can take."""
+        while self._queued and self._can_take(worker, self._queued[0]) and not self._broken:
             self._send(worker, self._queued.popleft())
 
     # -- reading ------------------------------------------------------------------------
     def poll(self, timeout: float | None) -> None:
         """Read every result that arrives within ``timeout`` s (None: until one does),
-        giving each worker that finished its next queued task."""
-        busy = {w.conn: w for w in self._workers if w.handle is not None}
+        giving each worker that finished the next queued tasks it can take."""
+        busy = {w.conn: w for w in self._workers if w.handles}
         if not busy:
             return
         sentinels = {w.process.sentinel: w for w in busy.values()}
         for ready in wait([*busy, *sentinels], timeout):
             worker = busy.get(ready) or sentinels[ready]
-            if worker.handle is not None:
-                self._read(worker)
+            while worker.handles and self._read(worker) and worker.conn.poll(0):
+                pass
 
-    def _read(self, worker: _Worker) -> None:
+    def _read(self, worker: _Worker) -> bool:
+        """Read ``worker``'s next result into its handle; False if the worker died."""
         try:
             ok, value, text = worker.conn.recv()
         except (EOFError, OSError):
             self._break(worker)
-            return
+            return False
         except Exception as exc:  # a reply the driver cannot unpickle
             ok, text = False, None
             value = RuntimeError(
-                f"the result of {_task_name(worker.handle.fn)} could not be read: {exc}"
+                f"the result of {_task_name(worker.handles[0].fn)} could not be read: {exc}"
             )
-        handle, worker.handle = worker.handle, None
+        now = time.monotonic()
+        handle = worker.handles.popleft()
+        self._seconds[_task_name(handle.fn)] = now - worker.since
+        worker.since = now
         if ok:
             handle.set_result(value)
         else:
@@ -242,6 +283,7 @@ class WorkerPool:
                 value.__cause__ = RemoteTraceback(text)
             handle.set_exception(value)
         self._feed(worker)
+        return True
 
     def wait(self, handles: Iterable[PoolHandle], timeout: float | None = None) -> tuple[set, set]:
         """``(done, not_done)`` of ``handles`` once at least one is done or ``timeout`` s
@@ -255,7 +297,7 @@ class WorkerPool:
             left = None if deadline is None else deadline - time.monotonic()
             if left is not None and left <= 0:
                 return set(), handles
-            if not any(w.handle is not None for w in self._workers):
+            if not any(w.handles for w in self._workers):
                 self._strand(handles)  # nothing can finish them: cancelled or broken
                 continue
             self.poll(left)
@@ -272,16 +314,15 @@ class WorkerPool:
         worker.process.join(1.0)
         code = worker.process.exitcode
         how = f"exit code {code}" if code is None or code >= 0 else signal.Signals(-code).name
-        task = _task_name(worker.handle.fn) if worker.handle is not None else "no task"
+        task = _task_name(worker.handles[0].fn) if worker.handles else "no task"
         self._broken = (
             f"worker process {worker.process.pid} ended ({how}) while running {task}; "
             "the pool's unfinished tasks are lost"
         )
         error = BrokenProcessPool(self._broken)
         for w in self._workers:
-            if w.handle is not None:
-                w.handle.set_exception(error)
-                w.handle = None
+            while w.handles:
+                w.handles.popleft().set_exception(error)
         while self._queued:
             handle = self._queued.popleft()
             if handle.set_running_or_notify_cancel():
@@ -297,10 +338,10 @@ class WorkerPool:
             while self._queued:
                 self._queued.popleft().cancel()
         else:
-            while self._broken is None and any(w.handle is not None for w in self._workers):
+            while self._broken is None and any(w.handles for w in self._workers):
                 self.poll(None)
         self._closed = True
-        running = [w.handle for w in self._workers if w.handle is not None]
+        running = [h for w in self._workers for h in w.handles]
         self._stop(terminate=cancel)
         for handle in running:  # terminated in mid-task
             handle.set_exception(BrokenProcessPool("the worker pool was shut down"))
