@@ -42,6 +42,7 @@ import resource
 import signal
 import sqlite3
 import sys
+from concurrent.futures.process import BrokenProcessPool
 from typing import Annotated
 
 import typer
@@ -234,6 +235,16 @@ def _run(argv: list[str] | None) -> int:
         return code
 
 
+def worker_died_line(exc: BaseException) -> str:
+    """The one line for a worker process that died mid-run: what happened, that the finished
+    work is kept (the point store, the probe's units, a study's finished jobs), how to go on;
+    SIGKILL with the out-of-memory killer's usual cure."""
+    line = f"{exc}. The finished work is kept: run the same command again to resume"
+    if "SIGKILL" in str(exc):
+        line += " (SIGKILL is what the system's out-of-memory killer sends: fewer workers need less memory)"
+    return line
+
+
 def _command(argv: list[str] | None) -> int:
     """The command's exit status; every refusal and resource fault one line."""
     try:
@@ -273,6 +284,9 @@ def _command(argv: list[str] | None) -> int:
             print_error(file_size_line(OSError(errno.EFBIG, f"SQLite: {exc}")))
             return 2
         raise
+    except BrokenProcessPool as exc:  # a worker process died (a crash, the OOM killer)
+        print_error(worker_died_line(exc))
+        return 1
     except typer.TyperException as exc:  # typer's (vendored click's) usage errors
         code = getattr(exc, "exit_code", 2)
         if type(exc).__name__ != "NoArgsIsHelpError":  # that one has printed the help already
