@@ -31,8 +31,8 @@ WRITER = textwrap.dedent(
 )
 
 
-def test_points_written_before_a_kill_9_are_all_kept(tmp_path):
-    db = tmp_path / "points.db"
+def write_and_kill(db) -> None:
+    """:data:`WRITER` stores 25 points in ``db`` and is killed with SIGKILL right after."""
     proc = subprocess.Popen(
         [sys.executable, "-c", WRITER, str(db)], stdout=subprocess.PIPE, text=True
     )
@@ -41,6 +41,11 @@ def test_points_written_before_a_kill_9_are_all_kept(tmp_path):
     finally:
         proc.send_signal(signal.SIGKILL)
         proc.wait()
+
+
+def test_points_written_before_a_kill_9_are_all_kept(tmp_path):
+    db = tmp_path / "points.db"
+    write_and_kill(db)
     ref = toy_interface(layers=3)
     with PointStore(db, {"test": "crash"}, ref) as store:
         assert len(store) == 25

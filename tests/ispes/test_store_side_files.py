@@ -11,13 +11,10 @@ connection is a reference cycle) and would keep the side files only until it hap
 
 import gc
 import shutil
-import signal
-import subprocess
-import sys
 
 import numpy as np
 import pytest
-from tests.ispes.test_store_crash import WRITER
+from tests.ispes.test_store_crash import write_and_kill
 from tests.ispes.test_store_rows import _result
 
 from flatcontact.foundation.errors import InputError
@@ -99,14 +96,7 @@ def test_a_reopen_folds_the_log_a_kill_9_left_into_the_file(tmp_path):
     """The killed driver's committed points live in its -wal; a reopen and close moves them
     into points.db: the file copied alone then holds all 25."""
     db = tmp_path / "points.db"
-    proc = subprocess.Popen(
-        [sys.executable, "-c", WRITER, str(db)], stdout=subprocess.PIPE, text=True
-    )
-    try:
-        assert proc.stdout.readline().strip() == "written"
-    finally:
-        proc.send_signal(signal.SIGKILL)
-        proc.wait()
+    write_and_kill(db)
     assert "-wal" in _beside(db)
     PointStore(db, {"test": "crash"}, toy_interface(layers=3)).close()
     assert _beside(db) == []
