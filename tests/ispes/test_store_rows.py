@@ -22,6 +22,7 @@ from ase.calculators.singlepoint import SinglePointCalculator
 
 from flatcontact.ispes.relax import PointResult
 from flatcontact.ispes.store import PointStore
+from flatcontact.ispes.store_schema import stored_rows
 from flatcontact.structures.toy import toy_interface
 
 COLUMNS = (
@@ -52,7 +53,7 @@ def _result(ref, k, n=12):
 def _ase_rows(path):
     """Every row's columns as ASE reads them, by grid index."""
     out = {}
-    for row in ase.db.connect(str(path)).select():
+    for row in stored_rows(path):  # one connection, closed after: no -wal left beside
         out[(row.i_a, row.i_b, row.i_z)] = {key: row.get(key) for key in COLUMNS}
     return out
 
