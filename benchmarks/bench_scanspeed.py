@@ -7,8 +7,9 @@ eV/Å, the benchmarks' :func:`benchmarks.bench_scan.build`):
 1. the 12 × 12 grid with the thicknesses for -0.5 … 5 GPa chosen by the probe (6 loads), the
    whole scan from scratch (probe, ideal work of separation, symmetry, grid, writing) with 1
    worker (in this process) and 2 local worker processes, alternated :data:`PAIRS` times:
-   wall time, each pair's speed-up and their median, force calls and the driver's phases (:mod:`flatcontact.ispes.phases`; a phase's seconds on 2 workers
-   are the driver's wait, the time it holds the scan up);
+   wall time, each pair's speed-up and their median, force calls and the driver's phases
+   (:mod:`flatcontact.ispes.phases`; a phase's seconds on 2 workers are the driver's wait,
+   the time it holds the scan up);
 2. the 6 × 6 grid at those 6 thicknesses, serial, against the hand-written native LAMMPS
    input script on the same grid (:mod:`benchmarks.native_lammps`: ``minimize`` cg,
    snake order, same max-norm tolerance): wall ratio, force calls per point;

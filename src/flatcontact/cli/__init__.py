@@ -241,7 +241,10 @@ def worker_died_line(exc: BaseException) -> str:
     SIGKILL with the out-of-memory killer's usual cure."""
     line = f"{exc}. The finished work is kept: run the same command again to resume"
     if "SIGKILL" in str(exc):
-        line += " (SIGKILL is what the system's out-of-memory killer sends: fewer workers need less memory)"
+        line += (
+            " (SIGKILL is what the system's out-of-memory killer sends: fewer workers need"
+            " less memory)"
+        )
     return line
 
 

@@ -12,8 +12,9 @@ to the driver, which alone writes the point store.
 - :class:`SerialExecutor`: in the driver process (debugging, tests, 1 core).
 - :class:`ProcessExecutor`: worker processes fed over pipes by the driver's own thread
   (:mod:`flatcontact.ispes.worker_pool`), started with the ``spawn`` start method (no
-  fork of a process that holds a LAMMPS instance or MPI), one worker per core by default; workers ignore SIGINT so Ctrl-C reaches only the
-  driver, and die with the driver (``kill -9`` of the driver alone leaves no worker).
+  fork of a process that holds a LAMMPS instance or MPI), one worker per core by default;
+  workers ignore SIGINT so Ctrl-C reaches only the driver, and die with the driver
+  (``kill -9`` of the driver alone leaves no worker).
 - :class:`DaskExecutor`: a ``distributed.Client`` on a running scheduler
   (``--dask-address tcp://host:8786``), a ``LocalCluster``, or a dask-jobqueue
   cluster (SLURM, PBS, ...) described by a dict (see :func:`jobqueue_cluster`).

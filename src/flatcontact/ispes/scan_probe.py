@@ -53,8 +53,8 @@ from flatcontact.ispes.work_of_separation import ideal_work_of_separation
 #: From this many workers on, the probe runs as many short chains (:func:`probe_many`):
 #: each column's compression in segments started cold
 #: (:class:`~flatcontact.ispes.probe.CompressionSegments`). Below, the columns are relaxed
-#: exactly as in sequence (a 1-3 worker run keeps its numbers); a segment's cold start moves the probe's loads, and
-#: the thicknesses with them, within the force tolerance.
+#: exactly as in sequence (a 1-3 worker run keeps its numbers); a segment's cold start
+#: moves the probe's loads, and the thicknesses with them, within the force tolerance.
 MANY_WORKERS = 4
 
 
@@ -113,6 +113,11 @@ def _rigid_serial(
         )
         for row in range(grid.n_a)
     ]
+    return _joined(parts)
+
+
+def _joined(parts: list[tuple]) -> RigidStackings:
+    """The rows' ``(energy, load)`` units, in row order, as one :class:`RigidStackings`."""
     return RigidStackings(
         np.concatenate([e for e, _ in parts]), np.concatenate([p for _, p in parts])
     )
@@ -175,7 +180,7 @@ def resolve(
     ``resolved``: the lattice vectors, the potential's label, the thicknesses (given, or
     chosen by the probe: :func:`probe`) and the ``adhesion`` record
     (:func:`adhesion_record`). Returns ``(resolved, notes, pending)``: ``notes`` the probe's,
-    ``pending`` the ideal work of separation still running on a worker (many workers: the
+    ``pending`` the ideal work of separation still running on a worker (with workers: the
     driver stores it after the grid, :func:`store_pending_work`), else None. A store
     resolved before the ideal work of separation existed gets it here (in the returned
     entry, not in the store). ``hessian``: the driver's root of the reference's Hessian
@@ -441,10 +446,7 @@ class RigidRows:
                     part = self.units.put("rigid", self.inputs[row], part)
                 self.rows[row] = part
         self.blocks, self.handles = [], []
-        parts = [self.rows[row] for row in range(self.grid.n_a)]
-        return RigidStackings(
-            np.concatenate([e for e, _ in parts]), np.concatenate([p for _, p in parts])
-        )
+        return _joined([self.rows[row] for row in range(self.grid.n_a)])
 
 
 class _SegmentedColumns:
