@@ -153,6 +153,25 @@ def test_finite_differences_are_exact_on_a_quadratic():
     assert len(calls) == 2 * coords.size
 
 
+def test_the_hook_between_columns_runs_after_each_and_leaves_the_hessian_alone():
+    """``between_columns`` (a scan's driver feeding its workers) is called once per column,
+    after that column's two force calls, and K is bit for bit the same without it."""
+    rng = np.random.default_rng(6)
+    evaluate = quadratic(spd(rng, 9), rng.normal(size=(3, 3)))
+    x0, coords = rng.normal(size=(3, 3)), np.array([0, 4, 8])
+    events = []
+
+    def counted(x):
+        events.append("call")
+        return evaluate(x)
+
+    k = finite_difference_hessian(
+        counted, x0, coords, between_columns=lambda: events.append("between")
+    )
+    assert events == ["call", "call", "between"] * coords.size
+    np.testing.assert_array_equal(k, finite_difference_hessian(evaluate, x0, coords))
+
+
 def test_root_is_the_floored_inverse_and_commutes_with_the_projector():
     rng = np.random.default_rng(2)
     free = np.array([3, 4, 5, 9, 10, 11])

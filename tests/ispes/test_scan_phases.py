@@ -6,6 +6,7 @@ from __future__ import annotations
 import logging
 
 import numpy as np
+import pytest
 
 from flatcontact.ispes.executors import SerialExecutor
 from flatcontact.ispes.grid import GridSpec
@@ -116,3 +117,22 @@ def test_with_workers_the_probes_single_points_run_while_the_driver_computes_the
     assert rigid_units(tmp_path / "two") == rigid_units(tmp_path / "one")
     np.testing.assert_array_equal(two.dataset.thickness.values, serial.dataset.thickness.values)
     np.testing.assert_array_equal(two.dataset.energy.values, serial.dataset.energy.values)
+
+
+def test_the_timeline_counts_idle_core_seconds_and_the_drivers_cpu():
+    """``python -m benchmarks scantimeline``'s accounting on samples of known CPU: idle =
+    cores × wall − CPU used, over the intervals inside the window only; a process that
+    starts between two samples counts from its first."""
+    from benchmarks.bench_scantimeline import usage
+
+    s = 1_000_000_000  # ns per CPU second
+    rows = [
+        (0.0, {1: 0}),
+        (1.0, {1: s // 2, 2: 0}),  # driver half busy, worker 2 appears
+        (2.0, {1: s // 2, 2: s, 3: 0}),  # worker 2 fully busy, worker 3 appears
+        (3.0, {1: s, 2: 2 * s, 3: s // 2}),  # 0.5 + 1 + 0.5 CPU s in the last second
+    ]
+    idle, driver = usage(rows, 1, 0.0, 3.0)  # used 0.5, 1.0, 2.0 CPU s
+    assert idle == pytest.approx(2 * 3.0 - 3.5) and driver == pytest.approx(1.0)
+    idle, driver = usage(rows, 1, 0.5, 3.0)  # the first interval is not inside
+    assert idle == pytest.approx(2 * 2.0 - 3.0) and driver == pytest.approx(0.5)

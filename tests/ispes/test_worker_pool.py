@@ -135,3 +135,28 @@ def test_shutdown_waits_for_submitted_tasks_or_cancels_them():
             h.result(timeout=0)
     _gone, alive = psutil.wait_procs(procs, timeout=10)
     assert not alive
+
+
+def test_serve_gives_a_finished_worker_its_next_task_without_waiting():
+    """A driver busy with its own computation calls ``ProcessExecutor.serve`` between its
+    steps: the result that is in is read and the queued task sent, so the worker does not
+    idle until the driver's next wait. Tasks of a function not run before are never
+    prefetched, so the second waits in the driver's queue until then."""
+    from flatcontact.ispes.executors import ProcessExecutor
+
+    executor = ProcessExecutor(1)
+    try:
+        first = executor.submit(pool_tasks.square, 4)
+        second = executor.submit(time.sleep, 0.0)
+        pool = executor._pool
+        assert list(pool._queued) == [second]
+        deadline = time.monotonic() + 60.0
+        while not pool._workers[0].conn.poll(0) and time.monotonic() < deadline:
+            time.sleep(0.01)  # the first result is in the pipe, nobody has read it
+        assert not first.finished() and list(pool._queued) == [second]
+        executor.serve()
+        assert first.finished() and first.result() == 16
+        assert not pool._queued and list(pool._workers[0].handles) == [second]
+        assert second.result() is None
+    finally:
+        executor.close()

@@ -82,12 +82,16 @@ def finite_difference_hessian(
     positions: np.ndarray,
     coordinates: np.ndarray,
     step_angstrom: float = FD_STEP_ANGSTROM,
+    between_columns: Callable[[], None] | None = None,
 ) -> np.ndarray:
     """K = -∂F/∂x over the flat indices ``coordinates`` (k,) of ``positions`` (n, 3), (k, k).
 
     Central differences, column j from the forces at x ± h e_j (2k calls of
     ``evaluate(positions) -> (energy_ev, forces)``, in the order of ``coordinates``),
     symmetrised (K + Kᵀ)/2. Exact to round-off for a quadratic energy.
+    ``between_columns()``, if given, is called after each column (a scan's driver feeds its
+    workers there: :meth:`flatcontact.ispes.executors.ProcessExecutor.serve`); it cannot
+    change K.
     """
     coordinates = np.asarray(coordinates, dtype=np.intp)
     if step_angstrom <= 0:
@@ -104,6 +108,8 @@ def finite_difference_hessian(
         minus = np.array(evaluate(work)[1], dtype=float).reshape(-1)[coordinates]
         flat[i] = x0.flat[i]
         hessian[:, col] = (minus - plus) / (2.0 * step_angstrom)
+        if between_columns is not None:
+            between_columns()
     return 0.5 * (hessian + hessian.T)
 
 

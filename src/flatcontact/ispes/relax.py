@@ -464,11 +464,14 @@ def constraint_projector(fixed: np.ndarray, mode: str, groups: list[np.ndarray])
     return project
 
 
-def reference_root(reference: Atoms, calc, fixed, mode: str, project) -> np.ndarray | None:
+def reference_root(
+    reference: Atoms, calc, fixed, mode: str, project, between_columns=None
+) -> np.ndarray | None:
     """L = H0^{1/2} from the Hessian of ``reference`` over the coordinates ``project`` keeps
     (:mod:`flatcontact.ispes.precondition`), kept per calculator and key (reference, mode):
     computed at the first call unless a scan's driver handed its own (:func:`context_calculator`);
-    None beyond ``precondition.MAX_COORDINATES`` relaxed coordinates."""
+    None beyond ``precondition.MAX_COORDINATES`` relaxed coordinates. ``between_columns``:
+    :func:`~flatcontact.ispes.precondition.finite_difference_hessian`'s."""
     coordinates = np.flatnonzero(project(np.ones((len(reference), 3))).ravel() != 0.0)
     if coordinates.size > precondition.MAX_COORDINATES:
         return None
@@ -476,7 +479,10 @@ def reference_root(reference: Atoms, calc, fixed, mode: str, project) -> np.ndar
 
     def compute() -> np.ndarray:
         hessian = precondition.finite_difference_hessian(
-            point_evaluator(calc, reference), reference.positions, coordinates
+            point_evaluator(calc, reference),
+            reference.positions,
+            coordinates,
+            between_columns=between_columns,
         )
         return precondition.inverse_hessian_root(
             hessian, coordinates, 3 * len(reference), ASE_ALPHA_EV_PER_A2

@@ -157,11 +157,13 @@ def early_rigid_rows(
 ) -> RigidRows | None:
     """The probe's rigid single points submitted now, if the probe will run and has workers
     (:class:`RigidRows`): the store is not resolved yet, the grid is given by a pressure
-    range and the executor is not the driver itself. Two blocks per worker: the workers
-    start one after the other and the first takes more. None otherwise."""
+    range and the executor is not the driver itself. One row per task: the workers start
+    one after the other, the driver hands them their next rows between the Hessian's
+    columns (:meth:`~flatcontact.ispes.executors.ProcessExecutor.serve`) and the probe
+    waits for the last row, so the smaller the tasks the shorter that wait. None otherwise."""
     if executor.inline or store.resolved is not None or grid.thickness_angstrom is not None:
         return None
-    return RigidRows(executor, units, context, grid, blocks=2 * executor.workers)
+    return RigidRows(executor, units, context, grid, blocks=grid.n_a)
 
 
 def resolve(

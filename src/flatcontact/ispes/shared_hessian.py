@@ -120,7 +120,12 @@ class HessianSharing:
         before = calc.force_calls
         with failing_at("the reference interface's Hessian"):
             root = reference_root(
-                reference, calc, fixed, relax.mode, constraint_projector(fixed, relax.mode, [])
+                reference,
+                calc,
+                fixed,
+                relax.mode,
+                constraint_projector(fixed, relax.mode, []),
+                between_columns=getattr(executor, "serve", None),  # the workers fed meanwhile
             )
         self.hessian_force_calls += calc.force_calls - before
         if root is None:
