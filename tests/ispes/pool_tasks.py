@@ -34,3 +34,11 @@ def die_with_code(code: int):
 
 def pid_and_nice():
     return os.getpid(), os.nice(0)
+
+
+def nap(seconds: float) -> int:
+    """Sleep ``seconds``, then return this worker's pid."""
+    import time
+
+    time.sleep(seconds)
+    return os.getpid()

@@ -160,3 +160,22 @@ def test_serve_gives_a_finished_worker_its_next_task_without_waiting():
         assert second.result() is None
     finally:
         executor.close()
+
+
+def test_one_short_run_does_not_let_a_long_task_wait_behind_another():
+    """A task waits in a busy worker's pipe only when its function ran at least twice, each
+    time briefly. After one short run of ``nap``, a long one (0.2 s) submitted while both
+    workers are busy stays in the driver's queue and goes to the worker that frees first
+    (the one on a 0.1 s nap), not behind the 0.4 s nap it would have been prefetched to."""
+    p = WorkerPool(2, multiprocessing.get_context("spawn"))
+    try:
+        for handle in p.submit_to_each(pool_tasks.pid_and_nice):  # both workers started
+            handle.result()
+        first = p.submit(pool_tasks.nap, 0.005)
+        first.result()  # one short run of nap: ``first``'s worker is free again
+        long_a = p.submit(pool_tasks.nap, 0.4)
+        short_b = p.submit(pool_tasks.nap, 0.1)
+        late = p.submit(pool_tasks.nap, 0.2)
+        assert late.result() == short_b.result() != long_a.result()
+    finally:
+        p.shutdown()

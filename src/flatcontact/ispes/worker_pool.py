@@ -14,8 +14,11 @@ Protocol
 A worker holds one task, or two when both are small and short: the driver sends a worker
 that is computing a second task only if both tasks pickle to at most
 :data:`SMALL_TASK_BYTES` (together far below a pipe's buffer, so the driver's write never
-blocks) and the last runs of both tasks' functions took less than :data:`PREFETCH_BELOW_S`
-(a long task never waits behind another while a worker is free). A worker with its next task in its
+blocks) and both tasks' functions ran at least twice and their last runs
+(:data:`PREFETCH_HISTORY`) all took less than :data:`PREFETCH_BELOW_S` (a long task never
+waits behind another while a worker is free; one short run says little: the probe's first
+chain, a stretching of 14 ms, had let the next compression of 140 ms wait behind another
+while a worker was free). A worker with its next task in its
 pipe goes on without sleeping between tasks; the driver reads a worker's results before it
 gives that worker more, so neither side can block on a full pipe while the other blocks
 too, whatever the size of a task or a result. The tasks no worker can take queue in the
@@ -58,10 +61,13 @@ STOP_GRACE_S = 5.0
 #: a task pickled to at most this many bytes may wait in a busy worker's pipe (two of them
 #: stay far below the pipe's buffer, 64 KiB and more: the driver's write never blocks)
 SMALL_TASK_BYTES = 16 * 1024
-#: a task may wait behind another in a worker's pipe if the last run of both tasks'
-#: functions took less than this (s): a scan's point (~10 ms) does, a study's or an
-#: asperity's job (minutes) never, nor anything not run yet
+#: a task may wait behind another in a worker's pipe if the last runs of both tasks'
+#: functions (at least two, at most :data:`PREFETCH_HISTORY`) each took less than this (s):
+#: a scan's point (~10 ms) does, a study's or an asperity's job (minutes) never, nor
+#: anything run fewer than two times
 PREFETCH_BELOW_S = 0.05
+#: how many of a function's last runs decide whether its tasks may wait in a pipe
+PREFETCH_HISTORY = 4
 
 
 class RemoteTraceback(Exception):
@@ -170,8 +176,8 @@ class WorkerPool:
         self._queued: collections.deque[PoolHandle] = collections.deque()
         self._broken: str | None = None
         self._closed = False
-        #: wall seconds of the last run of each task function (by name)
-        self._seconds: dict[str, float] = {}
+        #: wall seconds of the last runs of each task function (by name)
+        self._seconds: dict[str, collections.deque[float]] = {}
 
     # -- starting and feeding -----------------------------------------------------------
     def _start(self) -> None:
@@ -237,10 +243,14 @@ class WorkerPool:
             return False
         running = worker.handles[0]
         return all(
-            h.size <= SMALL_TASK_BYTES
-            and self._seconds.get(_task_name(h.fn), PREFETCH_BELOW_S) < PREFETCH_BELOW_S
+            h.size <= SMALL_TASK_BYTES and self._known_short(_task_name(h.fn))
             for h in (running, handle)
         )
+
+    def _known_short(self, name: str) -> bool:
+        """Whether the function ``name`` ran at least twice and its last runs were short."""
+        runs = self._seconds.get(name, ())
+        return len(runs) >= 2 and max(runs) < PREFETCH_BELOW_S
 
     def _feed(self, worker: _Worker) -> None:
         """Give ``worker`` the oldest queued tasks it can take."""
@@ -274,7 +284,10 @@ class WorkerPool:
             )
         now = time.monotonic()
         handle = worker.handles.popleft()
-        self._seconds[_task_name(handle.fn)] = now - worker.since
+        runs = self._seconds.setdefault(
+            _task_name(handle.fn), collections.deque(maxlen=PREFETCH_HISTORY)
+        )
+        runs.append(now - worker.since)
         worker.since = now
         if ok:
             handle.set_result(value)
