@@ -63,6 +63,7 @@ from __future__ import annotations
 import dataclasses
 import threading
 import time
+from collections.abc import Callable
 from typing import Any, Literal
 
 import numpy as np
@@ -465,7 +466,7 @@ def constraint_projector(fixed: np.ndarray, mode: str, groups: list[np.ndarray])
 
 
 def reference_root(
-    reference: Atoms, calc, fixed, mode: str, project, between_columns=None
+    reference: Atoms, calc, fixed, mode: str, project, between_columns: Callable | None = None
 ) -> np.ndarray | None:
     """L = H0^{1/2} from the Hessian of ``reference`` over the coordinates ``project`` keeps
     (:mod:`flatcontact.ispes.precondition`), kept per calculator and key (reference, mode):
@@ -478,11 +479,9 @@ def reference_root(
     key = precondition.root_key(reference, fixed, mode)
 
     def compute() -> np.ndarray:
+        evaluate = point_evaluator(calc, reference)
         hessian = precondition.finite_difference_hessian(
-            point_evaluator(calc, reference),
-            reference.positions,
-            coordinates,
-            between_columns=between_columns,
+            evaluate, reference.positions, coordinates, between_columns=between_columns
         )
         return precondition.inverse_hessian_root(
             hessian, coordinates, 3 * len(reference), ASE_ALPHA_EV_PER_A2

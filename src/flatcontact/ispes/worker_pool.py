@@ -18,8 +18,8 @@ blocks) and both tasks' functions ran at least twice and their last runs
 (:data:`PREFETCH_HISTORY`) all took less than :data:`PREFETCH_BELOW_S` (a long task never
 waits behind another while a worker is free; one short run says little: the probe's first
 chain, a stretching of 14 ms, had let the next compression of 140 ms wait behind another
-while a worker was free). A worker with its next task in its
-pipe goes on without sleeping between tasks; the driver reads a worker's results before it
+while a worker was free). A worker with its next task in its pipe goes on without
+sleeping between tasks; the driver reads a worker's results before it
 gives that worker more, so neither side can block on a full pipe while the other blocks
 too, whatever the size of a task or a result. The tasks no worker can take queue in the
 driver (first in, first out) and go to the first worker that can, when its result is read.
