@@ -122,6 +122,14 @@ def in_slab_slip(layer_slip: Mapping | None) -> Finding | None:
     )
 
 
+def _refused(loads_gpa) -> str:
+    """``"loads refused: 2.5, 3 GPa"``, or that none of the requested loads lies above the
+    fold (the fold is gated all the same: docs/scan.md, *Folds*)."""
+    if not loads_gpa:
+        return "none of the requested loads above it"
+    return "loads refused: " + ", ".join(f"{p:g}" for p in loads_gpa) + " GPa"
+
+
 def load_fold(scan: Mapping) -> Finding | None:
     """``load_fold`` from ``scan.json["load_folds"]`` (absent or empty: none)."""
     folds = scan.get("load_folds") or []
@@ -129,7 +137,8 @@ def load_fold(scan: Mapping) -> Finding | None:
         return None
     parts = [
         f"column {f['column']} at z = {f['z_angstrom']:.3f} Å (p = {f['p_gpa']:.3g} GPa; "
-        "loads refused: " + ", ".join(f"{p:g}" for p in f.get("loads_refused_gpa", [])) + " GPa)"
+        + _refused(f.get("loads_refused_gpa", []))
+        + ")"
         for f in folds
     ]
     return Finding(

@@ -77,11 +77,12 @@ class LoadFold:
     def message(self) -> str:
         """One line: the column, the fold's z and p, the loads refused and the remedy."""
         refused = ", ".join(f"{v:.4g}" for v in self.loads_refused_gpa)
+        refused = f"refused: {refused} GPa" if refused else "none of the requested loads"
         return (
             f"p-range-gpa: the {self.column} folds: p = {self.below_p_gpa:.4g} GPa at z = "
             f"{self.below_z_angstrom:.4g} Å rises to {self.p_gpa:.4g} GPa at z = "
             f"{self.z_angstrom:.4g} Å; loads above {self.p_gpa:.4g} GPa are not on one branch "
-            f"with P = 0 and are refused ({refused} GPa); {FOLD_REMEDY}; or lower "
+            f"with P = 0 ({refused}); {FOLD_REMEDY}; or lower "
             f"scan.p_range_gpa.hi_gpa to at most {self.p_gpa:.3g} GPa"
         )
 
