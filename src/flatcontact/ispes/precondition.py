@@ -293,17 +293,16 @@ def _with_layers(reference):
     structure, found once per reference (the guard asks for them at every point)."""
     if "layer" in reference.arrays:
         return reference
-    key = (
-        reference.positions.tobytes(),
-        reference.numbers.tobytes(),
-        reference.cell.array.tobytes(),
-        np.asarray(reference.arrays["slab"]).tobytes(),
-    )
+    from flatcontact.structures.interface_contract import atoms_content
+
+    key = atoms_content(reference, ("slab",))
     if key not in _LAYERED:
         from flatcontact.structures.layers import interface_layers
 
         layered = reference.copy()
         layered.arrays["layer"] = interface_layers(reference)
+        if key is None:  # an object array: no key to keep it by
+            return layered
         _LAYERED.clear()
         _LAYERED[key] = layered
     return _LAYERED[key]

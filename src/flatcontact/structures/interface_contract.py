@@ -103,6 +103,24 @@ def fixed_mask(atoms: Atoms) -> np.ndarray:
     return np.isin(per_atom_array(atoms, "surface"), FIXED_SURFACES)
 
 
+def atoms_content(atoms: Atoms, arrays: tuple[str, ...]) -> tuple | None:
+    """``atoms``' numbers, positions, cell, pbc and those of the per-atom ``arrays`` it has
+    (name, dtype, shape, values) as bytes: equal for two structures exactly when all of these
+    are, so a key for what is computed from them once per structure; None when one of those
+    arrays holds objects (its bytes are pointers, not values)."""
+    names = [k for k in arrays if k in atoms.arrays]
+    values = [np.asarray(atoms.arrays[k]) for k in names]
+    if any(a.dtype.hasobject for a in values):
+        return None
+    return (
+        tuple((k, a.dtype.str, a.shape, a.tobytes()) for k, a in zip(names, values, strict=True)),
+        atoms.numbers.tobytes(),
+        atoms.positions.tobytes(),
+        atoms.cell.array.tobytes(),
+        np.asarray(atoms.pbc).tobytes(),
+    )
+
+
 def validate_interface(atoms: Atoms, source: str = "interface") -> None:
     """Check the interface contract; raise a one-line :class:`InputError` naming ``source``.
 

@@ -14,6 +14,7 @@ from ase import Atoms
 from flatcontact.foundation.errors import InputError, require
 from flatcontact.structures.interface_contract import (
     DEFAULT_VACUUM_ANGSTROM,
+    atoms_content,
     fixed_mask,
     in_plane_vectors,
     per_atom_array,
@@ -102,31 +103,18 @@ def _closest_pair_distance(points: np.ndarray, queries: np.ndarray) -> float:
     return float(np.sqrt(squared.min()))
 
 
-#: What :func:`_contract_content` gave for the last reference found to follow the contract.
+#: The per-atom arrays of the interface contract ``validate_interface`` reads.
+_CONTRACT_ARRAYS = ("slab", "surface", "held", "layer")
+#: :func:`atoms_content` of the last reference found to follow the contract.
 _VALID_REFERENCE: list[tuple] = []
-
-
-def _contract_content(atoms: Atoms) -> tuple | None:
-    """Everything ``validate_interface`` reads of ``atoms`` as bytes: the contract's per-atom
-    arrays (name, dtype, shape, values), pbc, cell and positions; None for an object array
-    (its bytes are pointers, not values)."""
-    names = [k for k in ("slab", "surface", "held", "layer") if k in atoms.arrays]
-    arrays = [np.asarray(atoms.arrays[k]) for k in names]
-    if any(a.dtype.hasobject for a in arrays):
-        return None
-    return (
-        tuple((k, a.dtype.str, a.shape, a.tobytes()) for k, a in zip(names, arrays, strict=True)),
-        np.asarray(atoms.pbc).tobytes(),
-        atoms.cell.array.tobytes(),
-        atoms.positions.tobytes(),
-    )
 
 
 def _validate_once(reference: Atoms) -> None:
     """``validate_interface(reference, "reference interface")``, skipped when the last
-    reference that passed had the same content (:func:`_contract_content`): a pure function of
-    that content, so the verdict is the same; a failure is never kept, it raises every time."""
-    content = _contract_content(reference)
+    reference that passed had the same content (:func:`atoms_content` with the contract's
+    arrays): a pure function of that content, so the verdict is the same; a failure is never
+    kept, it raises every time."""
+    content = atoms_content(reference, _CONTRACT_ARRAYS)
     if content is not None and content in _VALID_REFERENCE:
         return
     validate_interface(reference, "reference interface")
